@@ -1,0 +1,48 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace deformkit {
+
+// Every error DeformKit raises on user data derives from Error. The message names the input (a file
+// path, or a label such as "mesh 'body'"), the element (a line, a face, a vertex, a pixel) and what
+// was expected. Library code never aborts on user data; hosts convert Error at their boundary
+// (CLI: one line on stderr and exit code 2).
+class Error : public std::runtime_error {
+public:
+    explicit Error(const std::string& message) : std::runtime_error(message) {}
+};
+
+// A file or folder that is missing, unreadable or unwritable.
+class IoError : public Error {
+public:
+    using Error::Error;
+};
+
+// A file whose bytes do not follow its format: OBJ syntax, a truncated or corrupt image.
+class ParseError : public Error {
+public:
+    using Error::Error;
+};
+
+// Well-formed data with values an algorithm cannot take: an index out of range, NaN coordinates, an
+// image with the wrong channel count, a bad argument.
+class InvalidInput : public Error {
+public:
+    using Error::Error;
+};
+
+// Connectivity an algorithm cannot take: a non-manifold edge or vertex where a manifold is required.
+class TopologyError : public InvalidInput {
+public:
+    using InvalidInput::InvalidInput;
+};
+
+// Builds the message used across the library: "<source>: <element>: <problem> (expected <expected>)".
+// Empty parts are left out.
+[[nodiscard]] std::string formatError(std::string_view source, std::string_view element,
+                                      std::string_view problem, std::string_view expected = {});
+
+}  // namespace deformkit

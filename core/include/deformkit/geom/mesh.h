@@ -1,0 +1,90 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/box.h"
+
+namespace deformkit::geom {
+
+class HalfEdgeMesh;
+
+// A polygon mesh: float32 positions, faces as counts + offsets + vertex indices (triangles, quads,
+// n-gons), optional face-varying UVs (values + one index per face corner).
+//
+// Connectivity (faces, UV indices) is fixed at construction and validated there; positions may change
+// (a deformer writes them), which is why the half-edge structure, built on demand and cached, depends
+// on connectivity alone and is shared by copies of the mesh.
+class Mesh {
+public:
+    struct Data {
+        std::vector<glm::vec3> points;       // #V positions, scene units
+        std::vector<int32_t> faceCounts;     // #F vertex counts, each >= 3
+        std::vector<int32_t> faceIndices;    // sum(faceCounts) vertex indices in [0, #V), face by face
+        std::vector<glm::vec2> uvs;          // #UV texture coordinates (UDIM: tile 1001 + floor(u) + 10 floor(v))
+        std::vector<int32_t> uvIndices;      // empty, or one index into uvs per face corner
+    };
+
+    Mesh();
+    // Validates `data` and throws InvalidInput naming `source` (a file path or a label) and the first
+    // bad element: a face with fewer than 3 vertices or a repeated vertex, an index out of range, a
+    // NaN or infinite coordinate, UV indices that do not match the corners.
+    explicit Mesh(Data data, const std::string& source = "mesh");
+
+    [[nodiscard]] int32_t numVertices() const { return static_cast<int32_t>(points_.size()); }
+    [[nodiscard]] int32_t numFaces() const { return static_cast<int32_t>(faceCounts_.size()); }
+    [[nodiscard]] int32_t numCorners() const { return static_cast<int32_t>(faceIndices_.size()); }
+    [[nodiscard]] int32_t numUVs() const { return static_cast<int32_t>(uvs_.size()); }
+    [[nodiscard]] bool hasUVs() const { return !uvIndices_.empty(); }
+
+    [[nodiscard]] std::span<const glm::vec3> points() const { return points_; }
+    // Mutable positions for deformers; the vertex count cannot change.
+    [[nodiscard]] std::span<glm::vec3> points() { return points_; }
+    // Replaces every position; throws InvalidInput if the count differs or a value is not finite.
+    void setPoints(std::span<const glm::vec3> points);
+
+    [[nodiscard]] std::span<const int32_t> faceCounts() const { return faceCounts_; }
+    // #F + 1 offsets into faceIndices(); face f spans [faceOffsets()[f], faceOffsets()[f + 1]).
+    [[nodiscard]] std::span<const int32_t> faceOffsets() const { return faceOffsets_; }
+    [[nodiscard]] std::span<const int32_t> faceIndices() const { return faceIndices_; }
+    [[nodiscard]] std::span<const int32_t> face(int32_t f) const {
+        return std::span<const int32_t>(faceIndices_).subspan(faceOffsets_[f], faceCounts_[f]);
+    }
+    [[nodiscard]] std::span<const glm::vec2> uvs() const { return uvs_; }
+    [[nodiscard]] std::span<glm::vec2> uvs() { return uvs_; }
+    [[nodiscard]] std::span<const int32_t> uvIndices() const { return uvIndices_; }
+    // The UV indices of face f's corners; empty when the mesh has no UVs.
+    [[nodiscard]] std::span<const int32_t> faceUVIndices(int32_t f) const {
+        if (uvIndices_.empty()) return {};
+        return std::span<const int32_t>(uvIndices_).subspan(faceOffsets_[f], faceCounts_[f]);
+    }
+
+    [[nodiscard]] Box3 bounds() const;
+    // The sorted UDIM tile numbers that UV faces touch (by each face's UV centroid). Empty without UVs.
+    [[nodiscard]] std::vector<int> udimTiles() const;
+
+    // The half-edge connectivity, built on first use and cached (thread-safe).
+    [[nodiscard]] const HalfEdgeMesh& halfEdges() const;
+
+private:
+    struct TopologyCache;
+
+    std::vector<glm::vec3> points_;
+    std::vector<int32_t> faceCounts_;
+    std::vector<int32_t> faceOffsets_;
+    std::vector<int32_t> faceIndices_;
+    std::vector<glm::vec2> uvs_;
+    std::vector<int32_t> uvIndices_;
+    std::shared_ptr<TopologyCache> topology_;
+};
+
+// UDIM tile number of a UV coordinate: 1001 + floor(u) + 10 floor(v). Valid for u in [0, 10), v >= 0.
+[[nodiscard]] int udimTileOf(const glm::vec2& uv);
+
+}  // namespace deformkit::geom

@@ -1,0 +1,49 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+namespace deformkit::geom {
+
+// A regular grid of width x height pixels in raster coordinates: pixel (x, y) covers [x, x+1) x [y, y+1)
+// and is sampled at its centre (x + 0.5, y + 0.5). How raster coordinates relate to an image's rows or
+// to UV space is the caller's mapping.
+struct RasterGrid {
+    int32_t width = 0;
+    int32_t height = 0;
+};
+
+// Calls visit(x, y, barycentric) for every pixel whose centre lies inside triangle (p0, p1, p2), given in
+// raster coordinates, either winding; barycentric (b0, b1, b2) sums to 1 and reproduces the centre.
+// Pixel centres on an edge follow the top-left rule, so a pixel is visited exactly once by a set of
+// triangles that tile a region without overlap (shared edges are never drawn twice or skipped).
+// Degenerate (zero-area) triangles and pixels outside the grid are skipped. Vertex coordinates are snapped
+// to 1/256 pixel, as GPUs do, which makes the rule exact.
+template <class Visit>
+void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
+                       Visit&& visit);
+
+// Per-pixel result of rasterizeAttributes.
+struct AttributeRaster {
+    int32_t width = 0;
+    int32_t height = 0;
+    int32_t channels = 0;
+    std::vector<float> values;      // width * height * channels, row y = 0 first; 0 where uncovered
+    std::vector<int32_t> triangle;  // width * height: covering triangle index, -1 where uncovered
+};
+
+// Rasterises triangles (vertex index triples into `positions`, raster coordinates) and interpolates
+// `attributes` (#positions x channels, vertex-major) barycentrically at every covered pixel centre.
+// Where triangles overlap, the one with the highest index wins (deterministic).
+void rasterizeAttributes(const RasterGrid& grid, std::span<const glm::vec2> positions,
+                         std::span<const std::array<int32_t, 3>> triangles, std::span<const float> attributes,
+                         int32_t channels, AttributeRaster& out);
+
+}  // namespace deformkit::geom
+
+#include "deformkit/geom/rasterizer_impl.h"

@@ -1,0 +1,20 @@
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string_view>
+
+namespace deformkit::io {
+
+// Writes `path` atomically. `write` is called with a temporary path in the same folder (same file
+// extension, so format-by-extension writers work) and must create that file; only when it returns
+// normally is the temporary flushed to disk and renamed over `path`. If `write` throws, or the folder is
+// not writable, the temporary is removed, an existing file at `path` is left intact, and the error
+// propagates (IoError names the folder and what was expected).
+void writeAtomically(const std::filesystem::path& path,
+                     const std::function<void(const std::filesystem::path& tmp)>& write);
+
+// Writes `bytes` to `path` atomically.
+void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace deformkit::io

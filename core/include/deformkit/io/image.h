@@ -1,0 +1,69 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace deformkit::io {
+
+// A float32 image in numpy's (H, W, C) layout: rows from the top, pixels left to right, channels
+// interleaved. Integer files are normalised to [0, 1] on read (8-bit 255 -> 1.0).
+struct Image {
+    int32_t width = 0;
+    int32_t height = 0;
+    int32_t channels = 0;
+    std::vector<float> pixels;  // width * height * channels
+
+    Image() = default;
+    Image(int32_t w, int32_t h, int32_t c, float fill = 0.0f)
+        : width(w), height(h), channels(c), pixels(static_cast<size_t>(w) * h * c, fill) {}
+
+    [[nodiscard]] float& at(int32_t x, int32_t y, int32_t c) {
+        return pixels[(static_cast<size_t>(y) * width + x) * channels + c];
+    }
+    [[nodiscard]] float at(int32_t x, int32_t y, int32_t c) const {
+        return pixels[(static_cast<size_t>(y) * width + x) * channels + c];
+    }
+};
+
+// Pixel type of a written file. Auto: half for EXR, 8-bit for every other format.
+enum class PixelType { Auto, UInt8, UInt16, Half, Float };
+
+struct ImageReadOptions {
+    int32_t expectedChannels = 0;  // 0: any; otherwise a file with another count is an InvalidInput error
+    std::string role;              // what the image is for ("rigidity map"), named in errors when set
+};
+
+struct ImageWriteOptions {
+    PixelType type = PixelType::Auto;
+    // String attributes written into the file's header (EXR/TIFF metadata), e.g. how a map was made.
+    std::vector<std::pair<std::string, std::string>> attributes;
+};
+
+struct ImageInfo {
+    int32_t width = 0;
+    int32_t height = 0;
+    int32_t channels = 0;
+    std::string format;     // OpenImageIO format name: "openexr", "png", "tiff", ...
+    std::string pixelType;  // "uint8", "uint16", "half", "float", ...
+    std::vector<std::string> channelNames;
+    std::vector<std::pair<std::string, std::string>> attributes;  // string header attributes
+};
+
+// Reads any format OpenImageIO reads (first subimage, first mip level) as float32.
+// Throws IoError for a missing or unreadable file, ParseError for a truncated or corrupt one (naming
+// the file and what OpenImageIO reported), InvalidInput for a channel count other than expected.
+[[nodiscard]] Image readImage(const std::filesystem::path& path, const ImageReadOptions& options = {});
+
+// Reads only the header.
+[[nodiscard]] ImageInfo readImageInfo(const std::filesystem::path& path);
+
+// Writes atomically (temporary file in the same folder, then rename): on failure no partial file is
+// left and an existing file is intact. The format follows the extension. Throws InvalidInput for an
+// empty image, a pixel count that does not match width * height * channels, or a pixel type the format
+// cannot store (PNG has no half or float); IoError when the folder is missing or not writable.
+void writeImage(const std::filesystem::path& path, const Image& image, const ImageWriteOptions& options = {});
+
+}  // namespace deformkit::io

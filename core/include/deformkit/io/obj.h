@@ -1,0 +1,44 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "deformkit/geom/mesh.h"
+
+namespace deformkit::io {
+
+// A named set of faces: OBJ `g` (or `o` when no `g` follows) statements.
+struct FaceGroup {
+    std::string name;
+    std::vector<int32_t> faces;  // ascending face indices
+};
+
+struct ObjContent {
+    geom::Mesh mesh;
+    std::vector<FaceGroup> groups;  // empty when the file names none
+};
+
+// Reads a Wavefront OBJ: `v` (extra w or colour values ignored), `vt` (u v [w]), `f` with v, v/vt,
+// v//vn and v/vt/vn corners, 1-based and negative (relative) indices, n-gons, `g`/`o` groups, line
+// continuations (`\`). Normals, materials and smoothing groups are ignored. Throws IoError for a
+// missing or unreadable file, ParseError/InvalidInput naming the file and line for: no faces, a malformed
+// number, an index of 0 or out of range, a face with fewer than 3 vertices, NaN/inf coordinates, some
+// faces with UVs and some without.
+[[nodiscard]] ObjContent readObj(const std::filesystem::path& path);
+
+// Parses OBJ text already in memory; `source` names it in errors.
+[[nodiscard]] ObjContent parseObj(std::string_view text, const std::string& source);
+
+struct ObjWriteOptions {
+    int precision = 9;  // significant digits; 9 round-trips float32 exactly
+};
+
+// Writes atomically (temporary file + rename). Groups are written as `g` statements.
+void writeObj(const std::filesystem::path& path, const geom::Mesh& mesh, const std::vector<FaceGroup>& groups = {},
+              const ObjWriteOptions& options = {});
+[[nodiscard]] std::string formatObj(const geom::Mesh& mesh, const std::vector<FaceGroup>& groups = {},
+                                    const ObjWriteOptions& options = {});
+
+}  // namespace deformkit::io

@@ -1,0 +1,25 @@
+#include "deformkit/error.h"
+
+namespace deformkit {
+
+std::string formatError(std::string_view source, std::string_view element, std::string_view problem,
+                        std::string_view expected) {
+    std::string message;
+    if (!source.empty()) {
+        message.append(source);
+        message.append(": ");
+    }
+    if (!element.empty()) {
+        message.append(element);
+        message.append(": ");
+    }
+    message.append(problem);
+    if (!expected.empty()) {
+        message.append(" (expected ");
+        message.append(expected);
+        message.append(")");
+    }
+    return message;
+}
+
+}  // namespace deformkit

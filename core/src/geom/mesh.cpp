@@ -1,0 +1,144 @@
+#include "deformkit/geom/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <set>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/half_edge.h"
+
+namespace deformkit::geom {
+
+struct Mesh::TopologyCache {
+    std::once_flag once;
+    std::unique_ptr<const HalfEdgeMesh> value;
+};
+
+namespace {
+
+bool finite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+bool finite(const glm::vec2& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+
+}  // namespace
+
+Mesh::Mesh() : faceOffsets_{0}, topology_(std::make_shared<TopologyCache>()) {}
+
+Mesh::Mesh(Data data, const std::string& source)
+    : points_(std::move(data.points)),
+      faceCounts_(std::move(data.faceCounts)),
+      faceIndices_(std::move(data.faceIndices)),
+      uvs_(std::move(data.uvs)),
+      uvIndices_(std::move(data.uvIndices)),
+      topology_(std::make_shared<TopologyCache>()) {
+    for (size_t v = 0; v < points_.size(); ++v) {
+        if (!finite(points_[v])) {
+            throw InvalidInput(formatError(source, "vertex " + std::to_string(v), "has a NaN or infinite coordinate",
+                                           "finite coordinates"));
+        }
+    }
+    for (size_t t = 0; t < uvs_.size(); ++t) {
+        if (!finite(uvs_[t])) {
+            throw InvalidInput(formatError(source, "uv " + std::to_string(t), "has a NaN or infinite coordinate",
+                                           "finite texture coordinates"));
+        }
+    }
+    faceOffsets_.resize(faceCounts_.size() + 1);
+    faceOffsets_[0] = 0;
+    int64_t total = 0;
+    for (size_t f = 0; f < faceCounts_.size(); ++f) {
+        if (faceCounts_[f] < 3) {
+            throw InvalidInput(formatError(source, "face " + std::to_string(f),
+                                           "has " + std::to_string(faceCounts_[f]) + " vertices",
+                                           "at least 3 vertices per face"));
+        }
+        total += faceCounts_[f];
+        if (total > static_cast<int64_t>(faceIndices_.size())) break;
+        faceOffsets_[f + 1] = static_cast<int32_t>(total);
+    }
+    if (total != static_cast<int64_t>(faceIndices_.size())) {
+        throw InvalidInput(formatError(source, "face indices",
+                                       "count " + std::to_string(faceIndices_.size()) +
+                                           " does not match the face vertex counts, which sum to " +
+                                           std::to_string(total),
+                                       "one vertex index per face corner"));
+    }
+    const int32_t nv = numVertices();
+    for (int32_t f = 0; f < numFaces(); ++f) {
+        const auto corners = face(f);
+        for (size_t k = 0; k < corners.size(); ++k) {
+            const int32_t v = corners[k];
+            if (v < 0 || v >= nv) {
+                throw InvalidInput(formatError(source, "face " + std::to_string(f) + " corner " + std::to_string(k),
+                                               "vertex index " + std::to_string(v) + " is out of range",
+                                               "an index in [0, " + std::to_string(nv) + ")"));
+            }
+            for (size_t j = 0; j < k; ++j) {
+                if (corners[j] == v) {
+                    throw InvalidInput(formatError(source, "face " + std::to_string(f),
+                                                   "uses vertex " + std::to_string(v) + " twice",
+                                                   "distinct vertices per face"));
+                }
+            }
+        }
+    }
+    if (!uvIndices_.empty()) {
+        if (uvIndices_.size() != faceIndices_.size()) {
+            throw InvalidInput(formatError(source, "uv indices",
+                                           "count " + std::to_string(uvIndices_.size()) +
+                                               " does not match the face corner count " +
+                                               std::to_string(faceIndices_.size()),
+                                           "one UV index per face corner, or none"));
+        }
+        const int32_t nt = numUVs();
+        for (size_t c = 0; c < uvIndices_.size(); ++c) {
+            if (uvIndices_[c] < 0 || uvIndices_[c] >= nt) {
+                throw InvalidInput(formatError(source, "face corner " + std::to_string(c),
+                                               "uv index " + std::to_string(uvIndices_[c]) + " is out of range",
+                                               "an index in [0, " + std::to_string(nt) + ")"));
+            }
+        }
+    }
+}
+
+void Mesh::setPoints(std::span<const glm::vec3> points) {
+    if (points.size() != points_.size()) {
+        throw InvalidInput(formatError("mesh", "points",
+                                       "got " + std::to_string(points.size()) + " positions",
+                                       std::to_string(points_.size()) + " positions, one per vertex"));
+    }
+    for (size_t v = 0; v < points.size(); ++v) {
+        if (!finite(points[v])) {
+            throw InvalidInput(formatError("mesh", "vertex " + std::to_string(v), "has a NaN or infinite coordinate",
+                                           "finite coordinates"));
+        }
+    }
+    std::copy(points.begin(), points.end(), points_.begin());
+}
+
+Box3 Mesh::bounds() const {
+    Box3 box;
+    for (const auto& p : points_) box.extend(p);
+    return box;
+}
+
+int udimTileOf(const glm::vec2& uv) {
+    return 1001 + static_cast<int>(std::floor(uv.x)) + 10 * static_cast<int>(std::floor(uv.y));
+}
+
+std::vector<int> Mesh::udimTiles() const {
+    std::set<int> tiles;
+    for (int32_t f = 0; f < numFaces() && hasUVs(); ++f) {
+        glm::vec2 centroid(0.0f);
+        for (int32_t t : faceUVIndices(f)) centroid += uvs_[t];
+        tiles.insert(udimTileOf(centroid / static_cast<float>(faceCounts_[f])));
+    }
+    return {tiles.begin(), tiles.end()};
+}
+
+const HalfEdgeMesh& Mesh::halfEdges() const {
+    std::call_once(topology_->once, [this] { topology_->value = std::make_unique<const HalfEdgeMesh>(*this); });
+    return *topology_->value;
+}
+
+}  // namespace deformkit::geom

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Installs every dependency of DeformKit from Debian 12 packages (skipping what is installed), then
+# configures and builds a Release build in ./build. Safe to run again: it only does what is missing.
+#
+#   ./scripts/setup.sh            install + configure + build
+#   ./scripts/setup.sh --deps     install only
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+    build-essential cmake pkg-config git
+    libosd-dev                       # OpenSubdiv
+    libopenimageio-dev openimageio-tools
+    libopenexr-dev libimath-dev      # OpenEXR
+    libglm-dev libeigen3-dev
+    catch2 libbenchmark-dev
+    libomp-dev zlib1g-dev
+    libcli11-dev nlohmann-json3-dev
+    python3 python3-dev pybind11-dev python3-numpy python3-pytest
+    clang libclang-rt-14-dev         # libFuzzer and sanitizers
+)
+
+missing=()
+for p in "${packages[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing+=("$p")
+    fi
+done
+if ((${#missing[@]})); then
+    echo "setup: installing ${missing[*]}"
+    sudo=""
+    if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+    echo "setup: every dependency is installed"
+fi
+
+if [ "${1:-}" = "--deps" ]; then exit 0; fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+# Build the Python module for Debian's own interpreter (the one Blender embeds), whatever python3
+# comes first on PATH.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build -j "$jobs"
+echo "setup: built into ./build (CLI: ./build/bin/deformkit, Python module: ./build/python)"
