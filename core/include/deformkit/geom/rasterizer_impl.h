@@ -1,0 +1,143 @@
+#pragma once
+
+// Definition of rasterizeTriangle, included at the end of rasterizer.h.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::geom {
+
+namespace rasterizer_detail {
+
+// Subpixel precision: coordinates are multiples of 1/256 pixel.
+inline constexpr int64_t kSubpixels = 256;
+// Largest |coordinate| in pixels a triangle touching the grid may have: keeps fixed-point coordinates
+// below 2^29, so every edge function (a difference of two products of differences) fits in int64.
+inline constexpr double kMaxCoordinate = 2097152.0;  // 2^21
+
+struct FixedPoint {
+    int64_t x, y;
+};
+
+inline FixedPoint snap(const glm::vec2& p) {
+    return {static_cast<int64_t>(std::llround(static_cast<double>(p.x) * kSubpixels)),
+            static_cast<int64_t>(std::llround(static_cast<double>(p.y) * kSubpixels))};
+}
+
+// Twice the signed area of (a, b, c), in subpixel units squared: positive when c lies to the left of a->b
+// with y up.
+inline int64_t edgeFunction(const FixedPoint& a, const FixedPoint& b, const FixedPoint& c) {
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+// Top-left rule for a triangle with positive edge functions inside: a sample exactly on edge a->b counts
+// iff the edge is a "top" or "left" one. This equals moving every sample by the same infinitesimal
+// (+e, +e k) with 0 < k << 1, so triangles that tile a region claim each sample exactly once.
+inline bool isTopLeft(const FixedPoint& a, const FixedPoint& b) {
+    const int64_t dy = b.y - a.y;
+    return dy < 0 || (dy == 0 && b.x - a.x > 0);
+}
+
+// Smallest pixel index whose centre (256 i + 128 in subpixels) is >= v, and largest one whose centre is <= v.
+inline int64_t firstCentreAtOrAbove(int64_t v) {
+    return -((kSubpixels / 2 - v) >> 8);
+}
+inline int64_t lastCentreAtOrBelow(int64_t v) {
+    return (v - kSubpixels / 2) >> 8;
+}
+
+[[noreturn]] inline void throwBadVertex(int corner, const glm::vec2& p) {
+    throw InvalidInput(formatError("rasterizeTriangle", "vertex " + std::to_string(corner),
+                                   "coordinates (" + std::to_string(p.x) + ", " + std::to_string(p.y) +
+                                       ") are not finite or lie too far from the grid",
+                                   "finite raster coordinates within +-2^21 pixels"));
+}
+
+}  // namespace rasterizer_detail
+
+template <class Visit>
+void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
+                       Visit&& visit) {
+    namespace rd = rasterizer_detail;
+    const glm::vec2* corners[3] = {&p0, &p1, &p2};
+    for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(corners[k]->x) || !std::isfinite(corners[k]->y))
+            rd::throwBadVertex(k, *corners[k]);
+    }
+    if (grid.width <= 0 || grid.height <= 0) return;
+    // Pixel centres lie in [0.5, size - 0.5]; snapping moves a vertex by at most 1/512 pixel.
+    const float minX = std::min({p0.x, p1.x, p2.x}), maxX = std::max({p0.x, p1.x, p2.x});
+    const float minY = std::min({p0.y, p1.y, p2.y}), maxY = std::max({p0.y, p1.y, p2.y});
+    if (maxX < 0.0f || maxY < 0.0f || minX > static_cast<float>(grid.width) ||
+        minY > static_cast<float>(grid.height)) {
+        return;
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (std::abs(corners[k]->x) > rd::kMaxCoordinate || std::abs(corners[k]->y) > rd::kMaxCoordinate) {
+            rd::throwBadVertex(k, *corners[k]);
+        }
+    }
+
+    rd::FixedPoint v0 = rd::snap(p0), v1 = rd::snap(p1), v2 = rd::snap(p2);
+    const int64_t area = rd::edgeFunction(v0, v1, v2);
+    if (area == 0) return;
+    if (area < 0) std::swap(v1, v2);
+
+    // Barycentrics come from the unsnapped vertices so they reproduce the pixel centre exactly; only
+    // coverage uses the snapped ones.
+    const double q0x = p0.x, q0y = p0.y, q1x = p1.x, q1y = p1.y, q2x = p2.x, q2y = p2.y;
+    const double exactArea = (q1x - q0x) * (q2y - q0y) - (q1y - q0y) * (q2x - q0x);
+    if (exactArea == 0.0) return;
+    const double inverseArea = 1.0 / exactArea;
+
+    const int64_t x0 = std::max<int64_t>(0, rd::firstCentreAtOrAbove(std::min({v0.x, v1.x, v2.x})));
+    const int64_t x1 =
+        std::min<int64_t>(grid.width - 1, rd::lastCentreAtOrBelow(std::max({v0.x, v1.x, v2.x})));
+    const int64_t y0 = std::max<int64_t>(0, rd::firstCentreAtOrAbove(std::min({v0.y, v1.y, v2.y})));
+    const int64_t y1 =
+        std::min<int64_t>(grid.height - 1, rd::lastCentreAtOrBelow(std::max({v0.y, v1.y, v2.y})));
+    if (x0 > x1 || y0 > y1) return;
+
+    // Edge k is opposite vertex k. A bias of -1 turns "> 0" into ">= 0" for edges that do not own their
+    // samples.
+    const rd::FixedPoint start{x0 * rd::kSubpixels + rd::kSubpixels / 2,
+                               y0 * rd::kSubpixels + rd::kSubpixels / 2};
+    const rd::FixedPoint* from[3] = {&v1, &v2, &v0};
+    const rd::FixedPoint* to[3] = {&v2, &v0, &v1};
+    int64_t rowValue[3], stepX[3], stepY[3];
+    for (int k = 0; k < 3; ++k) {
+        rowValue[k] = rd::edgeFunction(*from[k], *to[k], start) - (rd::isTopLeft(*from[k], *to[k]) ? 0 : 1);
+        stepX[k] = -(to[k]->y - from[k]->y) * rd::kSubpixels;
+        stepY[k] = (to[k]->x - from[k]->x) * rd::kSubpixels;
+    }
+
+    for (int64_t y = y0; y <= y1; ++y) {
+        int64_t w0 = rowValue[0], w1 = rowValue[1], w2 = rowValue[2];
+        const double cy = static_cast<double>(y) + 0.5;
+        for (int64_t x = x0; x <= x1; ++x) {
+            if ((w0 | w1 | w2) >= 0) {
+                const double cx = static_cast<double>(x) + 0.5;
+                const double b1 = ((cx - q0x) * (q2y - q0y) - (cy - q0y) * (q2x - q0x)) * inverseArea;
+                const double b2 = ((q1x - q0x) * (cy - q0y) - (q1y - q0y) * (cx - q0x)) * inverseArea;
+                const double b0 = ((q1x - cx) * (q2y - cy) - (q1y - cy) * (q2x - cx)) * inverseArea;
+                visit(static_cast<int32_t>(x), static_cast<int32_t>(y),
+                      glm::vec3(static_cast<float>(b0), static_cast<float>(b1), static_cast<float>(b2)));
+            }
+            w0 += stepX[0];
+            w1 += stepX[1];
+            w2 += stepX[2];
+        }
+        for (int k = 0; k < 3; ++k)
+            rowValue[k] += stepY[k];
+    }
+}
+
+}  // namespace deformkit::geom
