@@ -1,0 +1,511 @@
+#include <catch2/catch.hpp>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/io/image.h"
+#include "test_support.h"
+
+using namespace deformkit::io;
+using deformkit::test::readText;
+using deformkit::test::runUnprivileged;
+using deformkit::test::TempDir;
+using deformkit::test::writeText;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Independent float -> half -> float reference: round to 11 significant bits (10 stored), ties to even,
+// with the subnormal quantum 2^-24 below 2^-14 and overflow to infinity past 65504.
+float roundToHalf(float value) {
+    if (value == 0.0f || !std::isfinite(value)) return value;
+    int exponent = 0;
+    std::frexp(static_cast<double>(value), &exponent);  // |value| = m 2^exponent, m in [0.5, 1)
+    const int quantumExponent = std::max(exponent - 11, -24);
+    const double rounded =
+        std::ldexp(std::nearbyint(std::ldexp(static_cast<double>(value), -quantumExponent)), quantumExponent);
+    if (std::abs(rounded) > 65504.0) return std::copysign(INFINITY, value);
+    return static_cast<float>(rounded);
+}
+
+// A distinct value per (x, y, c) that tells a transposed, flipped or channel-swapped read apart.
+// Multiples of 1/255 so 8-bit files store it exactly; alpha-like channels include 0 under non-zero colour.
+float patternValue(int32_t x, int32_t y, int32_t c) {
+    return static_cast<float>((x * 5 + y * 41 + c * 67 + (x * y) % 7) % 256) / 255.0f;
+}
+
+Image patternImage(int32_t w, int32_t h, int32_t channels) {
+    Image img(w, h, channels);
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            for (int32_t c = 0; c < channels; ++c)
+                img.at(x, y, c) = patternValue(x, y, c);
+        }
+    }
+    return img;
+}
+
+std::vector<float> randomUnit(size_t n, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> dist(0.0f, 1.0f);
+    std::vector<float> v(n);
+    for (float& x : v)
+        x = dist(rng);
+    v[0] = 0.0f;
+    v[1] = 1.0f;
+    return v;
+}
+
+// Reads with OpenImageIO directly, as an independent check of what writeImage put in the file.
+std::vector<float> readWithOiio(const fs::path& path, int& w, int& h, int& c) {
+    OIIO::ImageSpec config;  // as stored: no premultiplication of 2- and 4-channel PNGs
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path.string(), &config);
+    REQUIRE(in);
+    w = in->spec().width;
+    h = in->spec().height;
+    c = in->spec().nchannels;
+    std::vector<float> px(static_cast<size_t>(w) * h * c);
+    REQUIRE(in->read_image(0, 0, 0, c, OIIO::TypeDesc::FLOAT, px.data()));
+    return px;
+}
+
+std::set<std::string> folderEntries(const fs::path& folder) {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(folder))
+        names.insert(e.path().filename().string());
+    return names;
+}
+
+// True when `stored` is the level of `levels` nearest to `value`. Where value * levels lies within
+// 1e-3 of a tie, the writer's float arithmetic may round either way, so both neighbours are accepted.
+bool isNearestLevel(float stored, float value, double levels) {
+    const double exact = static_cast<double>(value) * levels;
+    const double level = static_cast<double>(stored) * levels;
+    if (std::abs(level - std::round(level)) > 1e-2) return false;  // not a level (float error is < 5e-3)
+    if (std::abs(exact - std::floor(exact) - 0.5) < 1e-3) {
+        return std::round(level) == std::floor(exact) || std::round(level) == std::ceil(exact);
+    }
+    return std::round(level) == std::round(exact);
+}
+
+void truncateToHalf(const fs::path& path) {
+    fs::resize_file(path, fs::file_size(path) / 2);
+}
+
+}  // namespace
+
+TEST_CASE("the half reference rounds like IEEE binary16", "[io][image]") {
+    CHECK(roundToHalf(1.0f) == 1.0f);
+    CHECK(roundToHalf(0.1f) == 0.0999755859375f);
+    CHECK(roundToHalf(1.0f / 3.0f) == 0.333251953125f);
+    CHECK(roundToHalf(1.0f + 0x1p-11f) == 1.0f);                // tie to even (down)
+    CHECK(roundToHalf(1.0f + 3 * 0x1p-11f) == 1.0f + 0x1p-9f);  // tie to even (up)
+    CHECK(roundToHalf(65504.0f) == 65504.0f);
+    CHECK(roundToHalf(65519.0f) == 65504.0f);
+    CHECK(std::isinf(roundToHalf(65520.0f)));
+    CHECK(roundToHalf(1e-7f) == 0x1p-23f);  // subnormal: 1e-7 / 2^-24 = 1.68 quanta -> 2
+    CHECK(roundToHalf(-2.5e-8f) == 0.0f);
+}
+
+TEST_CASE("EXR float round trip is bit exact", "[io][image]") {
+    TempDir dir;
+    Image img(13, 7, 3);
+    std::mt19937 rng(7);
+    for (float& v : img.pixels) {
+        do {
+            v = std::bit_cast<float>(static_cast<uint32_t>(rng()));
+        } while (std::isnan(v));
+    }
+    img.pixels[0] = -0.0f;
+    img.pixels[1] = INFINITY;
+    img.pixels[2] = -3.75e30f;
+    img.pixels[3] = 1e-42f;  // subnormal
+    writeImage(dir / "f.exr", img, {PixelType::Float, {}});
+    const Image back = readImage(dir / "f.exr");
+    REQUIRE(back.width == 13);
+    REQUIRE(back.height == 7);
+    REQUIRE(back.channels == 3);
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+        INFO("index " << i << " value " << img.pixels[i]);
+        REQUIRE(std::bit_cast<uint32_t>(back.pixels[i]) == std::bit_cast<uint32_t>(img.pixels[i]));
+    }
+    CHECK(readImageInfo(dir / "f.exr").pixelType == "float");
+}
+
+TEST_CASE("EXR half round trip equals the value rounded to half", "[io][image]") {
+    TempDir dir;
+    Image img(16, 9, 2);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> wide(-3000.0f, 3000.0f), narrow(-1.0f, 1.0f);
+    std::uniform_real_distribution<float> tiny(-1e-4f, 1e-4f);
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+        img.pixels[i] = i % 3 == 0 ? wide(rng) : i % 3 == 1 ? narrow(rng) : tiny(rng);
+    img.pixels[0] = 1.0f + 0x1p-11f;
+    img.pixels[1] = 1.0f + 3 * 0x1p-11f;
+    img.pixels[2] = 65519.0f;
+    img.pixels[3] = 3e-8f;
+    writeImage(dir / "h.exr", img);  // Auto: half for EXR
+    CHECK(readImageInfo(dir / "h.exr").pixelType == "half");
+    const Image back = readImage(dir / "h.exr");
+    REQUIRE(back.pixels.size() == img.pixels.size());
+    int changed = 0;
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+        INFO("index " << i << " value " << img.pixels[i]);
+        REQUIRE(back.pixels[i] == roundToHalf(img.pixels[i]));
+        changed += back.pixels[i] != img.pixels[i];
+    }
+    CHECK(changed > static_cast<int>(img.pixels.size()) / 2);  // the rounding really happened
+}
+
+TEST_CASE("PNG 8-bit round trip equals round(v * 255) / 255", "[io][image]") {
+    TempDir dir;
+    Image img(11, 6, 3);
+    img.pixels = randomUnit(img.pixels.size(), 3);
+    writeImage(dir / "a.png", img);  // Auto: 8-bit
+    CHECK(readImageInfo(dir / "a.png").pixelType == "uint8");
+    const Image back = readImage(dir / "a.png");
+    REQUIRE(back.pixels.size() == img.pixels.size());
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+        INFO("index " << i << " value " << img.pixels[i]);
+        REQUIRE(isNearestLevel(back.pixels[i], img.pixels[i], 255.0));
+    }
+}
+
+TEST_CASE("PNG and TIFF 16-bit round trip equals round(v * 65535) / 65535", "[io][image]") {
+    TempDir dir;
+    for (const char* name : {"a.png", "a.tif"}) {
+        INFO(name);
+        Image img(9, 14, 4);
+        img.pixels = randomUnit(img.pixels.size(), 5);
+        writeImage(dir / name, img, {PixelType::UInt16, {}});
+        CHECK(readImageInfo(dir / name).pixelType == "uint16");
+        const Image back = readImage(dir / name);
+        REQUIRE(back.pixels.size() == img.pixels.size());
+        for (size_t i = 0; i < img.pixels.size(); ++i) {
+            INFO("index " << i << " value " << img.pixels[i]);
+            REQUIRE(isNearestLevel(back.pixels[i], img.pixels[i], 65535.0));
+        }
+    }
+}
+
+TEST_CASE("TIFF stores half and float", "[io][image]") {
+    TempDir dir;
+    Image img(5, 4, 1);
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<float> dist(-5.0f, 5.0f);
+    for (float& v : img.pixels)
+        v = dist(rng);
+    writeImage(dir / "h.tif", img, {PixelType::Half, {}});
+    writeImage(dir / "f.tif", img, {PixelType::Float, {}});
+    CHECK(readImageInfo(dir / "h.tif").pixelType == "half");
+    CHECK(readImageInfo(dir / "f.tif").pixelType == "float");
+    const Image h = readImage(dir / "h.tif"), f = readImage(dir / "f.tif");
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+        REQUIRE(h.pixels[i] == roundToHalf(img.pixels[i]));
+        REQUIRE(f.pixels[i] == img.pixels[i]);
+    }
+}
+
+TEST_CASE("pixel (x, y, c) comes back at (x, y, c) for 1 to 4 channels", "[io][image]") {
+    TempDir dir;
+    const int32_t w = 7, h = 4;
+    for (const char* ext : {".exr", ".png", ".tif"}) {
+        for (int32_t channels = 1; channels <= 4; ++channels) {
+            INFO(ext << " with " << channels << " channels");
+            const fs::path path = dir / ("p" + std::to_string(channels) + ext);
+            const Image img = patternImage(w, h, channels);
+            writeImage(path, img, {std::string(ext) == ".exr" ? PixelType::Float : PixelType::UInt16, {}});
+
+            const Image back = readImage(path);
+            REQUIRE(back.width == w);
+            REQUIRE(back.height == h);
+            REQUIRE(back.channels == channels);
+            int ow = 0, oh = 0, oc = 0;
+            const std::vector<float> oiio = readWithOiio(path, ow, oh, oc);
+            REQUIRE((ow == w && oh == h && oc == channels));
+            for (int32_t y = 0; y < h; ++y) {
+                for (int32_t x = 0; x < w; ++x) {
+                    for (int32_t c = 0; c < channels; ++c) {
+                        INFO("pixel " << x << ", " << y << ", channel " << c);
+                        REQUIRE(back.at(x, y, c) == Approx(patternValue(x, y, c)).margin(1e-6));
+                        REQUIRE(oiio[(static_cast<size_t>(y) * w + x) * channels + c] ==
+                                Approx(patternValue(x, y, c)).margin(1e-6));
+                    }
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("readImage lays out a file written by OpenImageIO directly as (H, W, C), top row first",
+          "[io][image]") {
+    TempDir dir;
+    const int w = 6, h = 3, channels = 3;
+    std::vector<uint8_t> bytes(static_cast<size_t>(w) * h * channels);
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            for (int c = 0; c < channels; ++c)
+                bytes[(static_cast<size_t>(y) * w + x) * channels + c] = 100 * c + 10 * y + x;
+        }
+    }
+    const fs::path path = dir / "direct.png";
+    auto out = OIIO::ImageOutput::create(path.string());
+    REQUIRE(out);
+    REQUIRE(out->open(path.string(), OIIO::ImageSpec(w, h, channels, OIIO::TypeDesc::UINT8)));
+    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, bytes.data()));
+    REQUIRE(out->close());
+
+    const Image img = readImage(path);
+    REQUIRE((img.width == w && img.height == h && img.channels == channels));
+    CHECK(img.at(0, 0, 0) == Approx(0.0f));
+    CHECK(img.at(5, 0, 0) == Approx(5.0f / 255.0f));
+    CHECK(img.at(0, 2, 0) == Approx(20.0f / 255.0f));
+    CHECK(img.at(4, 1, 2) == Approx(214.0f / 255.0f));
+    CHECK(img.pixels[3] == Approx(1.0f / 255.0f));  // second pixel, first channel
+}
+
+TEST_CASE("readImageInfo reads the header: format, pixel type, channels, string attributes", "[io][image]") {
+    TempDir dir;
+    writeImage(dir / "rgb.exr", patternImage(8, 5, 3),
+               {PixelType::Auto, {{"deformkit:solver", "uvwarp 0.1"}, {"deformkit:frame", "1042"}}});
+    const ImageInfo exr = readImageInfo(dir / "rgb.exr");
+    CHECK(exr.width == 8);
+    CHECK(exr.height == 5);
+    CHECK(exr.channels == 3);
+    CHECK(exr.format == "openexr");
+    CHECK(exr.pixelType == "half");
+    CHECK(exr.channelNames == std::vector<std::string>{"R", "G", "B"});
+    using Attr = std::pair<std::string, std::string>;
+    CHECK(std::count(exr.attributes.begin(), exr.attributes.end(), Attr{"deformkit:solver", "uvwarp 0.1"}) ==
+          1);
+    CHECK(std::count(exr.attributes.begin(), exr.attributes.end(), Attr{"deformkit:frame", "1042"}) == 1);
+
+    // Independently, through OpenImageIO.
+    auto in = OIIO::ImageInput::open((dir / "rgb.exr").string());
+    REQUIRE(in);
+    CHECK(in->spec().get_string_attribute("deformkit:solver") == "uvwarp 0.1");
+
+    writeImage(dir / "ga.png", patternImage(3, 2, 2), {PixelType::UInt16, {}});
+    const ImageInfo png = readImageInfo(dir / "ga.png");
+    CHECK(png.format == "png");
+    CHECK(png.pixelType == "uint16");
+    CHECK(png.channels == 2);
+
+    // Header only: a PNG cut after its header still describes itself, though its pixels are gone.
+    writeImage(dir / "big.png", patternImage(256, 256, 3));
+    truncateToHalf(dir / "big.png");
+    CHECK(readImageInfo(dir / "big.png").width == 256);
+    CHECK_THROWS_AS(readImage(dir / "big.png"), deformkit::ParseError);
+}
+
+TEST_CASE("written headers carry no clock time unless given one", "[io][image]") {
+    TempDir dir;
+    const Image img = patternImage(4, 4, 1);
+    for (const char* name : {"a.exr", "a.tif"}) {
+        INFO(name);
+        writeImage(dir / name, img);
+        for (const auto& [key, value] : readImageInfo(dir / name).attributes) {
+            if (key == "DateTime") CHECK(value.empty());
+        }
+    }
+    writeImage(dir / "b.exr", img);
+    CHECK(readText(dir / "a.exr") == readText(dir / "b.exr"));
+
+    writeImage(dir / "c.exr", img, {PixelType::Auto, {{"DateTime", "2024:05:06 07:08:09"}}});
+    auto in = OIIO::ImageInput::open((dir / "c.exr").string());
+    REQUIRE(in);
+    CHECK(in->spec().get_string_attribute("DateTime") == "2024:05:06 07:08:09");
+}
+
+TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
+    TempDir dir;
+    using deformkit::InvalidInput;
+    using deformkit::IoError;
+    using deformkit::ParseError;
+
+    SECTION("missing file or a folder") {
+        CHECK_THROWS_AS(readImage(dir / "none.exr"), IoError);
+        CHECK_THROWS_WITH(readImage(dir / "none.exr"),
+                          Catch::Contains((dir / "none.exr").string() + ": no such file"));
+        CHECK_THROWS_AS(readImageInfo(dir / "none.exr"), IoError);
+        CHECK_THROWS_AS(readImage(dir.path()), IoError);
+    }
+
+    SECTION("truncated EXR and PNG") {
+        writeImage(dir / "t.exr", patternImage(64, 64, 3), {PixelType::Float, {}});
+        writeImage(dir / "t.png", patternImage(64, 64, 3));
+        truncateToHalf(dir / "t.exr");
+        truncateToHalf(dir / "t.png");
+        CHECK_THROWS_AS(readImage(dir / "t.exr"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "t.exr"),
+                          Catch::Contains((dir / "t.exr").string()) &&
+                              Catch::Contains("end of file", Catch::CaseSensitive::No));
+        CHECK_THROWS_AS(readImage(dir / "t.png"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "t.png"), Catch::Contains((dir / "t.png").string()) &&
+                                                        Catch::Contains("chunk IDAT") &&
+                                                        Catch::Contains("truncated PNG"));
+    }
+
+    SECTION("a PNG with a flipped byte inside its pixel data fails its CRC") {
+        writeImage(dir / "c.png", patternImage(64, 64, 3));
+        std::string bytes = readText(dir / "c.png");
+        const size_t idat = bytes.find("IDAT");
+        REQUIRE(idat != std::string::npos);
+        bytes[idat + 10] = static_cast<char>(bytes[idat + 10] ^ 0x5a);
+        writeText(dir / "c.png", bytes);
+        CHECK_THROWS_AS(readImage(dir / "c.png"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "c.png"), Catch::Contains("chunk IDAT") && Catch::Contains("CRC"));
+    }
+
+    SECTION("garbage bytes under an image name") {
+        writeText(dir / "g.exr", std::string(300, 'x'));
+        writeText(dir / "g.png", "not a picture, just text\n");
+        CHECK_THROWS_AS(readImage(dir / "g.exr"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "g.exr"), Catch::Contains((dir / "g.exr").string()) &&
+                                                        Catch::Contains("not an OpenEXR file"));
+        CHECK_THROWS_AS(readImage(dir / "g.png"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "g.png"),
+                          Catch::Contains((dir / "g.png").string()) && Catch::Contains("Not a PNG file"));
+        CHECK_THROWS_AS(readImageInfo(dir / "g.png"), ParseError);
+    }
+
+    SECTION("no stale OpenImageIO error leaks into the next message") {
+        // A failed create leaves a pending per-thread error that OpenImageIO appends to later ones.
+        const auto leaveStaleError = [&] {
+            CHECK_FALSE(OIIO::ImageOutput::create((dir / "stale.unknownformat").string()));
+            REQUIRE(OIIO::has_error());
+        };
+        writeImage(dir / "t.png", patternImage(64, 64, 3));
+        truncateToHalf(dir / "t.png");
+        writeText(dir / "g.exr", "garbage");
+        for (const char* name : {"t.png", "g.exr"}) {
+            INFO(name);
+            leaveStaleError();
+            try {
+                (void)readImage(dir / name);
+                FAIL("no error");
+            } catch (const ParseError& e) {
+                CHECK_THAT(e.what(), Catch::Contains(name) && !Catch::Contains("unknownformat"));
+            }
+        }
+        leaveStaleError();
+        writeImage(dir / "ok.png", patternImage(2, 2, 1));
+        CHECK(readImage(dir / "ok.png").width == 2);
+        CHECK_FALSE(OIIO::has_error());
+    }
+
+    SECTION("channel count other than expected") {
+        writeImage(dir / "rgb.exr", patternImage(4, 4, 3));
+        CHECK_THROWS_AS(readImage(dir / "rgb.exr", {1, ""}), InvalidInput);
+        CHECK_THROWS_WITH(
+            readImage(dir / "rgb.exr", {1, ""}),
+            Catch::Contains((dir / "rgb.exr").string() + ": has 3 channels (expected 1 channel)"));
+        CHECK_THROWS_WITH(readImage(dir / "rgb.exr", {1, "rigidity map"}),
+                          Catch::Contains((dir / "rgb.exr").string() +
+                                          ": rigidity map: has 3 channels (expected 1 channel)"));
+        CHECK(readImage(dir / "rgb.exr", {3, "colour"}).channels == 3);
+    }
+
+    SECTION("unreadable file") {
+        writeImage(dir / "locked.png", patternImage(4, 4, 1));
+        fs::permissions(dir / "locked.png", fs::perms::none);
+        const fs::path locked = dir / "locked.png";
+        CHECK(runUnprivileged([&] {
+            try {
+                (void)readImage(locked);
+            } catch (const IoError& e) {
+                return std::string(e.what()).find("permission denied") != std::string::npos;
+            } catch (...) {
+            }
+            return false;
+        }));
+    }
+}
+
+TEST_CASE("writeImage rejects what it cannot store faithfully and leaves no file", "[io][image]") {
+    TempDir dir;
+    using deformkit::InvalidInput;
+    const Image img = patternImage(4, 3, 3);
+
+    CHECK_THROWS_AS(writeImage(dir / "e.exr", Image{}), InvalidInput);
+    CHECK_THROWS_WITH(writeImage(dir / "e.exr", Image(0, 3, 1)), Catch::Contains("empty image"));
+    Image wrongSize = img;
+    wrongSize.pixels.pop_back();
+    CHECK_THROWS_WITH(writeImage(dir / "w.exr", wrongSize),
+                      Catch::Contains("has 35 values") && Catch::Contains("36 = width * height * channels"));
+
+    for (const PixelType type : {PixelType::Half, PixelType::Float}) {
+        CHECK_THROWS_AS(writeImage(dir / "a.png", img, {type, {}}), InvalidInput);
+    }
+    CHECK_THROWS_WITH(writeImage(dir / "a.png", img, {PixelType::Half, {}}),
+                      Catch::Contains("a.png") && Catch::Contains("png files cannot store half pixels"));
+    CHECK_THROWS_AS(writeImage(dir / "a.exr", img, {PixelType::UInt8, {}}), InvalidInput);
+    CHECK_THROWS_AS(writeImage(dir / "a.exr", img, {PixelType::UInt16, {}}), InvalidInput);
+    CHECK_THROWS_AS(writeImage(dir / "a.jpg", img, {PixelType::Float, {}}), InvalidInput);
+    CHECK_THROWS_AS(writeImage(dir / "five.png", patternImage(2, 2, 5)), InvalidInput);
+    CHECK_THROWS_WITH(writeImage(dir / "a.notaformat", img), Catch::Contains("'.notaformat'"));
+    // TIFF keeps only its standard tags: a custom attribute would be lost.
+    CHECK_THROWS_WITH(writeImage(dir / "a.tif", img, {PixelType::Auto, {{"deformkit:solver", "x"}}}),
+                      Catch::Contains("attribute 'deformkit:solver'") && Catch::Contains("cannot store"));
+    CHECK(folderEntries(dir.path()).empty());
+
+    // A rejected write over an existing file leaves it as it was.
+    writeImage(dir / "keep.png", img);
+    const std::string before = readText(dir / "keep.png");
+    CHECK_THROWS_AS(writeImage(dir / "keep.png", patternImage(9, 9, 1), {PixelType::Float, {}}),
+                    InvalidInput);
+    CHECK(readText(dir / "keep.png") == before);
+    CHECK(folderEntries(dir.path()) == std::set<std::string>{"keep.png"});
+
+    // More than 4 channels where the format takes them.
+    const Image many = patternImage(3, 2, 12);
+    writeImage(dir / "many.exr", many, {PixelType::Float, {}});
+    const Image back = readImage(dir / "many.exr");
+    REQUIRE(back.channels == 12);
+    for (size_t i = 0; i < many.pixels.size(); ++i)
+        REQUIRE(back.pixels[i] == many.pixels[i]);
+}
+
+TEST_CASE("writeImage replaces a file atomically and fails on a missing or unwritable folder",
+          "[io][image]") {
+    TempDir dir;
+    using deformkit::IoError;
+    const fs::path target = dir / "map.exr";
+    writeImage(target, patternImage(4, 4, 1));
+    writeImage(target, patternImage(6, 2, 2));
+    CHECK(readImage(target).width == 6);
+    CHECK(folderEntries(dir.path()) == std::set<std::string>{"map.exr"});
+
+    CHECK_THROWS_AS(writeImage(dir / "missing" / "map.exr", patternImage(2, 2, 1)), IoError);
+    CHECK_THROWS_WITH(writeImage(dir / "missing" / "map.exr", patternImage(2, 2, 1)),
+                      Catch::Contains((dir / "missing").string()) && Catch::Contains("does not exist"));
+    CHECK_FALSE(fs::exists(dir / "missing"));
+
+    const std::string before = readText(target);
+    fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                    fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+    const bool rejected = runUnprivileged([&] {
+        try {
+            writeImage(target, patternImage(8, 8, 3));
+        } catch (const IoError& e) {
+            return std::string(e.what()).find("not writable") != std::string::npos;
+        } catch (...) {
+        }
+        return false;
+    });
+    fs::permissions(dir.path(), fs::perms::owner_all);
+    CHECK(rejected);
+    CHECK(readText(target) == before);
+    CHECK(folderEntries(dir.path()) == std::set<std::string>{"map.exr"});
+}
