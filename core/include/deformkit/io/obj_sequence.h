@@ -33,6 +33,8 @@ private:
     std::string prefix_, suffix_;  // file name around the token
     int padding_ = 0;
     bool haveReference_ = false;
+    std::filesystem::path referencePath_;  // the first frame read, named in topology errors
+    int32_t referenceVertices_ = 0;
     std::vector<int32_t> referenceCounts_, referenceIndices_;
 };
 
