@@ -1,0 +1,101 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/primitives.h"
+#include "deformkit/io/preview.h"
+
+using namespace deformkit;
+
+namespace {
+
+bool isBackground(const io::Image& img, int32_t x, int32_t y, const glm::vec3& bg) {
+    return std::abs(img.at(x, y, 0) - bg.r) < 1e-6f && std::abs(img.at(x, y, 1) - bg.g) < 1e-6f &&
+           std::abs(img.at(x, y, 2) - bg.b) < 1e-6f;
+}
+
+io::Image solid(glm::vec3 c) {
+    io::Image img(4, 4, 3);
+    for (int32_t i = 0; i < 16; ++i) {
+        for (int k = 0; k < 3; ++k) img.pixels[3 * i + k] = c[k];
+    }
+    return img;
+}
+
+}  // namespace
+
+TEST_CASE("preview: a sphere's silhouette matches the perspective closed form", "[io][preview]") {
+    const float r = 1.0f;
+    const geom::Mesh sphere = geom::makeSphere({r, 256, 128});
+    io::PreviewOptions o;
+    o.width = o.height = 400;
+    o.viewDirection = {0.0f, 0.0f, -1.0f};
+    const io::Image img = io::renderPreview(sphere, o);
+    int64_t covered = 0;
+    for (int32_t y = 0; y < o.height; ++y) {
+        for (int32_t x = 0; x < o.width; ++x) covered += isBackground(img, x, y, o.background) ? 0 : 1;
+    }
+    // Documented framing: distance D = 1.08 R_box / sin(fov/2), R_box = r sqrt(3) for the sphere's box.
+    // A sphere seen from D projects to a disk of radius focal * r / sqrt(D^2 - r^2), focal = (H/2) / tan(fov/2).
+    const double halfFov = 15.0 * std::numbers::pi / 180.0;
+    const double D = 1.08 * r * std::sqrt(3.0) / std::sin(halfFov);
+    const double focal = 0.5 * o.height / std::tan(halfFov);
+    const double rho = focal * r / std::sqrt(D * D - r * r);
+    CHECK(static_cast<double>(covered) == Approx(std::numbers::pi * rho * rho).epsilon(0.01));
+    // Centred: the centre pixel is covered and lit, the corners are background.
+    CHECK_FALSE(isBackground(img, 200, 200, o.background));
+    CHECK(isBackground(img, 0, 0, o.background));
+    CHECK(isBackground(img, 399, 399, o.background));
+}
+
+TEST_CASE("preview: textures follow UV orientation and UDIM tiles", "[io][preview]") {
+    io::PreviewOptions o;
+    o.width = 200;
+    o.height = 100;
+    o.viewDirection = {0.0f, 0.0f, -1.0f};  // looking down -z: x to the right, y up
+
+    SECTION("one image: top row of the image is v = 1") {
+        const geom::Mesh grid = geom::makeGrid({4, 4, 1.0f, 1.0f});
+        io::PreviewTexture tex;
+        tex.single = io::Image(2, 2, 3);
+        for (int32_t x = 0; x < 2; ++x) {
+            tex.single->at(x, 0, 1) = 1.0f;  // top row green
+            tex.single->at(x, 1, 0) = 1.0f;  // bottom row red
+        }
+        const io::Image img = io::renderPreview(grid, o, &tex);
+        const int32_t top = 30, bottom = 70, cx = 100;
+        CHECK(img.at(cx, top, 1) > 0.3f);
+        CHECK(img.at(cx, top, 0) < 0.05f);
+        CHECK(img.at(cx, bottom, 0) > 0.3f);
+        CHECK(img.at(cx, bottom, 1) < 0.05f);
+    }
+    SECTION("UDIM: u in [0, 1) reads tile 1001, u in [1, 2) tile 1002") {
+        geom::Mesh grid = geom::makeGrid({8, 4, 2.0f, 1.0f});
+        for (auto& uv : grid.uvs()) uv.x *= 2.0f;
+        io::PreviewTexture tex;
+        tex.tiles.emplace(1001, solid({1.0f, 0.0f, 0.0f}));
+        tex.tiles.emplace(1002, solid({0.0f, 0.0f, 1.0f}));
+        const io::Image img = io::renderPreview(grid, o, &tex);
+        CHECK(img.at(75, 50, 0) > 0.3f);
+        CHECK(img.at(75, 50, 2) == 0.0f);
+        CHECK(img.at(125, 50, 2) > 0.3f);
+        CHECK(img.at(125, 50, 0) == 0.0f);
+    }
+}
+
+TEST_CASE("preview: bad input is reported", "[io][preview][errors]") {
+    CHECK_THROWS_WITH(io::renderPreview(geom::Mesh()), Catch::Contains("has no faces"));
+    geom::Mesh::Data d;
+    d.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    d.faceCounts = {3};
+    d.faceIndices = {0, 1, 2};
+    const geom::Mesh noUVs(d);
+    io::PreviewTexture tex;
+    tex.single = solid({1, 1, 1});
+    CHECK_THROWS_WITH(io::renderPreview(noUVs, {}, &tex), Catch::Contains("no UVs"));
+    io::PreviewOptions o;
+    o.width = 0;
+    CHECK_THROWS_AS(io::renderPreview(noUVs, o), InvalidInput);
+}
