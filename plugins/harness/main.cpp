@@ -1,20 +1,88 @@
-// deformkit: the standalone host. Exit codes: 0 success, 2 bad input or usage (one line on stderr),
-// 1 internal error.
+// deformkit: the standalone host. Exit codes: 0 success; 2 bad input or usage, with one line on
+// stderr; 1 internal error.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
 
+#include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/version.h"
 
+namespace {
+
+// "x,y,z" -> vec3, for --view.
+glm::vec3 parseVec3(const std::string& text) {
+    glm::vec3 v;
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3) {
+        throw deformkit::InvalidInput(
+            deformkit::formatError("--view", "", "'" + text + "' is not a direction", "three numbers: x,y,z"));
+    }
+    return v;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+    using namespace deformkit;
     CLI::App app{"DeformKit: production deformers (slide, warps, content-aware UV warp)", "deformkit"};
-    app.set_version_flag("--version", std::string("deformkit ") + deformkit::kVersionString);
+    app.set_version_flag("--version", std::string("deformkit ") + kVersionString);
     app.require_subcommand(1);
+
+    std::string infoFile;
+    auto* info = app.add_subcommand("info", "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern");
+    info->add_option("FILE", infoFile, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
+        ->required();
+
+    harness::PreviewCommand previewCommand;
+    std::string previewMesh, previewTexture, previewOut, previewView;
+    auto* preview = app.add_subcommand("preview", "Render a shaded, optionally textured view of a mesh to an image");
+    preview->add_option("MESH", previewMesh, "mesh (.obj)")->required();
+    preview->add_option("--texture", previewTexture, "image, or UDIM pattern such as albedo.<UDIM>.png");
+    preview->add_option("--out", previewOut, "output image (.png)")->required();
+    preview->add_option("--width", previewCommand.options.width, "pixels")->capture_default_str();
+    preview->add_option("--height", previewCommand.options.height, "pixels")->capture_default_str();
+    preview->add_option("--view", previewView, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
+    preview->add_flag("--edges", previewCommand.options.drawEdges, "draw polygon edges");
+
+    harness::DemoCommand demoCommand;
+    std::string demoOut = demoCommand.outDir.string();
+    auto* demo = app.add_subcommand("demo", "Generate the demo assets and previews into a folder");
+    demo->add_option("--out", demoOut, "output folder")->capture_default_str();
+    demo->add_option("--resolution", demoCommand.resolution, "texels per UDIM tile side")->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        // Help and version print and exit 0; a usage error is one line on stderr and exit code 2.
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::cerr << "deformkit: usage error: " << e.what() << " (see deformkit --help)\n";
+        return 2;
+    }
+
+    try {
+        if (*info) {
+            harness::describe(infoFile, std::cout);
+        } else if (*preview) {
+            previewCommand.mesh = previewMesh;
+            previewCommand.out = previewOut;
+            if (!previewTexture.empty()) previewCommand.texture = previewTexture;
+            if (!previewView.empty()) previewCommand.options.viewDirection = parseVec3(previewView);
+            harness::preview(previewCommand);
+            std::cout << "wrote " << previewOut << "\n";
+        } else if (*demo) {
+            demoCommand.outDir = demoOut;
+            const auto files = harness::demo(demoCommand);
+            std::cout << "demo: wrote " << files.size() << " files to " << demoCommand.outDir.string() << "/\n";
+            for (const auto& f : files) std::cout << "  " << f.string() << "\n";
+        }
+    } catch (const Error& e) {
+        std::cerr << "deformkit: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "deformkit: internal error: " << e.what() << "\n";
+        return 1;
     }
     return 0;
 }

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Usage: cli_test.sh DEFORMKIT SCRATCH_DIR
+# Checks the CLI's contract: exit 0 on success, 2 with exactly one line on stderr for bad input or
+# usage, outputs that exist and are readable.
+set -u
+dk=$1
+work=$2
+rm -rf "$work" && mkdir -p "$work"
+failures=0
+passed=0
+
+expect() {  # expect NAME EXPECTED_RC CMD...
+    local name=$1 want=$2; shift 2
+    "$@" >"$work/out" 2>"$work/err"
+    local rc=$?
+    if [ "$rc" -ne "$want" ]; then
+        echo "FAIL $name: exit $rc, expected $want"; cat "$work/err"; failures=$((failures + 1)); return 1
+    fi
+    if [ "$want" -eq 2 ] && [ "$(wc -l <"$work/err")" -ne 1 ]; then
+        echo "FAIL $name: expected one line on stderr, got:"; cat "$work/err"; failures=$((failures + 1)); return 1
+    fi
+    passed=$((passed + 1))
+}
+contains() {  # contains NAME FILE TEXT
+    if ! grep -qF -- "$3" "$2"; then
+        echo "FAIL $1: '$3' not in $2:"; cat "$2"; failures=$((failures + 1)); return 1
+    fi
+    passed=$((passed + 1))
+}
+
+expect version 0 "$dk" --version
+contains version "$work/out" "deformkit 0."
+expect help 0 "$dk" preview --help
+contains help "$work/out" "--texture"
+expect no-subcommand 2 "$dk"
+expect unknown-option 2 "$dk" info --bogus x
+expect missing-mesh 2 "$dk" info "$work/nope.obj"
+contains missing-mesh "$work/err" "nope.obj"
+
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n' >"$work/bad.obj"
+expect bad-index 2 "$dk" info "$work/bad.obj"
+contains bad-index "$work/err" "line 4"
+
+expect demo 0 "$dk" demo --out "$work/demo" --resolution 64
+for f in tube.obj rigidity.1001.exr rigidity.1002.exr mask.1001.exr mask.1002.exr albedo.1001.png albedo.1002.png preview.png; do
+    if [ ! -s "$work/demo/$f" ]; then echo "FAIL demo: $f missing"; failures=$((failures + 1)); fi
+done
+expect info-mesh 0 "$dk" info "$work/demo/tube.obj"
+contains info-mesh "$work/out" "vertices    22242"
+contains info-mesh "$work/out" "UDIM tiles 1001 1002"
+contains info-mesh "$work/out" "manifold    yes"
+expect info-image 0 "$dk" info "$work/demo/rigidity.1001.exr"
+contains info-image "$work/out" "64 x 64"
+contains info-image "$work/out" "half"
+expect info-udim 0 "$dk" info "$work/demo/mask.<UDIM>.exr"
+contains info-udim "$work/out" "tiles       2: 1001 1002"
+expect info-udim-none 2 "$dk" info "$work/demo/nothing.<UDIM>.exr"
+
+expect preview 0 "$dk" preview "$work/demo/tube.obj" --texture "$work/demo/albedo.<UDIM>.png" --out "$work/p.png" --width 200 --height 150 --edges
+expect preview-size 0 "$dk" info "$work/p.png"
+contains preview-size "$work/out" "200 x 150"
+expect preview-bad-view 2 "$dk" preview "$work/demo/tube.obj" --view 1,2 --out "$work/q.png"
+expect preview-no-folder 2 "$dk" preview "$work/demo/tube.obj" --out "$work/missing/dir/q.png"
+
+# A truncated image is a clear error, not a crash.
+head -c 300 "$work/demo/albedo.1001.png" >"$work/trunc.png"
+expect truncated-texture 2 "$dk" preview "$work/demo/tube.obj" --texture "$work/trunc.png" --out "$work/r.png"
+[ ! -e "$work/r.png" ] || { echo "FAIL truncated-texture: output written"; failures=$((failures + 1)); }
+
+echo "$passed passed, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,15 @@
+// A studio plugin's view of DeformKit: headers and deformkit::core from an installed package.
+#include <cstdio>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/half_edge.h"
+#include "deformkit/geom/primitives.h"
+#include "deformkit/version.h"
+
+int main() {
+    const deformkit::geom::Mesh grid = deformkit::geom::makeGrid({4, 4});
+    if (!grid.halfEdges().report().isManifold()) return 1;
+    std::printf("deformkit %s grid %d vertices %d faces\n", deformkit::kVersionString, grid.numVertices(),
+                grid.numFaces());
+    return 0;
+}

@@ -1,0 +1,108 @@
+"""The deformkit Python module: numpy views, round trips and errors, checked against numpy references."""
+import os
+import sys
+
+import numpy as np
+import pytest
+
+import deformkit as dk
+
+
+def quad_and_triangle():
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], dtype=np.float32)
+    return dk.Mesh(points, np.array([4, 3]), np.array([0, 1, 2, 3, 1, 4, 2]))
+
+
+def test_built_for_debian_python():
+    # Blender embeds Debian's own interpreter; the module must import there.
+    assert sys.version_info[:2] == (3, 11)
+    assert dk.__file__.endswith(".cpython-311-x86_64-linux-gnu.so")
+
+
+def test_points_are_a_writable_view_without_copy():
+    mesh = quad_and_triangle()
+    pts = mesh.points
+    assert pts.shape == (5, 3) and pts.dtype == np.float32
+    assert not pts.flags.owndata  # a view of the C++ mesh
+    pts[4] = (7, 8, 9)
+    assert mesh.points[4].tolist() == [7, 8, 9]
+    assert mesh.face_counts.tolist() == [4, 3]
+    assert mesh.face_indices.tolist() == [0, 1, 2, 3, 1, 4, 2]
+    assert not mesh.face_counts.flags.writeable
+    assert mesh.uvs is None and mesh.uv_indices is None
+
+
+def test_mesh_round_trip_is_bit_exact(tmp_path):
+    rng = np.random.default_rng(7)
+    tube = dk.make_capped_tube()
+    tube.points[:] += rng.normal(scale=1e-3, size=tube.points.shape).astype(np.float32)
+    path = tmp_path / "tube.obj"
+    dk.write_mesh(path, tube)
+    back = dk.read_mesh(path)
+    assert np.array_equal(back.points, tube.points)
+    assert np.array_equal(back.uvs, tube.uvs)
+    assert np.array_equal(back.face_indices, tube.face_indices)
+    assert np.array_equal(back.uv_indices, tube.uv_indices)
+    assert back.udim_tiles() == [1001, 1002]
+    assert back.is_manifold()
+
+
+def test_image_round_trips(tmp_path):
+    rng = np.random.default_rng(3)
+    data = rng.uniform(-2, 3, size=(5, 7, 3)).astype(np.float32)
+    dk.write_image(tmp_path / "a.exr", data, type="float", attributes={"deformkit:frame": "12"})
+    back = dk.read_image(tmp_path / "a.exr")
+    assert back.shape == (5, 7, 3) and back.dtype == np.float32
+    assert np.array_equal(back, data)
+
+    half = dk.read_image(_write(tmp_path / "h.exr", data, "half"))
+    assert np.array_equal(half, data.astype(np.float16).astype(np.float32))
+
+    unit = rng.uniform(0, 1, size=(4, 6)).astype(np.float32)
+    png = dk.read_image(_write(tmp_path / "b.png", unit, "uint8"), channels=1)
+    assert png.shape == (4, 6, 1)
+    assert np.allclose(png[..., 0], np.round(unit * 255) / 255, atol=1e-7)
+
+
+def _write(path, data, type):
+    dk.write_image(path, data, type=type)
+    return path
+
+
+def test_udim_tiles(tmp_path):
+    img = np.zeros((2, 2, 1), dtype=np.float32)
+    for tile in (1001, 1002, 1011):
+        dk.write_image(tmp_path / dk.expand_udim("r.<UDIM>.exr", tile), img)
+    (tmp_path / "r.0999.exr").write_bytes(b"decoy")
+    tiles = dk.udim_tiles(str(tmp_path / "r.<UDIM>.exr"))
+    assert list(tiles) == [1001, 1002, 1011]
+    assert tiles[1011].endswith("r.1011.exr")
+    assert dk.expand_udim("t.<UVTILE>.png", 1012) == "t.u2_v2.png"
+
+
+def test_errors_are_deformkit_errors(tmp_path):
+    with pytest.raises(dk.IoError, match="nope.obj"):
+        dk.read_mesh(tmp_path / "nope.obj")
+    assert issubclass(dk.IoError, dk.Error) and issubclass(dk.TopologyError, dk.InvalidInput)
+    with pytest.raises(dk.InvalidInput, match=r"face 1 corner 1"):
+        dk.Mesh(np.zeros((3, 3), np.float32), np.array([3, 3]), np.array([0, 1, 2, 0, 9, 1]))
+    with pytest.raises(dk.InvalidInput, match=r"\(n, 3\)"):
+        dk.Mesh(np.zeros((3, 2), np.float32), np.array([3]), np.array([0, 1, 2]))
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")
+    with pytest.raises(dk.Error, match="line 3"):
+        dk.read_mesh(bad)
+    dk.write_image(tmp_path / "rgb.exr", np.zeros((2, 2, 3), np.float32))
+    with pytest.raises(dk.InvalidInput, match="3 channels"):
+        dk.read_image(tmp_path / "rgb.exr", channels=1)
+    with pytest.raises(dk.Error, match="matches no file"):
+        dk.udim_tiles(str(tmp_path / "none.<UDIM>.exr"))
+
+
+def test_preview_of_a_grid_fills_the_expected_region():
+    grid = dk.make_grid(4, 4, 2.0, 2.0)
+    img = dk.render_preview(grid, width=64, height=48)
+    assert img.shape == (48, 64, 3)
+    background = np.array([0.16, 0.17, 0.19], np.float32)
+    covered = np.any(np.abs(img - background) > 1e-3, axis=2)
+    assert 0.1 < covered.mean() < 0.9
