@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Prints one table from Google Benchmark JSON files: median throughput per benchmark and the ratio
+against the reference benchmark measured in the same run. Usage: bench_table.py FILE.json..."""
+import json
+import sys
+
+# benchmark -> (reference benchmark, what the ratio means)
+REFERENCES = {
+    "BM_ObjRead": ("BM_PlainRead", "OBJ read / plain read of the same bytes"),
+    "BM_ObjParse": ("BM_PlainRead", "OBJ parse from memory / plain read"),
+    "BM_BvhClosestPoint": ("BM_BruteForceClosestPoint", "BVH / brute-force closest point"),
+    "BM_BvhRayCast": ("BM_BruteForceRayCast", "BVH / brute-force ray cast"),
+}
+
+
+def base_name(name):
+    return name.split("/")[0]
+
+
+def throughput(run):
+    if "bytes_per_second" in run:
+        return run["bytes_per_second"] / 1e6, "MB/s"
+    if "items_per_second" in run:
+        return run["items_per_second"], "items/s"
+    return 1e9 / run["real_time"] if run.get("time_unit") == "ns" else None, "runs/s"
+
+
+def main(paths):
+    medians = {}
+    context = None
+    for path in paths:
+        with open(path) as f:
+            data = json.load(f)
+        context = context or data.get("context", {})
+        runs = data["benchmarks"]
+        has_aggregates = any(r.get("run_type") == "aggregate" for r in runs)
+        for r in runs:
+            if has_aggregates and r.get("aggregate_name") != "median":
+                continue
+            medians[base_name(r["run_name"] if "run_name" in r else r["name"])] = r
+    if context:
+        print(f"# {context.get('host_name', '')}: {context.get('num_cpus', '?')} cpus, "
+              f"{context.get('date', '')}; medians of repetitions")
+    print(f"{'benchmark':34} {'median time':>14} {'throughput':>18}   ratio vs reference")
+    for name, run in sorted(medians.items()):
+        value, unit = throughput(run)
+        time = f"{run['real_time']:.3g} {run['time_unit']}"
+        ratio = ""
+        if name in REFERENCES and REFERENCES[name][0] in medians:
+            ref_value, _ = throughput(medians[REFERENCES[name][0]])
+            ratio = f"{value / ref_value:8.3f}x  ({REFERENCES[name][1]})"
+        shown = f"{value:,.1f} {unit}" if value is not None else "-"
+        print(f"{name:34} {time:>14} {shown:>18}   {ratio}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
