@@ -18,7 +18,10 @@ trap 'rm -rf "$out"' EXIT
 for exe in build/bin/bench_*; do
     name=$(basename "$exe")
     echo "running $name ..." >&2
-    "$exe" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
-        --benchmark_out="$out/$name.json" --benchmark_out_format=json >/dev/null
+    if ! "$exe" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
+        --benchmark_out="$out/$name.json" --benchmark_out_format=json >"$out/$name.log" 2>&1; then
+        cat "$out/$name.log" >&2
+        exit 1
+    fi
 done
 python3 scripts/bench_table.py "$out"/*.json

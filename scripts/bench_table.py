@@ -25,6 +25,14 @@ def throughput(run):
     return 1e9 / run["real_time"] if run.get("time_unit") == "ns" else None, "runs/s"
 
 
+def format_time(value, unit):
+    seconds = value * {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[unit]
+    for scale, name in ((1.0, "s"), (1e-3, "ms"), (1e-6, "us")):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {name}"
+    return f"{seconds / 1e-9:.3g} ns"
+
+
 def main(paths):
     medians = {}
     context = None
@@ -44,7 +52,7 @@ def main(paths):
     print(f"{'benchmark':34} {'median time':>14} {'throughput':>18}   ratio vs reference")
     for name, run in sorted(medians.items()):
         value, unit = throughput(run)
-        time = f"{run['real_time']:.3g} {run['time_unit']}"
+        time = format_time(run["real_time"], run["time_unit"])
         ratio = ""
         if name in REFERENCES and REFERENCES[name][0] in medians:
             ref_value, _ = throughput(medians[REFERENCES[name][0]])
