@@ -49,6 +49,19 @@ expect info-mesh 0 "$dk" info "$work/demo/tube.obj"
 contains info-mesh "$work/out" "vertices    22242"
 contains info-mesh "$work/out" "UDIM tiles 1001 1002"
 contains info-mesh "$work/out" "manifold    yes"
+# The same inputs give the same bytes: a second demo run is identical file for file.
+expect demo-again 0 "$dk" demo --out "$work/demo2" --resolution 64
+for f in "$work"/demo/*; do
+    if ! cmp -s "$f" "$work/demo2/$(basename "$f")"; then
+        echo "FAIL determinism: $(basename "$f") differs between two demo runs"; failures=$((failures + 1))
+    fi
+done
+
+# Non-manifold input is reported by info, not refused.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >"$work/fin.obj"
+expect info-nonmanifold 0 "$dk" info "$work/fin.obj"
+contains info-nonmanifold "$work/out" "manifold    no (1 non-manifold edges"
+
 expect info-image 0 "$dk" info "$work/demo/rigidity.1001.exr"
 contains info-image "$work/out" "64 x 64"
 contains info-image "$work/out" "half"
