@@ -1,0 +1,106 @@
+#include "deformkit/warp/engine.h"
+
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::warp {
+namespace {
+
+void requireSize(const char* what, size_t got, size_t expected) {
+    if (got != expected) {
+        throw InvalidInput(formatError("warp engine", what, "has " + std::to_string(got) + " entries",
+                                       std::to_string(expected) + " entries"));
+    }
+}
+
+// (s . T_i)<p> for one field entry.
+glm::vec3 applyScaled(const Transformations& t, int32_t i, float s, const glm::vec3& p) {
+    if (t.method == ScaleMethod::Displacement) {
+        const glm::vec3 moved = t.affine[i].apply(p);
+        return p + s * (moved - p);
+    }
+    return toAffine(scaleByComposition(t.components[i], s)).apply(p);
+}
+
+}  // namespace
+
+void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields, const Transformations& transforms,
+                  std::span<glm::vec3> out, const EngineOptions& options) {
+    const size_t n = points.size();
+    requireSize("output points", out.size(), n);
+    requireSize("field offsets", fields.offsets.size(), n + 1);
+    const size_t entries = static_cast<size_t>(fields.offsets.back());
+    requireSize("field transformation indices", fields.transform.size(), entries);
+    requireSize("strength field", fields.strength.size(), entries);
+    requireSize("weighting field", fields.weight.size(), entries);
+    if (transforms.method == ScaleMethod::Composition) {
+        requireSize("transformations", transforms.components.size(), static_cast<size_t>(transforms.size()));
+    }
+    const int32_t numTransforms = transforms.size();
+    for (size_t e = 0; e < entries; ++e) {
+        if (fields.transform[e] < 0 || fields.transform[e] >= numTransforms) {
+            throw InvalidInput(formatError("warp engine", "field entry " + std::to_string(e),
+                                           "names transformation " + std::to_string(fields.transform[e]),
+                                           "an index in [0, " + std::to_string(numTransforms) + ")"));
+        }
+    }
+    const float m = options.displacementWeightExponent;
+
+#pragma omp parallel for schedule(static)
+    for (int64_t u = 0; u < static_cast<int64_t>(n); ++u) {
+        const glm::vec3 p = points[u];
+        // Eq. (3) with the weighted sum taken over displacements (matrix addition, §3.3), in double so
+        // the result does not depend on how many entries a point has.
+        glm::dvec3 displacement(0.0);
+        double weightSum = 0.0;
+        for (int32_t e = fields.offsets[u]; e < fields.offsets[u + 1]; ++e) {
+            const glm::vec3 d = applyScaled(transforms, fields.transform[e], fields.strength[e], p) - p;
+            double w = fields.weight[e];
+            if (m != 0.0f) w *= std::pow(static_cast<double>(glm::length(d)), static_cast<double>(m));
+            displacement += w * glm::dvec3(d);
+            weightSum += w;
+        }
+        // All-zero weights: the identity (paper footnote 6).
+        out[u] = weightSum > 0.0 ? p + glm::vec3(displacement / weightSum) : p;
+    }
+}
+
+void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, std::span<const float> weights,
+                   float envelope, std::span<glm::vec3> out) {
+    requireSize("deformed points", deformed.size(), in.size());
+    requireSize("output points", out.size(), in.size());
+    if (!weights.empty()) requireSize("painted weights", weights.size(), in.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t u = 0; u < static_cast<int64_t>(in.size()); ++u) {
+        const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+        out[u] = in[u] + k * (deformed[u] - in[u]);
+    }
+}
+
+void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
+    fields_.clear();
+    warp_.bind(restPoints, fields_);
+    if (fields_.numPoints() != static_cast<int32_t>(restPoints.size())) {
+        throw InvalidInput(formatError("warp", "bind", "produced fields for " + std::to_string(fields_.numPoints()) +
+                                                           " points",
+                                       std::to_string(restPoints.size()) + " points, one entry list per point"));
+    }
+    deformed_.resize(restPoints.size());
+    bound_ = true;
+}
+
+void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
+    if (!bound_) {
+        throw InvalidInput(formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
+    }
+    requireSize("points", points.size(), deformed_.size());
+    warp_.transformations(transforms_);
+    evaluateWarp(points, fields_, transforms_, deformed_, warp_.engineOptions());
+    applyEnvelope(points, deformed_, weights, envelope, points);
+}
+
+}  // namespace deformkit::warp
