@@ -1,0 +1,135 @@
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include "deformkit/warp/engine.h"
+
+namespace deformkit::warp {
+
+// Free-form deformation (paper §4.1, Sederberg and Parry 1986): point features on a uniform lattice in a
+// parallelepiped, strength 1, transformations T_ijk = P*_ijk - P_ijk, weighting fields the trivariate
+// Bernstein polynomials of the point's local coordinates. Also the local B-spline variant (§4.1, after
+// Greissmair and Purgathofer 1989). Decisions: docs/warps/ffd_decisions.md.
+
+enum class FfdBasis {
+    Bernstein,  // B^l_i(s) B^m_j(t) B^n_k(u): every control reaches every point inside the lattice
+    BSpline,    // uniform cubic B-spline with linearly extrapolated end controls: a point pays for 4x4x4
+};
+
+enum class FfdOutside {
+    None,         // points outside the lattice are left where they are (Maya's default)
+    Extrapolate,  // the polynomial (Bernstein) or end-span polynomial (B-spline) is evaluated beyond [0, 1]
+};
+
+// The source lattice. Control point P_ijk = origin + i/l X + j/m Y + k/n Z for 0 <= i <= l, 0 <= j <= m,
+// 0 <= k <= n, stored at index (i (m + 1) + j) (n + 1) + k: a C-order (l+1, m+1, n+1) array.
+struct Lattice {
+    glm::vec3 origin{0.0f};  // corner of the parallelepiped, scene units
+    glm::mat3 axes{1.0f};    // columns X, Y, Z: the parallelepiped's edge vectors, need not be orthogonal
+    glm::ivec3 divisions{1, 1, 1};  // l, m, n: cells along X, Y, Z, each in [1, kMaxFfdDivisions]
+
+    [[nodiscard]] int32_t numControls() const {
+        return (divisions.x + 1) * (divisions.y + 1) * (divisions.z + 1);
+    }
+    [[nodiscard]] int32_t index(int32_t i, int32_t j, int32_t k) const {
+        return (i * (divisions.y + 1) + j) * (divisions.z + 1) + k;
+    }
+    [[nodiscard]] glm::vec3 controlPoint(int32_t i, int32_t j, int32_t k) const;
+    // All P_ijk in index order.
+    [[nodiscard]] std::vector<glm::vec3> controlPoints() const;
+};
+
+// Divisions per axis are limited so that a lattice stays a deformer, not a volume grid; the Bernstein
+// basis (global support, degree = divisions) is limited further, beyond which the B-spline basis is the tool.
+inline constexpr int32_t kMaxFfdDivisions = 1024;
+inline constexpr int32_t kMaxBernsteinDegree = 64;
+
+struct FfdOptions {
+    FfdBasis basis = FfdBasis::Bernstein;
+    FfdOutside outside = FfdOutside::None;
+};
+
+// The lattice geometry, its weighting fields and the bind cache (each point's local coordinates), shared
+// by Ffd and FfdFrames. Throws InvalidInput naming the element on a bad lattice: divisions < 1 or too
+// large, non-finite origin or axes, a zero-length axis or coplanar axes.
+class FfdLattice {
+  public:
+    explicit FfdLattice(const Lattice& lattice, const FfdOptions& options = {});
+
+    [[nodiscard]] const Lattice& lattice() const { return lattice_; }
+    [[nodiscard]] const FfdOptions& options() const { return options_; }
+    [[nodiscard]] int32_t numControls() const { return lattice_.numControls(); }
+
+    // (s, t, u): the point's coordinates in the frame (origin; X, Y, Z), found by solving the 3x3 system
+    // axes (s, t, u) = p - origin; the lattice is [0, 1]^3.
+    [[nodiscard]] glm::vec3 localCoordinates(const glm::vec3& p) const;
+
+    // Caches each rest point's local coordinates (the only per-point bind data). Throws on a non-finite
+    // point.
+    void bind(std::span<const glm::vec3> restPoints);
+    [[nodiscard]] bool isBound() const { return bound_; }
+    [[nodiscard]] int32_t numBoundPoints() const { return static_cast<int32_t>(local_.size()); }
+
+    // Weighting fields from the cache, non-zero weights only, strength 1. With FfdOutside::None a point
+    // outside the lattice gets no entries (the engine's identity); with Extrapolate weights may be negative
+    // but still sum to 1, so Eq. (3)'s normalisation leaves them as they are.
+    void fields(SparseFields& out) const;
+
+    // Separable weights of one point along one axis: writes count weights for controls first..first+count-1
+    // into w (room for kMaxBernsteinDegree + 1) and returns count. x is the local coordinate times divisions.
+    int32_t axisWeights(int32_t axis, float x, int32_t& first, float* w) const;
+
+    // Fast path of Eq. (3) for the bind cache: points[u] += envelope * weight[u] * D_u(points[u]) with
+    // D_u(p) = sum_c w_c(rest_u) (T_c<p> - p). deltas holds one record per control: 3 floats (a translation)
+    // when stride is 3, or 12 floats (the 3x4 matrix T_c - I, column-major: three linear columns, then the
+    // translation) when stride is 12. OpenMP over points; allocates nothing; bit-identical for any thread
+    // count.
+    void deform(std::span<glm::vec3> points, std::span<const float> deltas, int32_t stride,
+                std::span<const float> weights, float envelope) const;
+
+  private:
+    Lattice lattice_;
+    FfdOptions options_;
+    glm::dmat3 toLocal_{1.0};         // inverse of the axes
+    std::vector<float> binomial_[3];  // Bernstein coefficients C(d, i) per axis
+    std::vector<glm::vec3> local_;    // per bound point: (s l, t m, u n), lattice units
+    std::vector<uint8_t> active_;     // per bound point: 1 if the warp reaches it
+    bool bound_ = false;
+};
+
+// Plain FFD as a Warp for the generic engine (bind() builds the sparse fields, transformations() the
+// translations), plus a fast bind/evaluate path that skips the fields and equals the engine to 1e-5.
+// Moving controls (setTargets) never redoes bind work.
+class Ffd : public Warp {
+  public:
+    // Targets start equal to the source lattice (the identity).
+    explicit Ffd(const Lattice& lattice, const FfdOptions& options = {});
+
+    [[nodiscard]] const FfdLattice& lattice() const { return lattice_; }
+    [[nodiscard]] std::span<const glm::vec3> sourcePoints() const { return source_; }
+    [[nodiscard]] std::span<const glm::vec3> targets() const { return target_; }
+    // P*_ijk in index order, (l+1)(m+1)(n+1) of them. Throws on a wrong count or a non-finite target.
+    void setTargets(std::span<const glm::vec3> targets);
+
+    // Warp (generic engine): caches local coordinates and writes the fields.
+    void bind(std::span<const glm::vec3> restPoints, SparseFields& fields) override;
+    void transformations(Transformations& out) const override;
+
+    // Fast path: bind caches local coordinates only; evaluate deforms points (the bound rest points or the
+    // upstream points of the same count) in place; painted weights (#points, or empty for 1) and the
+    // envelope scale the displacement as in WarpDeformer.
+    void bind(std::span<const glm::vec3> restPoints) { lattice_.bind(restPoints); }
+    void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
+                  float envelope = 1.0f) const;
+
+  private:
+    FfdLattice lattice_;
+    std::vector<glm::vec3> source_, target_, translation_;
+};
+
+}  // namespace deformkit::warp

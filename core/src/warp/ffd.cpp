@@ -1,0 +1,401 @@
+#include "deformkit/warp/ffd.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::warp {
+namespace {
+
+constexpr const char* kAxisNames[3] = {"X", "Y", "Z"};
+constexpr const char* kDivisionNames[3] = {"divisions[0] (l)", "divisions[1] (m)", "divisions[2] (n)"};
+// Points this far outside [0, 1] in local coordinates (round-off on the lattice faces) still count as
+// inside; they are evaluated with their unclamped coordinates, so nothing is clamped.
+constexpr double kInsideTolerance = 1e-5;
+constexpr int64_t kMaxControls = int64_t{1} << 24;
+
+bool finite(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+std::string vecText(const glm::vec3& v) {
+    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+}
+
+void validate(const Lattice& lattice, const FfdOptions& options) {
+    const char* source = "FFD lattice";
+    const int32_t maxDiv = options.basis == FfdBasis::Bernstein ? kMaxBernsteinDegree : kMaxFfdDivisions;
+    for (int a = 0; a < 3; ++a) {
+        const int32_t d = lattice.divisions[a];
+        if (d < 1 || d > maxDiv) {
+            throw InvalidInput(formatError(
+                source, kDivisionNames[a], "is " + std::to_string(d),
+                "an integer in [1, " + std::to_string(maxDiv) + "]" +
+                    (options.basis == FfdBasis::Bernstein && d > maxDiv ? "; use the B-spline basis for more"
+                                                                        : "")));
+        }
+    }
+    int64_t controls = 1;
+    for (int a = 0; a < 3; ++a)
+        controls *= lattice.divisions[a] + 1;
+    if (controls > kMaxControls) {
+        throw InvalidInput(formatError(source, "divisions",
+                                       "give " + std::to_string(controls) + " control points",
+                                       "at most " + std::to_string(kMaxControls)));
+    }
+    if (!finite(lattice.origin)) {
+        throw InvalidInput(
+            formatError(source, "origin", "is not finite: " + vecText(lattice.origin), "finite"));
+    }
+    double lengths = 1.0;
+    for (int a = 0; a < 3; ++a) {
+        const glm::vec3 axis = lattice.axes[a];
+        const std::string element = std::string("axis ") + kAxisNames[a];
+        if (!finite(axis))
+            throw InvalidInput(formatError(source, element, "is not finite: " + vecText(axis), "finite"));
+        const double len = glm::length(glm::dvec3(axis));
+        if (len == 0.0) {
+            throw InvalidInput(formatError(source, element, "has zero length", "a non-zero edge vector"));
+        }
+        lengths *= len;
+    }
+    const double det = glm::determinant(glm::dmat3(lattice.axes));
+    if (std::abs(det) <= 1e-6 * lengths) {
+        throw InvalidInput(formatError(source, "axes X, Y, Z", "are coplanar (zero volume)",
+                                       "three linearly independent edge vectors"));
+    }
+}
+
+// Uniform cubic B-spline basis on one span, u in [0, 1] (beyond it when extrapolating).
+void cubicBSpline(float u, float* b) {
+    const float u2 = u * u, u3 = u2 * u, v = 1.0f - u;
+    b[0] = v * v * v / 6.0f;
+    b[1] = (3.0f * u3 - 6.0f * u2 + 4.0f) / 6.0f;
+    b[2] = (-3.0f * u3 + 3.0f * u2 + 3.0f * u + 1.0f) / 6.0f;
+    b[3] = u3 / 6.0f;
+}
+
+// The hot loop for a 4x4x4 window of controls (B-spline, or Bernstein of degree 3): for each (i, j) the
+// window's run of 4 controls is contiguous (4 Stride floats), so the sum over (i, j) is a fixed-width
+// vector accumulation and the k weights are applied once at the end. Fixed order: deterministic.
+// GCC/Clang vector extension: four floats in one SSE register; loads and stores through memcpy (unaligned).
+typedef float Float4 __attribute__((vector_size(16)));
+
+inline Float4 load4(const float* p) {
+    Float4 v;
+    std::memcpy(&v, p, sizeof(v));
+    return v;
+}
+
+template <int Stride>
+void windowSum(const float* data, int32_t ny, int32_t nz, const int32_t* first, const float (*w)[4],
+               float* out) {
+    constexpr int kVectors = Stride;  // 4 controls x Stride floats = Stride vectors of 4
+    Float4 acc[kVectors] = {};
+    for (int32_t a = 0; a < 4; ++a) {
+        for (int32_t b = 0; b < 4; ++b) {
+            const float wab = w[0][a] * w[1][b];
+            const float* row =
+                data + static_cast<size_t>(((first[0] + a) * ny + first[1] + b) * nz + first[2]) * Stride;
+            for (int v = 0; v < kVectors; ++v)
+                acc[v] += wab * load4(row + 4 * v);
+        }
+    }
+    float sum[4 * Stride];
+    std::memcpy(sum, acc, sizeof(sum));
+    for (int e = 0; e < Stride; ++e) {
+        out[e] = w[2][0] * sum[e] + w[2][1] * sum[Stride + e] + w[2][2] * sum[2 * Stride + e] +
+                 w[2][3] * sum[3 * Stride + e];
+    }
+}
+
+// Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
+inline int32_t basisWeights(FfdBasis basis, int32_t d, const float* binomial, float x, int32_t& first,
+                            float* w) {
+    if (basis == FfdBasis::Bernstein && d == 3) {
+        // The common cubic in closed form.
+        const float s = x / 3.0f, r = 1.0f - s;
+        w[0] = r * r * r;
+        w[1] = 3.0f * s * r * r;
+        w[2] = 3.0f * s * s * r;
+        w[3] = s * s * s;
+        first = 0;
+        return 4;
+    }
+    if (basis == FfdBasis::Bernstein) {
+        // B^d_i(s) = C(d, i) s^i (1 - s)^(d - i), s = x / d (Sederberg and Parry's convention: i = 0 at s =
+        // 0).
+        const float s = x / static_cast<float>(d), r = 1.0f - s;
+        float power = 1.0f;
+        for (int32_t i = 0; i <= d; ++i) {
+            w[i] = binomial[i] * power;
+            power *= s;
+        }
+        power = 1.0f;
+        for (int32_t i = d; i >= 0; --i) {
+            w[i] *= power;
+            power *= r;
+        }
+        first = 0;
+        return d + 1;
+    }
+    // Uniform cubic B-spline on span [span, span + 1] touching controls span - 1 .. span + 2. The missing
+    // controls -1 and d + 1 beyond the ends are linear extrapolations (T_-1 = 2 T_0 - T_1), folded into
+    // the weights here: partition of unity, linear precision and interpolation of the end faces.
+    const int32_t span = std::clamp(static_cast<int32_t>(std::floor(x)), 0, d - 1);
+    float b[4];
+    cubicBSpline(x - static_cast<float>(span), b);
+    if (span == 0) {
+        b[1] += 2.0f * b[0];
+        b[2] -= b[0];
+        b[0] = 0.0f;
+    }
+    if (span + 2 > d) {
+        b[2] += 2.0f * b[3];
+        b[1] -= b[3];
+        b[3] = 0.0f;
+    }
+    const int32_t lo = span - 1;
+    first = std::max(lo, 0);
+    const int32_t last = std::min(span + 2, d);
+    for (int32_t i = first; i <= last; ++i)
+        w[i - first] = b[i - lo];
+    return last - first + 1;
+}
+
+}  // namespace
+
+glm::vec3 Lattice::controlPoint(int32_t i, int32_t j, int32_t k) const {
+    // In double so that the corner P_lmn lands on origin + X + Y + Z up to one rounding.
+    const glm::dvec3 st(static_cast<double>(i) / divisions.x, static_cast<double>(j) / divisions.y,
+                        static_cast<double>(k) / divisions.z);
+    return glm::vec3(glm::dvec3(origin) + glm::dmat3(axes) * st);
+}
+
+std::vector<glm::vec3> Lattice::controlPoints() const {
+    std::vector<glm::vec3> out(static_cast<size_t>(numControls()));
+    for (int32_t i = 0; i <= divisions.x; ++i)
+        for (int32_t j = 0; j <= divisions.y; ++j)
+            for (int32_t k = 0; k <= divisions.z; ++k)
+                out[index(i, j, k)] = controlPoint(i, j, k);
+    return out;
+}
+
+FfdLattice::FfdLattice(const Lattice& lattice, const FfdOptions& options)
+    : lattice_(lattice), options_(options) {
+    validate(lattice, options);
+    toLocal_ = glm::inverse(glm::dmat3(lattice.axes));
+    for (int a = 0; a < 3; ++a) {
+        const int32_t d = lattice.divisions[a];
+        binomial_[a].assign(static_cast<size_t>(d) + 1, 1.0f);
+        if (options.basis != FfdBasis::Bernstein) continue;
+        double c = 1.0;
+        for (int32_t i = 1; i <= d; ++i) {
+            c = c * (d - i + 1) / i;
+            binomial_[a][i] = static_cast<float>(c);
+        }
+    }
+}
+
+glm::vec3 FfdLattice::localCoordinates(const glm::vec3& p) const {
+    return glm::vec3(toLocal_ * (glm::dvec3(p) - glm::dvec3(lattice_.origin)));
+}
+
+void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
+    // Validate first: a rejected bind leaves the previous one in place.
+    const int64_t n = static_cast<int64_t>(restPoints.size());
+    for (int64_t u = 0; u < n; ++u) {
+        if (!finite(restPoints[u])) {
+            throw InvalidInput(formatError("FFD bind", "point " + std::to_string(u),
+                                           "is not finite: " + vecText(restPoints[u]), "finite positions"));
+        }
+    }
+    local_.resize(static_cast<size_t>(n));
+    active_.resize(static_cast<size_t>(n));
+    const glm::dvec3 scale(lattice_.divisions);
+    const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
+    // Dynamic chunks: a thread the host deschedules does not hold up the others. Each point is written
+    // by one thread from its own inputs only, so the output does not depend on the schedule.
+#pragma omp parallel for schedule(dynamic, 4096)
+    for (int64_t u = 0; u < n; ++u) {
+        const glm::dvec3 s = toLocal_ * (glm::dvec3(restPoints[u]) - glm::dvec3(lattice_.origin));
+        bool inside = true;
+        for (int a = 0; a < 3; ++a)
+            inside = inside && s[a] >= -kInsideTolerance && s[a] <= 1.0 + kInsideTolerance;
+        local_[u] = glm::vec3(s * scale);
+        active_[u] = (inside || extrapolate) ? 1 : 0;
+    }
+    bound_ = true;
+}
+
+int32_t FfdLattice::axisWeights(int32_t axis, float x, int32_t& first, float* w) const {
+    return basisWeights(options_.basis, lattice_.divisions[axis], binomial_[axis].data(), x, first, w);
+}
+
+void FfdLattice::fields(SparseFields& out) const {
+    out.clear();
+    const int32_t n = numBoundPoints();
+    const int32_t ny = lattice_.divisions.y + 1, nz = lattice_.divisions.z + 1;
+    float w[3][kMaxBernsteinDegree + 1];
+    int32_t first[3], count[3];
+    for (int32_t u = 0; u < n; ++u) {
+        if (active_[u]) {
+            for (int a = 0; a < 3; ++a)
+                count[a] = axisWeights(a, local_[u][a], first[a], w[a]);
+            for (int32_t a = 0; a < count[0]; ++a) {
+                for (int32_t b = 0; b < count[1]; ++b) {
+                    const float wab = w[0][a] * w[1][b];
+                    const int32_t row = ((first[0] + a) * ny + first[1] + b) * nz + first[2];
+                    for (int32_t c = 0; c < count[2]; ++c) {
+                        const float wabc = wab * w[2][c];
+                        if (wabc != 0.0f) out.add(row + c, 1.0f, wabc);
+                    }
+                }
+            }
+        }
+        out.endPoint();
+    }
+}
+
+void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> deltas, int32_t stride,
+                        std::span<const float> weights, float envelope) const {
+    if (!bound_) {
+        throw InvalidInput(formatError("FFD", "evaluate", "called before bind", "bind(restPoints) first"));
+    }
+    const int64_t n = numBoundPoints();
+    if (static_cast<int64_t>(points.size()) != n) {
+        throw InvalidInput(formatError("FFD evaluate", "points",
+                                       "has " + std::to_string(points.size()) + " points",
+                                       std::to_string(n) + " points, as bound"));
+    }
+    if (!weights.empty() && static_cast<int64_t>(weights.size()) != n) {
+        throw InvalidInput(formatError("FFD evaluate", "painted weights",
+                                       "has " + std::to_string(weights.size()) + " entries",
+                                       std::to_string(n) + " entries, one per point, or none"));
+    }
+    if ((stride != 3 && stride != 12) || deltas.size() != static_cast<size_t>(numControls()) * stride) {
+        throw InvalidInput(formatError("FFD evaluate", "control transformations",
+                                       "has " + std::to_string(deltas.size()) + " floats",
+                                       "3 or 12 per control point"));
+    }
+    const glm::ivec3 div = lattice_.divisions;
+    const int32_t ny = div.y + 1, nz = div.z + 1;
+    const float* data = deltas.data();
+    // Every point's weights fit a 4x4x4 window of controls: B-spline with >= 3 divisions per axis, or the
+    // Bernstein cubic (the benchmark's 4x4x4 lattice).
+    const bool window = options_.basis == FfdBasis::BSpline ? (div.x >= 3 && div.y >= 3 && div.z >= 3)
+                                                            : (div.x == 3 && div.y == 3 && div.z == 3);
+
+#pragma omp parallel for schedule(dynamic, 4096)
+    for (int64_t u = 0; u < n; ++u) {
+        if (!active_[u]) continue;
+        const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+        float w[3][kMaxBernsteinDegree + 1];
+        int32_t first[3], count[3];
+        for (int a = 0; a < 3; ++a) {
+            count[a] =
+                basisWeights(options_.basis, div[a], binomial_[a].data(), local_[u][a], first[a], w[a]);
+        }
+        float acc[12] = {};
+        if (window) {
+            float w4[3][4];
+            int32_t start[3];
+            for (int a = 0; a < 3; ++a) {
+                start[a] = std::min(first[a], div[a] - 3);
+                for (int c = 0; c < 4; ++c) {
+                    const int32_t i = start[a] + c - first[a];
+                    w4[a][c] = (i >= 0 && i < count[a]) ? w[a][i] : 0.0f;
+                }
+            }
+            if (stride == 3) {
+                windowSum<3>(data, ny, nz, start, w4, acc);
+            } else {
+                windowSum<12>(data, ny, nz, start, w4, acc);
+            }
+        } else {
+            // Separable: sum_i w_i sum_j w_j sum_k w_k delta_ijk, the innermost run contiguous in memory.
+            for (int32_t a = 0; a < count[0]; ++a) {
+                for (int32_t b = 0; b < count[1]; ++b) {
+                    const float wab = w[0][a] * w[1][b];
+                    const float* row =
+                        data +
+                        static_cast<size_t>(((first[0] + a) * ny + first[1] + b) * nz + first[2]) * stride;
+                    float s[12] = {};
+                    for (int32_t c = 0; c < count[2]; ++c) {
+                        for (int e = 0; e < stride; ++e)
+                            s[e] += w[2][c] * row[stride * c + e];
+                    }
+                    for (int e = 0; e < stride; ++e)
+                        acc[e] += wab * s[e];
+                }
+            }
+        }
+        const glm::vec3 p = points[u];
+        glm::vec3 d;
+        if (stride == 3) {
+            d = {acc[0], acc[1], acc[2]};
+        } else {
+            d = glm::vec3(acc[0], acc[1], acc[2]) * p.x + glm::vec3(acc[3], acc[4], acc[5]) * p.y +
+                glm::vec3(acc[6], acc[7], acc[8]) * p.z + glm::vec3(acc[9], acc[10], acc[11]);
+        }
+        points[u] = p + k * d;
+    }
+}
+
+Ffd::Ffd(const Lattice& lattice, const FfdOptions& options)
+    : lattice_(lattice, options),
+      source_(lattice.controlPoints()),
+      target_(source_),
+      translation_(source_.size(), glm::vec3(0.0f)) {}
+
+void Ffd::setTargets(std::span<const glm::vec3> targets) {
+    const Lattice& l = lattice_.lattice();
+    if (targets.size() != source_.size()) {
+        throw InvalidInput(formatError("FFD", "targets", "has " + std::to_string(targets.size()) + " points",
+                                       "(l+1)(m+1)(n+1) = " + std::to_string(source_.size()) +
+                                           " points for divisions (" + std::to_string(l.divisions.x) + ", " +
+                                           std::to_string(l.divisions.y) + ", " +
+                                           std::to_string(l.divisions.z) + ")"));
+    }
+    const int32_t ny = l.divisions.y + 1, nz = l.divisions.z + 1;
+    for (size_t c = 0; c < targets.size(); ++c) {
+        if (!finite(targets[c])) {
+            const int32_t ci = static_cast<int32_t>(c);
+            throw InvalidInput(formatError(
+                "FFD",
+                "target " + std::to_string(c) + " (i=" + std::to_string(ci / (ny * nz)) +
+                    ", j=" + std::to_string(ci / nz % ny) + ", k=" + std::to_string(ci % nz) + ")",
+                "is not finite: " + vecText(targets[c]), "finite positions"));
+        }
+    }
+    std::copy(targets.begin(), targets.end(), target_.begin());
+    // T_ijk = P*_ijk - P_ijk (§4.1).
+    for (size_t c = 0; c < targets.size(); ++c)
+        translation_[c] = target_[c] - source_[c];
+}
+
+void Ffd::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
+    lattice_.bind(restPoints);
+    lattice_.fields(fields);
+}
+
+void Ffd::transformations(Transformations& out) const {
+    out.method = ScaleMethod::Displacement;  // translations: both methods agree (§4.1)
+    out.components.clear();
+    out.affine.resize(translation_.size());
+    for (size_t c = 0; c < translation_.size(); ++c)
+        out.affine[c] = Affine::translate(translation_[c]);
+}
+
+void Ffd::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) const {
+    lattice_.deform(points, {reinterpret_cast<const float*>(translation_.data()), translation_.size() * 3}, 3,
+                    weights, envelope);
+}
+
+}  // namespace deformkit::warp

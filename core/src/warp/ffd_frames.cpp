@@ -1,0 +1,126 @@
+#include "deformkit/warp/ffd_frames.h"
+
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::warp {
+namespace {
+
+bool finite(const Frame& f) {
+    for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(f.origin[a])) return false;
+        for (int b = 0; b < 3; ++b) {
+            if (!std::isfinite(f.basis[a][b])) return false;
+        }
+    }
+    return true;
+}
+
+std::string controlName(const Lattice& l, size_t c) {
+    const int32_t ny = l.divisions.y + 1, nz = l.divisions.z + 1, ci = static_cast<int32_t>(c);
+    return "control " + std::to_string(c) + " (i=" + std::to_string(ci / (ny * nz)) +
+           ", j=" + std::to_string(ci / nz % ny) + ", k=" + std::to_string(ci % nz) + ")";
+}
+
+}  // namespace
+
+Affine frameToFrame(const Frame& from, const Frame& to, const std::string& element) {
+    if (!finite(from) || !finite(to)) {
+        throw InvalidInput(
+            formatError("FFD frames", element, "is not finite", "finite origins and basis vectors"));
+    }
+    const glm::dmat3 b(from.basis);
+    double lengths = 1.0;
+    for (int a = 0; a < 3; ++a)
+        lengths *= glm::length(b[a]);
+    const double det = glm::determinant(b);
+    if (!(std::abs(det) > 1e-9 * lengths) || lengths == 0.0) {
+        throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
+                                       "three linearly independent basis vectors"));
+    }
+    const glm::dmat3 linear = glm::dmat3(to.basis) * glm::inverse(b);
+    const glm::dvec3 translation = glm::dvec3(to.origin) - linear * glm::dvec3(from.origin);
+    return {glm::mat3(linear), glm::vec3(translation)};
+}
+
+FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : lattice_(lattice, options) {
+    const std::vector<glm::vec3> points = lattice.controlPoints();
+    source_.resize(points.size());
+    for (size_t c = 0; c < points.size(); ++c)
+        source_[c].origin = points[c];
+    target_ = source_;
+    transform_.resize(points.size());
+    delta_.resize(points.size() * 12);
+    update();
+}
+
+void FfdFrames::checkCount(std::span<const Frame> frames, const char* what) const {
+    if (frames.size() != source_.size()) {
+        const glm::ivec3 d = lattice_.lattice().divisions;
+        throw InvalidInput(formatError("FFD frames", what, "has " + std::to_string(frames.size()) + " frames",
+                                       "(l+1)(m+1)(n+1) = " + std::to_string(source_.size()) +
+                                           " frames for divisions (" + std::to_string(d.x) + ", " +
+                                           std::to_string(d.y) + ", " + std::to_string(d.z) + ")"));
+    }
+}
+
+void FfdFrames::setSourceFrames(std::span<const Frame> frames) {
+    checkCount(frames, "source frames");
+    // Validate all before changing anything.
+    for (size_t c = 0; c < frames.size(); ++c) {
+        (void)frameToFrame(frames[c], target_[c], "source frame of " + controlName(lattice_.lattice(), c));
+    }
+    source_.assign(frames.begin(), frames.end());
+    update();
+}
+
+void FfdFrames::setTargetFrames(std::span<const Frame> frames) {
+    checkCount(frames, "target frames");
+    for (size_t c = 0; c < frames.size(); ++c) {
+        if (!finite(frames[c])) {
+            throw InvalidInput(formatError("FFD frames",
+                                           "target frame of " + controlName(lattice_.lattice(), c),
+                                           "is not finite", "finite origins and basis vectors"));
+        }
+    }
+    target_.assign(frames.begin(), frames.end());
+    update();
+}
+
+void FfdFrames::update() {
+    for (size_t c = 0; c < source_.size(); ++c) {
+        const Affine t = frameToFrame(source_[c], target_[c], controlName(lattice_.lattice(), c));
+        transform_[c] = t;
+        float* d = &delta_[c * 12];
+        for (int col = 0; col < 3; ++col) {
+            for (int row = 0; row < 3; ++row)
+                d[col * 3 + row] = t.linear[col][row] - (col == row ? 1.0f : 0.0f);
+        }
+        d[9] = t.translation.x;
+        d[10] = t.translation.y;
+        d[11] = t.translation.z;
+    }
+}
+
+void FfdFrames::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
+    lattice_.bind(restPoints);
+    lattice_.fields(fields);
+}
+
+void FfdFrames::transformations(Transformations& out) const {
+    out.method =
+        ScaleMethod::Displacement;  // strength 1 everywhere; the weighted sum is of displacements (§3.3)
+    out.components.clear();
+    out.affine.assign(transform_.begin(), transform_.end());
+}
+
+void FfdFrames::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) const {
+    lattice_.deform(points, delta_, 12, weights, envelope);
+}
+
+}  // namespace deformkit::warp

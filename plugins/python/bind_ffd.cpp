@@ -1,0 +1,348 @@
+// Python bindings of free-form deformation (core/include/deformkit/warp/ffd.h) and FFD with coordinate
+// frames (ffd_frames.h): one-off functions ffd / ffd_frames and Ffd / FfdFrames classes that bind once and
+// evaluate many times. numpy float32 in and out. Lattice axes and frame bases are given as rows:
+// axes[0] = X, axes[1] = Y, axes[2] = Z; bases[..., a, :] = basis vector a.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/warp/ffd.h"
+#include "deformkit/warp/ffd_frames.h"
+
+namespace py = pybind11;
+
+namespace deformkit::python {
+namespace {
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+using warp::Ffd;
+using warp::FfdFrames;
+using warp::Frame;
+using warp::Lattice;
+
+std::string shapeOf(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i)
+        s += (i ? ", " : "") + std::to_string(a.shape(i));
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::vector<glm::vec3> pointsOf(const FloatArray& a, const char* source, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != 3) {
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
+    }
+    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
+    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+    return out;
+}
+
+Lattice latticeOf(const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
+                  const char* source) {
+    if (origin.ndim() != 1 || origin.shape(0) != 3) {
+        throw InvalidInput(formatError(source, "origin", "has shape " + shapeOf(origin), "(3,)"));
+    }
+    if (axes.ndim() != 2 || axes.shape(0) != 3 || axes.shape(1) != 3) {
+        throw InvalidInput(
+            formatError(source, "axes", "has shape " + shapeOf(axes), "(3, 3), one axis X, Y, Z per row"));
+    }
+    if (divisions.ndim() != 1 || divisions.shape(0) != 3) {
+        throw InvalidInput(
+            formatError(source, "divisions", "has shape " + shapeOf(divisions), "(3,) integers l, m, n"));
+    }
+    Lattice l;
+    l.origin = {origin.data()[0], origin.data()[1], origin.data()[2]};
+    for (int a = 0; a < 3; ++a) {
+        l.axes[a] = {axes.data()[3 * a], axes.data()[3 * a + 1], axes.data()[3 * a + 2]};
+        l.divisions[a] = divisions.data()[a];
+    }
+    return l;
+}
+
+warp::FfdOptions optionsOf(const std::string& basis, const std::string& outside, const char* source) {
+    warp::FfdOptions o;
+    if (basis == "bernstein") {
+        o.basis = warp::FfdBasis::Bernstein;
+    } else if (basis == "bspline") {
+        o.basis = warp::FfdBasis::BSpline;
+    } else {
+        throw InvalidInput(
+            formatError(source, "basis", "'" + basis + "' is not a basis", "bernstein or bspline"));
+    }
+    if (outside == "none") {
+        o.outside = warp::FfdOutside::None;
+    } else if (outside == "extrapolate") {
+        o.outside = warp::FfdOutside::Extrapolate;
+    } else {
+        throw InvalidInput(
+            formatError(source, "outside", "'" + outside + "' is not an option", "none or extrapolate"));
+    }
+    return o;
+}
+
+// A (l+1, m+1, n+1, trailing...) array in the lattice's index order, checked against the divisions.
+void checkLatticeShape(const FloatArray& a, const Lattice& l, std::vector<py::ssize_t> trailing,
+                       const char* source, const char* name) {
+    std::vector<py::ssize_t> expected{l.divisions.x + 1, l.divisions.y + 1, l.divisions.z + 1};
+    expected.insert(expected.end(), trailing.begin(), trailing.end());
+    bool ok = a.ndim() == static_cast<py::ssize_t>(expected.size());
+    for (size_t i = 0; ok && i < expected.size(); ++i)
+        ok = a.shape(static_cast<py::ssize_t>(i)) == expected[i];
+    if (!ok) {
+        std::string e = "(";
+        for (size_t i = 0; i < expected.size(); ++i)
+            e += (i ? ", " : "") + std::to_string(expected[i]);
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a),
+                                       e + ") for divisions (" + std::to_string(l.divisions.x) + ", " +
+                                           std::to_string(l.divisions.y) + ", " +
+                                           std::to_string(l.divisions.z) + ")"));
+    }
+}
+
+std::vector<glm::vec3> latticePointsOf(const FloatArray& a, const Lattice& l, const char* source,
+                                       const char* name) {
+    checkLatticeShape(a, l, {3}, source, name);
+    std::vector<glm::vec3> out(static_cast<size_t>(l.numControls()));
+    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+    return out;
+}
+
+// Bases (l+1, m+1, n+1, 3, 3), basis vectors as rows.
+std::vector<glm::mat3> basesOf(const FloatArray& bases, const Lattice& l, const char* source,
+                               const char* name) {
+    checkLatticeShape(bases, l, {3, 3}, source, name);
+    std::vector<glm::mat3> out(static_cast<size_t>(l.numControls()));
+    const float* b = bases.data();
+    for (size_t c = 0; c < out.size(); ++c) {
+        for (int a = 0; a < 3; ++a)
+            out[c][a] = {b[9 * c + 3 * a], b[9 * c + 3 * a + 1], b[9 * c + 3 * a + 2]};
+    }
+    return out;
+}
+
+std::vector<Frame> framesOf(const FloatArray& origins, const FloatArray& bases, const Lattice& l,
+                            const char* source, const char* originName, const char* basisName) {
+    const std::vector<glm::vec3> o = latticePointsOf(origins, l, source, originName);
+    const std::vector<glm::mat3> b = basesOf(bases, l, source, basisName);
+    std::vector<Frame> frames(o.size());
+    for (size_t c = 0; c < o.size(); ++c)
+        frames[c] = {o[c], b[c]};
+    return frames;
+}
+
+std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t count, const char* source) {
+    if (!weights) return {};
+    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != count) {
+        throw InvalidInput(formatError(source, "weights", "has shape " + shapeOf(*weights),
+                                       "(" + std::to_string(count) + ",), one per point"));
+    }
+    return std::vector<float>(weights->data(), weights->data() + count);
+}
+
+py::array_t<float> toArray(const std::vector<glm::vec3>& pts) {
+    py::array_t<float> out({static_cast<py::ssize_t>(pts.size()), static_cast<py::ssize_t>(3)});
+    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
+    return out;
+}
+
+py::array_t<float> latticeArray(std::span<const glm::vec3> pts, const Lattice& l) {
+    py::array_t<float> out({static_cast<py::ssize_t>(l.divisions.x + 1),
+                            static_cast<py::ssize_t>(l.divisions.y + 1),
+                            static_cast<py::ssize_t>(l.divisions.z + 1), static_cast<py::ssize_t>(3)});
+    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
+    return out;
+}
+
+// Binds `warp` to `points` and deforms a copy of them, without the GIL.
+template <class W>
+py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::optional<FloatArray>& weights,
+                              float envelope, const char* source) {
+    std::vector<glm::vec3> pts = pointsOf(points, source, "points");
+    const std::vector<float> w = weightsOf(weights, pts.size(), source);
+    {
+        py::gil_scoped_release release;
+        warp.bind(pts);
+        warp.evaluate(pts, w, envelope);
+    }
+    return toArray(pts);
+}
+
+// Evaluates a bound warp on `points` (the rest points when None).
+template <class W>
+py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& rest,
+                                 const std::optional<FloatArray>& points,
+                                 const std::optional<FloatArray>& weights, float envelope,
+                                 const char* source) {
+    std::vector<glm::vec3> pts = points ? pointsOf(*points, source, "points") : rest;
+    const std::vector<float> w = weightsOf(weights, pts.size(), source);
+    {
+        py::gil_scoped_release release;
+        warp.evaluate(pts, w, envelope);
+    }
+    return toArray(pts);
+}
+
+// The bound classes keep their rest points so evaluate() without points deforms the rest shape.
+struct PyFfd {
+    Ffd ffd;
+    std::vector<glm::vec3> rest;
+};
+
+struct PyFfdFrames {
+    FfdFrames frames;
+    std::vector<glm::vec3> rest;
+};
+
+}  // namespace
+
+void bindFfd(py::module_& m) {
+    m.def(
+        "ffd",
+        [](const FloatArray& points, const FloatArray& origin, const FloatArray& axes,
+           const IntArray& divisions, const FloatArray& target, const std::string& basis,
+           const std::string& outside, const std::optional<FloatArray>& weights, float envelope) {
+            const char* source = "ffd";
+            const Lattice l = latticeOf(origin, axes, divisions, source);
+            Ffd ffd(l, optionsOf(basis, outside, source));
+            ffd.setTargets(latticePointsOf(target, l, source, "target"));
+            return bindAndRun(ffd, points, weights, envelope, source);
+        },
+        py::arg("points"), py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("target"),
+        py::arg("basis") = "bernstein", py::arg("outside") = "none", py::arg("weights") = py::none(),
+        py::arg("envelope") = 1.0f,
+        "Free-form deformation (Sederberg-Parry; Milliron et al. 4.1). points (N, 3); origin (3,); axes (3, "
+        "3) with\n"
+        "rows X, Y, Z (edge vectors of the parallelepiped); divisions (3,) = l, m, n; target (l+1, m+1, n+1, "
+        "3)\n"
+        "moved control points; basis 'bernstein' or 'bspline'; outside 'none' (unchanged) or 'extrapolate';\n"
+        "weights (N,) painted, envelope scalar. Returns (N, 3) float32.");
+
+    m.def(
+        "ffd_frames",
+        [](const FloatArray& points, const FloatArray& origin, const FloatArray& axes,
+           const IntArray& divisions, const FloatArray& targetOrigins, const FloatArray& targetBases,
+           const std::optional<FloatArray>& sourceOrigins, const std::optional<FloatArray>& sourceBases,
+           const std::string& basis, const std::string& outside, const std::optional<FloatArray>& weights,
+           float envelope) {
+            const char* source = "ffd_frames";
+            const Lattice l = latticeOf(origin, axes, divisions, source);
+            FfdFrames frames(l, optionsOf(basis, outside, source));
+            if (sourceOrigins || sourceBases) {
+                std::vector<Frame> src(frames.sourceFrames().begin(), frames.sourceFrames().end());
+                if (sourceOrigins) {
+                    const auto o = latticePointsOf(*sourceOrigins, l, source, "source_origins");
+                    for (size_t c = 0; c < src.size(); ++c)
+                        src[c].origin = o[c];
+                }
+                if (sourceBases) {
+                    const auto b = basesOf(*sourceBases, l, source, "source_bases");
+                    for (size_t c = 0; c < src.size(); ++c)
+                        src[c].basis = b[c];
+                }
+                frames.setSourceFrames(src);
+            }
+            frames.setTargetFrames(
+                framesOf(targetOrigins, targetBases, l, source, "target_origins", "target_bases"));
+            return bindAndRun(frames, points, weights, envelope, source);
+        },
+        py::arg("points"), py::arg("origin"), py::arg("axes"), py::arg("divisions"),
+        py::arg("target_origins"), py::arg("target_bases"), py::arg("source_origins") = py::none(),
+        py::arg("source_bases") = py::none(), py::arg("basis") = "bernstein", py::arg("outside") = "none",
+        py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
+        "FFD with coordinate-frame features (Milliron et al. 5.1): each control carries a frame; the source "
+        "frame\n"
+        "(origin, basis) is mapped to the target frame. target_origins (l+1, m+1, n+1, 3); target_bases\n"
+        "(l+1, m+1, n+1, 3, 3) with basis vectors as rows; source_origins default to the lattice points, "
+        "source_bases\n"
+        "to the identity. Other arguments as ffd. Returns (N, 3) float32.");
+
+    py::class_<PyFfd>(m, "Ffd",
+                      "Free-form deformation bound once to rest points, evaluated for many target lattices.")
+        .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
+                         const std::string& basis, const std::string& outside) {
+                 const Lattice l = latticeOf(origin, axes, divisions, "Ffd");
+                 return PyFfd{Ffd(l, optionsOf(basis, outside, "Ffd")), {}};
+             }),
+             py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
+             py::arg("outside") = "none")
+        .def(
+            "bind",
+            [](PyFfd& self, const FloatArray& points) {
+                self.rest = pointsOf(points, "Ffd.bind", "points");
+                py::gil_scoped_release release;
+                self.ffd.bind(self.rest);
+            },
+            py::arg("points"), "Cache each rest point's lattice coordinates (N, 3).")
+        .def(
+            "set_target",
+            [](PyFfd& self, const FloatArray& target) {
+                self.ffd.setTargets(
+                    latticePointsOf(target, self.ffd.lattice().lattice(), "Ffd.set_target", "target"));
+            },
+            py::arg("target"), "Move the controls: target (l+1, m+1, n+1, 3). Does no bind work.")
+        .def_property_readonly(
+            "source_points",
+            [](const PyFfd& self) {
+                return latticeArray(self.ffd.sourcePoints(), self.ffd.lattice().lattice());
+            },
+            "(l+1, m+1, n+1, 3) undeformed control points P_ijk")
+        .def_property_readonly(
+            "target",
+            [](const PyFfd& self) { return latticeArray(self.ffd.targets(), self.ffd.lattice().lattice()); })
+        .def(
+            "evaluate",
+            [](const PyFfd& self, const std::optional<FloatArray>& points,
+               const std::optional<FloatArray>& weights, float envelope) {
+                return evaluateBound(self.ffd, self.rest, points, weights, envelope, "Ffd.evaluate");
+            },
+            py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
+            "Deform points (N, 3), the bound rest points when None; returns (N, 3) float32.");
+
+    py::class_<PyFfdFrames>(m, "FfdFrames",
+                            "FFD with coordinate-frame features, bound once, evaluated many times.")
+        .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
+                         const std::string& basis, const std::string& outside) {
+                 const Lattice l = latticeOf(origin, axes, divisions, "FfdFrames");
+                 return PyFfdFrames{FfdFrames(l, optionsOf(basis, outside, "FfdFrames")), {}};
+             }),
+             py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
+             py::arg("outside") = "none")
+        .def(
+            "bind",
+            [](PyFfdFrames& self, const FloatArray& points) {
+                self.rest = pointsOf(points, "FfdFrames.bind", "points");
+                py::gil_scoped_release release;
+                self.frames.bind(self.rest);
+            },
+            py::arg("points"))
+        .def(
+            "set_source_frames",
+            [](PyFfdFrames& self, const FloatArray& origins, const FloatArray& bases) {
+                self.frames.setSourceFrames(framesOf(origins, bases, self.frames.lattice().lattice(),
+                                                     "FfdFrames.set_source_frames", "origins", "bases"));
+            },
+            py::arg("origins"), py::arg("bases"))
+        .def(
+            "set_target_frames",
+            [](PyFfdFrames& self, const FloatArray& origins, const FloatArray& bases) {
+                self.frames.setTargetFrames(framesOf(origins, bases, self.frames.lattice().lattice(),
+                                                     "FfdFrames.set_target_frames", "origins", "bases"));
+            },
+            py::arg("origins"), py::arg("bases"),
+            "origins (l+1, m+1, n+1, 3), bases (l+1, m+1, n+1, 3, 3) rows.")
+        .def(
+            "evaluate",
+            [](const PyFfdFrames& self, const std::optional<FloatArray>& points,
+               const std::optional<FloatArray>& weights, float envelope) {
+                return evaluateBound(self.frames, self.rest, points, weights, envelope, "FfdFrames.evaluate");
+            },
+            py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f);
+}
+
+}  // namespace deformkit::python

@@ -1,0 +1,445 @@
+// FFD (paper §4.1) against references written here: a direct Bernstein sum with local coordinates by
+// Cramer's rule, and a Cox-de Boor B-spline over a lattice explicitly extended by phantom controls.
+#include <catch2/catch.hpp>
+
+#include <omp.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/warp/engine.h"
+#include "deformkit/warp/ffd.h"
+
+using namespace deformkit;
+using namespace deformkit::warp;
+
+namespace {
+
+// A skewed parallelepiped, not axis-aligned, not orthogonal.
+Lattice skewLattice(glm::ivec3 divisions) {
+    Lattice l;
+    l.origin = {-0.7f, 0.3f, 1.1f};
+    l.axes =
+        glm::mat3(glm::vec3(2.0f, 0.3f, -0.2f), glm::vec3(0.4f, 1.5f, 0.1f), glm::vec3(-0.3f, 0.2f, 1.8f));
+    l.divisions = divisions;
+    return l;
+}
+
+// Local coordinates by Cramer's rule, in double.
+glm::dvec3 cramer(const Lattice& l, const glm::vec3& p) {
+    const glm::dvec3 x(l.axes[0]), y(l.axes[1]), z(l.axes[2]), r = glm::dvec3(p) - glm::dvec3(l.origin);
+    const double det = glm::dot(x, glm::cross(y, z));
+    return {glm::dot(r, glm::cross(y, z)) / det, glm::dot(x, glm::cross(r, z)) / det,
+            glm::dot(x, glm::cross(y, r)) / det};
+}
+
+double choose(int n, int k) {
+    double c = 1.0;
+    for (int i = 0; i < k; ++i)
+        c = c * (n - i) / (i + 1);
+    return c;
+}
+
+double bernstein(int d, int i, double t) {
+    return choose(d, i) * std::pow(t, i) * std::pow(1.0 - t, d - i);
+}
+
+glm::dvec3 controlRef(const Lattice& l, int i, int j, int k) {
+    return glm::dvec3(l.origin) + glm::dvec3(l.axes[0]) * (double(i) / l.divisions.x) +
+           glm::dvec3(l.axes[1]) * (double(j) / l.divisions.y) +
+           glm::dvec3(l.axes[2]) * (double(k) / l.divisions.z);
+}
+
+// Sederberg-Parry: X_ffd = sum_ijk B_i(s) B_j(t) B_k(u) P*_ijk, written as p + sum B (P* - P).
+glm::vec3 bernsteinRef(const Lattice& l, const std::vector<glm::vec3>& target, const glm::vec3& p) {
+    const glm::dvec3 s = cramer(l, p);
+    const glm::ivec3 d = l.divisions;
+    glm::dvec3 out(p);
+    for (int i = 0; i <= d.x; ++i)
+        for (int j = 0; j <= d.y; ++j)
+            for (int k = 0; k <= d.z; ++k) {
+                const double w = bernstein(d.x, i, s.x) * bernstein(d.y, j, s.y) * bernstein(d.z, k, s.z);
+                out += w * (glm::dvec3(target[(i * (d.y + 1) + j) * (d.z + 1) + k]) - controlRef(l, i, j, k));
+            }
+    return glm::vec3(out);
+}
+
+// Cox-de Boor recursion on the integer knots.
+double coxDeBoor(int i, int p, double x) {
+    if (p == 0) return (x >= i && x < i + 1) ? 1.0 : 0.0;
+    return (x - i) / p * coxDeBoor(i, p - 1, x) + (i + p + 1 - x) / p * coxDeBoor(i + 1, p - 1, x);
+}
+
+// The displacement of control (a, b, c), extended beyond the lattice linearly: T_-1 = 2 T_0 - T_1.
+glm::dvec3 extendedDisplacement(const Lattice& l, const std::vector<glm::vec3>& target, int a, int b, int c) {
+    const glm::ivec3 d = l.divisions;
+    if (a < 0)
+        return 2.0 * extendedDisplacement(l, target, 0, b, c) - extendedDisplacement(l, target, 1, b, c);
+    if (a > d.x)
+        return 2.0 * extendedDisplacement(l, target, d.x, b, c) -
+               extendedDisplacement(l, target, d.x - 1, b, c);
+    if (b < 0)
+        return 2.0 * extendedDisplacement(l, target, a, 0, c) - extendedDisplacement(l, target, a, 1, c);
+    if (b > d.y)
+        return 2.0 * extendedDisplacement(l, target, a, d.y, c) -
+               extendedDisplacement(l, target, a, d.y - 1, c);
+    if (c < 0)
+        return 2.0 * extendedDisplacement(l, target, a, b, 0) - extendedDisplacement(l, target, a, b, 1);
+    if (c > d.z)
+        return 2.0 * extendedDisplacement(l, target, a, b, d.z) -
+               extendedDisplacement(l, target, a, b, d.z - 1);
+    return glm::dvec3(target[(a * (d.y + 1) + b) * (d.z + 1) + c]) - controlRef(l, a, b, c);
+}
+
+// Uniform cubic B-spline volume over the extended controls -1 .. d + 1; basis of control a: N_{a-2,3}.
+glm::vec3 bsplineRef(const Lattice& l, const std::vector<glm::vec3>& target, const glm::vec3& p) {
+    const glm::dvec3 x = cramer(l, p) * glm::dvec3(l.divisions);
+    const glm::ivec3 d = l.divisions;
+    glm::dvec3 out(p);
+    for (int a = -1; a <= d.x + 1; ++a)
+        for (int b = -1; b <= d.y + 1; ++b)
+            for (int c = -1; c <= d.z + 1; ++c) {
+                const double w =
+                    coxDeBoor(a - 2, 3, x.x) * coxDeBoor(b - 2, 3, x.y) * coxDeBoor(c - 2, 3, x.z);
+                if (w != 0.0) out += w * extendedDisplacement(l, target, a, b, c);
+            }
+    return glm::vec3(out);
+}
+
+std::vector<glm::vec3> randomTargets(const Lattice& l, std::mt19937& rng, float amount) {
+    std::uniform_real_distribution<float> uni(-amount, amount);
+    std::vector<glm::vec3> t = l.controlPoints();
+    for (auto& p : t)
+        p += glm::vec3(uni(rng), uni(rng), uni(rng));
+    return t;
+}
+
+// Points at local coordinates uniform in [lo, hi]^3.
+std::vector<glm::vec3> samplePoints(const Lattice& l, std::mt19937& rng, int count, float lo, float hi) {
+    std::uniform_real_distribution<float> uni(lo, hi);
+    std::vector<glm::vec3> pts(count);
+    for (auto& p : pts)
+        p = l.origin + l.axes * glm::vec3(uni(rng), uni(rng), uni(rng));
+    return pts;
+}
+
+std::vector<glm::vec3> viaEngine(Warp& warp, std::vector<glm::vec3> pts, std::span<const float> weights = {},
+                                 float envelope = 1.0f) {
+    WarpDeformer deformer(warp);
+    deformer.bind(pts);
+    deformer.evaluate(pts, weights, envelope);
+    return pts;
+}
+
+float maxError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+    float e = 0.0f;
+    for (size_t i = 0; i < a.size(); ++i)
+        e = std::max(e, glm::length(a[i] - b[i]));
+    return e;
+}
+
+bool outsideUnit(const glm::dvec3& s) {
+    for (int a = 0; a < 3; ++a)
+        if (s[a] < 0.0 || s[a] > 1.0) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST_CASE("ffd: Bernstein FFD equals a direct Bernstein sum", "[warp][ffd]") {
+    std::mt19937 rng(11);
+    for (glm::ivec3 div : {glm::ivec3(3, 3, 3), glm::ivec3(1, 2, 4), glm::ivec3(5, 1, 2)}) {
+        const Lattice l = skewLattice(div);
+        Ffd ffd(l);
+        const auto target = randomTargets(l, rng, 0.4f);
+        ffd.setTargets(target);
+        const auto pts = samplePoints(l, rng, 500, 0.0f, 1.0f);
+        std::vector<glm::vec3> ref(pts.size());
+        for (size_t i = 0; i < pts.size(); ++i)
+            ref[i] = bernsteinRef(l, target, pts[i]);
+        CHECK(maxError(viaEngine(ffd, pts), ref) < 1e-5f);
+        std::vector<glm::vec3> fast = pts;
+        ffd.bind(pts);
+        ffd.evaluate(fast);
+        CHECK(maxError(fast, ref) < 1e-5f);
+    }
+}
+
+TEST_CASE("ffd: identity when targets equal sources", "[warp][ffd]") {
+    std::mt19937 rng(12);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+        for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
+            const Lattice l = skewLattice({4, 3, 2});
+            Ffd ffd(l, {basis, outside});
+            ffd.setTargets(l.controlPoints());
+            const auto pts = samplePoints(l, rng, 400, -0.3f, 1.3f);
+            CHECK(maxError(viaEngine(ffd, pts), pts) < 1e-6f);
+            std::vector<glm::vec3> fast = pts;
+            ffd.bind(pts);
+            ffd.evaluate(fast);
+            CHECK(maxError(fast, pts) < 1e-6f);
+        }
+    }
+}
+
+TEST_CASE("ffd: linear precision, an affine target lattice gives that affine map", "[warp][ffd]") {
+    std::mt19937 rng(13);
+    const glm::mat3 a(glm::vec3(1.2f, 0.3f, -0.1f), glm::vec3(-0.2f, 0.8f, 0.25f),
+                      glm::vec3(0.1f, -0.3f, 1.4f));
+    const glm::vec3 b(0.5f, -1.0f, 0.25f);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+        for (glm::ivec3 div : {glm::ivec3(3, 3, 3), glm::ivec3(1, 4, 6)}) {
+            const Lattice l = skewLattice(div);
+            // Extrapolation continues the polynomials, and they reproduce linear functions everywhere.
+            Ffd ffd(l, {basis, FfdOutside::Extrapolate});
+            std::vector<glm::vec3> target = l.controlPoints();
+            for (auto& p : target)
+                p = a * p + b;
+            ffd.setTargets(target);
+            const auto pts = samplePoints(l, rng, 400, -0.2f, 1.2f);
+            std::vector<glm::vec3> ref(pts.size());
+            for (size_t i = 0; i < pts.size(); ++i)
+                ref[i] = a * pts[i] + b;
+            CHECK(maxError(viaEngine(ffd, pts), ref) < 1e-5f);
+            std::vector<glm::vec3> fast = pts;
+            ffd.bind(pts);
+            ffd.evaluate(fast);
+            CHECK(maxError(fast, ref) < 1e-5f);
+        }
+    }
+}
+
+TEST_CASE("ffd: weighting fields are a partition of unity, sparse and non-negative inside", "[warp][ffd]") {
+    std::mt19937 rng(14);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+        const Lattice l = skewLattice({6, 5, 4});
+        FfdLattice lattice(l, {basis, FfdOutside::Extrapolate});
+        auto pts = samplePoints(l, rng, 300, -0.25f, 1.25f);
+        pts.push_back(l.origin);  // a corner: only the corner control, weight 1, for both bases
+        lattice.bind(pts);
+        SparseFields f;
+        lattice.fields(f);
+        REQUIRE(f.numPoints() == static_cast<int32_t>(pts.size()));
+        for (int32_t u = 0; u < f.numPoints(); ++u) {
+            double sum = 0.0;
+            bool nonNegative = true;
+            for (int32_t e = f.offsets[u]; e < f.offsets[u + 1]; ++e) {
+                sum += f.weight[e];
+                nonNegative = nonNegative && f.weight[e] > 0.0f;
+                CHECK(f.strength[e] == 1.0f);
+            }
+            CHECK(sum == Approx(1.0).margin(1e-5));
+            const int32_t count = f.offsets[u + 1] - f.offsets[u];
+            if (basis == FfdBasis::BSpline) CHECK(count <= 64);  // a point pays only for its 4x4x4 support
+            if (!outsideUnit(cramer(l, pts[u]))) CHECK(nonNegative);
+        }
+        const int32_t corner = f.numPoints() - 1;
+        REQUIRE(f.offsets[corner + 1] - f.offsets[corner] == 1);
+        CHECK(f.transform[f.offsets[corner]] == 0);
+        CHECK(f.weight[f.offsets[corner]] == Approx(1.0f).margin(1e-6));
+    }
+}
+
+TEST_CASE("ffd: outside points, unchanged or extrapolated", "[warp][ffd]") {
+    std::mt19937 rng(15);
+    const Lattice l = skewLattice({3, 2, 3});
+    const auto target = randomTargets(l, rng, 0.3f);
+    auto pts = samplePoints(l, rng, 400, -0.5f, 1.5f);
+    int outside = 0;
+    for (const auto& p : pts)
+        outside += outsideUnit(cramer(l, p)) ? 1 : 0;
+    REQUIRE(outside > 100);
+    REQUIRE(outside < 400);
+
+    Ffd none(l, {FfdBasis::Bernstein, FfdOutside::None});
+    none.setTargets(target);
+    Ffd extra(l, {FfdBasis::Bernstein, FfdOutside::Extrapolate});
+    extra.setTargets(target);
+    const auto outNone = viaEngine(none, pts), outExtra = viaEngine(extra, pts);
+    std::vector<glm::vec3> fastNone = pts;
+    none.bind(pts);
+    none.evaluate(fastNone);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const glm::vec3 ref = bernsteinRef(l, target, pts[i]);
+        if (outsideUnit(cramer(l, pts[i]))) {
+            CHECK(outNone[i] == pts[i]);  // exactly, no entries at all
+            CHECK(fastNone[i] == pts[i]);
+        } else {
+            CHECK(glm::length(outNone[i] - ref) < 1e-5f);
+        }
+        CHECK(glm::length(outExtra[i] - ref) < 2e-5f);  // the polynomial beyond [0, 1]
+    }
+    SparseFields f;
+    none.bind(pts, f);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        if (outsideUnit(cramer(l, pts[i]))) CHECK(f.offsets[i + 1] == f.offsets[i]);
+    }
+
+    // B-spline extrapolation continues the end span's cubic: continuous across the face.
+    Ffd bs(l, {FfdBasis::BSpline, FfdOutside::Extrapolate});
+    bs.setTargets(target);
+    const glm::vec3 onFace = l.origin + l.axes * glm::vec3(1.0f, 0.4f, 0.6f);
+    const glm::vec3 step = l.axes[0] * 1e-4f;
+    std::vector<glm::vec3> across{onFace - step, onFace + step};
+    const auto moved = viaEngine(bs, across);
+    const glm::vec3 jump = (moved[1] - across[1]) - (moved[0] - across[0]);
+    CHECK(glm::length(jump) < 2e-3f);
+}
+
+TEST_CASE("ffd: B-spline variant equals a Cox-de Boor evaluation over phantom controls", "[warp][ffd]") {
+    std::mt19937 rng(16);
+    for (glm::ivec3 div : {glm::ivec3(5, 4, 6), glm::ivec3(1, 2, 3), glm::ivec3(3, 3, 3)}) {
+        const Lattice l = skewLattice(div);
+        Ffd ffd(l, {FfdBasis::BSpline, FfdOutside::None});
+        const auto target = randomTargets(l, rng, 0.4f);
+        ffd.setTargets(target);
+        const auto pts = samplePoints(l, rng, 300, 0.001f, 0.999f);
+        std::vector<glm::vec3> ref(pts.size());
+        for (size_t i = 0; i < pts.size(); ++i)
+            ref[i] = bsplineRef(l, target, pts[i]);
+        CHECK(maxError(viaEngine(ffd, pts), ref) < 1e-5f);
+        std::vector<glm::vec3> fast = pts;
+        ffd.bind(pts);
+        ffd.evaluate(fast);
+        CHECK(maxError(fast, ref) < 1e-5f);
+        // The choice of end handling makes lattice corners interpolate their control.
+        const glm::vec3 corner = l.controlPoint(div.x, 0, div.z);
+        std::vector<glm::vec3> c{corner};
+        CHECK(glm::length(viaEngine(ffd, c)[0] - target[l.index(div.x, 0, div.z)]) < 1e-5f);
+    }
+    // For 3 divisions the B-spline is not the Bernstein cubic: a real local variant.
+    const Lattice l = skewLattice({3, 3, 3});
+    const auto target = randomTargets(l, rng, 0.4f);
+    const glm::vec3 p = l.origin + l.axes * glm::vec3(0.3f, 0.5f, 0.7f);
+    CHECK(glm::length(bsplineRef(l, target, p) - bernsteinRef(l, target, p)) > 1e-3f);
+}
+
+TEST_CASE("ffd: B-spline is local, a control moves only points in its support", "[warp][ffd]") {
+    std::mt19937 rng(17);
+    const Lattice l = skewLattice({8, 8, 8});
+    Ffd ffd(l, {FfdBasis::BSpline});
+    const auto pts = samplePoints(l, rng, 2000, 0.0f, 1.0f);
+    ffd.bind(pts);
+    auto target = l.controlPoints();
+    target[l.index(4, 4, 4)] += glm::vec3(0.5f, 0.0f, 0.0f);
+    ffd.setTargets(target);  // no re-bind: moving a control redoes no bind work
+    std::vector<glm::vec3> out = pts;
+    ffd.evaluate(out);
+    int moved = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const glm::dvec3 x = cramer(l, pts[i]) * 8.0;
+        const bool inSupport = std::abs(x.x - 4) < 2 && std::abs(x.y - 4) < 2 && std::abs(x.z - 4) < 2;
+        if (!inSupport) CHECK(out[i] == pts[i]);
+        moved += out[i] != pts[i] ? 1 : 0;
+        CHECK(glm::length(out[i] - bsplineRef(l, target, pts[i])) < 1e-5f);
+    }
+    CHECK(moved > 50);
+}
+
+TEST_CASE("ffd: fast path equals the generic engine with painted weights and envelope", "[warp][ffd]") {
+    std::mt19937 rng(18);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+        for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
+            const Lattice l = skewLattice({4, 3, 5});
+            Ffd ffd(l, {basis, outside});
+            ffd.setTargets(randomTargets(l, rng, 0.5f));
+            const auto rest = samplePoints(l, rng, 3000, -0.2f, 1.2f);
+            std::vector<float> weights(rest.size());
+            for (auto& w : weights)
+                w = unit(rng);
+            // Evaluate at upstream points that differ from the rest points, as a deformer stack would.
+            std::vector<glm::vec3> upstream = rest;
+            for (auto& p : upstream)
+                p += glm::vec3(0.01f, -0.02f, 0.03f);
+            WarpDeformer deformer(ffd);
+            deformer.bind(rest);
+            std::vector<glm::vec3> generic = upstream;
+            deformer.evaluate(generic, weights, 0.7f);
+            ffd.bind(rest);
+            std::vector<glm::vec3> fast = upstream;
+            ffd.evaluate(fast, weights, 0.7f);
+            CHECK(maxError(generic, fast) < 1e-5f);
+        }
+    }
+}
+
+TEST_CASE("ffd: bit-identical output for 1 and 2 threads", "[warp][ffd][determinism]") {
+    std::mt19937 rng(19);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+        const Lattice l = skewLattice({3, 4, 5});
+        Ffd ffd(l, {basis, FfdOutside::Extrapolate});
+        ffd.setTargets(randomTargets(l, rng, 0.5f));
+        const auto rest = samplePoints(l, rng, 20000, -0.2f, 1.2f);
+        std::vector<glm::vec3> one = rest, two = rest, engineOne, engineTwo;
+        omp_set_num_threads(1);
+        ffd.bind(rest);
+        ffd.evaluate(one);
+        engineOne = viaEngine(ffd, rest);
+        omp_set_num_threads(2);
+        ffd.bind(rest);
+        ffd.evaluate(two);
+        engineTwo = viaEngine(ffd, rest);
+        CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)) == 0);
+        CHECK(std::memcmp(engineOne.data(), engineTwo.data(), one.size() * sizeof(glm::vec3)) == 0);
+    }
+    omp_set_num_threads(omp_get_num_procs());
+}
+
+TEST_CASE("ffd: bad input names the element", "[warp][ffd][errors]") {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    Lattice l = skewLattice({3, 0, 3});
+    CHECK_THROWS_AS(Ffd(l), InvalidInput);
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("divisions[1] (m)") && Catch::Contains("is 0"));
+    l.divisions = {-2, 3, 3};
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("divisions[0] (l)") && Catch::Contains("is -2"));
+    l.divisions = {3, 3, 100};
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("divisions[2] (n)") && Catch::Contains("B-spline"));
+    CHECK_NOTHROW(Ffd(l, {FfdBasis::BSpline}));
+    l.divisions = {3, 3, 100000};
+    CHECK_THROWS_WITH(Ffd(l, {FfdBasis::BSpline}),
+                      Catch::Contains("divisions[2] (n)") && Catch::Contains("1024"));
+
+    l = skewLattice({3, 3, 3});
+    l.axes[1] = glm::vec3(0.0f);
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("axis Y") && Catch::Contains("zero length"));
+    l = skewLattice({3, 3, 3});
+    l.axes[2] = l.axes[0] * 0.5f + l.axes[1] * 2.0f;  // coplanar: zero volume
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("coplanar"));
+    l = skewLattice({3, 3, 3});
+    l.axes[0].y = nan;
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("axis X") && Catch::Contains("not finite"));
+    l = skewLattice({3, 3, 3});
+    l.origin.z = std::numeric_limits<float>::infinity();
+    CHECK_THROWS_WITH(Ffd(l), Catch::Contains("origin"));
+
+    l = skewLattice({3, 3, 3});
+    Ffd ffd(l);
+    std::vector<glm::vec3> target = l.controlPoints();
+    target.pop_back();
+    CHECK_THROWS_WITH(ffd.setTargets(target), Catch::Contains("targets") && Catch::Contains("63 points") &&
+                                                  Catch::Contains("= 64 points"));
+    target = l.controlPoints();
+    target[l.index(1, 2, 3)].x = nan;
+    CHECK_THROWS_WITH(ffd.setTargets(target),
+                      Catch::Contains("target 27 (i=1, j=2, k=3)") && Catch::Contains("not finite"));
+    CHECK(ffd.targets()[27] == l.controlPoint(1, 2, 3));  // nothing changed
+
+    std::vector<glm::vec3> pts{{0, 0, 0}, {1, 1, 1}};
+    CHECK_THROWS_WITH(ffd.evaluate(pts), Catch::Contains("before bind"));
+    pts[1].y = nan;
+    CHECK_THROWS_WITH(ffd.bind(pts), Catch::Contains("point 1") && Catch::Contains("not finite"));
+    pts[1].y = 1.0f;
+    ffd.bind(pts);
+    std::vector<glm::vec3> three(3);
+    CHECK_THROWS_WITH(ffd.evaluate(three), Catch::Contains("3 points") && Catch::Contains("2 points"));
+    std::vector<float> w(5, 1.0f);
+    CHECK_THROWS_WITH(ffd.evaluate(pts, w), Catch::Contains("painted weights"));
+}
