@@ -1,0 +1,70 @@
+#pragma once
+
+#include <span>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include "deformkit/warp/barr.h"
+#include "deformkit/warp/profile_curve.h"
+
+namespace deformkit::warp {
+
+// The parameterisations hosts expose for taper, twist and bend, mapped onto Barr's parameters
+// (barr.h). The Maya and Blender plugins call these; they hold no deformation code of their own.
+// docs/warps/barr_decisions.md records how each mapping was derived.
+
+struct AxialSetup {  // for TaperWarp / TwistWarp
+    AxisFrame frame;
+    ProfileCurve profile = ProfileCurve::constant(0.0f);
+};
+
+struct BendSetup {  // for BendWarp
+    AxisFrame frame;
+    BendParams params;
+};
+
+// Maya's nonLinear bend (deformBend): bends along the handle's local Y axis towards its local +X axis,
+// curvature in radians per handle-space unit along Y (the attribute is an angle; the UI shows degrees),
+// bent between lowBound and highBound on handle Y, centred on the handle origin.
+struct MayaBend {
+    glm::vec3 handleOrigin{0.0f};         // handle translation, world units
+    glm::vec3 handleX{1.0f, 0.0f, 0.0f};  // world images of the handle's unit X and Y axes (rotation x scale)
+    glm::vec3 handleY{0.0f, 1.0f, 0.0f};
+    double curvature = 0.0;  // radians
+    double lowBound = -1.0;  // handle units, <= highBound
+    double highBound = 1.0;
+};
+// Throws InvalidInput for zero or non-finite handle axes, X not perpendicular to Y, X and Y scaled
+// differently (a handle-space circle would be an ellipse in the world, which Barr's bend cannot give),
+// a non-finite curvature or bound, lowBound > highBound.
+[[nodiscard]] BendSetup fromMayaBend(const MayaBend& maya);
+
+// Blender's SimpleDeform modifier (twist, bend, taper modes), evaluated in the space of its origin
+// object (or the modified object when there is none): `basis` columns are that space's unit x, y, z
+// axes in world, `origin` its origin. The limits are fractions of the mesh's extent along the limit
+// axis in that space, measured on `points` (world positions, as Blender measures the evaluated mesh).
+enum class BlenderAxis { X = 0, Y = 1, Z = 2 };
+struct BlenderSimpleDeform {
+    glm::vec3 origin{0.0f};
+    glm::mat3 basis{1.0f};  // orthonormal columns
+    BlenderAxis deformAxis = BlenderAxis::Z;
+    double angle = 0.0;       // twist and bend: radians over the limited range
+    double factor = 0.0;      // taper: scale change per unit over the limited range
+    double lowerLimit = 0.0;  // fractions in [0, 1], lower <= upper
+    double upperLimit = 1.0;
+};
+// twist: theta(z) = angle / (L1 - L0) * clamp(z, L0, L1) about the deform axis.
+[[nodiscard]] AxialSetup fromBlenderTwist(const BlenderSimpleDeform& blender,
+                                          std::span<const glm::vec3> points);
+// taper: f(z) = 1 + factor / (L1 - L0) * clamp(z, L0, L1) across the deform axis.
+[[nodiscard]] AxialSetup fromBlenderTaper(const BlenderSimpleDeform& blender,
+                                          std::span<const glm::vec3> points);
+// bend: rate = angle / (L1 - L0), centre 0, range [L0, L1] along x (deform Z) or z (deform X, Y), bending
+// towards y (deform X, Z) or x (deform Y). Lock axes are not supported.
+// All three throw InvalidInput for limits outside [0, 1] or reversed, a non-finite angle/factor, no
+// points, or a zero-length limited range (Blender divides by FLT_EPSILON there instead).
+[[nodiscard]] BendSetup fromBlenderBend(const BlenderSimpleDeform& blender,
+                                        std::span<const glm::vec3> points);
+
+}  // namespace deformkit::warp

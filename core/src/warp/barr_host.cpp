@@ -1,0 +1,133 @@
+#include "deformkit/warp/barr_host.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::warp {
+namespace {
+
+void requireFinite(double v, const char* source, const char* name) {
+    if (!std::isfinite(v)) throw InvalidInput(formatError(source, name, "is not finite", "a number"));
+}
+
+struct Range {
+    double lo, hi;
+};
+
+// Blender's limits: fractions of the [min, max] extent of the points along `axis` of the origin space.
+Range blenderLimits(const BlenderSimpleDeform& b, std::span<const glm::vec3> points, int axis,
+                    const char* source) {
+    requireFinite(b.lowerLimit, source, "lower limit");
+    requireFinite(b.upperLimit, source, "upper limit");
+    if (b.lowerLimit < 0.0 || b.upperLimit > 1.0 || b.lowerLimit > b.upperLimit) {
+        throw InvalidInput(
+            formatError(source, "limits",
+                        "are [" + std::to_string(b.lowerLimit) + ", " + std::to_string(b.upperLimit) + "]",
+                        "0 <= lower <= upper <= 1"));
+    }
+    if (points.empty()) throw InvalidInput(formatError(source, "points", "is empty", "the mesh's points"));
+    double lower = std::numeric_limits<double>::infinity(), upper = -lower;
+    const glm::dvec3 dir(b.basis[axis]);
+    for (size_t i = 0; i < points.size(); ++i) {
+        const double c = glm::dot(glm::dvec3(points[i]) - glm::dvec3(b.origin), dir);
+        if (!std::isfinite(c)) {
+            throw InvalidInput(
+                formatError(source, "point " + std::to_string(i), "is not finite", "finite coordinates"));
+        }
+        lower = std::min(lower, c);
+        upper = std::max(upper, c);
+    }
+    const Range r{lower + (upper - lower) * b.lowerLimit, lower + (upper - lower) * b.upperLimit};
+    if (!(r.hi > r.lo)) {
+        throw InvalidInput(formatError(source, "limits", "span zero length along the limit axis",
+                                       "a limited range of positive length"));
+    }
+    return r;
+}
+
+AxisFrame blenderFrame(const BlenderSimpleDeform& b, int along, int up) {
+    return {b.origin, b.basis[along], b.basis[up]};
+}
+
+// Linear profile a * clamp(z, lo, hi) + offset, exactly as two samples with constant extension.
+ProfileCurve linearProfile(const Range& r, double slope, double offset, const char* name) {
+    return ProfileCurve(
+        {static_cast<float>(r.lo), static_cast<float>(r.hi)},
+        {static_cast<float>(offset + slope * r.lo), static_cast<float>(offset + slope * r.hi)}, name);
+}
+
+}  // namespace
+
+BendSetup fromMayaBend(const MayaBend& m) {
+    const char* source = "Maya bend";
+    for (int i = 0; i < 3; ++i) {
+        requireFinite(m.handleOrigin[i], source, "handle origin");
+        requireFinite(m.handleX[i], source, "handle X axis");
+        requireFinite(m.handleY[i], source, "handle Y axis");
+    }
+    requireFinite(m.curvature, source, "curvature");
+    requireFinite(m.lowBound, source, "lowBound");
+    requireFinite(m.highBound, source, "highBound");
+    const double sx = glm::length(glm::dvec3(m.handleX)), sy = glm::length(glm::dvec3(m.handleY));
+    if (!(sx > 0.0) || !(sy > 0.0)) {
+        throw InvalidInput(
+            formatError(source, "handle axes", "include a zero vector", "a non-degenerate handle"));
+    }
+    if (std::abs(glm::dot(glm::dvec3(m.handleX), glm::dvec3(m.handleY))) > 1e-5 * sx * sy) {
+        throw InvalidInput(
+            formatError(source, "handle axes", "X and Y are not perpendicular", "an unsheared handle"));
+    }
+    if (std::abs(sx - sy) > 1e-5 * std::max(sx, sy)) {
+        throw InvalidInput(formatError(source, "handle scale",
+                                       "X is " + std::to_string(sx) + " and Y is " + std::to_string(sy),
+                                       "equal X and Y scale (a circular arc)"));
+    }
+    if (m.lowBound > m.highBound) {
+        throw InvalidInput(formatError(source, "lowBound", "is above highBound", "lowBound <= highBound"));
+    }
+    BendSetup out;
+    out.frame = {m.handleOrigin, m.handleY, m.handleX};
+    // Handle units -> world units: lengths times sy, a rate (angle per length) divided by sy.
+    out.params = {static_cast<float>(m.curvature / sy), 0.0f, static_cast<float>(m.lowBound * sy),
+                  static_cast<float>(m.highBound * sy)};
+    return out;
+}
+
+AxialSetup fromBlenderTwist(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
+    requireFinite(b.angle, "Blender twist", "angle");
+    const int axis = static_cast<int>(b.deformAxis);
+    const Range r = blenderLimits(b, points, axis, "Blender twist");
+    return {blenderFrame(b, axis, (axis + 1) % 3),
+            linearProfile(r, b.angle / (r.hi - r.lo), 0.0, "Blender twist")};
+}
+
+AxialSetup fromBlenderTaper(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
+    requireFinite(b.factor, "Blender taper", "factor");
+    const int axis = static_cast<int>(b.deformAxis);
+    const Range r = blenderLimits(b, points, axis, "Blender taper");
+    return {blenderFrame(b, axis, (axis + 1) % 3),
+            linearProfile(r, b.factor / (r.hi - r.lo), 1.0, "Blender taper")};
+}
+
+BendSetup fromBlenderBend(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
+    requireFinite(b.angle, "Blender bend", "angle");
+    // Blender bends about the deform axis: along z towards y (X), along z towards x (Y), along x towards y
+    // (Z).
+    int along = 0, up = 1;
+    if (b.deformAxis == BlenderAxis::X) along = 2, up = 1;
+    if (b.deformAxis == BlenderAxis::Y) along = 2, up = 0;
+    const Range r = blenderLimits(b, points, along, "Blender bend");
+    BendSetup out;
+    out.frame = blenderFrame(b, along, up);
+    out.params = {static_cast<float>(b.angle / (r.hi - r.lo)), 0.0f, static_cast<float>(r.lo),
+                  static_cast<float>(r.hi)};
+    return out;
+}
+
+}  // namespace deformkit::warp
