@@ -1,0 +1,174 @@
+// Python bindings of the coarse-mesh warp (core/include/deformkit/warp/mesh_warp.h, paper §6): the
+// one-off function mesh_warp and the MeshWarp class that binds once to a rest surface and evaluates for
+// many target cages. numpy float32 in and out.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/mesh.h"
+#include "deformkit/warp/engine.h"
+#include "deformkit/warp/mesh_warp.h"
+
+namespace py = pybind11;
+
+namespace deformkit::python {
+namespace {
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+constexpr const char* kSource = "mesh_warp";
+
+std::string shapeOf(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i)
+        s += (i ? ", " : "") + std::to_string(a.shape(i));
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::vector<glm::vec3> pointsOf(const FloatArray& a, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != 3) {
+        throw InvalidInput(formatError(kSource, name, "has shape " + shapeOf(a), "(n, 3) float32"));
+    }
+    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
+    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+    return out;
+}
+
+std::vector<int32_t> intsOf(const IntArray& a, const char* name) {
+    if (a.ndim() != 1)
+        throw InvalidInput(formatError(kSource, name, "has shape " + shapeOf(a), "a 1-D int array"));
+    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
+}
+
+std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t numPoints) {
+    if (!weights) return {};
+    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != numPoints) {
+        throw InvalidInput(formatError(kSource, "weights", "has shape " + shapeOf(*weights),
+                                       "(" + std::to_string(numPoints) + ",), one per point"));
+    }
+    return std::vector<float>(weights->data(), weights->data() + numPoints);
+}
+
+geom::Mesh cageOf(const FloatArray& points, const IntArray& counts, const IntArray& indices) {
+    geom::Mesh::Data d;
+    d.points = pointsOf(points, "cage_points");
+    d.faceCounts = intsOf(counts, "cage_face_counts");
+    d.faceIndices = intsOf(indices, "cage_face_indices");
+    return geom::Mesh(std::move(d), "mesh_warp cage");
+}
+
+warp::MeshWarpOptions optionsOf(float alpha, float beta, float gamma, float mu) {
+    warp::MeshWarpOptions o;
+    o.alpha = alpha;
+    o.beta = beta;
+    o.gamma = gamma;
+    o.mu = mu;
+    return o;
+}
+
+py::array_t<float> toArray(const std::vector<glm::vec3>& pts) {
+    py::array_t<float> out({static_cast<py::ssize_t>(pts.size()), static_cast<py::ssize_t>(3)});
+    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
+    return out;
+}
+
+// Bind once to a rest surface, evaluate for many target cages.
+class PyMeshWarp {
+  public:
+    PyMeshWarp(const FloatArray& cagePoints, const IntArray& counts, const IntArray& indices, float alpha,
+               float beta, float gamma, float mu)
+        : warp_(std::make_unique<warp::MeshWarp>(cageOf(cagePoints, counts, indices),
+                                                 optionsOf(alpha, beta, gamma, mu), kSource)),
+          deformer_(std::make_unique<warp::WarpDeformer>(*warp_)) {}
+
+    void bind(const FloatArray& restPoints) {
+        rest_ = pointsOf(restPoints, "rest_points");
+        py::gil_scoped_release release;
+        deformer_->bind(rest_);
+    }
+
+    py::array_t<float> evaluate(const FloatArray& targetCage, const std::optional<FloatArray>& points,
+                                const std::optional<FloatArray>& weights, float envelope) {
+        if (!deformer_->isBound()) {
+            throw InvalidInput(
+                formatError(kSource, "evaluate", "called before bind", "bind(rest_points) first"));
+        }
+        warp_->setTarget(pointsOf(targetCage, "target_cage_points"));
+        std::vector<glm::vec3> pts = points ? pointsOf(*points, "points") : rest_;
+        const std::vector<float> w = weightsOf(weights, pts.size());
+        {
+            py::gil_scoped_release release;
+            deformer_->evaluate(pts, w, envelope);
+        }
+        return toArray(pts);
+    }
+
+    [[nodiscard]] int32_t numControlVertices() const { return warp_->numControlVertices(); }
+    [[nodiscard]] bool isBound() const { return deformer_->isBound(); }
+    [[nodiscard]] int64_t numFieldEntries() const {
+        return static_cast<int64_t>(deformer_->fields().weight.size());
+    }
+
+  private:
+    std::unique_ptr<warp::MeshWarp> warp_;
+    std::unique_ptr<warp::WarpDeformer> deformer_;
+    std::vector<glm::vec3> rest_;
+};
+
+}  // namespace
+
+void bindMeshWarp(py::module_& m) {
+    m.def(
+        "mesh_warp",
+        [](const FloatArray& points, const FloatArray& cagePoints, const IntArray& counts,
+           const IntArray& indices, const FloatArray& targetCage, float alpha, float beta, float gamma,
+           float mu, const std::optional<FloatArray>& weights, float envelope) {
+            std::vector<glm::vec3> pts = pointsOf(points, "points");
+            const geom::Mesh cage = cageOf(cagePoints, counts, indices);
+            const std::vector<glm::vec3> target = pointsOf(targetCage, "target_cage_points");
+            const std::vector<float> w = weightsOf(weights, pts.size());
+            {
+                py::gil_scoped_release release;
+                warp::meshWarp(pts, cage, target, optionsOf(alpha, beta, gamma, mu), w, envelope);
+            }
+            return toArray(pts);
+        },
+        py::arg("points"), py::arg("cage_points"), py::arg("cage_face_counts"), py::arg("cage_face_indices"),
+        py::arg("target_cage_points"), py::arg("alpha") = 0.0f, py::arg("beta") = 1.0f,
+        py::arg("gamma") = 0.0f, py::arg("mu") = 1.0f, py::arg("weights") = py::none(),
+        py::arg("envelope") = 1.0f,
+        "Coarse-mesh warp (Milliron et al. 2002, §6). points (n, 3) float32, the surface at rest; "
+        "cage_points\n"
+        "(m, 3), cage_face_counts (F,) int32, cage_face_indices (sum of counts,) int32: the control mesh at "
+        "rest;\n"
+        "target_cage_points (m, 3): the edited control mesh. alpha < beta: radial falloff in units of each\n"
+        "control vertex's longest edge; gamma < mu: falloff along each edge in units of its length. weights\n"
+        "(n,) painted per point, envelope scalar. Returns the deformed points (n, 3) float32.");
+
+    py::class_<PyMeshWarp>(
+        m, "MeshWarp",
+        "Coarse-mesh warp that binds once to a rest surface (weights cached) and evaluates for "
+        "many target cages.")
+        .def(py::init<const FloatArray&, const IntArray&, const IntArray&, float, float, float, float>(),
+             py::arg("cage_points"), py::arg("cage_face_counts"), py::arg("cage_face_indices"),
+             py::arg("alpha") = 0.0f, py::arg("beta") = 1.0f, py::arg("gamma") = 0.0f, py::arg("mu") = 1.0f)
+        .def("bind", &PyMeshWarp::bind, py::arg("rest_points"),
+             "Compute the sparse weights on the rest surface (n, 3) float32.")
+        .def(
+            "evaluate", &PyMeshWarp::evaluate, py::arg("target_cage_points"), py::arg("points") = py::none(),
+            py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
+            "Deform `points` (default: the bound rest points) for target_cage_points (m, 3); returns (n, 3).")
+        .def_property_readonly("num_control_vertices", &PyMeshWarp::numControlVertices)
+        .def_property_readonly("is_bound", &PyMeshWarp::isBound)
+        .def_property_readonly("num_field_entries", &PyMeshWarp::numFieldEntries,
+                               "Total (point, control vertex) pairs with non-zero weight.");
+}
+
+}  // namespace deformkit::python
