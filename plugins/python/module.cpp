@@ -7,6 +7,7 @@
 
 #include <cstring>
 
+#include "bindings.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/geom/mesh.h"
@@ -205,5 +206,11 @@ PYBIND11_MODULE(deformkit, m) {
 
     m.def("make_grid", [](int32_t cx, int32_t cy, float sx, float sy) { return geom::makeGrid({cx, cy, sx, sy}); },
           py::arg("cells_x") = 16, py::arg("cells_y") = 16, py::arg("size_x") = 1.0f, py::arg("size_y") = 1.0f);
+    python::bindWarpEngine(m);
+    python::bindFfd(m);
+    python::bindBarr(m);
+    python::bindWires(m);
+    python::bindMeshWarp(m);
+
     m.def("make_capped_tube", [] { return geom::makeCappedTube(); }, "The demo's capped tube (UDIM 1001-1002).");
 }
