@@ -10,11 +10,31 @@ REFERENCES = {
     "BM_ObjParse": ("BM_PlainRead", "OBJ parse from memory / plain read"),
     "BM_BvhClosestPoint": ("BM_BruteForceClosestPoint", "BVH / brute-force closest point"),
     "BM_BvhRayCast": ("BM_BruteForceRayCast", "BVH / brute-force ray cast"),
+    "BM_BarrEvaluateEngine": ("BM_BarrEvaluate", "generic engine / fast path"),
+    "BM_WiresEngineEvaluate": ("BM_WiresEvaluate", "generic engine / fast path"),
 }
 
 
-def base_name(name):
-    return name.split("/")[0]
+def split_name(name):
+    """'BM_X/2/real_time' -> ('BM_X', '/2')."""
+    parts = name.split("/")
+    args = [a for a in parts[1:] if not a.startswith(("real_time", "min_time", "repeats", "iterations"))]
+    return parts[0], "".join("/" + a for a in args)
+
+
+def reference_for(name, medians):
+    """The in-run reference of a benchmark: an explicit pair, or its 1-thread twin."""
+    base, args = split_name(name)
+    if base in REFERENCES:
+        ref_base, meaning = REFERENCES[base]
+        for candidate in (ref_base + args, ref_base):
+            if candidate in medians:
+                return candidate, meaning
+    for suffix in ("1Thread", "_1Thread"):
+        twin = base + suffix + args
+        if twin in medians:
+            return twin, "speed-up over 1 thread"
+    return None, None
 
 
 def throughput(run):
@@ -45,20 +65,23 @@ def main(paths):
         for r in runs:
             if has_aggregates and r.get("aggregate_name") != "median":
                 continue
-            medians[base_name(r["run_name"] if "run_name" in r else r["name"])] = r
+            name = r["run_name"] if "run_name" in r else r["name"]
+            base, args = split_name(name)
+            medians[base + args] = r
     if context:
         print(f"# {context.get('host_name', '')}: {context.get('num_cpus', '?')} cpus, "
               f"{context.get('date', '')}; medians of repetitions")
-    print(f"{'benchmark':34} {'median time':>14} {'throughput':>18}   ratio vs reference")
+    print(f"{'benchmark':40} {'median time':>14} {'throughput':>18}   ratio vs reference")
     for name, run in sorted(medians.items()):
         value, unit = throughput(run)
         time = format_time(run["real_time"], run["time_unit"])
         ratio = ""
-        if name in REFERENCES and REFERENCES[name][0] in medians:
-            ref_value, _ = throughput(medians[REFERENCES[name][0]])
-            ratio = f"{value / ref_value:8.3f}x  ({REFERENCES[name][1]})"
+        ref, meaning = reference_for(name, medians)
+        if ref and value is not None:
+            ref_value, _ = throughput(medians[ref])
+            ratio = f"{value / ref_value:8.3f}x  ({meaning})"
         shown = f"{value:,.1f} {unit}" if value is not None else "-"
-        print(f"{name:34} {time:>14} {shown:>18}   {ratio}")
+        print(f"{name:40} {time:>14} {shown:>18}   {ratio}")
 
 
 if __name__ == "__main__":

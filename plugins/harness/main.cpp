@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "warp_command.h"
 #include "deformkit/error.h"
 #include "deformkit/version.h"
 
@@ -52,6 +53,19 @@ int main(int argc, char** argv) {
     demo->add_option("--out", demoOut, "output folder")->capture_default_str();
     demo->add_option("--resolution", demoCommand.resolution, "texels per UDIM tile side")->capture_default_str();
 
+    harness::WarpImageCommand warpCommand;
+    std::string warpImage, warpLines, warpOut, warpVariant = "original", warpInterp = "bilinear";
+    auto* warpImageApp = app.add_subcommand("warp", "Warp an image with Beier-Neely segment pairs (inverse mapping)");
+    warpImageApp->add_option("IMAGE", warpImage, "source image")->required();
+    warpImageApp->add_option("--lines", warpLines, "segment pairs, JSON (docs/warps/beier_neely.md)")->required();
+    warpImageApp->add_option("--out", warpOut, "output image, same size and channels")->required();
+    warpImageApp->add_option("--variant", warpVariant, "original or global (no fold-over, paper 5.2)")
+        ->check(CLI::IsMember({"original", "global"}))
+        ->capture_default_str();
+    warpImageApp->add_option("--interp", warpInterp, "bilinear or bicubic")
+        ->check(CLI::IsMember({"bilinear", "bicubic"}))
+        ->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -71,6 +85,16 @@ int main(int argc, char** argv) {
             if (!previewView.empty()) previewCommand.options.viewDirection = parseVec3(previewView);
             harness::preview(previewCommand);
             std::cout << "wrote " << previewOut << "\n";
+        } else if (*warpImageApp) {
+            warpCommand.image = warpImage;
+            warpCommand.lines = warpLines;
+            warpCommand.out = warpOut;
+            warpCommand.variant =
+                warpVariant == "global" ? warp::BeierNeelyVariant::Global : warp::BeierNeelyVariant::Original;
+            warpCommand.interpolation =
+                warpInterp == "bicubic" ? warp::Interpolation::Bicubic : warp::Interpolation::Bilinear;
+            harness::warpImageCommand(warpCommand);
+            std::cout << "wrote " << warpOut << "\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);
