@@ -137,7 +137,7 @@ std::vector<Affine> beierNeelyTransformations(std::span<const SegmentPair> pairs
         if (options.variant == BeierNeelyVariant::Global) {
             // §5.2: N*_i = normalised sum_j w^_ij R_j<N_i>, R_j the rotation taking L_j's direction to
             // L*_j's; w_ij = (len_j^p_j / ((a_j + dist_ij)(a_j + |d_i . d_j| / len_i)))^b_j
-            // (reconstruction: docs/warps/beier_neely_decisions.md).
+            // (reconstruction: docs/decisions.md, BN-3).
             const double lengthI = glm::length(d);
             glm::dvec2 sum(0.0);
             double weightSum = 0.0;

@@ -53,7 +53,7 @@ std::vector<glm::vec2> pixelCentres(int w, int h) {
     return out;
 }
 
-// The L-shaped shear of Fig. 15 (docs/warps/beier_neely_decisions.md): a horizontal segment that stays
+// The L-shaped shear of Fig. 15 (docs/decisions.md, BN-5): a horizontal segment that stays
 // put and a vertical segment above it whose source copy leans over by 1.1 rad about its foot.
 std::vector<SegmentPair> shearCase() {
     const float tilt = 1.1f;

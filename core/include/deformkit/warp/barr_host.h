@@ -12,7 +12,7 @@ namespace deformkit::warp {
 
 // The parameterisations hosts expose for taper, twist and bend, mapped onto Barr's parameters
 // (barr.h). The Maya and Blender plugins call these; they hold no deformation code of their own.
-// docs/warps/barr_decisions.md records how each mapping was derived.
+// docs/decisions.md records how each mapping was derived.
 
 struct AxialSetup {  // for TaperWarp / TwistWarp
     AxisFrame frame;

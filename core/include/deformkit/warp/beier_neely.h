@@ -47,7 +47,7 @@ void validateSegmentPairs(std::span<const SegmentPair> pairs, const std::string&
 
 // The construction function's transformations T_i: the affine map of the frame (P_i, Q_i - P_i, N_i)
 // onto (P*_i, Q*_i - P*_i, N*_i), N = unit perpendicular (-d.y, d.x) / |d|. With Global, N*_i is the
-// §5.2 weighted average (docs/warps/beier_neely_decisions.md). z untouched. Validates the pairs.
+// §5.2 weighted average (docs/decisions.md). z untouched. Validates the pairs.
 [[nodiscard]] std::vector<Affine> beierNeelyTransformations(std::span<const SegmentPair> pairs,
                                                             const BeierNeelyOptions& options = {});
 

@@ -13,7 +13,7 @@ namespace deformkit::warp {
 // inversion: every active T_i a translation (FFD, point-feature warps), all active T_i equal (a rigid
 // motion of a whole mesh-warp cage), or a single active T_i with strength 1 (a point at a mesh-warp
 // control vertex). Elsewhere the average of inverses is not the inverse of the average and the result
-// is only approximate (docs/warps/mesh_warp_decisions.md).
+// is only approximate (docs/decisions.md, INV-1).
 //
 // Displacement method: Affine inverse. Composition method: the inverse affine map re-decomposed about
 // the image of the pivot (T<pivot> = pivot + translation), so its components (-translation, the

@@ -18,7 +18,7 @@ namespace deformkit::warp {
 // where f_ab(t) = 1 for t <= a, 0 for t >= b and 1 - smoothstep((t - a) / (b - a)) between, E_ij the rest
 // edge vectors leaving control vertex i and E_im the longest of them. With the defaults a control vertex
 // reaches one longest-edge length around it and, along each edge, stops at the edge's far end, so it does
-// not compete with its neighbours there (docs/warps/mesh_warp_decisions.md).
+// not compete with its neighbours there (docs/decisions.md).
 struct MeshWarpOptions {
     float alpha = 0.0f;  // radial: full weight within alpha * |E_im| of P_i; 0 <= alpha < beta
     float beta = 1.0f;   // radial: zero weight beyond beta * |E_im|

@@ -18,7 +18,7 @@ namespace deformkit::warp {
 // transformation s . T(v) = X . R . S of the curve point C(v) it is attached to: S a uniform scale x about
 // C(v), R the minimal rotation taking the reference tangent to the wire tangent (about C(v)), X the
 // translation C*(v) - C(v); s = f(|P - C(v)| / r); transformations scaled by the composition method.
-// Decisions (parameterisation, tangents, quadrature, m): docs/warps/wires_decisions.md.
+// Decisions (parameterisation, tangents, quadrature, m): docs/decisions.md.
 
 enum class WiresVariant {
     Original,  // §4.4: each point follows only the nearest point of each reference curve (smallest
