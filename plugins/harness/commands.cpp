@@ -5,6 +5,7 @@
 #include <map>
 
 #include "demo_assets.h"
+#include "demo_warps.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/io/image.h"
@@ -149,6 +150,9 @@ std::vector<fs::path> demo(const DemoCommand& command) {
     view.drawEdges = false;
     written.push_back(command.outDir / "preview.png");
     io::writeImage(written.back(), io::renderPreview(assets.mesh, view, &texture));
+    for (fs::path& f : writeDemoWarps(assets.mesh, texture, assets.albedo.at(1001), command.outDir)) {
+        written.push_back(std::move(f));
+    }
     return written;
 }
 

@@ -45,14 +45,21 @@ expect demo 0 "$dk" demo --out "$work/demo" --resolution 64
 for f in tube.obj rigidity.1001.exr rigidity.1002.exr mask.1001.exr mask.1002.exr albedo.1001.png albedo.1002.png preview.png; do
     if [ ! -s "$work/demo/$f" ]; then echo "FAIL demo: $f missing"; failures=$((failures + 1)); fi
 done
+for w in ffd ffd_frames taper twist bend wires wires_smooth mesh_warp; do
+    for ext in obj png; do
+        [ -s "$work/demo/warps/$w.$ext" ] || { echo "FAIL demo: warps/$w.$ext missing"; failures=$((failures + 1)); }
+    done
+done
+[ -s "$work/demo/warps/beier_neely.png" ] || { echo "FAIL demo: warps/beier_neely.png missing"; failures=$((failures + 1)); }
 expect info-mesh 0 "$dk" info "$work/demo/tube.obj"
 contains info-mesh "$work/out" "vertices    22242"
 contains info-mesh "$work/out" "UDIM tiles 1001 1002"
 contains info-mesh "$work/out" "manifold    yes"
 # The same inputs give the same bytes: a second demo run is identical file for file.
 expect demo-again 0 "$dk" demo --out "$work/demo2" --resolution 64
-for f in "$work"/demo/*; do
-    if ! cmp -s "$f" "$work/demo2/$(basename "$f")"; then
+for f in "$work"/demo/* "$work"/demo/warps/*; do
+    [ -f "$f" ] || continue
+    if ! cmp -s "$f" "$work/demo2/${f#"$work"/demo/}"; then
         echo "FAIL determinism: $(basename "$f") differs between two demo runs"; failures=$((failures + 1))
     fi
 done
