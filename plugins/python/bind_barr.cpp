@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/barr.h"
 #include "deformkit/warp/barr_host.h"
@@ -20,26 +21,9 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using warp::AxialWarp;
 using warp::AxisFrame;
 using warp::ProfileCurve;
-
-std::string shapeOf(const FloatArray& a) {
-    std::string s = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i)
-        s += (i ? ", " : "") + std::to_string(a.shape(i));
-    return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
-std::vector<glm::vec3> pointsOf(const FloatArray& a, const char* source, const char* name) {
-    if (a.ndim() != 2 || a.shape(1) != 3) {
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
-    }
-    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
-    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
-    return out;
-}
 
 glm::vec3 vec3Of(const FloatArray& a, const char* source, const char* name) {
     if (a.ndim() != 1 || a.shape(0) != 3) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "deformkit/warp/beier_neely.h"
@@ -23,19 +24,11 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using warp::BeierNeelyVariant;
 using warp::Interpolation;
 using warp::SegmentPair;
 
 constexpr const char* kSource = "beier_neely";
-
-std::string shapeOf(const py::array& a) {
-    std::string s = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i)
-        s += (i ? ", " : "") + std::to_string(a.shape(i));
-    return s + (a.ndim() == 1 ? ",)" : ")");
-}
 
 // (n, 2, 2) lines: line i from (x, y) = a[i, 0] to a[i, 1], pixels.
 std::vector<glm::vec2> linesOf(const FloatArray& a, const char* name) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/ffd_frames.h"
@@ -20,28 +21,10 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 using warp::Ffd;
 using warp::FfdFrames;
 using warp::Frame;
 using warp::Lattice;
-
-std::string shapeOf(const py::array& a) {
-    std::string s = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i)
-        s += (i ? ", " : "") + std::to_string(a.shape(i));
-    return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
-std::vector<glm::vec3> pointsOf(const FloatArray& a, const char* source, const char* name) {
-    if (a.ndim() != 2 || a.shape(1) != 3) {
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
-    }
-    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
-    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
-    return out;
-}
 
 Lattice latticeOf(const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
                   const char* source) {
@@ -134,21 +117,6 @@ std::vector<Frame> framesOf(const FloatArray& origins, const FloatArray& bases, 
     for (size_t c = 0; c < o.size(); ++c)
         frames[c] = {o[c], b[c]};
     return frames;
-}
-
-std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t count, const char* source) {
-    if (!weights) return {};
-    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != count) {
-        throw InvalidInput(formatError(source, "weights", "has shape " + shapeOf(*weights),
-                                       "(" + std::to_string(count) + ",), one per point"));
-    }
-    return std::vector<float>(weights->data(), weights->data() + count);
-}
-
-py::array_t<float> toArray(const std::vector<glm::vec3>& pts) {
-    py::array_t<float> out({static_cast<py::ssize_t>(pts.size()), static_cast<py::ssize_t>(3)});
-    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
-    return out;
 }
 
 py::array_t<float> latticeArray(std::span<const glm::vec3> pts, const Lattice& l) {

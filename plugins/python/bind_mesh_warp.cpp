@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/mesh.h"
 #include "deformkit/warp/engine.h"
@@ -21,25 +22,7 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 constexpr const char* kSource = "mesh_warp";
-
-std::string shapeOf(const py::array& a) {
-    std::string s = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i)
-        s += (i ? ", " : "") + std::to_string(a.shape(i));
-    return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
-std::vector<glm::vec3> pointsOf(const FloatArray& a, const char* name) {
-    if (a.ndim() != 2 || a.shape(1) != 3) {
-        throw InvalidInput(formatError(kSource, name, "has shape " + shapeOf(a), "(n, 3) float32"));
-    }
-    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
-    std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
-    return out;
-}
 
 std::vector<int32_t> intsOf(const IntArray& a, const char* name) {
     if (a.ndim() != 1)
@@ -47,18 +30,9 @@ std::vector<int32_t> intsOf(const IntArray& a, const char* name) {
     return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
 }
 
-std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t numPoints) {
-    if (!weights) return {};
-    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != numPoints) {
-        throw InvalidInput(formatError(kSource, "weights", "has shape " + shapeOf(*weights),
-                                       "(" + std::to_string(numPoints) + ",), one per point"));
-    }
-    return std::vector<float>(weights->data(), weights->data() + numPoints);
-}
-
 geom::Mesh cageOf(const FloatArray& points, const IntArray& counts, const IntArray& indices) {
     geom::Mesh::Data d;
-    d.points = pointsOf(points, "cage_points");
+    d.points = pointsOf(points, kSource, "cage_points");
     d.faceCounts = intsOf(counts, "cage_face_counts");
     d.faceIndices = intsOf(indices, "cage_face_indices");
     return geom::Mesh(std::move(d), "mesh_warp cage");
@@ -73,12 +47,6 @@ warp::MeshWarpOptions optionsOf(float alpha, float beta, float gamma, float mu) 
     return o;
 }
 
-py::array_t<float> toArray(const std::vector<glm::vec3>& pts) {
-    py::array_t<float> out({static_cast<py::ssize_t>(pts.size()), static_cast<py::ssize_t>(3)});
-    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
-    return out;
-}
-
 // Bind once to a rest surface, evaluate for many target cages.
 class PyMeshWarp {
   public:
@@ -89,7 +57,7 @@ class PyMeshWarp {
           deformer_(std::make_unique<warp::WarpDeformer>(*warp_)) {}
 
     void bind(const FloatArray& restPoints) {
-        rest_ = pointsOf(restPoints, "rest_points");
+        rest_ = pointsOf(restPoints, kSource, "rest_points");
         py::gil_scoped_release release;
         deformer_->bind(rest_);
     }
@@ -100,9 +68,9 @@ class PyMeshWarp {
             throw InvalidInput(
                 formatError(kSource, "evaluate", "called before bind", "bind(rest_points) first"));
         }
-        warp_->setTarget(pointsOf(targetCage, "target_cage_points"));
-        std::vector<glm::vec3> pts = points ? pointsOf(*points, "points") : rest_;
-        const std::vector<float> w = weightsOf(weights, pts.size());
+        warp_->setTarget(pointsOf(targetCage, kSource, "target_cage_points"));
+        std::vector<glm::vec3> pts = points ? pointsOf(*points, kSource, "points") : rest_;
+        const std::vector<float> w = weightsOf(weights, pts.size(), kSource);
         {
             py::gil_scoped_release release;
             deformer_->evaluate(pts, w, envelope);
@@ -130,10 +98,10 @@ void bindMeshWarp(py::module_& m) {
         [](const FloatArray& points, const FloatArray& cagePoints, const IntArray& counts,
            const IntArray& indices, const FloatArray& targetCage, float alpha, float beta, float gamma,
            float mu, const std::optional<FloatArray>& weights, float envelope) {
-            std::vector<glm::vec3> pts = pointsOf(points, "points");
+            std::vector<glm::vec3> pts = pointsOf(points, kSource, "points");
             const geom::Mesh cage = cageOf(cagePoints, counts, indices);
-            const std::vector<glm::vec3> target = pointsOf(targetCage, "target_cage_points");
-            const std::vector<float> w = weightsOf(weights, pts.size());
+            const std::vector<glm::vec3> target = pointsOf(targetCage, kSource, "target_cage_points");
+            const std::vector<float> w = weightsOf(weights, pts.size(), kSource);
             {
                 py::gil_scoped_release release;
                 warp::meshWarp(pts, cage, target, optionsOf(alpha, beta, gamma, mu), w, envelope);

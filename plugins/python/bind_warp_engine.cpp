@@ -1,6 +1,7 @@
 // deformkit.warp_engine: the framework's Eq. (3) on dense per-point fields, for studio prototypes.
 #include <pybind11/numpy.h>
 
+#include "numpy_support.h"
 #include "bindings.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/engine.h"
@@ -9,8 +10,6 @@ namespace py = pybind11;
 
 namespace deformkit::python {
 namespace {
-
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
 void requireShape(const FloatArray& a, const char* name, std::initializer_list<py::ssize_t> shape) {
     bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());

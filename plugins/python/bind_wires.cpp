@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/curve.h"
 #include "deformkit/warp/wires.h"
@@ -19,24 +20,7 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using PerWire = std::variant<float, std::vector<float>>;
-
-std::string shapeOf(const FloatArray& a) {
-    std::string s = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i)
-        s += (i ? ", " : "") + std::to_string(a.shape(i));
-    return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
-std::vector<glm::vec3> points3(const FloatArray& a, const std::string& name) {
-    if (a.ndim() != 2 || a.shape(1) != 3) {
-        throw InvalidInput(formatError("wires", name, "has shape " + shapeOf(a), "(n, 3)"));
-    }
-    std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
-    if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
-    return out;
-}
 
 warp::CurveType curveType(const std::string& name) {
     if (name == "polyline") return warp::CurveType::Polyline;
@@ -68,7 +52,7 @@ struct CurveSampling {
     int32_t samplesPerSpan = 8;
 
     std::vector<glm::vec3> operator()(const FloatArray& a, const std::string& name) const {
-        const std::vector<glm::vec3> controls = points3(a, name);
+        const std::vector<glm::vec3> controls = pointsOf(a, "wires", name);
         if (type == warp::CurveType::Polyline) return controls;
         return warp::sampleCurve(controls, type, samplesPerSpan, name);
     }
@@ -99,21 +83,6 @@ std::vector<warp::Wire> makeWires(const std::vector<FloatArray>& references,
     return wires;
 }
 
-std::vector<float> paintedWeights(const std::optional<FloatArray>& weights, size_t n) {
-    if (!weights) return {};
-    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != n) {
-        throw InvalidInput(formatError("wires", "weights", "has shape " + shapeOf(*weights),
-                                       "(" + std::to_string(n) + ",), one per point"));
-    }
-    return std::vector<float>(weights->data(), weights->data() + n);
-}
-
-py::array_t<float> toArray(const std::vector<glm::vec3>& points) {
-    py::array_t<float> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-    if (!points.empty()) std::memcpy(out.mutable_data(), points.data(), points.size() * sizeof(glm::vec3));
-    return out;
-}
-
 // Bind once to rest points, then evaluate for new wire curves.
 class PyWires {
   public:
@@ -125,7 +94,7 @@ class PyWires {
                  warp::WiresOptions{variantOf(variant), m, samples}) {}
 
     void bind(const FloatArray& points) {
-        const std::vector<glm::vec3> rest = points3(points, "points");
+        const std::vector<glm::vec3> rest = pointsOf(points, "wires", "points");
         py::gil_scoped_release release;
         wires_.bind(rest);
     }
@@ -156,8 +125,8 @@ class PyWires {
                                 const std::optional<std::vector<FloatArray>>& wireCurves,
                                 const std::optional<FloatArray>& weights, float envelope) {
         if (wireCurves) setWireCurves(*wireCurves);
-        std::vector<glm::vec3> p = points3(points, "points");
-        const std::vector<float> w = paintedWeights(weights, p.size());
+        std::vector<glm::vec3> p = pointsOf(points, "wires", "points");
+        const std::vector<float> w = weightsOf(weights, p.size(), "wires");
         {
             py::gil_scoped_release release;
             wires_.evaluate(p, w, envelope);
@@ -185,8 +154,8 @@ void bindWires(py::module_& m) {
             const CurveSampling sampling{curveType(type), samplesPerSpan};
             warp::Wires wires(makeWires(referenceCurves, wireCurves, radius, scale, falloff, sampling),
                               warp::WiresOptions{variantOf(variant), exponent, samples});
-            std::vector<glm::vec3> p = points3(points, "points");
-            const std::vector<float> w = paintedWeights(weights, p.size());
+            std::vector<glm::vec3> p = pointsOf(points, "wires", "points");
+            const std::vector<float> w = weightsOf(weights, p.size(), "wires");
             {
                 py::gil_scoped_release release;
                 wires.bind(p);
