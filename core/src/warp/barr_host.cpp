@@ -99,6 +99,30 @@ BendSetup fromMayaBend(const MayaBend& m) {
     return out;
 }
 
+AxialSetup fromMayaTwist(const MayaTwist& m) {
+    const char* source = "Maya twist";
+    for (int i = 0; i < 3; ++i) {
+        requireFinite(m.handleOrigin[i], source, "handle origin");
+        requireFinite(m.handleY[i], source, "handle Y axis");
+    }
+    requireFinite(m.startAngle, source, "startAngle");
+    requireFinite(m.endAngle, source, "endAngle");
+    requireFinite(m.lowBound, source, "lowBound");
+    requireFinite(m.highBound, source, "highBound");
+    const double sy = glm::length(glm::dvec3(m.handleY));
+    if (!(sy > 0.0)) {
+        throw InvalidInput(formatError(source, "handle Y axis", "is a zero vector", "a non-degenerate handle"));
+    }
+    if (!(m.lowBound < m.highBound)) {
+        throw InvalidInput(formatError(source, "lowBound", "is not below highBound", "lowBound < highBound"));
+    }
+    // Handle units -> world units along the axis: times the handle's Y scale.
+    const Range r{m.lowBound * sy, m.highBound * sy};
+    const double slope = (m.endAngle - m.startAngle) / (r.hi - r.lo);
+    return {{m.handleOrigin, m.handleY, glm::vec3(0.0f)},
+            linearProfile(r, slope, m.startAngle - slope * r.lo, "Maya twist")};
+}
+
 AxialSetup fromBlenderTwist(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
     requireFinite(b.angle, "Blender twist", "angle");
     const int axis = static_cast<int>(b.deformAxis);

@@ -40,6 +40,21 @@ struct MayaBend {
 // a non-finite curvature or bound, lowBound > highBound.
 [[nodiscard]] BendSetup fromMayaBend(const MayaBend& maya);
 
+// Maya's nonLinear twist (deformTwist): rotates about the handle's local Y axis by startAngle at lowBound
+// and endAngle at highBound (radians; the UI shows degrees), linearly in between and held constant
+// beyond the bounds. Right-handed about handle +Y (not checked against Maya here; see docs/decisions.md).
+struct MayaTwist {
+    glm::vec3 handleOrigin{0.0f};         // handle translation, world units
+    glm::vec3 handleY{0.0f, 1.0f, 0.0f};  // world image of the handle's unit Y axis (rotation x scale)
+    double startAngle = 0.0;              // radians, at lowBound
+    double endAngle = 0.0;                // radians, at highBound
+    double lowBound = -1.0;               // handle units, < highBound
+    double highBound = 1.0;
+};
+// Throws InvalidInput for a zero or non-finite handle axis, a non-finite angle or bound, or
+// lowBound >= highBound.
+[[nodiscard]] AxialSetup fromMayaTwist(const MayaTwist& maya);
+
 // Blender's SimpleDeform modifier (twist, bend, taper modes), evaluated in the space of its origin
 // object (or the modified object when there is none): `basis` columns are that space's unit x, y, z
 // axes in world, `origin` its origin. The limits are fractions of the mesh's extent along the limit
