@@ -4,18 +4,27 @@
 #
 #   ./scripts/bench.sh                 all benchmarks, 5 repetitions each
 #   ./scripts/bench.sh --quick         1 repetition (a smoke run)
+#   DEFORMKIT_BUILD_DIR=build-perf ./scripts/bench.sh    benchmarks of another build folder
+#
+# When `blender` is on PATH, scripts/bench_blender.py also times Blender's Lattice and SimpleDeform modifiers
+# on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios (issue 3).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 reps=5
-if [ "${1:-}" = "--quick" ]; then reps=1; fi
+blender_reps=15
+if [ "${1:-}" = "--quick" ]; then
+    reps=1
+    blender_reps=3
+fi
+build=${DEFORMKIT_BUILD_DIR:-build}
 
-if ! ls build/bin/bench_* >/dev/null 2>&1; then
+if ! ls "$build"/bin/bench_* >/dev/null 2>&1; then
     ./scripts/setup.sh >/dev/null
 fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-for exe in build/bin/bench_*; do
+for exe in "$build"/bin/bench_*; do
     name=$(basename "$exe")
     echo "running $name ..." >&2
     if ! "$exe" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
@@ -24,4 +33,17 @@ for exe in build/bin/bench_*; do
         exit 1
     fi
 done
-python3 scripts/bench_table.py "$out"/*.json
+blender_json=()
+if command -v blender >/dev/null 2>&1; then
+    echo "running Blender's modifiers (scripts/bench_blender.py) ..." >&2
+    if ! blender -b --factory-startup --python-exit-code 1 --python scripts/bench_blender.py -- \
+        --reps "$blender_reps" --out "$out/blender.json" >"$out/blender.log" 2>&1; then
+        cat "$out/blender.log" >&2
+        exit 1
+    fi
+    blender_json=(--blender "$out/blender.json")
+fi
+python3 scripts/bench_table.py "${blender_json[@]}" "$out"/bench_*.json
+if [ ${#blender_json[@]} -eq 0 ]; then
+    echo "Blender comparison skipped: blender is not on PATH"
+fi

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Prints one table from Google Benchmark JSON files: median throughput per benchmark and the ratio
-against the reference benchmark measured in the same run. Usage: bench_table.py FILE.json..."""
+against the reference benchmark measured in the same run. With --blender (the JSON of
+scripts/bench_blender.py), also Blender's modifier shares and our evaluate / Blender ratios.
+Usage: bench_table.py [--blender BLENDER.json] FILE.json..."""
 import json
+import os
 import sys
 
 # benchmark -> (reference benchmark, what the ratio means)
@@ -12,7 +15,20 @@ REFERENCES = {
     "BM_BvhRayCast": ("BM_BruteForceRayCast", "BVH / brute-force ray cast"),
     "BM_BarrEvaluateEngine": ("BM_BarrEvaluate", "generic engine / fast path"),
     "BM_WiresEngineEvaluate": ("BM_WiresEvaluate", "generic engine / fast path"),
+    "BM_FfdEvaluatePortable": ("BM_FfdEvaluate", "portable kernel / runtime-selected kernel"),
 }
+
+
+# Our evaluate benchmark -> (Blender modifier in bench_blender.py's JSON, row label). Issue 3's target:
+# ours at least 3x faster than Blender's modifier share.
+BLENDER_PAIRS = [
+    ("BM_FfdEvaluate", "lattice", "FFD Bernstein 4x4x4 / Lattice (B-spline)"),
+    ("BM_FfdBSplineEvaluate", "lattice", "FFD B-spline 4x4x4 / Lattice (B-spline)"),
+    ("BM_BarrEvaluate/0", "taper", "taper / SimpleDeform taper"),
+    ("BM_BarrEvaluate/1", "twist", "twist / SimpleDeform twist"),
+    ("BM_BarrEvaluate/2", "bend", "bend / SimpleDeform bend"),
+]
+BLENDER_TARGET = 3.0
 
 
 def split_name(name):
@@ -53,7 +69,39 @@ def format_time(value, unit):
     return f"{seconds / 1e-9:.3g} ns"
 
 
-def main(paths):
+def print_blender(blender, medians, context):
+    shares = blender["modifier_share_ms"]
+    ours_threads = os.environ.get("OMP_NUM_THREADS") or f"all {context.get('num_cpus', '?')} cores"
+    print()
+    print(f"# Blender {blender['blender']} on the same {blender['vertices']:,}-vertex grid, same run: modifier "
+          f"share = depsgraph evaluation with the modifier - without, median of {blender['repetitions']}.")
+    print(f"# Threads: Blender {blender['threads']}, {blender['cpus']} cpus; ours OpenMP default "
+          f"({ours_threads}). Lattice interpolation {blender['lattice_interpolation']}.")
+    without = blender["eval_without_modifier_ms"]
+    print(f"{'blender evaluation, no modifier':40} {without['ffd_grid']:11.3g} ms   (1x1 grid); "
+          f"{without['barr_grid']:.3g} ms (4x1 grid)")
+    for name in ("lattice", "taper", "twist", "bend"):
+        label = "Lattice" if name == "lattice" else f"SimpleDeform {name}"
+        print(f"{'blender share: ' + label:40} {shares[name]:11.3g} ms")
+    print(f"{'ours / Blender (> 1: ours faster)':40} {'ours':>14} {'Blender':>10}   ratio (target >= {BLENDER_TARGET:g})")
+    for ours, theirs, label in BLENDER_PAIRS:
+        if ours not in medians:
+            continue
+        run = medians[ours]
+        ours_ms = run["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[run["time_unit"]]
+        ratio = shares[theirs] / ours_ms
+        verdict = "meets" if ratio >= BLENDER_TARGET else "MISSES"
+        print(f"{label:40} {ours_ms:11.3g} ms {shares[theirs]:7.3g} ms   {ratio:8.2f}x  ({verdict} target)")
+
+
+def main(argv):
+    blender = None
+    if "--blender" in argv:
+        at = argv.index("--blender")
+        with open(argv[at + 1]) as f:
+            blender = json.load(f)
+        argv = argv[:at] + argv[at + 2:]
+    paths = argv
     medians = {}
     context = None
     for path in paths:
@@ -82,6 +130,8 @@ def main(paths):
             ratio = f"{value / ref_value:8.3f}x  ({meaning})"
         shown = f"{value:,.1f} {unit}" if value is not None else "-"
         print(f"{name:40} {time:>14} {shown:>18}   {ratio}")
+    if blender:
+        print_blender(blender, medians, context or {})
 
 
 if __name__ == "__main__":

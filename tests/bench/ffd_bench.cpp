@@ -1,6 +1,7 @@
 // FFD (paper §4.1) with 4x4x4 control points (divisions 3, 3, 3) on a 1,000,000-vertex grid: bind (local
 // coordinates cached) and evaluate (a new target lattice) timed apart; evaluate on all threads and on one,
-// so the table shows the speed-up; the B-spline variant and FFD with frames beside it.
+// so the table shows the speed-up; the portable kernel (no AVX2), the B-spline variant and FFD with frames
+// beside it. scripts/bench_blender.py builds the same grid and lattice in Blender.
 #include <benchmark/benchmark.h>
 
 #include <omp.h>
@@ -89,6 +90,14 @@ void BM_FfdEvaluate1Thread(benchmark::State& state) {
     evaluateLoop(state, ffd, 1);
 }
 
+// The portable kernel where the CPU would take the AVX2 one: the table shows what runtime dispatch buys.
+void BM_FfdEvaluatePortable(benchmark::State& state) {
+    Ffd ffd(input().lattice, {FfdBasis::Bernstein, FfdOutside::None, FfdKernel::Portable});
+    ffd.setTargets(input().target);
+    evaluateLoop(state, ffd, 0);
+    state.SetLabel(ffdHasAvx2Kernel() ? "portable vs AVX2" : "no AVX2 here: both portable");
+}
+
 void BM_FfdBSplineEvaluate(benchmark::State& state) {
     Ffd ffd(input().lattice, {FfdBasis::BSpline});
     ffd.setTargets(input().target);
@@ -114,6 +123,7 @@ void BM_FfdSetTargets(benchmark::State& state) {
 BENCHMARK(BM_FfdBind)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate1Thread)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FfdEvaluatePortable)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdBSplineEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdFramesEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdSetTargets)->Unit(benchmark::kMicrosecond);

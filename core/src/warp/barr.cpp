@@ -38,13 +38,97 @@ double versinc(double t) {
     const double s = std::sin(0.5 * t);
     return 2.0 * s * s / t;
 }
-float sincf(float t) {
-    return std::abs(t) < 1e-3f ? 1.0f - t * t * (1.0f / 6.0f) : std::sin(t) / t;
-}
 float versincf(float t) {
     if (std::abs(t) < 1e-3f) return 0.5f * t;
     const float s = std::sin(0.5f * t);
     return 2.0f * s * s / t;
+}
+
+// The profile curve for the direct paths: the same Fritsch-Carlson Hermite segments as
+// ProfileCurve::operator(), evaluated inline in float. ProfileCurve works in double behind a call into
+// another translation unit, which was most of the per-point cost of taper and twist; the two agree to float
+// rounding (the engine path, which uses ProfileCurve, is checked against this one to 1e-5).
+class InlineProfile {
+  public:
+    explicit InlineProfile(const ProfileCurve& curve)
+        : z_(curve.z().data()),
+          y_(curve.values().data()),
+          m_(curve.tangents().data()),
+          n_(curve.z().size()) {}
+
+    float operator()(float z) const {
+        if (!(z > z_[0])) return y_[0];
+        if (z >= z_[n_ - 1]) return y_[n_ - 1];
+        const size_t k = static_cast<size_t>(std::upper_bound(z_, z_ + n_, z) - z_) - 1;
+        const float h = z_[k + 1] - z_[k], t = (z - z_[k]) / h;
+        const float t2 = t * t, t3 = t2 * t;
+        const float h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+        return h00 * y_[k] + h10 * h * m_[k] + h01 * y_[k + 1] + h11 * h * m_[k + 1];
+    }
+
+  private:
+    const float *z_, *y_, *m_;
+    size_t n_;
+};
+
+// sinc and versinc from an already computed s = sin t, c = cos t, sparing the bend's direct path two more
+// trigonometric calls per point: (1 - cos t) / t = sin^2 t / ((1 + cos t) t), exact algebra, well
+// conditioned while cos t > -1/2; near t = 0 and beyond |t| = 2 pi / 3 the direct forms above.
+float sincFrom(float t, float s) {
+    return std::abs(t) < 1e-3f ? 1.0f - t * t * (1.0f / 6.0f) : s / t;
+}
+float versincFrom(float t, float s, float c) {
+    if (std::abs(t) < 1e-3f) return 0.5f * t;
+    if (c > -0.5f) return s * s / ((1.0f + c) * t);
+    return versincf(t);
+}
+
+// sin and cos of a block of angles without calls or branches, so that the compiler vectorises the loop
+// (4 angles an SSE2 instruction; a glibc sincosf call per point was a third of the twist's time). The angle
+// is reduced by the nearest multiple q of pi/2, with pi/2 split in three parts (Cody-Waite) so that q * part
+// stays exact or nearly, to r in [-pi/4, pi/4]; then the Taylor series to degree 9 (sin) and 10 (cos), whose
+// truncation error there is below 2e-9, far under float rounding. The quadrant q mod 4 swaps and negates.
+// Valid for |t| <= kBlockTrigLimit; the callers fall back to std::sin/std::cos beyond it.
+constexpr float kBlockTrigLimit = 8192.0f;
+constexpr int kTrigBlock = 256;  // points per block: the scratch arrays live on the stack
+
+void sinCosBlock(const float* t, float* sinOut, float* cosOut, int count) {
+    constexpr float kTwoOverPi = 0.636619772367581343f;
+    constexpr float kHalfPi1 = 1.5703125f;                // 8 significant bits: q * kHalfPi1 exact
+    constexpr float kHalfPi2 = 4.837512969970703125e-4f;  // 13 bits
+    constexpr float kHalfPi3 = 7.54978995489188216e-8f;   // the rest of pi/2
+    constexpr float kRound = 12582912.0f;                 // 1.5 * 2^23: adding it rounds to an integer
+    for (int i = 0; i < count; ++i) {
+        const float x = t[i];
+        const float q = (x * kTwoOverPi + kRound) - kRound;
+        const float r = ((x - q * kHalfPi1) - q * kHalfPi2) - q * kHalfPi3;
+        const float r2 = r * r;
+        const float sr =
+            r * (1.0f + r2 * (-1.0f / 6 + r2 * (1.0f / 120 + r2 * (-1.0f / 5040 + r2 * (1.0f / 362880)))));
+        const float cr =
+            1.0f + r2 * (-0.5f + r2 * (1.0f / 24 +
+                                       r2 * (-1.0f / 720 + r2 * (1.0f / 40320 + r2 * (-1.0f / 3628800)))));
+        const int quadrant = static_cast<int>(q) & 3;
+        const float sq = (quadrant & 1) ? cr : sr, cq = (quadrant & 1) ? sr : cr;
+        sinOut[i] = (quadrant & 2) ? -sq : sq;
+        cosOut[i] = ((quadrant + 1) & 2) ? -cq : cq;
+    }
+}
+
+// sinCosBlock, or std::sin/std::cos for the whole block when an angle is beyond its range (or not finite).
+// The choice depends on the block's own angles only, so the output does not depend on the thread count.
+void sinCos(const float* t, float* sinOut, float* cosOut, int count) {
+    bool small = true;
+    for (int i = 0; i < count; ++i)
+        small = small && std::abs(t[i]) <= kBlockTrigLimit;
+    if (small) {
+        sinCosBlock(t, sinOut, cosOut, count);
+        return;
+    }
+    for (int i = 0; i < count; ++i) {
+        sinOut[i] = std::sin(t[i]);
+        cosOut[i] = std::cos(t[i]);
+    }
 }
 
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
@@ -182,12 +266,15 @@ void TaperWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3>
     requireBound(points.size(), "points");
     requireBound(out.size(), "output points");
     const glm::vec3 o = frame_.origin, a = frame_.axis;
-#pragma omp parallel for schedule(static)
+    const InlineProfile profile(profile_);
+    // Dynamic chunks of 4096 points (here and in twist and bend): a thread the host deschedules does not
+    // hold up the others. Each point depends on its own inputs only: any schedule gives the same output.
+#pragma omp parallel for schedule(dynamic, 4096)
     for (int64_t u = 0; u < static_cast<int64_t>(points.size()); ++u) {
         const glm::vec3 p = points[u];
         const glm::vec3 d = p - o;
         const glm::vec3 radial = d - glm::dot(d, a) * a;
-        out[u] = p + (profile_(restZ_[u]) - 1.0f) * radial;
+        out[u] = p + (profile(restZ_[u]) - 1.0f) * radial;
     }
 }
 
@@ -206,14 +293,25 @@ void TwistWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3>
     requireBound(points.size(), "points");
     requireBound(out.size(), "output points");
     const glm::vec3 o = frame_.origin, a = frame_.axis;
-#pragma omp parallel for schedule(static)
-    for (int64_t u = 0; u < static_cast<int64_t>(points.size()); ++u) {
-        const glm::vec3 p = points[u];
-        const glm::vec3 d = p - o;
-        const glm::vec3 radial = d - glm::dot(d, a) * a;
-        const float t = angle_(restZ_[u]);
-        // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
-        out[u] = p + (std::cos(t) - 1.0f) * radial + std::sin(t) * glm::cross(a, radial);
+    const InlineProfile angle(angle_);
+    const int64_t n = static_cast<int64_t>(points.size());
+    // Blocks of points: the angles first, then their sines and cosines in one vectorised pass. Chunks of 16
+    // blocks = 4096 points.
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
+        const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
+        float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
+        for (int i = 0; i < count; ++i)
+            t[i] = angle(restZ_[begin + i]);
+        sinCos(t, sinT, cosT, count);
+        for (int i = 0; i < count; ++i) {
+            const int64_t u = begin + i;
+            const glm::vec3 p = points[u];
+            const glm::vec3 d = p - o;
+            const glm::vec3 radial = d - glm::dot(d, a) * a;
+            // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
+            out[u] = p + (cosT[i] - 1.0f) * radial + sinT[i] * glm::cross(a, radial);
+        }
     }
 }
 
@@ -257,16 +355,26 @@ void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> 
         if (out.data() != points.data()) std::copy(points.begin(), points.end(), out.begin());
         return;
     }
-#pragma omp parallel for schedule(static)
-    for (int64_t u = 0; u < static_cast<int64_t>(points.size()); ++u) {
-        const glm::vec3 l = f.toLocal(points[u]);
-        const float zc = std::clamp(restZ_[u], lo, hi);
-        const float d = zc - z0, t = k * d;
-        const float c = std::cos(t), s = std::sin(t);
-        const float along = l.z - zc;  // 0 inside the range for the rest points themselves
-        const float y = c * l.y + s * along + d * versincf(t);
-        const float z = z0 + d * sincf(t) - s * l.y + c * along;
-        out[u] = f.origin + l.x * f.side + y * f.up + z * f.axis;
+    const int64_t n = static_cast<int64_t>(points.size());
+    // Blocks of points as in the twist: angles, then their sines and cosines in one vectorised pass.
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
+        const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
+        float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
+        for (int i = 0; i < count; ++i)
+            t[i] = k * (std::clamp(restZ_[begin + i], lo, hi) - z0);
+        sinCos(t, sinT, cosT, count);
+        for (int i = 0; i < count; ++i) {
+            const int64_t u = begin + i;
+            const glm::vec3 l = f.toLocal(points[u]);
+            const float zc = std::clamp(restZ_[u], lo, hi);
+            const float d = zc - z0;
+            const float c = cosT[i], s = sinT[i];
+            const float along = l.z - zc;  // 0 inside the range for the rest points themselves
+            const float y = c * l.y + s * along + d * versincFrom(t[i], s, c);
+            const float z = z0 + d * sincFrom(t[i], s) - s * l.y + c * along;
+            out[u] = f.origin + l.x * f.side + y * f.up + z * f.axis;
+        }
     }
 }
 

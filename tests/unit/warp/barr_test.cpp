@@ -252,6 +252,37 @@ TEST_CASE("Barr identity: f = 1, theta = 0, k = 0", "[barr][warp]") {
     CHECK(maxDistance(enginePath(bend, rest, rest), rest) < 1e-6f);
 }
 
+TEST_CASE("twist: block sine and cosine over every quadrant and beyond their range", "[barr][warp]") {
+    // The direct twist and bend paths take sin/cos of blocks of angles with their own reduction and
+    // polynomials (barr.cpp); here against double std::cos/std::sin of the same float angle, with constant
+    // profiles so the angle is exactly the sample. Half-steps from -60 to 60 rad, angles just either side of
+    // multiples of pi/4 (the quadrant switches), and two beyond the block range (the std:: fallback).
+    std::vector<float> angles;
+    for (int i = -120; i <= 120; ++i)
+        angles.push_back(0.5f * static_cast<float>(i));
+    for (int k = -16; k <= 16; ++k) {
+        const float at = static_cast<float>(k) * kPi / 4.0f;
+        angles.push_back(std::nextafter(at, -1e9f));
+        angles.push_back(std::nextafter(at, 1e9f));
+    }
+    angles.push_back(10000.5f);
+    angles.push_back(-9000.25f);
+    const std::vector<glm::vec3> rest = {{1.0f, 0.0f, 0.3f}, {0.0f, 1.0f, -2.0f}, {0.6f, -0.8f, 5.0f}};
+    float worst = 0.0f;
+    for (const float theta : angles) {
+        TwistWarp twist({{0, 0, 0}, {0, 0, 1}, {0, 1, 0}}, ProfileCurve::constant(theta));
+        const auto out = directPath(twist, rest, rest);
+        const double c = std::cos(static_cast<double>(theta)), s = std::sin(static_cast<double>(theta));
+        for (size_t i = 0; i < rest.size(); ++i) {
+            const glm::dvec3 p(rest[i]);
+            const glm::dvec3 expected(c * p.x - s * p.y, s * p.x + c * p.y, p.z);
+            worst = std::max(worst, static_cast<float>(glm::length(glm::dvec3(out[i]) - expected)));
+        }
+    }
+    INFO("largest error " << worst);
+    CHECK(worst < 1e-6f);
+}
+
 TEST_CASE("Barr: the direct path equals the engine path, also on moved points", "[barr][warp]") {
     const auto rest = randomPoints(5000, 2.5f, 12);
     auto moved = rest;

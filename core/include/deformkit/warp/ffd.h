@@ -49,10 +49,20 @@ struct Lattice {
 inline constexpr int32_t kMaxFfdDivisions = 1024;
 inline constexpr int32_t kMaxBernsteinDegree = 64;
 
+// Which kernel the fast path may use for the common Bernstein 4x4x4 lattice (divisions 3, 3, 3). Auto takes
+// the AVX2+FMA kernel when the CPU has it (checked at run time; the build sets no -march), else the portable
+// one. Portable forces the portable kernel: for tests and benchmarks that compare the two. Results of the
+// two agree to float rounding (FMA), not bit for bit; each is bit-identical for any thread count.
+enum class FfdKernel { Auto, Portable };
+
 struct FfdOptions {
     FfdBasis basis = FfdBasis::Bernstein;
     FfdOutside outside = FfdOutside::None;
+    FfdKernel kernel = FfdKernel::Auto;
 };
+
+// True when this CPU runs the AVX2+FMA kernel under FfdKernel::Auto.
+[[nodiscard]] bool ffdHasAvx2Kernel();
 
 // The lattice geometry, its weighting fields and the bind cache (each point's local coordinates), shared
 // by Ffd and FfdFrames. Throws InvalidInput naming the element on a bad lattice: divisions < 1 or too
@@ -93,6 +103,11 @@ class FfdLattice {
                 std::span<const float> weights, float envelope) const;
 
   private:
+    // deform() for Bernstein divisions (3, 3, 3) with translations: SoA blocks of 8 points through the
+    // kernel options_.kernel selects (ffd.cpp).
+    void deformBernstein444(std::span<glm::vec3> points, const float* translations,
+                            std::span<const float> weights, float envelope) const;
+
     Lattice lattice_;
     FfdOptions options_;
     glm::dmat3 toLocal_{1.0};         // inverse of the axes
