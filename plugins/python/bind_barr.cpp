@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/barr.h"
 #include "deformkit/warp/barr_host.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 
@@ -81,6 +81,32 @@ py::dict frameDict(const AxisFrame& f) {
 
 }  // namespace
 
+// The bind/evaluate class of a profile-driven axial warp (Taper, Twist): constructed bound to rest points.
+template <class W>
+void bindProfileWarpClass(py::module_& m, const char* name, const char* doc) {
+    using namespace pybind11::literals;
+    py::class_<W>(m, name, doc)
+        .def(py::init([name](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
+                             const FloatArray& z, const FloatArray& v) {
+                 auto w = std::make_unique<W>(
+                     AxisFrame{vec3Of(origin, name, "axis_origin"), vec3Of(axis, name, "axis_dir")},
+                     profileOf(z, v, name));
+                 bindRest(*w, rest, name);
+                 return w;
+             }),
+             "rest_points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a)
+        .def(
+            "set_profile",
+            [name](W& w, const FloatArray& z, const FloatArray& v) { w.setProfile(profileOf(z, v, name)); },
+            "z_samples"_a, "value_samples"_a)
+        .def(
+            "evaluate",
+            [name](W& w, const FloatArray& points, const std::optional<FloatArray>& weights, float envelope) {
+                return run(w, points, weights, envelope, name);
+            },
+            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f);
+}
+
 void bindBarr(py::module_& m) {
     using namespace pybind11::literals;
 
@@ -130,49 +156,10 @@ void bindBarr(py::module_& m) {
         "[lo, hi] onto an arc of radius 1/k and continued straight outside. "
         "weights: (n,) painted weights or None for 1; envelope scales the whole effect.");
 
-    py::class_<warp::TaperWarp>(m, "Taper", "Barr taper bound to rest points; set_profile, then evaluate.")
-        .def(py::init([](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
-                         const FloatArray& z, const FloatArray& v) {
-                 auto w = std::make_unique<warp::TaperWarp>(
-                     AxisFrame{vec3Of(origin, "Taper", "axis_origin"), vec3Of(axis, "Taper", "axis_dir")},
-                     profileOf(z, v, "Taper"));
-                 bindRest(*w, rest, "Taper");
-                 return w;
-             }),
-             "rest_points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a)
-        .def(
-            "set_profile",
-            [](warp::TaperWarp& w, const FloatArray& z, const FloatArray& v) {
-                w.setProfile(profileOf(z, v, "Taper"));
-            },
-            "z_samples"_a, "value_samples"_a)
-        .def(
-            "evaluate",
-            [](warp::TaperWarp& w, const FloatArray& points, const std::optional<FloatArray>& weights,
-               float envelope) { return run(w, points, weights, envelope, "Taper"); },
-            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f);
-
-    py::class_<warp::TwistWarp>(m, "Twist", "Barr twist bound to rest points; set_profile, then evaluate.")
-        .def(py::init([](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
-                         const FloatArray& z, const FloatArray& v) {
-                 auto w = std::make_unique<warp::TwistWarp>(
-                     AxisFrame{vec3Of(origin, "Twist", "axis_origin"), vec3Of(axis, "Twist", "axis_dir")},
-                     profileOf(z, v, "Twist"));
-                 bindRest(*w, rest, "Twist");
-                 return w;
-             }),
-             "rest_points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a)
-        .def(
-            "set_profile",
-            [](warp::TwistWarp& w, const FloatArray& z, const FloatArray& v) {
-                w.setProfile(profileOf(z, v, "Twist"));
-            },
-            "z_samples"_a, "value_samples"_a)
-        .def(
-            "evaluate",
-            [](warp::TwistWarp& w, const FloatArray& points, const std::optional<FloatArray>& weights,
-               float envelope) { return run(w, points, weights, envelope, "Twist"); },
-            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f);
+    bindProfileWarpClass<warp::TaperWarp>(m, "Taper",
+                                          "Barr taper bound to rest points; set_profile, then evaluate.");
+    bindProfileWarpClass<warp::TwistWarp>(m, "Twist",
+                                          "Barr twist bound to rest points; set_profile, then evaluate.");
 
     py::class_<warp::BendWarp>(m, "Bend", "Barr bend bound to rest points; set_params, then evaluate.")
         .def(py::init([](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
