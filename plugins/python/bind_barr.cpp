@@ -81,6 +81,23 @@ py::dict frameDict(const AxisFrame& f) {
 
 }  // namespace
 
+// The one-off function of a profile-driven axial warp (taper, twist): bind to `points`, deform a copy.
+template <class W>
+void defineProfileWarpFunction(py::module_& m, const char* name, const char* doc) {
+    using namespace pybind11::literals;
+    m.def(
+        name,
+        [name](const FloatArray& points, const FloatArray& origin, const FloatArray& axis,
+               const FloatArray& z, const FloatArray& v, const std::optional<FloatArray>& weights,
+               float envelope) {
+            W w({vec3Of(origin, name, "axis_origin"), vec3Of(axis, name, "axis_dir")}, profileOf(z, v, name));
+            bindRest(w, points, name);
+            return run(w, points, weights, envelope, name);
+        },
+        "points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a, "weights"_a = py::none(),
+        "envelope"_a = 1.0f, doc);
+}
+
 // The bind/evaluate class of a profile-driven axial warp (Taper, Twist): constructed bound to rest points.
 template <class W>
 void bindProfileWarpClass(py::module_& m, const char* name, const char* doc) {
@@ -110,32 +127,13 @@ void bindProfileWarpClass(py::module_& m, const char* name, const char* doc) {
 void bindBarr(py::module_& m) {
     using namespace pybind11::literals;
 
-    m.def(
-        "taper",
-        [](const FloatArray& points, const FloatArray& origin, const FloatArray& axis, const FloatArray& z,
-           const FloatArray& v, const std::optional<FloatArray>& weights, float envelope) {
-            warp::TaperWarp w({vec3Of(origin, "taper", "axis_origin"), vec3Of(axis, "taper", "axis_dir")},
-                              profileOf(z, v, "taper"));
-            bindRest(w, points, "taper");
-            return run(w, points, weights, envelope, "taper");
-        },
-        "points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a, "weights"_a = py::none(),
-        "envelope"_a = 1.0f,
+    defineProfileWarpFunction<warp::TaperWarp>(
+        m, "taper",
         "Barr taper (paper §4.3.1): the two coordinates across the axis scaled by f(z), f given by samples\n"
         "(z ascending, monotone cubic, held outside). points (n, 3) float32; returns a new (n, 3) array.\n"
         "weights: (n,) painted weights or None for 1; envelope scales the whole effect.");
-
-    m.def(
-        "twist",
-        [](const FloatArray& points, const FloatArray& origin, const FloatArray& axis, const FloatArray& z,
-           const FloatArray& v, const std::optional<FloatArray>& weights, float envelope) {
-            warp::TwistWarp w({vec3Of(origin, "twist", "axis_origin"), vec3Of(axis, "twist", "axis_dir")},
-                              profileOf(z, v, "twist"));
-            bindRest(w, points, "twist");
-            return run(w, points, weights, envelope, "twist");
-        },
-        "points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a, "weights"_a = py::none(),
-        "envelope"_a = 1.0f,
+    defineProfileWarpFunction<warp::TwistWarp>(
+        m, "twist",
         "Barr twist: rotation by theta(z) radians about the axis (right-handed), theta given by samples.\n"
         "weights: (n,) painted weights or None for 1; envelope scales the whole effect.");
 

@@ -17,10 +17,14 @@
 #include "deformkit/error.h"
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/ffd.h"
+#include "warp_test_support.h"
 #include "deformkit/warp/ffd_frames.h"
 
 using namespace deformkit;
 using namespace deformkit::warp;
+using deformkit::test::maxError;
+using deformkit::test::samplePoints;
+using deformkit::test::viaEngine;
 
 namespace {
 
@@ -44,28 +48,6 @@ Lattice skewLattice(glm::ivec3 divisions) {
 glm::mat3 rotationZ(float angle) {
     const float c = std::cos(angle), s = std::sin(angle);
     return glm::mat3(glm::vec3(c, s, 0), glm::vec3(-s, c, 0), glm::vec3(0, 0, 1));
-}
-
-std::vector<glm::vec3> samplePoints(const Lattice& l, std::mt19937& rng, int count, float lo, float hi) {
-    std::uniform_real_distribution<float> uni(lo, hi);
-    std::vector<glm::vec3> pts(count);
-    for (auto& p : pts)
-        p = l.origin + l.axes * glm::vec3(uni(rng), uni(rng), uni(rng));
-    return pts;
-}
-
-std::vector<glm::vec3> viaEngine(Warp& warp, std::vector<glm::vec3> pts) {
-    WarpDeformer deformer(warp);
-    deformer.bind(pts);
-    deformer.evaluate(pts);
-    return pts;
-}
-
-float maxError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
 }
 
 }  // namespace

@@ -16,9 +16,13 @@
 #include "deformkit/error.h"
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/ffd.h"
+#include "warp_test_support.h"
 
 using namespace deformkit;
 using namespace deformkit::warp;
+using deformkit::test::maxError;
+using deformkit::test::samplePoints;
+using deformkit::test::viaEngine;
 
 namespace {
 
@@ -121,23 +125,6 @@ std::vector<glm::vec3> randomTargets(const Lattice& l, std::mt19937& rng, float 
     return t;
 }
 
-// Points at local coordinates uniform in [lo, hi]^3.
-std::vector<glm::vec3> samplePoints(const Lattice& l, std::mt19937& rng, int count, float lo, float hi) {
-    std::uniform_real_distribution<float> uni(lo, hi);
-    std::vector<glm::vec3> pts(count);
-    for (auto& p : pts)
-        p = l.origin + l.axes * glm::vec3(uni(rng), uni(rng), uni(rng));
-    return pts;
-}
-
-std::vector<glm::vec3> viaEngine(Warp& warp, std::vector<glm::vec3> pts, std::span<const float> weights = {},
-                                 float envelope = 1.0f) {
-    WarpDeformer deformer(warp);
-    deformer.bind(pts);
-    deformer.evaluate(pts, weights, envelope);
-    return pts;
-}
-
 // The generic engine bound to rest and evaluated at upstream points.
 std::vector<glm::vec3> viaEngineFrom(Warp& warp, const std::vector<glm::vec3>& rest,
                                      std::vector<glm::vec3> upstream, std::span<const float> weights,
@@ -146,13 +133,6 @@ std::vector<glm::vec3> viaEngineFrom(Warp& warp, const std::vector<glm::vec3>& r
     deformer.bind(rest);
     deformer.evaluate(upstream, weights, envelope);
     return upstream;
-}
-
-float maxError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
 }
 
 bool outsideUnit(const glm::dvec3& s) {
