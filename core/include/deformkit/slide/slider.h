@@ -1,0 +1,111 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/slide/falloff.h"
+#include "deformkit/slide/region.h"
+
+namespace deformkit::slide {
+
+// Which surface slid vertices travel over.
+enum class SurfaceMode {
+    Cage,   // the mesh itself (its fan triangles): slid vertices stay exactly on it (the paper)
+    Limit,  // the Catmull-Clark limit surface of the rest mesh (OpenSubdiv): a vertex moves by how far the
+            // limit point under it travels, so a mesh subdivided at render time slides over its smooth shape
+};
+
+// What a rigger sets up per handle; fixed at bind.
+struct SlideHandle {
+    int32_t vertex = 0;                             // the handle vertex P0
+    double radius = 1.0;                            // support radius r, scene units, > 0
+    RegionMetric region = RegionMetric::Euclidean;  // how r is measured
+};
+
+// What drives a handle at evaluation; one per handle.
+struct SlideDrive {
+    glm::dvec3 displacement{0.0};  // d = end locator - start locator, scene units (world space of the mesh)
+    Falloff falloff = Falloff::smooth();  // of distance / radius
+};
+
+struct SlideOptions {
+    SurfaceMode surface = SurfaceMode::Cage;
+    // Triangles one vertex's walk may cross in one evaluation before it stops (and is counted): the
+    // expansion limit for displacements many times larger than the region.
+    int32_t maxWalkTriangles = 4096;
+};
+
+// Where a moved vertex landed: a triangle of the rest mesh's fan triangulation, given by its polygon and
+// its three vertices, and barycentric coordinates on them (Eq. 8).
+struct SlideLanding {
+    int32_t vertex = -1;
+    int32_t face = -1;
+    std::array<int32_t, 3> triangle{-1, -1, -1};
+    std::array<double, 3> barycentric{0.0, 0.0, 0.0};
+};
+
+struct SlideResult {
+    std::vector<SlideLanding> landings;  // one per moved vertex, ascending vertex index
+    int32_t moved = 0;
+    int32_t boundaryStopped = 0;      // reached a mesh boundary (or a degenerate triangle) and stopped on it
+    int32_t limitStopped = 0;         // stopped after maxWalkTriangles triangles
+    int32_t unreachable = 0;          // within a radius but not reachable by the propagation: unmoved (bind)
+    int32_t withoutTangentPlane = 0;  // within a radius but only degenerate triangles around: unmoved (bind)
+    int32_t degenerateTriangles = 0;  // zero-area triangles touching an active vertex: skipped (bind)
+    int32_t chordFallbacks = 0;       // local-map vertices whose normal curve failed; the chord stood in
+};
+
+// The sliding deformer (Pinskiy, "Sliding deformation"): bind once per rest mesh and handle set, evaluate
+// per locator drag. Binding builds the rest surface, each handle's support region and propagated region
+// basis; each vertex's local parameterisation starts as its one-ring and grows on demand during
+// evaluation, and what it grows is kept for the next evaluation.
+//
+// Several handles compose by adding their tangent displacements in each vertex's tangent space before the
+// single walk over the surface (order-independent; on a plane exactly the sum of the translations).
+// evaluate() may be called from several threads; calls are serialised, each one runs in parallel.
+class Slider {
+  public:
+    // Throws InvalidInput naming `source` for: no handles, a handle index out of range, a handle that no
+    // face uses or that is non-manifold, a radius <= 0 or not finite; TopologyError for a non-manifold
+    // handle.
+    Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const SlideOptions& options = {},
+           const std::string& source = "mesh");
+    ~Slider();
+    Slider(Slider&&) noexcept;
+    Slider& operator=(Slider&&) noexcept;
+
+    [[nodiscard]] int32_t numVertices() const;
+    [[nodiscard]] int32_t numHandles() const;
+    [[nodiscard]] const std::vector<SlideHandle>& handles() const;
+    [[nodiscard]] const SupportRegion& region(int32_t handle) const;
+    // Vertices in at least one handle's region (union), ascending.
+    [[nodiscard]] std::span<const int32_t> activeVertices() const;
+    // Vertices cached beyond one-rings by all local maps so far (grows with larger displacements).
+    [[nodiscard]] size_t expandedMapEntries() const;
+
+    // points: #V positions, moved in place by each vertex's slide (landing - rest position); pass the rest
+    // positions for a plain slide. drives: one per handle. weights: #V painted weights in [0, 1] scaling
+    // the falloff (empty: all 1). envelope scales every slide. Throws InvalidInput for a wrong count or a
+    // non-finite value, naming it, before anything is written.
+    void evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
+                  std::span<const float> weights = {}, float envelope = 1.0f, SlideResult* result = nullptr);
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// One-off: bind and evaluate once, returning the slid copy of the mesh's points.
+[[nodiscard]] std::vector<glm::vec3> slide(const geom::Mesh& mesh, std::span<const SlideHandle> handles,
+                                           std::span<const SlideDrive> drives,
+                                           std::span<const float> weights = {}, float envelope = 1.0f,
+                                           const SlideOptions& options = {}, SlideResult* result = nullptr);
+
+}  // namespace deformkit::slide
