@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <thread>
 
 #include <omp.h>
 #include <catch2/catch.hpp>
@@ -521,4 +522,25 @@ TEST_CASE("slide on the limit surface follows the Catmull-Clark limit of the cag
     CHECK(largestMove > 0.2);
     CHECK(worst < 1e-5);  // float positions (~1e-7); the closest curve point is found to ~1e-12
     CHECK(worstZ < 1e-5);
+}
+
+TEST_CASE("slide: evaluations from several threads match sequential ones", "[slide]") {
+    // The on-demand expansion of local maps is shared state: concurrent evaluate calls must not corrupt it.
+    const geom::Mesh mesh = test::icosphere(4, 1.0f);
+    const std::vector<SlideDrive> small = {{glm::dvec3(0.02, 0.05, -0.01)}};
+    const std::vector<SlideDrive> large = {{glm::dvec3(-0.2, 0.1, 0.15)}};  // grows the maps beyond one-rings
+    Slider reference(mesh, {{30, 0.6}});
+    auto expectedSmall = restPoints(mesh), expectedLarge = restPoints(mesh);
+    reference.evaluate(small, expectedSmall);
+    reference.evaluate(large, expectedLarge);
+
+    Slider shared(mesh, {{30, 0.6}});
+    std::vector<std::vector<glm::vec3>> outs(8, restPoints(mesh));
+    std::vector<std::thread> threads;
+    for (int i = 0; i < 8; ++i)
+        threads.emplace_back([&, i] { shared.evaluate(i % 2 ? large : small, outs[i]); });
+    for (auto& t : threads) t.join();
+    for (int i = 0; i < 8; ++i) CHECK(outs[i] == (i % 2 ? expectedLarge : expectedSmall));
+    CHECK(shared.expandedMapEntries() == reference.expandedMapEntries());
+    CHECK(shared.expandedMapEntries() > 0);
 }
