@@ -1,0 +1,81 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "deformkit/uvwarp/grid.h"
+
+namespace deformkit::uvwarp {
+
+struct SolverOptions {
+    // Hierarchy depth (paper §4.4): number of levels including the finest. 0 picks the depth whose coarsest
+    // grid has 8 cells per side (or fewer levels for small grids).
+    int32_t levels = 0;
+    // PBD iterations per solve (paper §4.1). With warm start, frames after the first start from the last
+    // warp.
+    int32_t iterations = 12;
+    // Constraint-projection sweeps (all 8 parallel sets) per iteration at each level, finest first; levels
+    // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion.
+    std::vector<int32_t> sweepsPerLevel = {1, 2, 4};
+    // Orientation preservation in [0, 1] (§4.2): after projection a segment is turned this fraction of the
+    // way back towards its canonical direction (0°, 45°, 90°, 135°). Multiplied by the optional map.
+    float orientationPreservation = 0.05f;
+    // s in Eq. 4: how much as-rigid-as-possible points are smoothed (non-rigid points are smoothed fully).
+    float smoothing = 0.1f;
+    // Velocity damping in [0, 1]: the fraction of the velocity removed each iteration (§4.1 step 1).
+    float damping = 0.5f;
+    // Stiffness multiplier per level above the finest: level l applies corrections scaled by
+    // coarseStiffness^l (§4.4: coarse segments map to curves, not lines, so coarse corrections are applied
+    // more conservatively).
+    float coarseStiffness = 0.9f;
+};
+
+// Figures from the last solve.
+struct SolveStats {
+    int32_t iterations = 0;
+    int32_t levels = 0;
+    int32_t untangledPoints = 0;  // points moved by the fold repair (should be 0 in normal use)
+    int32_t remainingFolds = 0;   // grid triangles left with non-positive area (both cell splittings)
+};
+
+// The content-aware warp solver of Koniaris et al. on one UV tile's grid: hierarchical position-based
+// dynamics over the 8-connected grid's edge constraints (Eq. 1-3), with regularisation (Eq. 4-5).
+// State (positions, velocities) persists between solves: each solve warm-starts from the last warp, so a
+// static pose converges to a static warp and an animation changes smoothly.
+//
+// Inputs are fields on the (n + 1)^2 grid points (grid.h): restGeometry f_O (3 channels), rigidity R in
+// [0, 1], mask M (0 or 1; tile-border points never move whatever the mask says), and optionally an
+// orientation-preservation map in [0, 1] (empty: 1 everywhere).
+class Solver {
+  public:
+    Solver(const PointField& restGeometry, const PointField& rigidity, const PointField& mask,
+           const SolverOptions& options = {}, const PointField& orientation = {},
+           const std::string& source = "tile");
+    ~Solver();
+    Solver(Solver&&) noexcept;
+    Solver& operator=(Solver&&) noexcept;
+
+    // New rigidity / mask / orientation maps (a painter's edit): rebuilds the per-level hierarchies (Eq.
+    // 7-8).
+    void setMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation = {});
+    // One frame: deformedGeometry f_D (3 channels, same grid). Returns the warp W.
+    const WarpGrid& solve(const PointField& deformedGeometry);
+    // Back to the identity warp with zero velocity (a cut in the shot).
+    void reset();
+
+    [[nodiscard]] const WarpGrid& warp() const;
+    [[nodiscard]] const SolveStats& stats() const;
+    [[nodiscard]] int32_t cells() const;
+    [[nodiscard]] int32_t levels() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Number of grid triangles with signed area <= 0, counting both diagonal splittings of every cell.
+[[nodiscard]] int32_t countFolds(const WarpGrid& warp);
+
+}  // namespace deformkit::uvwarp

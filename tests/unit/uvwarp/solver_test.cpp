@@ -1,0 +1,249 @@
+#include <cmath>
+#include <cstring>
+#include <functional>
+
+#include <omp.h>
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/uvwarp/solver.h"
+
+using namespace deformkit;
+using uvwarp::PointField;
+using uvwarp::WarpGrid;
+
+namespace {
+
+PointField field(int32_t cells, int32_t channels, const std::function<void(float, float, float*)>& f) {
+    PointField out;
+    out.cells = cells;
+    out.channels = channels;
+    out.values.resize(static_cast<size_t>(cells + 1) * (cells + 1) * channels);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i)
+            f(static_cast<float>(i) / cells, static_cast<float>(j) / cells, &out.values[out.index(i, j)]);
+    return out;
+}
+
+// Rigid disks of radius 0.07 on a 3 x 3 lattice over an elastic background.
+float disks(float u, float v) {
+    for (float cu : {0.25f, 0.5f, 0.75f})
+        for (float cv : {0.25f, 0.5f, 0.75f})
+            if (std::hypot(u - cu, v - cv) < 0.07f) return 1.0f;
+    return 0.0f;
+}
+
+// Independent bilinear look-up of a 3-channel field (the test's own, not the solver's).
+glm::dvec3 lookup(const PointField& f, double u, double v) {
+    const double x = std::clamp(u, 0.0, 1.0) * f.cells, y = std::clamp(v, 0.0, 1.0) * f.cells;
+    const int i = std::min(static_cast<int>(x), f.cells - 1), j = std::min(static_cast<int>(y), f.cells - 1);
+    const double fx = x - i, fy = y - j;
+    auto at = [&](int a, int b) {
+        const float* p = &f.values[f.index(a, b)];
+        return glm::dvec3(p[0], p[1], p[2]);
+    };
+    return (1 - fx) * (1 - fy) * at(i, j) + fx * (1 - fy) * at(i + 1, j) + (1 - fx) * fy * at(i, j + 1) +
+           fx * fy * at(i + 1, j + 1);
+}
+
+// Mean |l_def / l_org - 1| over the 8-connected edges whose rigidity (max of the ends) is >= 0.5.
+double rigidStretchError(const WarpGrid& w, const PointField& rest, const PointField& deformed,
+                         const PointField& rigidity) {
+    const int n = w.cells, side = n + 1;
+    double sum = 0.0;
+    int count = 0;
+    const int offsets[4][4] = {{0, 0, 1, 0}, {0, 0, 0, 1}, {0, 0, 1, 1}, {1, 0, 0, 1}};
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            for (const auto& o : offsets) {
+                const int ai = i + o[0], aj = j + o[1], bi = i + o[2], bj = j + o[3];
+                if (std::max({ai, bi}) > n || std::max({aj, bj}) > n) continue;
+                const size_t a = static_cast<size_t>(aj) * side + ai, b = static_cast<size_t>(bj) * side + bi;
+                if (std::max(rigidity.values[a], rigidity.values[b]) < 0.5f) continue;
+                const double lOrg = glm::length(lookup(rest, double(bi) / n, double(bj) / n) -
+                                                lookup(rest, double(ai) / n, double(aj) / n));
+                const double lDef =
+                    glm::length(lookup(deformed, w.u[b], w.v[b]) - lookup(deformed, w.u[a], w.v[a]));
+                sum += std::abs(lDef / lOrg - 1.0);
+                ++count;
+            }
+    return sum / count;
+}
+
+struct Scene {
+    PointField rest, deformed, rigidity, mask;
+};
+
+Scene stretchedPlane(int32_t cells, float stretch) {
+    Scene s;
+    s.rest = field(cells, 3, [](float u, float v, float* p) {
+        p[0] = u;
+        p[1] = v;
+        p[2] = 0.0f;
+    });
+    s.deformed = field(cells, 3, [&](float u, float v, float* p) {
+        p[0] = stretch * u;
+        p[1] = v;
+        p[2] = 0.0f;
+    });
+    s.rigidity = field(cells, 1, [](float u, float v, float* p) { p[0] = disks(u, v); });
+    s.mask = field(cells, 1, [](float, float, float* p) { p[0] = 1.0f; });
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("uv warp keeps rigid disks at rest size on a plane stretched 1.5x along u", "[uvwarp]") {
+    const Scene s = stretchedPlane(128, 1.5f);
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    const WarpGrid identity = WarpGrid::identity(128);
+    const double before = rigidStretchError(identity, s.rest, s.deformed, s.rigidity);
+    const WarpGrid& warp = solver.solve(s.deformed);
+    const double after = rigidStretchError(warp, s.rest, s.deformed, s.rigidity);
+    INFO("rigid stretch error: identity " << before << ", warp " << after << ", removed "
+                                          << 100.0 * (1.0 - after / before) << "%, untangled "
+                                          << solver.stats().untangledPoints);
+    CHECK(after <= 0.2 * before);  // the "at least 80% removed"
+    CHECK(uvwarp::countFolds(warp) == 0);
+    CHECK(solver.stats().remainingFolds == 0);
+}
+
+TEST_CASE("uv warp under 0.7x compression removes at least half the rigid error", "[uvwarp]") {
+    const Scene s = stretchedPlane(128, 0.7f);
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    const double before = rigidStretchError(WarpGrid::identity(128), s.rest, s.deformed, s.rigidity);
+    const WarpGrid& warp = solver.solve(s.deformed);
+    const double after = rigidStretchError(warp, s.rest, s.deformed, s.rigidity);
+    INFO("compression 0.7: identity " << before << " warp " << after << " untangled "
+                                      << solver.stats().untangledPoints);
+    CHECK(after <= 0.5 * before);  // the "at least 50%": a bounded domain cannot grow every feature
+    CHECK(uvwarp::countFolds(warp) == 0);
+}
+
+namespace {
+
+double maxMove(const WarpGrid& a, const WarpGrid& b) {
+    double worst = 0.0;
+    for (size_t k = 0; k < a.u.size(); ++k)
+        worst = std::max(worst, std::hypot(double(a.u[k]) - b.u[k], double(a.v[k]) - b.v[k]));
+    return worst;
+}
+
+}  // namespace
+
+TEST_CASE("uv warp: extreme compression keeps every grid triangle positive", "[uvwarp]") {
+    for (float squeeze : {0.4f, 0.25f}) {
+        const Scene s = stretchedPlane(64, squeeze);
+        uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+        for (int frame = 0; frame < 3; ++frame)
+            solver.solve(s.deformed);
+        INFO("squeeze " << squeeze);
+        CHECK(uvwarp::countFolds(solver.warp()) == 0);
+    }
+}
+
+TEST_CASE("uv warp: masked points and the tile border do not move", "[uvwarp]") {
+    Scene s = stretchedPlane(64, 1.5f);
+    // A masked vertical stripe through the middle disk's column.
+    s.mask = field(64, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.5f) < 0.05f ? 0.0f : 1.0f; });
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    const WarpGrid& warp = solver.solve(s.deformed);
+    const WarpGrid identity = WarpGrid::identity(64);
+    double worstMasked = 0.0, worstBorder = 0.0, moved = 0.0;
+    for (int j = 0; j <= 64; ++j)
+        for (int i = 0; i <= 64; ++i) {
+            const size_t k = static_cast<size_t>(j) * 65 + i;
+            const double d = std::hypot(double(warp.u[k]) - identity.u[k], double(warp.v[k]) - identity.v[k]);
+            if (s.mask.values[k] < 0.5f) worstMasked = std::max(worstMasked, d);
+            if (i == 0 || j == 0 || i == 64 || j == 64) worstBorder = std::max(worstBorder, d);
+            moved = std::max(moved, d);
+        }
+    CHECK(worstMasked == 0.0);
+    CHECK(worstBorder == 0.0);
+    CHECK(moved > 0.01);  // the rest of the tile did warp
+}
+
+TEST_CASE("uv warp: an undeformed pose keeps the identity warp", "[uvwarp]") {
+    const Scene s = stretchedPlane(64, 1.0f);  // f_D = f_O
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    const WarpGrid& warp = solver.solve(s.deformed);
+    CHECK(maxMove(warp, WarpGrid::identity(64)) < 1e-6);  // float rounding of the Gaussian blend only
+}
+
+TEST_CASE("uv warp: a static pose converges to a static warp with warm start", "[uvwarp]") {
+    const Scene s = stretchedPlane(64, 1.5f);
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    WarpGrid previous = solver.solve(s.deformed);
+    double firstChange = 0.0, lastChange = 0.0;
+    for (int frame = 1; frame < 12; ++frame) {
+        const WarpGrid& current = solver.solve(s.deformed);
+        const double change = maxMove(current, previous);
+        if (frame == 1) firstChange = change;
+        lastChange = change;
+        previous = current;
+    }
+    INFO("warp change per frame: first " << firstChange << ", last " << lastChange << " (texels: x64)");
+    CHECK(lastChange < 0.05 / 64.0);  // under a twentieth of a texel per frame once settled
+    CHECK(lastChange < 0.25 * firstChange);
+}
+
+TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]") {
+    // Stretch ramps 1.30, 1.31, ... : the per-frame warp change stays bounded by a small multiple of the
+    // change a 1-frame step causes at a settled state, and never jumps.
+    const int n = 64;
+    Scene s = stretchedPlane(n, 1.3f);
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    for (int f = 0; f < 6; ++f)
+        solver.solve(s.deformed);  // settle on the first pose
+    WarpGrid previous = solver.warp();
+    std::vector<double> changes;
+    for (int f = 1; f <= 8; ++f) {
+        const float stretch = 1.3f + 0.01f * f;
+        s.deformed = field(n, 3, [&](float u, float v, float* p) {
+            p[0] = stretch * u;
+            p[1] = v;
+            p[2] = 0.0f;
+        });
+        const WarpGrid& current = solver.solve(s.deformed);
+        changes.push_back(maxMove(current, previous));
+        previous = current;
+    }
+    const double largest = *std::max_element(changes.begin(), changes.end());
+    const double smallest = *std::min_element(changes.begin(), changes.end());
+    INFO("per-frame change from " << smallest << " to " << largest);
+    CHECK(largest < 4.0 * smallest);
+    CHECK(largest < 2.0 / n);  // under two texels for a 0.01 stretch step
+}
+
+TEST_CASE("uv warp: the same bytes for 1 and 2 threads", "[uvwarp]") {
+    const Scene s = stretchedPlane(64, 0.6f);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    uvwarp::Solver one(s.rest, s.rigidity, s.mask);
+    const WarpGrid a = one.solve(s.deformed);
+    omp_set_num_threads(2);
+    uvwarp::Solver two(s.rest, s.rigidity, s.mask);
+    const WarpGrid b = two.solve(s.deformed);
+    omp_set_num_threads(saved);
+    CHECK(std::memcmp(a.u.data(), b.u.data(), a.u.size() * sizeof(float)) == 0);
+    CHECK(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(float)) == 0);
+}
+
+TEST_CASE("uv warp: bad solver input names what is wrong", "[uvwarp]") {
+    const Scene s = stretchedPlane(64, 1.5f);
+    Scene bad = stretchedPlane(48, 1.5f);
+    CHECK_THROWS_WITH(uvwarp::Solver(bad.rest, bad.rigidity, bad.mask), Catch::Contains("power of two"));
+    PointField wrong = s.rigidity;
+    wrong.values.pop_back();
+    CHECK_THROWS_WITH(uvwarp::Solver(s.rest, wrong, s.mask), Catch::Contains("rigidity"));
+    PointField outOfRange = s.rigidity;
+    outOfRange.values[100] = 1.5f;
+    CHECK_THROWS_WITH(uvwarp::Solver(s.rest, outOfRange, s.mask), Catch::Contains("grid point 100"));
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    CHECK_THROWS_WITH(solver.solve(bad.deformed), Catch::Contains("deformed geometry image"));
+    uvwarp::SolverOptions options;
+    options.damping = 2.0f;
+    CHECK_THROWS_AS(uvwarp::Solver(s.rest, s.rigidity, s.mask, options), InvalidInput);
+}
