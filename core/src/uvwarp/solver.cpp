@@ -25,6 +25,10 @@ constexpr std::array<EdgeType, 4> kEdgeTypes = {{
     {1, 0, 0, 1, -kHalfSqrt2, kHalfSqrt2},  // shear1, 135°
 }};
 
+// Loops over fewer rows than this run on one thread: coarse levels are tiny, and a fork and barrier per
+// tiny loop costs more than the loop (badly so when the machine is oversubscribed).
+constexpr int64_t kParallelRows = 64;
+
 // 3x3 Gaussian kernel K_G (Eq. 5 and 7): (1 2 1) x (1 2 1) / 16.
 constexpr std::array<float, 3> kGauss = {0.25f, 0.5f, 0.25f};
 
@@ -185,7 +189,7 @@ struct Solver::Impl {
                     // Vertical segments of cell rows j = parity, parity + 2, ...: a band (rows j, j+1 of
                     // points) reads rows j-1 .. j+2, so bands 4 rows apart run together.
                     for (int32_t phase = 0; phase < 2; ++phase) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
                         for (int32_t j = parity + 2 * phase; j < c; j += 4) {
                             for (int32_t i = 0; i <= c; ++i)
                                 projectEdge(level, 1, i, j, stiffness);
@@ -198,7 +202,7 @@ struct Solver::Impl {
                 const int32_t bands = type == 0 ? c + 1 : c;
                 const int32_t phases = type == 0 ? 2 : 3;
                 for (int32_t phase = 0; phase < phases; ++phase) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(bands))
                     for (int32_t j = phase; j < bands; j += phases) {
                         for (int32_t i = parity; i < c; i += 2)
                             projectEdge(level, type, i, j, stiffness);
@@ -214,7 +218,7 @@ struct Solver::Impl {
         const int32_t c = level.cells;
         const size_t s = static_cast<size_t>(level.stride);
         const size_t row = s * static_cast<size_t>(side());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
         for (int32_t j = 1 + ((colourJ + 1) & 1); j < c; j += 2) {
             for (int32_t i = 1 + ((colourI + 1) & 1); i < c; i += 2) {
                 if (onlyNew && (i % 2 == 0) && (j % 2 == 0)) continue;
@@ -256,7 +260,7 @@ struct Solver::Impl {
             int32_t movedThisPass = 0, folded = 0;
             for (int32_t colour = 0; colour < 4; ++colour) {
                 const int32_t colourI = colour & 1, colourJ = colour >> 1;
-#pragma omp parallel for schedule(static) reduction(+ : movedThisPass, folded)
+#pragma omp parallel for schedule(static) reduction(+ : movedThisPass, folded) if(kParallelRows < static_cast<int64_t>(c))
                 for (int32_t j = 1 + ((colourJ + 1) & 1); j < c; j += 2) {
                     for (int32_t i = 1 + ((colourI + 1) & 1); i < c; i += 2) {
                         const size_t k = fine(level, i, j);
@@ -285,7 +289,7 @@ struct Solver::Impl {
     // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level.
     void propagate(const Level& coarse, const Level& finer) {
         const int32_t c = coarse.cells;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(finer.cells))
         for (int32_t jj = 0; jj <= finer.cells; ++jj) {
             for (int32_t ii = 0; ii <= finer.cells; ++ii) {
                 if ((ii & 1) == 0 && (jj & 1) == 0) continue;  // a coarse point: moved by its own level
@@ -311,7 +315,7 @@ struct Solver::Impl {
 
     void snapshot(Level& level) {
         const int32_t n = level.side();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
         for (int32_t j = 0; j < n; ++j) {
             for (int32_t i = 0; i < n; ++i) {
                 const size_t k = fine(level, i, j);
@@ -330,7 +334,7 @@ struct Solver::Impl {
         const size_t n = grid.u.size();
         const float keep = 1.0f - options.damping;
         // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force).
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
             oldU[k] = grid.u[k];
             oldV[k] = grid.v[k];
@@ -360,7 +364,7 @@ struct Solver::Impl {
         // Step 4: regularisation (Eq. 4-5) on the finest grid.
         regulariseAll(levels[0], false);
         // Step 5: integration.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
             velU[k] = grid.u[k] - oldU[k];
             velV[k] = grid.v[k] - oldV[k];
@@ -421,7 +425,7 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         const Level& from = levels[l - 1];
         Level& to = levels[l];
         const int32_t fc = from.cells;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(to.cells))
         for (int32_t j = 0; j <= to.cells; ++j) {
             for (int32_t i = 0; i <= to.cells; ++i) {
                 float r = 0.0f, o = 0.0f;
@@ -561,7 +565,7 @@ int32_t Solver::levels() const {
 int32_t countFolds(const WarpGrid& warp) {
     const int32_t n = warp.cells, side = n + 1;
     int32_t folds = 0;
-#pragma omp parallel for schedule(static) reduction(+ : folds)
+#pragma omp parallel for schedule(static) reduction(+ : folds) if (kParallelRows < static_cast <int64_t>(n))
     for (int32_t j = 0; j < n; ++j) {
         for (int32_t i = 0; i < n; ++i) {
             const size_t a = static_cast<size_t>(j) * side + i, b = a + 1, c = a + side + 1, d = a + side;
