@@ -5,6 +5,7 @@
 #include <map>
 
 #include "demo_assets.h"
+#include "demo_slide.h"
 #include "demo_warps.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
@@ -151,6 +152,9 @@ std::vector<fs::path> demo(const DemoCommand& command) {
     written.push_back(command.outDir / "preview.png");
     io::writeImage(written.back(), io::renderPreview(assets.mesh, view, &texture));
     for (fs::path& f : writeDemoWarps(assets.mesh, texture, assets.albedo.at(1001), command.outDir)) {
+        written.push_back(std::move(f));
+    }
+    for (fs::path& f : writeDemoSlide(assets.mesh, command.outDir)) {
         written.push_back(std::move(f));
     }
     return written;

@@ -28,7 +28,8 @@ struct DemoCommand {
     std::filesystem::path outDir = "demo-out";
     int32_t resolution = 1024;
 };
-// `deformkit demo`: writes the demo assets and a preview into outDir; returns the files written.
+// `deformkit demo`: writes the demo assets and a preview into outDir, the warps into outDir/warps and the
+// slide into outDir/slide; returns the files written.
 std::vector<std::filesystem::path> demo(const DemoCommand& command);
 
 }  // namespace deformkit::harness

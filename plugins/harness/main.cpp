@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "slide_command.h"
 #include "warp_command.h"
 #include "deformkit/error.h"
 #include "deformkit/version.h"
@@ -66,6 +67,36 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"bilinear", "bicubic"}))
         ->capture_default_str();
 
+    harness::SlideCommand slideCommand;
+    std::string slideMesh, slideOut, slideFrom, slideTo, slideFalloff = "smooth", slideWeights;
+    std::string slideRegion = "euclidean", slideSurface = "cage";
+    auto* slideApp = app.add_subcommand("slide", "Slide vertices over the surface around a handle (Pinskiy)");
+    slideApp->add_option("MESH", slideMesh, "mesh (.obj)")->required();
+    slideApp->add_option("--handle", slideCommand.handle.vertex, "handle vertex index (0-based)")->required();
+    slideApp->add_option("--from", slideFrom, "start locator x,y,z")->required();
+    slideApp->add_option("--to", slideTo, "end locator x,y,z: the handle region slides by to - from")
+        ->required();
+    slideApp->add_option("--radius", slideCommand.handle.radius, "support radius, scene units")->required();
+    slideApp->add_option("--out", slideOut, "output mesh (.obj), UVs and groups kept")->required();
+    slideApp
+        ->add_option("--falloff", slideFalloff,
+                     "smooth, linear, or ramp samples v0,v1,... over distance/radius")
+        ->capture_default_str();
+    slideApp->add_option("--weights", slideWeights, "painted weights: a JSON array of one number per vertex");
+    slideApp->add_option("--envelope", slideCommand.envelope, "scales every slide")->capture_default_str();
+    slideApp->add_option("--region", slideRegion, "euclidean (3D distance) or geodesic (over the surface)")
+        ->check(CLI::IsMember({"euclidean", "geodesic"}))
+        ->capture_default_str();
+    slideApp
+        ->add_option("--surface", slideSurface, "cage (the mesh) or limit (its Catmull-Clark limit surface)")
+        ->check(CLI::IsMember({"cage", "limit"}))
+        ->capture_default_str();
+    slideApp
+        ->add_option("--max-walk", slideCommand.options.maxWalkTriangles,
+                     "triangles one vertex may cross before it stops")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -95,6 +126,19 @@ int main(int argc, char** argv) {
                 warpInterp == "bicubic" ? warp::Interpolation::Bicubic : warp::Interpolation::Bilinear;
             harness::warpImageCommand(warpCommand);
             std::cout << "wrote " << warpOut << "\n";
+        } else if (*slideApp) {
+            slideCommand.mesh = slideMesh;
+            slideCommand.out = slideOut;
+            slideCommand.from = harness::parsePoint(slideFrom, "--from");
+            slideCommand.to = harness::parsePoint(slideTo, "--to");
+            slideCommand.falloff = harness::parseFalloff(slideFalloff);
+            if (!slideWeights.empty()) slideCommand.weights = slideWeights;
+            slideCommand.handle.region =
+                slideRegion == "geodesic" ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean;
+            slideCommand.options.surface =
+                slideSurface == "limit" ? slide::SurfaceMode::Limit : slide::SurfaceMode::Cage;
+            const slide::SlideResult result = harness::slideCommand(slideCommand);
+            std::cout << harness::slideSummary(slideOut, result) << "\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);

@@ -11,5 +11,6 @@ void bindBeierNeely(pybind11::module_& m);
 void bindWires(pybind11::module_& m);
 void bindMeshWarp(pybind11::module_& m);
 void bindWarpEngine(pybind11::module_& m);
+void bindSlide(pybind11::module_& m);
 
 }  // namespace deformkit::python

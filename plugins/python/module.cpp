@@ -212,6 +212,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindWires(m);
     python::bindMeshWarp(m);
     python::bindBeierNeely(m);
+    python::bindSlide(m);
 
     m.def("make_capped_tube", [] { return geom::makeCappedTube(); }, "The demo's capped tube (UDIM 1001-1002).");
 }

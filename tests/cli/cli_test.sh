@@ -51,13 +51,24 @@ for w in ffd ffd_frames taper twist bend wires wires_smooth mesh_warp; do
     done
 done
 [ -s "$work/demo/warps/beier_neely.png" ] || { echo "FAIL demo: warps/beier_neely.png missing"; failures=$((failures + 1)); }
+for f in tube_slid.obj checker.1001.png checker.1002.png before.png after.png slide.png; do
+    [ -s "$work/demo/slide/$f" ] || { echo "FAIL demo: slide/$f missing"; failures=$((failures + 1)); }
+done
+# docs/slide.md's commands remake the demo's slide pictures byte for byte.
+for pair in "tube.obj before" "slide/tube_slid.obj after"; do
+    set -- $pair
+    expect "slide-preview-$2" 0 "$dk" preview "$work/demo/$1" --texture "$work/demo/slide/checker.<UDIM>.png" \
+        --width 480 --height 480 --view -0.45,-0.3,-1 --out "$work/slide_$2.png"
+    cmp -s "$work/slide_$2.png" "$work/demo/slide/$2.png" ||
+        { echo "FAIL slide-preview-$2: differs from the demo's slide/$2.png"; failures=$((failures + 1)); }
+done
 expect info-mesh 0 "$dk" info "$work/demo/tube.obj"
 contains info-mesh "$work/out" "vertices    22242"
 contains info-mesh "$work/out" "UDIM tiles 1001 1002"
 contains info-mesh "$work/out" "manifold    yes"
 # The same inputs give the same bytes: a second demo run is identical file for file.
 expect demo-again 0 "$dk" demo --out "$work/demo2" --resolution 64
-for f in "$work"/demo/* "$work"/demo/warps/*; do
+for f in "$work"/demo/* "$work"/demo/warps/* "$work"/demo/slide/*; do
     [ -f "$f" ] || continue
     if ! cmp -s "$f" "$work/demo2/${f#"$work"/demo/}"; then
         echo "FAIL determinism: $(basename "$f") differs between two demo runs"; failures=$((failures + 1))
@@ -95,6 +106,44 @@ expect warp-bad-json 2 "$dk" warp "$work/demo/albedo.1001.png" --lines "$work/ba
 contains warp-bad-json "$work/err" "lines[0].src[1][1]"
 [ ! -e "$work/w2.png" ] || { echo "FAIL warp-bad-json: output written"; failures=$((failures + 1)); }
 expect warp-bad-variant 2 "$dk" warp "$work/demo/albedo.1001.png" --lines "$work/same.json" --out "$work/w3.png" --variant sideways
+
+# Slide: an 11 x 11 grid of 0.1-unit quads at z = 0 with UVs and a group. Vertex (i, j) is number
+# 11 j + i (0-based) at (0.1 i, 0.1 j, 0).
+awk 'BEGIN {
+    for (j = 0; j <= 10; j++) for (i = 0; i <= 10; i++) printf "v %g %g 0\n", i / 10, j / 10
+    for (j = 0; j <= 10; j++) for (i = 0; i <= 10; i++) printf "vt %g %g\n", i / 10, j / 10
+    print "g sheet"
+    for (j = 0; j < 10; j++) for (i = 0; i < 10; i++) {
+        a = 11 * j + i + 1
+        printf "f %d/%d %d/%d %d/%d %d/%d\n", a, a, a + 1, a + 1, a + 12, a + 12, a + 11, a + 11
+    }
+}' >"$work/grid.obj"
+expect slide 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --out "$work/slid.obj"
+contains slide "$work/out" "wrote $work/slid.obj: moved "
+contains slide "$work/out" "boundary-stopped 0, limit-stopped 0, unreachable 0, degenerate 0"
+[ "$(wc -l <"$work/out")" -eq 1 ] || { echo "FAIL slide: expected one summary line"; failures=$((failures + 1)); }
+[ "$(grep -c '^vt ' "$work/slid.obj")" -eq 121 ] || { echo "FAIL slide-uvs: UVs not kept"; failures=$((failures + 1)); }
+contains slide-group "$work/slid.obj" "g sheet"
+# Closed form on a plane: vertex 61 at (0.6, 0.5) is 0.1 from the handle (0.5, 0.5), x = 1/3 of the
+# radius, falloff 1 - 3x^2 + 2x^3 = 20/27: it moves to x = 0.6 + 0.1 * 20/27 (float positions: 1e-6).
+awk -v want="$(awk 'BEGIN { printf "%.9f", 0.6 + 0.1 * 20 / 27 }')" '
+    /^v / { n++; if (n == 62) { d = $2 - want; if (d < 0) d = -d; found = 1; e = $3 - 0.5; if (e < 0) e = -e; exit (d < 1e-6 && e < 1e-6 && $4 == 0) ? 0 : 1 } }
+    END { if (!found) exit 1 }' "$work/slid.obj" && passed=$((passed + 1)) ||
+    { echo "FAIL slide-closed-form: vertex 61 is not at x = 0.674074"; grep '^v ' "$work/slid.obj" | sed -n 62p; failures=$((failures + 1)); }
+printf '[1, 1]' >"$work/short.json"
+expect slide-bad-weights 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --weights "$work/short.json" --out "$work/s2.obj"
+contains slide-bad-weights "$work/err" "has 2 weights"
+expect slide-bad-handle 2 "$dk" slide "$work/grid.obj" --handle 500 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --out "$work/s2.obj"
+contains slide-bad-handle "$work/err" "vertex index out of range"
+expect slide-bad-from 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0 --to 0.1,0,0 --radius 0.3 --out "$work/s2.obj"
+contains slide-bad-from "$work/err" "--from: '0,0' is not a point"
+expect slide-bad-falloff 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --falloff 1,2 --out "$work/s2.obj"
+contains slide-bad-falloff "$work/err" "--falloff"
+expect slide-bad-region 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --region sphere --out "$work/s2.obj"
+expect slide-missing-mesh 2 "$dk" slide "$work/nope.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --out "$work/s2.obj"
+contains slide-missing-mesh "$work/err" "nope.obj"
+[ ! -e "$work/s2.obj" ] || { echo "FAIL slide errors: output written"; failures=$((failures + 1)); }
+expect slide-options 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0.05,0 --radius 0.3 --falloff 1,0.5,0 --envelope 0.5 --region geodesic --surface limit --max-walk 64 --out "$work/s3.obj"
 
 # A truncated image is a clear error, not a crash.
 head -c 300 "$work/demo/albedo.1001.png" >"$work/trunc.png"

@@ -1,0 +1,138 @@
+#include "slide_command.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/io/obj.h"
+
+namespace deformkit::harness {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Comma-separated numbers; false when a field is empty, not a number, or not finite.
+bool parseNumbers(std::string_view text, std::vector<double>& out) {
+    out.clear();
+    size_t start = 0;
+    while (true) {
+        const size_t comma = text.find(',', start);
+        const std::string field(
+            text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+        if (field.empty()) return false;
+        char* end = nullptr;
+        const double value = std::strtod(field.c_str(), &end);
+        if (end == field.c_str()) return false;
+        while (*end == ' ')
+            ++end;
+        if (*end != '\0' || !std::isfinite(value)) return false;
+        out.push_back(value);
+        if (comma == std::string_view::npos) return true;
+        start = comma + 1;
+    }
+}
+
+std::string typeName(const json& v) {
+    if (v.is_null()) return "null";
+    if (v.is_boolean()) return "a boolean";
+    if (v.is_number()) return "a number";
+    if (v.is_string()) return "a string";
+    if (v.is_array()) return "an array of " + std::to_string(v.size());
+    return "an object";
+}
+
+}  // namespace
+
+glm::dvec3 parsePoint(std::string_view text, const std::string& option) {
+    std::vector<double> v;
+    if (!parseNumbers(text, v) || v.size() != 3) {
+        throw InvalidInput(formatError(option, "", "'" + std::string(text) + "' is not a point",
+                                       "three finite numbers: x,y,z"));
+    }
+    return {v[0], v[1], v[2]};
+}
+
+slide::Falloff parseFalloff(std::string_view text, const std::string& option) {
+    if (text == "smooth") return slide::Falloff::smooth();
+    if (text == "linear") return slide::Falloff::linear();
+    std::vector<double> v;
+    if (!parseNumbers(text, v)) {
+        throw InvalidInput(formatError(option, "", "'" + std::string(text) + "' is not a falloff",
+                                       "smooth, linear, or ramp samples v0,v1,... in [0, 1]"));
+    }
+    std::vector<float> samples(v.begin(), v.end());
+    return slide::Falloff::ramp(samples, option);
+}
+
+std::vector<float> parseWeights(std::string_view text, size_t count, const std::string& source) {
+    json root;
+    try {
+        root = json::parse(text.begin(), text.end());
+    } catch (const json::exception& e) {
+        // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: ...": keep the part
+        // after the bracketed id.
+        std::string what = e.what();
+        const size_t at = what.find("] ");
+        throw ParseError(formatError(source, "", at == std::string::npos ? what : what.substr(at + 2),
+                                     "a JSON array of one number per vertex"));
+    }
+    if (!root.is_array()) {
+        throw InvalidInput(
+            formatError(source, "(top level)", "is " + typeName(root), "an array of one number per vertex"));
+    }
+    if (root.size() != count) {
+        throw InvalidInput(formatError(source, "", "has " + std::to_string(root.size()) + " weights",
+                                       std::to_string(count) + ", one per vertex of the mesh"));
+    }
+    std::vector<float> weights(count);
+    for (size_t i = 0; i < count; ++i) {
+        const json& v = root[i];
+        const std::string path = std::string("[").append(std::to_string(i)).append("]");
+        if (!v.is_number()) throw InvalidInput(formatError(source, path, "is " + typeName(v), "a number"));
+        const double d = v.get<double>();
+        if (!std::isfinite(d) || std::abs(d) > 3.0e38) {
+            throw InvalidInput(
+                formatError(source, path, "is " + v.dump(), "a finite number, normally in [0, 1]"));
+        }
+        weights[i] = static_cast<float>(d);
+    }
+    return weights;
+}
+
+std::vector<float> readWeights(const fs::path& path, size_t count) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw IoError(formatError(path.string(), "", "cannot open the weights file", "a readable JSON file"));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseWeights(text.str(), count, path.string());
+}
+
+slide::SlideResult slideCommand(const SlideCommand& command) {
+    io::ObjContent obj = io::readObj(command.mesh);
+    const size_t count = static_cast<size_t>(obj.mesh.numVertices());
+    const std::vector<float> weights =
+        command.weights ? readWeights(*command.weights, count) : std::vector<float>{};
+    slide::Slider slider(obj.mesh, {command.handle}, command.options, command.mesh.string());
+    const std::vector<slide::SlideDrive> drives = {{command.to - command.from, command.falloff}};
+    std::vector<glm::vec3> points(obj.mesh.points().begin(), obj.mesh.points().end());
+    slide::SlideResult result;
+    slider.evaluate(drives, points, weights, command.envelope, &result);
+    obj.mesh.setPoints(points);
+    io::writeObj(command.out, obj.mesh, obj.groups);
+    return result;
+}
+
+std::string slideSummary(const fs::path& out, const slide::SlideResult& result) {
+    return "wrote " + out.string() + ": moved " + std::to_string(result.moved) + ", boundary-stopped " +
+           std::to_string(result.boundaryStopped) + ", limit-stopped " + std::to_string(result.limitStopped) +
+           ", unreachable " + std::to_string(result.unreachable) + ", degenerate " +
+           std::to_string(result.degenerateTriangles);
+}
+
+}  // namespace deformkit::harness

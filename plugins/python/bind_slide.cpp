@@ -1,0 +1,457 @@
+// Python bindings of the slide (core/include/deformkit/slide/slider.h, Pinskiy "Sliding deformation"): the
+// one-off function slide and the Slider class that binds once to a rest mesh and its handles and
+// evaluates for many displacements. numpy float32 points in and out; landings as int32 / float64 arrays.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/mesh.h"
+#include "deformkit/slide/slider.h"
+#include "numpy_support.h"
+
+namespace py = pybind11;
+
+namespace deformkit::python {
+namespace {
+
+using slide::Falloff;
+using slide::RegionMetric;
+using slide::SlideDrive;
+using slide::SlideHandle;
+using slide::Slider;
+using slide::SlideResult;
+using slide::SurfaceMode;
+
+std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const char* name) {
+    if (a.ndim() != 1)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
+    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
+}
+
+geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const IntArray& indices,
+                  const std::string& source) {
+    geom::Mesh::Data d;
+    d.points = pointsOf(points, source, "points");
+    d.faceCounts = intsOf(counts, source, "face_counts");
+    d.faceIndices = intsOf(indices, source, "face_indices");
+    return geom::Mesh(std::move(d), source + " mesh");
+}
+
+RegionMetric regionOf(const std::string& name, const std::string& source, const std::string& element) {
+    if (name == "euclidean") return RegionMetric::Euclidean;
+    if (name == "geodesic") return RegionMetric::Geodesic;
+    throw InvalidInput(formatError(source, element, "is '" + name + "'", "'euclidean' or 'geodesic'"));
+}
+
+const char* regionName(RegionMetric metric) {
+    return metric == RegionMetric::Geodesic ? "geodesic" : "euclidean";
+}
+
+slide::SlideOptions optionsOf(const std::string& surface, int64_t maxWalk, const std::string& source) {
+    slide::SlideOptions o;
+    if (surface == "cage") {
+        o.surface = SurfaceMode::Cage;
+    } else if (surface == "limit") {
+        o.surface = SurfaceMode::Limit;
+    } else {
+        throw InvalidInput(formatError(source, "surface", "is '" + surface + "'", "'cage' or 'limit'"));
+    }
+    if (maxWalk < 1 || maxWalk > std::numeric_limits<int32_t>::max()) {
+        throw InvalidInput(formatError(source, "max_walk_triangles", "is " + std::to_string(maxWalk),
+                                       "an integer in [1, 2147483647]"));
+    }
+    o.maxWalkTriangles = static_cast<int32_t>(maxWalk);
+    return o;
+}
+
+int32_t vertexOf(int64_t vertex, const std::string& source, const std::string& element) {
+    // Larger values would wrap into range as int32; the core names everything else out of range.
+    if (vertex < std::numeric_limits<int32_t>::min() || vertex > std::numeric_limits<int32_t>::max()) {
+        throw InvalidInput(formatError(source, element,
+                                       std::to_string(vertex) + ": vertex index out of range",
+                                       "a vertex index of the mesh"));
+    }
+    return static_cast<int32_t>(vertex);
+}
+
+// "smooth", "linear", or a 1-D sequence of ramp samples at x = i / (n - 1).
+Falloff falloffOf(py::handle value, const std::string& source, const std::string& name) {
+    const char* expected = "'smooth', 'linear' or a 1-D sequence of ramp samples";
+    if (py::isinstance<py::str>(value)) {
+        const auto text = value.cast<std::string>();
+        if (text == "smooth") return Falloff::smooth();
+        if (text == "linear") return Falloff::linear();
+        throw InvalidInput(formatError(source, name, "is '" + text + "'", expected));
+    }
+    const std::string type = py::str(py::type::of(value).attr("__name__"));
+    if (!py::isinstance<py::sequence>(value) && !py::isinstance<py::array>(value)) {
+        throw InvalidInput(formatError(source, name, "is a " + type, expected));
+    }
+    const FloatArray samples = FloatArray::ensure(value);  // null (error cleared) when not numeric
+    if (!samples)
+        throw InvalidInput(formatError(source, name, "is a " + type + " that is not numeric", expected));
+    if (samples.ndim() != 1)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(samples), expected));
+    return Falloff::ramp(std::span<const float>(samples.data(), static_cast<size_t>(samples.shape(0))), name);
+}
+
+// One falloff for every handle, or a list of one per handle: a list whose items are strings or
+// sequences (or a 2-D array) is per handle; a flat list of numbers is one ramp.
+std::vector<Falloff> falloffsOf(py::handle value, size_t handles, const std::string& source) {
+    bool perHandle = false;
+    if (py::isinstance<py::array>(value)) {
+        perHandle = py::reinterpret_borrow<py::array>(value).ndim() == 2;
+    } else if ((py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) && py::len(value) > 0) {
+        const py::handle first = py::reinterpret_borrow<py::sequence>(value)[0];
+        perHandle = py::isinstance<py::str>(first) || py::isinstance<py::sequence>(first) ||
+                    py::isinstance<py::array>(first);
+    }
+    if (!perHandle) return std::vector<Falloff>(handles, falloffOf(value, source, "falloff"));
+    const auto items = py::reinterpret_borrow<py::sequence>(value);
+    if (items.size() != handles) {
+        throw InvalidInput(formatError(source, "falloff", "has " + std::to_string(items.size()) + " items",
+                                       "one falloff, or one per handle (" + std::to_string(handles) + ")"));
+    }
+    std::vector<Falloff> out;
+    for (size_t h = 0; h < handles; ++h)
+        out.push_back(falloffOf(items[h], source, "falloff[" + std::to_string(h) + "]"));
+    return out;
+}
+
+// Displacements: (3,) for one handle, (H, 3) for H handles.
+std::vector<glm::dvec3> displacementsOf(const FloatArray& a, size_t handles, const std::string& source) {
+    const bool single = a.ndim() == 1 && a.shape(0) == 3 && handles == 1;
+    const bool rows = a.ndim() == 2 && a.shape(1) == 3 && static_cast<size_t>(a.shape(0)) == handles;
+    if (!single && !rows) {
+        throw InvalidInput(formatError(
+            source, "displacement", "has shape " + shapeOf(a),
+            handles == 1 ? "(3,) or (1, 3)" : "(" + std::to_string(handles) + ", 3), one row per handle"));
+    }
+    std::vector<glm::dvec3> out(handles);
+    for (size_t h = 0; h < handles; ++h) {
+        const float* d = a.data() + 3 * h;
+        out[h] = glm::dvec3(d[0], d[1], d[2]);
+    }
+    return out;
+}
+
+// handles=[{"vertex": .., "radius": .., "region": ..}, ...]; "region" is optional.
+std::vector<SlideHandle> handlesOf(const std::optional<int64_t>& handle, const std::optional<double>& radius,
+                                   const std::string& region,
+                                   const std::optional<std::vector<py::dict>>& handles,
+                                   const std::string& source) {
+    if (handles) {
+        if (handle || radius) {
+            throw InvalidInput(formatError(source, "handles", "given together with handle or radius",
+                                           "either handle and radius, or handles"));
+        }
+        std::vector<SlideHandle> out;
+        for (size_t h = 0; h < handles->size(); ++h) {
+            const py::dict& item = (*handles)[h];
+            const std::string at = "handles[" + std::to_string(h) + "]";
+            for (const auto& [key, value] : item) {
+                const std::string k = py::str(key);
+                if (k != "vertex" && k != "radius" && k != "region") {
+                    throw InvalidInput(
+                        formatError(source, at, "has the key '" + k + "'", "'vertex', 'radius', 'region'"));
+                }
+            }
+            for (const char* key : {"vertex", "radius"}) {
+                if (!item.contains(key)) {
+                    throw InvalidInput(formatError(source, at + "." + key, "is missing", "a value"));
+                }
+            }
+            SlideHandle s;
+            try {
+                s.vertex = vertexOf(item["vertex"].cast<int64_t>(), source, at + ".vertex");
+                s.radius = item["radius"].cast<double>();
+                if (item.contains("region")) {
+                    s.region = regionOf(item["region"].cast<std::string>(), source, at + ".region");
+                }
+            } catch (const py::cast_error&) {
+                throw InvalidInput(formatError(source, at, "has a value of the wrong type",
+                                               "vertex an int, radius a number, region a string"));
+            }
+            out.push_back(s);
+        }
+        return out;
+    }
+    if (!handle || !radius) {
+        throw InvalidInput(
+            formatError(source, "handle", "no handle given", "handle and radius, or handles=[...]"));
+    }
+    return {{vertexOf(*handle, source, "handle"), *radius, regionOf(region, source, "region")}};
+}
+
+// What an evaluation returns: the slid points and, per moved vertex, where it landed.
+struct PySlideResult {
+    py::array_t<float> points;
+    py::array_t<int32_t> vertices, faces, triangles;
+    py::array_t<double> barycentric;
+    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0, unreachable = 0, withoutTangentPlane = 0,
+            degenerateTriangles = 0, chordFallbacks = 0;
+};
+
+PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& r) {
+    PySlideResult out;
+    out.points = toArray(points);
+    const auto m = static_cast<py::ssize_t>(r.landings.size());
+    out.vertices = py::array_t<int32_t>(m);
+    out.faces = py::array_t<int32_t>(m);
+    out.triangles = py::array_t<int32_t>({m, py::ssize_t{3}});
+    out.barycentric = py::array_t<double>({m, py::ssize_t{3}});
+    int32_t* vertices = out.vertices.mutable_data();
+    int32_t* faces = out.faces.mutable_data();
+    int32_t* triangles = out.triangles.mutable_data();
+    double* barycentric = out.barycentric.mutable_data();
+    for (py::ssize_t i = 0; i < m; ++i) {
+        const slide::SlideLanding& l = r.landings[static_cast<size_t>(i)];
+        vertices[i] = l.vertex;
+        faces[i] = l.face;
+        for (int k = 0; k < 3; ++k) {
+            triangles[3 * i + k] = l.triangle[k];
+            barycentric[3 * i + k] = l.barycentric[k];
+        }
+    }
+    out.moved = r.moved;
+    out.boundaryStopped = r.boundaryStopped;
+    out.limitStopped = r.limitStopped;
+    out.unreachable = r.unreachable;
+    out.withoutTangentPlane = r.withoutTangentPlane;
+    out.degenerateTriangles = r.degenerateTriangles;
+    out.chordFallbacks = r.chordFallbacks;
+    return out;
+}
+
+template <class T>
+py::array_t<T> arrayOf(std::span<const T> values) {
+    py::array_t<T> out(static_cast<py::ssize_t>(values.size()));
+    if (!values.empty()) std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+    return out;
+}
+
+py::tuple tupleOf(const glm::dvec3& v) {
+    return py::make_tuple(v.x, v.y, v.z);
+}
+
+// The Slider binding. The bound core object is shared so that bind() during another thread's evaluate
+// (which runs without the GIL) cannot free the slider under it.
+class PySlider {
+  public:
+    PySlider(const FloatArray& points, const IntArray& counts, const IntArray& indices,
+             const std::optional<int64_t>& handle, const std::optional<double>& radius,
+             const std::string& region, const std::optional<std::vector<py::dict>>& handles,
+             const std::string& surface, int64_t maxWalk) {
+        bind(points, counts, indices, handle, radius, region, handles, surface, maxWalk);
+    }
+
+    void bind(const FloatArray& points, const IntArray& counts, const IntArray& indices,
+              const std::optional<int64_t>& handle, const std::optional<double>& radius,
+              const std::string& region, const std::optional<std::vector<py::dict>>& handles,
+              const std::string& surface, int64_t maxWalk) {
+        const std::string source = "Slider";
+        const geom::Mesh mesh = meshOf(points, counts, indices, source);
+        std::vector<SlideHandle> h = handlesOf(handle, radius, region, handles, source);
+        const slide::SlideOptions options = optionsOf(surface, maxWalk, source);
+        std::shared_ptr<Slider> bound;
+        {
+            py::gil_scoped_release release;
+            bound = std::make_shared<Slider>(mesh, std::move(h), options, source);
+        }
+        slider_ = std::move(bound);
+        rest_.assign(mesh.points().begin(), mesh.points().end());
+    }
+
+    PySlideResult evaluate(const FloatArray& displacement, py::handle falloff,
+                           const std::optional<FloatArray>& weights, float envelope,
+                           const std::optional<FloatArray>& points) const {
+        const std::string source = "Slider.evaluate";
+        const std::shared_ptr<Slider> slider = slider_;
+        const auto handles = static_cast<size_t>(slider->numHandles());
+        const std::vector<glm::dvec3> d = displacementsOf(displacement, handles, source);
+        const std::vector<Falloff> f = falloffsOf(falloff, handles, source);
+        std::vector<SlideDrive> drives;
+        for (size_t h = 0; h < handles; ++h)
+            drives.push_back({d[h], f[h]});
+        std::vector<glm::vec3> pts = points ? pointsOf(*points, source, "points") : rest_;
+        const std::vector<float> w = weightsOf(weights, static_cast<size_t>(slider->numVertices()), source);
+        SlideResult result;
+        {
+            py::gil_scoped_release release;
+            slider->evaluate(drives, pts, w, envelope, &result);
+        }
+        return resultOf(pts, result);
+    }
+
+    [[nodiscard]] const Slider& slider() const { return *slider_; }
+
+  private:
+    std::shared_ptr<Slider> slider_;
+    std::vector<glm::vec3> rest_;
+};
+
+py::dict regionDict(const slide::SupportRegion& r) {
+    py::dict out;
+    out["vertex"] = r.handle;
+    out["radius"] = r.radius;
+    out["region"] = regionName(r.metric);
+    out["vertices"] = arrayOf<int32_t>(r.vertices);
+    out["normalized_distance"] = arrayOf<float>(r.normalizedDistance);
+    out["a1"] = tupleOf(r.a1);
+    out["a2"] = tupleOf(r.a2);
+    out["unreachable"] = r.unreachable;
+    out["without_tangent_plane"] = r.withoutTangentPlane;
+    return out;
+}
+
+}  // namespace
+
+void bindSlide(py::module_& m) {
+    m.def(
+        "slide",
+        [](const FloatArray& points, const IntArray& counts, const IntArray& indices, int64_t handle,
+           const FloatArray& displacement, double radius, py::object falloff,
+           const std::optional<FloatArray>& weights, float envelope, const std::string& region,
+           const std::string& surface) {
+            const std::string source = "slide";
+            const geom::Mesh mesh = meshOf(points, counts, indices, source);
+            const std::vector<SlideHandle> handles = {
+                {vertexOf(handle, source, "handle"), radius, regionOf(region, source, "region")}};
+            const slide::SlideOptions options = optionsOf(surface, 4096, source);
+            const std::vector<SlideDrive> drives = {
+                {displacementsOf(displacement, 1, source)[0], falloffOf(falloff, source, "falloff")}};
+            const std::vector<float> w = weightsOf(weights, static_cast<size_t>(mesh.numVertices()), source);
+            std::vector<glm::vec3> out(mesh.points().begin(), mesh.points().end());
+            {
+                py::gil_scoped_release release;
+                Slider slider(mesh, handles, options, source);
+                slider.evaluate(drives, out, w, envelope);
+            }
+            return toArray(out);
+        },
+        py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("handle"),
+        py::arg("displacement"), py::arg("radius"), py::arg("falloff") = "smooth",
+        py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("region") = "euclidean",
+        py::arg("surface") = "cage",
+        "Slide vertices over the surface (Pinskiy, 'Sliding deformation'): the region within `radius` of "
+        "the\n"
+        "`handle` vertex moves by `displacement` (3,) times the falloff, along the surface, so the shape "
+        "stays\n"
+        "and the texture travels. points (N, 3) float32; face_counts (F,) int32; face_indices (sum of "
+        "counts,)\n"
+        "int32; radius in scene units; falloff 'smooth' (1 - 3x^2 + 2x^3), 'linear' or ramp samples at\n"
+        "x = i / (n - 1) of distance / radius; weights (N,) painted, envelope scalar; region 'euclidean' or\n"
+        "'geodesic'; surface 'cage' or 'limit' (Catmull-Clark). Returns the slid points (N, 3) float32.");
+
+    py::class_<PySlideResult>(m, "SlideResult", "The slid points and, per moved vertex, where it landed.")
+        .def_readonly("points", &PySlideResult::points, "(N, 3) float32 slid points")
+        .def_readonly("vertices", &PySlideResult::vertices, "(M,) int32 moved vertices, ascending")
+        .def_readonly("faces", &PySlideResult::faces, "(M,) int32 polygon each landed on")
+        .def_readonly("triangles", &PySlideResult::triangles,
+                      "(M, 3) int32 vertices of the rest-mesh triangle (fan of the polygon) each landed on")
+        .def_readonly(
+            "barycentric", &PySlideResult::barycentric,
+            "(M, 3) float64 barycentric coordinates on `triangles`: on the cage surface the slid point is\n"
+            "their combination of the rest positions")
+        .def_readonly("moved", &PySlideResult::moved)
+        .def_readonly("boundary_stopped", &PySlideResult::boundaryStopped,
+                      "moved vertices that reached a mesh boundary and stopped on it")
+        .def_readonly("limit_stopped", &PySlideResult::limitStopped,
+                      "moved vertices stopped after max_walk_triangles triangles")
+        .def_readonly("unreachable", &PySlideResult::unreachable,
+                      "vertices within a radius that the region's propagation cannot reach: unmoved")
+        .def_readonly("without_tangent_plane", &PySlideResult::withoutTangentPlane,
+                      "vertices within a radius with only degenerate triangles around: unmoved")
+        .def_readonly("degenerate_triangles", &PySlideResult::degenerateTriangles,
+                      "zero-area triangles touching the region: skipped")
+        .def_readonly("chord_fallbacks", &PySlideResult::chordFallbacks)
+        .def("__repr__", [](const PySlideResult& r) {
+            return "<deformkit.SlideResult moved " + std::to_string(r.moved) + ", boundary_stopped " +
+                   std::to_string(r.boundaryStopped) + ", limit_stopped " + std::to_string(r.limitStopped) +
+                   ", unreachable " + std::to_string(r.unreachable) + ", degenerate_triangles " +
+                   std::to_string(r.degenerateTriangles) + ">";
+        });
+
+    py::class_<PySlider>(
+        m, "Slider",
+        "The slide bound once to a rest mesh and its handles (support regions, region bases),\n"
+        "evaluated for many displacements.")
+        .def(py::init<const FloatArray&, const IntArray&, const IntArray&, const std::optional<int64_t>&,
+                      const std::optional<double>&, const std::string&,
+                      const std::optional<std::vector<py::dict>>&, const std::string&, int64_t>(),
+             py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
+             py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
+             py::arg("handles") = py::none(), py::arg("surface") = "cage",
+             py::arg("max_walk_triangles") = 4096,
+             "Bind to the rest mesh (points (N, 3), face_counts, face_indices) and one handle (handle, "
+             "radius,\n"
+             "region) or several: handles=[{'vertex': i, 'radius': r, 'region': 'geodesic'}, ...] ('region'\n"
+             "optional, default 'euclidean'). surface 'cage' or 'limit'; max_walk_triangles bounds one "
+             "vertex's\n"
+             "walk in one evaluation.")
+        .def("bind", &PySlider::bind, py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
+             py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
+             py::arg("handles") = py::none(), py::arg("surface") = "cage",
+             py::arg("max_walk_triangles") = 4096,
+             "Bind again, to a new rest mesh or handle set; arguments as the constructor.")
+        .def(
+            "evaluate", &PySlider::evaluate, py::arg("displacement"), py::arg("falloff") = "smooth",
+            py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("points") = py::none(),
+            "Slide for displacement (3,) (one handle) or (H, 3) (one row per handle); falloff one value for\n"
+            "every handle or a list of one per handle; weights (N,), envelope scalar; points (N, 3) to move\n"
+            "(default: the rest points). Returns a SlideResult.")
+        .def_property_readonly("num_vertices", [](const PySlider& s) { return s.slider().numVertices(); })
+        .def_property_readonly("num_handles", [](const PySlider& s) { return s.slider().numHandles(); })
+        .def_property_readonly(
+            "handles",
+            [](const PySlider& s) {
+                py::list out;
+                for (const SlideHandle& h : s.slider().handles()) {
+                    py::dict d;
+                    d["vertex"] = h.vertex;
+                    d["radius"] = h.radius;
+                    d["region"] = regionName(h.region);
+                    out.append(d);
+                }
+                return out;
+            },
+            "The bound handles as [{'vertex', 'radius', 'region'}, ...]")
+        .def_property_readonly(
+            "active_vertices",
+            [](const PySlider& s) { return arrayOf<int32_t>(s.slider().activeVertices()); },
+            "(A,) int32 vertices in at least one handle's region, ascending")
+        .def(
+            "region",
+            [](const PySlider& s, int32_t handle) {
+                if (handle < 0 || handle >= s.slider().numHandles()) {
+                    throw InvalidInput(formatError("Slider.region", "handle",
+                                                   std::to_string(handle) + " is out of range",
+                                                   "[0, " + std::to_string(s.slider().numHandles()) + ")"));
+                }
+                return regionDict(s.slider().region(handle));
+            },
+            py::arg("handle") = 0,
+            "Handle `handle`'s support region: {'vertex', 'radius', 'region', 'vertices' (K,) int32 in\n"
+            "breadth-first order, 'normalized_distance' (K,) float32 = distance / radius, 'a1', 'a2' (the "
+            "region\n"
+            "basis at the handle), 'unreachable', 'without_tangent_plane'}.")
+        .def_property_readonly(
+            "expanded_map_entries",
+            [](const PySlider& s) { return static_cast<int64_t>(s.slider().expandedMapEntries()); },
+            "Vertices cached beyond one-rings by the local maps so far")
+        .def("__repr__", [](const PySlider& s) {
+            return "<deformkit.Slider " + std::to_string(s.slider().numVertices()) + " vertices, " +
+                   std::to_string(s.slider().numHandles()) + " handles, " +
+                   std::to_string(s.slider().activeVertices().size()) + " active>";
+        });
+}
+
+}  // namespace deformkit::python
