@@ -57,7 +57,9 @@ struct Solver::Impl {
     std::vector<Level> levels;
     WarpGrid grid;
     std::vector<float> oldU, oldV, velU, velV;
-    const float* deformed = nullptr;  // f_D of the current solve, 3 floats per fine point
+    const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
+    std::vector<int32_t> untangleWork;  // scratch of untangle(), kept between calls
+    std::vector<std::vector<int32_t>> untangleRows;
     SolveStats stats;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
@@ -251,37 +253,62 @@ struct Solver::Impl {
 
     // Repairs folds a propagation or prediction step may have made: a point with a non-positive triangle
     // around it moves towards the mean of its 8 neighbours (as far as keeps its triangles positive).
+    bool isFolded(const Level& level, int32_t i, int32_t j) const {
+        const size_t k = fine(level, i, j);
+        return !keepsOrientation(level, i, j, grid.u[k], grid.v[k]);
+    }
+
+    // One full scan finds the points with a non-positive triangle around them; after that only the
+    // neighbourhoods of moved points are looked at again, in ascending order (deterministic, serial: the
+    // list is short in normal use).
     int32_t untangle(const Level& level) {
-        int32_t moved = 0;
         const int32_t c = level.cells;
+        std::vector<int32_t>& work = untangleWork;
+        work.clear();
+        std::vector<std::vector<int32_t>>& rows = untangleRows;
+        rows.resize(static_cast<size_t>(c + 1));
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
+        for (int32_t j = 1; j < c; ++j) {
+            rows[j].clear();
+            for (int32_t i = 1; i < c; ++i) {
+                if (isFolded(level, i, j)) rows[j].push_back(j * (c + 1) + i);
+            }
+        }
+        for (int32_t j = 1; j < c; ++j)
+            work.insert(work.end(), rows[j].begin(), rows[j].end());
+        int32_t moved = 0;
         const size_t s = static_cast<size_t>(level.stride);
         const size_t row = s * static_cast<size_t>(side());
-        for (int pass = 0; pass < 64; ++pass) {
-            int32_t movedThisPass = 0, folded = 0;
-            for (int32_t colour = 0; colour < 4; ++colour) {
-                const int32_t colourI = colour & 1, colourJ = colour >> 1;
-#pragma omp parallel for schedule(static) reduction(+ : movedThisPass, folded) if(kParallelRows < static_cast<int64_t>(c))
-                for (int32_t j = 1 + ((colourJ + 1) & 1); j < c; j += 2) {
-                    for (int32_t i = 1 + ((colourI + 1) & 1); i < c; i += 2) {
-                        const size_t k = fine(level, i, j);
-                        if (keepsOrientation(level, i, j, grid.u[k], grid.v[k])) continue;
-                        ++folded;
-                        if (!level.movable[level.index(i, j)]) continue;
-                        float mu = 0.0f, mv = 0.0f;
-                        const size_t n[8] = {k + s, k + s + row, k + row, k - s + row,
-                                             k - s, k - s - row, k - row, k + s - row};
-                        for (size_t q : n) {
-                            mu += grid.u[q] / 8.0f;
-                            mv += grid.v[q] / 8.0f;
-                        }
-                        grid.u[k] = mu;  // the neighbours' mean: repairs most folds at once
-                        grid.v[k] = mv;
-                        ++movedThisPass;
+        std::vector<int32_t> next;
+        for (int pass = 0; pass < 64 && !work.empty(); ++pass) {
+            next.clear();
+            for (int32_t id : work) {
+                const int32_t i = id % (c + 1), j = id / (c + 1);
+                if (!level.movable[level.index(i, j)] || !isFolded(level, i, j)) continue;
+                const size_t k = fine(level, i, j);
+                const size_t n[8] = {k + s, k + s + row, k + row, k - s + row,
+                                     k - s, k - s - row, k - row, k + s - row};
+                float mu = 0.0f, mv = 0.0f;
+                for (size_t q : n) {
+                    mu += grid.u[q] / 8.0f;
+                    mv += grid.v[q] / 8.0f;
+                }
+                grid.u[k] = mu;  // the neighbours' mean repairs most folds at once
+                grid.v[k] = mv;
+                ++moved;
+                for (int32_t dj = -1; dj <= 1; ++dj) {
+                    for (int32_t di = -1; di <= 1; ++di) {
+                        const int32_t ni = i + di, nj = j + dj;
+                        if (ni > 0 && nj > 0 && ni < c && nj < c) next.push_back(nj * (c + 1) + ni);
                     }
                 }
             }
-            moved += movedThisPass;
-            if (folded == 0 || movedThisPass == 0) break;
+            std::sort(next.begin(), next.end());
+            next.erase(std::unique(next.begin(), next.end()), next.end());
+            work.clear();
+            for (int32_t id : next) {
+                if (isFolded(level, id % (c + 1), id / (c + 1))) work.push_back(id);
+            }
         }
         return moved;
     }
