@@ -82,9 +82,20 @@ struct Slider::Impl {
     Impl(const geom::Mesh& rest, std::vector<SlideHandle> h, const SlideOptions& o, std::string s)
         : source(std::move(s)), mesh(rest), options(o), handles(std::move(h)), surface(rest, source) {}
 
-    glm::dvec2 imageOf(int32_t p, LocalMap& map, int32_t q) const {
+    // The one-ring part of a vertex's local map (Eq. 1-2 for the vertices sharing a triangle with it),
+    // computed at bind: per corner c at the vertex, the images of vertex(next(c)) and vertex(prev(c)).
+    std::vector<int32_t> ringOffsets;  // per slot, into ringNext / ringPrev; corners in vertexCorners order
+    std::vector<glm::dvec2> ringNext, ringPrev;
+    std::vector<uint8_t> interior;  // per slot: no boundary edge at the vertex
+
+    glm::dvec2 imageOf(int32_t slot, int32_t p, LocalMap& map, int32_t q) const {
         if (q == p) return glm::dvec2(0.0);
-        if (surface.areNeighbors(p, q)) return expMap(surface, p, q);
+        const auto corners = surface.vertexCorners(p);
+        const int32_t base = ringOffsets[slot];
+        for (size_t k = 0; k < corners.size(); ++k) {
+            if (surface.vertex(SlideSurface::next(corners[k])) == q) return ringNext[base + k];
+            if (surface.vertex(SlideSurface::prev(corners[k])) == q) return ringPrev[base + k];
+        }
         return map.coords(surface, p, q);
     }
 
@@ -100,7 +111,7 @@ struct Slider::Impl {
     // At a boundary vertex, a slide along the boundary (within kParallel radians of a boundary edge) is
     // turned kInward radians into the surface, so that rounding in the propagated direction cannot start
     // its path just outside the surface, which would stop it at once.
-    glm::dvec2 alongBoundary(int32_t p, LocalMap& map, const glm::dvec2& target) const {
+    glm::dvec2 alongBoundary(int32_t slot, int32_t p, LocalMap& map, const glm::dvec2& target) const {
         constexpr double kParallel = 1e-6, kInward = 1e-9;
         const double length = glm::length(target);
         const glm::dvec2 direction = target / length;
@@ -116,20 +127,20 @@ struct Slider::Impl {
         for (int32_t c : surface.vertexCorners(p)) {
             if (surface.isDegenerate(SlideSurface::triangleOf(c))) continue;
             if (surface.opposite(c) < 0) {  // boundary edge p -> a: the surface lies counter-clockwise of it
-                const glm::dvec2 a = imageOf(p, map, surface.vertex(SlideSurface::next(c)));
+                const glm::dvec2 a = imageOf(slot, p, map, surface.vertex(SlideSurface::next(c)));
                 if (parallel(a)) return turned(a, kInward);
             }
             if (surface.opposite(SlideSurface::prev(c)) <
                 0) {  // boundary edge b -> p: the surface lies clockwise
-                const glm::dvec2 b = imageOf(p, map, surface.vertex(SlideSurface::prev(c)));
+                const glm::dvec2 b = imageOf(slot, p, map, surface.vertex(SlideSurface::prev(c)));
                 if (parallel(b)) return turned(b, -kInward);
             }
         }
         return target;
     }
 
-    Landing walk(int32_t p, LocalMap& map, const glm::dvec2& requested) const {
-        const glm::dvec2 target = alongBoundary(p, map, requested);
+    Landing walk(int32_t slot, int32_t p, LocalMap& map, const glm::dvec2& requested) const {
+        const glm::dvec2 target = interior[slot] ? requested : alongBoundary(slot, p, map, requested);
         // The sector at p that contains the direction of the target.
         int32_t start = -1;
         glm::dvec2 ca, cb;
@@ -137,10 +148,12 @@ struct Slider::Impl {
         double bestScore = -1e300;
         int32_t best = -1;
         glm::dvec2 bestA, bestB;
-        for (int32_t c : surface.vertexCorners(p)) {
+        const auto corners = surface.vertexCorners(p);
+        for (size_t k = 0; k < corners.size(); ++k) {
+            const int32_t c = corners[k];
             if (surface.isDegenerate(SlideSurface::triangleOf(c))) continue;
-            const glm::dvec2 a = imageOf(p, map, surface.vertex(SlideSurface::next(c)));
-            const glm::dvec2 b = imageOf(p, map, surface.vertex(SlideSurface::prev(c)));
+            const glm::dvec2 a = ringNext[ringOffsets[slot] + k];
+            const glm::dvec2 b = ringPrev[ringOffsets[slot] + k];
             const double sa = cross2(a, target), sb = cross2(target, b);
             if (sa >= 0.0 && sb >= 0.0 && cross2(a, b) > 0.0) {
                 start = c;
@@ -162,7 +175,7 @@ struct Slider::Impl {
         }
         if (start < 0) {
             // The direction leaves the surface at a boundary vertex: the vertex stays on the boundary.
-            if (best < 0 || !isInteriorVertex(p))
+            if (best < 0 || !interior[slot])
                 return onEdge(surface.vertexCorners(p).empty() ? 0 : surface.vertexCorners(p)[0], 0.0,
                               Stop::Boundary);
             start = best;  // rounding at an interior vertex: the nearest sector
@@ -198,7 +211,7 @@ struct Slider::Impl {
             if (step + 1 >= options.maxWalkTriangles) return onEdge(edge, mu, Stop::Limit);
             // The entered triangle: entry runs from e1's vertex to e0's vertex; w is the third vertex.
             const int32_t wCorner = SlideSurface::prev(entry);
-            const glm::dvec2 cw = imageOf(p, map, surface.vertex(wCorner));
+            const glm::dvec2 cw = imageOf(slot, p, map, surface.vertex(wCorner));
             const glm::dvec2 cEntry = e1, cNext = e0;  // vertex(entry), vertex(next(entry))
             if (barycentric(cEntry, cNext, cw, target, bary) &&
                 glm::all(glm::greaterThanEqual(bary, glm::dvec3(-1e-12)))) {
@@ -328,6 +341,29 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
         m.regionSlots.push_back(std::move(slots));
     }
     m.maps.resize(m.active.size());
+    m.ringOffsets.resize(m.active.size() + 1, 0);
+    m.interior.resize(m.active.size());
+    for (size_t i = 0; i < m.active.size(); ++i) {
+        m.ringOffsets[i + 1] =
+            m.ringOffsets[i] + static_cast<int32_t>(m.surface.vertexCorners(m.active[i]).size());
+    }
+    m.ringNext.resize(m.ringOffsets.back());
+    m.ringPrev.resize(m.ringOffsets.back());
+    {
+        const auto count = static_cast<int32_t>(m.active.size());
+#pragma omp parallel for schedule(static)
+        for (int32_t i = 0; i < count; ++i) {
+            const int32_t v = m.active[i];
+            const auto corners = m.surface.vertexCorners(v);
+            m.interior[i] = m.isInteriorVertex(v) ? 1 : 0;
+            for (size_t k = 0; k < corners.size(); ++k) {
+                m.ringNext[m.ringOffsets[i] + k] =
+                    expMap(m.surface, v, m.surface.vertex(SlideSurface::next(corners[k])));
+                m.ringPrev[m.ringOffsets[i] + k] =
+                    expMap(m.surface, v, m.surface.vertex(SlideSurface::prev(corners[k])));
+            }
+        }
+    }
     m.displacement.resize(m.active.size());
     m.landings.resize(m.active.size());
 
@@ -447,7 +483,7 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
         Landing& landing = m.landings[i];
         landing = Landing{};
         if (target.x == 0.0 && target.y == 0.0) continue;
-        landing = m.walk(v, m.maps[i], target);
+        landing = m.walk(i, v, m.maps[i], target);
         ++moved;
         boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
         limitStopped += landing.stop == Stop::Limit ? 1 : 0;
