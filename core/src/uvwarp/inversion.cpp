@@ -1,0 +1,369 @@
+#include "deformkit/uvwarp/inversion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+
+namespace deformkit::uvwarp {
+namespace {
+
+constexpr int32_t kMaxCells = 32768;
+// Output rows per parallel work item: fixed, so which triangle wins an overlapped texel of a folded warp
+// does not depend on the thread count.
+constexpr int32_t kBandRows = 16;
+// Cells per chunk: the unit of work a band looks up.
+constexpr int32_t kChunkCells = 64;
+
+void requireRegion(const io::Image& image, int32_t size, const char* what) {
+    if (image.width != size || image.height != size || image.channels < 1 ||
+        image.pixels.size() != static_cast<size_t>(size) * size * image.channels) {
+        throw InvalidInput(formatError("inversion error", what,
+                                       "is " + std::to_string(image.width) + " x " +
+                                           std::to_string(image.height) + " with " +
+                                           std::to_string(image.channels) + " channels",
+                                       "the redirect map's size"));
+    }
+}
+
+// A warped grid point in raster coordinates (x = u T, y = (1 - v) T; raster pixels are image texels),
+// with its position snapped to 1/256 texel for exact coverage, as geom::rasterizeTriangle snaps.
+struct RasterPoint {
+    float x, y;
+    int64_t sx, sy;
+};
+
+// Rounds to the nearest 1/256, halves away from zero (llround's rule, without a library call): x * 256 and
+// x * 256 +- 0.5 are exact in double for a float |x| < 2^21.
+inline int64_t snap(float x) {
+    const double scaled = static_cast<double>(x) * 256.0;
+    return static_cast<int64_t>(scaled + (scaled >= 0.0 ? 0.5 : -0.5));
+}
+
+// Far-off points (a broken warp) are clamped to 2^20 texels, which keeps every edge function within int64.
+inline RasterPoint rasterPoint(float u, float v, float t) {
+    constexpr float kLimit = 1048576.0f;
+    const float x = std::clamp(u * t, -kLimit, kLimit), y = std::clamp((1.0f - v) * t, -kLimit, kLimit);
+    return {x, y, snap(x), snap(y)};
+}
+
+// Twice the signed area of (a, b, c) in snapped units, positive when c is left of a -> b with y up.
+inline int64_t edgeFunction(const RasterPoint& a, const RasterPoint& b, int64_t cx, int64_t cy) {
+    return (b.sx - a.sx) * (cy - a.sy) - (b.sy - a.sy) * (cx - a.sx);
+}
+
+// Smallest pixel whose centre (256 i + 128) is >= s, largest whose centre is <= s.
+inline int64_t firstCentreAtOrAbove(int64_t s) {
+    return -((128 - s) >> 8);
+}
+inline int64_t lastCentreAtOrBelow(int64_t s) {
+    return (s - 128) >> 8;
+}
+
+// The edge function of from -> to at (cx, cy), minus 1 when the edge does not own the centres on it: an
+// edge of a positively oriented triangle owns them when it is a top or a left edge (geom::rasterizeTriangle's
+// rule), so triangles tiling a region cover each centre exactly once.
+inline int64_t ownedEdge(const RasterPoint& from, const RasterPoint& to, int64_t cx, int64_t cy) {
+    const int64_t dx = to.sx - from.sx, dy = to.sy - from.sy;
+    const int64_t notTopLeft = (dy > 0 || (dy == 0 && dx <= 0)) ? 1 : 0;
+    return dx * (cy - from.sy) - dy * (cx - from.sx) - notTopLeft;
+}
+
+// Twice the signed area of (a, b, c) from the unsnapped positions.
+inline double exactArea(const RasterPoint& a, const RasterPoint& b, const RasterPoint& c) {
+    return (static_cast<double>(b.x) - a.x) * (static_cast<double>(c.y) - a.y) -
+           (static_cast<double>(b.y) - a.y) * (static_cast<double>(c.x) - a.x);
+}
+
+// Does triangle (a, b, c), of snapped twice-signed-area `area`, cover the pixel centre (cx, cy) (snapped
+// units)? As geom::rasterizeTriangle, a triangle that is degenerate before or after snapping covers nothing.
+inline bool covers(const RasterPoint& a, const RasterPoint& b, const RasterPoint& c, int64_t area, int64_t cx,
+                   int64_t cy) {
+    if (area == 0) return false;
+    const RasterPoint& p1 = area > 0 ? b : c;
+    const RasterPoint& p2 = area > 0 ? c : b;
+    if ((ownedEdge(p1, p2, cx, cy) | ownedEdge(p2, a, cx, cy) | ownedEdge(a, p1, cx, cy)) < 0) return false;
+    return exactArea(a, b, c) != 0.0;
+}
+
+// Barycentric coordinates (of b and c) of pixel centre (x + 0.5, y + 0.5) in a triangle (a, b, c) that
+// covers it, from the unsnapped positions so they reproduce the centre exactly.
+inline void barycentric(const RasterPoint& a, const RasterPoint& b, const RasterPoint& c, int64_t x,
+                        int64_t y, double& bb, double& bc) {
+    const double ax = a.x, ay = a.y, bx = b.x, by = b.y, cx = c.x, cy = c.y;
+    const double px = static_cast<double>(x) + 0.5, py = static_cast<double>(y) + 0.5;
+    const double area = exactArea(a, b, c);
+    bb = ((px - ax) * (cy - ay) - (py - ay) * (cx - ax)) / area;
+    bc = ((bx - ax) * (py - ay) - (by - ay) * (px - ax)) / area;
+}
+
+InversionError measure(const WarpGrid& warp, const io::Image& redirect, const io::Image* region) {
+    validateWarpGrid(warp, "inversion error: warp grid");
+    const int32_t size = redirect.width;
+    if (size < 1 || redirect.height != size || redirect.channels < 2 ||
+        redirect.pixels.size() != static_cast<size_t>(size) * size * redirect.channels) {
+        throw InvalidInput(formatError("inversion error", "redirect map",
+                                       "is " + std::to_string(redirect.width) + " x " +
+                                           std::to_string(redirect.height) + " with " +
+                                           std::to_string(redirect.channels) + " channels",
+                                       "a square T x T map with 2 channels (u', v')"));
+    }
+    if (region) requireRegion(*region, size, "region");
+
+    std::vector<double> rowMax(size, 0.0), rowSum(size, 0.0);
+    std::vector<int64_t> rowCount(size, 0);
+    std::vector<int32_t> rowBad(size, -1);
+    const auto t = static_cast<float>(size);
+#pragma omp parallel for schedule(static)
+    for (int32_t y = 0; y < size; ++y) {
+        const float v = 1.0f - (static_cast<float>(y) + 0.5f) / t;
+        double largest = 0.0, sum = 0.0;
+        int64_t count = 0;
+        for (int32_t x = 0; x < size; ++x) {
+            const float ru = redirect.at(x, y, 0), rv = redirect.at(x, y, 1);
+            if (!std::isfinite(ru) || !std::isfinite(rv)) {
+                rowBad[y] = x;
+                break;
+            }
+            if (region && !(region->at(x, y, 0) >= 0.5f)) continue;
+            const float u = (static_cast<float>(x) + 0.5f) / t;
+            const glm::vec2 w = evaluateWarp(warp, ru, rv);
+            const double du = (static_cast<double>(w.x) - u) * size,
+                         dv = (static_cast<double>(w.y) - v) * size;
+            const double e = std::sqrt(du * du + dv * dv);
+            largest = std::max(largest, e);
+            sum += e;
+            ++count;
+        }
+        rowMax[y] = largest;
+        rowSum[y] = sum;
+        rowCount[y] = count;
+    }
+    InversionError out;
+    double sum = 0.0;
+    for (int32_t y = 0; y < size; ++y) {
+        if (rowBad[y] >= 0) {
+            throw InvalidInput(
+                formatError("inversion error",
+                            "redirect texel (" + std::to_string(rowBad[y]) + ", " + std::to_string(y) + ")",
+                            "is not finite", "finite tile-local UVs"));
+        }
+        out.maxTexels = std::max(out.maxTexels, rowMax[y]);
+        sum += rowSum[y];
+        out.texels += rowCount[y];
+    }
+    out.meanTexels = out.texels > 0 ? sum / static_cast<double>(out.texels) : 0.0;
+    return out;
+}
+
+}  // namespace
+
+void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
+    if (!isPowerOfTwo(warp.cells) || warp.cells > kMaxCells) {
+        throw InvalidInput(formatError(source, "cells", "is " + std::to_string(warp.cells),
+                                       "a power of two from 1 to " + std::to_string(kMaxCells)));
+    }
+    const size_t count = static_cast<size_t>(warp.cells + 1) * static_cast<size_t>(warp.cells + 1);
+    if (warp.u.size() != count || warp.v.size() != count) {
+        throw InvalidInput(formatError(
+            source, "points",
+            "has " + std::to_string(warp.u.size()) + " u and " + std::to_string(warp.v.size()) + " v values",
+            std::to_string(count) + " of each ((cells + 1)^2)"));
+    }
+    for (size_t k = 0; k < count; ++k) {
+        if (!std::isfinite(warp.u[k]) || !std::isfinite(warp.v[k])) {
+            const size_t side = static_cast<size_t>(warp.cells) + 1;
+            throw InvalidInput(formatError(
+                source, "point (" + std::to_string(k % side) + ", " + std::to_string(k / side) + ")",
+                "is not finite", "finite tile-local UVs"));
+        }
+    }
+}
+
+void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
+    validateWarpGrid(warp, "invert warp: warp grid");
+    if (texels < 1) {
+        throw InvalidInput(
+            formatError("invert warp", "texels", "is " + std::to_string(texels), "at least 1"));
+    }
+    const int32_t cells = warp.cells, side = cells + 1, size = texels;
+    if (redirect.width != size || redirect.height != size || redirect.channels != 2 ||
+        redirect.pixels.size() != static_cast<size_t>(size) * size * 2) {
+        redirect = io::Image(size, size, 2);
+    }
+    const auto t = static_cast<float>(size);
+    const float* wu = warp.u.data();
+    const float* wv = warp.v.data();
+    float* out = redirect.pixels.data();
+
+    // Work is split into bands of output rows; each band draws the chunks of cells (runs of kChunkCells
+    // in one cell row) whose raster y range reaches it, in (j, i) order.
+    const int32_t numBands = (size + kBandRows - 1) / kBandRows;
+    const int32_t chunksPerRow = (cells + kChunkCells - 1) / kChunkCells;
+    const int64_t numChunks = static_cast<int64_t>(cells) * chunksPerRow;
+    std::vector<int32_t> chunkFirstBand(numChunks), chunkLastBand(numChunks);
+#pragma omp parallel for schedule(static)
+    for (int32_t j = 0; j < cells; ++j) {
+        for (int32_t c = 0; c < chunksPerRow; ++c) {
+            const int32_t i0 = c * kChunkCells, i1 = std::min(cells, i0 + kChunkCells);
+            float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+            for (int32_t row = j; row <= j + 1; ++row) {
+                for (int32_t i = i0; i <= i1; ++i) {
+                    const float y = rasterPoint(wu[0], wv[static_cast<size_t>(row) * side + i], t).y;
+                    lo = std::min(lo, y);
+                    hi = std::max(hi, y);
+                }
+            }
+            const int64_t chunk = static_cast<int64_t>(j) * chunksPerRow + c;
+            // Texel rows whose centre lies within the snapped y range (snapping can move a vertex onto a
+            // centre).
+            const int64_t first = firstCentreAtOrAbove(snap(lo));
+            const int64_t last = lastCentreAtOrBelow(snap(hi));
+            if (last < 0 || first >= size || first > last) {
+                chunkFirstBand[chunk] = 1;
+                chunkLastBand[chunk] = 0;
+                continue;
+            }
+            chunkFirstBand[chunk] = static_cast<int32_t>(std::max<int64_t>(first, 0) / kBandRows);
+            chunkLastBand[chunk] = static_cast<int32_t>(std::min<int64_t>(last, size - 1) / kBandRows);
+        }
+    }
+    std::vector<int64_t> bandBegin(static_cast<size_t>(numBands) + 1, 0);
+    for (int64_t chunk = 0; chunk < numChunks; ++chunk) {
+        for (int32_t band = chunkFirstBand[chunk]; band <= chunkLastBand[chunk]; ++band)
+            ++bandBegin[band + 1];
+    }
+    for (int32_t band = 0; band < numBands; ++band)
+        bandBegin[band + 1] += bandBegin[band];
+    std::vector<int64_t> bandChunks(static_cast<size_t>(bandBegin[numBands]));
+    {
+        std::vector<int64_t> fill(bandBegin.begin(), bandBegin.end() - 1);
+        for (int64_t chunk = 0; chunk < numChunks; ++chunk) {
+            for (int32_t band = chunkFirstBand[chunk]; band <= chunkLastBand[chunk]; ++band)
+                bandChunks[fill[band]++] = chunk;
+        }
+    }
+
+    const double inverseCells = 1.0 / cells;  // exact: cells is a power of two
+#pragma omp parallel
+    {
+        // Raster points of a chunk's two point rows.
+        std::vector<RasterPoint> lowerRow(kChunkCells + 1), upperRow(kChunkCells + 1);
+#pragma omp for schedule(dynamic, 1)
+        for (int32_t band = 0; band < numBands; ++band) {
+            const int32_t y0 = band * kBandRows, y1 = std::min(size, y0 + kBandRows);
+            for (int32_t y = y0; y < y1; ++y) {
+                const float v = 1.0f - (static_cast<float>(y) + 0.5f) / t;
+                float* row = out + static_cast<size_t>(y) * size * 2;
+                for (int32_t x = 0; x < size; ++x) {
+                    row[2 * x] = (static_cast<float>(x) + 0.5f) / t;
+                    row[2 * x + 1] = v;
+                }
+            }
+            for (int64_t e = bandBegin[band]; e < bandBegin[band + 1]; ++e) {
+                const int64_t chunk = bandChunks[e];
+                const auto j = static_cast<int32_t>(chunk / chunksPerRow);
+                const auto i0 = static_cast<int32_t>(chunk % chunksPerRow) * kChunkCells;
+                const int32_t i1 = std::min(cells, i0 + kChunkCells);
+                for (int32_t i = i0; i <= i1; ++i) {
+                    const size_t k = static_cast<size_t>(j) * side + i;
+                    lowerRow[i - i0] = rasterPoint(wu[k], wv[k], t);
+                    upperRow[i - i0] = rasterPoint(wu[k + side], wv[k + side], t);
+                }
+                for (int32_t i = i0; i < i1; ++i) {
+                    const RasterPoint &p00 = lowerRow[i - i0], &p10 = lowerRow[i - i0 + 1];
+                    const RasterPoint &p01 = upperRow[i - i0], &p11 = upperRow[i - i0 + 1];
+                    // Candidate texel centres: those in the cell's bounding box within the band.
+                    const int64_t xFirst = std::max<int64_t>(
+                        0,
+                        firstCentreAtOrAbove(std::min(std::min(p00.sx, p10.sx), std::min(p01.sx, p11.sx))));
+                    const int64_t xLast = std::min<int64_t>(
+                        size - 1,
+                        lastCentreAtOrBelow(std::max(std::max(p00.sx, p10.sx), std::max(p01.sx, p11.sx))));
+                    if (xFirst > xLast) continue;
+                    const int64_t yFirst = std::max<int64_t>(
+                        y0,
+                        firstCentreAtOrAbove(std::min(std::min(p00.sy, p10.sy), std::min(p01.sy, p11.sy))));
+                    const int64_t yLast = std::min<int64_t>(
+                        y1 - 1,
+                        lastCentreAtOrBelow(std::max(std::max(p00.sy, p10.sy), std::max(p01.sy, p11.sy))));
+                    if (yFirst > yLast) continue;
+                    // Lower (i, j), (i+1, j), (i+1, j+1); upper (i, j), (i+1, j+1), (i, j+1). Where both
+                    // cover a texel (a fold) the upper one, drawn later, wins.
+                    const int64_t lowerArea = edgeFunction(p00, p10, p11.sx, p11.sy);
+                    const int64_t upperArea = edgeFunction(p00, p11, p01.sx, p01.sy);
+                    // Same orientation: the two lie on opposite sides of the diagonal, which decides the
+                    // candidate's triangle with one edge test (the diagonal's top-left owner).
+                    const bool split = (lowerArea > 0 && upperArea > 0) || (lowerArea < 0 && upperArea < 0);
+                    const RasterPoint& diagFrom = upperArea > 0 ? p00 : p11;
+                    const RasterPoint& diagTo = upperArea > 0 ? p11 : p00;
+                    for (int64_t y = yFirst; y <= yLast; ++y) {
+                        for (int64_t x = xFirst; x <= xLast; ++x) {
+                            const int64_t cx = 256 * x + 128, cy = 256 * y + 128;
+                            bool upper = false, lower = false;
+                            if (split) {
+                                if (ownedEdge(diagFrom, diagTo, cx, cy) >= 0) {
+                                    upper = covers(p00, p11, p01, upperArea, cx, cy);
+                                } else {
+                                    lower = covers(p00, p10, p11, lowerArea, cx, cy);
+                                }
+                            } else {
+                                upper = covers(p00, p11, p01, upperArea, cx, cy);
+                                lower = !upper && covers(p00, p10, p11, lowerArea, cx, cy);
+                            }
+                            double bb = 0.0, bc = 0.0, u = 0.0, v = 0.0;
+                            if (upper) {
+                                barycentric(p00, p11, p01, x, y, bb, bc);
+                                u = i + bb;
+                                v = j + bb + bc;
+                            } else if (lower) {
+                                barycentric(p00, p10, p11, x, y, bb, bc);
+                                u = i + bb + bc;
+                                v = j + bc;
+                            } else {
+                                continue;
+                            }
+                            float* texel = out + (static_cast<size_t>(y) * size + static_cast<size_t>(x)) * 2;
+                            texel[0] = static_cast<float>(u * inverseCells);
+                            texel[1] = static_cast<float>(v * inverseCells);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+io::Image invertWarp(const WarpGrid& warp, int32_t texels) {
+    io::Image redirect;
+    invertWarp(warp, texels, redirect);
+    return redirect;
+}
+
+glm::vec2 evaluateWarp(const WarpGrid& warp, float u, float v) {
+    const int32_t n = warp.cells;
+    const size_t side = static_cast<size_t>(n) + 1;
+    const float x = std::clamp(std::isnan(u) ? 0.0f : u, 0.0f, 1.0f) * static_cast<float>(n);
+    const float y = std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f) * static_cast<float>(n);
+    const int32_t i = std::min(static_cast<int32_t>(x), n - 1);
+    const int32_t j = std::min(static_cast<int32_t>(y), n - 1);
+    const float fx = x - static_cast<float>(i), fy = y - static_cast<float>(j);
+    const size_t k00 = static_cast<size_t>(j) * side + i, k10 = k00 + 1, k01 = k00 + side, k11 = k01 + 1;
+    const glm::vec2 p00(warp.u[k00], warp.v[k00]), p10(warp.u[k10], warp.v[k10]);
+    const glm::vec2 p01(warp.u[k01], warp.v[k01]), p11(warp.u[k11], warp.v[k11]);
+    if (fx >= fy) return p00 + fx * (p10 - p00) + fy * (p11 - p10);  // lower triangle
+    return p00 + fx * (p11 - p01) + fy * (p01 - p00);                // upper triangle
+}
+
+InversionError inversionError(const WarpGrid& warp, const io::Image& redirect) {
+    return measure(warp, redirect, nullptr);
+}
+
+InversionError inversionError(const WarpGrid& warp, const io::Image& redirect, const io::Image& region) {
+    return measure(warp, redirect, &region);
+}
+
+}  // namespace deformkit::uvwarp

@@ -1,0 +1,235 @@
+#include "deformkit/uvwarp/mask.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/rasterizer.h"
+#include "tile_uvs.h"
+
+namespace deformkit::uvwarp {
+namespace {
+
+constexpr int32_t kMaxCells = 32768;
+
+std::string sourceOf(const MapLabel& label) {
+    return label.tile == 0 ? label.name : detail::tileSource(label.name, label.tile);
+}
+
+std::string texelName(int32_t x, int32_t y) {
+    return "texel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+void requireSquareMap(const io::Image& image, const MapLabel& label) {
+    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+        image.pixels.size() != static_cast<size_t>(image.width) * image.height * image.channels) {
+        throw InvalidInput(formatError(sourceOf(label), "image",
+                                       "is " + std::to_string(image.width) + " x " +
+                                           std::to_string(image.height) + " with " +
+                                           std::to_string(image.channels) + " channels and " +
+                                           std::to_string(image.pixels.size()) + " values",
+                                       "a non-empty image with width * height * channels values"));
+    }
+    if (image.width != image.height) {
+        throw InvalidInput(
+            formatError(sourceOf(label), "image",
+                        "is " + std::to_string(image.width) + " x " + std::to_string(image.height),
+                        "a square T x T map"));
+    }
+}
+
+void requireCells(int32_t cells, const MapLabel& label) {
+    if (!isPowerOfTwo(cells) || cells > kMaxCells) {
+        throw InvalidInput(formatError(sourceOf(label), "grid cells", "is " + std::to_string(cells),
+                                       "a power of two from 1 to " + std::to_string(kMaxCells)));
+    }
+}
+
+// The range of texel indices whose centre lies within one texel of continuous texel coordinate c
+// (texel k centred at k), clamped to [0, size - 1].
+void texelsWithinOne(double c, int32_t size, int32_t& lo, int32_t& hi) {
+    lo = std::clamp(static_cast<int32_t>(std::ceil(c - 1.0)), 0, size - 1);
+    hi = std::clamp(static_cast<int32_t>(std::floor(c + 1.0)), 0, size - 1);
+}
+
+}  // namespace
+
+io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
+                         const DerivedMaskOptions& options) {
+    if (texels < 1) {
+        throw InvalidInput(
+            formatError(options.label, "mask texels", "is " + std::to_string(texels), "at least 1"));
+    }
+    if (options.borderWidth < 1) {
+        throw InvalidInput(formatError(options.label, "mask border width",
+                                       "is " + std::to_string(options.borderWidth), "at least 1 texel"));
+    }
+    const detail::TileUVs uvs = detail::collectTileUVs(rest, tile, options.label);
+    const int32_t size = texels;
+    const auto t = static_cast<float>(texels);
+
+    // Raster row r holds v from r / T to (r + 1) / T, i.e. image row T - 1 - r.
+    io::Image mask(size, size, 1, 0.0f);
+    const geom::RasterGrid grid{size, size};
+    for (const auto& c : uvs.uvs) {
+        rasterizeTriangle(grid, c[0] * t, c[1] * t, c[2] * t, [&](int32_t x, int32_t r, const glm::vec3&) {
+            mask.at(x, size - 1 - r, 0) = 1.0f;
+        });
+    }
+
+    // Border band: texel (x, r) is fixed when the edge meets [x - g, x + 1 + g] x [r - g, r + 1 + g].
+    const double g = 0.5 * (options.borderWidth - 1);
+    for (const auto& edge : uvs.borderEdges) {
+        const double ax = static_cast<double>(edge[0].x) * texels,
+                     ay = static_cast<double>(edge[0].y) * texels;
+        const double bx = static_cast<double>(edge[1].x) * texels,
+                     by = static_cast<double>(edge[1].y) * texels;
+        const double yMin = std::min(ay, by), yMax = std::max(ay, by);
+        const double rFirst = std::max(0.0, std::ceil(yMin - 1.0 - g));
+        const double rLast = std::min(static_cast<double>(size - 1), std::floor(yMax + g));
+        for (double rr = rFirst; rr <= rLast; rr += 1.0) {
+            // The edge clipped to the slab of this row's grown squares.
+            double xLo = std::min(ax, bx), xHi = std::max(ax, bx);
+            if (by != ay) {
+                const double t0 = std::clamp((rr - g - ay) / (by - ay), 0.0, 1.0);
+                const double t1 = std::clamp((rr + 1.0 + g - ay) / (by - ay), 0.0, 1.0);
+                xLo = std::min(ax + t0 * (bx - ax), ax + t1 * (bx - ax));
+                xHi = std::max(ax + t0 * (bx - ax), ax + t1 * (bx - ax));
+            }
+            const double xFirst = std::max(0.0, std::ceil(xLo - 1.0 - g));
+            const double xLast = std::min(static_cast<double>(size - 1), std::floor(xHi + g));
+            const int32_t row = size - 1 - static_cast<int32_t>(rr);
+            for (double xx = xFirst; xx <= xLast; xx += 1.0)
+                mask.at(static_cast<int32_t>(xx), row, 0) = 0.0f;
+        }
+    }
+    return mask;
+}
+
+io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label) {
+    requireSquareMap(mask, label);
+    io::Image out(mask.width, mask.height, 1);
+    for (int32_t y = 0; y < mask.height; ++y) {
+        for (int32_t x = 0; x < mask.width; ++x) {
+            const float value = mask.at(x, y, 0);
+            if (std::isnan(value)) {
+                throw InvalidInput(formatError(sourceOf(label), texelName(x, y), "warp mask value is NaN",
+                                               "a number (thresholded at 0.5)"));
+            }
+            out.at(x, y, 0) = value >= 0.5f ? 1.0f : 0.0f;
+        }
+    }
+    return out;
+}
+
+io::Image readWarpMask(const std::filesystem::path& path, int tile) {
+    io::ImageReadOptions read;
+    read.role = "warp mask";
+    return binariseWarpMask(io::readImage(path, read), MapLabel{path.string(), tile});
+}
+
+void validateRigidityMap(const io::Image& rigidity, const MapLabel& label) {
+    requireSquareMap(rigidity, label);
+    for (int32_t y = 0; y < rigidity.height; ++y) {
+        for (int32_t x = 0; x < rigidity.width; ++x) {
+            const float value = rigidity.at(x, y, 0);
+            if (!(value >= 0.0f && value <= 1.0f)) {
+                throw InvalidInput(formatError(sourceOf(label), texelName(x, y),
+                                               "rigidity is " + std::to_string(value),
+                                               "a finite value in [0, 1]"));
+            }
+        }
+    }
+}
+
+io::Image readRigidityMap(const std::filesystem::path& path, int tile) {
+    io::ImageReadOptions read;
+    read.role = "rigidity map";
+    const io::Image image = io::readImage(path, read);
+    validateRigidityMap(image, MapLabel{path.string(), tile});
+    io::Image out(image.width, image.height, 1);
+    for (size_t k = 0; k < out.pixels.size(); ++k)
+        out.pixels[k] = image.pixels[k * image.channels];
+    return out;
+}
+
+PointField rigidityAtPoints(const io::Image& rigidity, int32_t cells, const MapLabel& label) {
+    requireCells(cells, label);
+    validateRigidityMap(rigidity, label);
+    const int32_t size = rigidity.width;
+    PointField out;
+    out.cells = cells;
+    out.channels = 1;
+    const int32_t side = cells + 1;
+    out.values.resize(static_cast<size_t>(side) * side);
+    // Continuous texel coordinates (texel centres at integers) of u = i / n and of v = j / n (image rows
+    // run down), clamped to the edge texels: taps and weights per column and per row.
+    const double scale = static_cast<double>(size) / cells;
+    std::vector<int32_t> x0(side), x1(side), y0(side), y1(side);
+    std::vector<float> tx(side), ty(side);
+    for (int32_t k = 0; k < side; ++k) {
+        const double fx = std::clamp(k * scale - 0.5, 0.0, static_cast<double>(size - 1));
+        x0[k] = std::min(static_cast<int32_t>(fx), size - 1);
+        x1[k] = std::min(x0[k] + 1, size - 1);
+        tx[k] = static_cast<float>(fx - x0[k]);
+        const double fy = std::clamp((cells - k) * scale - 0.5, 0.0, static_cast<double>(size - 1));
+        y0[k] = std::min(static_cast<int32_t>(fy), size - 1);
+        y1[k] = std::min(y0[k] + 1, size - 1);
+        ty[k] = static_cast<float>(fy - y0[k]);
+    }
+    const int32_t channels = rigidity.channels;
+#pragma omp parallel for schedule(static)
+    for (int32_t j = 0; j < side; ++j) {
+        const float* upperRow = &rigidity.pixels[static_cast<size_t>(y0[j]) * size * channels];
+        const float* lowerRow = &rigidity.pixels[static_cast<size_t>(y1[j]) * size * channels];
+        float* row = &out.values[out.index(0, j)];
+        for (int32_t i = 0; i < side; ++i) {
+            const size_t a = static_cast<size_t>(x0[i]) * channels, b = static_cast<size_t>(x1[i]) * channels;
+            const float upper = upperRow[a] + tx[i] * (upperRow[b] - upperRow[a]);
+            const float lower = lowerRow[a] + tx[i] * (lowerRow[b] - lowerRow[a]);
+            row[i] = upper + ty[j] * (lower - upper);
+        }
+    }
+    return out;
+}
+
+PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& label) {
+    requireCells(cells, label);
+    requireSquareMap(mask, label);
+    const int32_t size = mask.width;
+    const int32_t side = cells + 1;
+    const double scale = static_cast<double>(size) / cells;
+    std::vector<int32_t> columnLo(side), columnHi(side), rowLo(side), rowHi(side);
+    for (int32_t k = 0; k < side; ++k) {
+        texelsWithinOne(k * scale - 0.5, size, columnLo[k], columnHi[k]);
+        texelsWithinOne((cells - k) * scale - 0.5, size, rowLo[k], rowHi[k]);
+    }
+    // Separable minimum: over each point column's texel columns per image row, then over texel rows.
+    std::vector<uint8_t> rowMin(static_cast<size_t>(size) * side);
+#pragma omp parallel for schedule(static)
+    for (int32_t y = 0; y < size; ++y) {
+        for (int32_t i = 0; i < side; ++i) {
+            uint8_t value = 1;
+            for (int32_t x = columnLo[i]; x <= columnHi[i]; ++x)
+                value = mask.at(x, y, 0) >= 0.5f ? value : 0;
+            rowMin[static_cast<size_t>(y) * side + i] = value;
+        }
+    }
+    PointField out;
+    out.cells = cells;
+    out.channels = 1;
+    out.values.resize(static_cast<size_t>(side) * side);
+#pragma omp parallel for schedule(static)
+    for (int32_t j = 0; j < side; ++j) {
+        for (int32_t i = 0; i < side; ++i) {
+            uint8_t value = 1;
+            for (int32_t y = rowLo[j]; y <= rowHi[j]; ++y)
+                value = std::min(value, rowMin[static_cast<size_t>(y) * side + i]);
+            out.values[out.index(i, j)] = value;
+        }
+    }
+    return out;
+}
+
+}  // namespace deformkit::uvwarp
