@@ -1,0 +1,68 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
+#include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/solver.h"
+
+namespace deformkit::uvwarp {
+
+struct TileWarpOptions {
+    // Grid cells per side (a power of two); 0 = the rigidity map's resolution T.
+    int32_t cells = 0;
+    SolverOptions solver;
+    DerivedMaskOptions derivedMask;  // used when no mask map is given
+    int32_t dilationRings = 4;       // geometry-image dilation past chart borders
+};
+
+// The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's
+// UV triangles of the tile (geometry images), the rigidity map R, the warp mask M (derived from the UVs
+// when none is given) and an optional orientation-preservation map, then per frame rasterises the deformed
+// positions, runs the solver (warm-started from the previous frame) and inverts the warp.
+class TileWarp {
+  public:
+    // rest: mesh with UVs; tile: UDIM number; rigidity: T x T, channel 0 used, values in [0, 1]; mask: T x T
+    // (channel 0, >= 0.5 may warp) or an empty Image to derive one; orientation: T x T in [0, 1] or empty.
+    // `source` names the tile's inputs in errors ("rig.1001.exr"). Throws InvalidInput for: a mesh without
+    // UVs or a face straddling tiles, a non-square map or one whose size is not a power of two (when
+    // cells = 0), maps of different sizes, rigidity outside [0, 1], cells not a power of two.
+    TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask = {},
+             const TileWarpOptions& options = {}, const io::Image& orientation = {},
+             const std::string& source = "tile");
+    ~TileWarp();
+    TileWarp(TileWarp&&) noexcept;
+    TileWarp& operator=(TileWarp&&) noexcept;
+
+    // One frame: deformed positions of the rest mesh's vertices (same count). Returns the warp W.
+    const WarpGrid& solve(std::span<const glm::vec3> deformedPoints);
+    // W^-1 of the last solve as a T x T x 2 image of tile-local uv (the identity before any solve).
+    void redirect(io::Image& out) const;
+    [[nodiscard]] io::Image redirect() const;
+    // Quality figures of the last solve (identity vs. ours, folds, masked and border motion).
+    [[nodiscard]] WarpMetrics metrics() const;
+    // Back to the identity warp (a cut in the shot).
+    void reset();
+
+    [[nodiscard]] int tile() const;
+    [[nodiscard]] int32_t texels() const;
+    [[nodiscard]] int32_t cells() const;
+    [[nodiscard]] const WarpGrid& warp() const;
+    [[nodiscard]] const SolveStats& stats() const;
+    [[nodiscard]] const PointField& rigidityAtGridPoints() const;
+    [[nodiscard]] const PointField& maskAtGridPoints() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace deformkit::uvwarp

@@ -1,0 +1,139 @@
+#include "deformkit/uvwarp/tile_warp.h"
+
+#include <string>
+
+#include "deformkit/error.h"
+#include "deformkit/uvwarp/geometry_image.h"
+#include "deformkit/uvwarp/inversion.h"
+
+namespace deformkit::uvwarp {
+
+namespace {
+
+void requireSquare(const io::Image& map, const std::string& source, int tile, const char* what) {
+    if (map.width <= 0 || map.width != map.height || map.channels < 1) {
+        throw InvalidInput(formatError(source, std::string(what) + ", UDIM tile " + std::to_string(tile),
+                                       std::to_string(map.width) + " x " + std::to_string(map.height) +
+                                           " x " + std::to_string(map.channels),
+                                       "a square map with at least one channel"));
+    }
+}
+
+}  // namespace
+
+struct TileWarp::Impl {
+    std::string source;
+    int tile = 0;
+    int32_t texels = 0;
+    int32_t cells = 0;
+    std::unique_ptr<GeometryImager> imager;
+    PointField rest, deformed, rigidity, mask;
+    std::unique_ptr<Solver> solver;
+    bool solved = false;
+};
+
+TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+                   const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& m = *impl_;
+    m.source = source;
+    m.tile = tile;
+    requireSquare(rigidity, source, tile, "rigidity map");
+    m.texels = rigidity.width;
+    const bool derive = mask.pixels.empty();
+    if (!derive) {
+        requireSquare(mask, source, tile, "warp mask");
+        if (mask.width != m.texels) {
+            throw InvalidInput(formatError(source, "warp mask, UDIM tile " + std::to_string(tile),
+                                           std::to_string(mask.width) + " texels per side",
+                                           std::to_string(m.texels) + ", the rigidity map's size"));
+        }
+    }
+    if (!orientation.pixels.empty()) requireSquare(orientation, source, tile, "orientation map");
+    m.cells = options.cells == 0 ? m.texels : options.cells;
+    if (!isPowerOfTwo(m.cells) || m.cells < 2) {
+        throw InvalidInput(formatError(source, "grid resolution, UDIM tile " + std::to_string(tile),
+                                       std::to_string(m.cells) + " cells per side" +
+                                           (options.cells == 0 ? " (the rigidity map's size)" : ""),
+                                       "a power of two, at least 2"));
+    }
+
+    GeometryImageOptions imageOptions;
+    imageOptions.dilationRings = options.dilationRings;
+    imageOptions.label = source;
+    m.imager = std::make_unique<GeometryImager>(rest, tile, m.cells, imageOptions);
+    m.imager->sample(rest.points(), m.rest);
+
+    const MapLabel rigidityLabel{source + " rigidity map", tile};
+    m.rigidity = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
+    if (derive) {
+        DerivedMaskOptions maskOptions = options.derivedMask;
+        maskOptions.label = source;
+        m.mask = maskAtPoints(deriveWarpMask(rest, tile, m.texels, maskOptions), m.cells,
+                              {source + " derived mask", tile});
+    } else {
+        m.mask = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
+    }
+    PointField orientationAtPoints;
+    if (!orientation.pixels.empty()) {
+        orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});
+    }
+    m.solver = std::make_unique<Solver>(m.rest, m.rigidity, m.mask, options.solver, orientationAtPoints,
+                                        source + ", UDIM tile " + std::to_string(tile));
+}
+
+TileWarp::~TileWarp() = default;
+TileWarp::TileWarp(TileWarp&&) noexcept = default;
+TileWarp& TileWarp::operator=(TileWarp&&) noexcept = default;
+
+const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
+    Impl& m = *impl_;
+    m.imager->sample(deformedPoints, m.deformed);
+    m.solved = true;
+    return m.solver->solve(m.deformed);
+}
+
+void TileWarp::redirect(io::Image& out) const {
+    invertWarp(impl_->solver->warp(), impl_->texels, out);
+}
+
+io::Image TileWarp::redirect() const {
+    io::Image out;
+    redirect(out);
+    return out;
+}
+
+WarpMetrics TileWarp::metrics() const {
+    const Impl& m = *impl_;
+    MetricsOptions options;
+    options.texels = m.texels;
+    return measureWarp(m.solver->warp(), m.rest, m.solved ? m.deformed : m.rest, m.rigidity, m.mask, options);
+}
+
+void TileWarp::reset() {
+    impl_->solver->reset();
+}
+
+int TileWarp::tile() const {
+    return impl_->tile;
+}
+int32_t TileWarp::texels() const {
+    return impl_->texels;
+}
+int32_t TileWarp::cells() const {
+    return impl_->cells;
+}
+const WarpGrid& TileWarp::warp() const {
+    return impl_->solver->warp();
+}
+const SolveStats& TileWarp::stats() const {
+    return impl_->solver->stats();
+}
+const PointField& TileWarp::rigidityAtGridPoints() const {
+    return impl_->rigidity;
+}
+const PointField& TileWarp::maskAtGridPoints() const {
+    return impl_->mask;
+}
+
+}  // namespace deformkit::uvwarp
