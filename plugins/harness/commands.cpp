@@ -6,6 +6,7 @@
 
 #include "demo_assets.h"
 #include "demo_slide.h"
+#include "demo_uvwarp.h"
 #include "demo_warps.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
@@ -155,6 +156,10 @@ std::vector<fs::path> demo(const DemoCommand& command) {
         written.push_back(std::move(f));
     }
     for (fs::path& f : writeDemoSlide(assets.mesh, command.outDir)) {
+        written.push_back(std::move(f));
+    }
+    for (fs::path& f : writeDemoUvWarp(assets.mesh, assets.rigidity.at(1001), assets.mask.at(1001), assets.albedo,
+                                       command.outDir)) {
         written.push_back(std::move(f));
     }
     return written;

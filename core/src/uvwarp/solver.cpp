@@ -60,6 +60,7 @@ struct Solver::Impl {
     const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
     std::vector<int32_t> untangleWork;  // scratch of untangle(), kept between calls
     std::vector<std::vector<int32_t>> untangleRows;
+    std::vector<int32_t> untangleNext;
     SolveStats stats;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
@@ -279,7 +280,7 @@ struct Solver::Impl {
         int32_t moved = 0;
         const size_t s = static_cast<size_t>(level.stride);
         const size_t row = s * static_cast<size_t>(side());
-        std::vector<int32_t> next;
+        std::vector<int32_t>& next = untangleNext;
         for (int pass = 0; pass < 64 && !work.empty(); ++pass) {
             next.clear();
             for (int32_t id : work) {

@@ -1,0 +1,146 @@
+#include "demo_uvwarp.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/io/preview.h"
+#include "deformkit/io/udim.h"
+#include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "deformkit/warp/barr.h"
+
+namespace deformkit::harness {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+// Images laid out in rows on the first image's background, `gap` pixels apart.
+io::Image sheet(const std::vector<std::vector<const io::Image*>>& rows, int32_t gap) {
+    const io::Image& first = *rows[0][0];
+    int32_t width = 0, height = 0;
+    for (const auto& row : rows) {
+        int32_t w = 0, h = 0;
+        for (const io::Image* image : row) {
+            w += image->width + gap;
+            h = std::max(h, image->height);
+        }
+        width = std::max(width, w - gap);
+        height += h + gap;
+    }
+    height -= gap;
+    io::Image out(width, height, 3);
+    for (int32_t y = 0; y < height; ++y)
+        for (int32_t x = 0; x < width; ++x)
+            for (int c = 0; c < 3; ++c)
+                out.at(x, y, c) = first.at(0, 0, c);
+    int32_t y0 = 0;
+    for (const auto& row : rows) {
+        int32_t x0 = 0, h = 0;
+        for (const io::Image* image : row) {
+            for (int32_t y = 0; y < image->height; ++y)
+                for (int32_t x = 0; x < image->width; ++x)
+                    for (int c = 0; c < 3; ++c)
+                        out.at(x0 + x, y0 + y, c) = image->at(x, y, c);
+            x0 += image->width + gap;
+            h = std::max(h, image->height);
+        }
+        y0 += h + gap;
+    }
+    return out;
+}
+
+}  // namespace
+
+DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, const io::Image& mask,
+                          const io::Image& albedo) {
+    // Bend about the axis frame's "up" (+x) over the tube's length: the bend radius 1/k ~ 1.9 puts the
+    // -x side (1 unit further out) at ~1.5x stretch and the +x side at ~0.5x.
+    const warp::AxisFrame axis{{0, 0, 0}, {0, 1, 0}, {1, 0, 0}};
+    warp::BendWarp bend(axis, {kPi / 2 / 3.0f, 0.5f, 0.5f, 3.5f});
+    std::vector<glm::vec3> points(tube.points().begin(), tube.points().end());
+    warp::SparseFields unused;
+    bend.bind(points, unused);
+    bend.deform(points);
+    DemoUvWarp demo{tube, {}, {}, {}};
+    demo.bent.setPoints(points);
+
+    uvwarp::TileWarpOptions options;
+    options.cells = std::min<int32_t>(rigidity.width, 256);
+    uvwarp::TileWarp tile(tube, 1001, rigidity, mask, options, {}, "demo tube");
+    // Two solves of the same pose: the second warm-starts from the first, as frames of a held pose would.
+    tile.solve(points);
+    tile.solve(points);
+    demo.redirect = tile.redirect();
+    demo.metrics = tile.metrics();
+    demo.warpedAlbedo = uvwarp::bakeTexture(albedo, demo.redirect);  // bilinear: no overshoot past [0, 1]
+    return demo;
+}
+
+std::vector<fs::path> writeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity,
+                                      const io::Image& mask, const std::map<int, io::Image>& albedo,
+                                      const fs::path& outDir) {
+    const fs::path dir = outDir / "uvwarp";
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) {
+        throw IoError(formatError(dir.string(), "", "cannot create the folder: " + ec.message(),
+                                  "a writable location"));
+    }
+    const DemoUvWarp demo = makeDemoUvWarp(tube, rigidity, mask, albedo.at(1001));
+    std::vector<fs::path> written;
+    written.push_back(dir / "tube_bent.obj");
+    io::writeObj(written.back(), demo.bent);
+    io::ImageWriteOptions exr;
+    exr.type = io::PixelType::Float;
+    exr.attributes = {{"deformkit:content", "uv redirect, tile-local uv' = W^-1(uv)"},
+                      {"deformkit:tile", "1001"}};
+    written.push_back(dir / "redirect.1001.exr");
+    io::writeImage(written.back(), demo.redirect, exr);
+
+    io::PreviewTexture before, after;
+    for (const auto& [tile, image] : albedo) {
+        before.tiles.emplace(tile, image);
+        const io::Image& warped = tile == 1001 ? demo.warpedAlbedo : image;
+        after.tiles.emplace(tile, warped);
+        written.push_back(dir / io::expandUdim("albedo_warped.<UDIM>.png", tile));
+        io::writeImage(written.back(), warped);
+    }
+    io::PreviewOptions outer;  // looks along +x at the stretched -x side
+    outer.width = 420;
+    outer.height = 420;
+    outer.fieldOfViewDegrees = 22.0f;
+    outer.viewDirection = {1.0f, -0.25f, -0.15f};
+    io::PreviewOptions inner = outer;            // the squashed +x side, seen from below the crook
+    inner.viewDirection = {-1.0f, 0.8f, -0.3f};  // from below the crook
+    const io::Image outerBefore = io::renderPreview(demo.bent, outer, &before);
+    const io::Image outerAfter = io::renderPreview(demo.bent, outer, &after);
+    const io::Image innerBefore = io::renderPreview(demo.bent, inner, &before);
+    const io::Image innerAfter = io::renderPreview(demo.bent, inner, &after);
+    for (const auto& [name, image] :
+         std::vector<std::pair<std::string, const io::Image*>>{{"outer_before.png", &outerBefore},
+                                                               {"outer_after.png", &outerAfter},
+                                                               {"inner_before.png", &innerBefore},
+                                                               {"inner_after.png", &innerAfter}}) {
+        written.push_back(dir / name);
+        io::writeImage(written.back(), *image);
+    }
+    written.push_back(dir / "uvwarp.png");
+    io::writeImage(written.back(), sheet({{&outerBefore, &outerAfter}, {&innerBefore, &innerAfter}}, 8));
+
+    const uvwarp::WarpMetrics& m = demo.metrics;
+    const std::string json =
+        "{\"tile\": 1001, \"rigid_stretch_error\": " + std::to_string(m.rigidStretchError) +
+        ", \"identity_stretch_error\": " + std::to_string(m.identityStretchError) +
+        ", \"fold_overs\": " + std::to_string(m.foldOvers) +
+        ", \"max_masked_displacement\": " + std::to_string(m.maxMaskedDisplacement) + "}\n";
+    written.push_back(dir / "metrics.json");
+    io::writeFileAtomically(written.back(), json);
+    return written;
+}
+
+}  // namespace deformkit::harness
