@@ -5,11 +5,14 @@
 #include <cstdio>
 #include <iostream>
 
+#include <unistd.h>
+
 #include "commands.h"
-#include "slide_command.h"
-#include "warp_command.h"
 #include "deformkit/error.h"
 #include "deformkit/version.h"
+#include "slide_command.h"
+#include "uvwarp_command.h"
+#include "warp_command.h"
 
 namespace {
 
@@ -18,8 +21,8 @@ glm::vec3 parseVec3(const std::string& text) {
     glm::vec3 v;
     char tail = 0;
     if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3) {
-        throw deformkit::InvalidInput(
-            deformkit::formatError("--view", "", "'" + text + "' is not a direction", "three numbers: x,y,z"));
+        throw deformkit::InvalidInput(deformkit::formatError(
+            "--view", "", "'" + text + "' is not a direction", "three numbers: x,y,z"));
     }
     return v;
 }
@@ -33,13 +36,15 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
 
     std::string infoFile;
-    auto* info = app.add_subcommand("info", "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern");
+    auto* info =
+        app.add_subcommand("info", "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern");
     info->add_option("FILE", infoFile, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
         ->required();
 
     harness::PreviewCommand previewCommand;
     std::string previewMesh, previewTexture, previewOut, previewView;
-    auto* preview = app.add_subcommand("preview", "Render a shaded, optionally textured view of a mesh to an image");
+    auto* preview =
+        app.add_subcommand("preview", "Render a shaded, optionally textured view of a mesh to an image");
     preview->add_option("MESH", previewMesh, "mesh (.obj)")->required();
     preview->add_option("--texture", previewTexture, "image, or UDIM pattern such as albedo.<UDIM>.png");
     preview->add_option("--out", previewOut, "output image (.png)")->required();
@@ -52,13 +57,16 @@ int main(int argc, char** argv) {
     std::string demoOut = demoCommand.outDir.string();
     auto* demo = app.add_subcommand("demo", "Generate the demo assets and previews into a folder");
     demo->add_option("--out", demoOut, "output folder")->capture_default_str();
-    demo->add_option("--resolution", demoCommand.resolution, "texels per UDIM tile side")->capture_default_str();
+    demo->add_option("--resolution", demoCommand.resolution, "texels per UDIM tile side")
+        ->capture_default_str();
 
     harness::WarpImageCommand warpCommand;
     std::string warpImage, warpLines, warpOut, warpVariant = "original", warpInterp = "bilinear";
-    auto* warpImageApp = app.add_subcommand("warp", "Warp an image with Beier-Neely segment pairs (inverse mapping)");
+    auto* warpImageApp =
+        app.add_subcommand("warp", "Warp an image with Beier-Neely segment pairs (inverse mapping)");
     warpImageApp->add_option("IMAGE", warpImage, "source image")->required();
-    warpImageApp->add_option("--lines", warpLines, "segment pairs, JSON (docs/warps/beier_neely.md)")->required();
+    warpImageApp->add_option("--lines", warpLines, "segment pairs, JSON (docs/warps/beier_neely.md)")
+        ->required();
     warpImageApp->add_option("--out", warpOut, "output image, same size and channels")->required();
     warpImageApp->add_option("--variant", warpVariant, "original or global (no fold-over, paper 5.2)")
         ->check(CLI::IsMember({"original", "global"}))
@@ -94,6 +102,72 @@ int main(int argc, char** argv) {
     slideApp
         ->add_option("--max-walk", slideCommand.options.maxWalkTriangles,
                      "triangles one vertex may cross before it stops")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+
+    harness::UvWarpCommand uvwarpCommand;
+    std::string uvFrames, uvTiles, uvMask, uvTexture, uvBake, uvLog, uvFilter = "bilinear";
+    std::string uvRest, uvDeformed, uvRigidity, uvOut;
+    uvwarp::SolverOptions& uvSolver = uvwarpCommand.options.solver;
+    auto* uvwarpApp = app.add_subcommand(
+        "uvwarp",
+        "Content-aware UV warp over a shot: per UDIM tile and frame a redirect map (and a baked texture)");
+    uvwarpApp->add_option("--rest", uvRest, "rest mesh with UVs (.obj)")->required();
+    uvwarpApp
+        ->add_option("--deformed", uvDeformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
+        ->required();
+    uvwarpApp->add_option("--frames", uvFrames, "frames: 1-24, or a list such as 1-10,15")->required();
+    uvwarpApp->add_option("--rigidity", uvRigidity, "rigidity maps, e.g. 'rig.<UDIM>.exr' (1 = rigid)")
+        ->required();
+    uvwarpApp->add_option("--mask", uvMask,
+                          "warp masks, e.g. 'mask.<UDIM>.exr' (>= 0.5 may warp); default: from the UVs");
+    auto* uvTextureOption = uvwarpApp->add_option("--texture", uvTexture,
+                                                  "texture to bake, e.g. 'col.<UDIM>.exr' (needs --bake)");
+    uvwarpApp
+        ->add_option("--out", uvOut,
+                     "redirect maps, e.g. 'out/redirect.<UDIM>.####.exr' (2-channel float EXR)")
+        ->required();
+    auto* uvBakeOption = uvwarpApp->add_option(
+        "--bake", uvBake, "baked textures, e.g. 'out/col.<UDIM>.####.exr' (needs --texture)");
+    uvTextureOption->needs(uvBakeOption);
+    uvBakeOption->needs(uvTextureOption);
+    uvwarpApp->add_option("--tiles", uvTiles,
+                          "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
+    uvwarpApp
+        ->add_option("--resolution", uvwarpCommand.resolution,
+                     "grid cells per side, a power of two; 0: the rigidity map's size")
+        ->capture_default_str();
+    uvwarpApp->add_option("--log", uvLog, "JSON-lines log, appended: one line per tile and frame");
+    uvwarpApp->add_option("--filter", uvFilter, "bake filter: bilinear or bicubic")
+        ->check(CLI::IsMember({"bilinear", "bicubic"}))
+        ->capture_default_str();
+    uvwarpApp->add_option("--iterations", uvSolver.iterations, "PBD iterations per frame")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarpApp->add_option("--levels", uvSolver.levels, "hierarchy levels; 0: automatic")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarpApp
+        ->add_option("--sweeps", uvSolver.sweepsPerLevel,
+                     "constraint sweeps per iteration and level, finest first")
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarpApp->add_option("--orientation-preservation", uvSolver.orientationPreservation, "in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarpApp->add_option("--smoothing", uvSolver.smoothing, "smoothing of rigid points, in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarpApp->add_option("--damping", uvSolver.damping, "velocity damping, in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarpApp->add_option("--coarse-stiffness", uvSolver.coarseStiffness, "per coarser level, in (0, 1]")
+        ->check(CLI::Range(1e-6f, 1.0f))
+        ->capture_default_str();
+    uvwarpApp
+        ->add_option("--border-width", uvwarpCommand.options.derivedMask.borderWidth,
+                     "texels of chart border kept fixed by a derived mask")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
 
@@ -139,11 +213,31 @@ int main(int argc, char** argv) {
                 slideSurface == "limit" ? slide::SurfaceMode::Limit : slide::SurfaceMode::Cage;
             const slide::SlideResult result = harness::slideCommand(slideCommand);
             std::cout << harness::slideSummary(slideOut, result) << "\n";
+        } else if (*uvwarpApp) {
+            uvwarpCommand.rest = uvRest;
+            uvwarpCommand.deformed = uvDeformed;
+            uvwarpCommand.frames = harness::parseFrames(uvFrames);
+            uvwarpCommand.rigidity = uvRigidity;
+            uvwarpCommand.out = uvOut;
+            if (!uvMask.empty()) uvwarpCommand.mask = uvMask;
+            if (!uvTexture.empty()) uvwarpCommand.texture = uvTexture;
+            if (!uvBake.empty()) uvwarpCommand.bake = uvBake;
+            if (!uvTiles.empty()) uvwarpCommand.tiles = harness::parseTiles(uvTiles);
+            if (!uvLog.empty()) uvwarpCommand.log = uvLog;
+            uvwarpCommand.filter =
+                uvFilter == "bicubic" ? warp::Interpolation::Bicubic : warp::Interpolation::Bilinear;
+            // The progress bar redraws one line in place: only for a person watching a terminal.
+            const harness::UvWarpReport report =
+                harness::uvwarpCommand(uvwarpCommand, ::isatty(STDERR_FILENO) ? &std::cerr : nullptr);
+            for (const std::string& line : harness::uvwarpSummary(report))
+                std::cout << "uvwarp: " << line << "\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);
-            std::cout << "demo: wrote " << files.size() << " files to " << demoCommand.outDir.string() << "/\n";
-            for (const auto& f : files) std::cout << "  " << f.string() << "\n";
+            std::cout << "demo: wrote " << files.size() << " files to " << demoCommand.outDir.string()
+                      << "/\n";
+            for (const auto& f : files)
+                std::cout << "  " << f.string() << "\n";
         }
     } catch (const Error& e) {
         std::cerr << "deformkit: error: " << e.what() << "\n";

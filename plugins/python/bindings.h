@@ -12,5 +12,6 @@ void bindWires(pybind11::module_& m);
 void bindMeshWarp(pybind11::module_& m);
 void bindWarpEngine(pybind11::module_& m);
 void bindSlide(pybind11::module_& m);
+void bindUvWarp(pybind11::module_& m);
 
 }  // namespace deformkit::python

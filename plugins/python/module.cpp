@@ -213,6 +213,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindMeshWarp(m);
     python::bindBeierNeely(m);
     python::bindSlide(m);
+    python::bindUvWarp(m);
 
     m.def("make_capped_tube", [] { return geom::makeCappedTube(); }, "The demo's capped tube (UDIM 1001-1002).");
 }

@@ -145,6 +145,34 @@ contains slide-missing-mesh "$work/err" "nope.obj"
 [ ! -e "$work/s2.obj" ] || { echo "FAIL slide errors: output written"; failures=$((failures + 1)); }
 expect slide-options 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0.05,0 --radius 0.3 --falloff 1,0.5,0 --envelope 0.5 --region geodesic --surface limit --max-walk 64 --out "$work/s3.obj"
 
+# UV warp over a 2-frame shot of the grid (UVs in tile 1001) with the demo's 64 x 64 rigidity map: frame 1 is the
+# rest pose, frame 2 stretches 1.5x along x.
+mkdir -p "$work/uv/out"
+cp "$work/grid.obj" "$work/uv/anim.0001.obj"
+awk '/^v / { printf "v %.9g %s %s\n", $2 * 1.5, $3, $4; next } { print }' "$work/grid.obj" >"$work/uv/anim.0002.obj"
+uvwarp() { "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/uv/anim.####.obj" --rigidity "$work/demo/rigidity.<UDIM>.exr" "$@"; }
+expect uvwarp 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr" --texture "$work/demo/albedo.<UDIM>.png" \
+    --bake "$work/uv/out/albedo.<UDIM>.####.png" --log "$work/uv/log.jsonl"
+contains uvwarp "$work/out" "uvwarp: tile 1001: 2 frames written (2 baked), 0 replayed, 0 skipped"
+[ "$(wc -l <"$work/uv/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
+[ -s "$work/uv/out/albedo.1001.0002.png" ] || { echo "FAIL uvwarp: bake missing"; failures=$((failures + 1)); }
+expect uvwarp-info 0 "$dk" info "$work/uv/out/redirect.1001.0002.exr"
+contains uvwarp-info "$work/out" "64 x 64"
+contains uvwarp-info "$work/out" "channels    2"
+contains uvwarp-info "$work/out" "type        float"
+contains uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
+expect uvwarp-resume 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr"
+contains uvwarp-resume "$work/out" "0 frames written, 0 replayed, 2 skipped"
+expect uvwarp-no-out 2 uvwarp --frames 1-2
+expect uvwarp-bake-alone 2 uvwarp --frames 1-2 --out "$work/uv/out/r.<UDIM>.####.exr" --bake "$work/uv/out/b.<UDIM>.####.png"
+expect uvwarp-bad-frames 2 uvwarp --frames 2-1 --out "$work/uv/out/r.<UDIM>.####.exr"
+contains uvwarp-bad-frames "$work/err" "--frames"
+expect uvwarp-resolution 2 uvwarp --frames 1-2 --resolution 48 --out "$work/uv/out/r.<UDIM>.####.exr"
+contains uvwarp-resolution "$work/err" "--resolution: 48"
+expect uvwarp-missing-frame 2 uvwarp --frames 1-3 --out "$work/uv/out/r.<UDIM>.####.exr"
+contains uvwarp-missing-frame "$work/err" "anim.0003.obj: frame 3: is missing"
+[ ! -e "$work/uv/out/r.1001.0001.exr" ] || { echo "FAIL uvwarp errors: output written"; failures=$((failures + 1)); }
+
 # A truncated image is a clear error, not a crash.
 head -c 300 "$work/demo/albedo.1001.png" >"$work/trunc.png"
 expect truncated-texture 2 "$dk" preview "$work/demo/tube.obj" --texture "$work/trunc.png" --out "$work/r.png"

@@ -1,0 +1,447 @@
+// Python bindings of the content-aware UV warp (core/include/deformkit/uvwarp/, Koniaris et al.): the
+// UvWarpSolver class that binds one UDIM tile's maps and rest mesh once and solves frame after frame
+// (warm start), the one-off uv_warp, and apply_redirect (texture bake through a redirect map). Maps are
+// numpy float32 images in (H, W, C) layout, row 0 at v = 1 (grid.h).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
+#include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "numpy_support.h"
+
+namespace py = pybind11;
+
+namespace deformkit::python {
+namespace {
+
+using uvwarp::TileWarp;
+using uvwarp::TileWarpOptions;
+
+constexpr const char* kOptionNames =
+    "iterations, levels, sweeps_per_level, orientation_preservation, smoothing, damping, coarse_stiffness, "
+    "border_width, dilation_rings";
+
+std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const char* name) {
+    if (a.ndim() != 1)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
+    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
+}
+
+// The rest mesh from arrays, as deformkit.Mesh takes them; uvs and uv_indices both or neither (None).
+geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const IntArray& indices,
+                  const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices,
+                  const std::string& source) {
+    geom::Mesh::Data d;
+    d.points = pointsOf(points, source, "points");
+    d.faceCounts = intsOf(counts, source, "face_counts");
+    d.faceIndices = intsOf(indices, source, "face_indices");
+    if (uvs.has_value() != uvIndices.has_value()) {
+        throw InvalidInput(formatError(source, "uvs", "given without uv_indices or the other way round",
+                                       "both uvs and uv_indices, or neither"));
+    }
+    if (uvs) {
+        if (uvs->ndim() != 2 || uvs->shape(1) != 2)
+            throw InvalidInput(formatError(source, "uvs", "has shape " + shapeOf(*uvs), "(k, 2) float32"));
+        d.uvs.resize(static_cast<size_t>(uvs->shape(0)));
+        if (!d.uvs.empty()) std::memcpy(d.uvs.data(), uvs->data(), d.uvs.size() * sizeof(glm::vec2));
+        d.uvIndices = intsOf(*uvIndices, source, "uv_indices");
+    }
+    return geom::Mesh(std::move(d), source + " mesh");
+}
+
+// A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
+// names the texel.
+io::Image mapOf(const FloatArray& a, const std::string& source, const char* name) {
+    if (!(a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1)) || a.shape(0) < 1 || a.shape(1) < 1) {
+        throw InvalidInput(
+            formatError(source, name, "has shape " + shapeOf(a), "(T, T) or (T, T, 1) float32"));
+    }
+    io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), 1);
+    std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));
+    return image;
+}
+
+io::Image optionalMapOf(const std::optional<FloatArray>& a, const std::string& source, const char* name) {
+    return a ? mapOf(*a, source, name) : io::Image{};
+}
+
+// Any image: (H, W) or (H, W, C) float32.
+io::Image imageOf(const FloatArray& a, const std::string& source, const char* name, const char* expected) {
+    if ((a.ndim() != 2 && a.ndim() != 3) || a.shape(0) < 1 || a.shape(1) < 1 ||
+        (a.ndim() == 3 && a.shape(2) < 1))
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
+    const int32_t channels = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
+    io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), channels);
+    std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));
+    return image;
+}
+
+// Moves an Image's pixels into a numpy (H, W, C) array (or (H, W) when `flat`) without copying.
+py::array toNumpy(io::Image&& image, bool flat = false) {
+    auto* pixels = new std::vector<float>(std::move(image.pixels));
+    py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+    if (flat) return py::array_t<float>({image.height, image.width}, pixels->data(), owner);
+    return py::array_t<float>({image.height, image.width, image.channels}, pixels->data(), owner);
+}
+
+int32_t intOption(py::handle value, const std::string& source, const std::string& name, int64_t lo,
+                  const char* expected) {
+    int64_t v = 0;
+    try {
+        if (py::isinstance<py::float_>(value)) throw py::cast_error();
+        v = value.cast<int64_t>();
+    } catch (const py::cast_error&) {
+        throw InvalidInput(formatError(
+            source, name, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))), expected));
+    }
+    if (v < lo || v > std::numeric_limits<int32_t>::max())
+        throw InvalidInput(formatError(source, name, "is " + std::to_string(v), expected));
+    return static_cast<int32_t>(v);
+}
+
+float floatOption(py::handle value, const std::string& source, const std::string& name, bool openLow,
+                  const char* expected) {
+    double v = 0.0;
+    try {
+        v = value.cast<double>();
+    } catch (const py::cast_error&) {
+        throw InvalidInput(formatError(
+            source, name, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))), expected));
+    }
+    if (!std::isfinite(v) || v > 1.0 || (openLow ? !(v > 0.0) : v < 0.0))
+        throw InvalidInput(formatError(source, name, "is " + std::string(py::str(value)), expected));
+    return static_cast<float>(v);
+}
+
+// resolution (grid cells per side, None = the rigidity map's size) and the keyword options, each checked
+// and named: the core checks them too but names only "solver options".
+TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs& kwargs,
+                          const std::string& source) {
+    TileWarpOptions o;
+    if (resolution) {
+        const int64_t n = *resolution;
+        if (n < 2 || n > (int64_t{1} << 15) || (n & (n - 1)) != 0) {
+            throw InvalidInput(formatError(source, "resolution", "is " + std::to_string(n),
+                                           "None (the rigidity map's size) or a power of two in [2, 32768]"));
+        }
+        o.cells = static_cast<int32_t>(n);
+    }
+    for (const auto& [key, value] : kwargs) {
+        const std::string k = py::str(key);
+        if (k == "iterations") {
+            o.solver.iterations = intOption(value, source, k, 0, "an integer >= 0");
+        } else if (k == "levels") {
+            o.solver.levels = intOption(value, source, k, 0, "an integer >= 0 (0: automatic)");
+        } else if (k == "sweeps_per_level") {
+            const char* expected = "a non-empty sequence of integers >= 0, finest level first";
+            if (!py::isinstance<py::sequence>(value) || py::isinstance<py::str>(value)) {
+                throw InvalidInput(formatError(
+                    source, k, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))),
+                    expected));
+            }
+            const auto items = py::reinterpret_borrow<py::sequence>(value);
+            if (items.size() == 0) throw InvalidInput(formatError(source, k, "is empty", expected));
+            o.solver.sweepsPerLevel.clear();
+            for (size_t i = 0; i < items.size(); ++i)
+                o.solver.sweepsPerLevel.push_back(
+                    intOption(items[i], source, k + "[" + std::to_string(i) + "]", 0, "an integer >= 0"));
+        } else if (k == "orientation_preservation") {
+            o.solver.orientationPreservation = floatOption(value, source, k, false, "a number in [0, 1]");
+        } else if (k == "smoothing") {
+            o.solver.smoothing = floatOption(value, source, k, false, "a number in [0, 1]");
+        } else if (k == "damping") {
+            o.solver.damping = floatOption(value, source, k, false, "a number in [0, 1]");
+        } else if (k == "coarse_stiffness") {
+            o.solver.coarseStiffness = floatOption(value, source, k, true, "a number in (0, 1]");
+        } else if (k == "border_width") {
+            o.derivedMask.borderWidth = intOption(value, source, k, 1, "an integer >= 1 (texels)");
+        } else if (k == "dilation_rings") {
+            o.dilationRings = intOption(value, source, k, 0, "an integer in [0, 64]");
+            if (o.dilationRings > 64)
+                throw InvalidInput(
+                    formatError(source, k, "is " + std::to_string(o.dilationRings), "an integer in [0, 64]"));
+        } else {
+            throw InvalidInput(formatError(source, k, "is not an option", kOptionNames));
+        }
+    }
+    return o;
+}
+
+uvwarp::BakeOptions bakeOptionsOf(const std::string& filter, const std::string& source) {
+    uvwarp::BakeOptions o;
+    if (filter == "bilinear") {
+        o.filter = warp::Interpolation::Bilinear;
+    } else if (filter == "bicubic") {
+        o.filter = warp::Interpolation::Bicubic;
+    } else {
+        throw InvalidInput(formatError(source, "filter", "is '" + filter + "'", "'bilinear' or 'bicubic'"));
+    }
+    return o;
+}
+
+// The warp grid as (n + 1, n + 1, 2) float32: [j, i] = (u, v) of grid point (i, j), j = 0 on v = 0.
+py::array_t<float> gridArray(const uvwarp::WarpGrid& w) {
+    const auto side = static_cast<py::ssize_t>(w.side());
+    py::array_t<float> out({side, side, py::ssize_t{2}});
+    float* p = out.mutable_data();
+    for (size_t k = 0; k < w.numPoints(); ++k) {
+        p[2 * k] = w.u[k];
+        p[2 * k + 1] = w.v[k];
+    }
+    return out;
+}
+
+py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
+    py::dict d;
+    d["rigid_stretch_error"] = m.rigidStretchError;
+    d["identity_stretch_error"] = m.identityStretchError;
+    d["rigid_edges"] = m.rigidEdges;
+    d["skipped_edges"] = m.skippedEdges;
+    d["fold_overs"] = m.foldOvers;
+    d["max_masked_displacement"] = m.maxMaskedDisplacement;
+    d["max_border_displacement"] = m.maxBorderDisplacement;
+    d["points_outside"] = m.pointsOutside;
+    d["iterations"] = s.iterations;
+    d["levels"] = s.levels;
+    d["untangled_points"] = s.untangledPoints;
+    d["remaining_folds"] = s.remainingFolds;
+    return d;
+}
+
+std::vector<glm::vec3> deformedOf(const FloatArray& a, int32_t vertices, const std::string& source) {
+    if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != vertices) {
+        throw InvalidInput(formatError(source, "deformed_points", "has shape " + shapeOf(a),
+                                       "(" + std::to_string(vertices) + ", 3), one row per rest vertex"));
+    }
+    return pointsOf(a, source, "deformed_points");
+}
+
+std::unique_ptr<TileWarp> bindTile(const geom::Mesh& mesh, int tile, const io::Image& rigidity,
+                                   const io::Image& mask, const TileWarpOptions& options,
+                                   const io::Image& orientation, const std::string& source) {
+    py::gil_scoped_release release;
+    return std::make_unique<TileWarp>(mesh, tile, rigidity, mask, options, orientation, source);
+}
+
+// The UvWarpSolver binding. A mutex serialises calls on one solver: solve runs without the GIL, so two
+// Python threads could otherwise enter the same warm-started state at once.
+class PyUvWarpSolver {
+  public:
+    PyUvWarpSolver(const geom::Mesh& mesh, int tile, const FloatArray& rigidity,
+                   const std::optional<FloatArray>& mask, const std::optional<int64_t>& resolution,
+                   const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
+        const std::string source = "UvWarpSolver";
+        const TileWarpOptions options = optionsOf(resolution, kwargs, source);
+        warp_ = bindTile(mesh, tile, mapOf(rigidity, source, "rigidity"), optionalMapOf(mask, source, "mask"),
+                         options, optionalMapOf(orientation, source, "orientation"), source);
+        vertices_ = mesh.numVertices();
+    }
+
+    py::array_t<float> solve(const FloatArray& deformed) {
+        const std::vector<glm::vec3> points = deformedOf(deformed, vertices_, "UvWarpSolver.solve");
+        uvwarp::WarpGrid w;
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            w = warp_->solve(points);
+        }
+        return gridArray(w);
+    }
+
+    py::array redirectMap() const {
+        io::Image out;
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            warp_->redirect(out);
+        }
+        return toNumpy(std::move(out));
+    }
+
+    py::dict metrics() const {
+        uvwarp::WarpMetrics m;
+        uvwarp::SolveStats s;
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            m = warp_->metrics();
+            s = warp_->stats();
+        }
+        return metricsDict(m, s);
+    }
+
+    void reset() {
+        py::gil_scoped_release release;
+        const std::lock_guard<std::mutex> lock(mutex_);
+        warp_->reset();
+    }
+
+    py::array_t<float> warp() const {
+        uvwarp::WarpGrid w;
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard<std::mutex> lock(mutex_);
+            w = warp_->warp();
+        }
+        return gridArray(w);
+    }
+
+    [[nodiscard]] const TileWarp& tileWarp() const { return *warp_; }
+    [[nodiscard]] int32_t vertices() const { return vertices_; }
+
+  private:
+    std::unique_ptr<TileWarp> warp_;
+    int32_t vertices_ = 0;
+    mutable std::mutex mutex_;
+};
+
+py::array uvWarp(const geom::Mesh& mesh, int tile, const FloatArray& rigidity, const FloatArray& deformed,
+                 const std::optional<FloatArray>& mask, const std::optional<int64_t>& resolution,
+                 const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
+    const std::string source = "uv_warp";
+    const TileWarpOptions options = optionsOf(resolution, kwargs, source);
+    const std::vector<glm::vec3> points = deformedOf(deformed, mesh.numVertices(), source);
+    const io::Image rigidityMap = mapOf(rigidity, source, "rigidity");
+    const io::Image maskMap = optionalMapOf(mask, source, "mask");
+    const io::Image orientationMap = optionalMapOf(orientation, source, "orientation");
+    io::Image out;
+    {
+        py::gil_scoped_release release;
+        TileWarp warp(mesh, tile, rigidityMap, maskMap, options, orientationMap, source);
+        warp.solve(points);
+        warp.redirect(out);
+    }
+    return toNumpy(std::move(out));
+}
+
+constexpr const char* kSolverDoc =
+    "The content-aware UV warp (Koniaris et al.) of one UDIM tile, bound once to the rest mesh and the\n"
+    "tile's maps, solved frame after frame: each solve warm-starts from the last warp, so a static pose\n"
+    "gives a static warp and an animation changes smoothly.\n\n"
+    "UvWarpSolver(points, face_counts, face_indices, uvs, uv_indices, tile, rigidity, mask=None,\n"
+    "             resolution=None, orientation=None, **options)\n"
+    "UvWarpSolver(mesh, tile, rigidity, mask=None, resolution=None, orientation=None, **options)\n\n"
+    "points (N, 3) float32 rest positions; face_counts (F,), face_indices (sum of counts,) int32; uvs (K, "
+    "2)\n"
+    "float32 and uv_indices (sum of counts,) int32 (absolute UDIM UVs), or a deformkit.Mesh with UVs.\n"
+    "tile: the UDIM tile (1001, ...). Maps are (T, T) or (T, T, 1) float32 images, row 0 at v = 1:\n"
+    "rigidity in [0, 1] (1 = as rigid as possible); mask (>= 0.5 may warp; None derives one from the UVs:\n"
+    "texels outside every UV triangle and on chart borders stay fixed); orientation in [0, 1] scales\n"
+    "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n"
+    "options: iterations (12), levels (0: automatic), sweeps_per_level ([1, 2, 4], finest first),\n"
+    "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
+    "border_width (1 texel, derived mask), dilation_rings (4, geometry images).";
+
+constexpr const char* kSolveDoc =
+    "Solve one frame: deformed_points (N, 3) float32, the rest mesh's vertices moved (scene units).\n"
+    "Returns the warp grid W as (n + 1, n + 1, 2) float32: n cells per side means n + 1 grid points per\n"
+    "side (deformkit/uvwarp/grid.h). [j, i] holds the tile-local (u, v) of grid point (i, j), which rests\n"
+    "at (i / n, j / n): row j = 0 lies on v = 0 (unlike images, whose row 0 is v = 1).";
+
+}  // namespace
+
+void bindUvWarp(py::module_& m) {
+    py::class_<PyUvWarpSolver>(m, "UvWarpSolver", kSolverDoc)
+        .def(py::init<const geom::Mesh&, int, const FloatArray&, const std::optional<FloatArray>&,
+                      const std::optional<int64_t>&, const std::optional<FloatArray>&, const py::kwargs&>(),
+             py::arg("mesh"), py::arg("tile"), py::arg("rigidity"), py::arg("mask") = py::none(),
+             py::arg("resolution") = py::none(), py::arg("orientation") = py::none())
+        .def(py::init([](const FloatArray& points, const IntArray& counts, const IntArray& indices,
+                         const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices,
+                         int tile, const FloatArray& rigidity, const std::optional<FloatArray>& mask,
+                         const std::optional<int64_t>& resolution,
+                         const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
+                 const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, "UvWarpSolver");
+                 return std::make_unique<PyUvWarpSolver>(mesh, tile, rigidity, mask, resolution, orientation,
+                                                         kwargs);
+             }),
+             py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("uvs"),
+             py::arg("uv_indices"), py::arg("tile"), py::arg("rigidity"), py::arg("mask") = py::none(),
+             py::arg("resolution") = py::none(), py::arg("orientation") = py::none())
+        .def("solve", &PyUvWarpSolver::solve, py::arg("deformed_points"), kSolveDoc)
+        .def("redirect_map", &PyUvWarpSolver::redirectMap,
+             "W^-1 of the last solve as a (T, T, 2) float32 image (row 0 at v = 1): texel (x, y) holds the\n"
+             "tile-local (u', v') to read the unwarped texture at for the texel centre ((x + 0.5) / T,\n"
+             "1 - (y + 0.5) / T). The identity before any solve.")
+        .def("metrics", &PyUvWarpSolver::metrics,
+             "Quality figures of the last solve: rigid_stretch_error and identity_stretch_error (mean\n"
+             "|l_def / l_org - 1| over rigid grid edges with our warp and with none), rigid_edges,\n"
+             "skipped_edges, fold_overs, max_masked_displacement and max_border_displacement (texels),\n"
+             "points_outside, and the solver's iterations, levels, untangled_points, remaining_folds.")
+        .def("reset", &PyUvWarpSolver::reset, "Back to the identity warp (a cut in the shot).")
+        .def_property_readonly("warp", &PyUvWarpSolver::warp, "The current warp grid, as solve returns it.")
+        .def_property_readonly("tile", [](const PyUvWarpSolver& s) { return s.tileWarp().tile(); })
+        .def_property_readonly(
+            "texels", [](const PyUvWarpSolver& s) { return s.tileWarp().texels(); },
+            "T, the maps' and redirect map's texels per side")
+        .def_property_readonly(
+            "cells", [](const PyUvWarpSolver& s) { return s.tileWarp().cells(); },
+            "n, the warp grid's cells per side")
+        .def_property_readonly("num_vertices", &PyUvWarpSolver::vertices)
+        .def("__repr__", [](const PyUvWarpSolver& s) {
+            return "<deformkit.UvWarpSolver tile " + std::to_string(s.tileWarp().tile()) + ", " +
+                   std::to_string(s.tileWarp().texels()) + " texels, " +
+                   std::to_string(s.tileWarp().cells()) + " cells>";
+        });
+
+    constexpr const char* uvWarpDoc =
+        "One frame of the UV warp, from scratch: the inputs of UvWarpSolver plus deformed_points (N, 3)\n"
+        "float32. Returns the redirect map (T, T, 2) float32 (see UvWarpSolver.redirect_map).";
+    m.def("uv_warp", &uvWarp, py::arg("mesh"), py::arg("tile"), py::arg("rigidity"),
+          py::arg("deformed_points"), py::arg("mask") = py::none(), py::arg("resolution") = py::none(),
+          py::arg("orientation") = py::none(), uvWarpDoc);
+    m.def(
+        "uv_warp",
+        [](const FloatArray& points, const IntArray& counts, const IntArray& indices,
+           const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices, int tile,
+           const FloatArray& rigidity, const FloatArray& deformed, const std::optional<FloatArray>& mask,
+           const std::optional<int64_t>& resolution, const std::optional<FloatArray>& orientation,
+           const py::kwargs& kwargs) {
+            const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, "uv_warp");
+            return uvWarp(mesh, tile, rigidity, deformed, mask, resolution, orientation, kwargs);
+        },
+        py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("uvs"),
+        py::arg("uv_indices"), py::arg("tile"), py::arg("rigidity"), py::arg("deformed_points"),
+        py::arg("mask") = py::none(), py::arg("resolution") = py::none(), py::arg("orientation") = py::none(),
+        uvWarpDoc);
+
+    m.def(
+        "apply_redirect",
+        [](const FloatArray& texture, const FloatArray& redirect, const std::string& filter) {
+            const std::string source = "apply_redirect";
+            const uvwarp::BakeOptions options = bakeOptionsOf(filter, source);
+            const io::Image tex = imageOf(texture, source, "texture", "(H, W) or (H, W, C) float32");
+            if (redirect.ndim() != 3 || redirect.shape(2) < 2) {
+                throw InvalidInput(
+                    formatError(source, "redirect", "has shape " + shapeOf(redirect), "(R, R, 2) float32"));
+            }
+            const io::Image map = imageOf(redirect, source, "redirect", "(R, R, 2) float32");
+            io::Image out;
+            {
+                py::gil_scoped_release release;
+                uvwarp::bakeTexture(tex, map, out, options);
+            }
+            return toNumpy(std::move(out), texture.ndim() == 2);
+        },
+        py::arg("texture"), py::arg("redirect"), py::arg("filter") = "bilinear",
+        "Bake texture (H, W) or (H, W, C) float32 (one UDIM tile, row 0 at v = 1) through redirect (R, R, "
+        "2),\n"
+        "as redirect_map returns it: out(texel) = texture(redirect(uv of the texel's centre)), sampled with\n"
+        "filter 'bilinear' or 'bicubic' (Catmull-Rom), clamped to the tile's edge texels. Returns an array\n"
+        "of the texture's shape.");
+}
+
+}  // namespace deformkit::python

@@ -1,0 +1,370 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "test_support.h"
+#include "uvwarp_command.h"
+
+using namespace deformkit;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kTexels = 32;  // maps and grid: 32 x 32
+constexpr int kQuads = 16;   // mesh quads per side and chart
+
+// One n x n quad chart per entry of `tileU` (chart c covers u in [tileU[c], tileU[c] + 1], v in [0, 1]), as
+// OBJ text. Vertex (i, j) of a chart sits at (stretch * i / n, j / n, 0) plus 2 along z per chart, so rest
+// positions equal tile-local UVs when stretch = 1. Without `uvs` no vt lines are written.
+std::string planeObj(double stretch, const std::vector<int>& tileU = {0}, bool uvs = true, int n = kQuads) {
+    std::ostringstream out;
+    out.precision(9);
+    for (size_t c = 0; c < tileU.size(); ++c)
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i)
+                out << "v " << stretch * i / n << " " << static_cast<double>(j) / n << " " << 2.0 * c << "\n";
+    if (uvs) {
+        for (int u0 : tileU)
+            for (int j = 0; j <= n; ++j)
+                for (int i = 0; i <= n; ++i)
+                    out << "vt " << u0 + static_cast<double>(i) / n << " " << static_cast<double>(j) / n
+                        << "\n";
+    }
+    for (size_t c = 0; c < tileU.size(); ++c) {
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const int a = static_cast<int>(c) * (n + 1) * (n + 1) + j * (n + 1) + i + 1;  // 1-based
+                out << "f";
+                for (int k : {a, a + 1, a + n + 2, a + n + 1}) {
+                    out << " " << k;
+                    if (uvs) out << "/" << k;
+                }
+                out << "\n";
+            }
+        }
+    }
+    return out.str();
+}
+
+// Rigidity 1 in disks of radius 0.1 on a 3 x 3 lattice, 0 elsewhere, at texel centres (grid.h).
+io::Image disks(int t = kTexels) {
+    io::Image image(t, t, 1);
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x)
+            for (double cu : {0.25, 0.5, 0.75})
+                for (double cv : {0.25, 0.5, 0.75})
+                    if (std::hypot((x + 0.5) / t - cu, 1.0 - (y + 0.5) / t - cv) < 0.1)
+                        image.at(x, y, 0) = 1.0f;
+    return image;
+}
+
+// A colour texture whose values are multiples of 1/256: exact in half floats, so a half EXR bake keeps them.
+io::Image texture() {
+    io::Image image(kTexels, kTexels, 3);
+    for (int y = 0; y < kTexels; ++y)
+        for (int x = 0; x < kTexels; ++x)
+            for (int c = 0; c < 3; ++c)
+                image.at(x, y, c) = static_cast<float>((x * 7 + y * 13 + c * 29) % 256) / 256.0f;
+    return image;
+}
+
+// The scene: rest.obj, anim.0001-0003.obj (undeformed, 1.25x and 1.5x along u), rig.1001.exr, col.1001.exr
+// and an out folder.
+struct Scene {
+    test::TempDir dir;
+    harness::UvWarpCommand command;
+
+    explicit Scene(const std::vector<int>& tileU = {0}) {
+        test::writeText(dir / "rest.obj", planeObj(1.0, tileU));
+        const double stretch[3] = {1.0, 1.25, 1.5};
+        for (int f = 1; f <= 3; ++f)
+            test::writeText(dir / ("anim.000" + std::to_string(f) + ".obj"), planeObj(stretch[f - 1], tileU));
+        io::writeImage(dir / "rig.1001.exr", disks(), {io::PixelType::Float, {}});
+        io::writeImage(dir / "col.1001.exr", texture(), {io::PixelType::Float, {}});
+        fs::create_directories(dir / "out");
+        command.rest = dir / "rest.obj";
+        command.deformed = dir / "anim.####.obj";
+        command.frames = {1, 2, 3};
+        command.rigidity = dir / "rig.<UDIM>.exr";
+        command.out = dir / "out/redirect.<UDIM>.####.exr";
+    }
+    [[nodiscard]] fs::path redirect(int frame, int tile = 1001) const {
+        return dir / ("out/redirect." + std::to_string(tile) + ".000" + std::to_string(frame) + ".exr");
+    }
+    [[nodiscard]] fs::path baked(int frame) const {
+        return dir / ("out/col.1001.000" + std::to_string(frame) + ".exr");
+    }
+};
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// Largest |redirect - texel centre| over the texels: 0 for the identity, whose texel (x, y) holds its own
+// centre ((x + 0.5) / T, 1 - (y + 0.5) / T).
+double distanceFromIdentity(const io::Image& redirect) {
+    double worst = 0.0;
+    for (int y = 0; y < redirect.height; ++y) {
+        for (int x = 0; x < redirect.width; ++x) {
+            const double u = (x + 0.5) / redirect.width, v = 1.0 - (y + 0.5) / redirect.height;
+            worst = std::max({worst, std::abs(redirect.at(x, y, 0) - u), std::abs(redirect.at(x, y, 1) - v)});
+        }
+    }
+    return worst;
+}
+
+std::string attribute(const io::ImageInfo& info, const std::string& name) {
+    for (const auto& [key, value] : info.attributes)
+        if (key == name) return value;
+    return "(missing)";
+}
+
+std::vector<nlohmann::json> logLines(const fs::path& path) {
+    std::vector<nlohmann::json> lines;
+    std::istringstream in(test::readText(path));
+    for (std::string line; std::getline(in, line);)
+        lines.push_back(nlohmann::json::parse(line));
+    return lines;
+}
+
+}  // namespace
+
+TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[harness][uvwarp]") {
+    CHECK(harness::parseFrames("1-3") == std::vector<int>{1, 2, 3});
+    CHECK(harness::parseFrames("7") == std::vector<int>{7});
+    CHECK(harness::parseFrames("10,1-3,2") == std::vector<int>{1, 2, 3, 10});
+    CHECK(harness::parseFrames("-2-1") == std::vector<int>{-2, -1, 0, 1});
+    CHECK(harness::parseFrames("-3--2") == std::vector<int>{-3, -2});
+    CHECK_THAT(errorOf([] { (void)harness::parseFrames("5-1"); }),
+               Catch::Contains("--frames") && Catch::Contains("'5-1' ends before it starts"));
+    CHECK_THAT(errorOf([] { (void)harness::parseFrames("1-x"); }),
+               Catch::Contains("'1-x' is not a frame range"));
+    CHECK_THAT(errorOf([] { (void)harness::parseFrames("1,,2"); }), Catch::Contains("'' is not a frame"));
+    CHECK_THAT(errorOf([] { (void)harness::parseFrames("0-2000000"); }),
+               Catch::Contains("more than 1000000"));
+    CHECK(harness::parseTiles("1002,1001,1002") == std::vector<int>{1001, 1002});
+    CHECK_THAT(errorOf([] { (void)harness::parseTiles("1001,1000"); }),
+               Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));
+    CHECK(harness::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
+    CHECK(harness::tileFramePath("r_<UVTILE>.%03d.exr", 1012, -4) == fs::path("r_u2_v2.-004.exr"));
+}
+
+TEST_CASE("uvwarp command: redirect maps and bakes per frame, identity for the undeformed frame",
+          "[harness][uvwarp]") {
+    Scene s;
+    s.command.texture = s.dir / "col.<UDIM>.exr";
+    s.command.bake = s.dir / "out/col.<UDIM>.####.exr";
+    s.command.log = s.dir / "log.jsonl";
+    std::ostringstream progress;
+    const harness::UvWarpReport report = harness::uvwarpCommand(s.command, &progress);
+    REQUIRE(report.tiles.size() == 1);
+    CHECK(report.tiles[0].tile == 1001);
+    CHECK(report.tiles[0].warped);
+    CHECK(report.tiles[0].written == 3);
+    CHECK(report.tiles[0].baked == 3);
+    CHECK(report.tiles[0].notes.empty());
+    CHECK_THAT(progress.str(), Catch::Contains("3/3") && Catch::Contains("ETA"));
+
+    // Frame 1 is the rest pose: its redirect is the identity. Float32 uv after barycentric interpolation
+    // of grid corners: a few ulps of 1 (6e-8 each).
+    const io::Image first = io::readImage(s.redirect(1));
+    REQUIRE(first.width == kTexels);
+    REQUIRE(first.channels == 2);
+    CHECK(distanceFromIdentity(first) < 1e-5);
+    // Baked through the identity, the texture comes back: bilinear weights (1, 0) at texel centres, up to
+    // float rounding (1e-6), then stored as half, which holds the texture's multiples of 1/256 exactly.
+    const io::Image tex = texture(), bakedFirst = io::readImage(s.baked(1));
+    REQUIRE(bakedFirst.pixels.size() == tex.pixels.size());
+    double worst = 0.0;
+    for (size_t k = 0; k < tex.pixels.size(); ++k)
+        worst = std::max(worst, static_cast<double>(std::abs(bakedFirst.pixels[k] - tex.pixels[k])));
+    CHECK(worst < 1e-6);
+
+    // Frame 3 (1.5x) warps, and is what a TileWarp solving frames 1, 2, 3 in order gives, bit for bit.
+    const io::Image third = io::readImage(s.redirect(3));
+    CHECK(distanceFromIdentity(third) > 0.5 / kTexels);
+    uvwarp::TileWarp reference(io::readObj(s.command.rest).mesh, 1001, disks());
+    for (int f = 1; f <= 3; ++f)
+        reference.solve(io::readObj(s.dir / ("anim.000" + std::to_string(f) + ".obj")).mesh.points());
+    CHECK(reference.redirect().pixels == third.pixels);
+
+    const io::ImageInfo info = io::readImageInfo(s.redirect(3));
+    CHECK(info.pixelType == "float");
+    CHECK(attribute(info, "deformkit:uvwarp:tile") == "1001");
+    CHECK(attribute(info, "deformkit:uvwarp:frame") == "3");
+    CHECK(attribute(info, "deformkit:version") != "(missing)");
+    const auto solver = nlohmann::json::parse(attribute(info, "deformkit:uvwarp:solver"));
+    CHECK(solver.at("cells") == kTexels);
+    CHECK(solver.at("iterations") == uvwarp::SolverOptions{}.iterations);
+    CHECK(solver.at("smoothing") == 0.1);  // written as the float's shortest decimal
+    CHECK(nlohmann::json::parse(attribute(info, "deformkit:uvwarp:inputs")).at("mask") == "derived");
+
+    // One log line per frame with the metrics: the undeformed frame has no stretch to remove, the 1.5x
+    // frame has some and the warp removes most of it.
+    const std::vector<nlohmann::json> lines = logLines(*s.command.log);
+    REQUIRE(lines.size() == 3);
+    for (int f = 0; f < 3; ++f) {
+        CHECK(lines[f].at("tile") == 1001);
+        CHECK(lines[f].at("frame") == f + 1);
+        CHECK(lines[f].at("status") == "written");
+        CHECK(lines[f].at("metrics").at("fold_overs") == 0);
+        CHECK(lines[f].at("seconds").at("solve").get<double>() >= 0.0);
+    }
+    CHECK(lines[0].at("metrics").at("identity_stretch_error").get<double>() < 1e-5);
+    const double identity = lines[2].at("metrics").at("identity_stretch_error").get<double>();
+    CHECK(identity > 0.2);  // disks stretched 1.5x along u: horizontal rigid edges alone are 0.5 off
+    CHECK(lines[2].at("metrics").at("rigid_stretch_error").get<double>() < 0.5 * identity);
+}
+
+TEST_CASE("uvwarp command: a rerun skips existing outputs and replays the warm start", "[harness][uvwarp]") {
+    Scene s;
+    s.command.log = s.dir / "log.jsonl";
+    (void)harness::uvwarpCommand(s.command);
+    const std::string frame2 = test::readText(s.redirect(2)), frame3 = test::readText(s.redirect(3));
+    const auto stamp = fs::last_write_time(s.redirect(3));
+
+    harness::UvWarpReport again = harness::uvwarpCommand(s.command);
+    CHECK(again.tiles[0].written == 0);
+    CHECK(again.tiles[0].replayed == 0);
+    CHECK(again.tiles[0].skipped == 3);
+    CHECK(fs::last_write_time(s.redirect(3)) == stamp);
+
+    // A job killed before frame 2 was written: frame 1 is solved again (not written) to warm-start frame 2,
+    // which comes out byte for byte as in the uninterrupted run; frame 3 is not touched.
+    fs::remove(s.redirect(2));
+    again = harness::uvwarpCommand(s.command);
+    CHECK(again.tiles[0].written == 1);
+    CHECK(again.tiles[0].replayed == 1);
+    CHECK(again.tiles[0].skipped == 1);
+    CHECK(test::readText(s.redirect(2)) == frame2);
+    CHECK(test::readText(s.redirect(3)) == frame3);
+    CHECK(fs::last_write_time(s.redirect(3)) == stamp);
+
+    // The log is appended: 3 lines per run, the last run's statuses in frame order.
+    const std::vector<nlohmann::json> lines = logLines(*s.command.log);
+    REQUIRE(lines.size() == 9);
+    CHECK(lines[3].at("status") == "skipped");
+    CHECK(lines[6].at("status") == "replayed");
+    CHECK(lines[7].at("status") == "written");
+    CHECK(lines[8].at("status") == "skipped");
+}
+
+TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harness][uvwarp]") {
+    SECTION("a missing frame") {
+        Scene s;
+        fs::remove(s.dir / "anim.0002.obj");
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("anim.0002.obj") && Catch::Contains("frame 2: is missing"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
+    SECTION("a frame with another vertex count") {
+        Scene s;
+        test::writeText(s.dir / "anim.0002.obj", planeObj(1.25, {0}, true, kQuads / 2));
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("anim.0002.obj") && Catch::Contains("has 81 vertices"));
+        CHECK(fs::exists(s.redirect(1)));  // frames before it are complete
+        CHECK_FALSE(fs::exists(s.redirect(2)));
+    }
+    SECTION("a rest mesh without UVs") {
+        Scene s;
+        test::writeText(s.dir / "rest.obj", planeObj(1.0, {0}, false));
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("rest.obj") && Catch::Contains("has no UVs"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
+    SECTION("a resolution that is not a power of two") {
+        Scene s;
+        s.command.resolution = 24;
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("--resolution: 24") && Catch::Contains("power of two"));
+    }
+    SECTION("a mask of another size than the rigidity map") {
+        Scene s;
+        io::writeImage(s.dir / "mask.1001.exr", io::Image(16, 16, 1, 1.0f));
+        s.command.mask = s.dir / "mask.<UDIM>.exr";
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("mask.1001.exr") && Catch::Contains("16 x 16 texels") &&
+                       Catch::Contains("32 x 32, the size of"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
+    SECTION("a rigidity map whose size is not a power of two") {
+        Scene s;
+        io::writeImage(s.dir / "rig.1001.exr", disks(48), {io::PixelType::Float, {}});
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("rig.1001.exr") && Catch::Contains("48 texels per side"));
+        // With the grid's size given, the map is resampled and the redirect keeps the map's size.
+        s.command.resolution = 32;
+        s.command.frames = {1};
+        (void)harness::uvwarpCommand(s.command);
+        const io::Image redirect = io::readImage(s.redirect(1));
+        CHECK(redirect.width == 48);
+        CHECK(distanceFromIdentity(redirect) < 1e-5);  // the rest pose, as above
+    }
+    SECTION("rigidity values outside [0, 1]") {
+        Scene s;
+        io::Image bad = disks();
+        bad.at(5, 6, 0) = 1.5f;
+        io::writeImage(s.dir / "rig.1001.exr", bad, {io::PixelType::Float, {}});
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("rig.1001.exr") && Catch::Contains("texel (5, 6)"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
+    SECTION("an output pattern without a frame token, a tile the mesh does not have") {
+        Scene s;
+        s.command.out = s.dir / "out/redirect.<UDIM>.exr";
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("--out") && Catch::Contains("no frame token"));
+        s.command.out = s.dir / "out/redirect.<UDIM>.####.exr";
+        s.command.tiles = {1001, 1005};
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("tile 1005") && Catch::Contains("no UV face"));
+        s.command.tiles = {};
+        s.command.out = s.dir / "missing/redirect.<UDIM>.####.exr";
+        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("does not exist"));
+    }
+}
+
+TEST_CASE("uvwarp command: a tile without a rigidity map is left unwarped and reported",
+          "[harness][uvwarp]") {
+    Scene s({0, 1});  // charts in tiles 1001 and 1002, rigidity for 1001 only
+    s.command.log = s.dir / "log.jsonl";
+    const harness::UvWarpReport report = harness::uvwarpCommand(s.command);
+    REQUIRE(report.tiles.size() == 2);
+    CHECK(report.tiles[0].written == 3);
+    CHECK_FALSE(report.tiles[1].warped);
+    CHECK(report.tiles[1].written == 0);
+    REQUIRE(report.tiles[1].notes.size() == 1);
+    CHECK_THAT(report.tiles[1].notes[0],
+               Catch::Contains("no rigidity map") && Catch::Contains("rig.1002.exr"));
+    CHECK(fs::exists(s.redirect(3, 1001)));
+    CHECK_FALSE(fs::exists(s.redirect(1, 1002)));
+    const std::vector<nlohmann::json> lines = logLines(*s.command.log);
+    REQUIRE(lines.size() == 6);
+    CHECK(lines[3].at("tile") == 1002);
+    CHECK(lines[3].at("status") == "unwarped");
+    const std::vector<std::string> summary = harness::uvwarpSummary(report);
+    REQUIRE(summary.size() == 2);
+    CHECK_THAT(summary[0], Catch::StartsWith("tile 1001: 3 frames written"));
+    CHECK_THAT(summary[1], Catch::StartsWith("tile 1002: left unwarped: no rigidity map"));
+
+    // Without any rigidity map the pattern itself is wrong: an error.
+    fs::remove(s.dir / "rig.1001.exr");
+    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+               Catch::Contains("--rigidity") && Catch::Contains("no tile has a rigidity map"));
+}
