@@ -19,7 +19,23 @@ REFERENCES = {
     # Same active vertices, falloff and drag, 1 thread: < 1 is the share of the slide's time that a plain
     # soft translate (off the surface) would take; the rest is the cost of staying on the surface.
     "BM_SlideEvaluate1Thread": ("BM_SlideSoftTranslate1Thread", "slide / soft translate, same vertices, 1 thread"),
+    # UV warp: the memory floor makes the same passes over the same arrays as a solve with trivial arithmetic;
+    # < 1 is the floor's share of the solve's time. All-thread ratios are in the uvwarp section below.
+    "BM_UvWarpSolve1Thread": ("BM_UvWarpFloor1Thread", "floor / solve, same passes, 1 thread"),
 }
+
+# Issue 5: paper Table 1 (GTX Titan GPU), ms, and the targets for a 2048^2 solve on a 2-core machine:
+# within 10x the paper's time, within 3x the memory floor; peak memory <= 64 bytes per finest texel.
+UVWARP_PAPER_MS = {
+    "BM_UvWarpSolve/1024": 3.87,
+    "BM_UvWarpSolve/2048": 14.1,
+    "BM_UvWarpSolve/4096": 119.0,
+    "BM_UvWarpInvert/2048": 3.85,
+}
+UVWARP_TARGET_CELLS = "/2048"
+UVWARP_PAPER_TARGET = 10.0
+UVWARP_FLOOR_TARGET = 3.0
+UVWARP_BYTES_TARGET = 64.0
 
 
 # Our evaluate benchmark -> (Blender modifier in bench_blender.py's JSON, row label). Issue 3's target:
@@ -97,6 +113,52 @@ def print_blender(blender, medians, context):
         print(f"{label:40} {ours_ms:11.3g} ms {shares[theirs]:7.3g} ms   {ratio:8.2f}x  ({verdict} target)")
 
 
+def print_uvwarp(medians):
+    """Issue 5's figures: ms per solve, solve / memory floor, ours / paper, 1-thread speed-up, memory."""
+    def ms(run):
+        return run["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[run["time_unit"]]
+
+    def by_size(names):
+        return sorted(names, key=lambda n: (n.split("/")[0], int(n.split("/")[1])))
+
+    rows = by_size(n for n in medians if n.startswith(("BM_UvWarpSolve/", "BM_UvWarpInvert/")))
+    if not rows:
+        return
+    print()
+    print("# UV warp (issue 5), all threads; paper = Table 1, GTX Titan GPU. Targets at 2048^2: "
+          f"<= {UVWARP_PAPER_TARGET:g}x paper, <= {UVWARP_FLOOR_TARGET:g}x floor, "
+          f"<= {UVWARP_BYTES_TARGET:g} bytes per texel")
+    print(f"{'benchmark':24} {'ms':>10} {'floor ms':>10} {'/ floor':>9} {'paper ms':>9} {'/ paper':>9} "
+          f"{'speed-up':>9}")
+    for name in rows:
+        base, args = split_name(name)
+        ours = ms(medians[name])
+        floor = medians.get("BM_UvWarpFloor" + args) if base == "BM_UvWarpSolve" else None
+        one = medians.get(base + "1Thread" + args)
+        paper = UVWARP_PAPER_MS.get(name)
+        cells = [f"{ours:10.1f}",
+                 f"{ms(floor):10.1f}" if floor else f"{'-':>10}",
+                 f"{ours / ms(floor):8.2f}x" if floor else f"{'-':>9}",
+                 f"{paper:9.3g}" if paper else f"{'-':>9}",
+                 f"{ours / paper:8.0f}x" if paper else f"{'-':>9}",
+                 f"{ms(one) / ours:8.2f}x" if one else f"{'-':>9}"]
+        verdict = ""
+        if base == "BM_UvWarpSolve" and args == UVWARP_TARGET_CELLS:
+            verdict = ("  paper target " + ("met" if paper and ours / paper <= UVWARP_PAPER_TARGET else "MISSED") +
+                       ", floor target " +
+                       ("met" if floor and ours / ms(floor) <= UVWARP_FLOOR_TARGET else "MISSED"))
+        print(f"{name:24} {' '.join(cells)}{verdict}")
+    for name in by_size(n for n in medians if n.startswith("BM_UvWarpMemory/")):
+        run = medians[name]
+        if "bytes_per_texel" not in run:
+            continue
+        total = run["bytes_per_texel"]
+        verdict = "met" if total <= UVWARP_BYTES_TARGET else "MISSED"
+        print(f"{name:24} peak {total:.1f} bytes per texel (solver {run.get('solver_bytes_per_texel', 0):.1f}, "
+              f"caller's fields {run.get('fields_bytes_per_texel', 0):.1f}), "
+              f"{run.get('allocs_per_solve', 0):.0f} allocations per warm solve; target {verdict}")
+
+
 def main(argv):
     blender = None
     if "--blender" in argv:
@@ -133,6 +195,7 @@ def main(argv):
             ratio = f"{value / ref_value:8.3f}x  ({meaning})"
         shown = f"{value:,.1f} {unit}" if value is not None else "-"
         print(f"{name:40} {time:>14} {shown:>18}   {ratio}")
+    print_uvwarp(medians)
     if blender:
         print_blender(blender, medians, context or {})
 
