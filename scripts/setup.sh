@@ -18,6 +18,7 @@ packages=(
     libcli11-dev nlohmann-json3-dev
     python3 python3-dev pybind11-dev python3-numpy python3-pytest
     clang libclang-rt-14-dev         # libFuzzer and sanitizers
+    slurm-wlm munge                  # farm tests: single-node Slurm
 )
 
 missing=()
