@@ -8,10 +8,14 @@
 // on one, 4096 (labelled slow) on all threads.
 //
 // Paper Table 1 (GTX Titan GPU): solve 1024^2 in 3.87 ms, 2048^2 in 14.1 ms, 4096^2 in 119 ms; inversion
-// of a 2048^2 warp in 3.85 ms. Every row with a paper figure carries the counter paper_ratio = our ms /
-// the paper's ms (on the floor rows: what the floor alone costs against the paper's whole solve). Issue
-// targets on a 2-core machine: 2048^2 solve within 10x the paper's time and within 3x the memory floor
-// (below); peak memory <= 64 bytes per finest-level texel.
+// of a 2048^2 warp in 3.85 ms. The paper states that "each simulation iteration involves running
+// approximately 70 GPU shader passes, most passes being constraint projection": 8 sets x 9 levels at
+// 2048^2 is 72, so its per-frame time is one hierarchical iteration with one sweep per level (how we read
+// it: docs/decisions.md UV-13). BM_UvWarpIteration times exactly that on a warm solver (SolverOptions
+// iterations 1, sweepsPerLevel {1}); our default per-frame solve does 12 iterations with {1, 2, 4} sweeps.
+// Every row with a paper figure carries paper_ratio = our ms / the paper's ms (floor rows: what the floor
+// alone costs against the paper's figure). Issue targets on a 2-core machine: 2048^2 solve within 10x the
+// paper's time and within 3x the memory floor (below); peak memory <= 64 bytes per finest-level texel.
 //
 // In-run reference, the memory floor (BM_UvWarpFloor): the same passes over the same arrays, level by level,
 // as one solve makes, each pass doing trivial arithmetic (floorSolve below counts them). Solve rows carry
@@ -33,6 +37,7 @@
 #include <map>
 #include <memory>
 #include <new>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -159,19 +164,33 @@ Scene makeScene(int32_t cells) {
     return s;
 }
 
-// A solver per grid size, built once and warmed by one solve, shared by the solve benchmarks.
+// The two timed schedules: the default full solve, and the paper's one iteration with one sweep per level.
+enum class Schedule { Full, Iteration };
+
+SolverOptions scheduleOptions(Schedule schedule) {
+    SolverOptions options;
+    if (schedule == Schedule::Iteration) {
+        options.iterations = 1;
+        options.sweepsPerLevel = {1};
+    }
+    return options;
+}
+
+// A scene and a solver per grid size and schedule, built once and warmed by one solve, shared by the
+// benchmarks.
 struct Warm {
     Scene scene;
     std::unique_ptr<Solver> solver;
 };
 
-Warm& warm(int32_t cells) {
-    static std::map<int32_t, std::unique_ptr<Warm>> cache;
-    std::unique_ptr<Warm>& w = cache[cells];
+Warm& warm(int32_t cells, Schedule schedule = Schedule::Full) {
+    static std::map<std::pair<int32_t, Schedule>, std::unique_ptr<Warm>> cache;
+    std::unique_ptr<Warm>& w = cache[{cells, schedule}];
     if (!w) {
         w = std::make_unique<Warm>();
         w->scene = makeScene(cells);
-        w->solver = std::make_unique<Solver>(w->scene.rest, w->scene.rigidity, w->scene.mask);
+        w->solver = std::make_unique<Solver>(w->scene.rest, w->scene.rigidity, w->scene.mask,
+                                             scheduleOptions(schedule));
         w->solver->solve(w->scene.deformed);
     }
     return *w;
@@ -179,30 +198,32 @@ Warm& warm(int32_t cells) {
 
 // ---- The memory floor ------------------------------------------------------------------------------------
 //
-// The arrays one solve streams, at their sizes: the warp u, v; the previous positions and velocities
-// (prediction and integration); one snapshot u, v per level above the finest; f_D (3 floats per fine point,
-// read by the projection passes, where the solver samples it bilinearly near each point). Level l is the fine
-// grid's every 2^l-th point in every 2^l-th row, as in the solver (levels share the fine arrays, Eq. 6).
+// The arrays one solve streams, at their sizes: the warp u, v; the velocities (which hold the positions
+// before the prediction until integration); one snapshot u, v per level above the finest; f_D (3 floats
+// per fine point, read by the projection passes, where the solver samples it bilinearly near each point).
+// Level l is the fine grid's every 2^l-th point in every 2^l-th row, as in the solver (levels share the fine
+// arrays, Eq. 6).
 //
 // Passes of one solver iteration (core/src/uvwarp/solver.cpp, iterate()), with L levels and s_l sweeps at
-// level l (SolverOptions::sweepsPerLevel, last value repeated):
-//   finest level: prediction (old = u, v; damp velocity; u, v += velocity: 1), the untangle scan (reads
-//       u, v: 1); from level 1: propagation (1), regularisation of the new points (4 colours), untangle
-//       scan (1); the s_0 sweeps of 8 parallel constraint sets (each set touches every point once, reading
-//       f_D near it: 8 s_0); the final regularisation (4 colours); integration (velocity = u, v - old: 1).
-//       13 + 8 s_0 passes: 21 with the default s_0 = 1, of which 8 read f_D.
-//   level 0 < l < L - 1: snapshot (copies u, v into the level's snapshot), 8 s_l projection passes, and
-//       from the level above: propagation, 4 regularisation colours, untangle scan (7 + 8 s_l passes).
-//   coarsest level L - 1: snapshot and 8 s_l projection passes.
-// A regularisation colour updates every second point of every second row reading the rows either side,
-// so it streams the whole level and writes half its rows: the floor's colour pass does the same with a
+// level l (SolverOptions::sweepsPerLevel, last value repeated). The solver runs the 8 parallel sets of a
+// sweep row by row (all 8 on a row while it is in cache), and regularises row by row, so a sweep and a
+// regularisation each stream the level once:
+//   finest level: prediction (velocity <- u, v; u, v += damped velocity: 1), the untangle scan (reads u, v:
+//       1); from level 1: propagation (1), regularisation of the new points (1), untangle scan (1); s_0
+//       sweeps (reading f_D near each point: s_0); the final regularisation (1); integration (velocity = u, v
+//       - velocity: 1). 7 + s_0 passes: 8 with the default s_0 = 1, of which 1 reads f_D.
+//   level 0 < l < L - 1: snapshot (copies u, v into the level's snapshot), s_l projection passes, and from
+//       the level above: propagation, regularisation, untangle scan (4 + s_l passes).
+//   coarsest level L - 1: snapshot and s_l projection passes.
+// A regularisation pass updates every point reading the rows either side: the floor's does the same with a
 // vertical 3-point average. Not streamed by the floor: the per-level maps the solver also reads (rigidity,
-// orientation, mask, rest lengths: 13 bytes per point and projection pass at the finest level), so the
-// floor is a lower bound on the traffic of this schedule, not an estimate of it.
+// mask, orientation when mapped) and f_O (through which it measures rest lengths: 12 bytes per point and
+// projection pass at the finest level), so the floor is a lower bound on the traffic of this schedule, not
+// an estimate of it.
 struct FloorArrays {
     int32_t cells = 0;
     int32_t levels = 0;
-    std::vector<float> u, v, oldU, oldV, velU, velV;
+    std::vector<float> u, v, velU, velV;
     std::vector<std::vector<float>> snapshotU, snapshotV;  // per level, 0 unused
     const float* deformed = nullptr;                       // 3 floats per fine point
 
@@ -222,8 +243,6 @@ FloorArrays& floorArrays(int32_t cells) {
         f->u = identity.u;
         f->v = identity.v;
         const size_t n = f->u.size();
-        f->oldU.assign(n, 0.0f);
-        f->oldV.assign(n, 0.0f);
         f->velU.assign(n, 0.0f);
         f->velV.assign(n, 0.0f);
         f->snapshotU.resize(static_cast<size_t>(f->levels));
@@ -282,21 +301,14 @@ void projectionPass(FloorArrays& a, int32_t l) {
 }
 
 // Interior points of colour (colourI, colourJ), as the solver's regularise().
-void colourPass(FloorArrays& a, int32_t l, int32_t colourI, int32_t colourJ) {
+void regularisePass(FloorArrays& a, int32_t l) {
     float* u = a.u.data();
     float* v = a.v.data();
     const int32_t c = a.cellsAt(l);
-    levelPass(a, l, 1 + ((colourJ + 1) & 1), c - 1, 2, 1 + ((colourI + 1) & 1), c - 1, 2,
-              [=](size_t k, int32_t, int32_t, size_t row) {
-                  u[k] += 1e-7f * (u[k - row] + u[k + row] - 2.0f * u[k]);
-                  v[k] += 1e-7f * (v[k - row] + v[k + row] - 2.0f * v[k]);
-              });
-}
-
-void regularisePasses(FloorArrays& a, int32_t l) {
-    for (int32_t cj = 0; cj < 2; ++cj)
-        for (int32_t ci = 0; ci < 2; ++ci)
-            colourPass(a, l, ci, cj);
+    levelPass(a, l, 1, c - 1, 1, 1, c - 1, 1, [=](size_t k, int32_t, int32_t, size_t row) {
+        u[k] += 1e-7f * (u[k - row] + u[k + row] - 2.0f * u[k]);
+        v[k] += 1e-7f * (v[k - row] + v[k + row] - 2.0f * v[k]);
+    });
 }
 
 int64_t untangleScan(const FloorArrays& a, int32_t l) {
@@ -332,9 +344,10 @@ void snapshotPass(FloorArrays& a, int32_t l) {
     });
 }
 
-// One solve's passes (see FloorArrays). Returns the untangle scans' count so nothing is optimised away.
-int64_t floorSolve(FloorArrays& a) {
-    const SolverOptions options;
+// One solve's passes (see FloorArrays) for a schedule. Returns the untangle scans' count so nothing is
+// optimised away.
+int64_t floorSolve(FloorArrays& a, Schedule schedule) {
+    const SolverOptions options = scheduleOptions(schedule);
     auto sweepsAt = [&](int32_t l) {
         if (options.sweepsPerLevel.empty()) return 1;
         return options.sweepsPerLevel[std::min(static_cast<size_t>(l), options.sweepsPerLevel.size() - 1)];
@@ -345,40 +358,39 @@ int64_t floorSolve(FloorArrays& a) {
     for (int32_t it = 0; it < options.iterations; ++it) {
 #pragma omp parallel for simd schedule(static) if (kParallelRows < n)
         for (int64_t k = 0; k < n; ++k) {
-            a.oldU[k] = a.u[k];
-            a.oldV[k] = a.v[k];
-            a.velU[k] *= keep;
-            a.velV[k] *= keep;
-            a.u[k] += a.velU[k];
-            a.v[k] += a.velV[k];
+            const float du = keep * a.velU[k], dv = keep * a.velV[k];
+            a.velU[k] = a.u[k];
+            a.velV[k] = a.v[k];
+            a.u[k] += du;
+            a.v[k] += dv;
         }
         scanned += untangleScan(a, 0);
         for (int32_t l = 1; l < a.levels; ++l)
             snapshotPass(a, l);
         for (int32_t l = a.levels; l-- > 0;) {
             for (int32_t s = 0; s < sweepsAt(l); ++s)
-                for (int32_t set = 0; set < 8; ++set)
-                    projectionPass(a, l);
+                projectionPass(a, l);
             if (l > 0) {
                 plainPass(a, l - 1);  // propagation
-                regularisePasses(a, l - 1);
+                regularisePass(a, l - 1);
                 scanned += untangleScan(a, l - 1);
             }
         }
-        regularisePasses(a, 0);
+        regularisePass(a, 0);
 #pragma omp parallel for simd schedule(static) if (kParallelRows < n)
         for (int64_t k = 0; k < n; ++k) {
-            a.velU[k] = a.u[k] - a.oldU[k];
-            a.velV[k] = a.v[k] - a.oldV[k];
+            a.velU[k] = a.u[k] - a.velU[k];
+            a.velV[k] = a.v[k] - a.velV[k];
         }
     }
     return scanned;
 }
 
-// Floor times (ms) per (cells, threads) measured in this run: BM_UvWarpFloor records its runs, and a solve
-// row whose floor has not run measures it (median of 3) before its own timing.
-std::map<std::pair<int32_t, int32_t>, std::vector<double>>& floorTimes() {
-    static std::map<std::pair<int32_t, int32_t>, std::vector<double>> times;
+// Floor times (ms) per (cells, threads, schedule) measured in this run: the floor rows record their runs,
+// and a solve row whose floor has not run measures it (median of 3) before its own timing.
+using FloorKey = std::tuple<int32_t, int32_t, Schedule>;
+std::map<FloorKey, std::vector<double>>& floorTimes() {
+    static std::map<FloorKey, std::vector<double>> times;
     return times;
 }
 
@@ -387,13 +399,13 @@ double median(std::vector<double> values) {
     return values[values.size() / 2];
 }
 
-double floorMs(int32_t cells, int32_t threads) {
-    std::vector<double>& times = floorTimes()[{cells, threads}];
+double floorMs(int32_t cells, int32_t threads, Schedule schedule) {
+    std::vector<double>& times = floorTimes()[{cells, threads, schedule}];
     if (times.empty()) {
         FloorArrays& a = floorArrays(cells);
         for (int r = 0; r < 3; ++r) {
             const auto start = std::chrono::steady_clock::now();
-            benchmark::DoNotOptimize(floorSolve(a));
+            benchmark::DoNotOptimize(floorSolve(a, schedule));
             times.push_back(
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         }
@@ -414,12 +426,12 @@ void setRatioCounters(benchmark::State& state, double ms, double paperMs) {
     if (paperMs > 0.0) state.counters["paper_ratio"] = ms / paperMs;
 }
 
-void solveLoop(benchmark::State& state, int32_t threads) {
+void solveLoop(benchmark::State& state, int32_t threads, Schedule schedule) {
     const auto cells = static_cast<int32_t>(state.range(0));
-    Warm& w = warm(cells);
+    Warm& w = warm(cells, schedule);
     const int32_t all = useThreads(threads);
     const int32_t used = threads > 0 ? threads : all;
-    const double floor = floorMs(cells, used);
+    const double floor = floorMs(cells, used, schedule);
     const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) {
         const WarpGrid& warp = w.solver->solve(w.scene.deformed);
@@ -441,27 +453,33 @@ void solveLoop(benchmark::State& state, int32_t threads) {
 }
 
 void BM_UvWarpSolve(benchmark::State& state) {
-    solveLoop(state, 0);
+    solveLoop(state, 0, Schedule::Full);
 }
 void BM_UvWarpSolve1Thread(benchmark::State& state) {
-    solveLoop(state, 1);
+    solveLoop(state, 1, Schedule::Full);
+}
+void BM_UvWarpIteration(benchmark::State& state) {
+    solveLoop(state, 0, Schedule::Iteration);
+}
+void BM_UvWarpIteration1Thread(benchmark::State& state) {
+    solveLoop(state, 1, Schedule::Iteration);
 }
 
-void floorLoop(benchmark::State& state, int32_t threads) {
+void floorLoop(benchmark::State& state, int32_t threads, Schedule schedule) {
     const auto cells = static_cast<int32_t>(state.range(0));
     FloorArrays& a = floorArrays(cells);
     const int32_t all = useThreads(threads);
     const int32_t used = threads > 0 ? threads : all;
     const auto start = std::chrono::steady_clock::now();
     for (auto _ : state) {
-        benchmark::DoNotOptimize(floorSolve(a));
+        benchmark::DoNotOptimize(floorSolve(a, schedule));
         benchmark::ClobberMemory();
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() /
         static_cast<double>(state.iterations());
     omp_set_num_threads(all);
-    floorTimes()[{cells, used}].push_back(ms);
+    floorTimes()[{cells, used, schedule}].push_back(ms);
     setRatioCounters(state, ms, paperSolveMs(cells));
     state.counters["threads"] = used;
     if (cells >= 4096) state.SetLabel("slow");
@@ -469,10 +487,13 @@ void floorLoop(benchmark::State& state, int32_t threads) {
 }
 
 void BM_UvWarpFloor(benchmark::State& state) {
-    floorLoop(state, 0);
+    floorLoop(state, 0, Schedule::Full);
 }
 void BM_UvWarpFloor1Thread(benchmark::State& state) {
-    floorLoop(state, 1);
+    floorLoop(state, 1, Schedule::Full);
+}
+void BM_UvWarpIterationFloor(benchmark::State& state) {
+    floorLoop(state, 0, Schedule::Iteration);
 }
 
 // A converged warp: the 2048^2 scene solved from the identity until the warp settles (warm start).
@@ -529,7 +550,8 @@ void BM_UvWarpMemory(benchmark::State& state) {
         auto scene = std::make_unique<Scene>(makeScene(cells));
         const int64_t fields = gLiveBytes.load() - base;
         gPeakBytes.store(gLiveBytes.load());
-        auto solver = std::make_unique<Solver>(scene->rest, scene->rigidity, scene->mask);
+        // f_O handed over (std::move), as TileWarp does: the solver keeps the one copy.
+        auto solver = std::make_unique<Solver>(std::move(scene->rest), scene->rigidity, scene->mask);
         solver->solve(scene->deformed);
         const int64_t solverPeak = gPeakBytes.load() - base - fields;
         const struct mallinfo2 after = mallinfo2();
@@ -575,6 +597,21 @@ BENCHMARK(BM_UvWarpSolve)
     ->MinTime(0.5)
     ->UseRealTime();
 BENCHMARK(BM_UvWarpSolve1Thread)
+    ->Apply(solveSizes)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5)
+    ->UseRealTime();
+BENCHMARK(BM_UvWarpIterationFloor)
+    ->Apply(solveSizesWithSlow)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5)
+    ->UseRealTime();
+BENCHMARK(BM_UvWarpIteration)
+    ->Apply(solveSizesWithSlow)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5)
+    ->UseRealTime();
+BENCHMARK(BM_UvWarpIteration1Thread)
     ->Apply(solveSizes)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "deformkit/error.h"
 
@@ -29,23 +30,121 @@ constexpr std::array<EdgeType, 4> kEdgeTypes = {{
 // tiny loop costs more than the loop (badly so when the machine is oversubscribed).
 constexpr int64_t kParallelRows = 64;
 
+// Rows per block of the row-wavefront schedule (sweep, regularise). A block's rows are processed in order;
+// blocks of one parity never touch a point another block of that parity reads or moves (a row reads at most
+// one row beyond its block on each side), so they run in parallel. Blocks depend on the grid size alone, so
+// the result does not depend on the thread count.
+constexpr int32_t kBlockRows = 16;
+
+// Runs rowFn(j) for j in [first, last): blocks of kBlockRows rows, even blocks (in parallel), then odd ones.
+template <class RowFn>
+void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
+    const int32_t rows = last - first;
+    if (rows <= 0) return;
+    const int32_t blocks = (rows + kBlockRows - 1) / kBlockRows;
+    for (int32_t parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(rows))
+        for (int32_t b = parity; b < blocks; b += 2) {
+            const int32_t end = std::min(last, first + (b + 1) * kBlockRows);
+            for (int32_t j = first + b * kBlockRows; j < end; ++j)
+                rowFn(j);
+        }
+    }
+}
+
+// Largest grid: f_D offsets fit 32 bits (sampleImage).
+constexpr int32_t kMaxCells = 32768;
+
 // 3x3 Gaussian kernel K_G (Eq. 5 and 7): (1 2 1) x (1 2 1) / 16.
 constexpr std::array<float, 3> kGauss = {0.25f, 0.5f, 0.25f};
 
 struct Level {
     int32_t cells = 0;   // cells per side at this level
     int32_t stride = 1;  // fine-grid points between neighbouring points of this level
-    std::vector<float> rigidity, orientation;
-    std::vector<uint8_t> movable;                  // mask and not on the tile border
-    std::array<std::vector<float>, 4> restLength;  // l_org per edge type, stored at the edge's cell corner
-    std::vector<float> snapshotU, snapshotV;       // positions before this level's sweeps (for propagation)
+    std::vector<float> rigidity;
+    std::vector<float> orientation;           // empty without an orientation map (1 everywhere)
+    std::vector<uint8_t> movable;             // mask and not on the tile border
+    std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)
+    // Per row of cells j, runs [spans[2r], spans[2r + 1]) of cells, r in [spanBegin[j], spanBegin[j + 1]),
+    // outside which no cell has a movable corner of rigidity > 0: no segment there is projected (§4.2), so
+    // sweeps skip them. Runs closer than kSpanGap cells are merged.
+    std::vector<int32_t> spanBegin, spans;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
     [[nodiscard]] size_t index(int32_t i, int32_t j) const { return static_cast<size_t>(j) * side() + i; }
 };
 
+constexpr int32_t kSpanGap = 8;
+
+// The SIMD loops are compiled twice, for AVX2 (8 lanes) and for the baseline (SSE2, 4 lanes); the CPU
+// picks at run time. No FMA: both give the same bits, so a farm of mixed CPUs writes identical maps.
+const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+
 float orient(float ax, float ay, float bx, float by, float cx, float cy) {
     return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+// Rows j - 1, j, j + 1 of a level in the fine warp arrays (south, centre, north).
+struct Rows3 {
+    const float *uS, *uC, *uN, *vS, *vC, *vN;
+};
+
+Rows3 rowsAround(const float* u, const float* v, ptrdiff_t centre, ptrdiff_t row) {
+    return {u + centre - row, u + centre, u + centre + row, v + centre - row, v + centre, v + centre + row};
+}
+
+// The clamp of §4.2 and the fold check of every move, for the point at offset k of the centre row (point
+// spacing s in fine points; the point and its 8 neighbours inside the grid): (x, y) is clamped to the
+// bounding box of the point's 8 neighbours; returns whether it keeps the 12 triangles around the point
+// (both diagonal splittings of its 4 cells) positively oriented. Branch-free, with 32-bit offsets, so loops
+// over independent points vectorise 8 lanes wide.
+[[gnu::always_inline]] inline bool clampKeepsOrientation(const Rows3& r, int32_t k, int32_t s, float& x,
+                                                         float& y) {
+    // Neighbours counter-clockwise from east.
+    const float eu = r.uC[k + s], ev = r.vC[k + s], neu = r.uN[k + s], nev = r.vN[k + s];
+    const float nu = r.uN[k], nv = r.vN[k], nwu = r.uN[k - s], nwv = r.vN[k - s];
+    const float wu = r.uC[k - s], wv = r.vC[k - s], swu = r.uS[k - s], swv = r.vS[k - s];
+    const float su = r.uS[k], sv = r.vS[k], seu = r.uS[k + s], sev = r.vS[k + s];
+    const float minU = std::min(std::min(std::min(eu, neu), std::min(nu, nwu)),
+                                std::min(std::min(wu, swu), std::min(su, seu)));
+    const float maxU = std::max(std::max(std::max(eu, neu), std::max(nu, nwu)),
+                                std::max(std::max(wu, swu), std::max(su, seu)));
+    const float minV = std::min(std::min(std::min(ev, nev), std::min(nv, nwv)),
+                                std::min(std::min(wv, swv), std::min(sv, sev)));
+    const float maxV = std::max(std::max(std::max(ev, nev), std::max(nv, nwv)),
+                                std::max(std::max(wv, swv), std::max(sv, sev)));
+    x = std::min(std::max(x, minU), maxU);
+    y = std::min(std::max(y, minV), maxV);
+    // Per cell (edge neighbour a, diagonal d, edge neighbour b): the three triangles with the point.
+    return (orient(x, y, eu, ev, neu, nev) > 0.0f) & (orient(x, y, neu, nev, nu, nv) > 0.0f) &
+           (orient(x, y, eu, ev, nu, nv) > 0.0f) & (orient(x, y, nu, nv, nwu, nwv) > 0.0f) &
+           (orient(x, y, nwu, nwv, wu, wv) > 0.0f) & (orient(x, y, nu, nv, wu, wv) > 0.0f) &
+           (orient(x, y, wu, wv, swu, swv) > 0.0f) & (orient(x, y, swu, swv, su, sv) > 0.0f) &
+           (orient(x, y, wu, wv, su, sv) > 0.0f) & (orient(x, y, su, sv, seu, sev) > 0.0f) &
+           (orient(x, y, seu, sev, eu, ev) > 0.0f) & (orient(x, y, su, sv, eu, ev) > 0.0f);
+}
+
+// f_D(u, v): bilinear look-up in a geometry image of `cells` cells (3 floats per point), clamped to the
+// tile. Branch-free.
+[[gnu::always_inline]] inline void sampleImage(const float* image, int32_t cells, float u, float v, float& x0,
+                                               float& x1, float& x2) {
+    const float n = static_cast<float>(cells);
+    float x = u * n, y = v * n;  // clamped to [0, n]: the same as clamping (u, v) to [0, 1] first
+    x = x < 0.0f ? 0.0f : x;
+    x = x > n ? n : x;
+    y = y < 0.0f ? 0.0f : y;
+    y = y > n ? n : y;
+    const int32_t i = std::min(static_cast<int32_t>(x), cells - 1);
+    const int32_t j = std::min(static_cast<int32_t>(y), cells - 1);
+    const float fx = x - static_cast<float>(i), fy = y - static_cast<float>(j);
+    // 32-bit offsets (SIMD gathers need them; 3 (n + 1)^2 < 2^32 up to n = 32768, the largest grid).
+    const uint32_t p00 =
+        3u * (static_cast<uint32_t>(j) * static_cast<uint32_t>(cells + 1) + static_cast<uint32_t>(i));
+    const uint32_t p10 = p00 + 3u, p01 = p00 + 3u * static_cast<uint32_t>(cells + 1), p11 = p01 + 3u;
+    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+    x0 = w00 * image[p00] + w10 * image[p10] + w01 * image[p01] + w11 * image[p11];
+    x1 = w00 * image[p00 + 1] + w10 * image[p10 + 1] + w01 * image[p01 + 1] + w11 * image[p11 + 1];
+    x2 = w00 * image[p00 + 2] + w10 * image[p10 + 2] + w01 * image[p01 + 2] + w11 * image[p11 + 2];
 }
 
 }  // namespace
@@ -56,11 +155,13 @@ struct Solver::Impl {
     int32_t cells = 0;
     std::vector<Level> levels;
     WarpGrid grid;
-    std::vector<float> oldU, oldV, velU, velV;
+    // Velocities; between prediction and integration they hold the positions before the prediction.
+    std::vector<float> velU, velV;
+    PointField rest;                    // f_O: rest lengths (Eq. 1) are measured through it when needed
     const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
-    std::vector<int32_t> untangleWork;  // scratch of untangle(), kept between calls
-    std::vector<std::vector<int32_t>> untangleRows;
+    std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
     std::vector<int32_t> untangleNext;
+    std::vector<int32_t> rowFolds;  // per cell row of the scan: triangles at or near zero area
     SolveStats stats;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
@@ -68,21 +169,16 @@ struct Solver::Impl {
         return static_cast<size_t>(j) * level.stride * side() + static_cast<size_t>(i) * level.stride;
     }
 
-    // f_D(u, v): bilinear look-up in the deformed geometry image (clamped to the tile).
-    void sampleDeformed(float u, float v, float out[3]) const {
-        const float x = std::clamp(u, 0.0f, 1.0f) * static_cast<float>(cells);
-        const float y = std::clamp(v, 0.0f, 1.0f) * static_cast<float>(cells);
-        const int32_t i = std::min(static_cast<int32_t>(x), cells - 1);
-        const int32_t j = std::min(static_cast<int32_t>(y), cells - 1);
-        const float fx = x - static_cast<float>(i), fy = y - static_cast<float>(j);
-        const size_t k = static_cast<size_t>(j) * side() + i;
-        const float* p00 = deformed + 3 * k;
-        const float* p10 = p00 + 3;
-        const float* p01 = p00 + 3 * static_cast<size_t>(side());
-        const float* p11 = p01 + 3;
-        const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
-        for (int c = 0; c < 3; ++c)
-            out[c] = w00 * p00[c] + w10 * p10[c] + w01 * p01[c] + w11 * p11[c];
+    // l_org (Eq. 1) of the segment between fine points a and b, through f_O at the rest grid points (Eq. 6).
+    [[nodiscard]] float restLength(size_t a, size_t b) const {
+        const float* pa = rest.values.data() + 3 * a;
+        const float* pb = rest.values.data() + 3 * b;
+        float d2 = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float d = pb[c] - pa[c];
+            d2 += d * d;
+        }
+        return std::sqrt(d2);
     }
 
     // True when moving level point (i, j) to (x, y) keeps all 12 triangles around it (both splittings of
@@ -105,181 +201,158 @@ struct Solver::Impl {
         return true;
     }
 
-    // Moves a point if that keeps the grid unfolded, after clamping to the bounding box of its 8 neighbours
-    // (§4.2: no correction overshoots its neighbourhood).
-    void tryMove(const Level& level, int32_t i, int32_t j, float x, float y) {
-        const size_t s = static_cast<size_t>(level.stride);
-        const size_t row = s * static_cast<size_t>(side());
-        const size_t k = fine(level, i, j);
-        const size_t n[8] = {k + s, k + s + row, k + row, k - s + row,
-                             k - s, k - s - row, k - row, k + s - row};
-        float minU = grid.u[n[0]], maxU = minU, minV = grid.v[n[0]], maxV = minV;
-        for (int q = 1; q < 8; ++q) {
-            minU = std::min(minU, grid.u[n[q]]);
-            maxU = std::max(maxU, grid.u[n[q]]);
-            minV = std::min(minV, grid.v[n[q]]);
-            maxV = std::max(maxV, grid.v[n[q]]);
-        }
-        x = std::clamp(x, minU, maxU);
-        y = std::clamp(y, minV, maxV);
-        if (keepsOrientation(level, i, j, x, y)) {
-            grid.u[k] = x;
-            grid.v[k] = y;
-        }
-    }
-
-    // Eq. 1-3 for one segment, then orientation preservation, then the clamped, fold-safe moves.
-    void projectEdge(const Level& level, int32_t type, int32_t ci, int32_t cj, float stiffness) {
-        const EdgeType& e = kEdgeTypes[type];
-        const int32_t ai = ci + e.ai, aj = cj + e.aj, bi = ci + e.bi, bj = cj + e.bj;
-        const size_t la = level.index(ai, aj), lb = level.index(bi, bj);
-        const bool moveA = level.movable[la] != 0, moveB = level.movable[lb] != 0;
-        if (!moveA || !moveB) return;  // a masked end: the constraint is not projected (§4.2)
-        const float rigidity = std::max(level.rigidity[la], level.rigidity[lb]);
-        if (rigidity <= 0.0f) return;  // both ends fully elastic
-        const size_t a = fine(level, ai, aj), b = fine(level, bi, bj);
-        const float pax = grid.u[a], pay = grid.v[a], pbx = grid.u[b], pby = grid.v[b];
-        float xa[3], xb[3];
-        sampleDeformed(pax, pay, xa);
-        sampleDeformed(pbx, pby, xb);
-        const float lDef = std::sqrt((xb[0] - xa[0]) * (xb[0] - xa[0]) + (xb[1] - xa[1]) * (xb[1] - xa[1]) +
-                                     (xb[2] - xa[2]) * (xb[2] - xa[2]));
-        const float dx = pbx - pax, dy = pby - pay;
-        const float length = std::sqrt(dx * dx + dy * dy);
-        const float lOrg = level.restLength[type][level.index(ci, cj)];
-        if (!(lDef > 1e-12f) || !(length > 1e-12f) || !(lOrg > 0.0f)) return;
-        // Along the segment f_D is taken as linear, so the UV length that gives l_def = l_org is
-        // length * l_org / l_def; stiffness = rigidity x level factor, equal inverse masses (Müller et al.).
-        const float correction = stiffness * rigidity * length * (1.0f - lOrg / lDef);
-        const float ux = dx / length, uy = dy / length;
-        float nax = pax + 0.5f * correction * ux, nay = pay + 0.5f * correction * uy;
-        float nbx = pbx - 0.5f * correction * ux, nby = pby - 0.5f * correction * uy;
-        const float preserve =
-            options.orientationPreservation * 0.5f * (level.orientation[la] + level.orientation[lb]);
-        if (preserve > 0.0f) {
-            // Turn the segment about its centre towards its canonical direction (normalised lerp of
-            // directions).
-            const float mx = 0.5f * (nax + nbx), my = 0.5f * (nay + nby);
-            const float hx = 0.5f * (nbx - nax), hy = 0.5f * (nby - nay);
-            const float half = std::sqrt(hx * hx + hy * hy);
-            if (half > 0.0f) {
-                float tx = hx / half + preserve * (e.canonicalU - hx / half);
-                float ty = hy / half + preserve * (e.canonicalV - hy / half);
-                const float tl = std::sqrt(tx * tx + ty * ty);
-                if (tl > 1e-6f) {
-                    tx *= half / tl;
-                    ty *= half / tl;
-                    nax = mx - tx;
-                    nay = my - ty;
-                    nbx = mx + tx;
-                    nby = my + ty;
-                }
-            }
-        }
-        tryMove(level, ai, aj, nax, nay);
-        tryMove(level, bi, bj, nbx, nby);
-    }
-
     // One sweep over the 8 parallel sets (paper Fig. 8): each edge type split by the parity of its cell
-    // column (types 0, 2, 3) or row (type 1), so no two segments of a set share a point. Rows of segments are
-    // run in parallel in phases far enough apart that no thread reads a point another one moves, and each
-    // row runs in order, so the result does not depend on the thread count.
+    // column, so no two segments of a set share a point. The sets are interleaved row by row: for each row
+    // of cells, the horizontal segments of its lower point row, then its vertical, then its two diagonal
+    // segments, each set by parity. A set's segments on one row are independent (one SIMD or GPU pass
+    // each); running all 8 on a row while it is in cache streams the grid once per sweep, not 8 times.
+    void sweepRow(const Level& level, int32_t j, float stiffness) {
+        // Within a set, segments `step` cells apart: ends of different segments are then never
+        // neighbours, so the fold checks of one projectRun are independent (SIMD lanes). Only the runs of
+        // cells that can hold a projected segment are visited; what is skipped would not move.
+        const int32_t* span = level.spans.data() + 2 * static_cast<size_t>(level.spanBegin[j]);
+        const int32_t runs = level.spanBegin[j + 1] - level.spanBegin[j];
+        for (int32_t first = 0; first < 4; ++first)
+            for (int32_t r = 0; r < runs; ++r)
+                projectRun<0>(level, j, first, span[2 * r], span[2 * r + 1], stiffness);
+        for (int32_t first = 0; first < 2; ++first)
+            for (int32_t r = 0; r < runs; ++r)  // vertical segments on both sides of the run's cells
+                projectRun<1>(level, j, first, span[2 * r], span[2 * r + 1] + 1, stiffness);
+        for (int32_t first = 0; first < 4; ++first)
+            for (int32_t r = 0; r < runs; ++r)
+                projectRun<2>(level, j, first, span[2 * r], span[2 * r + 1], stiffness);
+        for (int32_t first = 0; first < 4; ++first)
+            for (int32_t r = 0; r < runs; ++r)
+                projectRun<3>(level, j, first, span[2 * r], span[2 * r + 1], stiffness);
+    }
+
+#define DEFORMKIT_KERNEL(name) name##Avx2
+#define DEFORMKIT_KERNEL_ATTR __attribute__((target("avx2,prefer-vector-width=256")))
+#include "solver_kernels.inc"
+#undef DEFORMKIT_KERNEL
+#undef DEFORMKIT_KERNEL_ATTR
+#define DEFORMKIT_KERNEL(name) name##Base
+#define DEFORMKIT_KERNEL_ATTR
+#include "solver_kernels.inc"
+#undef DEFORMKIT_KERNEL
+#undef DEFORMKIT_KERNEL_ATTR
+
+    // The kernels for this CPU (same bytes either way). The point spacing stays a run-time value: with a
+    // constant 1 on the finest level the compiler trades gathers for shuffles, which measured slower.
+    template <int32_t Type>
+    void projectRun(const Level& level, int32_t j, int32_t first, int32_t begin, int32_t end,
+                    float stiffness) {
+        const bool mapped = !level.orientation.empty();
+        if (kHasAvx2) {
+            if (mapped) {
+                projectRunAvx2<Type, true>(level, j, first, begin, end, stiffness);
+            } else {
+                projectRunAvx2<Type, false>(level, j, first, begin, end, stiffness);
+            }
+        } else if (mapped) {
+            projectRunBase<Type, true>(level, j, first, begin, end, stiffness);
+        } else {
+            projectRunBase<Type, false>(level, j, first, begin, end, stiffness);
+        }
+    }
+
+    void regulariseRun(const Level& level, int32_t j, int32_t first) {
+        if (kHasAvx2) {
+            regulariseRunAvx2(level, j, first);
+        } else {
+            regulariseRunBase(level, j, first);
+        }
+    }
+
+    // Rows of cells j moves points on rows j and j + 1 and reads rows j - 1 .. j + 2 (the clamp and the
+    // fold check read 8-neighbours): forRowBlocks' blocks keep parallel rows apart.
     void sweep(const Level& level, float stiffness) {
-        const int32_t c = level.cells;
-        for (int32_t type = 0; type < 4; ++type) {
-            for (int32_t parity = 0; parity < 2; ++parity) {
-                if (type == 1) {
-                    // Vertical segments of cell rows j = parity, parity + 2, ...: a band (rows j, j+1 of
-                    // points) reads rows j-1 .. j+2, so bands 4 rows apart run together.
-                    for (int32_t phase = 0; phase < 2; ++phase) {
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
-                        for (int32_t j = parity + 2 * phase; j < c; j += 4) {
-                            for (int32_t i = 0; i <= c; ++i)
-                                projectEdge(level, 1, i, j, stiffness);
-                        }
-                    }
-                    continue;
-                }
-                // Horizontal: a band is one row of points, reading rows j-1 .. j+1 (2 phases). Shears: a band
-                // is one row of cells, rows j and j+1 of points, reading j-1 .. j+2 (3 phases).
-                const int32_t bands = type == 0 ? c + 1 : c;
-                const int32_t phases = type == 0 ? 2 : 3;
-                for (int32_t phase = 0; phase < phases; ++phase) {
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(bands))
-                    for (int32_t j = phase; j < bands; j += phases) {
-                        for (int32_t i = parity; i < c; i += 2)
-                            projectEdge(level, type, i, j, stiffness);
-                    }
-                }
-            }
-        }
+        forRowBlocks(0, level.cells, [&](int32_t j) { sweepRow(level, j, stiffness); });
     }
 
-    // Eq. 4-5 on a level's points of colour (ci, cj): blend with K_G by b = M((1 - R) + R s). Points of
-    // one colour are never neighbours, so a colour runs in parallel and reads only settled neighbours.
-    void regularise(const Level& level, int32_t colourI, int32_t colourJ, bool onlyNew) {
-        const int32_t c = level.cells;
-        const size_t s = static_cast<size_t>(level.stride);
-        const size_t row = s * static_cast<size_t>(side());
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
-        for (int32_t j = 1 + ((colourJ + 1) & 1); j < c; j += 2) {
-            for (int32_t i = 1 + ((colourI + 1) & 1); i < c; i += 2) {
-                if (onlyNew && (i % 2 == 0) && (j % 2 == 0)) continue;
-                const size_t l = level.index(i, j);
-                if (!level.movable[l]) continue;
-                const float r = level.rigidity[l];
-                const float blend = (1.0f - r) + r * options.smoothing;
-                if (blend <= 0.0f) continue;
-                const size_t k = fine(level, i, j);
-                float gu = 0.0f, gv = 0.0f;
-                for (int dj = -1; dj <= 1; ++dj) {
-                    for (int di = -1; di <= 1; ++di) {
-                        const size_t q = k + static_cast<size_t>(di) * s + static_cast<size_t>(dj) * row;
-                        const float w = kGauss[di + 1] * kGauss[dj + 1];
-                        gu += w * grid.u[q];
-                        gv += w * grid.v[q];
-                    }
-                }
-                tryMove(level, i, j, (1.0f - blend) * grid.u[k] + blend * gu,
-                        (1.0f - blend) * grid.v[k] + blend * gv);
-            }
-        }
+    // Odd points of the row, then even ones (after a propagation only the level's new points: every point
+    // of an odd row, the odd points of an even row).
+    void regulariseRow(const Level& level, int32_t j, bool onlyNew) {
+        regulariseRun(level, j, 1);
+        if (!onlyNew || (j % 2) == 1) regulariseRun(level, j, 2);
     }
 
+    // A row of points moves only itself and reads one row either side.
     void regulariseAll(const Level& level, bool onlyNew) {
-        for (int32_t cj = 0; cj < 2; ++cj)
-            for (int32_t ci = 0; ci < 2; ++ci)
-                regularise(level, ci, cj, onlyNew);
+        forRowBlocks(1, level.cells, [&](int32_t j) { regulariseRow(level, j, onlyNew); });
     }
 
     // Repairs folds a propagation or prediction step may have made: a point with a non-positive triangle
-    // around it moves towards the mean of its 8 neighbours (as far as keeps its triangles positive).
+    // around it moves to the mean of its 8 neighbours.
     bool isFolded(const Level& level, int32_t i, int32_t j) const {
         const size_t k = fine(level, i, j);
         return !keepsOrientation(level, i, j, grid.u[k], grid.v[k]);
     }
 
-    // One full scan finds the points with a non-positive triangle around them; after that only the
-    // neighbourhoods of moved points are looked at again, in ascending order (deterministic, serial: the
-    // list is short in normal use).
-    int32_t untangle(const Level& level) {
+    // Pushes the interior corners of cell (i, j)'s triangles (both splittings) at or below `nearZero` area.
+    void collectFolded(const Level& level, int32_t i, int32_t j, float nearZero,
+                       std::vector<int32_t>& out) const {
         const int32_t c = level.cells;
-        std::vector<int32_t>& work = untangleWork;
-        work.clear();
-        std::vector<std::vector<int32_t>>& rows = untangleRows;
-        rows.resize(static_cast<size_t>(c + 1));
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
-        for (int32_t j = 1; j < c; ++j) {
-            rows[j].clear();
-            for (int32_t i = 1; i < c; ++i) {
-                if (isFolded(level, i, j)) rows[j].push_back(j * (c + 1) + i);
+        const size_t s = static_cast<size_t>(level.stride);
+        const size_t a = fine(level, i, j), b = a + s, d = a + s * static_cast<size_t>(side()), e = d + s;
+        const float* u = grid.u.data();
+        const float* v = grid.v.data();
+        // Corners 0..3 = (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1); the four triangles of the cell.
+        const bool bad[4] = {orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero,
+                             orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero,
+                             orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero,
+                             orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero};
+        constexpr int32_t kCorners[4][3] = {{0, 1, 2}, {0, 2, 3}, {0, 1, 3}, {1, 2, 3}};
+        constexpr int32_t kDi[4] = {0, 1, 1, 0}, kDj[4] = {0, 0, 1, 1};
+        for (int t = 0; t < 4; ++t) {
+            if (!bad[t]) continue;
+            for (int32_t corner : kCorners[t]) {
+                const int32_t ci = i + kDi[corner], cj = j + kDj[corner];
+                if (ci > 0 && cj > 0 && ci < c && cj < c) out.push_back(cj * (c + 1) + ci);
             }
         }
-        for (int32_t j = 1; j < c; ++j)
-            work.insert(work.end(), rows[j].begin(), rows[j].end());
-        int32_t moved = 0;
+    }
+
+    // One scan over the level's cells (4 orientation tests per cell, vectorisable) finds the triangles at
+    // or near zero area; their corners are the candidates, each checked exactly before it moves. After
+    // that only the neighbourhoods of moved points are looked at again, in ascending order (deterministic,
+    // serial: the list is short in normal use).
+    int32_t untangle(const Level& level) {
+        const int32_t c = level.cells;
         const size_t s = static_cast<size_t>(level.stride);
-        const size_t row = s * static_cast<size_t>(side());
+        const size_t rowStep = s * static_cast<size_t>(side());
+        // Below a thousandth of a cell's area a triangle is a candidate: far above the rounding of orient()
+        // on unit-square coordinates, far below any triangle of a sound grid.
+        const float cellSize = static_cast<float>(level.stride) / static_cast<float>(cells);
+        const float nearZero = 1e-3f * cellSize * cellSize;
+        const float* u = grid.u.data();
+        const float* v = grid.v.data();
+        int32_t* counts = rowFolds.data();
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
+        for (int32_t j = 0; j < c; ++j) {
+            int32_t count = 0;
+            const size_t base = static_cast<size_t>(j) * rowStep;
+#pragma omp simd reduction(+ : count)
+            for (int32_t i = 0; i < c; ++i) {
+                const size_t a = base + static_cast<size_t>(i) * s, b = a + s, d = a + rowStep, e = d + s;
+                count += (orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero ? 1 : 0) +
+                         (orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0) +
+                         (orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero ? 1 : 0) +
+                         (orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0);
+            }
+            counts[j] = count;
+        }
+        std::vector<int32_t>& work = untangleWork;
+        work.clear();
+        for (int32_t j = 0; j < c; ++j) {
+            if (counts[j] == 0) continue;
+            for (int32_t i = 0; i < c; ++i)
+                collectFolded(level, i, j, nearZero, work);
+        }
+        std::sort(work.begin(), work.end());
+        work.erase(std::unique(work.begin(), work.end()), work.end());
+        int32_t moved = 0;
+        const size_t row = rowStep;
         std::vector<int32_t>& next = untangleNext;
         for (int pass = 0; pass < 64 && !work.empty(); ++pass) {
             next.clear();
@@ -314,29 +387,55 @@ struct Solver::Impl {
         return moved;
     }
 
-    // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level.
+    // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level:
+    // the mean of the displacements of the 2 or 4 coarse points around each (bilinear at the midpoints).
     void propagate(const Level& coarse, const Level& finer) {
         const int32_t c = coarse.cells;
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(finer.cells))
         for (int32_t jj = 0; jj <= finer.cells; ++jj) {
-            for (int32_t ii = 0; ii <= finer.cells; ++ii) {
-                if ((ii & 1) == 0 && (jj & 1) == 0) continue;  // a coarse point: moved by its own level
-                if (!finer.movable[finer.index(ii, jj)]) continue;
-                const int32_t i0 = ii >> 1, j0 = jj >> 1;
-                const int32_t i1 = std::min(i0 + (ii & 1), c), j1 = std::min(j0 + (jj & 1), c);
+            const int32_t j0 = jj >> 1, j1 = std::min(j0 + (jj & 1), c);
+            // Coarse rows j0 and j1: positions in the fine arrays, and their snapshots.
+            const ptrdiff_t coarseRow = static_cast<ptrdiff_t>(coarse.stride) * side();
+            const float* u0 = grid.u.data() + j0 * coarseRow;
+            const float* v0 = grid.v.data() + j0 * coarseRow;
+            const float* u1 = grid.u.data() + j1 * coarseRow;
+            const float* v1 = grid.v.data() + j1 * coarseRow;
+            const float* su0 = coarse.snapshotU.data() + coarse.index(0, j0);
+            const float* sv0 = coarse.snapshotV.data() + coarse.index(0, j0);
+            const float* su1 = coarse.snapshotU.data() + coarse.index(0, j1);
+            const float* sv1 = coarse.snapshotV.data() + coarse.index(0, j1);
+            const int32_t cs = coarse.stride;
+            const ptrdiff_t finerRow = static_cast<ptrdiff_t>(finer.stride) * side();
+            float* u = grid.u.data() + jj * finerRow;
+            float* v = grid.v.data() + jj * finerRow;
+            const uint8_t* movable = finer.movable.data() + finer.index(0, jj);
+            const int32_t fs = finer.stride;
+            // Coarse points (both indices even) are moved by their own level: on an even row only the odd
+            // points are new.
+            const auto move = [&](int32_t ii) {
+                const int32_t i0 = ii >> 1, i1 = std::min(i0 + (ii & 1), c);
                 float du = 0.0f, dv = 0.0f;
-                const int32_t is[2] = {i0, i1}, js[2] = {j0, j1};
-                for (int32_t b = 0; b < 2; ++b) {
-                    for (int32_t a = 0; a < 2; ++a) {
-                        const size_t l = coarse.index(is[a], js[b]);
-                        const size_t k = fine(coarse, is[a], js[b]);
-                        du += 0.25f * (grid.u[k] - coarse.snapshotU[l]);
-                        dv += 0.25f * (grid.v[k] - coarse.snapshotV[l]);
-                    }
-                }
-                const size_t k = fine(finer, ii, jj);
-                grid.u[k] += du;
-                grid.v[k] += dv;
+                du += 0.25f * (u0[i0 * cs] - su0[i0]);
+                dv += 0.25f * (v0[i0 * cs] - sv0[i0]);
+                du += 0.25f * (u0[i1 * cs] - su0[i1]);
+                dv += 0.25f * (v0[i1 * cs] - sv0[i1]);
+                du += 0.25f * (u1[i0 * cs] - su1[i0]);
+                dv += 0.25f * (v1[i0 * cs] - sv1[i0]);
+                du += 0.25f * (u1[i1 * cs] - su1[i1]);
+                dv += 0.25f * (v1[i1 * cs] - sv1[i1]);
+                const float m = static_cast<float>(movable[ii]);  // 0 or 1
+                const int32_t k = ii * fs;
+                u[k] += m * du;
+                v[k] += m * dv;
+            };
+            if (jj & 1) {
+#pragma omp simd
+                for (int32_t ii = 0; ii <= finer.cells; ++ii)
+                    move(ii);
+            } else {
+#pragma omp simd
+                for (int32_t ii = 1; ii <= finer.cells; ii += 2)
+                    move(ii);
             }
         }
     }
@@ -364,12 +463,11 @@ struct Solver::Impl {
         // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force).
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
-            oldU[k] = grid.u[k];
-            oldV[k] = grid.v[k];
-            velU[k] *= keep;
-            velV[k] *= keep;
-            grid.u[k] += velU[k];
-            grid.v[k] += velV[k];
+            const float du = keep * velU[k], dv = keep * velV[k];
+            velU[k] = grid.u[k];  // the position before prediction, until integration
+            velV[k] = grid.v[k];
+            grid.u[k] += du;
+            grid.v[k] += dv;
         }
         stats.untangledPoints += untangle(levels[0]);
         // Step 3, hierarchical (§4.4): coarsest level first; then propagate, smooth, and go finer.
@@ -394,12 +492,13 @@ struct Solver::Impl {
         // Step 5: integration.
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
-            velU[k] = grid.u[k] - oldU[k];
-            velV[k] = grid.v[k] - oldV[k];
+            velU[k] = grid.u[k] - velU[k];
+            velV[k] = grid.v[k] - velV[k];
         }
     }
 
     void buildMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation);
+    static void findSpans(Level& level);
 };
 
 namespace {
@@ -434,7 +533,12 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
     for (Level& level : levels) {
         const size_t count = static_cast<size_t>(level.side()) * level.side();
         level.rigidity.assign(count, 0.0f);
-        level.orientation.assign(count, 1.0f);
+        if (orientation.values.empty()) {
+            level.orientation.clear();
+            level.orientation.shrink_to_fit();
+        } else {
+            level.orientation.assign(count, 1.0f);
+        }
         level.movable.assign(count, 0);
     }
     Level& finest = levels[0];
@@ -444,7 +548,7 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
             const bool border = i == 0 || j == 0 || i == cells || j == cells;
             finest.rigidity[k] = rigidity.values[k];
             finest.movable[k] = (!border && mask.values[k] >= 0.5f) ? 1 : 0;
-            if (!orientation.values.empty())
+            if (!finest.orientation.empty())
                 finest.orientation[k] = std::clamp(orientation.values[k], 0.0f, 1.0f);
         }
     }
@@ -453,6 +557,7 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         const Level& from = levels[l - 1];
         Level& to = levels[l];
         const int32_t fc = from.cells;
+        const bool mapped = !from.orientation.empty();
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(to.cells))
         for (int32_t j = 0; j <= to.cells; ++j) {
             for (int32_t i = 0; i <= to.cells; ++i) {
@@ -464,21 +569,59 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
                         const size_t q = from.index(si, sj);
                         const float w = kGauss[di + 1] * kGauss[dj + 1];
                         r += w * from.rigidity[q];
-                        o += w * from.orientation[q];
+                        if (mapped) o += w * from.orientation[q];
                         m = std::min(m, from.movable[q]);
                     }
                 }
                 const size_t k = to.index(i, j);
                 const bool border = i == 0 || j == 0 || i == to.cells || j == to.cells;
                 to.rigidity[k] = r;
-                to.orientation[k] = o;
+                if (mapped) to.orientation[k] = o;
                 to.movable[k] = border ? 0 : m;
             }
         }
     }
+    for (Level& level : levels)
+        findSpans(level);
 }
 
-Solver::Solver(const PointField& restGeometry, const PointField& rigidity, const PointField& mask,
+void Solver::Impl::findSpans(Level& level) {
+    const int32_t c = level.cells;
+    auto pointActive = [&](int32_t i, int32_t j) {
+        const size_t k = level.index(i, j);
+        return level.movable[k] != 0 && level.rigidity[k] > 0.0f;
+    };
+    level.spanBegin.assign(static_cast<size_t>(c) + 1, 0);
+    level.spans.clear();
+    int32_t count = 0;
+    for (int32_t j = 0; j < c; ++j) {
+        level.spanBegin[j] = count;
+        int32_t open = -1, last = -1;  // current run [open, last + 1)
+        for (int32_t i = 0; i < c; ++i) {
+            const bool active = pointActive(i, j) || pointActive(i + 1, j) || pointActive(i, j + 1) ||
+                                pointActive(i + 1, j + 1);
+            if (!active) continue;
+            if (open >= 0 && i - (last + 1) < kSpanGap) {
+                last = i;
+                continue;
+            }
+            if (open >= 0) {
+                level.spans.push_back(open);
+                level.spans.push_back(last + 1);
+                ++count;
+            }
+            open = last = i;
+        }
+        if (open >= 0) {
+            level.spans.push_back(open);
+            level.spans.push_back(last + 1);
+            ++count;
+        }
+    }
+    level.spanBegin[c] = count;
+}
+
+Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointField& mask,
                const SolverOptions& options, const PointField& orientation, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
@@ -488,6 +631,10 @@ Solver::Solver(const PointField& restGeometry, const PointField& rigidity, const
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "a power of two, at least 2"));
+    }
+    if (m.cells > kMaxCells) {
+        throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
+                                       "at most " + std::to_string(kMaxCells)));
     }
     requireField(restGeometry, m.cells, 3, source, "rest geometry image");
     if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
@@ -520,30 +667,14 @@ Solver::Solver(const PointField& restGeometry, const PointField& rigidity, const
             level.snapshotU.resize(count);
             level.snapshotV.resize(count);
         }
-        // l_org (Eq. 1) of every segment of this level, through f_O at the rest grid points (Eq. 6).
-        for (int32_t type = 0; type < 4; ++type) {
-            const EdgeType& e = kEdgeTypes[type];
-            auto& lengths = level.restLength[type];
-            lengths.assign(count, 0.0f);
-            for (int32_t j = 0; j + std::max(e.aj, e.bj) <= level.cells; ++j) {
-                for (int32_t i = 0; i + std::max(e.ai, e.bi) <= level.cells; ++i) {
-                    const size_t a = restGeometry.index((i + e.ai) * level.stride, (j + e.aj) * level.stride);
-                    const size_t b = restGeometry.index((i + e.bi) * level.stride, (j + e.bj) * level.stride);
-                    float d2 = 0.0f;
-                    for (int c = 0; c < 3; ++c) {
-                        const float d = restGeometry.values[b + c] - restGeometry.values[a + c];
-                        d2 += d * d;
-                    }
-                    lengths[level.index(i, j)] = std::sqrt(d2);
-                }
-            }
-        }
     }
+    m.rest = std::move(restGeometry);
+    m.untangleWork.reserve(8 * static_cast<size_t>(m.cells + 1));
+    m.untangleNext.reserve(8 * static_cast<size_t>(m.cells + 1));
+    m.rowFolds.assign(static_cast<size_t>(m.cells) + 1, 0);
     m.buildMaps(rigidity, mask, orientation);
     m.grid = WarpGrid::identity(m.cells);
     const size_t n = m.grid.numPoints();
-    m.oldU.assign(n, 0.0f);
-    m.oldV.assign(n, 0.0f);
     m.velU.assign(n, 0.0f);
     m.velV.assign(n, 0.0f);
     m.stats.levels = levelCount;
@@ -579,6 +710,9 @@ void Solver::reset() {
 
 const WarpGrid& Solver::warp() const {
     return impl_->grid;
+}
+const PointField& Solver::restGeometry() const {
+    return impl_->rest;
 }
 const SolveStats& Solver::stats() const {
     return impl_->stats;

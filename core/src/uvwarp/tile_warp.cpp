@@ -1,6 +1,7 @@
 #include "deformkit/uvwarp/tile_warp.h"
 
 #include <string>
+#include <utility>
 
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/geometry_image.h"
@@ -27,7 +28,7 @@ struct TileWarp::Impl {
     int32_t texels = 0;
     int32_t cells = 0;
     std::unique_ptr<GeometryImager> imager;
-    PointField rest, deformed, rigidity, mask;
+    PointField deformed, rigidity, mask;  // f_O lives in the solver
     std::unique_ptr<Solver> solver;
     bool solved = false;
 };
@@ -62,7 +63,8 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     imageOptions.dilationRings = options.dilationRings;
     imageOptions.label = source;
     m.imager = std::make_unique<GeometryImager>(rest, tile, m.cells, imageOptions);
-    m.imager->sample(rest.points(), m.rest);
+    PointField restImage;
+    m.imager->sample(rest.points(), restImage);
 
     const MapLabel rigidityLabel{source + " rigidity map", tile};
     m.rigidity = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
@@ -78,8 +80,8 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});
     }
-    m.solver = std::make_unique<Solver>(m.rest, m.rigidity, m.mask, options.solver, orientationAtPoints,
-                                        source + ", UDIM tile " + std::to_string(tile));
+    m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
+                                        orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
 }
 
 TileWarp::~TileWarp() = default;
@@ -107,7 +109,8 @@ WarpMetrics TileWarp::metrics() const {
     const Impl& m = *impl_;
     MetricsOptions options;
     options.texels = m.texels;
-    return measureWarp(m.solver->warp(), m.rest, m.solved ? m.deformed : m.rest, m.rigidity, m.mask, options);
+    const PointField& rest = m.solver->restGeometry();
+    return measureWarp(m.solver->warp(), rest, m.solved ? m.deformed : rest, m.rigidity, m.mask, options);
 }
 
 void TileWarp::reset() {

@@ -47,10 +47,15 @@ struct SolveStats {
 //
 // Inputs are fields on the (n + 1)^2 grid points (grid.h): restGeometry f_O (3 channels), rigidity R in
 // [0, 1], mask M (0 or 1; tile-border points never move whatever the mask says), and optionally an
-// orientation-preservation map in [0, 1] (empty: 1 everywhere).
+// orientation-preservation map in [0, 1] (empty: 1 everywhere). The solver keeps f_O (rest lengths are
+// measured through it): pass it with std::move to keep one copy.
+//
+// Memory: 16 bytes per fine grid point for positions and velocities, 12 for f_O, 5 for rigidity and
+// movability, about 4.4 more for the coarser levels (+ 4 per point with an orientation map); no allocation
+// in a solve once the fold-repair scratch has grown to the largest fold count seen.
 class Solver {
   public:
-    Solver(const PointField& restGeometry, const PointField& rigidity, const PointField& mask,
+    Solver(PointField restGeometry, const PointField& rigidity, const PointField& mask,
            const SolverOptions& options = {}, const PointField& orientation = {},
            const std::string& source = "tile");
     ~Solver();
@@ -66,6 +71,7 @@ class Solver {
     void reset();
 
     [[nodiscard]] const WarpGrid& warp() const;
+    [[nodiscard]] const PointField& restGeometry() const;
     [[nodiscard]] const SolveStats& stats() const;
     [[nodiscard]] int32_t cells() const;
     [[nodiscard]] int32_t levels() const;
