@@ -1,0 +1,222 @@
+#include "deformkit/host/deformer.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::host {
+namespace {
+
+std::string numberText(double x) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+    return std::string(buffer, result.ptr);
+}
+
+std::string withContext(const std::string& context, const char* message) {
+    const std::string text(message);
+    if (text.starts_with(context)) return text;
+    return context + ": " + text;
+}
+
+// Called inside a catch block: rethrows the Error in flight as the same kind, its message prefixed with
+// `context` (unless it already starts with it).
+[[noreturn]] void rethrowWithContext(const std::string& context) {
+    try {
+        throw;
+    } catch (const TopologyError& e) {
+        throw TopologyError(withContext(context, e.what()));
+    } catch (const InvalidInput& e) {
+        throw InvalidInput(withContext(context, e.what()));
+    } catch (const ParseError& e) {
+        throw ParseError(withContext(context, e.what()));
+    } catch (const IoError& e) {
+        throw IoError(withContext(context, e.what()));
+    } catch (const Error& e) {
+        throw Error(withContext(context, e.what()));
+    }
+}
+
+}  // namespace
+
+Deformer::Deformer(std::string type, std::string label)
+    : type_(std::move(type)), label_(std::move(label)), context_(type_ + " '" + label_ + "'") {}
+
+size_t Deformer::addParameter(ParamInfo info, std::vector<double> initial) {
+    info.components = static_cast<int32_t>(initial.size());
+    infos_.push_back(std::move(info));
+    values_.push_back(std::move(initial));
+    return infos_.size() - 1;
+}
+
+bool Deformer::hasParameter(std::string_view name) const {
+    for (const ParamInfo& info : infos_)
+        if (info.name == name) return true;
+    return false;
+}
+
+const ParamInfo& Deformer::parameter(std::string_view name) const {
+    for (const ParamInfo& info : infos_)
+        if (info.name == name) return info;
+    std::string known;
+    for (const ParamInfo& info : infos_)
+        known += (known.empty() ? "" : ", ") + info.name;
+    throw InvalidInput(
+        formatError(context_, "parameter '" + std::string(name) + "'", "does not exist", "one of: " + known));
+}
+
+void Deformer::set(std::string_view name, std::span<const double> value) {
+    const size_t index = static_cast<size_t>(&parameter(name) - infos_.data());
+    const ParamInfo& info = infos_[index];
+    const size_t count = value.size();
+    if (info.stride > 0) {
+        if (count == 0 || count % static_cast<size_t>(info.stride) != 0) {
+            fail(index, "has " + std::to_string(count) + " values",
+                 "a positive multiple of " + std::to_string(info.stride) + " values");
+        }
+    } else if (count != static_cast<size_t>(info.components)) {
+        fail(index, "has " + std::to_string(count) + " values", std::to_string(info.components) + " values");
+    }
+    // The core computes in float32: a double beyond its range would become infinite there.
+    constexpr double kMax = std::numeric_limits<float>::max();
+    for (size_t i = 0; i < count; ++i) {
+        if (!std::isfinite(value[i]) || std::abs(value[i]) > kMax) {
+            fail(index, "value " + std::to_string(i) + " is " + numberText(value[i]),
+                 "finite numbers within float range");
+        }
+    }
+    validate(index, value);
+    std::vector<double>& current = values_[index];
+    if (current.size() == count && std::equal(current.begin(), current.end(), value.begin())) return;
+    current.assign(value.begin(), value.end());
+    infos_[index].components = static_cast<int32_t>(count);
+    if (info.rebinds) dirty_ = true;
+    changed(index);
+}
+
+std::vector<double> Deformer::get(std::string_view name) const {
+    return values_[static_cast<size_t>(&parameter(name) - infos_.data())];
+}
+
+void Deformer::assign(size_t index, std::vector<double> value) {
+    infos_[index].components = static_cast<int32_t>(value.size());
+    values_[index] = std::move(value);
+}
+
+void Deformer::validate(size_t, std::span<const double>) const {}
+
+void Deformer::changed(size_t) {}
+
+void Deformer::deformWeighted(std::span<const glm::vec3>, std::span<glm::vec3>, std::span<const float>,
+                              double) {
+    throw InvalidInput(formatError(context_, "weighted evaluation", "is not implemented by this deformer",
+                                   "deformWeighted() in a deformer whose weight mode is Native"));
+}
+
+void Deformer::fail(size_t index, const std::string& problem, const std::string& expected) const {
+    throw InvalidInput(formatError(context_, "parameter '" + infos_[index].name + "'", problem, expected));
+}
+
+void Deformer::requireIntegers(size_t index, std::span<const double> value, double lo, double hi) const {
+    for (size_t i = 0; i < value.size(); ++i) {
+        const double v = value[i];
+        if (v != std::floor(v) || v < lo || v > hi) {
+            const std::string where = value.size() == 1 ? "is " : "value " + std::to_string(i) + " is ";
+            fail(index, where + numberText(v),
+                 "whole numbers in [" + numberText(lo) + ", " + numberText(hi) + "]");
+        }
+    }
+}
+
+void Deformer::bind(const geom::Mesh& rest, std::span<const float> weights) {
+    dirty_ = true;
+    boundVertices_ = 0;
+    if (!weights.empty() && weights.size() != static_cast<size_t>(rest.numVertices())) {
+        throw InvalidInput(formatError(context_, "weights",
+                                       "has " + std::to_string(weights.size()) + " values",
+                                       std::to_string(rest.numVertices()) + ", one per rest vertex"));
+    }
+    try {
+        bindRest(rest, weights);
+    } catch (const Error&) {
+        rethrowWithContext(context_);
+    }
+    dirty_ = false;
+    boundVertices_ = rest.numVertices();
+    ++bindCount_;
+}
+
+void Deformer::checkSizes(size_t in, size_t out) const {
+    if (dirty_) {
+        throw InvalidInput(formatError(context_, "evaluate", "called before a needed bind",
+                                       "bind() after the rest mesh or a bind-time parameter changed"));
+    }
+    const size_t n = static_cast<size_t>(boundVertices_);
+    if (in != n || out != n) {
+        throw InvalidInput(
+            formatError(context_, "points",
+                        "has " + std::to_string(in) + " inputs and " + std::to_string(out) + " outputs",
+                        std::to_string(n) + " each, the bound mesh's vertex count"));
+    }
+}
+
+void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out) {
+    checkSizes(in.size(), out.size());
+    try {
+        deform(in, out);
+    } catch (const Error&) {
+        rethrowWithContext(context_);
+    }
+}
+
+void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
+                        std::span<const float> weights, double envelope) {
+    checkSizes(in.size(), out.size());
+    if (!weights.empty() && weights.size() != in.size()) {
+        throw InvalidInput(formatError(context_, "weights",
+                                       "has " + std::to_string(weights.size()) + " values",
+                                       std::to_string(in.size()) + ", one per vertex"));
+    }
+    if (!std::isfinite(envelope)) {
+        throw InvalidInput(
+            formatError(context_, "envelope", "is " + numberText(envelope), "a finite number"));
+    }
+    try {
+        if (weightMode() == WeightMode::Native) {
+            deformWeighted(in, out, weights, envelope);
+        } else {
+            deform(in, out);
+            blendDeformation(in, out, weights, envelope, out);
+        }
+    } catch (const Error&) {
+        rethrowWithContext(context_);
+    }
+}
+
+void blendDeformation(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
+                      std::span<const float> weights, double envelope, std::span<glm::vec3> out) {
+    const auto n = static_cast<int64_t>(in.size());
+    const bool painted = !weights.empty();
+#pragma omp parallel for schedule(static)
+    for (int64_t u = 0; u < n; ++u) {
+        const double k = painted ? envelope * static_cast<double>(weights[u]) : envelope;
+        if (k == 1.0) {
+            out[u] = deformed[u];
+        } else if (k == 0.0) {
+            out[u] = in[u];
+        } else {
+            const glm::dvec3 a(in[u]);
+            out[u] = glm::vec3(a + k * (glm::dvec3(deformed[u]) - a));
+        }
+    }
+}
+
+}  // namespace deformkit::host
