@@ -111,8 +111,9 @@ class ProgressBar {
 struct TilePlan {
     int tile = 0;
     fs::path rigidity;
-    std::optional<fs::path> mask;     // an existing mask file
-    std::optional<fs::path> texture;  // an existing texture file, baked
+    std::optional<fs::path> mask;         // an existing mask file
+    std::optional<fs::path> orientation;  // an existing orientation map
+    std::optional<fs::path> texture;      // an existing texture file, baked
     std::vector<fs::path> outPaths, bakePaths;
     std::vector<bool> needed;  // per frame: an output to write
     int lastNeeded = -1;       // index of the last needed frame
@@ -153,14 +154,14 @@ int32_t checkRigidityHeader(const fs::path& path, int32_t resolution) {
     return info.width;
 }
 
-void checkMaskHeader(const fs::path& path, int32_t texels, const fs::path& rigidity) {
+// A map that must have the rigidity map's size (`what`: "warp mask", "orientation map").
+void checkMapHeader(const fs::path& path, const char* what, int32_t texels, const fs::path& rigidity) {
     const io::ImageInfo info = io::readImageInfo(path);
     if (info.width != texels || info.height != texels) {
-        throw InvalidInput(
-            formatError(path.string(), "warp mask",
-                        std::to_string(info.width) + " x " + std::to_string(info.height) + " texels",
-                        std::to_string(texels) + " x " + std::to_string(texels) + ", the size of '" +
-                            rigidity.string() + "'"));
+        throw InvalidInput(formatError(
+            path.string(), what, std::to_string(info.width) + " x " + std::to_string(info.height) + " texels",
+            std::to_string(texels) + " x " + std::to_string(texels) + ", the size of '" + rigidity.string() +
+                "'"));
     }
 }
 
@@ -294,7 +295,8 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                                        "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
     }
     for (const auto& [option, pattern] :
-         {std::pair{"--mask", command.mask}, std::pair{"--texture", command.texture}}) {
+         {std::pair{"--mask", command.mask}, std::pair{"--orientation", command.orientation},
+          std::pair{"--texture", command.texture}}) {
         if (pattern && !io::hasUdimToken(pattern->string())) {
             throw InvalidInput(formatError(option, pattern->string(), "has no UDIM token",
                                            "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
@@ -376,10 +378,20 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
         if (command.mask) {
             const fs::path mask = io::expandUdim(command.mask->string(), tile);
             if (fileExists(mask)) {
-                checkMaskHeader(mask, texels, plan.rigidity);
+                checkMapHeader(mask, "warp mask", texels, plan.rigidity);
                 plan.mask = mask;
             } else {
                 plan.report.notes.push_back("no warp mask '" + mask.string() + "': derived from the UVs");
+            }
+        }
+        if (command.orientation) {
+            const fs::path orientation = io::expandUdim(command.orientation->string(), tile);
+            if (fileExists(orientation)) {
+                checkMapHeader(orientation, "orientation map", texels, plan.rigidity);
+                plan.orientation = orientation;
+            } else {
+                plan.report.notes.push_back("no orientation map '" + orientation.string() +
+                                            "': orientation preservation as given everywhere");
             }
         }
         if (command.texture) {
@@ -437,12 +449,18 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
         if (plan.lastNeeded >= 0) {
             const io::Image rigidity = uvwarp::readRigidityMap(plan.rigidity, plan.tile);
             const io::Image mask = plan.mask ? uvwarp::readWarpMask(*plan.mask, plan.tile) : io::Image{};
+            // In [0, 1] and finite, as a rigidity map; errors name the file and texel.
+            const io::Image orientation =
+                plan.orientation ? uvwarp::readRigidityMap(*plan.orientation, plan.tile, "orientation map")
+                                 : io::Image{};
             if (plan.texture) texture = io::readImage(*plan.texture);
-            warp.emplace(rest, plan.tile, rigidity, mask, options, io::Image{}, command.rest.string());
+            warp.emplace(rest, plan.tile, rigidity, mask, options, orientation, command.rest.string());
         }
-        const json inputs = {{"rest", command.rest.string()},
-                             {"rigidity", plan.rigidity.string()},
-                             {"mask", plan.mask ? plan.mask->string() : std::string("derived")}};
+        const json inputs = {
+            {"rest", command.rest.string()},
+            {"rigidity", plan.rigidity.string()},
+            {"mask", plan.mask ? plan.mask->string() : std::string("derived")},
+            {"orientation", plan.orientation ? plan.orientation->string() : std::string("none")}};
         for (size_t k = 0; k < command.frames.size(); ++k) {
             const int frame = command.frames[k];
             if (static_cast<int>(k) > plan.lastNeeded) {

@@ -37,23 +37,25 @@
 // Inputs are checked before anything is written: the rest mesh has UVs, every frame file exists, the
 // output folders exist, and per tile the maps' sizes (square, equal, a power of two when the grid takes the
 // map's size). A tile without a rigidity map is left unwarped (no outputs) and reported, unless no tile
-// has one (an error). A missing mask tile is derived from the UVs, a missing texture tile is not baked;
-// both are reported. Reading a frame whose vertex count differs from the rest mesh's is an error naming
-// the file; outputs of earlier frames stay complete.
+// has one (an error). A missing mask tile is derived from the UVs, a missing orientation tile means 1
+// everywhere, a missing texture tile is not baked; each is reported. Reading a frame whose vertex count
+// differs from the rest mesh's is an error naming the file; outputs of earlier frames stay complete.
 namespace deformkit::harness {
 
 struct UvWarpCommand {
-    std::filesystem::path rest;                    // OBJ with UVs (UDIM tiles 1001 + floor(u) + 10 floor(v))
-    std::filesystem::path deformed;                // frame pattern of OBJs with the rest mesh's vertex count
-    std::vector<int> frames;                       // ascending, e.g. parseFrames("1-24")
-    std::filesystem::path rigidity;                // UDIM pattern; channel 0 in [0, 1]
-    std::optional<std::filesystem::path> mask;     // UDIM pattern; channel 0 >= 0.5 may warp
-    std::optional<std::filesystem::path> texture;  // UDIM pattern, baked when `bake` is set
-    std::filesystem::path out;                     // UDIM + frame pattern, .exr
-    std::optional<std::filesystem::path> bake;     // UDIM + frame pattern, any writable format
-    std::vector<int> tiles;                        // empty: every tile the rest mesh's UVs touch
-    int32_t resolution = 0;                        // grid cells per side, a power of two; 0: map size
-    uvwarp::TileWarpOptions options;               // solver, derived mask, dilation (cells: resolution)
+    std::filesystem::path rest;                 // OBJ with UVs (UDIM tiles 1001 + floor(u) + 10 floor(v))
+    std::filesystem::path deformed;             // frame pattern of OBJs with the rest mesh's vertex count
+    std::vector<int> frames;                    // ascending, e.g. parseFrames("1-24")
+    std::filesystem::path rigidity;             // UDIM pattern; channel 0 in [0, 1]
+    std::optional<std::filesystem::path> mask;  // UDIM pattern; channel 0 >= 0.5 may warp
+    std::optional<std::filesystem::path> orientation;  // UDIM pattern; channel 0 in [0, 1] scales the
+                                                       // orientation preservation per texel
+    std::optional<std::filesystem::path> texture;      // UDIM pattern, baked when `bake` is set
+    std::filesystem::path out;                         // UDIM + frame pattern, .exr
+    std::optional<std::filesystem::path> bake;         // UDIM + frame pattern, any writable format
+    std::vector<int> tiles;                            // empty: every tile the rest mesh's UVs touch
+    int32_t resolution = 0;                            // grid cells per side, a power of two; 0: map size
+    uvwarp::TileWarpOptions options;                   // solver, derived mask, dilation (cells: resolution)
     warp::Interpolation filter = warp::Interpolation::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;                    // JSON lines, appended: one per tile x frame
 };

@@ -143,9 +143,9 @@ void validateRigidityMap(const io::Image& rigidity, const MapLabel& label) {
     }
 }
 
-io::Image readRigidityMap(const std::filesystem::path& path, int tile) {
+io::Image readRigidityMap(const std::filesystem::path& path, int tile, const std::string& role) {
     io::ImageReadOptions read;
-    read.role = "rigidity map";
+    read.role = role;
     const io::Image image = io::readImage(path, read);
     validateRigidityMap(image, MapLabel{path.string(), tile});
     io::Image out(image.width, image.height, 1);

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -367,4 +368,55 @@ TEST_CASE("uvwarp command: a tile without a rigidity map is left unwarped and re
     fs::remove(s.dir / "rig.1001.exr");
     CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
                Catch::Contains("--rigidity") && Catch::Contains("no tile has a rigidity map"));
+}
+
+TEST_CASE("uvwarp command: an orientation map scales the orientation preservation per texel",
+          "[harness][uvwarp]") {
+    // References that need no tolerance: the solver multiplies the global amount by the map, so a map of
+    // ones must give the bytes of no map, and a map of zeros the bytes of a zero global amount.
+    auto run = [](const io::Image* map, float preservation) {
+        Scene s;
+        s.command.options.solver.orientationPreservation = preservation;
+        if (map != nullptr) {
+            io::writeImage(s.dir / "orient.1001.exr", *map, {io::PixelType::Float, {}});
+            s.command.orientation = s.dir / "orient.<UDIM>.exr";
+        }
+        const harness::UvWarpReport report = harness::uvwarpCommand(s.command, nullptr);
+        REQUIRE(report.tiles.size() == 1);
+        CHECK(report.tiles[0].notes.empty());
+        return io::readImage(s.redirect(3));
+    };
+    io::Image ones(kTexels, kTexels, 1), zeros(kTexels, kTexels, 1);
+    std::fill(ones.pixels.begin(), ones.pixels.end(), 1.0f);
+    const io::Image none = run(nullptr, 0.5f);
+    CHECK(run(&ones, 0.5f).pixels == none.pixels);
+    CHECK(run(&zeros, 0.5f).pixels == run(nullptr, 0.0f).pixels);
+    // And the amount matters on this scene: 0.5 everywhere differs from 0.
+    CHECK(none.pixels != run(nullptr, 0.0f).pixels);
+
+    // A missing tile is reported and means 1 everywhere; a wrong size or a value outside [0, 1] is an error
+    // naming the file.
+    Scene missing;
+    missing.command.orientation = missing.dir / "orient.<UDIM>.exr";
+    const harness::UvWarpReport report = harness::uvwarpCommand(missing.command, nullptr);
+    REQUIRE(report.tiles.size() == 1);
+    REQUIRE(report.tiles[0].notes.size() == 1);
+    CHECK_THAT(report.tiles[0].notes[0], Catch::Contains("no orientation map"));
+
+    Scene wrongSize;
+    io::writeImage(wrongSize.dir / "orient.1001.exr", io::Image(kTexels / 2, kTexels / 2, 1),
+                   {io::PixelType::Float, {}});
+    wrongSize.command.orientation = wrongSize.dir / "orient.<UDIM>.exr";
+    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(wrongSize.command, nullptr); }),
+               Catch::Contains("orient.1001.exr") && Catch::Contains("orientation map") &&
+                   Catch::Contains("16 x 16 texels"));
+    CHECK_FALSE(fs::exists(wrongSize.redirect(1)));
+
+    Scene outOfRange;
+    io::Image bad(kTexels, kTexels, 1);
+    bad.at(3, 5, 0) = 1.5f;
+    io::writeImage(outOfRange.dir / "orient.1001.exr", bad, {io::PixelType::Float, {}});
+    outOfRange.command.orientation = outOfRange.dir / "orient.<UDIM>.exr";
+    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(outOfRange.command, nullptr); }),
+               Catch::Contains("orient.1001.exr") && Catch::Contains("1.5"));
 }

@@ -51,8 +51,10 @@ struct DerivedMaskOptions {
 // Throws InvalidInput naming the label, tile and the first bad texel (x, y) in row-major order.
 void validateRigidityMap(const io::Image& rigidity, const MapLabel& label = {});
 
-// Reads a rigidity map file and validates it; returns channel 0 as a 1-channel image.
-[[nodiscard]] io::Image readRigidityMap(const std::filesystem::path& path, int tile = 0);
+// Reads a rigidity map file and validates it; returns channel 0 as a 1-channel image. Also reads other
+// maps of values in [0, 1] (an orientation-preservation map): `role` names the map in read errors.
+[[nodiscard]] io::Image readRigidityMap(const std::filesystem::path& path, int tile = 0,
+                                        const std::string& role = "rigidity map");
 
 // Rigidity at the grid points of an n-cell grid (n = `cells`, a power of two; T may differ from n):
 // point (i, j) gets the bilinear sample of channel 0 at uv (i / n, j / n), texel centres as in grid.h,
