@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/version.h"
+#include "eval_command.h"
 #include "slide_command.h"
 #include "uvwarp_command.h"
 #include "warp_command.h"
@@ -60,6 +61,16 @@ int main(int argc, char** argv) {
     demo->add_option("--resolution", demoCommand.resolution, "texels per UDIM tile side")
         ->capture_default_str();
 
+    harness::EvalCommand evalCommand;
+    std::string evalScene, evalFrames, evalOut = evalCommand.outDir.string();
+    auto* evalApp = app.add_subcommand(
+        "eval", "Evaluate a scene's deformer stacks frame by frame and write one OBJ per object and frame");
+    evalApp->add_option("SCENE", evalScene, "scene (.json, docs/scene.md)")->required();
+    evalApp->add_option("--frames", evalFrames,
+                        "frames: 1-24, or a list such as 1-10,15; default: the scene's");
+    evalApp->add_option("--out", evalOut, "output folder: <object>.<frame 4 digits>.obj")
+        ->capture_default_str();
+
     harness::WarpImageCommand warpCommand;
     std::string warpImage, warpLines, warpOut, warpVariant = "original", warpInterp = "bilinear";
     auto* warpImageApp =
@@ -106,7 +117,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
 
     harness::UvWarpCommand uvwarpCommand;
-    std::string uvFrames, uvTiles, uvMask, uvTexture, uvBake, uvLog, uvFilter = "bilinear";
+    std::string uvFrames, uvTiles, uvMask, uvOrientation, uvTexture, uvBake, uvLog, uvFilter = "bilinear";
     std::string uvRest, uvDeformed, uvRigidity, uvOut;
     uvwarp::SolverOptions& uvSolver = uvwarpCommand.options.solver;
     auto* uvwarpApp = app.add_subcommand(
@@ -121,6 +132,9 @@ int main(int argc, char** argv) {
         ->required();
     uvwarpApp->add_option("--mask", uvMask,
                           "warp masks, e.g. 'mask.<UDIM>.exr' (>= 0.5 may warp); default: from the UVs");
+    uvwarpApp->add_option("--orientation", uvOrientation,
+                          "orientation-preservation maps, e.g. 'orient.<UDIM>.exr' (in [0, 1], scales "
+                          "--orientation-preservation per texel)");
     auto* uvTextureOption = uvwarpApp->add_option("--texture", uvTexture,
                                                   "texture to bake, e.g. 'col.<UDIM>.exr' (needs --bake)");
     uvwarpApp
@@ -220,6 +234,7 @@ int main(int argc, char** argv) {
             uvwarpCommand.rigidity = uvRigidity;
             uvwarpCommand.out = uvOut;
             if (!uvMask.empty()) uvwarpCommand.mask = uvMask;
+            if (!uvOrientation.empty()) uvwarpCommand.orientation = uvOrientation;
             if (!uvTexture.empty()) uvwarpCommand.texture = uvTexture;
             if (!uvBake.empty()) uvwarpCommand.bake = uvBake;
             if (!uvTiles.empty()) uvwarpCommand.tiles = harness::parseTiles(uvTiles);
@@ -231,6 +246,12 @@ int main(int argc, char** argv) {
                 harness::uvwarpCommand(uvwarpCommand, ::isatty(STDERR_FILENO) ? &std::cerr : nullptr);
             for (const std::string& line : harness::uvwarpSummary(report))
                 std::cout << "uvwarp: " << line << "\n";
+        } else if (*evalApp) {
+            evalCommand.scene = evalScene;
+            evalCommand.outDir = evalOut;
+            if (!evalFrames.empty()) evalCommand.frames = harness::parseFrames(evalFrames);
+            const harness::EvalReport report = harness::evalCommand(evalCommand, &std::cout);
+            std::cout << "eval: wrote " << report.files.size() << " files to " << evalOut << "/\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);

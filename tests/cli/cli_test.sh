@@ -173,6 +173,27 @@ expect uvwarp-missing-frame 2 uvwarp --frames 1-3 --out "$work/uv/out/r.<UDIM>.#
 contains uvwarp-missing-frame "$work/err" "anim.0003.obj: frame 3: is missing"
 [ ! -e "$work/uv/out/r.1001.0001.exr" ] || { echo "FAIL uvwarp errors: output written"; failures=$((failures + 1)); }
 
+# uvwarp with an orientation map (the demo's mask: 0 or 1 per texel), then one of the wrong size.
+expect uvwarp-orientation 0 uvwarp --frames 1-2 --orientation "$work/demo/mask.<UDIM>.exr" --out "$work/uv/out/o.<UDIM>.####.exr"
+[ -s "$work/uv/out/o.1001.0002.exr" ] || { echo "FAIL uvwarp-orientation: output missing"; failures=$((failures + 1)); }
+cp "$work/p.png" "$work/orient_bad.1001.png"  # 200 x 150: not the rigidity map's size
+expect uvwarp-orientation-size 2 uvwarp --frames 1-2 --orientation "$work/orient_bad.<UDIM>.png" --out "$work/uv/out/o2.<UDIM>.####.exr"
+contains uvwarp-orientation-size "$work/err" "orientation map"
+
+# eval: a scene with one twisted grid over two frames, then a scene with a misspelled parameter.
+cat >"$work/shot.json" <<JSON
+{"deformkit_scene": 1, "frames": [1, 2],
+ "objects": [{"name": "grid", "mesh": "grid.obj",
+   "stack": [{"type": "twist", "params": {"handleY": [0, 0, 1],
+     "endAngle": {"keys": [{"frame": 1, "value": 0}, {"frame": 2, "value": 0.5, "interpolation": "linear"}]}}}]}]}
+JSON
+expect eval 0 "$dk" eval "$work/shot.json" --out "$work/eval"
+[ -s "$work/eval/grid.0001.obj" ] && [ -s "$work/eval/grid.0002.obj" ] || { echo "FAIL eval: outputs missing"; failures=$((failures + 1)); }
+sed 's/endAngle/endAngel/' "$work/shot.json" >"$work/bad_shot.json"
+expect eval-bad-param 2 "$dk" eval "$work/bad_shot.json" --out "$work/eval-bad"
+contains eval-bad-param "$work/err" "objects[0].stack[0].params.endAngel"
+[ ! -e "$work/eval-bad" ] || { echo "FAIL eval-bad-param: output folder created"; failures=$((failures + 1)); }
+
 # A truncated image is a clear error, not a crash.
 head -c 300 "$work/demo/albedo.1001.png" >"$work/trunc.png"
 expect truncated-texture 2 "$dk" preview "$work/demo/tube.obj" --texture "$work/trunc.png" --out "$work/r.png"

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/host/scene.h"
+#include "deformkit/host/stack.h"
+
+namespace deformkit::host {
+
+// Evaluates a scene frame after frame the way a DCC does: one DeformerStack per object, built once (rest
+// mesh, deformers, painted weights, constant parameters), then at each frame every animated parameter and
+// envelope is set from its curves and the stack evaluated. Setting an animatable parameter never rebinds;
+// the stacks bind on the first evaluation and again only after a rest or bind-time change (an animated
+// [bind] parameter whose value moves, or a host's stack(o).setRest()), as DeformerStack says. A frame's
+// result depends only on the scene at that frame, not on the frames evaluated before it.
+//
+// Errors at evaluation (a constraint checked at bind, such as lowBound < highBound, or an interpolated key
+// value a deformer rejects) are InvalidInput naming the scene, the object's or parameter's JSON path and
+// the frame. Not thread-safe: one thread drives an evaluator.
+class SceneEvaluator {
+  public:
+    // Builds the stacks; throws InvalidInput as above for a value the deformers reject.
+    explicit SceneEvaluator(Scene scene);
+
+    [[nodiscard]] const Scene& scene() const { return scene_; }
+    [[nodiscard]] size_t numObjects() const { return objects_.size(); }
+
+    // Object `object`'s deformed mesh at `frame` (frames may be fractional; curves hold their end values
+    // outside their keys): the rest mesh's connectivity with the stack's output positions. The reference
+    // stays valid until the next evaluate() of that object. Throws InvalidInput for an object index out of
+    // range.
+    const geom::Mesh& evaluate(size_t object, double frame);
+
+    // The object's stack, for inspection (bind counts) and host changes (setRest, setWeights).
+    [[nodiscard]] DeformerStack& stack(size_t object);
+    [[nodiscard]] const DeformerStack& stack(size_t object) const;
+
+  private:
+    struct Object {
+        DeformerStack stack;
+        geom::Mesh deformed;
+        // Per stack entry: set every parameter each frame (an animated [bind] parameter can reset an
+        // animated counterpart that the scene holds constant), or only the animated ones.
+        std::vector<bool> setAll;
+    };
+
+    void setFrame(size_t object, double frame, bool all);
+
+    Scene scene_;
+    std::vector<Object> objects_;
+};
+
+}  // namespace deformkit::host

@@ -1,0 +1,79 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/host/anim_curve.h"
+#include "deformkit/io/obj.h"
+
+namespace deformkit::host {
+
+// The scene format version parseScene reads.
+inline constexpr int kSceneVersion = 1;
+
+// A parameter's value over time: constant, or animated with one keyframe curve per component (a vector
+// parameter's keys hold arrays; component c of every key makes curve c).
+struct SceneValue {
+    std::vector<double> constant;   // the value when not animated
+    std::vector<AnimCurve> curves;  // one per component when animated, else empty
+
+    [[nodiscard]] bool animated() const { return !curves.empty(); }
+    // The value at `frame` (the constant when not animated); one entry per component.
+    [[nodiscard]] std::vector<double> at(double frame) const;
+};
+
+// One parameter of a stack entry as the scene sets it.
+struct SceneParameter {
+    std::string name;
+    SceneValue value;
+    std::string path;  // JSON path for messages: "objects[0].stack[1].params.endAngle"
+};
+
+// One entry of an object's deformer stack.
+struct SceneDeformer {
+    std::string type;            // a makeDeformer type: ffd, twist, bend, taper, wires, slide
+    std::string label;           // unique in the stack; default: the type followed by the entry number from 1
+    SceneValue envelope;         // one component; constant 1 when the scene gives none
+    std::vector<float> weights;  // #V painted weights of the object's rest mesh, or empty for all 1
+    std::filesystem::path weightsFile;  // empty when none
+    // The parameters the scene gives, in the deformer's parameters() order (bind-time inputs first), which
+    // is the order hosts set them in.
+    std::vector<SceneParameter> params;
+    std::string path;  // "objects[0].stack[1]"
+};
+
+struct SceneObject {
+    std::string name;                // unique; names the output files, so letters, digits, '_', '-', '.' only
+    std::filesystem::path meshFile;  // resolved against the scene file's folder
+    geom::Mesh rest;
+    std::vector<io::FaceGroup> groups;  // of the rest OBJ, written back with every frame
+    std::vector<SceneDeformer> stack;
+    std::string path;  // "objects[0]"
+};
+
+// A DeformKit scene (docs/scene.md): objects, each a rest mesh under a deformer stack whose parameters
+// and envelopes are constant or keyframed, and a default frame range.
+struct Scene {
+    std::string source;  // the scene file, as named in messages
+    int firstFrame = 1;  // default frame range, inclusive
+    int lastFrame = 1;
+    std::vector<SceneObject> objects;
+};
+
+// Parses scene JSON text. `source` names the scene in messages and its folder resolves relative mesh and
+// weights paths. Loads the meshes and weights files, and checks every value the way the host will set it
+// (each parameter and every key value through the deformer's own set(), in parameters() order), so a
+// scene that parses sets without error; constraints checked only at bind or evaluation (a low bound below a
+// high bound) surface there. Throws ParseError for text that is not JSON, and InvalidInput for anything
+// else, its message "<source>: <JSON path>: <what was found> (expected <what>)", e.g.
+// "shot.json: objects[0].stack[1].params.endAngle.keys[2].frame: is 1, not after the previous key's 3
+// (expected increasing frames)". Problems inside the mesh or weights file name that file as well.
+[[nodiscard]] Scene parseScene(std::string_view text, const std::filesystem::path& source);
+
+// Reads and parses a scene file. Throws IoError when it cannot be read, then as parseScene.
+[[nodiscard]] Scene readScene(const std::filesystem::path& path);
+
+}  // namespace deformkit::host

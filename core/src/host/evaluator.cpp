@@ -1,0 +1,111 @@
+#include "deformkit/host/evaluator.h"
+
+#include <algorithm>
+#include <charconv>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "deformkit/error.h"
+#include "deformkit/host/deformers.h"
+
+namespace deformkit::host {
+namespace {
+
+std::string frameText(double frame) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), frame);
+    return "frame " + std::string(buffer, result.ptr);
+}
+
+}  // namespace
+
+SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
+    objects_.resize(scene_.objects.size());
+    for (size_t o = 0; o < scene_.objects.size(); ++o) {
+        const SceneObject& so = scene_.objects[o];
+        Object& ob = objects_[o];
+        ob.deformed = so.rest;
+        ob.stack.setRest(so.rest);
+        for (size_t i = 0; i < so.stack.size(); ++i) {
+            const SceneDeformer& sd = so.stack[i];
+            try {
+                const size_t index = ob.stack.add(makeDeformer(sd.type, sd.label));
+                if (!sd.weights.empty()) ob.stack.setWeights(index, sd.weights);
+            } catch (const Error& e) {
+                throw InvalidInput(formatError(scene_.source, sd.path, e.what()));
+            }
+            bool animatedBind = false;
+            const Deformer& d = ob.stack.deformer(i);
+            for (const SceneParameter& p : sd.params)
+                animatedBind = animatedBind || (p.value.animated() && d.parameter(p.name).rebinds);
+            ob.setAll.push_back(animatedBind);
+        }
+        // Constants once, at the first frame (animated values there too; the frame evaluated first sets
+        // them again).
+        setFrame(o, scene_.firstFrame, true);
+    }
+}
+
+void SceneEvaluator::setFrame(size_t object, double frame, bool all) {
+    const SceneObject& so = scene_.objects[object];
+    Object& ob = objects_[object];
+    for (size_t i = 0; i < so.stack.size(); ++i) {
+        const SceneDeformer& sd = so.stack[i];
+        const bool setAll = all || ob.setAll[i];
+        try {
+            if (setAll || sd.envelope.animated()) ob.stack.setEnvelope(i, sd.envelope.at(frame)[0]);
+        } catch (const Error& e) {
+            throw InvalidInput(
+                formatError(scene_.source, sd.path + ".envelope", frameText(frame) + ": " + e.what()));
+        }
+        for (const SceneParameter& p : sd.params) {
+            if (!setAll && !p.value.animated()) continue;
+            try {
+                ob.stack.set(i, p.name, p.value.at(frame));
+            } catch (const Error& e) {
+                throw InvalidInput(formatError(scene_.source, p.path, frameText(frame) + ": " + e.what()));
+            }
+        }
+    }
+}
+
+const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
+    if (object >= objects_.size()) {
+        throw InvalidInput(formatError(scene_.source, "object " + std::to_string(object), "does not exist",
+                                       "an index below " + std::to_string(objects_.size())));
+    }
+    setFrame(object, frame, false);
+    Object& ob = objects_[object];
+    const geom::Mesh& rest = ob.stack.rest();
+    std::span<glm::vec3> points = ob.deformed.points();
+    const bool sameConnectivity = points.size() == rest.points().size() &&
+                                  std::ranges::equal(ob.deformed.faceCounts(), rest.faceCounts()) &&
+                                  std::ranges::equal(ob.deformed.faceIndices(), rest.faceIndices());
+    if (!sameConnectivity) {
+        ob.deformed = rest;  // a host gave the stack a new rest mesh
+        points = ob.deformed.points();
+    }
+    std::copy(rest.points().begin(), rest.points().end(), points.begin());
+    try {
+        ob.stack.evaluate(points);
+    } catch (const Error& e) {
+        throw InvalidInput(formatError(scene_.source, scene_.objects[object].path + ".stack",
+                                       frameText(frame) + ": " + e.what()));
+    }
+    return ob.deformed;
+}
+
+DeformerStack& SceneEvaluator::stack(size_t object) {
+    if (object >= objects_.size()) {
+        throw InvalidInput(formatError(scene_.source, "object " + std::to_string(object), "does not exist",
+                                       "an index below " + std::to_string(objects_.size())));
+    }
+    return objects_[object].stack;
+}
+
+const DeformerStack& SceneEvaluator::stack(size_t object) const {
+    return const_cast<SceneEvaluator&>(*this).stack(object);
+}
+
+}  // namespace deformkit::host

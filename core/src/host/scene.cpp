@@ -1,0 +1,437 @@
+#include "deformkit/host/scene.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/host/deformers.h"
+
+namespace deformkit::host {
+
+std::vector<double> SceneValue::at(double frame) const {
+    if (curves.empty()) return constant;
+    std::vector<double> v(curves.size());
+    for (size_t c = 0; c < curves.size(); ++c)
+        v[c] = curves[c].evaluate(frame);
+    return v;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string numberText(double x) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+    return std::string(buffer, result.ptr);
+}
+
+std::string typeName(const json& v) {
+    if (v.is_null()) return "null";
+    if (v.is_boolean()) return "a boolean";
+    if (v.is_number()) return "a number";
+    if (v.is_string()) return "a string";
+    if (v.is_array()) return "an array of " + std::to_string(v.size());
+    return "an object";
+}
+
+std::string index(const std::string& path, size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+}
+
+// Reads one scene: every reader names the JSON path of what it reads.
+class Reader {
+  public:
+    Reader(std::string source, fs::path folder) : source_(std::move(source)), folder_(std::move(folder)) {}
+
+    [[noreturn]] void fail(const std::string& path, const std::string& problem,
+                           const std::string& expected) const {
+        throw InvalidInput(formatError(source_, path, problem, expected));
+    }
+
+    void requireObject(const json& v, const std::string& path, const std::string& expected) const {
+        if (!v.is_object()) fail(path, "is " + typeName(v), expected);
+    }
+
+    // Rejects keys outside `known` (a typo would otherwise be ignored silently).
+    void onlyKeys(const json& v, const std::string& path, std::initializer_list<const char*> known) const {
+        for (const auto& item : v.items()) {
+            bool found = false;
+            std::string list;
+            for (const char* k : known) {
+                found = found || item.key() == k;
+                list += (list.empty() ? "" : ", ") + std::string(k);
+            }
+            if (!found) {
+                fail(path.empty() ? item.key() : path + "." + item.key(), "is not a known key",
+                     "one of: " + list);
+            }
+        }
+    }
+
+    double number(const json& v, const std::string& path) const {
+        if (!v.is_number()) fail(path, "is " + typeName(v), "a number");
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) fail(path, "is " + v.dump(), "a finite number");
+        return d;
+    }
+
+    int integer(const json& v, const std::string& path) const {
+        const double d = number(v, path);
+        if (d != std::floor(d) || std::abs(d) > 1.0e9) fail(path, "is " + v.dump(), "a whole frame number");
+        return static_cast<int>(d);
+    }
+
+    std::string string(const json& v, const std::string& path, const std::string& expected) const {
+        if (!v.is_string() || v.get<std::string>().empty()) fail(path, "is " + typeName(v), expected);
+        return v.get<std::string>();
+    }
+
+    // A number or an array of numbers.
+    std::vector<double> numbers(const json& v, const std::string& path) const {
+        if (v.is_number()) return {number(v, path)};
+        if (!v.is_array() || v.empty())
+            fail(path, "is " + typeName(v), "a number or a non-empty array of numbers");
+        std::vector<double> out(v.size());
+        for (size_t i = 0; i < v.size(); ++i)
+            out[i] = number(v[i], index(path, i));
+        return out;
+    }
+
+    // A constant (number or array) or {"keys": [...]}.
+    SceneValue value(const json& v, const std::string& path) const {
+        SceneValue out;
+        if (!v.is_object()) {
+            out.constant = numbers(v, path);
+            return out;
+        }
+        onlyKeys(v, path, {"keys"});
+        if (!v.contains("keys")) fail(path + ".keys", "is missing", "an array of keys");
+        const json& keys = v.at("keys");
+        const std::string keysPath = path + ".keys";
+        if (!keys.is_array() || keys.empty())
+            fail(keysPath, "is " + typeName(keys), "a non-empty array of keys");
+        std::vector<std::vector<Key>> perComponent;
+        for (size_t k = 0; k < keys.size(); ++k) {
+            const std::string kp = index(keysPath, k);
+            const json& key = keys[k];
+            requireObject(key, kp, "{\"frame\": ..., \"value\": ...}");
+            onlyKeys(key, kp, {"frame", "value", "interpolation", "tangent", "in", "out"});
+            if (!key.contains("frame")) fail(kp + ".frame", "is missing", "a number");
+            if (!key.contains("value")) fail(kp + ".value", "is missing", "a number or an array of numbers");
+            Key base;
+            base.time = number(key.at("frame"), kp + ".frame");
+            if (k > 0 && !(base.time > perComponent[0].back().time)) {
+                fail(kp + ".frame",
+                     "is " + numberText(base.time) + ", not after the previous key's " +
+                         numberText(perComponent[0].back().time),
+                     "increasing frames");
+            }
+            const std::vector<double> values = numbers(key.at("value"), kp + ".value");
+            if (k == 0) {
+                perComponent.resize(values.size());
+            } else if (values.size() != perComponent.size()) {
+                fail(kp + ".value", "has " + std::to_string(values.size()) + " components",
+                     std::to_string(perComponent.size()) + ", as keys[0]");
+            }
+            if (key.contains("interpolation")) {
+                const std::string s = string(key.at("interpolation"), kp + ".interpolation",
+                                             "\"constant\", \"linear\" or \"bezier\"");
+                if (s == "constant") {
+                    base.interpolation = Interpolation::Constant;
+                } else if (s == "linear") {
+                    base.interpolation = Interpolation::Linear;
+                } else if (s == "bezier") {
+                    base.interpolation = Interpolation::Bezier;
+                } else {
+                    fail(kp + ".interpolation", "is \"" + s + "\"", "\"constant\", \"linear\" or \"bezier\"");
+                }
+            }
+            if (key.contains("tangent")) {
+                const std::string s =
+                    string(key.at("tangent"), kp + ".tangent", "\"auto\", \"flat\" or \"explicit\"");
+                if (s == "auto") {
+                    base.tangent = TangentMode::Auto;
+                } else if (s == "flat") {
+                    base.tangent = TangentMode::Flat;
+                } else if (s == "explicit") {
+                    base.tangent = TangentMode::Explicit;
+                } else {
+                    fail(kp + ".tangent", "is \"" + s + "\"", "\"auto\", \"flat\" or \"explicit\"");
+                }
+            }
+            // Slopes: value units per frame, a number for every component or one per component.
+            auto slopes = [&](const char* name) {
+                std::vector<double> s(values.size(), 0.0);
+                const std::string sp = kp + "." + name;
+                if (!key.contains(name)) {
+                    if (base.tangent == TangentMode::Explicit)
+                        fail(sp, "is missing", "a slope, as the tangent is \"explicit\"");
+                    return s;
+                }
+                if (base.tangent != TangentMode::Explicit)
+                    fail(sp, "is given", "slopes only with \"tangent\": \"explicit\"");
+                const std::vector<double> given = numbers(key.at(name), sp);
+                if (key.at(name).is_number()) return std::vector<double>(values.size(), given[0]);
+                if (given.size() != values.size()) {
+                    fail(sp, "has " + std::to_string(given.size()) + " slopes",
+                         std::to_string(values.size()) + ", one per component of the value");
+                }
+                return given;
+            };
+            const std::vector<double> in = slopes("in"), outSlopes = slopes("out");
+            for (size_t c = 0; c < values.size(); ++c) {
+                Key key1 = base;
+                key1.value = values[c];
+                key1.inSlope = in[c];
+                key1.outSlope = outSlopes[c];
+                perComponent[c].push_back(key1);
+            }
+        }
+        for (size_t c = 0; c < perComponent.size(); ++c) {
+            try {
+                out.curves.emplace_back(std::move(perComponent[c]), "component " + std::to_string(c));
+            } catch (const Error& e) {
+                fail(keysPath, e.what(), "valid keys");  // a backstop: the checks above come first
+            }
+        }
+        return out;
+    }
+
+    fs::path file(const json& v, const std::string& path, const std::string& expected) const {
+        const fs::path p = string(v, path, expected);
+        return p.is_absolute() ? p : folder_ / p;
+    }
+
+    std::vector<float> weights(const json& v, const std::string& path, int32_t count, fs::path& file) const {
+        file = this->file(v, path, "a weights file name (JSON)");
+        std::ifstream in(file, std::ios::binary);
+        if (!in)
+            fail(path, "names " + file.string() + ", which cannot be read", "a readable JSON weights file");
+        std::ostringstream text;
+        text << in.rdbuf();
+        json root;
+        try {
+            root = json::parse(text.str());
+        } catch (const json::exception& e) {
+            std::string what = e.what();
+            const size_t at = what.find("] ");
+            fail(path, file.string() + ": " + (at == std::string::npos ? what : what.substr(at + 2)),
+                 "a JSON array of weights or {\"weights\": [...]}");
+        }
+        const json* array = &root;
+        if (root.is_object() && root.contains("weights")) array = &root.at("weights");
+        if (!array->is_array()) {
+            fail(path, file.string() + " holds " + typeName(root),
+                 "a JSON array of weights or {\"weights\": [...]}");
+        }
+        if (array->size() != static_cast<size_t>(count)) {
+            fail(path, file.string() + " has " + std::to_string(array->size()) + " weights",
+                 std::to_string(count) + ", one per vertex of the rest mesh");
+        }
+        std::vector<float> w(array->size());
+        for (size_t i = 0; i < w.size(); ++i) {
+            const json& x = (*array)[i];
+            if (!x.is_number() || !std::isfinite(x.get<double>()) || std::abs(x.get<double>()) > 3.0e38) {
+                fail(path, file.string() + ": weight " + std::to_string(i) + " is " + x.dump(),
+                     "a finite number");
+            }
+            w[i] = static_cast<float>(x.get<double>());
+        }
+        return w;
+    }
+
+    SceneDeformer deformer(const json& v, const std::string& path, size_t entry, int32_t vertexCount) const {
+        requireObject(v, path, "{\"type\": ..., \"params\": {...}}");
+        onlyKeys(v, path, {"type", "label", "envelope", "weights", "params"});
+        SceneDeformer d;
+        d.path = path;
+        std::string known;
+        for (std::string_view t : deformerTypes())
+            known += (known.empty() ? "" : ", ") + std::string(t);
+        if (!v.contains("type")) fail(path + ".type", "is missing", "one of: " + known);
+        d.type = string(v.at("type"), path + ".type", "one of: " + known);
+        bool typeKnown = false;
+        for (std::string_view t : deformerTypes())
+            typeKnown = typeKnown || t == d.type;
+        if (!typeKnown) fail(path + ".type", "is \"" + d.type + "\"", "one of: " + known);
+        d.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
+                                      : d.type + std::to_string(entry + 1);
+        d.envelope.constant = {1.0};
+        if (v.contains("envelope")) {
+            d.envelope = value(v.at("envelope"), path + ".envelope");
+            const size_t n = d.envelope.animated() ? d.envelope.curves.size() : d.envelope.constant.size();
+            if (n != 1) fail(path + ".envelope", "has " + std::to_string(n) + " components", "one number");
+        }
+        if (v.contains("weights"))
+            d.weights = weights(v.at("weights"), path + ".weights", vertexCount, d.weightsFile);
+
+        // Parameters are checked by a probe deformer's own set(), in its parameters() order (bind-time
+        // inputs first, as a host sets them): the constant, or every key's value.
+        std::unique_ptr<Deformer> probe = makeDeformer(d.type, d.label);
+        const std::string paramsPath = path + ".params";
+        if (v.contains("params")) {
+            const json& params = v.at("params");
+            requireObject(params, paramsPath, "an object of parameter values by name");
+            for (const auto& item : params.items()) {
+                if (!probe->hasParameter(item.key())) {
+                    try {
+                        (void)probe->parameter(item.key());
+                    } catch (const Error& e) {
+                        fail(paramsPath + "." + item.key(), e.what(), "a parameter of " + d.type);
+                    }
+                }
+            }
+            for (const ParamInfo& info : probe->parameters()) {
+                if (!params.contains(info.name)) continue;
+                SceneParameter p;
+                p.name = info.name;
+                p.path = paramsPath + "." + info.name;
+                p.value = value(params.at(info.name), p.path);
+                try {
+                    if (!p.value.animated()) {
+                        probe->set(p.name, p.value.constant);
+                    } else {
+                        const size_t keyCount = p.value.curves[0].size();
+                        for (size_t k = 0; k < keyCount; ++k) {
+                            std::vector<double> x(p.value.curves.size());
+                            for (size_t c = 0; c < x.size(); ++c)
+                                x[c] = p.value.curves[c].keys()[k].value;
+                            try {
+                                probe->set(p.name, x);
+                            } catch (const Error& e) {
+                                fail(index(p.path + ".keys", k) + ".value", e.what(), "");
+                            }
+                        }
+                    }
+                } catch (const InvalidInput& e) {
+                    const std::string what = e.what();
+                    if (what.rfind(source_ + ": ", 0) == 0) throw;  // already names the key
+                    fail(p.path, what, "");
+                }
+                d.params.push_back(std::move(p));
+            }
+        }
+        return d;
+    }
+
+    SceneObject object(const json& v, const std::string& path) const {
+        requireObject(v, path, "{\"name\": ..., \"mesh\": ..., \"stack\": [...]}");
+        onlyKeys(v, path, {"name", "mesh", "stack"});
+        SceneObject o;
+        o.path = path;
+        if (!v.contains("name")) fail(path + ".name", "is missing", "a name");
+        o.name = string(v.at("name"), path + ".name", "a non-empty name");
+        for (char c : o.name) {
+            const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                            c == '_' || c == '-' || c == '.';
+            if (!ok || o.name[0] == '.') {
+                fail(path + ".name", "is \"" + o.name + "\"",
+                     "letters, digits, '_', '-' and '.' only, not starting with '.' (it names output files)");
+            }
+        }
+        if (!v.contains("mesh")) fail(path + ".mesh", "is missing", "an OBJ file name");
+        o.meshFile = file(v.at("mesh"), path + ".mesh", "an OBJ file name");
+        if (!fs::is_regular_file(o.meshFile))
+            fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "an OBJ file");
+        try {
+            io::ObjContent content = io::readObj(o.meshFile);
+            o.rest = std::move(content.mesh);
+            o.groups = std::move(content.groups);
+        } catch (const Error& e) {
+            fail(path + ".mesh", e.what(), "");
+        }
+        if (!v.contains("stack")) fail(path + ".stack", "is missing", "an array of deformers");
+        const json& stack = v.at("stack");
+        if (!stack.is_array()) fail(path + ".stack", "is " + typeName(stack), "an array of deformers");
+        std::set<std::string> labels;
+        for (size_t i = 0; i < stack.size(); ++i) {
+            SceneDeformer d = deformer(stack[i], index(path + ".stack", i), i, o.rest.numVertices());
+            if (!labels.insert(d.label).second) {
+                fail(index(path + ".stack", i) + ".label", "is \"" + d.label + "\", used by an earlier entry",
+                     "a label unique in the stack");
+            }
+            o.stack.push_back(std::move(d));
+        }
+        return o;
+    }
+
+    Scene scene(const json& root) const {
+        requireObject(root, "(top level)", "an object");
+        if (!root.contains("deformkit_scene")) {
+            fail("deformkit_scene", "is missing",
+                 std::to_string(kSceneVersion) + ", the scene format version (a DeformKit scene file)");
+        }
+        const json& version = root.at("deformkit_scene");
+        if (!version.is_number() || version.get<double>() != kSceneVersion) {
+            fail("deformkit_scene", "is " + version.dump(),
+                 std::to_string(kSceneVersion) + ", the version this DeformKit reads");
+        }
+        onlyKeys(root, "", {"deformkit_scene", "frames", "objects"});
+        Scene s;
+        s.source = source_;
+        if (!root.contains("frames")) fail("frames", "is missing", "[first, last]");
+        const json& frames = root.at("frames");
+        if (!frames.is_array() || frames.size() != 2)
+            fail("frames", "is " + typeName(frames), "[first, last]");
+        s.firstFrame = integer(frames[0], "frames[0]");
+        s.lastFrame = integer(frames[1], "frames[1]");
+        if (s.lastFrame < s.firstFrame) {
+            fail("frames", "is " + frames.dump(), "[first, last] with last >= first");
+        }
+        if (!root.contains("objects")) fail("objects", "is missing", "an array of objects");
+        const json& objects = root.at("objects");
+        if (!objects.is_array()) fail("objects", "is " + typeName(objects), "an array of objects");
+        std::set<std::string> names;
+        for (size_t i = 0; i < objects.size(); ++i) {
+            SceneObject o = object(objects[i], index("objects", i));
+            if (!names.insert(o.name).second) {
+                fail(index("objects", i) + ".name", "is \"" + o.name + "\", used by an earlier object",
+                     "a unique name");
+            }
+            s.objects.push_back(std::move(o));
+        }
+        return s;
+    }
+
+  private:
+    std::string source_;
+    fs::path folder_;
+};
+
+}  // namespace
+
+Scene parseScene(std::string_view text, const fs::path& source) {
+    json root;
+    try {
+        root = json::parse(text.begin(), text.end());
+    } catch (const json::exception& e) {
+        // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: ...": keep the part
+        // after the bracketed id.
+        std::string what = e.what();
+        const size_t at = what.find("] ");
+        throw ParseError(formatError(source.string(), "",
+                                     at == std::string::npos ? what : what.substr(at + 2),
+                                     "a JSON scene (docs/scene.md)"));
+    }
+    return Reader(source.string(), source.parent_path()).scene(root);
+}
+
+Scene readScene(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw IoError(formatError(path.string(), "", "cannot open the scene file", "a readable JSON file"));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseScene(text.str(), path);
+}
+
+}  // namespace deformkit::host
