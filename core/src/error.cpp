@@ -1,5 +1,7 @@
 #include "deformkit/error.h"
 
+#include <charconv>
+
 namespace deformkit {
 
 std::string formatError(std::string_view source, std::string_view element, std::string_view problem,
@@ -20,6 +22,12 @@ std::string formatError(std::string_view source, std::string_view element, std::
         message.append(")");
     }
     return message;
+}
+
+std::string numberText(double x) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+    return std::string(buffer, result.ptr);
 }
 
 }  // namespace deformkit

@@ -11,32 +11,32 @@ namespace deformkit {
 // was expected. Library code never aborts on user data; hosts convert Error at their boundary
 // (CLI: one line on stderr and exit code 2).
 class Error : public std::runtime_error {
-public:
+  public:
     explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
 // A file or folder that is missing, unreadable or unwritable.
 class IoError : public Error {
-public:
+  public:
     using Error::Error;
 };
 
 // A file whose bytes do not follow its format: OBJ syntax, a truncated or corrupt image.
 class ParseError : public Error {
-public:
+  public:
     using Error::Error;
 };
 
 // Well-formed data with values an algorithm cannot take: an index out of range, NaN coordinates, an
 // image with the wrong channel count, a bad argument.
 class InvalidInput : public Error {
-public:
+  public:
     using Error::Error;
 };
 
 // Connectivity an algorithm cannot take: a non-manifold edge or vertex where a manifold is required.
 class TopologyError : public InvalidInput {
-public:
+  public:
     using InvalidInput::InvalidInput;
 };
 
@@ -44,5 +44,8 @@ public:
 // Empty parts are left out.
 [[nodiscard]] std::string formatError(std::string_view source, std::string_view element,
                                       std::string_view problem, std::string_view expected = {});
+
+// The shortest text that reads back as `x` ("10", "0.1", "nan", "inf"), for numbers in messages.
+[[nodiscard]] std::string numberText(double x);
 
 }  // namespace deformkit

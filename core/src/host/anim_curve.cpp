@@ -1,7 +1,6 @@
 #include "deformkit/host/anim_curve.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -11,13 +10,6 @@
 
 namespace deformkit::host {
 namespace {
-
-// The shortest text that reads back as `x` ("10", "0.1", "nan", "inf").
-std::string numberText(double x) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-    return std::string(buffer, result.ptr);
-}
 
 std::string keyName(size_t k) {
     return "key " + std::to_string(k);

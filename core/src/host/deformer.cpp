@@ -1,7 +1,6 @@
 #include "deformkit/host/deformer.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -14,12 +13,6 @@
 
 namespace deformkit::host {
 namespace {
-
-std::string numberText(double x) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-    return std::string(buffer, result.ptr);
-}
 
 std::string withContext(const std::string& context, const char* message) {
     const std::string text(message);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -27,12 +26,6 @@
 
 namespace deformkit::host {
 namespace {
-
-std::string numberText(double x) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-    return std::string(buffer, result.ptr);
-}
 
 glm::vec3 vec3At(std::span<const double> v, size_t first = 0) {
     return {static_cast<float>(v[first]), static_cast<float>(v[first + 1]), static_cast<float>(v[first + 2])};

@@ -1,7 +1,6 @@
 #include "deformkit/host/evaluator.h"
 
 #include <algorithm>
-#include <charconv>
 #include <memory>
 #include <string>
 #include <utility>
@@ -13,9 +12,7 @@ namespace deformkit::host {
 namespace {
 
 std::string frameText(double frame) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), frame);
-    return "frame " + std::string(buffer, result.ptr);
+    return "frame " + numberText(frame);
 }
 
 }  // namespace

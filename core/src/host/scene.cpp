@@ -1,6 +1,5 @@
 #include "deformkit/host/scene.h"
 
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -27,12 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string numberText(double x) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-    return std::string(buffer, result.ptr);
-}
 
 std::string typeName(const json& v) {
     if (v.is_null()) return "null";

@@ -1,7 +1,6 @@
 #include "deformkit/host/stack.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -12,12 +11,6 @@ namespace deformkit::host {
 namespace {
 
 constexpr const char* kEnvelope = "envelope";
-
-std::string numberText(double x) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
-    return std::string(buffer, result.ptr);
-}
 
 }  // namespace
 
