@@ -1,22 +1,214 @@
 #include "eval_command.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string_view>
+
+#include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "deformkit/error.h"
 #include "deformkit/host/evaluator.h"
 #include "deformkit/host/scene.h"
+#include "deformkit/io/atomic_file.h"
+#include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/io/preview.h"
 
 namespace deformkit::harness {
 
 namespace fs = std::filesystem;
 
-std::string evalFileName(const std::string& object, int frame) {
+namespace {
+
+// The rest mesh plus two unreferenced vertices. The renderer frames a mesh's bounding box and unreferenced
+// vertices are never drawn, so the two corners choose the camera: every frame is rendered through the
+// camera of framingBox() below while the faces show the deformed positions.
+geom::Mesh makeFramingMesh(const geom::Mesh& rest) {
+    geom::Mesh::Data d;
+    d.points.assign(rest.points().begin(), rest.points().end());
+    d.points.resize(d.points.size() + 2, glm::vec3(0.0f));
+    d.faceCounts.assign(rest.faceCounts().begin(), rest.faceCounts().end());
+    d.faceIndices.assign(rest.faceIndices().begin(), rest.faceIndices().end());
+    d.uvs.assign(rest.uvs().begin(), rest.uvs().end());
+    d.uvIndices.assign(rest.uvIndices().begin(), rest.uvIndices().end());
+    return geom::Mesh(std::move(d), "preview");
+}
+
+// The box whose default-view camera shows a frame: the rest box while the deformed mesh stays inside it
+// (the rest camera, exactly). Otherwise a box about the rest centre that holds the deformed mesh with the
+// rest box's diagonal when one exists (the same camera up to float rounding of the corners), else the
+// smallest box about the rest centre holding it (the camera backs off along the same line for that frame
+// only, rather than cutting the mesh off).
+geom::Box3 framingBox(const geom::Box3& rest, const geom::Box3& frame) {
+    if (glm::all(glm::greaterThanEqual(frame.min, rest.min)) &&
+        glm::all(glm::lessThanEqual(frame.max, rest.max)))
+        return rest;
+    const glm::dvec3 centre(rest.center());
+    const glm::dvec3 restHalf = 0.5 * glm::dvec3(rest.extent());
+    const glm::dvec3 needed = glm::max(centre - glm::dvec3(frame.min), glm::dvec3(frame.max) - centre);
+    glm::dvec3 half = needed;
+    const double target = glm::dot(restHalf, restHalf);
+    if (glm::dot(needed, needed) < target) {
+        // |max(needed, s * restHalf)| grows with s from |needed| to >= |restHalf|: bisect for equality.
+        double lo = 0.0, hi = 1.0;
+        for (int i = 0; i < 60; ++i) {
+            const double s = 0.5 * (lo + hi);
+            const glm::dvec3 h = glm::max(needed, s * restHalf);
+            (glm::dot(h, h) < target ? lo : hi) = s;
+        }
+        half = glm::max(needed, hi * restHalf);
+    }
+    geom::Box3 box;
+    box.min = glm::vec3(centre - half);
+    box.max = glm::vec3(centre + half);
+    box.extend(frame);  // float rounding of the corners must not leave a vertex outside
+    return box;
+}
+
+uint32_t toByte(float v) {
+    return static_cast<uint32_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
+
+// Pastes `preview` (8-bit values as read from its PNG) shrunk by layout.factor into cell `cell` of `sheet`.
+void pasteTile(io::Image& sheet, const io::Image& preview, const ContactSheetLayout& layout, int32_t cell) {
+    const int32_t k = layout.factor;
+    const uint32_t area = static_cast<uint32_t>(k) * k;
+    const int32_t x0 = (cell % layout.columns) * layout.tileWidth;
+    const int32_t y0 = (cell / layout.columns) * layout.tileHeight;
+    for (int32_t y = 0; y < layout.tileHeight; ++y) {
+        for (int32_t x = 0; x < layout.tileWidth; ++x) {
+            for (int32_t c = 0; c < 3; ++c) {
+                uint32_t sum = 0;
+                for (int32_t j = 0; j < k; ++j)
+                    for (int32_t i = 0; i < k; ++i)
+                        sum += toByte(preview.at(x * k + i, y * k + j, c));
+                sheet.at(x0 + x, y0 + y, c) = static_cast<float>((sum + area / 2) / area) / 255.0f;
+            }
+        }
+    }
+}
+
+std::optional<fs::path> findOnPath(const std::string& program) {
+    const char* path = std::getenv("PATH");
+    if (!path) return std::nullopt;
+    std::string_view rest(path);
+    while (true) {
+        const size_t colon = rest.find(':');
+        const std::string_view dir = rest.substr(0, colon);
+        const fs::path candidate = (dir.empty() ? fs::path(".") : fs::path(dir)) / program;
+        std::error_code ec;
+        if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0) return candidate;
+        if (colon == std::string_view::npos) return std::nullopt;
+        rest.remove_prefix(colon + 1);
+    }
+}
+
+// Single-quoted for the POSIX shell: nothing inside is expanded; a quote becomes '\''.
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s)
+        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+// Removes a folder and its contents when leaving scope, on success or error.
+struct RemoveOnExit {
+    fs::path dir;
+    ~RemoveOnExit() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+};
+
+// Encodes `pngs` in order into `movie` with ffmpeg. The previews are linked (or copied) under sequential
+// names into a scratch folder first, so frame lists with gaps or negative frames make a plain pattern.
+void encodeMovie(const fs::path& ffmpeg, const std::vector<fs::path>& pngs, const fs::path& movie,
+                 int32_t fps) {
+    std::string scratchName = movie.filename().string();
+    scratchName.insert(0, 1, '.');
+    scratchName += ".frames.tmp";
+    RemoveOnExit scratch{movie.parent_path() / scratchName};
+    std::error_code ec;
+    fs::remove_all(scratch.dir, ec);
+    if (!fs::create_directory(scratch.dir, ec)) {
+        throw IoError(formatError(scratch.dir.string(), "", "cannot be created: " + ec.message(),
+                                  "a writable output folder"));
+    }
+    for (size_t i = 0; i < pngs.size(); ++i) {
+        char name[32];
+        std::snprintf(name, sizeof(name), "%06zu.png", i);
+        const fs::path link = scratch.dir / name;
+        fs::create_hard_link(pngs[i], link, ec);
+        if (ec && !fs::copy_file(pngs[i], link, ec)) {
+            throw IoError(formatError(link.string(), "", "cannot be written: " + ec.message(),
+                                      "a writable output folder"));
+        }
+    }
+    io::writeAtomically(movie, [&](const fs::path& tmp) {
+        const std::string command =
+            shellQuote(ffmpeg.string()) + " -nostdin -y -loglevel error -framerate " + std::to_string(fps) +
+            " -i " + shellQuote((scratch.dir / "%06d.png").string()) +
+            " -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + shellQuote(tmp.string());
+        const int status = std::system(command.c_str());
+        if (status != 0 || !fs::is_regular_file(tmp)) {
+            std::string what = "wrote no file";
+            if (status == -1) {
+                what = "could not be started";
+            } else if (status != 0) {
+                what = WIFEXITED(status) ? "exited with status " + std::to_string(WEXITSTATUS(status))
+                                         : "was stopped by a signal";
+            }
+            throw IoError(
+                formatError(command, "", what, "ffmpeg to encode the previews into " + movie.string()));
+        }
+    });
+}
+
+void checkSize(const char* what, int32_t value, int32_t lo, int32_t hi) {
+    if (value < lo || value > hi) {
+        throw InvalidInput(formatError("eval", what, "is " + std::to_string(value),
+                                       std::to_string(lo) + " to " + std::to_string(hi)));
+    }
+}
+
+}  // namespace
+
+std::string evalFileName(const std::string& object, int frame, const std::string& extension) {
     char digits[32];
     std::snprintf(digits, sizeof(digits), "%s%04lld", frame < 0 ? "-" : "",
                   std::llabs(static_cast<long long>(frame)));
-    return object + "." + digits + ".obj";
+    return object + "." + digits + extension;
+}
+
+ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32_t previewHeight,
+                                      int32_t maxColumns, int32_t maxWidth) {
+    checkSize("contact sheet tiles", tiles, 1, 1 << 30);
+    checkSize("preview width", previewWidth, 1, 16384);
+    checkSize("preview height", previewHeight, 1, 16384);
+    checkSize("contact sheet columns", maxColumns, 1, 1 << 30);
+    ContactSheetLayout layout;
+    layout.columns = std::min(tiles, maxColumns);
+    layout.rows = (tiles + layout.columns - 1) / layout.columns;
+    const int64_t wide = static_cast<int64_t>(layout.columns) * previewWidth;
+    layout.factor =
+        maxWidth < 1 ? 0 : static_cast<int32_t>(std::max<int64_t>(1, (wide + maxWidth - 1) / maxWidth));
+    if (layout.factor < 1 || layout.factor > std::min(previewWidth, previewHeight)) {
+        throw InvalidInput(formatError("eval", "contact sheet width",
+                                       "is " + std::to_string(maxWidth) + " pixels for " +
+                                           std::to_string(layout.columns) + " columns of " +
+                                           std::to_string(previewWidth) + "x" +
+                                           std::to_string(previewHeight) + " previews",
+                                       "room for tiles at least one pixel wide and high"));
+    }
+    layout.tileWidth = previewWidth / layout.factor;
+    layout.tileHeight = previewHeight / layout.factor;
+    return layout;
 }
 
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
@@ -29,28 +221,91 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     } else {
         report.frames = command.frames;
     }
+    const size_t numObjects = evaluator.numObjects();
+    const bool previews = command.previews && !report.frames.empty() && numObjects > 0;
+    io::PreviewOptions view;
+    ContactSheetLayout layout;
+    if (previews) {
+        checkSize("preview width", command.previewWidth, 1, 16384);
+        checkSize("preview height", command.previewHeight, 1, 16384);
+        view.width = command.previewWidth;
+        view.height = command.previewHeight;
+        layout = contactSheetLayout(static_cast<int32_t>(report.frames.size()), view.width, view.height,
+                                    command.contactColumns, command.contactMaxWidth);
+        if (command.movie) checkSize("movie frame rate", command.movieFrameRate, 1, 1000);
+    }
     std::error_code ec;
     fs::create_directories(command.outDir, ec);
     if (!fs::is_directory(command.outDir)) {
         throw IoError(
             formatError(command.outDir.string(), "", "cannot be created", "a writable output folder"));
     }
+
+    std::vector<geom::Mesh> framing;          // per object, see makeFramingMesh
+    std::vector<geom::Box3> restBounds;       // per object
+    std::vector<io::Image> sheets;            // per object
+    std::vector<std::vector<fs::path>> pngs;  // per object, frame by frame
+    if (previews) {
+        io::Image blank(layout.columns * layout.tileWidth, layout.rows * layout.tileHeight, 3);
+        for (int32_t i = 0; i < blank.width * blank.height; ++i) {
+            for (int32_t c = 0; c < 3; ++c)
+                blank.pixels[3 * i + c] = static_cast<float>(toByte(view.background[c])) / 255.0f;
+        }
+        for (const host::SceneObject& object : scene.objects) {
+            framing.push_back(makeFramingMesh(object.rest));
+            restBounds.push_back(object.rest.bounds());
+            sheets.push_back(blank);
+        }
+        pngs.resize(numObjects);
+    }
+
     for (size_t i = 0; i < report.frames.size(); ++i) {
         const int frame = report.frames[i];
-        for (size_t o = 0; o < evaluator.numObjects(); ++o) {
+        for (size_t o = 0; o < numObjects; ++o) {
             const geom::Mesh& mesh = evaluator.evaluate(o, frame);
             const fs::path file = command.outDir / evalFileName(scene.objects[o].name, frame);
             io::writeObj(file, mesh, scene.objects[o].groups);
             report.files.push_back(file);
+            if (!previews) continue;
+            const std::span<glm::vec3> points = framing[o].points();
+            std::copy(mesh.points().begin(), mesh.points().end(), points.begin());
+            const geom::Box3 box = framingBox(restBounds[o], mesh.bounds());
+            points[points.size() - 2] = box.min;
+            points[points.size() - 1] = box.max;
+            const fs::path png = command.outDir / evalFileName(scene.objects[o].name, frame, ".png");
+            io::writeImage(png, io::renderPreview(framing[o], view));
+            report.files.push_back(png);
+            pngs[o].push_back(png);
+            // The sheet is made from the file as written (8-bit), so a tile is reproducible from the preview.
+            pasteTile(sheets[o], io::readImage(png, {3, "preview"}), layout, static_cast<int32_t>(i));
         }
         if (progress) {
             *progress << "eval: frame " << frame << " (" << (i + 1) << "/" << report.frames.size()
-                      << "): " << evaluator.numObjects()
-                      << (evaluator.numObjects() == 1 ? " object" : " objects") << " written\n";
+                      << "): " << numObjects << (numObjects == 1 ? " object" : " objects") << " written\n";
         }
     }
-    for (size_t o = 0; o < evaluator.numObjects(); ++o)
+    for (size_t o = 0; o < numObjects; ++o)
         report.binds.push_back(evaluator.stack(o).bindCount());
+    if (!previews) return report;
+
+    for (size_t o = 0; o < numObjects; ++o) {
+        const fs::path sheet = command.outDir / (scene.objects[o].name + ".contact.png");
+        io::writeImage(sheet, sheets[o]);
+        report.files.push_back(sheet);
+    }
+    if (command.movie) {
+        const std::optional<fs::path> ffmpeg = findOnPath("ffmpeg");
+        if (!ffmpeg) {
+            report.notes.push_back("no ffmpeg on PATH: movies not written");
+            return report;
+        }
+        for (size_t o = 0; o < numObjects; ++o) {
+            const fs::path movie = command.outDir / (scene.objects[o].name + ".mp4");
+            encodeMovie(*ffmpeg, pngs[o], movie, command.movieFrameRate);
+            report.files.push_back(movie);
+            if (progress) *progress << "eval: movie " << movie.string() << " written\n";
+        }
+    }
     return report;
 }
 

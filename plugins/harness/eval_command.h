@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -7,9 +8,14 @@
 #include <vector>
 
 // `deformkit eval SCENE [--frames A-B] [--out DIR]`: evaluates a DeformKit scene (docs/scene.md) frame by
-// frame, as a DCC plays it back, and writes every object's deformed mesh per frame:
+// frame, as a DCC plays it back, and writes every object's deformed mesh per frame, with previews:
 //
-//   DIR/<object>.<frame>.obj   frame zero padded to 4 digits (-0001 for frame -1), rest UVs and groups kept
+//   DIR/<object>.<frame>.obj    frame zero padded to 4 digits (-0001 for frame -1), rest UVs and groups kept
+//   DIR/<object>.<frame>.png    shaded preview (io::renderPreview), one camera per object: the default view
+//                               framing the object's rest bounding box, so previews of a shot do not jump
+//   DIR/<object>.contact.png    the object's previews tiled in frame order, each downscaled
+//   (contactSheetLayout) DIR/<object>.mp4            with `movie`, when ffmpeg is on PATH: the previews at
+//   `movieFrameRate`
 //
 // Every file is written atomically; DIR is created when missing. Frames are evaluated in ascending order
 // through one host::SceneEvaluator, so each deformer binds once and animated parameters only change its
@@ -21,19 +27,57 @@ struct EvalCommand {
     // Frames to evaluate, ascending (parseFrames("1-24")); empty: the scene's "frames" range.
     std::vector<int> frames;
     std::filesystem::path outDir = "eval-out";
+
+    bool previews = true;            // write the PNG previews and contact sheets
+    int32_t previewWidth = 480;      // pixels, 1 to 16384
+    int32_t previewHeight = 360;     // pixels, 1 to 16384
+    int32_t contactColumns = 6;      // at most this many tiles per contact sheet row, >= 1
+    int32_t contactMaxWidth = 2048;  // contact sheet width limit in pixels (tiles shrink by a whole factor)
+    // Encode DIR/<object>.mp4 from the previews with ffmpeg (its default MP4 codec, yuv420p); needs
+    // `previews`. When no ffmpeg is on PATH the movies are skipped and EvalReport::notes says so.
+    bool movie = false;
+    int32_t movieFrameRate = 24;  // frames per second, >= 1
 };
 
 struct EvalReport {
-    std::vector<int> frames;                   // evaluated, ascending
-    std::vector<std::filesystem::path> files;  // written, frame by frame, objects in scene order
-    std::vector<int64_t> binds;                // per object: binds done by its stack over the run
+    std::vector<int> frames;  // evaluated, ascending
+    // Written: per frame, per object in scene order, the OBJ then the preview; then per object its contact
+    // sheet, then per object its movie (previews, sheets and movies only when made).
+    std::vector<std::filesystem::path> files;
+    std::vector<int64_t> binds;      // per object: binds done by its stack over the run
+    std::vector<std::string> notes;  // things not done that are not errors (no ffmpeg on PATH)
 };
 
 // Runs the command; writes one progress line per frame to `progress` when not null. Throws Error: bad
-// scene input is InvalidInput (ParseError for text that is not JSON) naming the scene file and JSON path.
+// scene input is InvalidInput (ParseError for text that is not JSON) naming the scene file and JSON path;
+// bad preview or contact sheet sizes are InvalidInput, checked before anything is written; a failing
+// ffmpeg is IoError naming the command.
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress = nullptr);
 
-// "<object>.<frame>.obj" with the frame zero padded to 4 digits, a sign before the padding.
-[[nodiscard]] std::string evalFileName(const std::string& object, int frame);
+// "<object>.<frame><extension>" with the frame zero padded to 4 digits, a sign before the padding.
+[[nodiscard]] std::string evalFileName(const std::string& object, int frame,
+                                       const std::string& extension = ".obj");
+
+// Contact sheet grid for `tiles` previews of previewWidth x previewHeight pixels:
+//   columns = min(tiles, maxColumns), rows = ceil(tiles / columns);
+//   factor  = max(1, ceil(columns * previewWidth / maxWidth)), the smallest whole shrink factor that keeps
+//             the sheet at most maxWidth wide;
+//   tile    = floor(previewWidth / factor) x floor(previewHeight / factor) (a preview's last columns and
+//             rows that do not fill a whole block are dropped); sheet = columns * tile by rows * tile.
+// A tile pixel is the box filter of its factor x factor block of the preview's 8-bit values, rounded half
+// up: (sum + factor^2 / 2) / factor^2 in integers. Tiles touch, in frame order row by row; cells after the
+// last tile have the preview background colour.
+struct ContactSheetLayout {
+    int32_t columns = 0;
+    int32_t rows = 0;
+    int32_t factor = 1;
+    int32_t tileWidth = 0;
+    int32_t tileHeight = 0;
+};
+
+// Throws InvalidInput when no whole factor fits (maxWidth < columns, or a tile would be empty).
+[[nodiscard]] ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth,
+                                                    int32_t previewHeight, int32_t maxColumns,
+                                                    int32_t maxWidth);
 
 }  // namespace deformkit::harness

@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <numbers>
 #include <sstream>
@@ -12,7 +14,9 @@
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
 #include "deformkit/host/stack.h"
+#include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/io/preview.h"
 #include "eval_command.h"
 #include "test_support.h"
 
@@ -59,6 +63,7 @@ TEST_CASE("eval command: file names pad the frame to 4 digits after the sign", "
     CHECK(harness::evalFileName("tube", 7) == "tube.0007.obj");
     CHECK(harness::evalFileName("tube", 12345) == "tube.12345.obj");
     CHECK(harness::evalFileName("tube", -3) == "tube.-0003.obj");
+    CHECK(harness::evalFileName("tube", -3, ".png") == "tube.-0003.png");
 }
 
 TEST_CASE("eval command: writes every object at every frame, equal to the stack evaluated directly",
@@ -71,6 +76,7 @@ TEST_CASE("eval command: writes every object at every frame, equal to the stack 
     harness::EvalCommand command;
     command.scene = dir / "shot.json";
     command.outDir = dir / "out" / "frames";  // created when missing
+    command.previews = false;                 // previews are checked below
     std::ostringstream progress;
     const harness::EvalReport report = harness::evalCommand(command, &progress);
     CHECK(report.frames == std::vector<int>{1, 2, 3});
@@ -140,4 +146,254 @@ TEST_CASE("eval command: a bad scene names the file and JSON path and writes not
                    Contains((dir / "shot.json").string() + ": objects[0].stack[1].params.curvatur"));
     }
     CHECK_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+namespace {
+
+// 8-bit values of an image read from an 8-bit PNG (readImage gives n / 255; rounding recovers n exactly).
+std::vector<int> bytesOf(const io::Image& image) {
+    std::vector<int> out(image.pixels.size());
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = static_cast<int>(std::lround(image.pixels[i] * 255.0f));
+    return out;
+}
+
+// Region [x0, x0 + w) x [y0, y0 + h) of an 8-bit RGB buffer `width` pixels wide.
+std::vector<int> crop(const std::vector<int>& bytes, int width, int x0, int y0, int w, int h) {
+    std::vector<int> out;
+    for (int y = y0; y < y0 + h; ++y)
+        for (int x = x0; x < x0 + w; ++x)
+            for (int c = 0; c < 3; ++c)
+                out.push_back(bytes[(static_cast<size_t>(y) * width + x) * 3 + c]);
+    return out;
+}
+
+// Reference downscale: mean of each k x k block, rounded half up, computed in double then floored.
+std::vector<int> boxDown(const std::vector<int>& bytes, int width, int height, int k) {
+    std::vector<int> out;
+    for (int y = 0; y < height / k; ++y)
+        for (int x = 0; x < width / k; ++x)
+            for (int c = 0; c < 3; ++c) {
+                double sum = 0.0;
+                for (int j = 0; j < k; ++j)
+                    for (int i = 0; i < k; ++i)
+                        sum += bytes[(static_cast<size_t>(y * k + j) * width + (x * k + i)) * 3 + c];
+                out.push_back(static_cast<int>(std::floor(sum / (k * k) + 0.5)));
+            }
+    return out;
+}
+
+size_t countFiles(const std::filesystem::path& dir) {
+    return static_cast<size_t>(std::distance(std::filesystem::directory_iterator(dir), {}));
+}
+
+bool onPath(const std::string& program) {
+    return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;
+}
+
+// Sets PATH for the scope of a test.
+struct ScopedPath {
+    std::string saved;
+    explicit ScopedPath(const std::string& value) : saved(std::getenv("PATH") ? std::getenv("PATH") : "") {
+        ::setenv("PATH", value.c_str(), 1);
+    }
+    ~ScopedPath() { ::setenv("PATH", saved.c_str(), 1); }
+};
+
+}  // namespace
+
+TEST_CASE("eval command: previews of the rest pose equal the renderer's view of the rest mesh",
+          "[harness][eval][preview]") {
+    test::TempDir dir;
+    const geom::Mesh tube = makeTube();
+    io::writeObj(dir / "tube.obj", tube);
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.outDir = dir / "out";
+    const harness::EvalReport report = harness::evalCommand(command);
+
+    // 3 frames x 2 objects, an OBJ and a PNG each, and one contact sheet per object; no temporaries.
+    CHECK(report.files.size() == 14);
+    CHECK(countFiles(command.outDir) == 14);
+    CHECK(report.notes.empty());
+    for (const char* name : {"tube", "still"}) {
+        for (int frame = 1; frame <= 3; ++frame) {
+            const io::ImageInfo info =
+                io::readImageInfo(command.outDir / harness::evalFileName(name, frame, ".png"));
+            CHECK(info.width == 480);
+            CHECK(info.height == 360);
+            CHECK(info.channels == 3);
+        }
+    }
+
+    // Reference: the renderer's default view of the rest mesh at the same size, written and read back the
+    // same way. Exact: the same camera, triangles and shading must give the same 8-bit pixels.
+    io::PreviewOptions view;
+    view.width = 480;
+    view.height = 360;
+    io::writeImage(dir / "rest.png", io::renderPreview(tube, view));
+    const std::vector<int> rest = bytesOf(io::readImage(dir / "rest.png"));
+    // The object without deformers, at every frame.
+    for (int frame = 1; frame <= 3; ++frame)
+        CHECK(bytesOf(io::readImage(command.outDir / harness::evalFileName("still", frame, ".png"))) == rest);
+    // Frame 1 of the deformed object: twist angle 0 and bend envelope 0 leave the rest positions exactly.
+    const io::ObjContent first = io::readObj(command.outDir / "tube.0001.obj");
+    REQUIRE(std::equal(first.mesh.points().begin(), first.mesh.points().end(), tube.points().begin()));
+    CHECK(bytesOf(io::readImage(command.outDir / "tube.0001.png")) == rest);
+    // Frame 3 is deformed: its preview differs from the rest view in many pixels (> 1% of the values).
+    const std::vector<int> last = bytesOf(io::readImage(command.outDir / "tube.0003.png"));
+    REQUIRE(last.size() == rest.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < rest.size(); ++i)
+        differing += last[i] != rest[i];
+    CHECK(differing > rest.size() / 100);
+
+    // Contact sheet: 3 tiles -> 3 columns, 1 row, factor max(1, ceil(3 * 480 / 2048)) = 1: the previews
+    // side by side, exactly.
+    const io::Image sheet = io::readImage(command.outDir / "tube.contact.png");
+    REQUIRE(sheet.width == 1440);
+    REQUIRE(sheet.height == 360);
+    const std::vector<int> sheetBytes = bytesOf(sheet);
+    CHECK(crop(sheetBytes, 1440, 0, 0, 480, 360) == rest);
+    CHECK(crop(sheetBytes, 1440, 960, 0, 480, 360) == last);
+}
+
+TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a whole factor",
+          "[harness][eval][preview]") {
+    test::TempDir dir;
+    io::writeObj(dir / "tube.obj", makeTube());
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.outDir = dir / "out";
+    command.frames = {-1, 0, 1, 2, 3, 5, 8};  // negative frames and gaps
+    command.previewWidth = 481;  // odd sizes: the last column and row of each preview are dropped
+    command.previewHeight = 361;
+    command.contactMaxWidth = 1000;
+    const harness::EvalReport report = harness::evalCommand(command);
+    CHECK(report.files.size() == 7 * 2 * 2 + 2);
+
+    // The grid, written out: 7 tiles, at most 6 columns -> 6 x 2; factor ceil(6 * 481 / 1000) = 3;
+    // tile floor(481 / 3) x floor(361 / 3) = 160 x 120; sheet 960 x 240 (<= 1000 wide).
+    const int columns = std::min(7, 6), rows = (7 + columns - 1) / columns;
+    const int factor = std::max(1, (columns * 481 + 1000 - 1) / 1000);
+    const int tileW = 481 / factor, tileH = 361 / factor;
+    CHECK(columns == 6);
+    CHECK(rows == 2);
+    CHECK(factor == 3);
+    const harness::ContactSheetLayout layout = harness::contactSheetLayout(7, 481, 361, 6, 1000);
+    CHECK(layout.columns == columns);
+    CHECK(layout.rows == rows);
+    CHECK(layout.factor == factor);
+    CHECK(layout.tileWidth == tileW);
+    CHECK(layout.tileHeight == tileH);
+
+    const io::Image sheet = io::readImage(command.outDir / "tube.contact.png");
+    REQUIRE(sheet.width == columns * tileW);
+    REQUIRE(sheet.height == rows * tileH);
+    const std::vector<int> sheetBytes = bytesOf(sheet);
+    // Every tile equals the reference box filter of its preview file, exactly (integer arithmetic on
+    // 8-bit values both ways).
+    for (size_t t = 0; t < command.frames.size(); ++t) {
+        const std::vector<int> preview =
+            bytesOf(io::readImage(command.outDir / harness::evalFileName("tube", command.frames[t], ".png")));
+        const int x0 = static_cast<int>(t % columns) * tileW, y0 = static_cast<int>(t / columns) * tileH;
+        CHECK(crop(sheetBytes, sheet.width, x0, y0, tileW, tileH) == boxDown(preview, 481, 361, factor));
+    }
+    // The 5 empty cells hold the background colour, the preview default's 8-bit value.
+    const glm::vec3 bg = io::PreviewOptions{}.background;
+    const std::vector<int> empty = crop(sheetBytes, sheet.width, tileW, tileH, 5 * tileW, tileH);
+    for (size_t i = 0; i < empty.size(); ++i) {
+        const int expected = static_cast<int>(std::lround(bg[static_cast<int>(i % 3)] * 255.0f));
+        if (empty[i] != expected) {
+            FAIL("empty cell value " << empty[i] << " at " << i << ", expected " << expected);
+        }
+    }
+}
+
+TEST_CASE("eval command: bad preview sizes are rejected before anything is written",
+          "[harness][eval][errors]") {
+    test::TempDir dir;
+    io::writeObj(dir / "tube.obj", makeTube());
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.outDir = dir / "out";
+    command.previewWidth = 0;
+    CHECK_THROWS_WITH(harness::evalCommand(command), Contains("preview width") && Contains("is 0"));
+    command.previewWidth = 480;
+    command.contactMaxWidth = 2;  // 3 columns cannot fit in 2 pixels
+    CHECK_THROWS_AS(harness::evalCommand(command), InvalidInput);
+    CHECK_FALSE(std::filesystem::exists(command.outDir));
+    command.previews = false;  // sizes do not matter without previews
+    CHECK(harness::evalCommand(command).files.size() == 6);
+}
+
+TEST_CASE("eval command: movies through ffmpeg, a note without it, an error naming a failing ffmpeg",
+          "[harness][eval][movie]") {
+    test::TempDir dir;
+    io::writeObj(dir / "tube.obj", makeTube());
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.frames = {1, 2, 3, 5, 8};
+    command.movie = true;
+
+    std::filesystem::create_directories(dir / "bin");
+    {
+        // No ffmpeg on PATH: not an error, a note, no movie.
+        ScopedPath path((dir / "bin").string());
+        command.outDir = dir / "none";
+        const harness::EvalReport report = harness::evalCommand(command);
+        REQUIRE(report.notes.size() == 1);
+        CHECK_THAT(report.notes[0], Contains("ffmpeg"));
+        CHECK_FALSE(std::filesystem::exists(command.outDir / "tube.mp4"));
+        CHECK(countFiles(command.outDir) == 5 * 2 * 2 + 2);
+    }
+    {
+        // An ffmpeg that fails: IoError naming the command and its status; no movie, no scratch files.
+        test::writeText(dir / "bin" / "ffmpeg", "#!/bin/sh\nexit 3\n");
+        std::filesystem::permissions(dir / "bin" / "ffmpeg", std::filesystem::perms::owner_all);
+        ScopedPath path((dir / "bin").string());
+        command.outDir = dir / "failing";
+        try {
+            (void)harness::evalCommand(command);
+            FAIL("no error");
+        } catch (const IoError& e) {
+            CHECK_THAT(e.what(),
+                       Contains((dir / "bin" / "ffmpeg").string()) && Contains("exited with status 3"));
+        }
+        CHECK_FALSE(std::filesystem::exists(command.outDir / "tube.mp4"));
+        CHECK(countFiles(command.outDir) == 5 * 2 * 2 + 2);
+    }
+    if (!onPath("ffmpeg")) {
+        WARN("ffmpeg not on PATH: movie encoding not tested");
+        return;
+    }
+    command.outDir = dir / "movie";
+    const harness::EvalReport report = harness::evalCommand(command);
+    CHECK(report.notes.empty());
+    CHECK(countFiles(command.outDir) == 5 * 2 * 2 + 2 + 2);  // no scratch folder or temporary left
+    for (const char* name : {"tube", "still"}) {
+        const std::filesystem::path movie = command.outDir / (std::string(name) + ".mp4");
+        REQUIRE(std::filesystem::is_regular_file(movie));
+        CHECK(std::filesystem::file_size(movie) > 0);
+        if (!onPath("ffprobe")) {
+            WARN("ffprobe not on PATH: movie frame count not checked");
+            continue;
+        }
+        // Decoded frame count and size: exactly one frame per evaluated frame, at the preview size.
+        const std::string probe =
+            "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+            "stream=nb_read_frames,width,height -of csv=p=0 '" +
+            movie.string() + "'";
+        FILE* pipe = ::popen(probe.c_str(), "r");
+        REQUIRE(pipe != nullptr);
+        char line[256] = {};
+        const bool read = std::fgets(line, sizeof(line), pipe) != nullptr;
+        ::pclose(pipe);
+        REQUIRE(read);
+        CHECK(std::string(line).substr(0, std::string(line).find_last_not_of("\r\n") + 1) == "480,360,5");
+    }
 }
