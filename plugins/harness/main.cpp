@@ -11,6 +11,7 @@
 #include "deformkit/error.h"
 #include "deformkit/version.h"
 #include "eval_command.h"
+#include "farm_command.h"
 #include "slide_command.h"
 #include "uvwarp_command.h"
 #include "warp_command.h"
@@ -68,8 +69,53 @@ int main(int argc, char** argv) {
     evalApp->add_option("SCENE", evalScene, "scene (.json, docs/scene.md)")->required();
     evalApp->add_option("--frames", evalFrames,
                         "frames: 1-24, or a list such as 1-10,15; default: the scene's");
-    evalApp->add_option("--out", evalOut, "output folder: <object>.<frame 4 digits>.obj")
+    evalApp
+        ->add_option("--out", evalOut,
+                     "output folder: <object>.<frame>.obj and .png, <object>.contact.png, <object>.mp4")
         ->capture_default_str();
+    bool evalNoPreviews = false;
+    evalApp->add_flag("--no-previews", evalNoPreviews,
+                      "write only the OBJs (no PNG previews, contact sheets or movies)");
+    evalApp->add_option("--preview-width", evalCommand.previewWidth, "preview width in pixels")
+        ->capture_default_str();
+    evalApp->add_option("--preview-height", evalCommand.previewHeight, "preview height in pixels")
+        ->capture_default_str();
+    evalApp->add_flag("--movie", evalCommand.movie,
+                      "also encode <object>.mp4 from the previews when ffmpeg is on PATH");
+    evalApp->add_option("--fps", evalCommand.movieFrameRate, "movie frame rate")->capture_default_str();
+
+    harness::FarmPlanCommand farmPlanCommand;
+    harness::FarmRunCommand farmRunCommand;
+    harness::FarmSubmitCommand farmSubmitCommand;
+    bool farmSlurm = false;
+    std::string farmScene, farmFrames, farmOut, farmPlanFile, farmRunPlan, farmSubmitPlan, farmSbatchArgs;
+    auto* farmApp = app.add_subcommand(
+        "farm",
+        "Cut a scene's evaluation into render-farm tasks, run one task, or submit them (docs/farm.md)");
+    farmApp->require_subcommand(1);
+    auto* farmPlanApp = farmApp->add_subcommand(
+        "plan", "Write a plan: tasks of at most --chunk frames with their output files");
+    farmPlanApp->add_option("SCENE", farmScene, "scene (.json, docs/scene.md)")->required();
+    farmPlanApp->add_option("--frames", farmFrames,
+                            "frames: 1-240, or a list such as 1-10,15; default: the scene's");
+    farmPlanApp->add_option("--chunk", farmPlanCommand.chunk, "frames per task at most")
+        ->capture_default_str();
+    farmPlanApp->add_option("--out", farmOut, "output folder of the tasks: <object>.<frame 4 digits>.obj")
+        ->required();
+    farmPlanApp->add_option("--plan", farmPlanFile, "plan file to write; default: <out>/farm_plan.json");
+    auto* farmRunApp = farmApp->add_subcommand(
+        "run",
+        "Run one task of a plan, skipping frames already written; JSON lines on stdout. Exit 0 done, "
+        "2 bad input, 1 worth a retry");
+    farmRunApp->add_option("PLAN", farmRunPlan, "plan (.json) from deformkit farm plan")->required();
+    farmRunApp->add_option("--task", farmRunCommand.task, "task index, from 0")->required();
+    auto* farmSubmitApp = farmApp->add_subcommand(
+        "submit", "Submit a plan as a job array, one element per task; prints the job id");
+    farmSubmitApp->add_flag("--slurm", farmSlurm, "submit with Slurm's sbatch (the one scheduler supported)")
+        ->required();
+    farmSubmitApp->add_option("PLAN", farmSubmitPlan, "plan (.json) from deformkit farm plan")->required();
+    farmSubmitApp->add_option("--sbatch-args", farmSbatchArgs,
+                              "extra sbatch options, e.g. \"--partition=batch --time=1:00:00\"");
 
     harness::WarpImageCommand warpCommand;
     std::string warpImage, warpLines, warpOut, warpVariant = "original", warpInterp = "bilinear";
@@ -250,8 +296,34 @@ int main(int argc, char** argv) {
             evalCommand.scene = evalScene;
             evalCommand.outDir = evalOut;
             if (!evalFrames.empty()) evalCommand.frames = harness::parseFrames(evalFrames);
+            evalCommand.previews = !evalNoPreviews;
             const harness::EvalReport report = harness::evalCommand(evalCommand, &std::cout);
             std::cout << "eval: wrote " << report.files.size() << " files to " << evalOut << "/\n";
+            for (const std::string& note : report.notes)
+                std::cout << "eval: " << note << "\n";
+        } else if (*farmPlanApp) {
+            farmPlanCommand.scene = farmScene;
+            farmPlanCommand.outDir = farmOut;
+            farmPlanCommand.plan = farmPlanFile;
+            if (!farmFrames.empty()) farmPlanCommand.frames = harness::parseFrames(farmFrames);
+            const harness::FarmPlan plan = harness::farmPlanCommand(farmPlanCommand);
+            std::cout << "farm: wrote " << harness::farmPlanPath(farmPlanCommand).string() << ": "
+                      << plan.tasks.size() << (plan.tasks.size() == 1 ? " task" : " tasks") << "\n";
+        } else if (*farmRunApp || *farmSubmitApp) {
+            // Exit codes a farm manager acts on: 2 bad input (no retry), 1 anything else (worth a retry).
+            try {
+                if (*farmRunApp) {
+                    farmRunCommand.plan = farmRunPlan;
+                    (void)harness::farmRunCommand(farmRunCommand, &std::cout);
+                } else {
+                    farmSubmitCommand.plan = farmSubmitPlan;
+                    farmSubmitCommand.sbatchArgs = harness::splitArguments(farmSbatchArgs, "--sbatch-args");
+                    std::cout << harness::farmSubmitCommand(farmSubmitCommand) << "\n";
+                }
+            } catch (const std::exception& e) {
+                std::cerr << "deformkit: error: " << e.what() << "\n";
+                return harness::farmExitCode(e);
+            }
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);

@@ -1,0 +1,377 @@
+#include <catch2/catch.hpp>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/io/obj.h"
+#include "eval_command.h"
+#include "farm_command.h"
+#include "test_support.h"
+
+using namespace deformkit;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A tube around the Y axis from y = -1 to 1 with UVs, quads.
+geom::Mesh makeTube(int rings = 6, int sides = 10) {
+    geom::Mesh::Data d;
+    for (int r = 0; r < rings; ++r) {
+        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
+        for (int s = 0; s < sides; ++s) {
+            const double a = 2.0 * std::numbers::pi * s / sides;
+            d.points.emplace_back(0.5f * static_cast<float>(std::cos(a)), y,
+                                  0.5f * static_cast<float>(std::sin(a)));
+            d.uvs.emplace_back(static_cast<float>(s) / sides, static_cast<float>(r) / (rings - 1));
+        }
+    }
+    for (int r = 0; r + 1 < rings; ++r) {
+        for (int s = 0; s < sides; ++s) {
+            const int s1 = (s + 1) % sides;
+            d.faceCounts.push_back(4);
+            d.faceIndices.insert(d.faceIndices.end(),
+                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
+        }
+    }
+    d.uvIndices = d.faceIndices;
+    return geom::Mesh(std::move(d), "tube");
+}
+
+// Two objects over 7 frames, both animated, so every frame's output differs.
+const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 7], "objects": [
+  {"name": "tube", "mesh": "tube.obj", "stack": [
+    {"type": "twist", "params": {"handleY": [0, 1, 0],
+       "endAngle": {"keys": [{"frame": 1, "value": 0, "interpolation": "linear"}, {"frame": 7, "value": 1.5}]}}}]},
+  {"name": "bent", "mesh": "tube.obj", "stack": [
+    {"type": "bend", "params": {"curvature": {"keys": [{"frame": 1, "value": 0.1}, {"frame": 7, "value": 0.9}]}}}]}]})";
+
+struct Shot {
+    test::TempDir dir;
+    fs::path scene;
+    Shot() {
+        io::writeObj(dir / "tube.obj", makeTube());
+        scene = dir / "shot.json";
+        test::writeText(scene, kScene);
+    }
+};
+
+// The names a task of frames first..last must list: frame by frame, objects in scene order.
+std::vector<std::string> namesOf(int first, int last) {
+    std::vector<std::string> names;
+    char buffer[64];
+    for (int f = first; f <= last; ++f) {
+        for (const char* object : {"tube", "bent"}) {
+            std::snprintf(buffer, sizeof(buffer), "%s.%04d.obj", object, f);
+            names.emplace_back(buffer);
+        }
+    }
+    return names;
+}
+
+std::vector<fs::path> filesIn(const fs::path& dir) {
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(dir))
+        files.push_back(entry.path().filename());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+template <class E>
+std::string errorOf(const std::function<void()>& body) {
+    try {
+        body();
+    } catch (const E& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("farm plan: 7 frames in chunks of 3 make tasks 1-3, 4-6, 7-7 with every object's outputs",
+          "[harness][farm]") {
+    Shot shot;
+    harness::FarmPlanCommand command;
+    command.scene = shot.scene;
+    command.chunk = 3;
+    command.outDir = shot.dir / "out";  // created
+    const harness::FarmPlan plan = harness::farmPlanCommand(command);
+
+    REQUIRE(plan.tasks.size() == 3);
+    const int ranges[3][2] = {{1, 3}, {4, 6}, {7, 7}};
+    for (size_t k = 0; k < 3; ++k) {
+        CHECK(plan.tasks[k].firstFrame == ranges[k][0]);
+        CHECK(plan.tasks[k].lastFrame == ranges[k][1]);
+        CHECK(plan.tasks[k].outputs == namesOf(ranges[k][0], ranges[k][1]));
+        CHECK(plan.tasks[k].tiles.empty());
+    }
+    CHECK(plan.tasks[2].outputs == std::vector<std::string>{"tube.0007.obj", "bent.0007.obj"});
+    CHECK(plan.scene.is_absolute());
+    CHECK(plan.scene == fs::absolute(shot.scene).lexically_normal());
+    CHECK(plan.outDir == fs::absolute(shot.dir / "out").lexically_normal());
+
+    // The file, read back as JSON by a second parser, holds the same plan.
+    const fs::path file = shot.dir / "out" / "farm_plan.json";
+    REQUIRE(fs::is_regular_file(file));
+    const nlohmann::json j = nlohmann::json::parse(test::readText(file));
+    CHECK(j["deformkit_farm_plan"] == 1);
+    CHECK(j["scene"] == plan.scene.string());
+    CHECK(j["out"] == plan.outDir.string());
+    CHECK(j["chunk"] == 3);
+    REQUIRE(j["tasks"].size() == 3);
+    CHECK(j["tasks"][1]["frames"] == nlohmann::json::array({4, 6}));
+    CHECK(j["tasks"][1]["tiles"] == nlohmann::json::array());
+    CHECK(j["tasks"][1]["outputs"].get<std::vector<std::string>>() == namesOf(4, 6));
+    CHECK(filesIn(shot.dir / "out") == std::vector<fs::path>{"farm_plan.json"});  // atomic: no temporary
+
+    // --plan elsewhere; a frame list never makes a task across its gap.
+    command.plan = shot.dir / "plans" / "p.json";
+    command.frames = {1, 2, 3, 4, 7};
+    const harness::FarmPlan gaps = harness::farmPlanCommand(command);
+    REQUIRE(gaps.tasks.size() == 3);
+    CHECK(gaps.tasks[1].firstFrame == 4);
+    CHECK(gaps.tasks[1].lastFrame == 4);
+    CHECK(gaps.tasks[2].firstFrame == 7);
+    CHECK(fs::is_regular_file(shot.dir / "plans" / "p.json"));
+    const harness::FarmPlan reread = harness::readFarmPlan(shot.dir / "plans" / "p.json");
+    CHECK(reread.tasks.size() == 3);
+    CHECK(reread.tasks[0].outputs == namesOf(1, 3));
+
+    command.chunk = 0;
+    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(command); }),
+               Contains("--chunk: is 0"));
+}
+
+TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun skips every frame",
+          "[harness][farm]") {
+    Shot shot;
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.chunk = 3;
+    planCommand.outDir = shot.dir / "farm";
+    (void)harness::farmPlanCommand(planCommand);
+    const fs::path planFile = harness::farmPlanPath(planCommand);
+
+    harness::EvalCommand evalCommand;
+    evalCommand.scene = shot.scene;
+    evalCommand.outDir = shot.dir / "eval";
+    (void)harness::evalCommand(evalCommand);
+
+    std::vector<std::string> lines;
+    for (int k = 0; k < 3; ++k) {
+        std::ostringstream log;
+        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        CHECK(report.skipped.empty());
+        CHECK(report.files.size() == 2 * report.written.size());
+        std::istringstream in(log.str());
+        for (std::string line; std::getline(in, line);)
+            lines.push_back(line);
+    }
+    // One JSON line per frame, in frame order, each naming its task.
+    REQUIRE(lines.size() == 7);
+    for (int f = 1; f <= 7; ++f) {
+        const nlohmann::json line = nlohmann::json::parse(lines[f - 1]);
+        CHECK(line["frame"] == f);
+        CHECK(line["task"] == (f - 1) / 3);
+        CHECK(line["status"] == "written");
+        CHECK(line["seconds"].get<double>() >= 0.0);
+    }
+    // Byte for byte what eval writes (the reference: one uninterrupted eval over all frames), and nothing
+    // else in the folder but the plan.
+    std::vector<fs::path> expectedFiles{"farm_plan.json"};
+    for (const std::string& name : namesOf(1, 7)) {
+        expectedFiles.emplace_back(name);
+        const std::string farm = test::readText(shot.dir / "farm" / name);
+        CHECK(!farm.empty());
+        CHECK(farm == test::readText(shot.dir / "eval" / name));
+    }
+    std::sort(expectedFiles.begin(), expectedFiles.end());
+    CHECK(filesIn(shot.dir / "farm") == expectedFiles);
+    // The frames differ from each other (the scene is animated), so equality above is not vacuous.
+    CHECK(test::readText(shot.dir / "farm" / "tube.0002.obj") !=
+          test::readText(shot.dir / "farm" / "tube.0003.obj"));
+
+    // Rerun: every frame skipped, no file touched. Modification times are set back an hour first so that a
+    // rewrite within the file system's timestamp granularity would still show.
+    const auto past = fs::file_time_type::clock::now() - std::chrono::hours(1);
+    for (const std::string& name : namesOf(1, 7))
+        fs::last_write_time(shot.dir / "farm" / name, past);
+    for (int k = 0; k < 3; ++k) {
+        std::ostringstream log;
+        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        CHECK(report.written.empty());
+        CHECK(report.files.empty());
+        CHECK(report.skipped.size() == (k < 2 ? 3u : 1u));
+        CHECK_THAT(log.str(), Contains("\"status\":\"skipped\""));
+    }
+    for (const std::string& name : namesOf(1, 7))
+        CHECK(fs::last_write_time(shot.dir / "farm" / name) == past);
+
+    // One output gone: its frame is written again (that object only), with the same bytes.
+    fs::remove(shot.dir / "farm" / "bent.0005.obj");
+    const harness::FarmRunReport again = harness::farmRunCommand({planFile, 1});
+    CHECK(again.written == std::vector<int>{5});
+    CHECK(again.skipped == std::vector<int>{4, 6});
+    REQUIRE(again.files.size() == 1);
+    CHECK(again.files[0].filename() == "bent.0005.obj");
+    CHECK(test::readText(shot.dir / "farm" / "bent.0005.obj") ==
+          test::readText(shot.dir / "eval" / "bent.0005.obj"));
+    CHECK(fs::last_write_time(shot.dir / "farm" / "tube.0005.obj") == past);
+}
+
+TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file and the JSON path or index",
+          "[harness][farm][errors]") {
+    Shot shot;
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.chunk = 3;
+    planCommand.outDir = shot.dir / "farm";
+    (void)harness::farmPlanCommand(planCommand);
+    const fs::path planFile = harness::farmPlanPath(planCommand);
+    const std::string good = test::readText(planFile);
+
+    SECTION("task index out of range") {
+        for (int task : {3, -1}) {
+            const std::string what = errorOf<InvalidInput>([&] {
+                (void)harness::farmRunCommand({planFile, task});
+            });
+            CHECK_THAT(what, Contains(planFile.string() + ": --task: is " + std::to_string(task) +
+                                      ", the plan has 3 tasks (expected a task index from 0 to 2)"));
+        }
+        CHECK(harness::farmExitCode(InvalidInput("x")) == 2);
+    }
+    SECTION("text that is not JSON") {
+        test::writeText(planFile, good.substr(0, good.size() / 2));
+        const std::string what = errorOf<ParseError>([&] { (void)harness::farmRunCommand({planFile, 0}); });
+        CHECK_THAT(what, Contains(planFile.string() + ": ") && Contains("farm plan"));
+        CHECK(harness::farmExitCode(ParseError("x")) == 2);
+    }
+    SECTION("bad values name their JSON path") {
+        struct Case {
+            const char* from;
+            const char* to;
+            const char* message;
+        };
+        const Case cases[] = {
+            {"\"frames\":[4,6]", "\"frames\":[4,9]", ": tasks[1].frames: is [4,9], 6 frames"},
+            {"\"frames\":[7,7]", "\"frames\":[7]", ": tasks[2].frames: is [7] (expected [first, last])"},
+            {"\"tiles\":[]", "\"tiles\":[1001]", ": tasks[0].tiles: is [1001]"},
+            {"\"deformkit_farm_plan\": 1", "\"deformkit_farm_plan\": 2", ": deformkit_farm_plan: is 2"},
+            {"\"chunk\": 3", "\"chunk\": 3, \"chunks\": 3", ": chunks: is not a plan key"},
+            {"\"tube.0004.obj\"", "\"../tube.0004.obj\"", ": tasks[1].outputs[0]: is \"../tube.0004.obj\""},
+            {"\"tube.0004.obj\"", "\"tube.4.obj\"",
+             ": tasks[1].outputs[0]: is \"tube.4.obj\", the scene makes "
+             "\"tube.0004.obj\""},
+        };
+        for (const Case& c : cases) {
+            std::string text = good;
+            const size_t at = text.find(c.from);
+            REQUIRE(at != std::string::npos);
+            text.replace(at, std::strlen(c.from), c.to);
+            test::writeText(planFile, text);
+            CAPTURE(c.to);
+            const std::string what = errorOf<InvalidInput>([&] {
+                (void)harness::farmRunCommand({planFile, 1});
+            });
+            CHECK_THAT(what, Contains(planFile.string() + c.message));
+        }
+    }
+    SECTION("a missing plan is bad input; an unwritable output folder is worth a retry") {
+        const fs::path missing = shot.dir / "nope.json";
+        CHECK_THAT(errorOf<InvalidInput>([&] {
+                       (void)harness::farmRunCommand({missing, 0});
+                   }),
+                   Contains(missing.string() + ": does not exist"));
+        CHECK(harness::farmExitCode(IoError("x")) == 1);
+        CHECK(harness::farmExitCode(std::runtime_error("x")) == 1);
+        if (!test::runningAsRoot()) {
+            fs::permissions(shot.dir / "farm", fs::perms::owner_read | fs::perms::owner_exec);
+            CHECK_THAT(errorOf<IoError>([&] {
+                           (void)harness::farmRunCommand({planFile, 0});
+                       }),
+                       Contains("not writable"));
+        }
+    }
+    // Nothing was written by a failing run.
+    CHECK(filesIn(shot.dir / "farm") == std::vector<fs::path>{"farm_plan.json"});
+}
+
+TEST_CASE("farm submit: one sbatch job array element per task running farm run --task",
+          "[harness][farm][slurm]") {
+    Shot shot;
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.chunk = 2;  // 7 frames: 4 tasks
+    planCommand.outDir = shot.dir / "farm";
+    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    const fs::path planFile = harness::farmPlanPath(planCommand);
+    const fs::path planAbs = fs::absolute(planFile).lexically_normal();
+
+    const std::vector<std::string> args =
+        harness::farmSbatchArguments(plan, planFile, "/opt/dk/bin/deformkit", {"--partition=batch"});
+    const std::vector<std::string> expected = {
+        "--parsable",
+        "--array=0-3",
+        "--job-name=deformkit-farm-shot",
+        "--output=" + (planAbs.parent_path() / "farm_plan.%A_%a.log").string(),
+        "--partition=batch",
+        "--wrap=exec '/opt/dk/bin/deformkit' farm run '" + planAbs.string() +
+            "' --task \"$SLURM_ARRAY_TASK_ID\""};
+    CHECK(args == expected);
+
+    // A stand-in sbatch that records its arguments and answers like `sbatch --parsable`.
+    const fs::path fake = shot.dir / "sbatch";
+    test::writeText(
+        fake, "#!/bin/sh\nfor a in \"$@\"; do printf '%s\\n' \"$a\"; done >\"$0.args\"\necho '4242;c1'\n");
+    fs::permissions(fake, fs::perms::owner_all);
+    harness::FarmSubmitCommand submit;
+    submit.plan = planFile;
+    submit.sbatch = fake.string();
+    submit.deformkit = "/opt/dk/bin/deformkit";
+    submit.sbatchArgs = harness::splitArguments("--partition=batch", "--sbatch-args");
+    CHECK(harness::farmSubmitCommand(submit) == "4242");
+    std::string recorded;
+    for (const std::string& a : expected)
+        recorded += a + "\n";
+    CHECK(test::readText(shot.dir / "sbatch.args") == recorded);
+
+    // sbatch refusing the job: its message, exit code 1.
+    test::writeText(fake, "#!/bin/sh\necho 'sbatch: error: invalid partition specified: nope' >&2\nexit 1\n");
+    try {
+        (void)harness::farmSubmitCommand(submit);
+        FAIL("no error");
+    } catch (const Error& e) {
+        CHECK_THAT(e.what(),
+                   Contains("exited with status 1: sbatch: error: invalid partition specified: nope"));
+        CHECK(harness::farmExitCode(e) == 1);
+    }
+
+    // No sbatch on PATH: InvalidInput (exit 2) saying so.
+    submit.sbatch = "deformkit-test-no-such-sbatch";
+    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmSubmitCommand(submit); }),
+               Contains("deformkit-test-no-such-sbatch: not found on PATH"));
+}
+
+TEST_CASE("farm submit: --sbatch-args splits like a shell", "[harness][farm]") {
+    CHECK(harness::splitArguments("  --partition=batch   --comment='two words' \"a\\\"b\" c\\ d ",
+                                  "--sbatch-args") ==
+          std::vector<std::string>{"--partition=batch", "--comment=two words", "a\"b", "c d"});
+    CHECK(harness::splitArguments("", "--sbatch-args").empty());
+    CHECK_THAT(errorOf<InvalidInput>([] { (void)harness::splitArguments("--comment='x", "--sbatch-args"); }),
+               Contains("--sbatch-args: has an unterminated ' quote"));
+}
