@@ -31,14 +31,14 @@ cat >"$work/shot.json" <<EOF
 EOF
 
 "$dk" eval "$work/shot.json" --out "$work/eval" >"$work/eval.log" 2>&1 || fail "deformkit eval failed: $(tail -n 3 "$work/eval.log")"
-"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk "$frames" --out "$work/farm" \
+"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk "$frames" --out "$work/tasks" \
     --plan "$work/plan.json" >"$work/plan.log" 2>&1 || fail "farm plan failed: $(cat "$work/plan.log")"
 
 # Run the one task in the background; kill it as soon as its first output appears.
 "$dk" farm run "$work/plan.json" --task 0 >"$work/run1.log" 2>&1 &
 pid=$!
 deadline=$((SECONDS + 60))
-until [ -e "$work/farm/grid.0001.obj" ]; do
+until [ -e "$work/tasks/grid.0001.obj" ]; do
     kill -0 "$pid" 2>/dev/null || break
     [ "$SECONDS" -lt "$deadline" ] || { kill -KILL "$pid"; fail "no output after 60 s"; }
     sleep 0.01
@@ -52,14 +52,14 @@ rc=$?
 # Visible files are complete outputs only: each equals the uninterrupted run's file. Temporaries of the
 # killed run, if any, are hidden (.grid.tmp-*).
 done_before=0
-for f in "$work"/farm/*; do
+for f in "$work"/tasks/*; do
     [ -e "$f" ] || continue
     name=${f##*/}
     [[ $name =~ ^grid\.[0-9]{4}\.obj$ ]] || fail "unexpected visible file $name after the kill"
     cmp -s "$f" "$work/eval/$name" || fail "$name after the kill differs from eval's (a partial file?)"
     done_before=$((done_before + 1))
 done
-hidden=$(find "$work/farm" -name '.*' -type f | wc -l)
+hidden=$(find "$work/tasks" -name '.*' -type f | wc -l)
 if [ "$done_before" -lt 1 ] || [ "$done_before" -ge "$frames" ]; then
     fail "$done_before of $frames outputs when killed (expected some, not all)"
 fi
@@ -72,10 +72,10 @@ written=$(grep -c '"status":"written"' "$work/run2.log")
 [ $((skipped + written)) -eq "$frames" ] || fail "rerun logged $((skipped + written)) frames, expected $frames"
 for f in $(seq 1 "$frames"); do
     name=$(printf 'grid.%04d.obj' "$f")
-    [ -f "$work/farm/$name" ] || fail "$name missing after the rerun"
-    cmp -s "$work/farm/$name" "$work/eval/$name" || fail "$name differs from eval's"
+    [ -f "$work/tasks/$name" ] || fail "$name missing after the rerun"
+    cmp -s "$work/tasks/$name" "$work/eval/$name" || fail "$name differs from eval's"
 done
-n=$(find "$work/farm" -maxdepth 1 -type f -name 'grid.*.obj' | wc -l)
+n=$(find "$work/tasks" -maxdepth 1 -type f -name 'grid.*.obj' | wc -l)
 [ "$n" -eq "$frames" ] || fail "$n outputs, expected $frames"
 echo "farm_kill: PASS (killed after $done_before of $frames frames, $hidden hidden temporaries left;" \
     "rerun skipped $skipped, wrote $written; all $frames outputs equal eval's)"

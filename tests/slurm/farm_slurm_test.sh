@@ -67,7 +67,7 @@ cat >"$work/shot.json" <<EOF
 EOF
 
 "$dk" eval "$work/shot.json" --out "$work/eval" >/dev/null || fail "deformkit eval failed"
-"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk $chunk --out "$work/farm" \
+"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk $chunk --out "$work/tasks" \
     --plan "$work/plan.json" >/dev/null || fail "deformkit farm plan failed"
 jobid=$("$dk" farm submit --slurm "$work/plan.json") || fail "deformkit farm submit failed"
 [[ $jobid =~ ^[0-9]+$ ]] || fail "farm submit printed '$jobid', expected a job id"
@@ -89,10 +89,10 @@ completed=$(grep -c 'JobState=COMPLETED .*ExitCode=0:0' <<<"$records" || true)
 
 for f in $(seq 1 $frames); do
     name=$(printf 'grid.%04d.obj' "$f")
-    [ -f "$work/farm/$name" ] || fail "$name was not written by the job"
-    cmp -s "$work/farm/$name" "$work/eval/$name" || fail "$name differs from deformkit eval's"
+    [ -f "$work/tasks/$name" ] || fail "$name was not written by the job"
+    cmp -s "$work/tasks/$name" "$work/eval/$name" || fail "$name differs from deformkit eval's"
 done
-n=$(find "$work/farm" -type f | wc -l)
+n=$(find "$work/tasks" -type f | wc -l)
 [ "$n" -eq $frames ] || fail "$n files in the output folder, expected $frames"
 # Each task logged one JSON line per frame of its chunk.
 for k in $(seq 0 $((tasks - 1))); do
