@@ -19,6 +19,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
+#include "scene_uvwarp.h"
 
 namespace deformkit::harness {
 
@@ -282,6 +283,22 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         if (progress) {
             *progress << "eval: frame " << frame << " (" << (i + 1) << "/" << report.frames.size()
                       << "): " << numObjects << (numObjects == 1 ? " object" : " objects") << " written\n";
+        }
+    }
+    // The UV-warp stages, object by object and tile by tile (one tile's solver in memory at a time).
+    for (size_t o = 0; o < numObjects; ++o) {
+        const host::SceneObject& object = scene.objects[o];
+        if (!object.uvwarp || report.frames.empty()) continue;
+        SceneUvWarpRun run;
+        run.frames = report.frames;
+        run.tiles = object.uvwarp->tiles;
+        run.outDir = command.outDir;
+        const UvWarpReport warped = runSceneUvWarp(evaluator, o, run);
+        for (const UvWarpTileReport& tile : warped.tiles)
+            report.files.insert(report.files.end(), tile.files.begin(), tile.files.end());
+        for (const std::string& line : uvwarpSummary(warped)) {
+            if (progress) *progress << "eval: " << object.name << " uvwarp " << line << "\n";
+            report.uvwarpLines.push_back(object.name + " " + line);
         }
     }
     for (size_t o = 0; o < numObjects; ++o)

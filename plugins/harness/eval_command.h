@@ -10,12 +10,15 @@
 // `deformkit eval SCENE [--frames A-B] [--out DIR]`: evaluates a DeformKit scene (docs/scene.md) frame by
 // frame, as a DCC plays it back, and writes every object's deformed mesh per frame, with previews:
 //
-//   DIR/<object>.<frame>.obj    frame zero padded to 4 digits (-0001 for frame -1), rest UVs and groups kept
-//   DIR/<object>.<frame>.png    shaded preview (io::renderPreview), one camera per object: the default view
-//                               framing the object's rest bounding box, so previews of a shot do not jump
-//   DIR/<object>.contact.png    the object's previews tiled in frame order, each downscaled
-//   (contactSheetLayout) DIR/<object>.mp4            with `movie`, when ffmpeg is on PATH: the previews at
-//   `movieFrameRate`
+//   DIR/<object>.<frame>.obj   frame zero padded to 4 digits (-0001 for frame -1), rest UVs and groups kept
+//   DIR/<object>.<frame>.png   shaded preview (io::renderPreview), one camera per object: the default view
+//                              framing the object's rest bounding box, so previews of a shot do not jump
+//   DIR/<object>.contact.png   the object's previews tiled in frame order, each downscaled
+//                              (contactSheetLayout)
+//   DIR/<object>.mp4           with `movie`, when ffmpeg is on PATH: the previews at `movieFrameRate`
+//   DIR/<object>.redirect.<tile>.<frame>.exr, DIR/<object>.bake.<tile>.<frame>.<ext>
+//                              the UV-warp stage of an object that has one (scene_uvwarp.h), tile after
+//                              tile, each tile's frames solved in order, warm-started
 //
 // Every file is written atomically; DIR is created when missing. Frames are evaluated in ascending order
 // through one host::SceneEvaluator, so each deformer binds once and animated parameters only change its
@@ -41,11 +44,14 @@ struct EvalCommand {
 
 struct EvalReport {
     std::vector<int> frames;  // evaluated, ascending
-    // Written: per frame, per object in scene order, the OBJ then the preview; then per object its contact
-    // sheet, then per object its movie (previews, sheets and movies only when made).
+    // Written: per frame, per object in scene order, the OBJ then the preview; then per object with a UV
+    // warp its maps, tile by tile, frame by frame; then per object its contact sheet, then per object its
+    // movie (previews, sheets and movies only when made).
     std::vector<std::filesystem::path> files;
     std::vector<int64_t> binds;      // per object: binds done by its stack over the run
     std::vector<std::string> notes;  // things not done that are not errors (no ffmpeg on PATH)
+    // Per object with a UV-warp stage, uvwarpSummary's lines prefixed with the object's name.
+    std::vector<std::string> uvwarpLines;
 };
 
 // Runs the command; writes one progress line per frame to `progress` when not null. Throws Error: bad

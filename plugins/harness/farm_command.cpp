@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
@@ -22,6 +23,7 @@
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
 #include "eval_command.h"
+#include "scene_uvwarp.h"
 
 extern char** environ;
 
@@ -38,14 +40,38 @@ fs::path absolutePath(const fs::path& path) {
     return fs::absolute(path).lexically_normal();
 }
 
-// The outputs of frames first..last of `scene`, frame by frame, objects in scene order.
-std::vector<std::string> taskOutputs(const host::Scene& scene, int first, int last) {
+// The outputs of a task of `scene`: without tiles the meshes of frames first..last, frame by frame,
+// objects in scene order; with tiles the UV-warp outputs, frame by frame, objects in scene order, tiles
+// ascending (uvwarpOutputs).
+std::vector<std::string> taskOutputs(const host::Scene& scene, int first, int last,
+                                     const std::vector<int>& tiles) {
     std::vector<std::string> outputs;
     for (int f = first; f <= last; ++f) {
-        for (const host::SceneObject& object : scene.objects)
-            outputs.push_back(evalFileName(object.name, f));
+        for (const host::SceneObject& object : scene.objects) {
+            if (tiles.empty()) {
+                outputs.push_back(evalFileName(object.name, f));
+                continue;
+            }
+            for (int tile : tiles) {
+                for (std::string& name : uvwarpOutputs(object, tile, f))
+                    outputs.push_back(std::move(name));
+            }
+        }
     }
     return outputs;
+}
+
+// Every tile some object's UV-warp stage warps, ascending.
+std::vector<int> warpedTiles(const host::Scene& scene) {
+    std::vector<int> tiles;
+    for (const host::SceneObject& object : scene.objects) {
+        if (!object.uvwarp) continue;
+        for (int tile : uvwarpWarpedTiles(*object.uvwarp))
+            tiles.push_back(tile);
+    }
+    std::sort(tiles.begin(), tiles.end());
+    tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
+    return tiles;
 }
 
 // Checks a plan's JSON, naming the plan file and the JSON path of what is wrong.
@@ -87,10 +113,14 @@ class PlanReader {
                  "first <= last and at most chunk (" + std::to_string(chunk) + ") frames");
         }
         const json& tiles = member(j, at, "tiles");
-        if (!tiles.is_array()) fail(at + ".tiles", "is " + describe(tiles), "an array");
-        if (!tiles.empty()) {
-            fail(at + ".tiles", "is " + tiles.dump(),
-                 "[]: scenes have no UV-warp stage yet, so a task has no tiles");
+        if (!tiles.is_array()) fail(at + ".tiles", "is " + describe(tiles), "an array of UDIM tiles");
+        for (size_t i = 0; i < tiles.size(); ++i) {
+            const std::string element = at + ".tiles[" + std::to_string(i) + "]";
+            const int tile = integer(tiles[i], element);
+            if (tile < 1001 || tile > 9999) fail(element, "is " + tiles[i].dump(), "a UDIM tile, 1001..9999");
+            if (!task.tiles.empty() && tile <= task.tiles.back())
+                fail(element, "is " + tiles[i].dump(), "tiles in ascending order, each once");
+            task.tiles.push_back(tile);
         }
         const json& outputs = member(j, at, "outputs");
         if (!outputs.is_array()) fail(at + ".outputs", "is " + describe(outputs), "an array of file names");
@@ -262,6 +292,10 @@ FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
         throw InvalidInput(formatError("--chunk", "", "is " + std::to_string(command.chunk),
                                        "a whole number of frames per task >= 1"));
     }
+    if (command.tilesPerTask < 1) {
+        throw InvalidInput(formatError("--tiles-per-task", "", "is " + std::to_string(command.tilesPerTask),
+                                       "a whole number of UDIM tiles per task >= 1"));
+    }
     if (command.outDir.empty()) throw InvalidInput(formatError("--out", "", "is empty", "an output folder"));
     const host::Scene scene = host::readScene(command.scene);
     std::vector<int> frames = command.frames;
@@ -273,18 +307,36 @@ FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
     plan.scene = absolutePath(command.scene);
     plan.outDir = absolutePath(command.outDir);
     plan.chunk = command.chunk;
+    // Runs of consecutive frames, each at most `chunk` long.
+    std::vector<std::pair<int, int>> ranges;
     for (size_t i = 0; i < frames.size();) {
-        // A task is a run of consecutive frames, at most `chunk` long.
         size_t end = i + 1;
         while (end < frames.size() && static_cast<int>(end - i) < command.chunk &&
                frames[end] == frames[end - 1] + 1)
             ++end;
-        FarmTask task;
-        task.firstFrame = frames[i];
-        task.lastFrame = frames[end - 1];
-        task.outputs = taskOutputs(scene, task.firstFrame, task.lastFrame);
-        plan.tasks.push_back(std::move(task));
+        ranges.emplace_back(frames[i], frames[end - 1]);
         i = end;
+    }
+    for (const auto& [first, last] : ranges) {
+        FarmTask task;
+        task.firstFrame = first;
+        task.lastFrame = last;
+        task.outputs = taskOutputs(scene, first, last, {});
+        plan.tasks.push_back(std::move(task));
+    }
+    const std::vector<int> tiles = warpedTiles(scene);
+    for (const auto& [first, last] : ranges) {
+        for (size_t t = 0; t < tiles.size(); t += static_cast<size_t>(command.tilesPerTask)) {
+            FarmTask task;
+            task.firstFrame = first;
+            task.lastFrame = last;
+            task.tiles.assign(
+                tiles.begin() + static_cast<ptrdiff_t>(t),
+                tiles.begin() + static_cast<ptrdiff_t>(
+                                    std::min(tiles.size(), t + static_cast<size_t>(command.tilesPerTask))));
+            task.outputs = taskOutputs(scene, first, last, task.tiles);
+            plan.tasks.push_back(std::move(task));
+        }
     }
     std::error_code ec;
     fs::create_directories(plan.outDir, ec);
@@ -360,7 +412,7 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
     }
     host::SceneEvaluator evaluator(host::readScene(plan.scene));
     const host::Scene& scene = evaluator.scene();
-    const std::vector<std::string> expected = taskOutputs(scene, task.firstFrame, task.lastFrame);
+    const std::vector<std::string> expected = taskOutputs(scene, task.firstFrame, task.lastFrame, task.tiles);
     if (expected != task.outputs) {
         size_t i = 0;
         while (i < expected.size() && i < task.outputs.size() && expected[i] == task.outputs[i])
@@ -380,6 +432,31 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
     FarmRunReport report;
     report.task = command.task;
     const size_t numObjects = evaluator.numObjects();
+    if (!task.tiles.empty()) {
+        // Frames whose outputs all exist are reported skipped (the run may still replay them for the warm
+        // start); the others written.
+        for (int frame = task.firstFrame; frame <= task.lastFrame; ++frame) {
+            bool all = true;
+            for (const std::string& name : taskOutputs(scene, frame, frame, task.tiles))
+                all = all && fs::exists(plan.outDir / name, ec);
+            (all ? report.skipped : report.written).push_back(frame);
+        }
+        SceneUvWarpRun run;
+        for (int frame = task.firstFrame; frame <= task.lastFrame; ++frame)
+            run.frames.push_back(frame);
+        run.tiles = task.tiles;
+        run.outDir = plan.outDir;
+        run.skipExisting = true;
+        run.log = log;
+        run.logTask = command.task;
+        for (size_t o = 0; o < numObjects; ++o) {
+            if (!scene.objects[o].uvwarp) continue;
+            const UvWarpReport warped = runSceneUvWarp(evaluator, o, run);
+            for (const UvWarpTileReport& tile : warped.tiles)
+                report.files.insert(report.files.end(), tile.files.begin(), tile.files.end());
+        }
+        return report;
+    }
     for (int frame = task.firstFrame; frame <= task.lastFrame; ++frame) {
         const Clock::time_point start = Clock::now();
         bool wrote = false;

@@ -10,15 +10,19 @@
 // `deformkit farm`: a scene's evaluation (deformkit eval, docs/scene.md) cut into independent tasks for a
 // render farm (docs/farm.md):
 //
-//   deformkit farm plan SCENE --frames A-B --chunk N --out DIR [--plan PLAN.json]
+//   deformkit farm plan SCENE --frames A-B --chunk N [--tiles-per-task T] --out DIR [--plan PLAN.json]
 //   deformkit farm run PLAN --task K
 //   deformkit farm submit --slurm PLAN [--sbatch-args "..."]
 //
-// A plan lists tasks, each a range of at most N consecutive frames with the files it writes
-// (DIR/<object>.<frame>.obj for every object, the names of deformkit eval). A task binds the scene's
-// stacks once and evaluates its frames in order; frames whose outputs all exist are skipped, and every
-// output is written atomically, so a task killed and run again finishes with the bytes an uninterrupted
-// run writes. Exit codes of `farm run`: 0 done, 2 bad input a retry cannot cure, 1 anything else.
+// A plan lists tasks, each a range of at most N consecutive frames with the files it writes (the names of
+// deformkit eval): first the mesh tasks (DIR/<object>.<frame>.obj for every object), then, when objects
+// have a UV-warp stage, one task per frame range and group of at most --tiles-per-task UDIM tiles writing
+// those tiles' redirect maps and bakes (scene_uvwarp.h; memory bounded by one tile's solver, warm start
+// within the task's frames, a cold start at its first frame). A task binds the scene's stacks once and
+// evaluates its frames in order; outputs that exist are kept (a UV-warp task replays the warm start up to
+// its last missing output), and every output is written atomically, so a task killed and run again
+// finishes with the bytes an uninterrupted run writes. Exit codes of `farm run`: 0 done, 2 bad input a
+// retry cannot cure, 1 anything else.
 namespace deformkit::harness {
 
 // The plan format version farm run reads.
@@ -28,8 +32,8 @@ inline constexpr int kFarmPlanVersion = 1;
 struct FarmTask {
     int firstFrame = 0;
     int lastFrame = 0;
-    // UDIM tiles of a UV-warp stage, per frame (reserved: scenes have no UV-warp stage yet, so it is always
-    // empty and farm run rejects a plan that fills it).
+    // Empty: the task writes the objects' meshes. Otherwise UDIM tiles, ascending: the task runs the UV-warp
+    // stages of the objects that have one, for these tiles only (no meshes).
     std::vector<int> tiles;
     // File names in the plan's output folder, frame by frame, objects in scene order.
     std::vector<std::string> outputs;
@@ -48,6 +52,7 @@ struct FarmPlanCommand {
     // of a list such as 1-10,15.
     std::vector<int> frames;
     int chunk = 10;                // frames per task at most, >= 1
+    int tilesPerTask = 1;          // UDIM tiles per UV-warp task at most, >= 1
     std::filesystem::path outDir;  // created when missing
     std::filesystem::path plan;    // empty: outDir / "farm_plan.json"
 };
@@ -82,8 +87,10 @@ struct FarmRunReport {
     std::vector<std::filesystem::path> files;  // written
 };
 
-// Runs one task. `log` gets one JSON line per frame, flushed as it is done:
+// Runs one task. `log` gets JSON lines, flushed as they are done: for a mesh task one per frame,
 //   {"task":0,"frame":1,"status":"written","seconds":0.012}   (status "written" or "skipped")
+// and for a UV-warp task one per object, tile and frame, as `deformkit uvwarp --log` writes them, with
+// "task" and "object" added.
 // Throws InvalidInput / ParseError for bad input (plan, scene, task index out of range, a plan whose
 // outputs differ from what the scene makes, a value the deformers reject at evaluation); IoError for a
 // scene or output that cannot be read or written.

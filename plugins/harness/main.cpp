@@ -100,6 +100,10 @@ int main(int argc, char** argv) {
                             "frames: 1-240, or a list such as 1-10,15; default: the scene's");
     farmPlanApp->add_option("--chunk", farmPlanCommand.chunk, "frames per task at most")
         ->capture_default_str();
+    farmPlanApp
+        ->add_option("--tiles-per-task", farmPlanCommand.tilesPerTask,
+                     "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
+        ->capture_default_str();
     farmPlanApp->add_option("--out", farmOut, "output folder of the tasks: <object>.<frame 4 digits>.obj")
         ->required();
     farmPlanApp->add_option("--plan", farmPlanFile, "plan file to write; default: <out>/farm_plan.json");

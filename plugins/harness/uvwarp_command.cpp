@@ -198,28 +198,6 @@ json solverJson(const uvwarp::TileWarpOptions& o, int32_t cells, int32_t texels,
     return j;
 }
 
-class JsonLog {
-  public:
-    explicit JsonLog(const std::optional<fs::path>& path) {
-        if (!path) return;
-        file_.open(*path, std::ios::app | std::ios::binary);
-        if (!file_) {
-            throw IoError(formatError(path->string(), "", "cannot open the log for appending",
-                                      "a writable file in an existing folder"));
-        }
-        path_ = *path;
-    }
-    void write(const json& line) {
-        if (!file_.is_open()) return;
-        file_ << line.dump() << "\n" << std::flush;
-        if (!file_) throw IoError(formatError(path_.string(), "", "cannot write the log", "a writable file"));
-    }
-
-  private:
-    std::ofstream file_;
-    fs::path path_;
-};
-
 }  // namespace
 
 std::vector<int> parseFrames(std::string_view text, const std::string& option) {
@@ -348,23 +326,74 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
         }
     }
 
-    uvwarp::TileWarpOptions options = command.options;
-    options.cells = command.resolution;
-    const bool wantBake = command.bake.has_value();
+    UvWarpJob job;
+    job.rest = &rest;
+    job.restName = command.rest.string();
+    job.frames = command.frames;
+    job.tiles = tiles;
+    job.rigidity = command.rigidity;
+    job.mask = command.mask;
+    job.orientation = command.orientation;
+    job.texture = command.texture;
+    job.outPath = [&](int tile, int frame) { return tileFramePath(command.out, tile, frame); };
+    if (command.bake) {
+        job.bakePath = [&](int tile, int frame) { return tileFramePath(*command.bake, tile, frame); };
+    }
+    job.options = command.options;
+    job.options.cells = command.resolution;
+    job.filter = command.filter;
+    io::ObjContent deformed;
+    job.deformed = [&](int frame, std::string& name) -> std::span<const glm::vec3> {
+        const fs::path framePath = sequence.framePath(frame);
+        name = framePath.string();
+        deformed = sequence.read(frame);
+        if (deformed.mesh.numVertices() != rest.numVertices()) {
+            throw InvalidInput(formatError(
+                framePath.string(), "", "has " + std::to_string(deformed.mesh.numVertices()) + " vertices",
+                std::to_string(rest.numVertices()) + ", the vertex count of the rest mesh '" +
+                    command.rest.string() + "'"));
+        }
+        return deformed.mesh.points();
+    };
+    std::ofstream logFile;
+    if (command.log) {
+        logFile.open(*command.log, std::ios::app | std::ios::binary);
+        if (!logFile) {
+            throw IoError(formatError(command.log->string(), "", "cannot open the log for appending",
+                                      "a writable file in an existing folder"));
+        }
+        job.log = &logFile;
+    }
+    UvWarpReport report = runUvWarpJob(job, progress);
+    if (command.log && !logFile.flush()) {
+        throw IoError(formatError(command.log->string(), "", "cannot write the log", "a writable file"));
+    }
+    return report;
+}
+
+UvWarpReport runUvWarpJob(const UvWarpJob& job, std::ostream* progress) {
+    if (!job.rest || job.frames.empty() || !job.outPath || !job.deformed ||
+        (job.texture.has_value() && !job.bakePath)) {
+        throw InvalidInput(formatError("uvwarp", "job", "incomplete",
+                                       "a rest mesh, frames, an output path, deformed positions, and a bake "
+                                       "path with a texture"));
+    }
+    const geom::Mesh& rest = *job.rest;
+    const int32_t resolution = job.options.cells;
+    const bool wantBake = job.texture.has_value();
     std::vector<TilePlan> plans;
     int64_t plannedSolves = 0;
-    for (int tile : tiles) {
+    for (int tile : job.tiles) {
         TilePlan plan;
         plan.tile = tile;
         plan.report.tile = tile;
-        plan.rigidity = io::expandUdim(command.rigidity.string(), tile);
-        std::vector<std::pair<const char*, fs::path>> outputs = {{"--out", command.out}};
-        if (wantBake) outputs.emplace_back("--bake", *command.bake);
-        for (const auto& [option, pattern] : outputs) {
-            const fs::path folder = tileFramePath(pattern, tile, command.frames.front()).parent_path();
+        plan.rigidity = io::expandUdim(job.rigidity.string(), tile);
+        std::vector<fs::path> folders = {job.outPath(tile, job.frames.front()).parent_path()};
+        if (wantBake) folders.push_back(job.bakePath(tile, job.frames.front()).parent_path());
+        for (const fs::path& folder : folders) {
             std::error_code ec;
             if (!folder.empty() && !fs::is_directory(folder, ec)) {
-                throw IoError(formatError(option, "folder '" + folder.string() + "'", "does not exist",
+                throw IoError(formatError(folder.string(), "output folder", "does not exist",
                                           "an existing folder for the outputs"));
             }
         }
@@ -374,9 +403,9 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
             plans.push_back(std::move(plan));
             continue;
         }
-        const int32_t texels = checkRigidityHeader(plan.rigidity, command.resolution);
-        if (command.mask) {
-            const fs::path mask = io::expandUdim(command.mask->string(), tile);
+        const int32_t texels = checkRigidityHeader(plan.rigidity, resolution);
+        if (job.mask) {
+            const fs::path mask = io::expandUdim(job.mask->string(), tile);
             if (fileExists(mask)) {
                 checkMapHeader(mask, "warp mask", texels, plan.rigidity);
                 plan.mask = mask;
@@ -384,8 +413,8 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                 plan.report.notes.push_back("no warp mask '" + mask.string() + "': derived from the UVs");
             }
         }
-        if (command.orientation) {
-            const fs::path orientation = io::expandUdim(command.orientation->string(), tile);
+        if (job.orientation) {
+            const fs::path orientation = io::expandUdim(job.orientation->string(), tile);
             if (fileExists(orientation)) {
                 checkMapHeader(orientation, "orientation map", texels, plan.rigidity);
                 plan.orientation = orientation;
@@ -394,8 +423,8 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                                             "': orientation preservation as given everywhere");
             }
         }
-        if (command.texture) {
-            const fs::path texture = io::expandUdim(command.texture->string(), tile);
+        if (job.texture) {
+            const fs::path texture = io::expandUdim(job.texture->string(), tile);
             if (fileExists(texture)) {
                 (void)io::readImageInfo(texture);  // readable
                 plan.texture = texture;
@@ -403,43 +432,49 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                 plan.report.notes.push_back("no texture '" + texture.string() + "': not baked");
             }
         }
-        for (size_t k = 0; k < command.frames.size(); ++k) {
-            const int frame = command.frames[k];
-            plan.outPaths.push_back(tileFramePath(command.out, tile, frame));
-            plan.bakePaths.push_back(plan.texture ? tileFramePath(*command.bake, tile, frame) : fs::path());
-            const bool needed =
-                !fileExists(plan.outPaths.back()) || (plan.texture && !fileExists(plan.bakePaths.back()));
+        for (size_t k = 0; k < job.frames.size(); ++k) {
+            const int frame = job.frames[k];
+            plan.outPaths.push_back(job.outPath(tile, frame));
+            plan.bakePaths.push_back(plan.texture ? job.bakePath(tile, frame) : fs::path());
+            const bool needed = !job.skipExisting || !fileExists(plan.outPaths.back()) ||
+                                (plan.texture && !fileExists(plan.bakePaths.back()));
             plan.needed.push_back(needed);
             if (needed) plan.lastNeeded = static_cast<int>(k);
         }
         plannedSolves += plan.lastNeeded + 1;
         plans.push_back(std::move(plan));
     }
-    if (std::none_of(plans.begin(), plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
+    if (!plans.empty() &&
+        std::none_of(plans.begin(), plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
         std::string list;
         for (const TilePlan& p : plans)
             list += (list.empty() ? "'" : ", '") + p.rigidity.string() + "'";
-        throw IoError(formatError("--rigidity", command.rigidity.string(), "no tile has a rigidity map",
+        throw IoError(formatError(job.rigidityOption, job.rigidity.string(), "no tile has a rigidity map",
                                   "at least one of " + list));
     }
 
-    JsonLog log(command.log);
-    ProgressBar bar(progress, static_cast<int64_t>(plans.size() * command.frames.size()), plannedSolves);
+    auto writeLog = [&](json line) {
+        if (!job.log) return;
+        if (job.logTask >= 0) line["task"] = job.logTask;
+        if (!job.logObject.empty()) line["object"] = job.logObject;
+        *job.log << line.dump() << "\n" << std::flush;
+    };
+    ProgressBar bar(progress, static_cast<int64_t>(plans.size() * job.frames.size()), plannedSolves);
     UvWarpReport report;
     for (TilePlan& plan : plans) {
         UvWarpTileReport& r = plan.report;
         auto baseLine = [&](size_t k, const char* status) {
-            json line = {{"tile", plan.tile}, {"frame", command.frames[k]}, {"status", status}};
+            json line = {{"tile", plan.tile}, {"frame", job.frames[k]}, {"status", status}};
             if (!plan.outPaths.empty()) line["redirect"] = plan.outPaths[k].string();
             if (plan.texture) line["bake"] = plan.bakePaths[k].string();
             return line;
         };
         if (!r.warped) {
-            for (size_t k = 0; k < command.frames.size(); ++k) {
+            for (size_t k = 0; k < job.frames.size(); ++k) {
                 json line = baseLine(k, "unwarped");
                 line["reason"] = "no rigidity map '" + plan.rigidity.string() + "'";
-                log.write(line);
-                bar.step(plan.tile, command.frames[k], false);
+                writeLog(line);
+                bar.step(plan.tile, job.frames[k], false);
             }
             report.tiles.push_back(std::move(r));
             continue;
@@ -454,34 +489,27 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                 plan.orientation ? uvwarp::readRigidityMap(*plan.orientation, plan.tile, "orientation map")
                                  : io::Image{};
             if (plan.texture) texture = io::readImage(*plan.texture);
-            warp.emplace(rest, plan.tile, rigidity, mask, options, orientation, command.rest.string());
+            warp.emplace(rest, plan.tile, rigidity, mask, job.options, orientation, job.restName);
         }
         const json inputs = {
-            {"rest", command.rest.string()},
+            {"rest", job.restName},
             {"rigidity", plan.rigidity.string()},
             {"mask", plan.mask ? plan.mask->string() : std::string("derived")},
             {"orientation", plan.orientation ? plan.orientation->string() : std::string("none")}};
-        for (size_t k = 0; k < command.frames.size(); ++k) {
-            const int frame = command.frames[k];
+        for (size_t k = 0; k < job.frames.size(); ++k) {
+            const int frame = job.frames[k];
             if (static_cast<int>(k) > plan.lastNeeded) {
                 ++r.skipped;
-                log.write(baseLine(k, "skipped"));
+                writeLog(baseLine(k, "skipped"));
                 bar.step(plan.tile, frame, false);
                 continue;
             }
             const Clock::time_point start = Clock::now();
-            const fs::path framePath = sequence.framePath(frame);
-            const io::ObjContent deformed = sequence.read(frame);
-            if (deformed.mesh.numVertices() != rest.numVertices()) {
-                throw InvalidInput(
-                    formatError(framePath.string(), "",
-                                "has " + std::to_string(deformed.mesh.numVertices()) + " vertices",
-                                std::to_string(rest.numVertices()) + ", the vertex count of the rest mesh '" +
-                                    command.rest.string() + "'"));
-            }
+            std::string frameName;
+            const std::span<const glm::vec3> points = job.deformed(frame, frameName);
             const double readSeconds = secondsSince(start);
             Clock::time_point t = Clock::now();
-            warp->solve(deformed.mesh.points());
+            warp->solve(points);
             const double solveSeconds = secondsSince(t);
             const uvwarp::WarpMetrics metrics = warp->metrics();
             r.lastMetrics = metrics;
@@ -494,26 +522,27 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                 seconds["invert"] = secondsSince(t);
                 io::ImageWriteOptions attributes;
                 json frameInputs = inputs;
-                frameInputs["deformed"] = framePath.string();
+                frameInputs["deformed"] = frameName;
                 attributes.attributes = {
                     {"deformkit:version", kVersionString},
                     {"deformkit:uvwarp:tile", std::to_string(plan.tile)},
                     {"deformkit:uvwarp:frame", std::to_string(frame)},
                     {"deformkit:uvwarp:solver",
-                     solverJson(options, warp->cells(), warp->texels(), warp->stats().levels, !plan.mask)
+                     solverJson(job.options, warp->cells(), warp->texels(), warp->stats().levels, !plan.mask)
                          .dump()},
                     {"deformkit:uvwarp:inputs", frameInputs.dump()}};
                 t = Clock::now();
-                if (!fileExists(plan.outPaths[k])) {
+                if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
                     io::ImageWriteOptions write = attributes;
                     write.type = io::PixelType::Float;
                     io::writeImage(plan.outPaths[k], redirect, write);
+                    r.files.push_back(plan.outPaths[k]);
                 }
                 double writeSeconds = secondsSince(t);
-                if (plan.texture && !fileExists(plan.bakePaths[k])) {
+                if (plan.texture && (!job.skipExisting || !fileExists(plan.bakePaths[k]))) {
                     t = Clock::now();
                     uvwarp::BakeOptions bakeOptions;
-                    bakeOptions.filter = command.filter;
+                    bakeOptions.filter = job.filter;
                     uvwarp::bakeTexture(texture, redirect, baked, bakeOptions);
                     seconds["bake"] = secondsSince(t);
                     std::string extension = plan.bakePaths[k].extension().string();
@@ -523,6 +552,7 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
                     t = Clock::now();
                     io::writeImage(plan.bakePaths[k], baked,
                                    extension == ".exr" ? attributes : io::ImageWriteOptions{});
+                    r.files.push_back(plan.bakePaths[k]);
                     writeSeconds += secondsSince(t);
                     ++r.baked;
                 }
@@ -535,7 +565,7 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
             json line = baseLine(k, needed ? "written" : "replayed");
             line["metrics"] = metricsJson(metrics, warp->stats());
             line["seconds"] = seconds;
-            log.write(line);
+            writeLog(line);
             bar.step(plan.tile, frame, true);
         }
         report.tiles.push_back(std::move(r));

@@ -2,12 +2,17 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "deformkit/warp/image_warp.h"
 
@@ -62,14 +67,15 @@ struct UvWarpCommand {
 
 struct UvWarpTileReport {
     int tile = 0;
-    bool warped = true;               // false: no rigidity map, no outputs
-    std::vector<std::string> notes;   // why unwarped, a derived mask, a texture not baked
-    int32_t written = 0;              // frames whose redirect or bake was written
-    int32_t baked = 0;                // bakes written
-    int32_t replayed = 0;             // outputs existed; solved to carry the warm start
-    int32_t skipped = 0;              // outputs existed; not solved
-    int lastFrame = 0;                // the last frame solved (replayed or written)
-    uvwarp::WarpMetrics lastMetrics;  // of lastFrame
+    bool warped = true;                        // false: no rigidity map, no outputs
+    std::vector<std::string> notes;            // why unwarped, a derived mask, a texture not baked
+    int32_t written = 0;                       // frames whose redirect or bake was written
+    int32_t baked = 0;                         // bakes written
+    int32_t replayed = 0;                      // outputs existed; solved to carry the warm start
+    int32_t skipped = 0;                       // outputs existed; not solved
+    int lastFrame = 0;                         // the last frame solved (replayed or written)
+    uvwarp::WarpMetrics lastMetrics;           // of lastFrame
+    std::vector<std::filesystem::path> files;  // written, in order
 };
 
 struct UvWarpReport {
@@ -80,6 +86,38 @@ struct UvWarpReport {
 // std::cerr when it is a terminal; nullptr draws nothing. Throws IoError / ParseError / InvalidInput
 // (deformkit::Error) on bad input.
 UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress = nullptr);
+
+// The engine under `deformkit uvwarp` and under the UV-warp stage of scenes (deformkit eval, farm tasks):
+// per tile one TileWarp, the frames solved in ascending order with warm start, a redirect EXR (and a bake)
+// written per tile and frame, atomically, resuming as uvwarpCommand describes when skipExisting is set.
+// Tiles run one after the other, so memory is bounded by one tile's solver. The deformed positions come
+// from `deformed`, asked once per solved frame and tile.
+struct UvWarpJob {
+    const geom::Mesh* rest = nullptr;  // with UVs; must outlive the run
+    std::string restName;              // names the rest mesh in messages and EXR headers
+    std::vector<int> frames;           // ascending, at least one
+    std::vector<int> tiles;            // tiles of the rest mesh's UVs, ascending
+    std::filesystem::path rigidity;    // UDIM pattern
+    std::optional<std::filesystem::path> mask, orientation, texture;  // UDIM patterns
+    // How messages name the rigidity pattern ("--rigidity", or a scene's JSON path).
+    std::string rigidityOption = "--rigidity";
+    // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
+    std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
+    uvwarp::TileWarpOptions options;  // cells: grid resolution (0: the rigidity map's size)
+    warp::Interpolation filter = warp::Interpolation::Bilinear;
+    // Existing outputs are kept and the warm start replayed (a resumed run writes an uninterrupted run's
+    // bytes); false writes every output again.
+    bool skipExisting = true;
+    // The deformed positions of the rest mesh's vertices at `frame`; sets `name` to what the EXR header
+    // records as the frame's input ("anim.0007.obj"). The span must stay valid until the next call.
+    std::function<std::span<const glm::vec3>(int frame, std::string& name)> deformed;
+    std::ostream* log = nullptr;  // JSON lines, one per tile x frame
+    int logTask = -1;             // >= 0: every log line carries "task": logTask
+    std::string logObject;        // not empty: every log line carries "object": logObject
+};
+
+// Runs the job. Throws as uvwarpCommand (maps checked per tile before anything is written).
+UvWarpReport runUvWarpJob(const UvWarpJob& job, std::ostream* progress = nullptr);
 
 // The lines the CLI prints: one per warped tile ("tile 1001: 24 frames written (24 baked), 0 replayed, 0
 // skipped (outputs exist); frame 24: rigid stretch error 0.041 (identity 0.262), 0 fold-overs") and one per

@@ -1,5 +1,6 @@
 #include "deformkit/host/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -11,6 +12,8 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/io/udim.h"
+#include "deformkit/uvwarp/grid.h"
 
 namespace deformkit::host {
 
@@ -247,9 +250,7 @@ class Reader {
         onlyKeys(v, path, {"type", "label", "envelope", "weights", "params"});
         SceneDeformer d;
         d.path = path;
-        std::string known;
-        for (std::string_view t : deformerTypes())
-            known += (known.empty() ? "" : ", ") + std::string(t);
+        const std::string known = knownTypes();
         if (!v.contains("type")) fail(path + ".type", "is missing", "one of: " + known);
         d.type = string(v.at("type"), path + ".type", "one of: " + known);
         bool typeKnown = false;
@@ -316,6 +317,140 @@ class Reader {
         return d;
     }
 
+    // The deformer types and the UV-warp stage, for messages.
+    static std::string knownTypes() {
+        std::string known;
+        for (std::string_view t : deformerTypes())
+            known += (known.empty() ? "" : ", ") + std::string(t);
+        return known + ", uvwarp (last entry)";
+    }
+
+    // A number in [lo, hi]; whole when `whole`.
+    double ranged(const json& v, const std::string& path, double lo, double hi, bool whole,
+                  const std::string& expected) const {
+        const double d = number(v, path);
+        if (d < lo || d > hi || (whole && d != std::floor(d))) fail(path, "is " + v.dump(), expected);
+        return d;
+    }
+
+    // A UDIM pattern ("rig.<UDIM>.exr"), resolved against the scene's folder.
+    fs::path udimPattern(const json& v, const std::string& path) const {
+        const fs::path p = file(v, path, "an image file name with a UDIM token");
+        if (!io::hasUdimToken(p.filename().string())) {
+            fail(path, "is \"" + v.get<std::string>() + "\", without a UDIM token",
+                 "a file name with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_");
+        }
+        return p;
+    }
+
+    // Stack entry `entry` of type "uvwarp" (docs/scene.md): patterns, tiles and solver options.
+    SceneUvWarp uvwarp(const json& v, const std::string& path, size_t entry, const geom::Mesh& rest) const {
+        onlyKeys(v, path,
+                 {"type", "label", "rigidity", "mask", "orientation", "texture", "tiles", "resolution",
+                  "filter", "params"});
+        SceneUvWarp u;
+        u.path = path;
+        u.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
+                                      : "uvwarp" + std::to_string(entry + 1);
+        if (!rest.hasUVs()) {
+            fail(path, "is a UV warp on a rest mesh without UVs",
+                 "a rest mesh with texture coordinates (vt) on its faces");
+        }
+        if (!v.contains("rigidity")) fail(path + ".rigidity", "is missing", "a rigidity map pattern");
+        u.rigidity = udimPattern(v.at("rigidity"), path + ".rigidity");
+        if (v.contains("mask")) u.mask = udimPattern(v.at("mask"), path + ".mask");
+        if (v.contains("orientation"))
+            u.orientation = udimPattern(v.at("orientation"), path + ".orientation");
+        if (v.contains("texture")) u.texture = udimPattern(v.at("texture"), path + ".texture");
+        const std::vector<int> meshTiles = rest.udimTiles();
+        if (v.contains("tiles")) {
+            const json& tiles = v.at("tiles");
+            if (!tiles.is_array() || tiles.empty())
+                fail(path + ".tiles", "is " + typeName(tiles), "a non-empty array of UDIM tile numbers");
+            std::string have;
+            for (int t : meshTiles)
+                have.append(have.empty() ? "" : " ").append(std::to_string(t));
+            for (size_t i = 0; i < tiles.size(); ++i) {
+                const std::string tp = index(path + ".tiles", i);
+                const int tile =
+                    static_cast<int>(ranged(tiles[i], tp, 1001, 9999, true, "a UDIM tile, 1001..9999"));
+                if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile))
+                    fail(tp, "is " + std::to_string(tile) + ", a tile without UV faces",
+                         "a tile of the rest mesh: " + have);
+                u.tiles.push_back(tile);
+            }
+            std::sort(u.tiles.begin(), u.tiles.end());
+            u.tiles.erase(std::unique(u.tiles.begin(), u.tiles.end()), u.tiles.end());
+        } else {
+            u.tiles = meshTiles;
+        }
+        if (v.contains("resolution")) {
+            const json& r = v.at("resolution");
+            const double cells = ranged(r, path + ".resolution", 0, 32768, true,
+                                        "0 (the map's size) or a power of two from 2 to 32768");
+            if (cells != 0 && (cells < 2 || !uvwarp::isPowerOfTwo(static_cast<int32_t>(cells))))
+                fail(path + ".resolution", "is " + r.dump(),
+                     "0 (the map's size) or a power of two from 2 to 32768");
+            u.options.cells = static_cast<int32_t>(cells);
+        }
+        if (v.contains("filter")) {
+            const std::string f = string(v.at("filter"), path + ".filter", "\"bilinear\" or \"bicubic\"");
+            if (f == "bilinear") {
+                u.filter = warp::Interpolation::Bilinear;
+            } else if (f == "bicubic") {
+                u.filter = warp::Interpolation::Bicubic;
+            } else {
+                fail(path + ".filter", "is \"" + f + "\"", "\"bilinear\" or \"bicubic\"");
+            }
+        }
+        if (v.contains("params")) {
+            const json& params = v.at("params");
+            const std::string pp = path + ".params";
+            requireObject(params, pp, "an object of UV-warp options by name");
+            onlyKeys(params, pp,
+                     {"iterations", "levels", "sweepsPerLevel", "orientationPreservation", "smoothing",
+                      "damping", "coarseStiffness", "dilationRings", "maskBorderWidth"});
+            uvwarp::SolverOptions& o = u.options.solver;
+            auto get = [&](const char* name) -> const json* {
+                return params.contains(name) ? &params.at(name) : nullptr;
+            };
+            if (const json* x = get("iterations"))
+                o.iterations =
+                    static_cast<int32_t>(ranged(*x, pp + ".iterations", 1, 100000, true, "1 to 100000"));
+            if (const json* x = get("levels"))
+                o.levels =
+                    static_cast<int32_t>(ranged(*x, pp + ".levels", 0, 16, true, "0 (automatic) to 16"));
+            if (const json* x = get("sweepsPerLevel")) {
+                const std::string sp = pp + ".sweepsPerLevel";
+                if (!x->is_array() || x->empty())
+                    fail(sp, "is " + typeName(*x), "a non-empty array of sweep counts");
+                o.sweepsPerLevel.clear();
+                for (size_t i = 0; i < x->size(); ++i)
+                    o.sweepsPerLevel.push_back(
+                        static_cast<int32_t>(ranged((*x)[i], index(sp, i), 1, 1000, true, "1 to 1000")));
+            }
+            if (const json* x = get("orientationPreservation"))
+                o.orientationPreservation =
+                    static_cast<float>(ranged(*x, pp + ".orientationPreservation", 0, 1, false, "0 to 1"));
+            if (const json* x = get("smoothing"))
+                o.smoothing = static_cast<float>(ranged(*x, pp + ".smoothing", 0, 1, false, "0 to 1"));
+            if (const json* x = get("damping"))
+                o.damping = static_cast<float>(ranged(*x, pp + ".damping", 0, 1, false, "0 to 1"));
+            if (const json* x = get("coarseStiffness")) {
+                o.coarseStiffness =
+                    static_cast<float>(ranged(*x, pp + ".coarseStiffness", 0, 1, false, "(0, 1]"));
+                if (!(o.coarseStiffness > 0.0f)) fail(pp + ".coarseStiffness", "is " + x->dump(), "(0, 1]");
+            }
+            if (const json* x = get("dilationRings"))
+                u.options.dilationRings =
+                    static_cast<int32_t>(ranged(*x, pp + ".dilationRings", 0, 64, true, "0 to 64"));
+            if (const json* x = get("maskBorderWidth"))
+                u.options.derivedMask.borderWidth =
+                    static_cast<int32_t>(ranged(*x, pp + ".maskBorderWidth", 1, 64, true, "1 to 64"));
+        }
+        return u;
+    }
+
     SceneObject object(const json& v, const std::string& path) const {
         requireObject(v, path, "{\"name\": ..., \"mesh\": ..., \"stack\": [...]}");
         onlyKeys(v, path, {"name", "mesh", "stack"});
@@ -347,9 +482,24 @@ class Reader {
         if (!stack.is_array()) fail(path + ".stack", "is " + typeName(stack), "an array of deformers");
         std::set<std::string> labels;
         for (size_t i = 0; i < stack.size(); ++i) {
-            SceneDeformer d = deformer(stack[i], index(path + ".stack", i), i, o.rest.numVertices());
+            const std::string entryPath = index(path + ".stack", i);
+            if (stack[i].is_object() && stack[i].contains("type") && stack[i].at("type") == "uvwarp") {
+                if (i + 1 != stack.size()) {
+                    fail(
+                        entryPath + ".type",
+                        "is \"uvwarp\" at entry " + std::to_string(i) + " of " + std::to_string(stack.size()),
+                        "the UV warp as the last entry: it works in texture space on the stack's result");
+                }
+                o.uvwarp = uvwarp(stack[i], entryPath, i, o.rest);
+                if (!labels.insert(o.uvwarp->label).second) {
+                    fail(entryPath + ".label", "is \"" + o.uvwarp->label + "\", used by an earlier entry",
+                         "a label unique in the stack");
+                }
+                continue;
+            }
+            SceneDeformer d = deformer(stack[i], entryPath, i, o.rest.numVertices());
             if (!labels.insert(d.label).second) {
-                fail(index(path + ".stack", i) + ".label", "is \"" + d.label + "\", used by an earlier entry",
+                fail(entryPath + ".label", "is \"" + d.label + "\", used by an earlier entry",
                      "a label unique in the stack");
             }
             o.stack.push_back(std::move(d));

@@ -270,7 +270,9 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
         const Case cases[] = {
             {"\"frames\":[4,6]", "\"frames\":[4,9]", ": tasks[1].frames: is [4,9], 6 frames"},
             {"\"frames\":[7,7]", "\"frames\":[7]", ": tasks[2].frames: is [7] (expected [first, last])"},
-            {"\"tiles\":[]", "\"tiles\":[1001]", ": tasks[0].tiles: is [1001]"},
+            {"\"bent.0006.obj\"],\"tiles\":[]", "\"bent.0006.obj\"],\"tiles\":[1001]",
+             ": tasks[1].outputs[0]: is \"tube.0004.obj\", the scene makes nothing"},
+            {"\"tiles\":[]", "\"tiles\":1001", ": tasks[0].tiles: is 1001 (expected an array of UDIM tiles)"},
             {"\"deformkit_farm_plan\": 1", "\"deformkit_farm_plan\": 2", ": deformkit_farm_plan: is 2"},
             {"\"chunk\": 3", "\"chunk\": 3, \"chunks\": 3", ": chunks: is not a plan key"},
             {"\"tube.0004.obj\"", "\"../tube.0004.obj\"", ": tasks[1].outputs[0]: is \"../tube.0004.obj\""},

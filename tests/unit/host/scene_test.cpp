@@ -120,7 +120,7 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
         Contains("objects[0].meshes: is not a known key"));
     CHECK_THAT(f.error(withEntry(R"({"type": "twirl"})")),
                Contains("objects[0].stack[0].type: is \"twirl\"") &&
-                   Contains("bend, ffd, slide, taper, twist, wires"));
+                   Contains("bend, ") && Contains("twist, wires, uvwarp (last entry)"));
     CHECK_THAT(f.error(withEntry(twist + R"({"endangle": 1}})")),
                Contains(file + ": objects[0].stack[0].params.endangle") && Contains("endAngle"));
     CHECK_THAT(

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -8,6 +9,8 @@
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/anim_curve.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "deformkit/warp/image_warp.h"
 
 namespace deformkit::host {
 
@@ -34,7 +37,7 @@ struct SceneParameter {
 
 // One entry of an object's deformer stack.
 struct SceneDeformer {
-    std::string type;            // a makeDeformer type: ffd, twist, bend, taper, wires, slide
+    std::string type;            // a makeDeformer type (deformerTypes())
     std::string label;           // unique in the stack; default: the type followed by the entry number from 1
     SceneValue envelope;         // one component; constant 1 when the scene gives none
     std::vector<float> weights;  // #V painted weights of the object's rest mesh, or empty for all 1
@@ -45,13 +48,28 @@ struct SceneDeformer {
     std::string path;  // "objects[0].stack[1]"
 };
 
+// The UV-warp stage of an object: a stack's last entry of type "uvwarp". It works in texture space on the
+// stack's result: per UDIM tile and frame, the content-aware UV warp (uvwarp/tile_warp.h) of the rest mesh
+// deformed by the stack, written as redirect maps (and bakes of a texture through them). It has no envelope
+// or weights; its options are constant over the shot.
+struct SceneUvWarp {
+    std::string label;                                                // "uvwarp<entry number>" by default
+    std::filesystem::path rigidity;                                   // UDIM pattern, resolved like meshes
+    std::optional<std::filesystem::path> mask, orientation, texture;  // UDIM patterns
+    std::vector<int> tiles;  // ascending; every tile of the rest mesh's UVs when the scene gives none
+    uvwarp::TileWarpOptions options;  // options.cells: the grid resolution (0: the rigidity map's size)
+    warp::Interpolation filter = warp::Interpolation::Bilinear;  // of the bake
+    std::string path;                                            // "objects[0].stack[2]"
+};
+
 struct SceneObject {
     std::string name;                // unique; names the output files, so letters, digits, '_', '-', '.' only
     std::filesystem::path meshFile;  // resolved against the scene file's folder
     geom::Mesh rest;
     std::vector<io::FaceGroup> groups;  // of the rest OBJ, written back with every frame
-    std::vector<SceneDeformer> stack;
-    std::string path;  // "objects[0]"
+    std::vector<SceneDeformer> stack;   // the geometric deformers, in order
+    std::optional<SceneUvWarp> uvwarp;  // the texture-space stage after them, when the scene has one
+    std::string path;                   // "objects[0]"
 };
 
 // A DeformKit scene (docs/scene.md): objects, each a rest mesh under a deformer stack whose parameters

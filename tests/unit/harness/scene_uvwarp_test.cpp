@@ -1,0 +1,420 @@
+#include <catch2/catch.hpp>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/host/deformers.h"
+#include "deformkit/host/scene.h"
+#include "deformkit/host/stack.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "eval_command.h"
+#include "farm_command.h"
+#include "scene_uvwarp.h"
+#include "test_support.h"
+
+// The UV-warp stage of scenes: parsing, `deformkit eval` and farm tasks, checked against TileWarp driven
+// directly by a DeformerStack built in the test.
+
+using namespace deformkit;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kTexels = 32;
+
+// Two open tubes around the Y axis (y from -1 to 1), the second shifted by 2 along X; tube t has its UVs in
+// tile 1001 + t (u in [t, t + 1]), a small margin inside the tile so the border texels stay fixed.
+geom::Mesh twoTubes(int rings = 9, int sides = 12) {
+    geom::Mesh::Data d;
+    for (int t = 0; t < 2; ++t) {
+        for (int r = 0; r < rings; ++r) {
+            const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
+            for (int s = 0; s <= sides; ++s) {  // a seam: the last column repeats the first's position
+                const double a = 2.0 * std::numbers::pi * s / sides;
+                d.points.emplace_back(2.0f * t + 0.5f * static_cast<float>(std::cos(a)), y,
+                                      0.5f * static_cast<float>(std::sin(a)));
+                d.uvs.emplace_back(t + 0.05f + 0.9f * static_cast<float>(s) / sides,
+                                   0.05f + 0.9f * static_cast<float>(r) / (rings - 1));
+            }
+        }
+    }
+    const int perTube = rings * (sides + 1);
+    for (int t = 0; t < 2; ++t) {
+        for (int r = 0; r + 1 < rings; ++r) {
+            for (int s = 0; s < sides; ++s) {
+                const int a = t * perTube + r * (sides + 1) + s;
+                d.faceCounts.push_back(4);
+                d.faceIndices.insert(d.faceIndices.end(), {a, a + 1, a + sides + 2, a + sides + 1});
+            }
+        }
+    }
+    d.uvIndices = d.faceIndices;
+    return geom::Mesh(std::move(d), "tubes");
+}
+
+// Rigidity 1 in disks of radius 0.12 at (0.3, 0.5) and (0.7, 0.5) of the tile, 0 elsewhere.
+io::Image disks() {
+    io::Image image(kTexels, kTexels, 1);
+    for (int y = 0; y < kTexels; ++y)
+        for (int x = 0; x < kTexels; ++x)
+            for (double cu : {0.3, 0.7})
+                if (std::hypot((x + 0.5) / kTexels - cu, 1.0 - (y + 0.5) / kTexels - 0.5) < 0.12)
+                    image.at(x, y, 0) = 1.0f;
+    return image;
+}
+
+// Values that are multiples of 1/256 (exact in half floats).
+io::Image texture() {
+    io::Image image(kTexels, kTexels, 3);
+    for (int y = 0; y < kTexels; ++y)
+        for (int x = 0; x < kTexels; ++x)
+            for (int c = 0; c < 3; ++c)
+                image.at(x, y, c) = static_cast<float>((x * 7 + y * 13 + c * 29) % 256) / 256.0f;
+    return image;
+}
+
+// Frames 1..3: a twist about Y that grows (stretching the tubes' surfaces along their diagonals), then
+// the UV warp with rigidity maps for both tiles and a texture for tile 1001 only.
+const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
+  {"name": "tubes", "mesh": "tubes.obj", "stack": [
+    {"type": "taper", "params": {"handleY": [0, 1, 0], "lowBound": -1, "highBound": 1,
+       "endScale": {"keys": [{"frame": 1, "value": 1.2, "interpolation": "linear"}, {"frame": 3, "value": 1.8}]}}},
+    {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr",
+     "params": {"iterations": 6}}]}]})";
+
+struct Shot {
+    test::TempDir dir;
+    fs::path scene;
+    geom::Mesh rest = twoTubes();
+    Shot() {
+        io::writeObj(dir / "tubes.obj", rest);
+        io::ImageWriteOptions floats;
+        floats.type = io::PixelType::Float;
+        io::writeImage(dir / "rig.1001.exr", disks(), floats);
+        io::writeImage(dir / "rig.1002.exr", disks(), floats);
+        io::writeImage(dir / "col.1001.exr", texture(), floats);
+        scene = dir / "shot.json";
+        test::writeText(scene, kScene);
+    }
+};
+
+// The stack of kScene built by hand, at `frame` (linear endScale from 1.2 at frame 1 to 1.8 at frame 3).
+std::vector<glm::vec3> stackPoints(const geom::Mesh& rest, int frame) {
+    host::DeformerStack stack;
+    stack.setRest(rest);
+    const size_t taper = stack.add(host::makeDeformer("taper", "taper1"));
+    stack.set(taper, "handleY", std::vector<double>{0, 1, 0});
+    stack.set(taper, "lowBound", -1.0);
+    stack.set(taper, "highBound", 1.0);
+    stack.set(taper, "endScale", 1.2 + 0.3 * (frame - 1));
+    std::vector<glm::vec3> points(rest.points().begin(), rest.points().end());
+    stack.evaluate(points);
+    return points;
+}
+
+std::vector<fs::path> filesIn(const fs::path& dir) {
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(dir))
+        files.push_back(entry.path().filename());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+template <class E>
+std::string errorOf(const std::function<void()>& body) {
+    try {
+        body();
+    } catch (const E& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space stage",
+          "[harness][uvwarp]") {
+    Shot shot;
+    const host::Scene scene = host::readScene(shot.scene);
+    REQUIRE(scene.objects.size() == 1);
+    const host::SceneObject& object = scene.objects[0];
+    CHECK(object.stack.size() == 1);  // the taper; the UV warp is not a geometric deformer
+    REQUIRE(object.uvwarp.has_value());
+    CHECK(object.uvwarp->label == "uvwarp2");
+    CHECK(object.uvwarp->path == "objects[0].stack[1]");
+    CHECK(object.uvwarp->tiles == std::vector<int>{1001, 1002});  // every tile of the rest UVs
+    CHECK(object.uvwarp->rigidity == shot.dir / "rig.<UDIM>.exr");
+    CHECK(object.uvwarp->options.solver.iterations == 6);
+    CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
+    CHECK(harness::uvwarpWarpedTiles(*object.uvwarp) == std::vector<int>{1001, 1002});
+    CHECK(harness::uvwarpOutputs(object, 1001, 7) ==
+          std::vector<std::string>{"tubes.redirect.1001.0007.exr", "tubes.bake.1001.0007.exr"});
+    CHECK(harness::uvwarpOutputs(object, 1002, -2) ==
+          std::vector<std::string>{"tubes.redirect.1002.-0002.exr"});
+    CHECK(harness::uvwarpOutputs(object, 1003, 1).empty());
+}
+
+TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON path",
+          "[harness][uvwarp][errors]") {
+    Shot shot;
+    io::writeObj(shot.dir / "nouv.obj",
+                 geom::Mesh(geom::Mesh::Data{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {3}, {0, 1, 2}}));
+    const std::string head =
+        R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "t", "mesh": ")";
+    struct Case {
+        const char* mesh;
+        const char* stack;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr"}, {"type": "twist"}])",
+         ": objects[0].stack[0].type: is \"uvwarp\" at entry 0 of 2 (expected the UV warp as the last entry"},
+        {"nouv.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr"}])",
+         ": objects[0].stack[0]: is a UV warp on a rest mesh without UVs"},
+        {"tubes.obj", R"([{"type": "uvwarp"}])", ": objects[0].stack[0].rigidity: is missing"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.exr"}])",
+         ": objects[0].stack[0].rigidity: is \"rig.exr\", without a UDIM token"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "tiles": [1001, 1005]}])",
+         ": objects[0].stack[0].tiles[1]: is 1005, a tile without UV faces (expected a tile of the rest "
+         "mesh: "
+         "1001 1002)"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "resolution": 48}])",
+         ": objects[0].stack[0].resolution: is 48"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "envelope": 0.5}])",
+         ": objects[0].stack[0].envelope: is not a known key"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"damping": 2}}])",
+         ": objects[0].stack[0].params.damping: is 2 (expected 0 to 1)"},
+        {"tubes.obj",
+         R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"sweepsPerLevel": [1, 0]}}])",
+         ": objects[0].stack[0].params.sweepsPerLevel[1]: is 0"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "filter": "lanczos"}])",
+         ": objects[0].stack[0].filter: is \"lanczos\""},
+        {"tubes.obj", R"([{"type": "uvwarps"}])", "uvwarp (last entry)"},
+    };
+    for (const Case& c : cases) {
+        CAPTURE(c.stack);
+        const std::string text = head + c.mesh + R"(", "stack": )" + c.stack + "}]}";
+        const std::string what =
+            errorOf<InvalidInput>([&] { (void)host::parseScene(text, shot.dir / "bad.json"); });
+        CHECK_THAT(what, Contains((shot.dir / "bad.json").string() + c.message) ||
+                             (Contains((shot.dir / "bad.json").string()) && Contains(c.message)));
+    }
+}
+
+TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed by the stack",
+          "[harness][uvwarp][eval]") {
+    Shot shot;
+    harness::EvalCommand command;
+    command.scene = shot.scene;
+    command.outDir = shot.dir / "eval";
+    command.previews = false;
+    const harness::EvalReport report = harness::evalCommand(command);
+    REQUIRE(report.uvwarpLines.size() >= 2);
+    CHECK_THAT(report.uvwarpLines[0], Contains("tubes tile 1001: 3 frames written (3 baked)"));
+
+    // The reference: one TileWarp per tile, solved over frames 1..3 in order with the same options,
+    // fed by the stack built by hand.
+    uvwarp::TileWarpOptions options;
+    options.solver.iterations = 6;
+    const io::Image rigidity = uvwarp::readRigidityMap(shot.dir / "rig.1001.exr", 1001);
+    for (int tile : {1001, 1002}) {
+        uvwarp::TileWarp warp(shot.rest, tile, rigidity, {}, options);
+        for (int frame = 1; frame <= 3; ++frame) {
+            const std::vector<glm::vec3> points = stackPoints(shot.rest, frame);
+            warp.solve(points);
+            const io::Image expected = warp.redirect();
+            const fs::path file = command.outDir / harness::uvwarpRedirectName("tubes", tile, frame);
+            const io::Image written = io::readImage(file);
+            REQUIRE(written.width == expected.width);
+            REQUIRE(written.channels == 2);
+            // Float EXR: the solver's floats exactly.
+            CHECK(written.pixels == expected.pixels);
+            // Not the identity: the taper stretches the rigid disks, the warp moves texels.
+            const uvwarp::WarpMetrics m = warp.metrics();
+            CHECK(m.rigidStretchError < 0.8 * m.identityStretchError);
+            CHECK(m.foldOvers == 0);
+            if (tile == 1001) {
+                // The bake: bakeTexture through the same redirect, written as a half-float EXR. Its texels
+                // are bilinear blends of multiples of 1/256 in [0, 1): half floats keep 11 significant
+                // bits, so each is within 2^-12 of the float value.
+                const io::Image bake = uvwarp::bakeTexture(texture(), expected);
+                const io::Image baked = io::readImage(command.outDir / ("tubes.bake.1001." +
+                                                                        std::string(frame == 1   ? "0001"
+                                                                                    : frame == 2 ? "0002"
+                                                                                                 : "0003") +
+                                                                        ".exr"));
+                REQUIRE(baked.pixels.size() == bake.pixels.size());
+                for (size_t i = 0; i < bake.pixels.size(); ++i)
+                    REQUIRE(std::abs(baked.pixels[i] - bake.pixels[i]) <= 1.0f / 4096.0f);
+            }
+        }
+    }
+    // No bake for tile 1002 (no texture there), meshes for every frame.
+    CHECK(!fs::exists(command.outDir / "tubes.bake.1002.0001.exr"));
+    CHECK(fs::exists(command.outDir / "tubes.0003.obj"));
+}
+
+TEST_CASE(
+    "scene uvwarp: farm tasks are frame ranges x tiles; they write eval's bytes over their range and resume",
+    "[harness][uvwarp][farm]") {
+    Shot shot;
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.chunk = 2;  // frames 1-2 and 3
+    planCommand.outDir = shot.dir / "farm";
+    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    const fs::path planFile = harness::farmPlanPath(planCommand);
+    // 2 mesh tasks, then 2 ranges x 2 tiles.
+    REQUIRE(plan.tasks.size() == 6);
+    CHECK(plan.tasks[0].tiles.empty());
+    CHECK(plan.tasks[1].tiles.empty());
+    CHECK(plan.tasks[2].tiles == std::vector<int>{1001});
+    CHECK(plan.tasks[2].firstFrame == 1);
+    CHECK(plan.tasks[2].lastFrame == 2);
+    CHECK(plan.tasks[2].outputs ==
+          std::vector<std::string>{"tubes.redirect.1001.0001.exr", "tubes.bake.1001.0001.exr",
+                                   "tubes.redirect.1001.0002.exr", "tubes.bake.1001.0002.exr"});
+    CHECK(plan.tasks[3].tiles == std::vector<int>{1002});
+    CHECK(plan.tasks[5].outputs == std::vector<std::string>{"tubes.redirect.1002.0003.exr"});
+    // The plan file reads back the same.
+    const harness::FarmPlan read = harness::readFarmPlan(planFile);
+    REQUIRE(read.tasks.size() == 6);
+    CHECK(read.tasks[4].tiles == std::vector<int>{1001});
+
+    for (int k = 0; k < 6; ++k) {
+        std::ostringstream log;
+        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        CHECK(report.skipped.empty());
+        if (k >= 2) {
+            // One JSON line per tile and frame, naming task, object and tile.
+            std::istringstream in(log.str());
+            int lines = 0;
+            for (std::string line; std::getline(in, line); ++lines) {
+                const nlohmann::json j = nlohmann::json::parse(line);
+                CHECK(j["task"] == k);
+                CHECK(j["object"] == "tubes");
+                CHECK(j["tile"] == plan.tasks[k].tiles[0]);
+                CHECK(j["status"] == "written");
+            }
+            CHECK(lines == plan.tasks[k].lastFrame - plan.tasks[k].firstFrame + 1);
+        }
+    }
+    // The reference: eval over each task's frame range (a run starts cold at its first frame).
+    harness::EvalCommand eval12;
+    eval12.scene = shot.scene;
+    eval12.frames = {1, 2};
+    eval12.outDir = shot.dir / "eval12";
+    eval12.previews = false;
+    (void)harness::evalCommand(eval12);
+    harness::EvalCommand eval3 = eval12;
+    eval3.frames = {3};
+    eval3.outDir = shot.dir / "eval3";
+    (void)harness::evalCommand(eval3);
+    std::vector<fs::path> expected{"farm_plan.json"};
+    for (const harness::FarmTask& task : plan.tasks) {
+        for (const std::string& name : task.outputs) {
+            expected.emplace_back(name);
+            const fs::path reference = (task.firstFrame == 3 ? eval3.outDir : eval12.outDir) / name;
+            CAPTURE(name);
+            CHECK(test::readText(shot.dir / "farm" / name) == test::readText(reference));
+        }
+    }
+    std::sort(expected.begin(), expected.end());
+    CHECK(filesIn(shot.dir / "farm") == expected);
+    // Frames differ (the shot is animated), so the equalities are not vacuous.
+    CHECK(test::readText(shot.dir / "farm" / "tubes.redirect.1001.0001.exr") !=
+          test::readText(shot.dir / "farm" / "tubes.redirect.1001.0002.exr"));
+
+    // A redirect map lost: the task replays frame 1 for the warm start and writes frame 2's map again, the
+    // same bytes; the bake of frame 2, still there, is kept.
+    const fs::path lost = shot.dir / "farm" / "tubes.redirect.1001.0002.exr";
+    const std::string before = test::readText(lost);
+    const auto past = fs::file_time_type::clock::now() - std::chrono::hours(1);
+    fs::last_write_time(shot.dir / "farm" / "tubes.bake.1001.0002.exr", past);
+    fs::remove(lost);
+    std::ostringstream log;
+    const harness::FarmRunReport again = harness::farmRunCommand({planFile, 2}, &log);
+    CHECK(again.written == std::vector<int>{2});
+    CHECK(again.skipped == std::vector<int>{1});
+    CHECK(again.files == std::vector<fs::path>{lost});
+    CHECK(test::readText(lost) == before);
+    CHECK(fs::last_write_time(shot.dir / "farm" / "tubes.bake.1001.0002.exr") == past);
+    CHECK_THAT(log.str(), Contains("\"status\":\"replayed\""));
+}
+
+TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm][errors]") {
+    Shot shot;
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.chunk = 3;
+    planCommand.outDir = shot.dir / "farm";
+    planCommand.tilesPerTask = 2;
+    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    REQUIRE(plan.tasks.size() == 2);
+    CHECK(plan.tasks[1].tiles == std::vector<int>{1001, 1002});
+    const fs::path planFile = harness::farmPlanPath(planCommand);
+    const std::string good = test::readText(planFile);
+    struct Case {
+        const char* from;
+        const char* to;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"\"tiles\":[1001,1002]", "\"tiles\":[1002,1001]",
+         ": tasks[1].tiles[1]: is 1001 (expected tiles in ascending order, each once)"},
+        {"\"tiles\":[1001,1002]", "\"tiles\":[5]",
+         ": tasks[1].tiles[0]: is 5 (expected a UDIM tile, 1001..9999)"},
+        {"\"tiles\":[1001,1002]", "\"tiles\":[1001]",
+         ": tasks[1].outputs[2]: is \"tubes.redirect.1002.0001.exr\", the scene makes "
+         "\"tubes.redirect.1001.0002.exr\""},
+    };
+    for (const Case& c : cases) {
+        std::string text = good;
+        const size_t at = text.find(c.from);
+        REQUIRE(at != std::string::npos);
+        text.replace(at, std::strlen(c.from), c.to);
+        test::writeText(planFile, text);
+        CAPTURE(c.to);
+        const std::string what = errorOf<InvalidInput>([&] { (void)harness::farmRunCommand({planFile, 1}); });
+        CHECK_THAT(what, Contains(planFile.string() + c.message));
+    }
+    planCommand.tilesPerTask = 0;
+    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(planCommand); }),
+               Contains("--tiles-per-task: is 0"));
+}
+
+TEST_CASE("scene uvwarp: eval writes the same bytes with 1 and 2 threads", "[harness][uvwarp][eval]") {
+    Shot shot;
+    const int threads = omp_get_max_threads();
+    std::vector<std::string> runs[2];
+    for (int t = 1; t <= 2; ++t) {
+        omp_set_num_threads(t);
+        harness::EvalCommand command;
+        command.scene = shot.scene;
+        command.outDir = shot.dir / ("eval" + std::to_string(t));
+        const harness::EvalReport report = harness::evalCommand(command);
+        for (const fs::path& file : report.files)
+            runs[t - 1].push_back(file.filename().string() + "\n" + test::readText(file));
+    }
+    omp_set_num_threads(threads);
+    REQUIRE(runs[0].size() == runs[1].size());
+    REQUIRE(runs[0].size() > 10);  // meshes, previews, maps, bakes, the contact sheet
+    for (size_t i = 0; i < runs[0].size(); ++i)
+        CHECK(runs[0][i] == runs[1][i]);
+}
