@@ -12,6 +12,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/host/weight_maps.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/grid.h"
 
@@ -207,8 +208,29 @@ class Reader {
         return p.is_absolute() ? p : folder_ / p;
     }
 
-    std::vector<float> weights(const json& v, const std::string& path, int32_t count, fs::path& file) const {
-        file = this->file(v, path, "a weights file name (JSON)");
+    // Painted weights: a JSON file of one number per vertex, or {"image": pattern, "channel": c} sampled
+    // through the rest mesh's UVs (weight_maps.h).
+    std::vector<float> weights(const json& v, const std::string& path, const geom::Mesh& rest,
+                               fs::path& file) const {
+        const int32_t count = rest.numVertices();
+        if (v.is_object()) {
+            onlyKeys(v, path, {"image", "channel"});
+            if (!v.contains("image"))
+                fail(path + ".image", "is missing", "an image file name or UDIM pattern");
+            file = this->file(v.at("image"), path + ".image", "an image file name or UDIM pattern");
+            const int32_t channel =
+                v.contains("channel")
+                    ? static_cast<int32_t>(ranged(v.at("channel"), path + ".channel", 0, 64, true, "0 to 64"))
+                    : 0;
+            try {
+                return weightsFromMaps(rest, file, channel, source_ + ": " + path + ".image");
+            } catch (const InvalidInput&) {
+                throw;
+            } catch (const Error& e) {
+                fail(path + ".image", e.what(), "a readable weight map");
+            }
+        }
+        file = this->file(v, path, "a weights file name (JSON), or {\"image\": ...}");
         std::ifstream in(file, std::ios::binary);
         if (!in)
             fail(path, "names " + file.string() + ", which cannot be read", "a readable JSON weights file");
@@ -245,7 +267,8 @@ class Reader {
         return w;
     }
 
-    SceneDeformer deformer(const json& v, const std::string& path, size_t entry, int32_t vertexCount) const {
+    SceneDeformer deformer(const json& v, const std::string& path, size_t entry,
+                           const geom::Mesh& rest) const {
         requireObject(v, path, "{\"type\": ..., \"params\": {...}}");
         onlyKeys(v, path, {"type", "label", "envelope", "weights", "params"});
         SceneDeformer d;
@@ -266,7 +289,7 @@ class Reader {
             if (n != 1) fail(path + ".envelope", "has " + std::to_string(n) + " components", "one number");
         }
         if (v.contains("weights"))
-            d.weights = weights(v.at("weights"), path + ".weights", vertexCount, d.weightsFile);
+            d.weights = weights(v.at("weights"), path + ".weights", rest, d.weightsFile);
 
         // Parameters are checked by a probe deformer's own set(), in its parameters() order (bind-time
         // inputs first, as a host sets them): the constant, or every key's value.
@@ -497,7 +520,7 @@ class Reader {
                 }
                 continue;
             }
-            SceneDeformer d = deformer(stack[i], entryPath, i, o.rest.numVertices());
+            SceneDeformer d = deformer(stack[i], entryPath, i, o.rest);
             if (!labels.insert(d.label).second) {
                 fail(entryPath + ".label", "is \"" + d.label + "\", used by an earlier entry",
                      "a label unique in the stack");

@@ -40,8 +40,9 @@ struct SceneDeformer {
     std::string type;            // a makeDeformer type (deformerTypes())
     std::string label;           // unique in the stack; default: the type followed by the entry number from 1
     SceneValue envelope;         // one component; constant 1 when the scene gives none
-    std::vector<float> weights;  // #V painted weights of the object's rest mesh, or empty for all 1
-    std::filesystem::path weightsFile;  // empty when none
+    std::vector<float> weights;  // #V painted weights of the object's rest mesh (from a file or sampled from
+                                 // maps through its UVs, host/weight_maps.h), or empty for all 1
+    std::filesystem::path weightsFile;  // the JSON file or the weight-map image (pattern); empty when none
     // The parameters the scene gives, in the deformer's parameters() order (bind-time inputs first), which
     // is the order hosts set them in.
     std::vector<SceneParameter> params;
