@@ -1,12 +1,14 @@
 #include "deformkit/host/evaluator.h"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/io/obj.h"
 
 namespace deformkit::host {
 namespace {
@@ -24,6 +26,7 @@ SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
         Object& ob = objects_[o];
         ob.deformed = so.rest;
         ob.stack.setRest(so.rest);
+        if (!so.sequence.empty()) ob.sequence = std::make_unique<io::ObjSequence>(so.sequence);
         for (size_t i = 0; i < so.stack.size(); ++i) {
             const SceneDeformer& sd = so.stack[i];
             try {
@@ -83,7 +86,11 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
         ob.deformed = rest;  // a host gave the stack a new rest mesh
         points = ob.deformed.points();
     }
-    std::copy(rest.points().begin(), rest.points().end(), points.begin());
+    if (ob.sequence && sameConnectivity) {
+        readInput(object, frame, points);
+    } else {
+        std::copy(rest.points().begin(), rest.points().end(), points.begin());
+    }
     try {
         ob.stack.evaluate(points);
     } catch (const Error& e) {
@@ -91,6 +98,39 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
                                        frameText(frame) + ": " + e.what()));
     }
     return ob.deformed;
+}
+
+void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3> points) {
+    const SceneObject& so = scene_.objects[object];
+    Object& ob = objects_[object];
+    const std::string element = so.path + ".mesh";
+    if (frame != std::floor(frame) || std::abs(frame) > 1.0e9) {
+        throw InvalidInput(formatError(scene_.source, element,
+                                       frameText(frame) + " of the sequence " + so.sequence.string(),
+                                       "whole frames for an object whose mesh is a frame sequence"));
+    }
+    const int whole = static_cast<int>(frame);
+    const std::filesystem::path file = ob.sequence->framePath(whole);
+    io::ObjContent content;
+    try {
+        content = io::readObj(file);
+    } catch (const Error& e) {
+        throw InvalidInput(formatError(scene_.source, element, frameText(frame) + ": " + e.what(),
+                                       "an OBJ for every evaluated frame of " + so.sequence.string()));
+    }
+    const geom::Mesh& m = content.mesh;
+    const geom::Mesh& rest = so.rest;
+    if (!std::ranges::equal(m.faceCounts(), rest.faceCounts()) ||
+        !std::ranges::equal(m.faceIndices(), rest.faceIndices()) || m.numVertices() != rest.numVertices()) {
+        throw InvalidInput(formatError(scene_.source, element,
+                                       frameText(frame) + ": " + file.string() + " has " +
+                                           std::to_string(m.numVertices()) + " vertices and " +
+                                           std::to_string(m.numFaces()) + " faces",
+                                       "the connectivity of the rest frame " + so.meshFile.string() + " (" +
+                                           std::to_string(rest.numVertices()) + " vertices, " +
+                                           std::to_string(rest.numFaces()) + " faces)"));
+    }
+    std::copy(m.points().begin(), m.points().end(), points.begin());
 }
 
 DeformerStack& SceneEvaluator::stack(size_t object) {

@@ -13,6 +13,7 @@
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
 #include "deformkit/host/weight_maps.h"
+#include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/grid.h"
 
@@ -474,9 +475,9 @@ class Reader {
         return u;
     }
 
-    SceneObject object(const json& v, const std::string& path) const {
+    SceneObject object(const json& v, const std::string& path, int firstFrame) const {
         requireObject(v, path, "{\"name\": ..., \"mesh\": ..., \"stack\": [...]}");
-        onlyKeys(v, path, {"name", "mesh", "stack"});
+        onlyKeys(v, path, {"name", "mesh", "restFrame", "stack"});
         SceneObject o;
         o.path = path;
         if (!v.contains("name")) fail(path + ".name", "is missing", "a name");
@@ -491,6 +492,21 @@ class Reader {
         }
         if (!v.contains("mesh")) fail(path + ".mesh", "is missing", "an OBJ file name");
         o.meshFile = file(v.at("mesh"), path + ".mesh", "an OBJ file name");
+        if (io::ObjSequence::isPattern(o.meshFile.filename().string())) {
+            o.sequence = o.meshFile;
+            o.restFrame =
+                v.contains("restFrame") ? integer(v.at("restFrame"), path + ".restFrame") : firstFrame;
+            o.meshFile = io::ObjSequence(o.sequence).framePath(o.restFrame);
+            if (!fs::is_regular_file(o.meshFile)) {
+                fail(path + ".mesh",
+                     "names the sequence " + o.sequence.string() + ", whose rest frame " +
+                         std::to_string(o.restFrame) + " (" + o.meshFile.string() + ") does not exist",
+                     "an OBJ file for the rest frame (restFrame, default the scene's first frame)");
+            }
+        } else if (v.contains("restFrame")) {
+            fail(path + ".restFrame", "is given for the single mesh " + o.meshFile.string(),
+                 "restFrame only with a frame sequence (\"mesh\": \"anim.####.obj\")");
+        }
         if (!fs::is_regular_file(o.meshFile))
             fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "an OBJ file");
         try {
@@ -558,7 +574,7 @@ class Reader {
         if (!objects.is_array()) fail("objects", "is " + typeName(objects), "an array of objects");
         std::set<std::string> names;
         for (size_t i = 0; i < objects.size(); ++i) {
-            SceneObject o = object(objects[i], index("objects", i));
+            SceneObject o = object(objects[i], index("objects", i), s.firstFrame);
             if (!names.insert(o.name).second) {
                 fail(index("objects", i) + ".name", "is \"" + o.name + "\", used by an earlier object",
                      "a unique name");

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/scene.h"
 #include "deformkit/host/stack.h"
+#include "deformkit/io/obj_sequence.h"
 
 namespace deformkit::host {
 
@@ -31,9 +33,12 @@ class SceneEvaluator {
     [[nodiscard]] size_t numObjects() const { return objects_.size(); }
 
     // Object `object`'s deformed mesh at `frame` (frames may be fractional; curves hold their end values
-    // outside their keys): the rest mesh's connectivity with the stack's output positions. The reference
-    // stays valid until the next evaluate() of that object. Throws InvalidInput for an object index out of
-    // range.
+    // outside their keys): the rest mesh's connectivity with the stack's output positions. The stack's
+    // input is the rest positions, or for an object with an input sequence that frame's positions (whole
+    // frames only; the file must exist and have the rest mesh's connectivity). The reference stays valid
+    // until the next evaluate() of that object. Throws InvalidInput for an object index out of range, and
+    // naming the scene, the object's "mesh" and the file for a sequence frame that is missing, fractional
+    // or of another connectivity.
     const geom::Mesh& evaluate(size_t object, double frame);
 
     // The object's stack, for inspection (bind counts) and host changes (setRest, setWeights).
@@ -47,9 +52,13 @@ class SceneEvaluator {
         // Per stack entry: set every parameter each frame (an animated [bind] parameter can reset an
         // animated counterpart that the scene holds constant), or only the animated ones.
         std::vector<bool> setAll;
+        // The object's input sequence (SceneObject::sequence), when it has one.
+        std::unique_ptr<io::ObjSequence> sequence;
     };
 
     void setFrame(size_t object, double frame, bool all);
+    // The input sequence's positions at `frame` into points (#V); errors as evaluate() says.
+    void readInput(size_t object, double frame, std::span<glm::vec3> points);
 
     Scene scene_;
     std::vector<Object> objects_;
