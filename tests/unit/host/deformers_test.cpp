@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -55,9 +56,10 @@ geom::Mesh testPlane() {
 
 }  // namespace
 
-TEST_CASE("the factory knows six types and names the unknown ones", "[host][deformers]") {
+TEST_CASE("the factory knows nine types and names the unknown ones", "[host][deformers]") {
     const auto types = host::deformerTypes();
-    REQUIRE(types.size() == 6);
+    REQUIRE(types.size() == 9);
+    CHECK(std::is_sorted(types.begin(), types.end()));
     for (std::string_view t : types) {
         const auto d = makeDeformer(t, "a");
         CHECK(d->type() == t);
@@ -68,7 +70,8 @@ TEST_CASE("the factory knows six types and names the unknown ones", "[host][defo
     }
     CHECK_THROWS_AS(makeDeformer("lattice", "l1"), InvalidInput);
     CHECK_THROWS_WITH(makeDeformer("lattice", "l1"),
-                      Contains("type 'lattice'") && Contains("bend, ffd, slide, taper, twist, wires"));
+                      Contains("type 'lattice'") &&
+                          Contains("beierneely, bend, ffd, ffdframes, meshwarp, slide, taper, twist, wires"));
     CHECK_THROWS_WITH(makeDeformer("ffd", ""), Contains("label") && Contains("is empty"));
 }
 
