@@ -22,6 +22,11 @@ REFERENCES = {
     # UV warp: the memory floor makes the same passes over the same arrays as a solve with trivial arithmetic;
     # < 1 is the floor's share of the solve's time. All-thread ratios are in the uvwarp section below.
     "BM_UvWarpSolve1Thread": ("BM_UvWarpFloor1Thread", "floor / solve, same passes, 1 thread"),
+    # Issue 6: the host layer per frame against the same work through the core (target: <= 5% slower).
+    "BM_HostEvaluate": ("BM_HostDirect", "host / direct core calls, throughput (target >= 0.952)"),
+    # A 100-frame, 2-tile shot: its farm plan's tasks run one after the other in one process, against one
+    # eval of the whole shot (the cost of cutting it into tasks: scene loading, cold starts per task).
+    "BM_FarmRunPlan": ("BM_FarmEval", "farm tasks / one eval, frames per second"),
 }
 
 # Issue 5: paper Table 1 (GTX Titan GPU), ms, and the targets for a 2048^2 solve on a 2-core machine:
@@ -166,6 +171,24 @@ def print_uvwarp(medians):
               f"{run.get('allocs_per_solve', 0):.0f} allocations per warm solve; target {verdict}")
 
 
+def print_host(medians):
+    """Issue 6: the host layer's per-frame overhead over direct core calls (target <= 5%)."""
+    rows = sorted(n for n in medians if n.startswith("BM_HostEvaluate/"))
+    if not rows:
+        return
+    print()
+    print("# Host layer per frame (issue 6): SceneEvaluator vs the same work through the core; target <= 5% more")
+    for name in rows:
+        direct = medians.get(name.replace("BM_HostEvaluate", "BM_HostDirect"))
+        if not direct:
+            continue
+        overhead = medians[name]["real_time"] / direct["real_time"] - 1.0
+        verdict = "met" if overhead <= 0.05 else "MISSED"
+        entries = name.split("/")[1]
+        print(f"{name:40} {overhead * 100:+7.1f}% per frame over direct calls ({entries} deformer(s)); "
+              f"target {verdict}")
+
+
 def main(argv):
     blender = None
     if "--blender" in argv:
@@ -203,6 +226,7 @@ def main(argv):
         shown = f"{value:,.1f} {unit}" if value is not None else "-"
         print(f"{name:40} {time:>14} {shown:>18}   {ratio}")
     print_uvwarp(medians)
+    print_host(medians)
     if blender:
         print_blender(blender, medians, context or {})
 

@@ -187,7 +187,8 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
             deformWeighted(in, out, weights, envelope);
         } else {
             deform(in, out);
-            blendDeformation(in, out, weights, envelope, out);
+            // k = 1 everywhere gives the deformed positions bit for bit: no pass needed.
+            if (!weights.empty() || envelope != 1.0) blendDeformation(in, out, weights, envelope, out);
         }
     } catch (const Error&) {
         rethrowWithContext(context_);

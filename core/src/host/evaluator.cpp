@@ -26,6 +26,7 @@ SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
         Object& ob = objects_[o];
         ob.deformed = so.rest;
         ob.stack.setRest(so.rest);
+        ob.restVersion = ob.sceneRestVersion = ob.stack.restVersion();
         if (!so.sequence.empty()) ob.sequence = std::make_unique<io::ObjSequence>(so.sequence);
         for (size_t i = 0; i < so.stack.size(); ++i) {
             const SceneDeformer& sd = so.stack[i];
@@ -79,20 +80,20 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
     Object& ob = objects_[object];
     const geom::Mesh& rest = ob.stack.rest();
     std::span<glm::vec3> points = ob.deformed.points();
-    const bool sameConnectivity = points.size() == rest.points().size() &&
-                                  std::ranges::equal(ob.deformed.faceCounts(), rest.faceCounts()) &&
-                                  std::ranges::equal(ob.deformed.faceIndices(), rest.faceIndices());
-    if (!sameConnectivity) {
+    if (ob.restVersion != ob.stack.restVersion()) {
         ob.deformed = rest;  // a host gave the stack a new rest mesh
+        ob.restVersion = ob.stack.restVersion();
         points = ob.deformed.points();
     }
-    if (ob.sequence && sameConnectivity) {
-        readInput(object, frame, points);
-    } else {
-        std::copy(rest.points().begin(), rest.points().end(), points.begin());
+    std::span<const glm::vec3> input = rest.points();
+    // The input sequence drives the scene's rest mesh only, not one a host set since.
+    if (ob.sequence && ob.restVersion == ob.sceneRestVersion) {
+        ob.input.resize(points.size());
+        readInput(object, frame, ob.input);
+        input = ob.input;
     }
     try {
-        ob.stack.evaluate(points);
+        ob.stack.evaluate(input, points);
     } catch (const Error& e) {
         throw InvalidInput(formatError(scene_.source, scene_.objects[object].path + ".stack",
                                        frameText(frame) + ": " + e.what()));

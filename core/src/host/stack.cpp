@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -15,6 +16,7 @@ constexpr const char* kEnvelope = "envelope";
 }  // namespace
 
 void DeformerStack::setRest(const geom::Mesh& rest) {
+    ++restVersion_;
     rest_ = rest;
     for (Entry& e : entries_)
         e.deformer->markForBind();
@@ -190,36 +192,78 @@ void DeformerStack::bind() {
         if (entries_[i].deformer->needsBind()) bindEntry(i);
 }
 
-void DeformerStack::evaluate(std::span<glm::vec3> points) {
+// Checks sizes and finiteness, and binds what the active entries need: everything that can fail on the
+// entries' setup fails here, before any work.
+void DeformerStack::prepare(std::span<const glm::vec3> in, size_t outSize) {
     const geom::Mesh& mesh = rest();
     const auto n = static_cast<size_t>(mesh.numVertices());
-    if (points.size() != n) {
-        throw InvalidInput(formatError("stack", "points",
-                                       "has " + std::to_string(points.size()) + " positions",
-                                       std::to_string(n) + ", one per rest vertex"));
+    if (in.size() != n || outSize != n) {
+        throw InvalidInput(formatError(
+            "stack", "points", "has " + std::to_string(in.size() != n ? in.size() : outSize) + " positions",
+            std::to_string(n) + ", one per rest vertex"));
     }
-    for (size_t u = 0; u < n; ++u) {
-        const glm::vec3& p = points[u];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            throw InvalidInput(
-                formatError("stack", "point " + std::to_string(u), "is not finite", "finite coordinates"));
+    // The rest mesh's own positions are finite (geom::Mesh checks them); anything else is scanned, in one
+    // branch-free pass (vectorised) before looking for the first bad point.
+    if (in.data() != mesh.points().data()) {
+        const float* f = &in.data()->x;
+        bool finite = true;
+        for (size_t i = 0; i < 3 * n; ++i)
+            finite &= std::abs(f[i]) <= std::numeric_limits<float>::max();
+        if (!finite) {
+            for (size_t u = 0; u < n; ++u) {
+                const glm::vec3& p = in[u];
+                if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+                    throw InvalidInput(formatError("stack", "point " + std::to_string(u), "is not finite",
+                                                   "finite coordinates"));
+                }
+            }
         }
     }
-    // Everything that can fail on the entries' setup fails here, before any work.
+    active_.clear();
     for (size_t i = 0; i < entries_.size(); ++i) {
         if (!isActive(i)) continue;
         checkWeightCount(i);
         if (entries_[i].deformer->needsBind()) bindEntry(i);
+        active_.push_back(i);
     }
-    work_.assign(points.begin(), points.end());
+}
+
+void DeformerStack::evaluate(std::span<glm::vec3> points) {
+    prepare(points, points.size());
+    if (active_.empty()) return;
+    // In place: the entries ping-pong between two buffers, read `points` first and are copied back last,
+    // so `points` is untouched when an entry throws.
+    const size_t n = points.size();
+    work_.resize(n);
     deformed_.resize(n);
-    for (size_t i = 0; i < entries_.size(); ++i) {
-        if (!isActive(i)) continue;
-        Entry& e = entries_[i];
-        e.deformer->evaluate(work_, deformed_, e.weights, e.envelope);
-        std::swap(work_, deformed_);
+    std::span<const glm::vec3> in = points;
+    for (size_t a = 0; a < active_.size(); ++a) {
+        Entry& e = entries_[active_[a]];
+        const std::span<glm::vec3> out(a % 2 == 0 ? work_ : deformed_);
+        e.deformer->evaluate(in, out, e.weights, e.envelope);
+        in = out;
     }
-    std::copy(work_.begin(), work_.end(), points.begin());
+    std::copy(in.begin(), in.end(), points.begin());
+}
+
+void DeformerStack::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out) {
+    prepare(in, out.size());
+    const std::vector<size_t>& active = active_;
+    if (active.empty()) {
+        std::copy(in.begin(), in.end(), out.begin());
+        return;
+    }
+    const size_t n = in.size();
+    if (active.size() > 1) work_.resize(n);
+    if (active.size() > 2) deformed_.resize(n);
+    std::span<const glm::vec3> from = in;
+    for (size_t a = 0; a < active.size(); ++a) {
+        Entry& e = entries_[active[a]];
+        const bool last = a + 1 == active.size();
+        std::span<glm::vec3> to = last ? out : std::span<glm::vec3>(a % 2 == 0 ? work_ : deformed_);
+        e.deformer->evaluate(from, to, e.weights, e.envelope);
+        from = to;
+    }
 }
 
 }  // namespace deformkit::host

@@ -27,7 +27,8 @@ std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem
                             "face " + std::to_string(face) + " has its UVs in tile " + std::to_string(tile),
                             "UVs in tile 1001, or a UDIM pattern for meshes on several tiles"));
         }
-        const std::filesystem::path file = perTile ? std::filesystem::path(io::expandUdim(pattern.string(), tile)) : pattern;
+        const std::filesystem::path file =
+            perTile ? std::filesystem::path(io::expandUdim(pattern.string(), tile)) : pattern;
         io::Image image = io::readImage(file, {0, "weight map"});
         if (channel < 0 || channel >= image.channels) {
             throw InvalidInput(formatError(source, file.string(),

@@ -54,6 +54,9 @@ class SceneEvaluator {
         std::vector<bool> setAll;
         // The object's input sequence (SceneObject::sequence), when it has one.
         std::unique_ptr<io::ObjSequence> sequence;
+        std::vector<glm::vec3> input;   // the sequence's positions at the frame evaluated
+        uint64_t restVersion = 0;       // the stack's rest version `deformed` was copied from
+        uint64_t sceneRestVersion = 0;  // the stack's rest version holding the scene's rest mesh
     };
 
     void setFrame(size_t object, double frame, bool all);

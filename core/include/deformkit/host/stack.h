@@ -41,6 +41,9 @@ class DeformerStack {
     // entry for a new bind.
     void setRest(const geom::Mesh& rest);
     [[nodiscard]] bool hasRest() const { return rest_.has_value(); }
+    // Counts setRest() calls: a host that caches something of the rest mesh compares it to know whether
+    // the rest changed (comparing meshes would cost a pass over them every frame).
+    [[nodiscard]] uint64_t restVersion() const { return restVersion_; }
     // Throws InvalidInput when no rest mesh was set.
     [[nodiscard]] const geom::Mesh& rest() const;
 
@@ -79,6 +82,11 @@ class DeformerStack {
     // Deforms `points` (#V positions: the rest positions, or what an upstream stage made of them) in
     // place through every active entry. Allocates only on the first call or after a vertex count change.
     void evaluate(std::span<glm::vec3> points);
+    // The same from `in` into `out` (#V each, not overlapping): the first active entry reads `in`, the last
+    // writes `out`, so a host that keeps its input (a DCC's upstream geometry, the rest mesh) copies
+    // nothing. When an entry throws, `out` may hold part of a result (setup errors, which are checked
+    // first, leave it untouched).
+    void evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out);
 
     // Binds done by this stack, in total and per entry.
     [[nodiscard]] int64_t bindCount() const { return bindCount_; }
@@ -102,8 +110,12 @@ class DeformerStack {
 
     std::optional<geom::Mesh> rest_;
     std::vector<Entry> entries_;
+    void prepare(std::span<const glm::vec3> in, size_t outSize);
+
     std::vector<glm::vec3> work_, deformed_;
+    std::vector<size_t> active_;  // the active entries of the evaluation under way
     int64_t bindCount_ = 0;
+    uint64_t restVersion_ = 0;
 };
 
 }  // namespace deformkit::host
