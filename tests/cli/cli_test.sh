@@ -194,6 +194,29 @@ expect eval-bad-param 2 "$dk" eval "$work/bad_shot.json" --out "$work/eval-bad"
 contains eval-bad-param "$work/err" "objects[0].stack[0].params.endAngel"
 [ ! -e "$work/eval-bad" ] || { echo "FAIL eval-bad-param: output folder created"; failures=$((failures + 1)); }
 
+# eval with the UV warp as the scene's last stage, then a farm plan of frame-range x tile tasks.
+cat >"$work/uvshot.json" <<JSON
+{"deformkit_scene": 1, "frames": [1, 2],
+ "objects": [{"name": "grid", "mesh": "grid.obj",
+   "stack": [{"type": "taper", "params": {"handleY": [1, 0, 0], "endScale": 1.4}},
+             {"type": "uvwarp", "rigidity": "demo/rigidity.<UDIM>.exr", "params": {"iterations": 4}}]}]}
+JSON
+expect eval-uvwarp 0 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv" --no-previews
+contains eval-uvwarp "$work/out" "grid uvwarp tile 1001: 2 frames written"
+expect eval-uvwarp-info 0 "$dk" info "$work/eval-uv/grid.redirect.1001.0002.exr"
+contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
+expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"
+contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
+expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
+cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" &&
+    { echo "FAIL farm-run-tiles: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
+[ -s "$work/farm-uv/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-tiles: output missing"; failures=$((failures + 1)); }
+expect farm-plan-bad-tiles 2 "$dk" farm plan "$work/uvshot.json" --tiles-per-task 0 --out "$work/farm-uv2"
+contains farm-plan-bad-tiles "$work/err" "--tiles-per-task: is 0"
+sed 's/"iterations": 4/"iterations": 0/' "$work/uvshot.json" >"$work/uvshot_bad.json"
+expect eval-uvwarp-bad 2 "$dk" eval "$work/uvshot_bad.json" --out "$work/eval-uv-bad"
+contains eval-uvwarp-bad "$work/err" "objects[0].stack[1].params.iterations: is 0"
+
 # A truncated image is a clear error, not a crash.
 head -c 300 "$work/demo/albedo.1001.png" >"$work/trunc.png"
 expect truncated-texture 2 "$dk" preview "$work/demo/tube.obj" --texture "$work/trunc.png" --out "$work/r.png"
