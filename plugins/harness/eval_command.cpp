@@ -27,20 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The rest mesh plus two unreferenced vertices. The renderer frames a mesh's bounding box and unreferenced
-// vertices are never drawn, so the two corners choose the camera: every frame is rendered through the
-// camera of framingBox() below while the faces show the deformed positions.
-geom::Mesh makeFramingMesh(const geom::Mesh& rest) {
-    geom::Mesh::Data d;
-    d.points.assign(rest.points().begin(), rest.points().end());
-    d.points.resize(d.points.size() + 2, glm::vec3(0.0f));
-    d.faceCounts.assign(rest.faceCounts().begin(), rest.faceCounts().end());
-    d.faceIndices.assign(rest.faceIndices().begin(), rest.faceIndices().end());
-    d.uvs.assign(rest.uvs().begin(), rest.uvs().end());
-    d.uvIndices.assign(rest.uvIndices().begin(), rest.uvIndices().end());
-    return geom::Mesh(std::move(d), "preview");
-}
-
 // The box whose default-view camera shows a frame: the rest box while the deformed mesh stays inside it
 // (the rest camera, exactly). Otherwise a box about the rest centre that holds the deformed mesh with the
 // rest box's diagonal when one exists (the same camera up to float rounding of the corners), else the
@@ -242,7 +228,6 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
             formatError(command.outDir.string(), "", "cannot be created", "a writable output folder"));
     }
 
-    std::vector<geom::Mesh> framing;          // per object, see makeFramingMesh
     std::vector<geom::Box3> restBounds;       // per object
     std::vector<io::Image> sheets;            // per object
     std::vector<std::vector<fs::path>> pngs;  // per object, frame by frame
@@ -253,7 +238,6 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
                 blank.pixels[3 * i + c] = static_cast<float>(toByte(view.background[c])) / 255.0f;
         }
         for (const host::SceneObject& object : scene.objects) {
-            framing.push_back(makeFramingMesh(object.rest));
             restBounds.push_back(object.rest.bounds());
             sheets.push_back(blank);
         }
@@ -268,13 +252,10 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
             io::writeObj(file, mesh, scene.objects[o].groups);
             report.files.push_back(file);
             if (!previews) continue;
-            const std::span<glm::vec3> points = framing[o].points();
-            std::copy(mesh.points().begin(), mesh.points().end(), points.begin());
-            const geom::Box3 box = framingBox(restBounds[o], mesh.bounds());
-            points[points.size() - 2] = box.min;
-            points[points.size() - 1] = box.max;
+            io::PreviewOptions frameView = view;
+            frameView.frame = framingBox(restBounds[o], mesh.bounds());
             const fs::path png = command.outDir / evalFileName(scene.objects[o].name, frame, ".png");
-            io::writeImage(png, io::renderPreview(framing[o], view));
+            io::writeImage(png, io::renderPreview(mesh, frameView));
             report.files.push_back(png);
             pngs[o].push_back(png);
             // The sheet is made from the file as written (8-bit), so a tile is reproducible from the preview.

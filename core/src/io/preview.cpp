@@ -67,8 +67,8 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
                                        "1 to 16384 pixels per side"));
     }
 
-    // Camera: auto-framed on the bounding sphere.
-    const geom::Box3 box = mesh.bounds();
+    // Camera: auto-framed on the bounding sphere (of the mesh, or of the box asked for).
+    const geom::Box3 box = o.frame ? *o.frame : mesh.bounds();
     const glm::vec3 centre = box.center();
     const float radius = std::max(0.5f * glm::length(box.extent()), 1e-6f);
     const glm::vec3 forward =

@@ -19,7 +19,8 @@ bool isBackground(const io::Image& img, int32_t x, int32_t y, const glm::vec3& b
 io::Image solid(glm::vec3 c) {
     io::Image img(4, 4, 3);
     for (int32_t i = 0; i < 16; ++i) {
-        for (int k = 0; k < 3; ++k) img.pixels[3 * i + k] = c[k];
+        for (int k = 0; k < 3; ++k)
+            img.pixels[3 * i + k] = c[k];
     }
     return img;
 }
@@ -35,10 +36,12 @@ TEST_CASE("preview: a sphere's silhouette matches the perspective closed form", 
     const io::Image img = io::renderPreview(sphere, o);
     int64_t covered = 0;
     for (int32_t y = 0; y < o.height; ++y) {
-        for (int32_t x = 0; x < o.width; ++x) covered += isBackground(img, x, y, o.background) ? 0 : 1;
+        for (int32_t x = 0; x < o.width; ++x)
+            covered += isBackground(img, x, y, o.background) ? 0 : 1;
     }
     // Documented framing: distance D = 1.08 R_box / sin(fov/2), R_box = r sqrt(3) for the sphere's box.
-    // A sphere seen from D projects to a disk of radius focal * r / sqrt(D^2 - r^2), focal = (H/2) / tan(fov/2).
+    // A sphere seen from D projects to a disk of radius focal * r / sqrt(D^2 - r^2), focal = (H/2) /
+    // tan(fov/2).
     const double halfFov = 15.0 * std::numbers::pi / 180.0;
     const double D = 1.08 * r * std::sqrt(3.0) / std::sin(halfFov);
     const double focal = 0.5 * o.height / std::tan(halfFov);
@@ -73,7 +76,8 @@ TEST_CASE("preview: textures follow UV orientation and UDIM tiles", "[io][previe
     }
     SECTION("UDIM: u in [0, 1) reads tile 1001, u in [1, 2) tile 1002") {
         geom::Mesh grid = geom::makeGrid({8, 4, 2.0f, 1.0f});
-        for (auto& uv : grid.uvs()) uv.x *= 2.0f;
+        for (auto& uv : grid.uvs())
+            uv.x *= 2.0f;
         io::PreviewTexture tex;
         tex.tiles.emplace(1001, solid({1.0f, 0.0f, 0.0f}));
         tex.tiles.emplace(1002, solid({0.0f, 0.0f, 1.0f}));
@@ -98,4 +102,32 @@ TEST_CASE("preview: bad input is reported", "[io][preview][errors]") {
     io::PreviewOptions o;
     o.width = 0;
     CHECK_THROWS_AS(io::renderPreview(noUVs, o), InvalidInput);
+}
+
+TEST_CASE("preview: a framing box sets the camera as the box's bounds would", "[io][preview]") {
+    const float r = 1.0f;
+    const geom::Mesh sphere = geom::makeSphere({r, 64, 32});
+    io::PreviewOptions o;
+    o.width = o.height = 200;
+    o.viewDirection = {0.0f, 0.0f, -1.0f};
+    // The mesh's own box: the default camera, the same pixels.
+    io::PreviewOptions own = o;
+    own.frame = sphere.bounds();
+    CHECK(io::renderPreview(sphere, own).pixels == io::renderPreview(sphere, o).pixels);
+    // A box 3 times as large about the same centre: the sphere's disk shrinks by the closed form of the
+    // first test, with R_box = 3 r sqrt(3) and the sphere's own r.
+    io::PreviewOptions wide = o;
+    wide.frame = geom::Box3{glm::vec3(-3.0f * r), glm::vec3(3.0f * r)};
+    const io::Image img = io::renderPreview(sphere, wide);
+    int64_t covered = 0;
+    for (int32_t y = 0; y < o.height; ++y)
+        for (int32_t x = 0; x < o.width; ++x)
+            covered += isBackground(img, x, y, o.background) ? 0 : 1;
+    const double halfFov = 15.0 * std::numbers::pi / 180.0;
+    const double D = 1.08 * 3.0 * r * std::sqrt(3.0) / std::sin(halfFov);
+    const double focal = 0.5 * o.height / std::tan(halfFov);
+    const double rho = focal * r / std::sqrt(D * D - r * r);
+    // A disk of about 9 pixels radius: the pixel count of a rasterised disk is within its perimeter of
+    // the area, so 2 pi rho / (pi rho^2) ~ 22% is the tolerance.
+    CHECK(static_cast<double>(covered) == Approx(std::numbers::pi * rho * rho).epsilon(2.0 / rho));
 }

@@ -28,6 +28,9 @@ struct PreviewOptions {
     // the camera aims at the bounding box centre from the distance at which the box's circumscribed
     // sphere, enlarged by 8%, exactly fits the narrower field of view.
     glm::vec3 viewDirection{-0.55f, -0.45f, -1.0f};
+    // The box the camera frames instead of the mesh's bounding box: one camera for every frame of a shot
+    // (the rest pose's box) so previews do not jump. Parts of the mesh outside it may leave the picture.
+    std::optional<geom::Box3> frame;
     float fieldOfViewDegrees = 30.0f;  // vertical
     glm::vec3 background{0.16f, 0.17f, 0.19f};
     glm::vec3 baseColor{0.78f, 0.76f, 0.72f};  // where no texture applies
