@@ -13,5 +13,6 @@ void bindMeshWarp(pybind11::module_& m);
 void bindWarpEngine(pybind11::module_& m);
 void bindSlide(pybind11::module_& m);
 void bindUvWarp(pybind11::module_& m);
+void bindHost(pybind11::module_& m);
 
 }  // namespace deformkit::python
