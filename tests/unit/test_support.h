@@ -1,12 +1,20 @@
 #pragma once
 
-// Helpers shared by the unit tests: a scratch folder that cleans up after itself.
+// Helpers shared by the unit tests: a scratch folder that cleans up after itself, file and error helpers,
+// bitwise comparison of positions.
 
+#include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
+#include <span>
 #include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
 
 #include <unistd.h>
 
@@ -45,6 +53,31 @@ inline void writeText(const std::filesystem::path& path, const std::string& text
 inline std::string readText(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The names of the entries of `dir`, sorted.
+inline std::vector<std::filesystem::path> filesIn(const std::filesystem::path& dir) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        files.push_back(entry.path().filename());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+// The message of the E that `body` throws, or "no error" when it returns. Other exceptions propagate.
+template <class E>
+std::string errorOf(const std::function<void()>& body) {
+    try {
+        body();
+    } catch (const E& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// True when `a` and `b` hold the same positions bit for bit (0.0f and -0.0f differ).
+inline bool sameBits(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
 // True when the process can bypass file permissions (root): permission tests are skipped then.

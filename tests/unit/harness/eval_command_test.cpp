@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,6 +17,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
 #include "eval_command.h"
+#include "mesh_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -25,29 +25,8 @@ using Catch::Contains;
 
 namespace {
 
-// A tube around the Y axis from y = -1 to 1 with UVs (u around, v along), quads.
-geom::Mesh makeTube(int rings = 6, int sides = 10) {
-    geom::Mesh::Data d;
-    for (int r = 0; r < rings; ++r) {
-        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-        for (int s = 0; s < sides; ++s) {
-            const double a = 2.0 * std::numbers::pi * s / sides;
-            d.points.emplace_back(0.5f * static_cast<float>(std::cos(a)), y,
-                                  0.5f * static_cast<float>(std::sin(a)));
-            d.uvs.emplace_back(static_cast<float>(s) / sides, static_cast<float>(r) / (rings - 1));
-        }
-    }
-    for (int r = 0; r + 1 < rings; ++r) {
-        for (int s = 0; s < sides; ++s) {
-            const int s1 = (s + 1) % sides;
-            d.faceCounts.push_back(4);
-            d.faceIndices.insert(d.faceIndices.end(),
-                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
-        }
-    }
-    d.uvIndices = d.faceIndices;
-    return geom::Mesh(std::move(d), "tube");
-}
+// 6 rings of 10 vertices, UVs u around and v along.
+const test::TubeOptions kTube{.rings = 6, .sides = 10, .uvs = test::TubeUVs::Wrapped};
 
 const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
   {"name": "tube", "mesh": "tube.obj", "stack": [
@@ -69,7 +48,7 @@ TEST_CASE("eval command: file names pad the frame to 4 digits after the sign", "
 TEST_CASE("eval command: writes every object at every frame, equal to the stack evaluated directly",
           "[harness][eval]") {
     test::TempDir dir;
-    const geom::Mesh tube = makeTube();
+    const geom::Mesh tube = test::tube(kTube);
     io::writeObj(dir / "tube.obj", tube);
     test::writeText(dir / "shot.json", kScene);
 
@@ -131,7 +110,7 @@ TEST_CASE("eval command: writes every object at every frame, equal to the stack 
 TEST_CASE("eval command: a bad scene names the file and JSON path and writes nothing",
           "[harness][eval][errors]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
     std::string text = kScene;
     text.replace(text.find("\"curvature\""), std::strlen("\"curvature\""), "\"curvatur\"");
     test::writeText(dir / "shot.json", text);
@@ -205,7 +184,7 @@ struct ScopedPath {
 TEST_CASE("eval command: previews of the rest pose equal the renderer's view of the rest mesh",
           "[harness][eval][preview]") {
     test::TempDir dir;
-    const geom::Mesh tube = makeTube();
+    const geom::Mesh tube = test::tube(kTube);
     io::writeObj(dir / "tube.obj", tube);
     test::writeText(dir / "shot.json", kScene);
     harness::EvalCommand command;
@@ -262,7 +241,7 @@ TEST_CASE("eval command: previews of the rest pose equal the renderer's view of 
 TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a whole factor",
           "[harness][eval][preview]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
     test::writeText(dir / "shot.json", kScene);
     harness::EvalCommand command;
     command.scene = dir / "shot.json";
@@ -315,7 +294,7 @@ TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a 
 TEST_CASE("eval command: bad preview sizes are rejected before anything is written",
           "[harness][eval][errors]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
     test::writeText(dir / "shot.json", kScene);
     harness::EvalCommand command;
     command.scene = dir / "shot.json";
@@ -333,7 +312,7 @@ TEST_CASE("eval command: bad preview sizes are rejected before anything is writt
 TEST_CASE("eval command: movies through ffmpeg, a note without it, an error naming a failing ffmpeg",
           "[harness][eval][movie]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
     test::writeText(dir / "shot.json", kScene);
     harness::EvalCommand command;
     command.scene = dir / "shot.json";

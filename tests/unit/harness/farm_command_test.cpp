@@ -4,12 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <functional>
-#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -20,6 +17,7 @@
 #include "deformkit/io/obj.h"
 #include "eval_command.h"
 #include "farm_command.h"
+#include "mesh_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -27,30 +25,6 @@ using Catch::Contains;
 namespace fs = std::filesystem;
 
 namespace {
-
-// A tube around the Y axis from y = -1 to 1 with UVs, quads.
-geom::Mesh makeTube(int rings = 6, int sides = 10) {
-    geom::Mesh::Data d;
-    for (int r = 0; r < rings; ++r) {
-        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-        for (int s = 0; s < sides; ++s) {
-            const double a = 2.0 * std::numbers::pi * s / sides;
-            d.points.emplace_back(0.5f * static_cast<float>(std::cos(a)), y,
-                                  0.5f * static_cast<float>(std::sin(a)));
-            d.uvs.emplace_back(static_cast<float>(s) / sides, static_cast<float>(r) / (rings - 1));
-        }
-    }
-    for (int r = 0; r + 1 < rings; ++r) {
-        for (int s = 0; s < sides; ++s) {
-            const int s1 = (s + 1) % sides;
-            d.faceCounts.push_back(4);
-            d.faceIndices.insert(d.faceIndices.end(),
-                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
-        }
-    }
-    d.uvIndices = d.faceIndices;
-    return geom::Mesh(std::move(d), "tube");
-}
 
 // Two objects over 7 frames, both animated, so every frame's output differs.
 const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 7], "objects": [
@@ -64,7 +38,7 @@ struct Shot {
     test::TempDir dir;
     fs::path scene;
     Shot() {
-        io::writeObj(dir / "tube.obj", makeTube());
+        io::writeObj(dir / "tube.obj", test::tube({.rings = 6, .sides = 10, .uvs = test::TubeUVs::Wrapped}));
         scene = dir / "shot.json";
         test::writeText(scene, kScene);
     }
@@ -81,24 +55,6 @@ std::vector<std::string> namesOf(int first, int last) {
         }
     }
     return names;
-}
-
-std::vector<fs::path> filesIn(const fs::path& dir) {
-    std::vector<fs::path> files;
-    for (const auto& entry : fs::directory_iterator(dir))
-        files.push_back(entry.path().filename());
-    std::sort(files.begin(), files.end());
-    return files;
-}
-
-template <class E>
-std::string errorOf(const std::function<void()>& body) {
-    try {
-        body();
-    } catch (const E& e) {
-        return e.what();
-    }
-    return "no error";
 }
 
 }  // namespace
@@ -137,7 +93,8 @@ TEST_CASE("farm plan: 7 frames in chunks of 3 make tasks 1-3, 4-6, 7-7 with ever
     CHECK(j["tasks"][1]["frames"] == nlohmann::json::array({4, 6}));
     CHECK(j["tasks"][1]["tiles"] == nlohmann::json::array());
     CHECK(j["tasks"][1]["outputs"].get<std::vector<std::string>>() == namesOf(4, 6));
-    CHECK(filesIn(shot.dir / "out") == std::vector<fs::path>{"farm_plan.json"});  // atomic: no temporary
+    CHECK(test::filesIn(shot.dir / "out") ==
+          std::vector<fs::path>{"farm_plan.json"});  // atomic: no temporary
 
     // --plan elsewhere; a frame list never makes a task across its gap.
     command.plan = shot.dir / "plans" / "p.json";
@@ -153,7 +110,7 @@ TEST_CASE("farm plan: 7 frames in chunks of 3 make tasks 1-3, 4-6, 7-7 with ever
     CHECK(reread.tasks[0].outputs == namesOf(1, 3));
 
     command.chunk = 0;
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(command); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(command); }),
                Contains("--chunk: is 0"));
 }
 
@@ -201,7 +158,7 @@ TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun sk
         CHECK(farm == test::readText(shot.dir / "eval" / name));
     }
     std::sort(expectedFiles.begin(), expectedFiles.end());
-    CHECK(filesIn(shot.dir / "farm") == expectedFiles);
+    CHECK(test::filesIn(shot.dir / "farm") == expectedFiles);
     // The frames differ from each other (the scene is animated), so equality above is not vacuous.
     CHECK(test::readText(shot.dir / "farm" / "tube.0002.obj") !=
           test::readText(shot.dir / "farm" / "tube.0003.obj"));
@@ -247,7 +204,7 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
 
     SECTION("task index out of range") {
         for (int task : {3, -1}) {
-            const std::string what = errorOf<InvalidInput>([&] {
+            const std::string what = test::errorOf<InvalidInput>([&] {
                 (void)harness::farmRunCommand({planFile, task});
             });
             CHECK_THAT(what, Contains(planFile.string() + ": --task: is " + std::to_string(task) +
@@ -257,7 +214,9 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
     }
     SECTION("text that is not JSON") {
         test::writeText(planFile, good.substr(0, good.size() / 2));
-        const std::string what = errorOf<ParseError>([&] { (void)harness::farmRunCommand({planFile, 0}); });
+        const std::string what = test::errorOf<ParseError>([&] {
+            (void)harness::farmRunCommand({planFile, 0});
+        });
         CHECK_THAT(what, Contains(planFile.string() + ": ") && Contains("farm plan"));
         CHECK(harness::farmExitCode(ParseError("x")) == 2);
     }
@@ -287,7 +246,7 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
             text.replace(at, std::strlen(c.from), c.to);
             test::writeText(planFile, text);
             CAPTURE(c.to);
-            const std::string what = errorOf<InvalidInput>([&] {
+            const std::string what = test::errorOf<InvalidInput>([&] {
                 (void)harness::farmRunCommand({planFile, 1});
             });
             CHECK_THAT(what, Contains(planFile.string() + c.message));
@@ -295,7 +254,7 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
     }
     SECTION("a missing plan is bad input; an unwritable output folder is worth a retry") {
         const fs::path missing = shot.dir / "nope.json";
-        CHECK_THAT(errorOf<InvalidInput>([&] {
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
                        (void)harness::farmRunCommand({missing, 0});
                    }),
                    Contains(missing.string() + ": does not exist"));
@@ -303,14 +262,14 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
         CHECK(harness::farmExitCode(std::runtime_error("x")) == 1);
         if (!test::runningAsRoot()) {
             fs::permissions(shot.dir / "farm", fs::perms::owner_read | fs::perms::owner_exec);
-            CHECK_THAT(errorOf<IoError>([&] {
+            CHECK_THAT(test::errorOf<IoError>([&] {
                            (void)harness::farmRunCommand({planFile, 0});
                        }),
                        Contains("not writable"));
         }
     }
     // Nothing was written by a failing run.
-    CHECK(filesIn(shot.dir / "farm") == std::vector<fs::path>{"farm_plan.json"});
+    CHECK(test::filesIn(shot.dir / "farm") == std::vector<fs::path>{"farm_plan.json"});
 }
 
 TEST_CASE("farm submit: one sbatch job array element per task running farm run --task",
@@ -365,7 +324,7 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
 
     // No sbatch on PATH: InvalidInput (exit 2) saying so.
     submit.sbatch = "deformkit-test-no-such-sbatch";
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmSubmitCommand(submit); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmSubmitCommand(submit); }),
                Contains("deformkit-test-no-such-sbatch: not found on PATH"));
 }
 
@@ -374,6 +333,7 @@ TEST_CASE("farm submit: --sbatch-args splits like a shell", "[harness][farm]") {
                                   "--sbatch-args") ==
           std::vector<std::string>{"--partition=batch", "--comment=two words", "a\"b", "c d"});
     CHECK(harness::splitArguments("", "--sbatch-args").empty());
-    CHECK_THAT(errorOf<InvalidInput>([] { (void)harness::splitArguments("--comment='x", "--sbatch-args"); }),
-               Contains("--sbatch-args: has an unterminated ' quote"));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([] { (void)harness::splitArguments("--comment='x", "--sbatch-args"); }),
+        Contains("--sbatch-args: has an unterminated ' quote"));
 }

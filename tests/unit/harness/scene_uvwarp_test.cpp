@@ -6,8 +6,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <functional>
-#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +22,7 @@
 #include "deformkit/uvwarp/tile_warp.h"
 #include "eval_command.h"
 #include "farm_command.h"
+#include "mesh_support.h"
 #include "scene_uvwarp.h"
 #include "test_support.h"
 
@@ -38,33 +37,18 @@ namespace {
 
 constexpr int kTexels = 32;
 
-// Two open tubes around the Y axis (y from -1 to 1), the second shifted by 2 along X; tube t has its UVs in
-// tile 1001 + t (u in [t, t + 1]), a small margin inside the tile so the border texels stay fixed.
+// Two open tubes of radius 0.5 around the Y axis (y from -1 to 1, a seam column), the second shifted by 2
+// along X; tube t has its UVs in tile 1001 + t (u in [t, t + 1]), a small margin inside the tile so the
+// border texels stay fixed.
 geom::Mesh twoTubes(int rings = 9, int sides = 12) {
     geom::Mesh::Data d;
-    for (int t = 0; t < 2; ++t) {
-        for (int r = 0; r < rings; ++r) {
-            const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-            for (int s = 0; s <= sides; ++s) {  // a seam: the last column repeats the first's position
-                const double a = 2.0 * std::numbers::pi * s / sides;
-                d.points.emplace_back(2.0f * t + 0.5f * static_cast<float>(std::cos(a)), y,
-                                      0.5f * static_cast<float>(std::sin(a)));
-                d.uvs.emplace_back(t + 0.05f + 0.9f * static_cast<float>(s) / sides,
-                                   0.05f + 0.9f * static_cast<float>(r) / (rings - 1));
-            }
-        }
-    }
-    const int perTube = rings * (sides + 1);
-    for (int t = 0; t < 2; ++t) {
-        for (int r = 0; r + 1 < rings; ++r) {
-            for (int s = 0; s < sides; ++s) {
-                const int a = t * perTube + r * (sides + 1) + s;
-                d.faceCounts.push_back(4);
-                d.faceIndices.insert(d.faceIndices.end(), {a, a + 1, a + sides + 2, a + sides + 1});
-            }
-        }
-    }
-    d.uvIndices = d.faceIndices;
+    for (int t = 0; t < 2; ++t)
+        test::appendTube(d, {.rings = rings,
+                             .sides = sides,
+                             .center = {2.0f * static_cast<float>(t), 0.0f, 0.0f},
+                             .uvs = test::TubeUVs::Seam,
+                             .uvOrigin = {static_cast<float>(t) + 0.05f, 0.05f},
+                             .uvSize = {0.9f, 0.9f}});
     return geom::Mesh(std::move(d), "tubes");
 }
 
@@ -126,24 +110,6 @@ std::vector<glm::vec3> stackPoints(const geom::Mesh& rest, int frame) {
     std::vector<glm::vec3> points(rest.points().begin(), rest.points().end());
     stack.evaluate(points);
     return points;
-}
-
-std::vector<fs::path> filesIn(const fs::path& dir) {
-    std::vector<fs::path> files;
-    for (const auto& entry : fs::directory_iterator(dir))
-        files.push_back(entry.path().filename());
-    std::sort(files.begin(), files.end());
-    return files;
-}
-
-template <class E>
-std::string errorOf(const std::function<void()>& body) {
-    try {
-        body();
-    } catch (const E& e) {
-        return e.what();
-    }
-    return "no error";
 }
 
 }  // namespace
@@ -211,7 +177,7 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
         CAPTURE(c.stack);
         const std::string text = head + c.mesh + R"(", "stack": )" + c.stack + "}]}";
         const std::string what =
-            errorOf<InvalidInput>([&] { (void)host::parseScene(text, shot.dir / "bad.json"); });
+            test::errorOf<InvalidInput>([&] { (void)host::parseScene(text, shot.dir / "bad.json"); });
         CHECK_THAT(what, Contains((shot.dir / "bad.json").string() + c.message) ||
                              (Contains((shot.dir / "bad.json").string()) && Contains(c.message)));
     }
@@ -336,7 +302,7 @@ TEST_CASE(
         }
     }
     std::sort(expected.begin(), expected.end());
-    CHECK(filesIn(shot.dir / "farm") == expected);
+    CHECK(test::filesIn(shot.dir / "farm") == expected);
     // Frames differ (the shot is animated), so the equalities are not vacuous.
     CHECK(test::readText(shot.dir / "farm" / "tubes.redirect.1001.0001.exr") !=
           test::readText(shot.dir / "farm" / "tubes.redirect.1001.0002.exr"));
@@ -391,11 +357,13 @@ TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm]
         text.replace(at, std::strlen(c.from), c.to);
         test::writeText(planFile, text);
         CAPTURE(c.to);
-        const std::string what = errorOf<InvalidInput>([&] { (void)harness::farmRunCommand({planFile, 1}); });
+        const std::string what = test::errorOf<InvalidInput>([&] {
+            (void)harness::farmRunCommand({planFile, 1});
+        });
         CHECK_THAT(what, Contains(planFile.string() + c.message));
     }
     planCommand.tilesPerTask = 0;
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(planCommand); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(planCommand); }),
                Contains("--tiles-per-task: is 0"));
 }
 

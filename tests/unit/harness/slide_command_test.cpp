@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <sstream>
 
 #include <glm/geometric.hpp>
@@ -46,47 +45,41 @@ double smoothFalloff(double x) {
     return x >= 1.0 ? 0.0 : 1.0 - x * x * (3.0 - 2.0 * x);
 }
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "no error";
-}
-
 }  // namespace
 
 TEST_CASE("slide command: points, falloffs and weights parse, bad text names the option",
           "[harness][slide]") {
     CHECK(harness::parsePoint("1,-2.5,3e-1", "--from") == glm::dvec3(1.0, -2.5, 0.3));
     CHECK(harness::parsePoint(" 1, 2 ,3", "--to") == glm::dvec3(1.0, 2.0, 3.0));
-    CHECK_THAT(errorOf([] { (void)harness::parsePoint("1,2", "--from"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,2", "--from"); }),
                Catch::Contains("--from") && Catch::Contains("'1,2' is not a point"));
-    CHECK_THAT(errorOf([] { (void)harness::parsePoint("1,2,x", "--to"); }), Catch::Contains("--to"));
-    CHECK_THAT(errorOf([] { (void)harness::parsePoint("1,2,nan", "--to"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,2,x", "--to"); }),
+               Catch::Contains("--to"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,2,nan", "--to"); }),
                Catch::Contains("three finite numbers"));
-    CHECK_THAT(errorOf([] { (void)harness::parsePoint("1,,2,3", "--to"); }), Catch::Contains("not a point"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,,2,3", "--to"); }),
+               Catch::Contains("not a point"));
 
     CHECK(harness::parseFalloff("smooth").isSmooth());
     // The linear curve and a ramp: values at x = 0.25 against 1 - x and the samples' interpolation.
     CHECK(harness::parseFalloff("linear")(0.25) == Approx(0.75).margin(1e-12));
     CHECK(harness::parseFalloff("1,1,0")(0.75) == Approx(0.5).margin(1e-7));  // float samples
-    CHECK_THAT(errorOf([] { (void)harness::parseFalloff("cubic"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFalloff("cubic"); }),
                Catch::Contains("--falloff") && Catch::Contains("'cubic' is not a falloff"));
-    CHECK_THAT(errorOf([] { (void)harness::parseFalloff("1,2,0"); }), Catch::Contains("--falloff"));
-    CHECK_THAT(errorOf([] { (void)harness::parseFalloff("1"); }), Catch::Contains("--falloff"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFalloff("1,2,0"); }),
+               Catch::Contains("--falloff"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFalloff("1"); }), Catch::Contains("--falloff"));
 
     CHECK(harness::parseWeights("[0, 0.5, 1]", 3, "w.json") == std::vector<float>{0.0f, 0.5f, 1.0f});
-    CHECK_THAT(errorOf([] { (void)harness::parseWeights("[0, 0.5]", 3, "w.json"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, 0.5]", 3, "w.json"); }),
                Catch::Contains("w.json") && Catch::Contains("has 2 weights") &&
                    Catch::Contains("3, one per vertex"));
-    CHECK_THAT(errorOf([] { (void)harness::parseWeights("[0, \"a\", 1]", 3, "w.json"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, \"a\", 1]", 3, "w.json"); }),
                Catch::Contains("w.json: [1]: is a string"));
-    CHECK_THAT(errorOf([] { (void)harness::parseWeights("{\"w\": 1}", 1, "w.json"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("{\"w\": 1}", 1, "w.json"); }),
                Catch::Contains("an object"));
     CHECK_THROWS_AS(harness::parseWeights("[0, 1", 2, "w.json"), ParseError);
-    CHECK_THAT(errorOf([] { (void)harness::parseWeights("[0, 1e999]", 2, "w.json"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, 1e999]", 2, "w.json"); }),
                Catch::Contains("w.json"));
 }
 
@@ -152,12 +145,12 @@ TEST_CASE("slide command: bad input is an error naming it, and nothing is writte
     command.out = dir / "out.obj";
     command.handle = {25, 0.5};
     command.to = {0.1, 0.0, 0.0};
-    CHECK_THAT(errorOf([&] { (void)harness::slideCommand(command); }), Catch::Contains("grid.obj") &&
-                                                                           Catch::Contains("vertex 25") &&
-                                                                           Catch::Contains("out of range"));
+    CHECK_THAT(
+        test::errorOf<Error>([&] { (void)harness::slideCommand(command); }),
+        Catch::Contains("grid.obj") && Catch::Contains("vertex 25") && Catch::Contains("out of range"));
     command.handle.vertex = 12;
     command.weights = dir / "w.json";
-    CHECK_THAT(errorOf([&] { (void)harness::slideCommand(command); }),
+    CHECK_THAT(test::errorOf<Error>([&] { (void)harness::slideCommand(command); }),
                Catch::Contains("w.json") && Catch::Contains("has 3 weights") &&
                    Catch::Contains("25, one per vertex"));
     command.weights = dir / "missing.json";

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -107,15 +106,6 @@ struct Scene {
     }
 };
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "no error";
-}
-
 // Largest |redirect - texel centre| over the texels: 0 for the identity, whose texel (x, y) holds its own
 // centre ((x + 0.5) / T, 1 - (y + 0.5) / T).
 double distanceFromIdentity(const io::Image& redirect) {
@@ -151,15 +141,16 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
     CHECK(harness::parseFrames("10,1-3,2") == std::vector<int>{1, 2, 3, 10});
     CHECK(harness::parseFrames("-2-1") == std::vector<int>{-2, -1, 0, 1});
     CHECK(harness::parseFrames("-3--2") == std::vector<int>{-3, -2});
-    CHECK_THAT(errorOf([] { (void)harness::parseFrames("5-1"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames("5-1"); }),
                Catch::Contains("--frames") && Catch::Contains("'5-1' ends before it starts"));
-    CHECK_THAT(errorOf([] { (void)harness::parseFrames("1-x"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames("1-x"); }),
                Catch::Contains("'1-x' is not a frame range"));
-    CHECK_THAT(errorOf([] { (void)harness::parseFrames("1,,2"); }), Catch::Contains("'' is not a frame"));
-    CHECK_THAT(errorOf([] { (void)harness::parseFrames("0-2000000"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames("1,,2"); }),
+               Catch::Contains("'' is not a frame"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames("0-2000000"); }),
                Catch::Contains("more than 1000000"));
     CHECK(harness::parseTiles("1002,1001,1002") == std::vector<int>{1001, 1002});
-    CHECK_THAT(errorOf([] { (void)harness::parseTiles("1001,1000"); }),
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1001,1000"); }),
                Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));
     CHECK(harness::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
     CHECK(harness::tileFramePath("r_<UVTILE>.%03d.exr", 1012, -4) == fs::path("r_u2_v2.-004.exr"));
@@ -269,14 +260,14 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
     SECTION("a missing frame") {
         Scene s;
         fs::remove(s.dir / "anim.0002.obj");
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("anim.0002.obj") && Catch::Contains("frame 2: is missing"));
         CHECK(fs::is_empty(s.dir / "out"));
     }
     SECTION("a frame with another vertex count") {
         Scene s;
         test::writeText(s.dir / "anim.0002.obj", planeObj(1.25, {0}, true, kQuads / 2));
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("anim.0002.obj") && Catch::Contains("has 81 vertices"));
         CHECK(fs::exists(s.redirect(1)));  // frames before it are complete
         CHECK_FALSE(fs::exists(s.redirect(2)));
@@ -284,21 +275,21 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
     SECTION("a rest mesh without UVs") {
         Scene s;
         test::writeText(s.dir / "rest.obj", planeObj(1.0, {0}, false));
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("rest.obj") && Catch::Contains("has no UVs"));
         CHECK(fs::is_empty(s.dir / "out"));
     }
     SECTION("a resolution that is not a power of two") {
         Scene s;
         s.command.resolution = 24;
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("--resolution: 24") && Catch::Contains("power of two"));
     }
     SECTION("a mask of another size than the rigidity map") {
         Scene s;
         io::writeImage(s.dir / "mask.1001.exr", io::Image(16, 16, 1, 1.0f));
         s.command.mask = s.dir / "mask.<UDIM>.exr";
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("mask.1001.exr") && Catch::Contains("16 x 16 texels") &&
                        Catch::Contains("32 x 32, the size of"));
         CHECK(fs::is_empty(s.dir / "out"));
@@ -306,7 +297,7 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
     SECTION("a rigidity map whose size is not a power of two") {
         Scene s;
         io::writeImage(s.dir / "rig.1001.exr", disks(48), {io::PixelType::Float, {}});
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("rig.1001.exr") && Catch::Contains("48 texels per side"));
         // With the grid's size given, the map is resampled and the redirect keeps the map's size.
         s.command.resolution = 32;
@@ -321,22 +312,22 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
         io::Image bad = disks();
         bad.at(5, 6, 0) = 1.5f;
         io::writeImage(s.dir / "rig.1001.exr", bad, {io::PixelType::Float, {}});
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("rig.1001.exr") && Catch::Contains("texel (5, 6)"));
         CHECK(fs::is_empty(s.dir / "out"));
     }
     SECTION("an output pattern without a frame token, a tile the mesh does not have") {
         Scene s;
         s.command.out = s.dir / "out/redirect.<UDIM>.exr";
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("--out") && Catch::Contains("no frame token"));
         s.command.out = s.dir / "out/redirect.<UDIM>.####.exr";
         s.command.tiles = {1001, 1005};
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("tile 1005") && Catch::Contains("no UV face"));
         s.command.tiles = {};
         s.command.out = s.dir / "missing/redirect.<UDIM>.####.exr";
-        CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("does not exist"));
     }
 }
@@ -366,7 +357,7 @@ TEST_CASE("uvwarp command: a tile without a rigidity map is left unwarped and re
 
     // Without any rigidity map the pattern itself is wrong: an error.
     fs::remove(s.dir / "rig.1001.exr");
-    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(s.command); }),
+    CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                Catch::Contains("--rigidity") && Catch::Contains("no tile has a rigidity map"));
 }
 
@@ -407,7 +398,7 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     io::writeImage(wrongSize.dir / "orient.1001.exr", io::Image(kTexels / 2, kTexels / 2, 1),
                    {io::PixelType::Float, {}});
     wrongSize.command.orientation = wrongSize.dir / "orient.<UDIM>.exr";
-    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(wrongSize.command, nullptr); }),
+    CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(wrongSize.command, nullptr); }),
                Catch::Contains("orient.1001.exr") && Catch::Contains("orientation map") &&
                    Catch::Contains("16 x 16 texels"));
     CHECK_FALSE(fs::exists(wrongSize.redirect(1)));
@@ -417,6 +408,6 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     bad.at(3, 5, 0) = 1.5f;
     io::writeImage(outOfRange.dir / "orient.1001.exr", bad, {io::PixelType::Float, {}});
     outOfRange.command.orientation = outOfRange.dir / "orient.<UDIM>.exr";
-    CHECK_THAT(errorOf([&] { (void)harness::uvwarpCommand(outOfRange.command, nullptr); }),
+    CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(outOfRange.command, nullptr); }),
                Catch::Contains("orient.1001.exr") && Catch::Contains("1.5"));
 }

@@ -22,6 +22,7 @@
 #include "deformkit/warp/mesh_warp.h"
 #include "deformkit/warp/wires.h"
 #include "slide/slide_test_support.h"
+#include "test_support.h"
 
 // The adapters added after the first six: ffdframes, beierneely, meshwarp, and wires with several wires.
 // Each is compared bit for bit with the core calls it stands for, and against a closed form where one
@@ -45,10 +46,6 @@ std::vector<glm::vec3> run(Deformer& d, const geom::Mesh& rest) {
     std::vector<glm::vec3> out(in.size());
     d.evaluate(in, out);
     return out;
-}
-
-bool sameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
 float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
@@ -107,7 +104,7 @@ void checkThreadCounts(const Make& make, const geom::Mesh& rest) {
     const auto two = make();
     const std::vector<glm::vec3> b = run(*two, rest);
     omp_set_num_threads(omp_get_num_procs());
-    CHECK(sameBits(a, b));
+    CHECK(test::sameBits(a, b));
     CHECK(maxDistance(a, restOf(rest)) > 0.01f);  // the comparison is of a real deformation
 }
 
@@ -318,7 +315,7 @@ TEST_CASE("ffdframes adapter equals warp::FfdFrames called directly", "[host][de
     const auto hosted = setup.make();
     const std::vector<glm::vec3> out = run(*hosted, rest);
     // The same core calls on the same float values: bit-identical.
-    CHECK(sameBits(out, setup.direct(rest, restOf(rest))));
+    CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
     CHECK(maxDistance(out, restOf(rest)) > 0.05f);
 }
 
@@ -381,7 +378,7 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     CHECK_FALSE(d->needsBind());
     const std::vector<glm::vec3> second = run(*d, rest);
     CHECK(d->bindCount() == 1);
-    CHECK(sameBits(second, turned.direct(rest, restOf(rest))));
+    CHECK(test::sameBits(second, turned.direct(rest, restOf(rest))));
     CHECK(maxDistance(first, second) > 0.01f);
 
     d->set("outside", 1.0);
@@ -394,7 +391,7 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     shifted.origin.x = -1.5f;
     CHECK(d->get("points") == flatten(shifted.controlPoints()));
     CHECK(d->get("frames")[9 * 5 + 4] == 1.0);
-    CHECK(sameBits(run(*d, rest), restOf(rest)));
+    CHECK(test::sameBits(run(*d, rest), restOf(rest)));
     CHECK(d->bindCount() == 3);
 }
 
@@ -425,7 +422,7 @@ TEST_CASE("beierneely adapter equals the core warp through the engine, both vari
     for (int global : {0, 1}) {
         const auto d = setup.make(global);
         const std::vector<glm::vec3> out = run(*d, rest);
-        CHECK(sameBits(out, setup.direct(global, rest)));
+        CHECK(test::sameBits(out, setup.direct(global, rest)));
         CHECK(maxDistance(out, restOf(rest)) > 0.05f);
         // A 2-D warp: z is kept bit for bit.
         bool zKept = true;
@@ -470,7 +467,7 @@ TEST_CASE("beierneely: deformed features do not rebind, rest features and consta
     setup.moved[5] += 0.2;
     d->set("features", setup.moved);
     CHECK_FALSE(d->needsBind());
-    CHECK(sameBits(run(*d, rest), setup.direct(0, rest)));
+    CHECK(test::sameBits(run(*d, rest), setup.direct(0, rest)));
     CHECK(d->bindCount() == 1);
 
     d->set("b", 1.5);  // the value it has: nothing changes
@@ -537,7 +534,7 @@ TEST_CASE("meshwarp adapter equals warp::MeshWarp through the engine", "[host][d
 
     const auto hosted = setup.make();
     const std::vector<glm::vec3> out = run(*hosted, rest);
-    CHECK(sameBits(out, setup.direct(rest, restOf(rest))));
+    CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
     CHECK(maxDistance(out, restOf(rest)) > 0.05f);
 }
 
@@ -574,7 +571,7 @@ TEST_CASE("meshwarp: the deformed cage does not rebind, the rest cage and weight
     setup.target[4] += glm::vec3(-0.2f, -0.1f, 0.1f);
     d->set("cage", flatten(setup.target));
     CHECK_FALSE(d->needsBind());
-    CHECK(sameBits(run(*d, rest), setup.direct(rest, restOf(rest))));
+    CHECK(test::sameBits(run(*d, rest), setup.direct(rest, restOf(rest))));
     CHECK(d->bindCount() == 1);
 
     d->set("mu", 1.1);
@@ -656,7 +653,7 @@ TEST_CASE("wires adapter with two wires equals warp::Wires called directly", "[h
     for (int smooth : {0, 1}) {
         const auto d = setup.make(smooth);
         const std::vector<glm::vec3> out = run(*d, rest);
-        CHECK(sameBits(out, setup.direct(smooth, rest)));
+        CHECK(test::sameBits(out, setup.direct(smooth, rest)));
         CHECK(maxDistance(out, restOf(rest)) > 0.1f);
     }
     // One dropoff for both wires.
@@ -664,7 +661,7 @@ TEST_CASE("wires adapter with two wires equals warp::Wires called directly", "[h
     d->set("dropoff", 0.55);
     TwoWires same = setup;
     same.first.radius = same.second.radius = 0.55f;
-    CHECK(sameBits(run(*d, rest), same.direct(0, rest)));
+    CHECK(test::sameBits(run(*d, rest), same.direct(0, rest)));
 }
 
 TEST_CASE("wires: a second wire at rest with scale 1 has no say", "[host][deformers][wires]") {
@@ -705,7 +702,7 @@ TEST_CASE("wires: curves do not rebind, sizes and dropoffs do", "[host][deformer
     curve.insert(curve.end(), second.begin(), second.end());
     d->set("curve", curve);
     CHECK_FALSE(d->needsBind());
-    CHECK(sameBits(run(*d, rest), setup.direct(0, rest)));
+    CHECK(test::sameBits(run(*d, rest), setup.direct(0, rest)));
     CHECK(d->bindCount() == 1);
 
     d->set("dropoff", std::vector<double>{0.6, 0.45});
@@ -818,7 +815,7 @@ TEST_CASE("a stack of ffdframes then meshwarp with weights 0.5 follows Maya's ru
     const std::vector<glm::vec3> first = blend(restOf(rest), frames.direct(rest, restOf(rest)));
     const std::vector<glm::vec3> expected = blend(first, cage.direct(rest, first));
     // The same float operations in the same order: bit for bit.
-    CHECK(sameBits(points, expected));
+    CHECK(test::sameBits(points, expected));
     CHECK(maxDistance(points, first) > 0.02f);
     CHECK(maxDistance(first, restOf(rest)) > 0.02f);
     CHECK(stack.bindCount() == 2);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <numbers>
 #include <vector>
@@ -17,6 +16,7 @@
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/wires.h"
 #include "slide/slide_test_support.h"
+#include "test_support.h"
 
 using namespace deformkit;
 using Catch::Contains;
@@ -36,10 +36,6 @@ std::vector<glm::vec3> run(Deformer& d, const geom::Mesh& rest) {
     std::vector<glm::vec3> out(in.size());
     d.evaluate(in, out);
     return out;
-}
-
-bool sameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
 float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
@@ -109,7 +105,7 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
         CHECK(resetPoints[3 * c + 2] == targets[c].z);
     }
     // At rest the lattice is the identity, bit for bit (every translation is 0).
-    CHECK(sameBits(run(*d, rest), restOf(rest)));
+    CHECK(test::sameBits(run(*d, rest), restOf(rest)));
 
     targets[lattice.index(1, 1, 2)] += glm::vec3(0.3f, -0.2f, 0.5f);
     targets[lattice.index(2, 0, 1)] += glm::vec3(-0.1f, 0.4f, 0.2f);
@@ -125,7 +121,7 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
     std::vector<glm::vec3> direct = restOf(rest);
     ffd.evaluate(direct);
     // The adapter makes the same core calls on the same float values: bit-identical.
-    CHECK(sameBits(hosted, direct));
+    CHECK(test::sameBits(hosted, direct));
     CHECK(maxDistance(direct, restOf(rest)) > 0.05f);  // the lattice moved something
 }
 
@@ -149,7 +145,7 @@ TEST_CASE("twist adapter: Maya's twist, equal to the core and to the closed form
     twist.bind(rest.points(), fields);
     std::vector<glm::vec3> direct(hosted.size());
     twist.evaluate(rest.points(), direct);
-    CHECK(sameBits(hosted, direct));
+    CHECK(test::sameBits(hosted, direct));
 
     // Closed form: theta(x) = pi (x + 1) / 4 on [-1, 3], a right-handed turn about +x through (1, 1, 0):
     // (y - 1, z) -> ((y - 1) cos - z sin, (y - 1) sin + z cos). Float trigonometry and the profile's
@@ -188,7 +184,7 @@ TEST_CASE("taper adapter: scales across the handle axis linearly between the bou
     taper.bind(rest.points(), fields);
     std::vector<glm::vec3> direct(out.size());
     taper.evaluate(rest.points(), direct);
-    CHECK(sameBits(out, direct));
+    CHECK(test::sameBits(out, direct));
 }
 
 TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][deformers]") {
@@ -214,7 +210,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         bend.bind(rest.points(), fields);
         std::vector<glm::vec3> direct(hosted.size());
         bend.evaluate(rest.points(), direct);
-        CHECK(sameBits(hosted, direct));
+        CHECK(test::sameBits(hosted, direct));
         CHECK(maxDistance(direct, restOf(rest)) > 0.05f);
     }
     SECTION("wires") {
@@ -233,7 +229,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         wires.bind(rest.points());
         std::vector<glm::vec3> direct = restOf(rest);
         wires.evaluate(direct);
-        CHECK(sameBits(hosted, direct));
+        CHECK(test::sameBits(hosted, direct));
         CHECK(maxDistance(direct, restOf(rest)) > 0.1f);
     }
     SECTION("slide") {
@@ -250,7 +246,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         const std::vector<slide::SlideDrive> drives{{glm::dvec3(0.2, 0.1, 0.0), slide::Falloff::ramp(ramp)}};
         std::vector<glm::vec3> direct = restOf(rest);
         slider.evaluate(drives, direct);
-        CHECK(sameBits(hosted, direct));
+        CHECK(test::sameBits(hosted, direct));
         // On a plane the slide is a translation by falloff x displacement: the handle moves by all of it.
         CHECK(glm::length(hosted[40] - (rest.points()[40] + glm::vec3(0.2f, 0.1f, 0.0f))) < 1e-6f);
     }

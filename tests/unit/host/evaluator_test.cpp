@@ -1,8 +1,5 @@
 #include <catch2/catch.hpp>
 
-#include <cmath>
-#include <cstring>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -12,34 +9,13 @@
 #include "deformkit/host/evaluator.h"
 #include "deformkit/host/scene.h"
 #include "deformkit/io/obj.h"
+#include "mesh_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
 using Catch::Contains;
 
 namespace {
-
-// A tube around the Y axis from y = -1 to 1: `rings` rings of `sides` vertices, quads between.
-geom::Mesh makeTube(int rings = 5, int sides = 8, float radius = 0.5f) {
-    geom::Mesh::Data d;
-    for (int r = 0; r < rings; ++r) {
-        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-        for (int s = 0; s < sides; ++s) {
-            const double a = 2.0 * std::numbers::pi * s / sides;
-            d.points.emplace_back(radius * static_cast<float>(std::cos(a)), y,
-                                  radius * static_cast<float>(std::sin(a)));
-        }
-    }
-    for (int r = 0; r + 1 < rings; ++r) {
-        for (int s = 0; s < sides; ++s) {
-            const int s1 = (s + 1) % sides;
-            d.faceCounts.push_back(4);
-            d.faceIndices.insert(d.faceIndices.end(),
-                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
-        }
-    }
-    return geom::Mesh(std::move(d), "tube");
-}
 
 const char* kAnimated = R"({"deformkit_scene": 1, "frames": [1, 10], "objects": [{"name": "tube",
     "mesh": "tube.obj", "stack": [
@@ -48,22 +24,18 @@ const char* kAnimated = R"({"deformkit_scene": 1, "frames": [1, 10], "objects": 
     {"type": "taper", "envelope": {"keys": [{"frame": 1, "value": 0.2}, {"frame": 10, "value": 1}]},
         "params": {"endScale": {"keys": [{"frame": 1, "value": 1}, {"frame": 10, "value": 1.8}]}}}]}]})";
 
-bool sameBits(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
-}
-
 }  // namespace
 
 TEST_CASE("evaluator: animated controls bind once per deformer over 10 frames", "[host][evaluator]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube());
     host::SceneEvaluator evaluator(host::parseScene(kAnimated, dir / "shot.json"));
     host::DeformerStack& stack = evaluator.stack(0);
     std::vector<glm::vec3> previous;
     for (int frame = 1; frame <= 10; ++frame) {
         const geom::Mesh& out = evaluator.evaluate(0, frame);
         // Every frame moves the mesh (the twist's end angle changes each frame).
-        if (frame > 1) CHECK_FALSE(sameBits(out.points(), previous));
+        if (frame > 1) CHECK_FALSE(test::sameBits(out.points(), previous));
         previous.assign(out.points().begin(), out.points().end());
     }
     CHECK(stack.bindCount(0) == 1);
@@ -73,7 +45,7 @@ TEST_CASE("evaluator: animated controls bind once per deformer over 10 frames", 
     CHECK(stack.envelope(1) == 1.0);
 
     // A new rest mesh rebinds both entries once, and the output follows it.
-    stack.setRest(makeTube(5, 8, 0.25f));
+    stack.setRest(test::tube({.radius = 0.25f}));
     const geom::Mesh& thin = evaluator.evaluate(0, 10);
     const geom::Mesh& thinAgain = evaluator.evaluate(0, 10);
     CHECK(stack.bindCount(0) == 2);
@@ -86,19 +58,19 @@ TEST_CASE("evaluator: animated controls bind once per deformer over 10 frames", 
 
 TEST_CASE("evaluator: a frame's result does not depend on the frames evaluated before", "[host][evaluator]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube());
     host::SceneEvaluator played(host::parseScene(kAnimated, dir / "shot.json"));
     for (int frame = 1; frame <= 7; ++frame)
         (void)played.evaluate(0, frame);
     host::SceneEvaluator alone(host::parseScene(kAnimated, dir / "shot.json"));
     // Same values set on stacks bound to the same rest mesh: bit-identical (a farm job at frame 7 alone).
-    CHECK(sameBits(played.evaluate(0, 7).points(), alone.evaluate(0, 7).points()));
+    CHECK(test::sameBits(played.evaluate(0, 7).points(), alone.evaluate(0, 7).points()));
     CHECK(alone.stack(0).bindCount() == 2);
 }
 
 TEST_CASE("evaluator: an animated bind-time parameter rebinds when its value moves", "[host][evaluator]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube());
     const std::string text = R"({"deformkit_scene": 1, "frames": [1, 10], "objects": [{"name": "tube",
         "mesh": "tube.obj", "stack": [{"type": "twist", "params": {"handleOrigin": {"keys": [
         {"frame": 1, "value": [0, 0, 0]}, {"frame": 4, "value": [0, 0.5, 0], "interpolation": "constant"}]},
@@ -114,7 +86,7 @@ TEST_CASE("evaluator: an animated bind-time parameter rebinds when its value mov
 TEST_CASE("evaluator: constraints checked at bind name the scene, path and frame",
           "[host][evaluator][errors]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", makeTube());
+    io::writeObj(dir / "tube.obj", test::tube());
     const std::string text = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "tube",
         "mesh": "tube.obj", "stack": [{"type": "twist", "params": {"lowBound": 1, "highBound": {"keys": [
         {"frame": 1, "value": 2, "interpolation": "linear"}, {"frame": 3, "value": 0}]}}}]}]})";

@@ -1,8 +1,5 @@
 #include <catch2/catch.hpp>
 
-#include <cmath>
-#include <cstring>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -12,6 +9,7 @@
 #include "deformkit/host/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj.h"
+#include "mesh_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -19,32 +17,10 @@ using Catch::Contains;
 
 namespace {
 
-// A closed tube around the Y axis from y = -1 to 1: `rings` rings of `sides` vertices, quads between.
-geom::Mesh makeTube(int rings = 5, int sides = 8) {
-    geom::Mesh::Data d;
-    for (int r = 0; r < rings; ++r) {
-        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-        for (int s = 0; s < sides; ++s) {
-            const double a = 2.0 * std::numbers::pi * s / sides;
-            d.points.emplace_back(0.5f * static_cast<float>(std::cos(a)), y,
-                                  0.5f * static_cast<float>(std::sin(a)));
-        }
-    }
-    for (int r = 0; r + 1 < rings; ++r) {
-        for (int s = 0; s < sides; ++s) {
-            const int s1 = (s + 1) % sides;
-            d.faceCounts.push_back(4);
-            d.faceIndices.insert(d.faceIndices.end(),
-                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
-        }
-    }
-    return geom::Mesh(std::move(d), "tube");
-}
-
 // A scene folder with tube.obj, and a scene text around one stack entry.
 struct Fixture {
     test::TempDir dir;
-    Fixture() { io::writeObj(dir / "tube.obj", makeTube()); }
+    Fixture() { io::writeObj(dir / "tube.obj", test::tube()); }
     [[nodiscard]] std::filesystem::path scenePath() const { return dir / "shot.json"; }
     [[nodiscard]] host::Scene parse(const std::string& text) const {
         return host::parseScene(text, scenePath());
@@ -67,10 +43,6 @@ std::string withEntry(const std::string& entry) {
 
 std::vector<glm::vec3> pointsOf(const geom::Mesh& mesh) {
     return {mesh.points().begin(), mesh.points().end()};
-}
-
-bool sameBits(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
 }  // namespace
@@ -186,7 +158,7 @@ TEST_CASE("scene: a linearly keyed twist equals the twist set directly", "[host]
     CHECK(evaluator.stack(0).get(0, "endAngle") == std::vector<double>{0.6});
 
     host::DeformerStack direct;
-    const geom::Mesh tube = makeTube();
+    const geom::Mesh tube = test::tube();
     direct.setRest(tube);
     direct.add(host::makeDeformer("twist", "t"));
     direct.set(0, "handleY", std::vector<double>{0, 1, 0});
@@ -196,7 +168,7 @@ TEST_CASE("scene: a linearly keyed twist equals the twist set directly", "[host]
     std::vector<glm::vec3> expected = pointsOf(tube);
     direct.evaluate(expected);
     // Same deformer, same values, same order of operations: bit-identical.
-    CHECK(sameBits(out.points(), expected));
+    CHECK(test::sameBits(out.points(), expected));
     // And the twist did move points (a top vertex with weight > 0).
     CHECK(out.points()[37] != tube.points()[37]);
 }

@@ -1,9 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include <cmath>
 #include <cstring>
-#include <functional>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -13,6 +10,7 @@
 #include "deformkit/host/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj.h"
+#include "mesh_support.h"
 #include "test_support.h"
 
 // Objects whose mesh is a frame sequence (an animated input under the stack, as after skinning).
@@ -26,24 +24,9 @@ namespace {
 // A tube around the Y axis, swaying along X with the frame and shrinking in radius: every frame differs.
 geom::Mesh tubeAt(int frame, int rings = 5, int sides = 8) {
     geom::Mesh::Data d;
-    const float radius = 0.5f - 0.02f * static_cast<float>(frame);
-    for (int r = 0; r < rings; ++r) {
-        const float y = -1.0f + 2.0f * static_cast<float>(r) / static_cast<float>(rings - 1);
-        for (int s = 0; s < sides; ++s) {
-            const double a = 2.0 * std::numbers::pi * s / sides;
-            d.points.emplace_back(
-                radius * static_cast<float>(std::cos(a)) + 0.05f * static_cast<float>(frame) * y, y,
-                radius * static_cast<float>(std::sin(a)));
-        }
-    }
-    for (int r = 0; r + 1 < rings; ++r) {
-        for (int s = 0; s < sides; ++s) {
-            const int s1 = (s + 1) % sides;
-            d.faceCounts.push_back(4);
-            d.faceIndices.insert(d.faceIndices.end(),
-                                 {r * sides + s, r * sides + s1, (r + 1) * sides + s1, (r + 1) * sides + s});
-        }
-    }
+    test::appendTube(d, {.rings = rings, .sides = sides, .radius = 0.5f - 0.02f * static_cast<float>(frame)});
+    for (glm::vec3& p : d.points)
+        p.x += 0.05f * static_cast<float>(frame) * p.y;
     return geom::Mesh(std::move(d), "tube");
 }
 
@@ -52,16 +35,6 @@ std::string scene(const std::string& objectExtra) {
            objectExtra + R"("stack": [
       {"type": "twist", "envelope": 0.5, "params": {"endAngle": {"keys": [{"frame": 1, "value": 0.2, "interpolation": "linear"},
                                                                 {"frame": 3, "value": 1.0}]}}}]}]})";
-}
-
-template <class E>
-std::string errorOf(const std::function<void()>& body) {
-    try {
-        body();
-    } catch (const E& e) {
-        return e.what();
-    }
-    return "no error";
 }
 
 }  // namespace
@@ -106,25 +79,25 @@ TEST_CASE("sequence input: missing, fractional and mismatched frames name the sc
     io::writeObj(dir / "anim.0003.obj", tubeAt(3, 4, 8));  // one ring fewer
     host::SceneEvaluator evaluator(host::parseScene(scene(""), dir / "shot.json"));
     const std::string source = (dir / "shot.json").string();
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 4); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 4); }),
                Contains(source + ": objects[0].mesh: frame 4: ") && Contains("anim.0004.obj"));
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 1.5); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 1.5); }),
                Contains(source + ": objects[0].mesh: frame 1.5 of the sequence ") &&
                    Contains("(expected whole frames for an object whose mesh is a frame sequence)"));
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 3); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 3); }),
                Contains(source + ": objects[0].mesh: frame 3: ") && Contains("anim.0003.obj"));
     // Frames that exist still evaluate after the errors.
     CHECK(evaluator.evaluate(0, 2).numVertices() == tubeAt(2).numVertices());
 
     io::writeObj(dir / "tube.obj", tubeAt(1));
-    CHECK_THAT(errorOf<InvalidInput>([&] {
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)host::parseScene(
                        R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "t",
                         "mesh": "tube.obj", "restFrame": 2, "stack": []}]})",
                        dir / "shot.json");
                }),
                Contains(source + ": objects[0].restFrame: is given for the single mesh "));
-    CHECK_THAT(errorOf<InvalidInput>(
+    CHECK_THAT(test::errorOf<InvalidInput>(
                    [&] { (void)host::parseScene(scene(R"("restFrame": 9, )"), dir / "shot.json"); }),
                Contains(source + ": objects[0].mesh: names the sequence ") && Contains("rest frame 9"));
 }

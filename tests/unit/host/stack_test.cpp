@@ -19,6 +19,7 @@
 #include "deformkit/warp/barr_host.h"
 #include "deformkit/warp/ffd.h"
 #include "slide/slide_test_support.h"
+#include "test_support.h"
 
 using namespace deformkit;
 using Catch::Contains;
@@ -29,10 +30,6 @@ namespace {
 
 std::vector<glm::vec3> restOf(const geom::Mesh& mesh) {
     return {mesh.points().begin(), mesh.points().end()};
-}
-
-bool sameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
 bool sameBits(const glm::vec3& a, const glm::vec3& b) {
@@ -130,14 +127,14 @@ TEST_CASE("a stack of two warps and a slide equals the same core calls made dire
     const std::vector<glm::vec3> expected = scene.direct();
     // Envelope 1 and no painted weights: each stage's output is its core deformer's, bit for bit (the blend
     // passes a weight of exactly 1 through untouched).
-    CHECK(sameBits(points, expected));
+    CHECK(test::sameBits(points, expected));
     CHECK(maxDistance(points, restOf(scene.rest)) > 0.1f);  // every stage did something
     CHECK(stack.bindCount() == 3);
 
     // Evaluating again from the rest positions repeats the result bit for bit, without binding.
     std::vector<glm::vec3> again = restOf(scene.rest);
     stack.evaluate(again);
-    CHECK(sameBits(again, expected));
+    CHECK(test::sameBits(again, expected));
     CHECK(stack.bindCount() == 3);
 
     // The slide takes weights and envelope itself (Native): equal to the Slider given them directly.
@@ -148,7 +145,7 @@ TEST_CASE("a stack of two warps and a slide equals the same core calls made dire
     stack.setEnvelope(2, 0.5);
     std::vector<glm::vec3> weighted = restOf(scene.rest);
     stack.evaluate(weighted);
-    CHECK(sameBits(weighted, scene.direct(weights, 0.5f)));
+    CHECK(test::sameBits(weighted, scene.direct(weights, 0.5f)));
     CHECK(stack.bindCount() == 3);
 }
 
@@ -203,13 +200,13 @@ TEST_CASE("envelope and painted weights follow out = in + e w (d - in)", "[host]
     CHECK_FALSE(stack.isActive(0));
     std::vector<glm::vec3> off = restOf(rest);
     stack.evaluate(off);
-    CHECK(sameBits(off, restOf(rest)));
+    CHECK(test::sameBits(off, restOf(rest)));
     stack.setEnvelope(0, 1.0);
     stack.setWeights(0, std::vector<float>(rest.numVertices(), 0.0f));
     CHECK_FALSE(stack.isActive(0));
     std::vector<glm::vec3> zero = restOf(rest);
     stack.evaluate(zero);
-    CHECK(sameBits(zero, restOf(rest)));
+    CHECK(test::sameBits(zero, restOf(rest)));
     // Envelope beyond 1 is not clamped: twice the displacement (0 + 2 (d - 0) on the twist's axis plane).
     stack.setWeights(0, {});
     stack.setEnvelope(0, 2.0);
@@ -447,17 +444,17 @@ TEST_CASE("bad inputs are reported with the entry and the parameter", "[host][st
     std::vector<glm::vec3> points = restOf(scene.rest);
     CHECK_THROWS_WITH(stack.evaluate(points),
                       Contains("stack entry 1 (twist 'twist1'): parameter 'lowBound': is 5"));
-    CHECK(sameBits(points, restOf(scene.rest)));
+    CHECK(test::sameBits(points, restOf(scene.rest)));
     stack.set(1, "lowBound", -1.0);
     // A failed bind names the entry, and the entry stays unbound until it succeeds.
     stack.set(2, "vertex", 1000.0);
     CHECK_THROWS_WITH(stack.evaluate(points),
                       Contains("stack entry 2 (slide 'slide1'): parameter 'vertex': is 1000"));
     CHECK(stack.deformer(2).needsBind());
-    CHECK(sameBits(points, restOf(scene.rest)));
+    CHECK(test::sameBits(points, restOf(scene.rest)));
     stack.set(2, "vertex", static_cast<double>(scene.centre));
     stack.evaluate(points);
-    CHECK(sameBits(points, scene.direct()));
+    CHECK(test::sameBits(points, scene.direct()));
 
     // Weights painted for another mesh are caught when the rest mesh changes under them.
     stack.setWeights(0, std::vector<float>(n, 0.5f));
@@ -492,7 +489,7 @@ TEST_CASE("the stack gives bit-identical output for 1 and 2 threads", "[host][st
     std::vector<glm::vec3> two = restOf(scene.rest);
     stack.evaluate(two);
     omp_set_num_threads(threads);
-    CHECK(sameBits(one, two));
+    CHECK(test::sameBits(one, two));
     CHECK(maxDistance(one, restOf(scene.rest)) > 0.1f);
 }
 
@@ -511,16 +508,17 @@ TEST_CASE("evaluate(in, out) gives the in-place result for 0 to 3 active entries
         stack.evaluate(inPlace);
         std::vector<glm::vec3> out(input.size(), glm::vec3(7.0f));
         stack.evaluate(input, out);
-        CHECK(sameBits(out, inPlace));
-        if (mask == 7) CHECK(sameBits(out, scene.direct()));  // the reference: the core calls made directly
-        if (mask == 0) CHECK(sameBits(out, input));
+        CHECK(test::sameBits(out, inPlace));
+        if (mask == 7)
+            CHECK(test::sameBits(out, scene.direct()));  // the reference: the core calls made directly
+        if (mask == 0) CHECK(test::sameBits(out, input));
     }
     // A non-finite input point is found before any work: out untouched, the point named.
     std::vector<glm::vec3> bad = input;
     bad[5].y = std::numeric_limits<float>::quiet_NaN();
     std::vector<glm::vec3> out(input.size(), glm::vec3(7.0f));
     CHECK_THROWS_WITH(stack.evaluate(bad, out), Contains("point 5: is not finite"));
-    CHECK(sameBits(out, std::vector<glm::vec3>(input.size(), glm::vec3(7.0f))));
+    CHECK(test::sameBits(out, std::vector<glm::vec3>(input.size(), glm::vec3(7.0f))));
     bad[5].y = std::numeric_limits<float>::infinity();
     CHECK_THROWS_WITH(stack.evaluate(bad), Contains("point 5: is not finite"));
 }

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -73,16 +72,6 @@ void writeFloat(const fs::path& path, const io::Image& image) {
     io::writeImage(path, image, options);
 }
 
-template <class E>
-std::string errorOf(const std::function<void()>& body) {
-    try {
-        body();
-    } catch (const E& e) {
-        return e.what();
-    }
-    return "no error";
-}
-
 }  // namespace
 
 TEST_CASE("weight maps: per-tile maps sampled through the UVs reproduce a linear painting",
@@ -134,18 +123,20 @@ TEST_CASE("weight maps: bad input names the source, the file and what was expect
     test::TempDir dir;
     writeFloat(dir / "w.1001.exr", linearMap(0.0));
     const geom::Mesh two = grids({1001, 1002});
-    CHECK_THAT(errorOf<InvalidInput>([&] { (void)host::weightsFromMaps(two, dir / "w.1001.exr", 0, "src"); }),
-               Contains("src: ") && Contains("face 16 has its UVs in tile 1002"));
-    CHECK_THAT(errorOf<InvalidInput>(
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)host::weightsFromMaps(two, dir / "w.1001.exr", 0, "src"); }),
+        Contains("src: ") && Contains("face 16 has its UVs in tile 1002"));
+    CHECK_THAT(test::errorOf<InvalidInput>(
                    [&] { (void)host::weightsFromMaps(grids({1001}), dir / "w.1001.exr", 2, "src"); }),
                Contains("w.1001.exr: has 2 channels, channel 2 asked (expected a channel from 0 to 1)"));
-    CHECK_THAT(errorOf<Error>([&] { (void)host::weightsFromMaps(two, dir / "w.<UDIM>.exr", 0, "src"); }),
-               Contains("w.1002.exr"));
+    CHECK_THAT(
+        test::errorOf<Error>([&] { (void)host::weightsFromMaps(two, dir / "w.<UDIM>.exr", 0, "src"); }),
+        Contains("w.1002.exr"));
     geom::Mesh::Data d;
     d.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     d.faceCounts = {3};
     d.faceIndices = {0, 1, 2};
-    CHECK_THAT(errorOf<InvalidInput>([&] {
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)host::weightsFromMaps(geom::Mesh(std::move(d), "m"), dir / "w.1001.exr", 0, "src");
                }),
                Contains("a weight map for a mesh without UVs"));
@@ -165,17 +156,17 @@ TEST_CASE("weight maps: a scene's weights may be an image sampled through the UV
     const std::vector<float> expected = host::weightsFromMaps(mesh, dir / "w.<UDIM>.exr", 1, "x");
     CHECK(scene.objects[0].stack[0].weights == expected);
     CHECK(scene.objects[0].stack[0].weightsFile == dir / "w.<UDIM>.exr");
-    CHECK_THAT(errorOf<InvalidInput>([&] {
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)host::parseScene(head + R"({"image": "w.<UDIM>.exr", "chanel": 1}}]}]})",
                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.chanel: is not a known key"));
-    CHECK_THAT(errorOf<InvalidInput>([&] {
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)host::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 5}}]}]})",
                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("channel 5 asked"));
-    CHECK_THAT(errorOf<InvalidInput>([&] {
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)host::parseScene(head + R"({"image": "v.<UDIM>.exr"}}]}]})", dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("v.1001.exr"));
