@@ -8,6 +8,7 @@
 # build-fuzz/corpus/NAME, fuzzes for SECONDS and prints one result line. Exits non-zero when the fuzzer
 # finds a crash; the crashing input is left in build-fuzz/artifacts/NAME/ (add it to the seed corpus
 # once fixed, as a regression test). tests/fuzz/<format>.dict, if present, is the fuzzer dictionary.
+# FUZZ_BUILD names another build folder (default build-fuzz), e.g. to fuzz beside another engineer's build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,7 +29,7 @@ if ! command -v clang++ >/dev/null; then
     exit 2
 fi
 
-build=build-fuzz
+build=${FUZZ_BUILD:-build-fuzz}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}  # JOBS=1 on a shared machine
 mkdir -p "$build"
 build_log=$build/build.log

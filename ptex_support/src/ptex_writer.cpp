@@ -1,0 +1,458 @@
+// Ptex writer: version 1, a 40-byte extended header, level 0 plus reductions, constant faces flagged with
+// their value in ConstData, large faces tiled, small and large metadata, no edit data.
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <string>
+
+#include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
+#include "deformkit/ptex/ptex_file.h"
+#include "format.h"
+
+namespace deformkit::ptex {
+namespace {
+
+using namespace detail;
+
+const char* const kFaceVertCounts = "PtexFaceVertCounts";
+const char* const kFaceVertIndices = "PtexFaceVertIndices";
+const char* const kVertPositions = "PtexVertPositions";
+
+class Writer {
+  public:
+    Writer(const PtexFile& file, const WriteOptions& options, std::string source)
+        : file_(file), options_(options), source_(std::move(source)) {}
+
+    std::vector<uint8_t> write() {
+        validate();
+        classifyFaces();
+        std::vector<uint8_t> levelInfo;
+        std::vector<uint8_t> levelData;
+        const int levels = levelCount();
+        std::vector<uint32_t> levelFaces;
+        ByteWriter info(levelInfo);
+        for (int level = 0; level < levels; ++level) {
+            const size_t before = levelData.size();
+            const auto [headerZipSize, faceCount] = writeLevel(level, levelData);
+            info.put(static_cast<uint64_t>(levelData.size() - before));
+            info.put(static_cast<uint32_t>(headerZipSize));
+            info.put(static_cast<uint32_t>(faceCount));
+        }
+
+        std::vector<uint8_t> faceInfo;
+        ByteWriter fi(faceInfo);
+        for (size_t f = 0; f < faces_.size(); ++f)
+            storeFaceInfo(fi, faces_[f]);
+        const std::vector<uint8_t> faceInfoZip = zip(faceInfo, "face info");
+        const std::vector<uint8_t> constZip = zip(constData_, "constant data");
+
+        const std::vector<MetaValue> entries = allMetadata();
+        std::vector<uint8_t> smallMeta;
+        std::vector<uint8_t> largeHeader;
+        std::vector<uint8_t> largeData;
+        for (const MetaValue& entry : entries) {
+            const std::vector<uint8_t> value = entry.bytes();
+            if (value.size() > kLargeMetaThreshold) {
+                const std::vector<uint8_t> valueZip = zip(value, "metadata '" + entry.key + "'");
+                ByteWriter h(largeHeader);
+                putMetaKey(h, entry, value.size());
+                h.put(static_cast<uint32_t>(valueZip.size()));
+                largeData.insert(largeData.end(), valueZip.begin(), valueZip.end());
+            } else {
+                ByteWriter m(smallMeta);
+                putMetaKey(m, entry, value.size());
+                m.bytes(value);
+            }
+        }
+        const std::vector<uint8_t> smallMetaZip =
+            smallMeta.empty() ? std::vector<uint8_t>{} : zip(smallMeta, "metadata");
+        const std::vector<uint8_t> largeHeaderZip =
+            largeHeader.empty() ? std::vector<uint8_t>{} : zip(largeHeader, "large metadata");
+        const bool barrier = !entries.empty();
+        checkU32(faceInfoZip.size(), "face info");
+        checkU32(constZip.size(), "constant data");
+        checkU32(smallMeta.size(), "metadata");
+        checkU32(largeHeader.size(), "large metadata");
+
+        const uint64_t total = kHeaderSize + kExtHeaderSize + faceInfoZip.size() + constZip.size() +
+                               levelInfo.size() + levelData.size() + smallMetaZip.size() +
+                               (barrier ? kBarrierSize : 0) + largeHeaderZip.size() + largeData.size();
+        std::vector<uint8_t> out;
+        out.reserve(total);
+        ByteWriter w(out);
+        w.put(kMagic);
+        w.put(kVersion);
+        w.put(static_cast<uint32_t>(file_.meshType));
+        w.put(static_cast<uint32_t>(file_.dataType));
+        w.put(static_cast<int32_t>(file_.alphaChannel));
+        w.put(static_cast<uint16_t>(file_.channels));
+        w.put(static_cast<uint16_t>(levels));
+        w.put(static_cast<uint32_t>(faces_.size()));
+        w.put(static_cast<uint32_t>(kExtHeaderSize));
+        w.put(static_cast<uint32_t>(faceInfoZip.size()));
+        w.put(static_cast<uint32_t>(constZip.size()));
+        w.put(static_cast<uint32_t>(levelInfo.size()));
+        w.put(kMinorVersion);
+        w.put(static_cast<uint64_t>(levelData.size()));
+        w.put(static_cast<uint32_t>(smallMetaZip.size()));
+        w.put(static_cast<uint32_t>(smallMeta.size()));
+        // Extended header.
+        w.put(static_cast<uint16_t>(file_.uBorderMode));
+        w.put(uint16_t{0});
+        w.put(static_cast<uint16_t>(file_.vBorderMode));
+        w.put(static_cast<uint16_t>(file_.edgeFilterMode));
+        w.put(static_cast<uint32_t>(largeHeaderZip.size()));
+        w.put(static_cast<uint32_t>(largeHeader.size()));
+        w.put(static_cast<uint64_t>(largeData.size()));
+        w.put(uint64_t{0});  // edit data size
+        w.put(total);        // edit data position: the end of the file
+        w.bytes(faceInfoZip);
+        w.bytes(constZip);
+        w.bytes(levelInfo);
+        w.bytes(levelData);
+        w.bytes(smallMetaZip);
+        if (barrier) out.insert(out.end(), kBarrierSize, uint8_t{0});
+        w.bytes(largeHeaderZip);
+        w.bytes(largeData);
+        return out;
+    }
+
+  private:
+    [[noreturn]] void fail(const std::string& element, const std::string& problem,
+                           const std::string& expected) const {
+        throw InvalidInput(formatError(source_, element, problem, expected));
+    }
+
+    void checkU32(size_t size, const std::string& section) const {
+        if (size > 0xffffffffu) fail(section, "is " + std::to_string(size) + " bytes", "less than 4 GiB");
+    }
+
+    void validate() const {
+        const auto dataType = static_cast<uint32_t>(file_.dataType);
+        const auto meshType = static_cast<uint32_t>(file_.meshType);
+        if (dataType > 3) fail("data type", "is " + std::to_string(dataType), "0..3 (u8, u16, half, float)");
+        if (meshType > 1) fail("mesh type", "is " + std::to_string(meshType), "0 (triangle) or 1 (quad)");
+        if (file_.channels < 1 || file_.channels > kMaxChannels) {
+            fail("channels", "is " + std::to_string(file_.channels), "1..64");
+        }
+        if (file_.alphaChannel < -1 || file_.alphaChannel >= file_.channels) {
+            fail("alpha channel", "is " + std::to_string(file_.alphaChannel),
+                 "-1 (none) or 0.." + std::to_string(file_.channels - 1));
+        }
+        if (static_cast<uint16_t>(file_.uBorderMode) > 2 || static_cast<uint16_t>(file_.vBorderMode) > 2) {
+            fail("border mode", "is out of range", "0 (clamp), 1 (black) or 2 (periodic)");
+        }
+        if (static_cast<uint16_t>(file_.edgeFilterMode) > 1) {
+            fail("edge filter mode", "is out of range", "0 (none) or 1 (tangent vectors)");
+        }
+        if (options_.compressionLevel < 0 || options_.compressionLevel > 9) {
+            fail("compression level", "is " + std::to_string(options_.compressionLevel), "0..9");
+        }
+        if (options_.tileBytes == 0) fail("tile size", "is 0 bytes", "at least 1");
+        const size_t n = file_.faces.size();
+        if (n > 0x7fffffffu) fail("faces", "are " + std::to_string(n), "fewer than 2^31");
+        if (file_.texels.size() != n) {
+            fail("texels", "has " + std::to_string(file_.texels.size()) + " faces",
+                 std::to_string(n) + " (one buffer per face)");
+        }
+        const size_t pixel = file_.pixelSize();
+        if (!file_.constData.empty() && file_.constData.size() != n * pixel) {
+            fail("constant data", "is " + std::to_string(file_.constData.size()) + " bytes",
+                 std::to_string(n * pixel) + " (one pixel per face) or empty");
+        }
+        for (size_t f = 0; f < n; ++f) {
+            const FaceInfo& info = file_.faces[f];
+            const std::string face = "face " + std::to_string(f);
+            if (info.ulog2 < 0 || info.ulog2 > kMaxLog2 || info.vlog2 < 0 || info.vlog2 > kMaxLog2) {
+                fail(face,
+                     "has resolution log2 " + std::to_string(info.ulog2) + " x " + std::to_string(info.vlog2),
+                     "each log2 in 0..15");
+            }
+            for (int e = 0; e < 4; ++e) {
+                if (info.adjFaces[e] < -1 || info.adjFaces[e] >= static_cast<int64_t>(n)) {
+                    fail(face,
+                         "edge " + std::to_string(e) + " names neighbour " + std::to_string(info.adjFaces[e]),
+                         "-1 (none) or a face id below " + std::to_string(n));
+                }
+                if (info.adjEdges[e] > 3) {
+                    fail(face,
+                         "edge " + std::to_string(e) + " names neighbour edge " +
+                             std::to_string(info.adjEdges[e]),
+                         "0..3");
+                }
+            }
+            const size_t expected = info.texelCount() * pixel;
+            if (file_.texels[f].empty()) {
+                if (file_.constData.empty()) {
+                    fail(face, "has no texels and there is no constant data", "texels or a constant value");
+                }
+            } else if (file_.texels[f].size() != expected) {
+                fail(face, "has " + std::to_string(file_.texels[f].size()) + " texel bytes",
+                     std::to_string(expected) + " (" + std::to_string(info.ures()) + " x " +
+                         std::to_string(info.vres()) + " texels of " + std::to_string(pixel) + " bytes)");
+            }
+        }
+        for (size_t i = 0; i < file_.metadata.size(); ++i)
+            validateMeta(file_.metadata[i], i);
+        if (options_.mesh) validateMesh(*options_.mesh);
+    }
+
+    void validateMeta(const MetaValue& m, size_t index) const {
+        const std::string element = "metadata entry " + std::to_string(index);
+        if (m.key.empty() || m.key.size() > 254 || m.key.find('\0') != std::string::npos) {
+            fail(element, "has key '" + m.key + "'", "1..254 bytes without NUL");
+        }
+        if (static_cast<uint8_t>(m.type) > 5) fail(element, "has an unknown type", "0..5");
+        if (m.bytes().size() > 0xffffffffu) fail(element, "is larger than 4 GiB", "a smaller value");
+        if (options_.mesh &&
+            (m.key == kFaceVertCounts || m.key == kFaceVertIndices || m.key == kVertPositions)) {
+            fail(element, "key '" + m.key + "' is also given as WriteOptions::mesh", "one or the other");
+        }
+    }
+
+    void validateMesh(const MeshData& mesh) const {
+        int64_t corners = 0;
+        for (size_t i = 0; i < mesh.faceVertCounts.size(); ++i) {
+            if (mesh.faceVertCounts[i] < 3) {
+                fail("mesh polygon " + std::to_string(i),
+                     "has " + std::to_string(mesh.faceVertCounts[i]) + " vertices", "at least 3");
+            }
+            corners += mesh.faceVertCounts[i];
+        }
+        if (corners != static_cast<int64_t>(mesh.faceVertIndices.size())) {
+            fail("mesh", "has " + std::to_string(mesh.faceVertIndices.size()) + " vertex indices",
+                 std::to_string(corners) + " (the sum of the polygon vertex counts)");
+        }
+        if (mesh.vertPositions.size() % 3 != 0) {
+            fail("mesh", "has " + std::to_string(mesh.vertPositions.size()) + " position floats",
+                 "3 per vertex");
+        }
+        const int64_t vertices = static_cast<int64_t>(mesh.vertPositions.size() / 3);
+        for (size_t i = 0; i < mesh.faceVertIndices.size(); ++i) {
+            if (mesh.faceVertIndices[i] < 0 || mesh.faceVertIndices[i] >= vertices) {
+                fail("mesh vertex index " + std::to_string(i),
+                     "is " + std::to_string(mesh.faceVertIndices[i]), "0.." + std::to_string(vertices - 1));
+            }
+        }
+    }
+
+    std::vector<MetaValue> allMetadata() const {
+        std::vector<MetaValue> entries = file_.metadata;
+        if (options_.mesh) {
+            entries.push_back(MetaValue::ofInt32(kFaceVertCounts, options_.mesh->faceVertCounts));
+            entries.push_back(MetaValue::ofInt32(kFaceVertIndices, options_.mesh->faceVertIndices));
+            entries.push_back(MetaValue::ofFloat(kVertPositions, options_.mesh->vertPositions));
+        }
+        return entries;
+    }
+
+    static void putMetaKey(ByteWriter& out, const MetaValue& m, size_t valueSize) {
+        out.put(static_cast<uint8_t>(m.key.size() + 1));
+        out.bytes({reinterpret_cast<const uint8_t*>(m.key.data()), m.key.size()});
+        out.put(uint8_t{0});
+        out.put(static_cast<uint8_t>(m.type));
+        out.put(static_cast<uint32_t>(valueSize));
+    }
+
+    // Decides which faces are constant, their ConstData pixel, and the neighbourhood-constant flag.
+    void classifyFaces() {
+        const size_t n = file_.faces.size();
+        const size_t pixel = file_.pixelSize();
+        faces_ = file_.faces;
+        constData_.assign(n * pixel, 0);
+        for (size_t f = 0; f < n; ++f) {
+            FaceInfo& info = faces_[f];
+            uint8_t* value = constData_.data() + f * pixel;
+            const std::vector<uint8_t>& texels = file_.texels[f];
+            info.hasEdits = false;
+            if (texels.empty()) {
+                info.constant = true;
+                std::memcpy(value, file_.constData.data() + f * pixel, pixel);
+                continue;
+            }
+            bool allEqual = true;
+            for (size_t t = pixel; t < texels.size() && allEqual; t += pixel) {
+                allEqual = std::memcmp(texels.data(), texels.data() + t, pixel) == 0;
+            }
+            info.constant = allEqual;
+            const std::vector<uint8_t> average =
+                allEqual ? std::vector<uint8_t>(texels.begin(), texels.begin() + pixel)
+                         : averagePixel(texels, info.texelCount(), file_.dataType, file_.channels,
+                                        file_.alphaChannel);
+            std::memcpy(value, average.data(), pixel);
+        }
+        for (size_t f = 0; f < n; ++f) {
+            FaceInfo& info = faces_[f];
+            bool same = info.constant;
+            for (int e = 0; e < 4 && same; ++e) {
+                const int32_t g = info.adjFaces[e];
+                if (g < 0) continue;
+                same = faces_[g].constant &&
+                       std::memcmp(constData_.data() + f * pixel, constData_.data() + g * pixel, pixel) == 0;
+            }
+            info.neighbourhoodConstant = same;
+        }
+    }
+
+    int levelCount() const {
+        if (!options_.reductions) return 1;
+        int maxMin = 0;
+        for (const FaceInfo& info : faces_)
+            maxMin = std::max(maxMin, static_cast<int>(std::min(info.ulog2, info.vlog2)));
+        return maxMin + 1;
+    }
+
+    // Appends one level (zipped face-data headers, then the blocks) and returns the zipped header size and
+    // the number of faces.
+    std::pair<size_t, size_t> writeLevel(int level, std::vector<uint8_t>& out) {
+        std::vector<uint32_t> order;
+        if (level == 0) {
+            order.resize(faces_.size());
+            std::iota(order.begin(), order.end(), 0u);
+            reduced_.assign(faces_.size(), {});
+        } else {
+            for (uint32_t f = 0; f < faces_.size(); ++f) {
+                if (std::min(faces_[f].ulog2, faces_[f].vlog2) >= level) order.push_back(f);
+            }
+            std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+                return std::min(faces_[a].ulog2, faces_[a].vlog2) >
+                       std::min(faces_[b].ulog2, faces_[b].vlog2);
+            });
+        }
+        std::vector<uint8_t> headers;
+        std::vector<uint8_t> blocks;
+        ByteWriter h(headers);
+        for (const uint32_t f : order) {
+            const FaceInfo& info = faces_[f];
+            if (info.constant) {
+                h.put(uint32_t{0});
+                continue;
+            }
+            const int w = info.ures() >> level;
+            const int hgt = info.vres() >> level;
+            if (level > 0) {
+                const std::vector<uint8_t>& source = level == 1 ? file_.texels[f] : reduced_[f];
+                reduced_[f] =
+                    reduceFace(source, w * 2, hgt * 2, file_.dataType, file_.channels, file_.alphaChannel);
+            }
+            const std::vector<uint8_t>& texels = level == 0 ? file_.texels[f] : reduced_[f];
+            const std::string element = "face " + std::to_string(f) + " at level " + std::to_string(level);
+            h.put(encodeFace(texels, w, hgt, blocks, element));
+        }
+        const std::vector<uint8_t> headerZip = zip(headers, "level " + std::to_string(level) + " headers");
+        out.insert(out.end(), headerZip.begin(), headerZip.end());
+        out.insert(out.end(), blocks.begin(), blocks.end());
+        return {headerZip.size(), order.size()};
+    }
+
+    // Appends a non-constant face block and returns its face-data header.
+    uint32_t encodeFace(const std::vector<uint8_t>& texels, int w, int h, std::vector<uint8_t>& out,
+                        const std::string& element) {
+        const size_t pixel = file_.pixelSize();
+        const size_t bytes = static_cast<size_t>(w) * h * pixel;
+        if (bytes < options_.tileThresholdBytes || w * h == 1) {
+            const size_t before = out.size();
+            const uint32_t encoding = zipRect(texels.data(), w, 0, 0, w, h, out, element);
+            return blockHeader(encoding, checkedBlockSize(out.size() - before, element));
+        }
+        int tileULog2 = std::countr_zero(static_cast<unsigned>(w));
+        int tileVLog2 = std::countr_zero(static_cast<unsigned>(h));
+        while ((size_t{1} << (tileULog2 + tileVLog2)) * pixel > options_.tileBytes &&
+               tileULog2 + tileVLog2 > 0) {
+            if (tileULog2 >= tileVLog2) {
+                --tileULog2;
+            } else {
+                --tileVLog2;
+            }
+        }
+        const int tw = 1 << tileULog2;
+        const int th = 1 << tileVLog2;
+        std::vector<uint8_t> tileHeaders;
+        std::vector<uint8_t> tiles;
+        ByteWriter th_(tileHeaders);
+        for (int ty = 0; ty < h / th; ++ty) {
+            for (int tx = 0; tx < w / tw; ++tx) {
+                const uint8_t* first = texels.data() + (static_cast<size_t>(ty) * th * w + tx * tw) * pixel;
+                bool allEqual = true;
+                for (int y = 0; y < th && allEqual; ++y) {
+                    const uint8_t* row =
+                        texels.data() + (static_cast<size_t>(ty * th + y) * w + tx * tw) * pixel;
+                    for (int x = 0; x < tw && allEqual; ++x)
+                        allEqual = std::memcmp(first, row + x * pixel, pixel) == 0;
+                }
+                if (allEqual) {
+                    tiles.insert(tiles.end(), first, first + pixel);
+                    th_.put(blockHeader(kConstant, static_cast<uint32_t>(pixel)));
+                    continue;
+                }
+                const size_t before = tiles.size();
+                const uint32_t encoding = zipRect(texels.data(), w, tx * tw, ty * th, tw, th, tiles, element);
+                th_.put(blockHeader(encoding, checkedBlockSize(tiles.size() - before, element)));
+            }
+        }
+        const std::vector<uint8_t> headerZip = zip(tileHeaders, element + " tile headers");
+        const size_t before = out.size();
+        ByteWriter o(out);
+        o.put(static_cast<int8_t>(tileULog2));
+        o.put(static_cast<int8_t>(tileVLog2));
+        o.put(static_cast<uint32_t>(headerZip.size()));
+        o.bytes(headerZip);
+        o.bytes(tiles);
+        return blockHeader(kTiled, checkedBlockSize(out.size() - before, element));
+    }
+
+    uint32_t checkedBlockSize(size_t size, const std::string& element) const {
+        if (size > kBlockSizeMask) {
+            fail(element, "encodes to " + std::to_string(size) + " bytes",
+                 "fewer than 2^30 (the block size field)");
+        }
+        return static_cast<uint32_t>(size);
+    }
+
+    // Zips the (x0, y0, w, h) rectangle in channel planes, difference-coded for u8/u16; returns the encoding.
+    uint32_t zipRect(const uint8_t* face, int faceWidth, int x0, int y0, int w, int h,
+                     std::vector<uint8_t>& out, const std::string& element) {
+        const int bpc = static_cast<int>(bytesPerChannel(file_.dataType));
+        planar_.resize(static_cast<size_t>(w) * h * file_.pixelSize());
+        interleavedToPlanar(face, faceWidth, x0, y0, w, h, file_.channels, bpc, planar_.data());
+        const bool diff = file_.dataType == DataType::UInt8 || file_.dataType == DataType::UInt16;
+        if (diff) diffEncode(planar_, bpc);
+        const std::vector<uint8_t> zipped = zip(planar_, element);
+        out.insert(out.end(), zipped.begin(), zipped.end());
+        return diff ? kDiffZipped : kZipped;
+    }
+
+    std::vector<uint8_t> zip(std::span<const uint8_t> data, const std::string& element) const {
+        uLongf size = compressBound(static_cast<uLong>(data.size()));
+        std::vector<uint8_t> out(size);
+        const int rc = compress2(out.data(), &size, data.data(), static_cast<uLong>(data.size()),
+                                 options_.compressionLevel);
+        if (rc != Z_OK) fail(element, "zlib compression failed (code " + std::to_string(rc) + ")", "");
+        out.resize(size);
+        return out;
+    }
+
+    const PtexFile& file_;
+    const WriteOptions& options_;
+    std::string source_;
+    std::vector<FaceInfo> faces_;
+    std::vector<uint8_t> constData_;
+    std::vector<std::vector<uint8_t>> reduced_;
+    std::vector<uint8_t> planar_;
+};
+
+}  // namespace
+
+std::vector<uint8_t> writePtexBytes(const PtexFile& file, const WriteOptions& options) {
+    return Writer(file, options, "Ptex data").write();
+}
+
+void writePtex(const std::filesystem::path& path, const PtexFile& file, const WriteOptions& options) {
+    const std::vector<uint8_t> bytes = Writer(file, options, path.string()).write();
+    io::writeFileAtomically(path, {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+}
+
+}  // namespace deformkit::ptex
