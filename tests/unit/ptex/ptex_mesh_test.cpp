@@ -1,0 +1,485 @@
+// Ptex faces of meshes: OpenSubdiv face ids and adjacency checked against the geometry of the faces,
+// filtered look-ups against linear paintings, per-vertex values, baking, and UDIM conversions.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+#include <set>
+
+#include <glm/geometric.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/ptex/half.h"
+#include "deformkit/ptex/ptex_mesh.h"
+
+#include "../test_support.h"
+
+using namespace deformkit;
+using deformkit::ptex::PtexMesh;
+
+namespace {
+
+// A planar mesh mixing quads, triangles and a pentagon (with a straight-angle corner):
+//
+//   8 ------ 9 ---- 10          T  = (4, 5, 8),  T2 = (5, 9, 8)
+//   | T  /T2  \  P   |          P  = (5, 6, 7, 10, 9)
+//   4 ----- 5 ---- 6 ---- 7     Q0 = (0, 1, 5, 4), Q1 = (1, 2, 6, 5), Q2 = (2, 3, 7, 6)
+//   |  Q0   |  Q1  |  Q2  |
+//   0 ----- 1 ---- 2 ---- 3
+geom::Mesh mixedMesh() {
+    geom::Mesh::Data d;
+    d.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0},    {3, 0, 0},    {0, 1, 0}, {1, 1, 0},
+                {2, 1, 0}, {3, 1, 0}, {0.5f, 2, 0}, {2, 2.2f, 0}, {3, 2, 0}};
+    d.faceCounts = {4, 4, 4, 3, 3, 5};
+    d.faceIndices = {0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 4, 5, 8, 5, 9, 8, 5, 6, 7, 10, 9};
+    for (const glm::vec3& p : d.points)
+        d.uvs.emplace_back(0.1f + 0.25f * p.x, 0.1f + 0.3f * p.y);
+    d.uvIndices = d.faceIndices;
+    return geom::Mesh(std::move(d), "mixed.obj");
+}
+
+// An n x n grid of unit quads in the plane z = 0 (UVs = position / n squeezed into [0.1, 0.9] of tile
+// 1001, or spread over `tilesU` tiles along u); face k's corner list is rotated by k % 4 so that the Ptex
+// (u, v) axes of neighbours point every which way.
+geom::Mesh grid(int n, bool rotate, int tilesU = 1) {
+    geom::Mesh::Data d;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            d.points.emplace_back(i, j, 0);
+            d.uvs.emplace_back(tilesU * (0.1f + 0.8f * i / n), 0.1f + 0.8f * j / n);
+        }
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const int v0 = j * (n + 1) + i;
+            std::array<int, 4> c{v0, v0 + 1, v0 + n + 2, v0 + n + 1};
+            if (rotate) std::rotate(c.begin(), c.begin() + (j * n + i) % 4, c.end());
+            d.faceCounts.push_back(4);
+            d.faceIndices.insert(d.faceIndices.end(), c.begin(), c.end());
+        }
+    d.uvIndices = d.faceIndices;
+    return geom::Mesh(std::move(d), "grid.obj");
+}
+
+// The four corners of a Ptex face in 3D, written from the convention (quad corners; sub-face k: corner k,
+// midpoint of edge k, centre, midpoint of edge k - 1), independently of PtexMesh::cornerWeights.
+std::array<glm::dvec3, 4> ptexCorners(const geom::Mesh& mesh, const PtexMesh& pm, int32_t p) {
+    const auto face = mesh.face(pm.meshFace(p));
+    const auto P = [&](size_t k) { return glm::dvec3(mesh.points()[face[k % face.size()]]); };
+    if (face.size() == 4) return {P(0), P(1), P(2), P(3)};
+    const size_t n = face.size(), k = static_cast<size_t>(pm.subFace(p));
+    glm::dvec3 centre(0.0);
+    for (size_t c = 0; c < n; ++c)
+        centre += P(c) / static_cast<double>(n);
+    return {P(k), 0.5 * (P(k) + P(k + 1)), centre, 0.5 * (P(k + n - 1) + P(k))};
+}
+
+glm::dvec3 ptexPoint(const std::array<glm::dvec3, 4>& c, double u, double v) {
+    return (1 - u) * (1 - v) * c[0] + u * (1 - v) * c[1] + u * v * c[2] + (1 - u) * v * c[3];
+}
+
+// A linear painting of the plane.
+double paint(const glm::dvec3& p) {
+    return 0.3 + 0.2 * p.x - 0.15 * p.y;
+}
+const double kPaintGradient = std::hypot(0.2, 0.15);
+
+// The three meshes' paintings baked at 2^log2 texels per side.
+ptex::PtexFile bakePaint(const geom::Mesh& mesh, const PtexMesh& pm, int8_t log2) {
+    std::vector<float> values;
+    for (const glm::vec3& p : mesh.points())
+        values.push_back(static_cast<float>(paint(glm::dvec3(p))));
+    return ptex::bakeVertexValues(pm, values, 1, {log2, log2, ptex::DataType::Float});
+}
+
+float floatAt(const ptex::PtexFile& file, int32_t face, size_t index) {
+    float value = 0.0f;
+    std::memcpy(&value, file.texels[face].data() + index * 4, 4);
+    return value;
+}
+
+}  // namespace
+
+TEST_CASE("ptex mesh: one Ptex face per quad and N per N-gon, in face order", "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh, "mixed.obj");
+    CHECK(pm.numPtexFaces() == 3 + 3 + 3 + 5);
+    CHECK(pm.numMeshFaces() == 6);
+    const std::vector<int32_t> first{0, 1, 2, 3, 6, 9};
+    for (int32_t f = 0; f < 6; ++f)
+        CHECK(pm.firstPtexFace(f) == first[f]);
+    CHECK(pm.meshFace(4) == 3);
+    CHECK(pm.subFace(4) == 1);
+    CHECK(pm.subFace(1) == -1);
+    CHECK(pm.meshFace(13) == 5);
+    CHECK(pm.subFace(13) == 4);
+    const auto infos = pm.faceInfos(3, 2);
+    CHECK(infos[0].subface == false);
+    CHECK(infos[10].subface == true);
+    CHECK(infos[10].ures() == 8);
+    CHECK(infos[10].vres() == 4);
+}
+
+TEST_CASE("ptex mesh: adjacency joins faces along the same segment of the surface", "[ptex][mesh]") {
+    // Independent check of OpenSubdiv's adjacency: edge e of face p runs from corner e to corner e + 1 of
+    // the Ptex face; its neighbour's edge must run along the same line the other way, over the same
+    // segment (equal kinds) or over a half of it (a quad edge next to a sub-face's half edge).
+    for (const geom::Mesh& mesh : {mixedMesh(), grid(3, true)}) {
+        const PtexMesh pm(mesh);
+        int shared = 0, boundary = 0;
+        for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+            const auto c = ptexCorners(mesh, pm, p);
+            for (int e = 0; e < 4; ++e) {
+                const int32_t g = pm.adjFaces(p)[e];
+                if (g < 0) {
+                    ++boundary;
+                    continue;
+                }
+                ++shared;
+                const int ge = pm.adjEdges(p)[e];
+                const auto d = ptexCorners(mesh, pm, g);
+                const glm::dvec3 a0 = c[e], a1 = c[(e + 1) % 4], b0 = d[ge], b1 = d[(ge + 1) % 4];
+                const bool pSub = pm.subFace(p) >= 0, gSub = pm.subFace(g) >= 0;
+                const bool outer = [&](int edge, bool sub) { return !sub || edge == 0 || edge == 3; }(e,
+                                                                                                      pSub);
+                if (pSub == gSub || !outer) {
+                    // The same segment, reversed; and the neighbour points back.
+                    CHECK(glm::length(a0 - b1) < 1e-6);
+                    CHECK(glm::length(a1 - b0) < 1e-6);
+                    CHECK(pm.adjFaces(g)[ge] == p);
+                    CHECK(pm.adjEdges(g)[ge] == e);
+                } else {
+                    // Quad edge and a half of it: the shorter lies on the longer, in the opposite direction.
+                    const glm::dvec3 L0 = pSub ? b0 : a0, L1 = pSub ? b1 : a1, S0 = pSub ? a0 : b0,
+                                     S1 = pSub ? a1 : b1;
+                    const glm::dvec3 dir = L1 - L0;
+                    for (const glm::dvec3& s : {S0, S1}) {
+                        const double t = glm::dot(s - L0, dir) / glm::dot(dir, dir);
+                        CHECK(glm::length(L0 + t * dir - s) < 1e-6);
+                        CHECK(t > -1e-9);
+                        CHECK(t < 1 + 1e-9);
+                    }
+                    CHECK(glm::dot(S1 - S0, dir) < 0.0);
+                    CHECK(glm::length(S1 - S0) == Approx(0.5 * glm::length(dir)).epsilon(1e-6));
+                }
+            }
+        }
+        // Boundary Ptex edges, counted from the mesh: a quad's edge with no twin is one, an N-gon's two.
+        int boundaryHalfEdges = 0;
+        for (int32_t f = 0; f < mesh.numFaces(); ++f) {
+            const auto face = mesh.face(f);
+            for (size_t k = 0; k < face.size(); ++k) {
+                const int32_t a = face[k], b = face[(k + 1) % face.size()];
+                bool found = false;
+                for (int32_t g = 0; g < mesh.numFaces() && !found; ++g) {
+                    const auto other = mesh.face(g);
+                    for (size_t m = 0; m < other.size(); ++m)
+                        found = found || (other[m] == b && other[(m + 1) % other.size()] == a);
+                }
+                if (!found) boundaryHalfEdges += face.size() == 4 ? 1 : 2;
+            }
+        }
+        CHECK(boundary == boundaryHalfEdges);
+        CHECK(shared + boundary == 4 * pm.numPtexFaces());
+    }
+}
+
+TEST_CASE("ptex mesh: corner weights place (u, v) bilinearly on the quad or sub-face", "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        const auto face = mesh.face(pm.meshFace(p));
+        const auto c = ptexCorners(mesh, pm, p);
+        std::vector<double> w(face.size());
+        for (int s = 0; s < 20; ++s) {
+            const double u = unit(rng), v = unit(rng);
+            pm.cornerWeights(p, u, v, w);
+            glm::dvec3 at(0.0);
+            double sum = 0.0;
+            for (size_t k = 0; k < face.size(); ++k) {
+                at += w[k] * glm::dvec3(mesh.points()[face[k]]);
+                sum += w[k];
+                CHECK(w[k] >= 0.0);
+            }
+            CHECK(sum == Approx(1.0).margin(1e-12));
+            CHECK(glm::length(at - ptexPoint(c, u, v)) < 1e-12 * 10);
+        }
+    }
+}
+
+TEST_CASE("ptex mesh: baking a linear painting stores its value at every texel centre", "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh);
+    const ptex::PtexFile file = bakePaint(mesh, pm, 3);
+    REQUIRE(file.faces.size() == static_cast<size_t>(pm.numPtexFaces()));
+    // A linear painting interpolated over the corners equals the painting at the interpolated point; the
+    // texels are float, so within float rounding of values below 1.
+    double worst = 0.0;
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        const auto c = ptexCorners(mesh, pm, p);
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i)
+                worst = std::max(worst, std::abs(floatAt(file, p, static_cast<size_t>(j * 8 + i)) -
+                                                 paint(ptexPoint(c, (i + 0.5) / 8, (j + 0.5) / 8))));
+    }
+    CHECK(worst < 1e-6);
+
+    SECTION("8-bit texels round to the nearest 1/255") {
+        std::vector<float> values;
+        for (const glm::vec3& p : mesh.points())
+            values.push_back(static_cast<float>(paint(glm::dvec3(p))));
+        const auto u8 = ptex::bakeVertexValues(pm, values, 1, {1, 1, ptex::DataType::UInt8});
+        const auto c = ptexCorners(mesh, pm, 5);
+        const double expected = paint(ptexPoint(c, 0.75, 0.25));
+        CHECK(std::abs(u8.texels[5][1] / 255.0 - expected) <= 0.5 / 255 + 1e-7);
+    }
+    SECTION("bad inputs name the problem") {
+        std::vector<float> values(static_cast<size_t>(mesh.numVertices()), 0.5f);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::bakeVertexValues(pm, values, 2); }),
+                   Catch::Contains("11 vertices x 2 channels"));
+        values[7] = std::nanf("");
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::bakeVertexValues(pm, values, 1); }),
+                   Catch::Contains("vertex 7"));
+        values[7] = 0.0f;
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)ptex::bakeVertexValues(pm, values, 1, {16, 1});
+                   }),
+                   Catch::Contains("[0, 15]"));
+    }
+}
+
+TEST_CASE("ptex sampler: bilinear look-ups reproduce a linear painting across face edges", "[ptex][mesh]") {
+    // On a grid of unit squares every face maps affinely to the plane, so the painting is linear in each
+    // face's (u, v) and bilinear filtering reproduces it exactly, also beyond edges and corners where texels
+    // come from neighbours whose axes are rotated. Tolerance: float texels of values below 1 (1e-6).
+    const geom::Mesh mesh = grid(4, true);
+    const PtexMesh pm(mesh);
+    const ptex::PtexFile file = bakePaint(mesh, pm, 2);
+    const ptex::PtexSampler sampler(file, "paint.ptx");
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double worstInside = 0.0;
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        const auto c = ptexCorners(mesh, pm, p);
+        bool interior = true;  // all four neighbours exist: no clamping at the mesh boundary
+        for (int e = 0; e < 4; ++e)
+            interior = interior && pm.adjFaces(p)[e] >= 0;
+        if (!interior) continue;
+        for (int s = 0; s < 200; ++s) {
+            const double u = unit(rng), v = unit(rng);
+            float value = 0.0f;
+            sampler.sample(p, u, v, std::span<float>(&value, 1));
+            worstInside = std::max(worstInside, std::abs(value - paint(ptexPoint(c, u, v))));
+        }
+    }
+    CHECK(worstInside < 1e-6);
+}
+
+TEST_CASE("ptex sampler: continuous across quad, triangle and pentagon edges", "[ptex][mesh]") {
+    // Mixed mesh: the painting is reproduced to first order everywhere (within the gradient times one
+    // texel's diagonal, the resolution of the map), and a point on a shared edge reads the same value from
+    // both faces where both have the same kind (an exact ghost texel), to float rounding.
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh);
+    const ptex::PtexFile file = bakePaint(mesh, pm, 3);
+    const ptex::PtexSampler sampler(file, "paint.ptx");
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double worstRatio = 0.0;
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        const auto c = ptexCorners(mesh, pm, p);
+        const double texelDiagonal = std::max(glm::length(c[2] - c[0]), glm::length(c[3] - c[1])) / 8.0;
+        for (int s = 0; s < 100; ++s) {
+            const double u = unit(rng), v = unit(rng);
+            float value = 0.0f;
+            sampler.sample(p, u, v, std::span<float>(&value, 1));
+            worstRatio = std::max(
+                worstRatio, std::abs(value - paint(ptexPoint(c, u, v))) / (kPaintGradient * texelDiagonal));
+        }
+        for (int e = 0; e < 4; ++e) {
+            const int32_t g = pm.adjFaces(p)[e];
+            if (g < 0 || (pm.subFace(p) >= 0) != (pm.subFace(g) >= 0)) continue;
+            const int ge = pm.adjEdges(p)[e];
+            for (double t : {0.3, 0.5, 0.7}) {
+                // Edge parameter t on p's edge e is 1 - t on g's edge ge.
+                const auto onEdge = [](int edge, double s) {
+                    return edge == 0   ? glm::dvec2(s, 0)
+                           : edge == 1 ? glm::dvec2(1, s)
+                           : edge == 2 ? glm::dvec2(1 - s, 1)
+                                       : glm::dvec2(0, 1 - s);
+                };
+                const glm::dvec2 a = onEdge(e, t), b = onEdge(ge, 1 - t);
+                REQUIRE(glm::length(ptexPoint(c, a.x, a.y) - ptexPoint(ptexCorners(mesh, pm, g), b.x, b.y)) <
+                        1e-6);
+                float va = 0.0f, vb = 0.0f;
+                sampler.sample(p, a.x, a.y, std::span<float>(&va, 1));
+                sampler.sample(g, b.x, b.y, std::span<float>(&vb, 1));
+                CHECK(va == Approx(vb).margin(2e-6));
+            }
+        }
+    }
+    CHECK(worstRatio < 1.0);
+}
+
+TEST_CASE("ptex mesh: per-vertex values average the corner texels of the incident faces", "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh);
+    // Constant faces: face p holds p + 1 in channel 0 and 10 (p + 1) in channel 1. The value at a vertex
+    // is the mean over the Ptex faces touching it at a corner (a sub-face touches only its own corner).
+    ptex::PtexFile file;
+    file.dataType = ptex::DataType::Float;
+    file.channels = 2;
+    file.faces = pm.faceInfos(2, 2);
+    file.texels.resize(file.faces.size());
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        for (float value : {p + 1.0f, 10.0f * (p + 1)}) {
+            uint8_t b[4];
+            std::memcpy(b, &value, 4);
+            file.constData.insert(file.constData.end(), b, b + 4);
+        }
+    }
+    std::map<int32_t, std::vector<double>> touching;
+    for (int32_t f = 0; f < mesh.numFaces(); ++f) {
+        const auto face = mesh.face(f);
+        for (size_t k = 0; k < face.size(); ++k)
+            touching[face[k]].push_back(face.size() == 4
+                                            ? pm.firstPtexFace(f) + 1.0
+                                            : pm.firstPtexFace(f) + static_cast<double>(k) + 1.0);
+    }
+    const std::vector<float> values = ptex::vertexValues(pm, file, "const.ptx");
+    REQUIRE(values.size() == 2 * 11u);
+    for (const auto& [vertex, list] : touching) {
+        double mean = 0.0;
+        for (double x : list)
+            mean += x / static_cast<double>(list.size());
+        CHECK(values[2 * vertex] == Approx(mean).epsilon(1e-6));
+        CHECK(values[2 * vertex + 1] == Approx(10 * mean).epsilon(1e-6));
+    }
+
+    SECTION("a quad's corner k reads texel (0,0), (u max, 0), (u max, v max), (0, v max)") {
+        ptex::PtexFile one = bakePaint(mesh, pm, 2);
+        // Overwrite every texel with a code of its face and position; vertex 0 is corner 0 of Q0 alone,
+        // vertex 3 corner 1 of Q2 alone, vertex 7 corner 2 of Q2 and corner 2 of the pentagon (sub-face 2).
+        for (int32_t p = 0; p < pm.numPtexFaces(); ++p)
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i) {
+                    const float code = 100.0f * p + 10.0f * j + i;
+                    std::memcpy(one.texels[p].data() + 4 * (j * 4 + i), &code, 4);
+                }
+        const auto v = ptex::vertexValues(pm, one, "codes.ptx");
+        CHECK(v[0] == 0.0f);
+        CHECK(v[3] == 200.0f + 3.0f);
+        CHECK(v[7] == Approx(0.5 * ((200 + 33) + 100 * (pm.firstPtexFace(5) + 2))));
+        CHECK(v[10] == Approx(100.0 * (pm.firstPtexFace(5) + 3)));
+    }
+}
+
+TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and both counts", "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh, "mixed.obj");
+    const geom::Mesh other = grid(2, false);
+    const ptex::PtexFile file = bakePaint(other, PtexMesh(other), 1);
+    const std::string message =
+        test::errorOf<InvalidInput>([&] { (void)ptex::vertexValues(pm, file, "paint.ptx"); });
+    CHECK_THAT(message, Catch::Contains("paint.ptx"));
+    CHECK_THAT(message, Catch::Contains("has 4 faces"));
+    CHECK_THAT(message, Catch::Contains("14 Ptex faces"));
+    CHECK_THAT(message, Catch::Contains("mixed.obj"));
+
+    ptex::PtexFile bad = bakePaint(mesh, pm, 1);
+    bad.faces[3].adjFaces[1] = 99;
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::PtexSampler(bad, "bad.ptx"); }),
+               Catch::Contains("face 3 edge 1"));
+}
+
+TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[ptex][mesh][udim]") {
+    // UVs are an affine image of the positions, so a painting linear in UV is linear on every face. From
+    // UDIM: each texel is the bilinear image sample at its UV, exact for a linear image away from the tile
+    // border (1e-5: float pixel coordinates). To UDIM: each covered pixel samples the Ptex map at the
+    // (u, v) interpolated over a grid of cells on the face; exact for the linear map up to float (1e-4:
+    // the raster's float (u, v) and the sampler's float texels).
+    const geom::Mesh mesh = grid(4, true, 2);  // columns of faces end at u = 1: none crosses a tile
+    const PtexMesh pm(mesh);
+    const auto uvPaint = [](double u, double v) { return 0.2 + 0.15 * u + 0.4 * v; };  // u over both tiles
+    const int res = 64;
+    std::vector<ptex::UdimTile> tiles;
+    for (int tile : {1001, 1002}) {
+        ptex::UdimTile t{tile, io::Image(res, res, 1)};
+        for (int y = 0; y < res; ++y)
+            for (int x = 0; x < res; ++x)
+                t.image.at(x, y, 0) =
+                    static_cast<float>(uvPaint(tile - 1001 + (x + 0.5) / res, 1.0 - (y + 0.5) / res));
+        tiles.push_back(std::move(t));
+    }
+    const ptex::PtexFile file = ptex::udimToPtex(pm, mesh, tiles, {3, 3, ptex::DataType::Float});
+    double worst = 0.0;
+    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
+        std::array<glm::dvec2, 4> uv;
+        for (int k = 0; k < 4; ++k)
+            uv[k] = glm::dvec2(mesh.uvs()[mesh.faceUVIndices(pm.meshFace(p))[k]]);
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) {
+                const double u = (i + 0.5) / 8, v = (j + 0.5) / 8;
+                const glm::dvec2 at =
+                    (1 - u) * (1 - v) * uv[0] + u * (1 - v) * uv[1] + u * v * uv[2] + (1 - u) * v * uv[3];
+                worst = std::max(
+                    worst, std::abs(floatAt(file, p, static_cast<size_t>(j * 8 + i)) - uvPaint(at.x, at.y)));
+            }
+    }
+    CHECK(worst < 1e-5);
+
+    SECTION("automatic face resolution follows the face's size in texels") {
+        const ptex::PtexFile autoRes = ptex::udimToPtex(pm, mesh, tiles);
+        // Each face spans 0.4 of a tile in u (the mesh is stretched over two tiles) and 0.2 in v: 25.6
+        // and 12.8 texels -> 32 x 16 (nearest powers of two in log scale), whichever way its axes turn.
+        for (const auto& info : autoRes.faces) {
+            CHECK(std::set<int>{info.ures(), info.vres()} == std::set<int>{32, 16});
+        }
+    }
+
+    const auto back = ptex::ptexToUdim(pm, mesh, file, "paint.ptx", {res, {}, true});
+    REQUIRE(back.size() == 2);
+    double worstBack = 0.0, worstNearBoundary = 0.0;
+    int covered = 0, expectedCovered = 0;
+    for (const auto& tile : back) {
+        for (int y = 0; y < res; ++y)
+            for (int x = 0; x < res; ++x) {
+                const double u = (x + 0.5) / res, v = 1.0 - (y + 0.5) / res;
+                // The mesh covers u = 2 (0.1 + 0.8 i / 4) in [0.2, 1.8] and v in [0.1, 0.9].
+                const double globalU = u + (tile.tile - 1001);
+                const bool inside = globalU > 0.2 && globalU < 1.8 && v > 0.1 && v < 0.9;
+                expectedCovered += inside ? 1 : 0;
+                if (tile.image.at(x, y, 1) != 1.0f) continue;
+                ++covered;
+                // Within one Ptex texel (0.05 of a tile) of the mesh boundary the sampler repeats the edge
+                // texels (clamp), which is first-order there: gradient x texel.
+                const double error = std::abs(tile.image.at(x, y, 0) - uvPaint(globalU, v));
+                const bool nearBoundary = globalU < 0.25 || globalU > 1.75 || v < 0.15 || v > 0.85;
+                if (nearBoundary)
+                    worstNearBoundary = std::max(worstNearBoundary, error);
+                else
+                    worstBack = std::max(worstBack, error);
+            }
+    }
+    CHECK(covered == expectedCovered);
+    CHECK(worstBack < 1e-4);
+    CHECK(worstNearBoundary < std::hypot(0.15, 0.4) * 0.05);
+
+    SECTION("errors: no UVs, a tile without an image") {
+        geom::Mesh::Data d;
+        d.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+        d.faceCounts = {4};
+        d.faceIndices = {0, 1, 2, 3};
+        const geom::Mesh bare(std::move(d), "bare.obj");
+        const PtexMesh barePm(bare, "bare.obj");
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::udimToPtex(barePm, bare, tiles); }),
+                   Catch::Contains("bare.obj") && Catch::Contains("no UVs"));
+        const std::vector<ptex::UdimTile> oneTile(tiles.begin(), tiles.begin() + 1);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::udimToPtex(pm, mesh, oneTile); }),
+                   Catch::Contains("UDIM tile 1002"));
+    }
+}
