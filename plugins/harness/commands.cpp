@@ -13,6 +13,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
+#include "deformkit/ptex/ptex_mesh.h"
 
 namespace deformkit::harness {
 namespace fs = std::filesystem;
@@ -163,6 +164,12 @@ std::vector<fs::path> demo(const DemoCommand& command) {
         written.push_back(std::move(f));
     }
     return written;
+}
+
+host::Scene readScene(const fs::path& path) {
+    host::SceneReadOptions options;
+    options.ptexWeights = ptex::weightsFromPtex;
+    return host::readScene(path, options);
 }
 
 }  // namespace deformkit::harness

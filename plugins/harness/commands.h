@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "deformkit/host/scene.h"
 #include "deformkit/io/preview.h"
 
 // The deformkit CLI's subcommands as plain functions, so tests call them in-process. Each throws
@@ -14,6 +15,9 @@ namespace deformkit::harness {
 
 // `deformkit info FILE`: a mesh (.obj), an image, or a UDIM pattern. Writes a human-readable report.
 void describe(const std::filesystem::path& file, std::ostream& out);
+
+// Reads a scene the way every command does: all weight sources, Ptex files included.
+[[nodiscard]] host::Scene readScene(const std::filesystem::path& path);
 
 struct PreviewCommand {
     std::filesystem::path mesh;

@@ -1,5 +1,7 @@
 #include "eval_command.h"
 
+#include "commands.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -199,7 +201,7 @@ ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32
 }
 
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
-    host::SceneEvaluator evaluator(host::readScene(command.scene));
+    host::SceneEvaluator evaluator(readScene(command.scene));
     const host::Scene& scene = evaluator.scene();
     EvalReport report;
     if (command.frames.empty()) {

@@ -1,5 +1,7 @@
 #include "farm_command.h"
 
+#include "commands.h"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -297,7 +299,7 @@ FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
                                        "a whole number of UDIM tiles per task >= 1"));
     }
     if (command.outDir.empty()) throw InvalidInput(formatError("--out", "", "is empty", "an output folder"));
-    const host::Scene scene = host::readScene(command.scene);
+    const host::Scene scene = readScene(command.scene);
     std::vector<int> frames = command.frames;
     if (frames.empty()) {
         for (int f = scene.firstFrame; f <= scene.lastFrame; ++f)
@@ -410,7 +412,7 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
                                        "'" + plan.scene.string() + "' does not exist",
                                        "the scene the plan was made from"));
     }
-    host::SceneEvaluator evaluator(host::readScene(plan.scene));
+    host::SceneEvaluator evaluator(readScene(plan.scene));
     const host::Scene& scene = evaluator.scene();
     const std::vector<std::string> expected = taskOutputs(scene, task.firstFrame, task.lastFrame, task.tiles);
     if (expected != task.outputs) {

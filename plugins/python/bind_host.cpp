@@ -27,12 +27,20 @@
 #include "deformkit/host/evaluator.h"
 #include "deformkit/host/scene.h"
 #include "deformkit/host/stack.h"
+#include "deformkit/ptex/ptex_mesh.h"
 #include "numpy_support.h"
 
 namespace py = pybind11;
 
 namespace deformkit::python {
 namespace {
+
+// Scenes read from Python take every weight source, Ptex files included (as the CLI does).
+host::Scene readSceneFile(const std::filesystem::path& path) {
+    host::SceneReadOptions options;
+    options.ptexWeights = ptex::weightsFromPtex;
+    return host::readScene(path, options);
+}
 
 using host::DeformerStack;
 using host::Scene;
@@ -415,7 +423,7 @@ void bindHost(py::module_& m) {
         "read_scene",
         [](const std::filesystem::path& path) {
             py::gil_scoped_release release;
-            return host::readScene(path);
+            return readSceneFile(path);
         },
         "path"_a, "Reads and checks a scene file (meshes and weights files load relative to it).");
 
@@ -431,7 +439,7 @@ void bindHost(py::module_& m) {
              "scene"_a)
         .def(py::init([](const std::filesystem::path& path) {
                  py::gil_scoped_release release;
-                 return std::make_unique<PyEvaluator>(host::readScene(path));
+                 return std::make_unique<PyEvaluator>(readSceneFile(path));
              }),
              "path"_a, "Reads the scene file, then builds the stacks.")
         .def_property_readonly("num_objects",

@@ -427,6 +427,32 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
     return values;
 }
 
+std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::filesystem::path& file, int32_t channel,
+                                   const std::string& source) {
+    const std::string fileSource = source.empty() ? file.string() : source + ": " + file.string();
+    const PtexFile ptexFile = [&] {
+        try {
+            return readPtex(file);
+        } catch (const IoError& e) {
+            throw IoError(source.empty() ? e.what() : source + ": " + e.what());
+        } catch (const ParseError& e) {
+            throw ParseError(source.empty() ? e.what() : source + ": " + e.what());
+        }
+    }();
+    if (channel < 0 || channel >= ptexFile.channels) {
+        throw InvalidInput(
+            formatError(fileSource, "channel " + std::to_string(channel),
+                        "is not one of the file's " + std::to_string(ptexFile.channels) + " channels",
+                        "a channel in [0, " + std::to_string(ptexFile.channels) + ")"));
+    }
+    const PtexMesh ptexMesh(mesh, source.empty() ? "mesh" : source);
+    const std::vector<float> values = vertexValues(ptexMesh, ptexFile, fileSource);
+    std::vector<float> weights(static_cast<size_t>(mesh.numVertices()));
+    for (size_t v = 0; v < weights.size(); ++v)
+        weights[v] = values[v * ptexFile.channels + channel];
+    return weights;
+}
+
 PtexFile bakeVertexValues(const PtexMesh& mesh, std::span<const float> values, int32_t channels,
                           const BakeOptions& options) {
     if (channels < 1 || channels > 64) {

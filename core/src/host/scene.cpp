@@ -48,7 +48,8 @@ std::string index(const std::string& path, size_t i) {
 // Reads one scene: every reader names the JSON path of what it reads.
 class Reader {
   public:
-    Reader(std::string source, fs::path folder) : source_(std::move(source)), folder_(std::move(folder)) {}
+    Reader(std::string source, fs::path folder, const SceneReadOptions& options)
+        : source_(std::move(source)), folder_(std::move(folder)), options_(options) {}
 
     [[noreturn]] void fail(const std::string& path, const std::string& problem,
                            const std::string& expected) const {
@@ -215,14 +216,35 @@ class Reader {
                                fs::path& file) const {
         const int32_t count = rest.numVertices();
         if (v.is_object()) {
-            onlyKeys(v, path, {"image", "channel"});
-            if (!v.contains("image"))
-                fail(path + ".image", "is missing", "an image file name or UDIM pattern");
-            file = this->file(v.at("image"), path + ".image", "an image file name or UDIM pattern");
+            onlyKeys(v, path, {"image", "ptex", "channel"});
+            if (v.contains("image") == v.contains("ptex"))
+                fail(path,
+                     v.contains("image") ? "has both \"image\" and \"ptex\""
+                                         : "has neither \"image\" nor \"ptex\"",
+                     "one of an image file name or UDIM pattern (\"image\") and a Ptex file (\"ptex\")");
             const int32_t channel =
                 v.contains("channel")
                     ? static_cast<int32_t>(ranged(v.at("channel"), path + ".channel", 0, 64, true, "0 to 64"))
                     : 0;
+            if (v.contains("ptex")) {
+                file = this->file(v.at("ptex"), path + ".ptex", "a Ptex file name");
+                if (!options_.ptexWeights)
+                    fail(path + ".ptex", "names a Ptex file, which this application cannot read",
+                         "the deformkit CLI or Python module, which read Ptex weights");
+                std::vector<float> weights;
+                try {
+                    weights = options_.ptexWeights(rest, file, channel, source_ + ": " + path + ".ptex");
+                } catch (const InvalidInput&) {
+                    throw;
+                } catch (const Error& e) {
+                    throw InvalidInput(e.what());  // an unreadable file; the message names the JSON path
+                }
+                if (weights.size() != static_cast<size_t>(count))
+                    fail(path + ".ptex", "gives " + std::to_string(weights.size()) + " weights",
+                         std::to_string(count) + ", one per vertex");
+                return weights;
+            }
+            file = this->file(v.at("image"), path + ".image", "an image file name or UDIM pattern");
             try {
                 return weightsFromMaps(rest, file, channel, source_ + ": " + path + ".image");
             } catch (const InvalidInput&) {
@@ -587,11 +609,16 @@ class Reader {
   private:
     std::string source_;
     fs::path folder_;
+    const SceneReadOptions& options_;
 };
 
 }  // namespace
 
 Scene parseScene(std::string_view text, const fs::path& source) {
+    return parseScene(text, source, SceneReadOptions{});
+}
+
+Scene parseScene(std::string_view text, const fs::path& source, const SceneReadOptions& options) {
     json root;
     try {
         root = json::parse(text.begin(), text.end());
@@ -604,16 +631,20 @@ Scene parseScene(std::string_view text, const fs::path& source) {
                                      at == std::string::npos ? what : what.substr(at + 2),
                                      "a JSON scene (docs/scene.md)"));
     }
-    return Reader(source.string(), source.parent_path()).scene(root);
+    return Reader(source.string(), source.parent_path(), options).scene(root);
 }
 
 Scene readScene(const fs::path& path) {
+    return readScene(path, SceneReadOptions{});
+}
+
+Scene readScene(const fs::path& path, const SceneReadOptions& options) {
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw IoError(formatError(path.string(), "", "cannot open the scene file", "a readable JSON file"));
     std::ostringstream text;
     text << in.rdbuf();
-    return parseScene(text.str(), path);
+    return parseScene(text.str(), path, options);
 }
 
 }  // namespace deformkit::host

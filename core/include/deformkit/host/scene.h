@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -37,12 +38,14 @@ struct SceneParameter {
 
 // One entry of an object's deformer stack.
 struct SceneDeformer {
-    std::string type;            // a makeDeformer type (deformerTypes())
-    std::string label;           // unique in the stack; default: the type followed by the entry number from 1
-    SceneValue envelope;         // one component; constant 1 when the scene gives none
-    std::vector<float> weights;  // #V painted weights of the object's rest mesh (from a file or sampled from
-                                 // maps through its UVs, host/weight_maps.h), or empty for all 1
-    std::filesystem::path weightsFile;  // the JSON file or the weight-map image (pattern); empty when none
+    std::string type;     // a makeDeformer type (deformerTypes())
+    std::string label;    // unique in the stack; default: the type followed by the entry number from 1
+    SceneValue envelope;  // one component; constant 1 when the scene gives none
+    // #V painted weights of the object's rest mesh (from a JSON file, sampled from maps through its UVs
+    // (host/weight_maps.h), or per-vertex values of a Ptex file), or empty for all 1; and the file they came
+    // from (the JSON file, weight-map pattern or Ptex file), empty when none.
+    std::vector<float> weights;
+    std::filesystem::path weightsFile;
     // The parameters the scene gives, in the deformer's parameters() order (bind-time inputs first), which
     // is the order hosts set them in.
     std::vector<SceneParameter> params;
@@ -87,6 +90,16 @@ struct Scene {
     std::vector<SceneObject> objects;
 };
 
+// Weight sources that live outside the core library, provided by the application reading the scene (the
+// deformkit CLI and the Python module give every one).
+struct SceneReadOptions {
+    // `"weights": {"ptex": file, "channel": c}`: (rest mesh, file, channel, source for messages) -> #V
+    // weights (deformkit::ptex::weightsFromPtex). Unset: such a scene is refused with a message saying so.
+    std::function<std::vector<float>(const geom::Mesh&, const std::filesystem::path&, int32_t,
+                                     const std::string&)>
+        ptexWeights;
+};
+
 // Parses scene JSON text. `source` names the scene in messages and its folder resolves relative mesh and
 // weights paths. Loads the meshes and weights files, and checks every value the way the host will set it
 // (each parameter and every key value through the deformer's own set(), in parameters() order), so a
@@ -95,9 +108,12 @@ struct Scene {
 // else, its message "<source>: <JSON path>: <what was found> (expected <what>)", e.g.
 // "shot.json: objects[0].stack[1].params.endAngle.keys[2].frame: is 1, not after the previous key's 3
 // (expected increasing frames)". Problems inside the mesh or weights file name that file as well.
+[[nodiscard]] Scene parseScene(std::string_view text, const std::filesystem::path& source,
+                               const struct SceneReadOptions& options);
 [[nodiscard]] Scene parseScene(std::string_view text, const std::filesystem::path& source);
 
 // Reads and parses a scene file. Throws IoError when it cannot be read, then as parseScene.
+[[nodiscard]] Scene readScene(const std::filesystem::path& path, const struct SceneReadOptions& options);
 [[nodiscard]] Scene readScene(const std::filesystem::path& path);
 
 }  // namespace deformkit::host
