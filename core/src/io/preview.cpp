@@ -54,12 +54,26 @@ PreviewTexture loadPreviewTexture(const std::filesystem::path& pathOrPattern) {
     return tex;
 }
 
+glm::vec3 weightColor(float weight) {
+    // Piecewise linear through blue, cyan, green, yellow and red at 0, 1/4, 1/2, 3/4 and 1.
+    static constexpr glm::vec3 stops[5] = {{0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 1.0f}, {0.0f, 1.0f, 0.0f},
+                                           {1.0f, 1.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    const float x = std::isnan(weight) ? 0.0f : 4.0f * std::clamp(weight, 0.0f, 1.0f);
+    const int i = std::min(static_cast<int>(x), 3);
+    return stops[i] + (x - static_cast<float>(i)) * (stops[i + 1] - stops[i]);
+}
+
 Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const PreviewTexture* texture) {
     if (mesh.numFaces() == 0) {
         throw InvalidInput(formatError("preview", "mesh", "has no faces", "a mesh with at least one face"));
     }
     if (texture && !mesh.hasUVs()) {
         throw InvalidInput(formatError("preview", "mesh", "has no UVs but a texture was given", "a mesh with UVs"));
+    }
+    if (!o.vertexColors.empty() && o.vertexColors.size() != static_cast<size_t>(mesh.numVertices())) {
+        throw InvalidInput(formatError("preview", "vertex colours",
+                                       "has " + std::to_string(o.vertexColors.size()) + " colours",
+                                       std::to_string(mesh.numVertices()) + ", one per vertex"));
     }
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384) {
         throw InvalidInput(formatError("preview", "size",
@@ -139,7 +153,9 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
             if (glm::dot(n, forward) > 0.0f) n = -n;  // two-sided
             const float light = 0.18f + 0.52f * std::max(0.0f, glm::dot(n, keyLight)) +
                                 0.38f * std::max(0.0f, -glm::dot(n, forward));
-            glm::vec3 albedo = o.baseColor;
+            glm::vec3 albedo = o.vertexColors.empty() ? o.baseColor
+                                                      : w.x * o.vertexColors[v0] + w.y * o.vertexColors[v1] +
+                                                            w.z * o.vertexColors[v2];
             if (texture) {
                 const glm::vec2 uv = w.x * mesh.uvs()[uvIndices[c[0]]] + w.y * mesh.uvs()[uvIndices[c[1]]] +
                                      w.z * mesh.uvs()[uvIndices[c[2]]];

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <numbers>
 
+#include <glm/geometric.hpp>
+
 #include "deformkit/error.h"
+#include "deformkit/geom/box.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/io/preview.h"
 
@@ -130,4 +133,42 @@ TEST_CASE("preview: a framing box sets the camera as the box's bounds would", "[
     // A disk of about 9 pixels radius: the pixel count of a rasterised disk is within its perimeter of
     // the area, so 2 pi rho / (pi rho^2) ~ 22% is the tolerance.
     CHECK(static_cast<double>(covered) == Approx(std::numbers::pi * rho * rho).epsilon(2.0 / rho));
+}
+
+TEST_CASE("preview: per-vertex colours are interpolated over the faces", "[io][preview]") {
+    // A grid in the z = 0 plane seen straight down: every pixel has the same light, so colours keep their
+    // ratios. Vertex colour (s, 0, 1 - s) with s linear in x: the red share r / (r + b) at a pixel is s at
+    // the point it sees, which is 1/2 at the centre and mirror-symmetric about it (the view is).
+    const geom::Mesh grid = geom::makeGrid({8, 8, 2.0f, 2.0f});
+    const geom::Box3 box = grid.bounds();
+    io::PreviewOptions o;
+    o.width = o.height = 200;
+    o.viewDirection = {0.0f, 0.0f, -1.0f};
+    for (const glm::vec3& p : grid.points()) {
+        const float s = (p.x - box.min.x) / (box.max.x - box.min.x);
+        o.vertexColors.emplace_back(s, 0.0f, 1.0f - s);
+    }
+    const io::Image img = io::renderPreview(grid, o);
+    const auto share = [&](int32_t x) { return img.at(x, 100, 0) / (img.at(x, 100, 0) + img.at(x, 100, 2)); };
+    // Pixel centres at 99.5 and 100.5 straddle the centre line: shares 1/2 -+ one pixel's step.
+    CHECK(share(99) + share(100) == Approx(1.0).margin(1e-4));
+    CHECK(share(60) + share(139) == Approx(1.0).margin(1e-4));
+    CHECK(share(60) < 0.4f);
+    CHECK(img.at(100, 100, 1) == 0.0f);
+
+    o.vertexColors.pop_back();
+    CHECK_THROWS_WITH(io::renderPreview(grid, o), Catch::Contains("one per vertex"));
+}
+
+TEST_CASE("preview: weight colours run blue, cyan, green, yellow, red", "[io][preview]") {
+    const auto same = [](glm::vec3 a, glm::vec3 b) { return glm::length(a - b) < 1e-6f; };
+    CHECK(same(io::weightColor(0.0f), {0, 0, 1}));
+    CHECK(same(io::weightColor(0.25f), {0, 1, 1}));
+    CHECK(same(io::weightColor(0.5f), {0, 1, 0}));
+    CHECK(same(io::weightColor(0.75f), {1, 1, 0}));
+    CHECK(same(io::weightColor(1.0f), {1, 0, 0}));
+    CHECK(same(io::weightColor(0.125f), {0, 0.5f, 1}));
+    CHECK(same(io::weightColor(-2.0f), {0, 0, 1}));
+    CHECK(same(io::weightColor(7.0f), {1, 0, 0}));
+    CHECK(same(io::weightColor(std::nanf("")), {0, 0, 1}));
 }

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -35,7 +36,14 @@ struct PreviewOptions {
     glm::vec3 background{0.16f, 0.17f, 0.19f};
     glm::vec3 baseColor{0.78f, 0.76f, 0.72f};  // where no texture applies
     bool drawEdges = false;                    // darken polygon edges (not the triangulation's diagonals)
+    // Per-vertex colours (empty, or one per vertex), interpolated over the faces in place of baseColor, e.g.
+    // painted weights through weightColor(); a texture, where it applies, still takes precedence.
+    std::vector<glm::vec3> vertexColors;
 };
+
+// The colour of a painted weight as weight-paint views show it: 0 blue, then cyan, green, yellow, 1 red
+// (clamped to [0, 1]; NaN shows as 0).
+[[nodiscard]] glm::vec3 weightColor(float weight);
 
 // Renders a shaded view of `mesh` with the software rasteriser: perspective camera, z-buffer, smooth
 // normals, two-sided Lambert lighting from a key light and a headlight, perspective-correct UVs for
