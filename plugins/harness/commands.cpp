@@ -5,6 +5,7 @@
 #include <map>
 
 #include "demo_assets.h"
+#include "demo_ptex.h"
 #include "demo_slide.h"
 #include "demo_uvwarp.h"
 #include "demo_warps.h"
@@ -157,6 +158,9 @@ std::vector<fs::path> demo(const DemoCommand& command) {
         written.push_back(std::move(f));
     }
     for (fs::path& f : writeDemoSlide(assets.mesh, command.outDir)) {
+        written.push_back(std::move(f));
+    }
+    for (fs::path& f : writeDemoPtex(assets.mesh, command.outDir)) {
         written.push_back(std::move(f));
     }
     for (fs::path& f : writeDemoUvWarp(assets.mesh, assets.rigidity.at(1001), assets.mask.at(1001), assets.albedo,

@@ -33,7 +33,7 @@ struct DemoCommand {
     int32_t resolution = 1024;
 };
 // `deformkit demo`: writes the demo assets and a preview into outDir, the warps into outDir/warps and the
-// slide into outDir/slide; returns the files written.
+// slide into outDir/slide, the Ptex-painted slide into outDir/ptex; returns the files written.
 std::vector<std::filesystem::path> demo(const DemoCommand& command);
 
 }  // namespace deformkit::harness

@@ -18,7 +18,8 @@ namespace {
 // (-0.45, -0.3, -1), so it sees the side whose outward normal is (0.45, 0, 1) in x and z.
 constexpr double kFacingX = 0.45, kFacingZ = 1.0;
 
-// Two images side by side on the first one's background, `gap` pixels apart.
+}  // namespace
+
 io::Image sideBySide(const io::Image& left, const io::Image& right, int32_t gap) {
     const int32_t height = std::max(left.height, right.height);
     io::Image out(left.width + gap + right.width, height, 3);
@@ -40,8 +41,6 @@ io::Image sideBySide(const io::Image& left, const io::Image& right, int32_t gap)
     place(right, left.width + gap);
     return out;
 }
-
-}  // namespace
 
 DemoSlide makeDemoSlide(const geom::Mesh& tube) {
     const glm::dvec3 facing = glm::normalize(glm::dvec3(kFacingX, 0.0, kFacingZ));

@@ -30,6 +30,9 @@ struct DemoSlide {
 // -0.45,-0.3,-1` gives the same.
 [[nodiscard]] io::PreviewOptions demoSlideView();
 
+// Two images side by side on the first one's background, `gap` pixels apart.
+[[nodiscard]] io::Image sideBySide(const io::Image& left, const io::Image& right, int32_t gap);
+
 // Writes slide/tube_slid.obj, slide/checker.<UDIM>.png, slide/before.png and slide/after.png (the rest and
 // the slid tube with the checker) and slide/slide.png (the two side by side); returns the files written.
 std::vector<std::filesystem::path> writeDemoSlide(const geom::Mesh& tube,

@@ -54,6 +54,9 @@ done
 for f in tube_slid.obj checker.1001.png checker.1002.png before.png after.png slide.png; do
     [ -s "$work/demo/slide/$f" ] || { echo "FAIL demo: slide/$f missing"; failures=$((failures + 1)); }
 done
+for f in tube.obj tube_slid.obj falloff.ptx before.png after.png ptex.png; do
+    [ -s "$work/demo/ptex/$f" ] || { echo "FAIL demo: ptex/$f missing"; failures=$((failures + 1)); }
+done
 # docs/slide.md's commands remake the demo's slide pictures byte for byte.
 for pair in "tube.obj before" "slide/tube_slid.obj after"; do
     set -- $pair
@@ -68,7 +71,7 @@ contains info-mesh "$work/out" "UDIM tiles 1001 1002"
 contains info-mesh "$work/out" "manifold    yes"
 # The same inputs give the same bytes: a second demo run is identical file for file.
 expect demo-again 0 "$dk" demo --out "$work/demo2" --resolution 64
-for f in "$work"/demo/* "$work"/demo/warps/* "$work"/demo/slide/*; do
+for f in "$work"/demo/* "$work"/demo/warps/* "$work"/demo/slide/* "$work"/demo/ptex/*; do
     [ -f "$f" ] || continue
     if ! cmp -s "$f" "$work/demo2/${f#"$work"/demo/}"; then
         echo "FAIL determinism: $(basename "$f") differs between two demo runs"; failures=$((failures + 1))
