@@ -646,26 +646,15 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
         const io::Image& image = *found->second;
         const io::TileOrigin origin = io::udimOrigin(tile);
         FaceInfo& info = file.faces[p];
-        if (ulog2 >= 0) {
-            info.ulog2 = ulog2;
-        } else {  // mean length of the face's u edges (v = 0 and v = 1), in texels of its tile
-            const glm::dvec2 size(image.width, image.height);
-            const double bottom = glm::length(
-                (ptexUV(ptexMesh, mesh, p, 1, 0, weights) - ptexUV(ptexMesh, mesh, p, 0, 0, weights)) * size);
-            const double top = glm::length(
-                (ptexUV(ptexMesh, mesh, p, 1, 1, weights) - ptexUV(ptexMesh, mesh, p, 0, 1, weights)) * size);
-            info.ulog2 = log2Near(0.5 * (bottom + top));
-        }
-        if (vlog2 >= 0) {
-            info.vlog2 = vlog2;
-        } else {
-            const glm::dvec2 size(image.width, image.height);
-            const double left = glm::length(
-                (ptexUV(ptexMesh, mesh, p, 0, 1, weights) - ptexUV(ptexMesh, mesh, p, 0, 0, weights)) * size);
-            const double right = glm::length(
-                (ptexUV(ptexMesh, mesh, p, 1, 1, weights) - ptexUV(ptexMesh, mesh, p, 1, 0, weights)) * size);
-            info.vlog2 = log2Near(0.5 * (left + right));
-        }
+        // Automatic resolution: per axis, the mean length of the face's two edges along it in tile texels.
+        const glm::dvec2 size(image.width, image.height);
+        const auto edge = [&](double u0, double v0, double u1, double v1) {
+            return glm::length(
+                (ptexUV(ptexMesh, mesh, p, u1, v1, weights) - ptexUV(ptexMesh, mesh, p, u0, v0, weights)) *
+                size);
+        };
+        info.ulog2 = ulog2 >= 0 ? ulog2 : log2Near(0.5 * (edge(0, 0, 1, 0) + edge(0, 1, 1, 1)));
+        info.vlog2 = vlog2 >= 0 ? vlog2 : log2Near(0.5 * (edge(0, 0, 0, 1) + edge(1, 0, 1, 1)));
         std::vector<uint8_t>& texels = file.texels[p];
         texels.resize(info.texelCount() * file.pixelSize());
         for (int32_t j = 0; j < info.vres(); ++j) {

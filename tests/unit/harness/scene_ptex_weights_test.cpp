@@ -16,6 +16,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "mesh_support.h"
+#include "ptex/ptex_mesh_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -25,20 +26,9 @@ namespace {
 
 // A two-channel Ptex file of the tube with constant faces: face p holds (p / 100, (p % 7) / 8).
 ptex::PtexFile constantFaces(const geom::Mesh& mesh) {
-    const ptex::PtexMesh pm(mesh);
-    ptex::PtexFile file;
-    file.dataType = ptex::DataType::Float;
-    file.channels = 2;
-    file.faces = pm.faceInfos(1, 1);
-    file.texels.resize(file.faces.size());
-    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
-        for (float value : {p / 100.0f, static_cast<float>(p % 7) / 8.0f}) {
-            uint8_t bytes[4];
-            std::memcpy(bytes, &value, 4);
-            file.constData.insert(file.constData.end(), bytes, bytes + 4);
-        }
-    }
-    return file;
+    return test::constantFaces(ptex::PtexMesh(mesh), 2, 1, [](int32_t p, int32_t c) {
+        return c == 0 ? p / 100.0f : static_cast<float>(p % 7) / 8.0f;
+    });
 }
 
 std::string sceneWith(const std::string& weights) {

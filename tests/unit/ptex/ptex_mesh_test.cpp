@@ -16,6 +16,7 @@
 #include "deformkit/ptex/ptex_mesh.h"
 
 #include "../test_support.h"
+#include "ptex_mesh_support.h"
 
 using namespace deformkit;
 using deformkit::ptex::PtexMesh;
@@ -330,18 +331,8 @@ TEST_CASE("ptex mesh: per-vertex values average the corner texels of the inciden
     const PtexMesh pm(mesh);
     // Constant faces: face p holds p + 1 in channel 0 and 10 (p + 1) in channel 1. The value at a vertex
     // is the mean over the Ptex faces touching it at a corner (a sub-face touches only its own corner).
-    ptex::PtexFile file;
-    file.dataType = ptex::DataType::Float;
-    file.channels = 2;
-    file.faces = pm.faceInfos(2, 2);
-    file.texels.resize(file.faces.size());
-    for (int32_t p = 0; p < pm.numPtexFaces(); ++p) {
-        for (float value : {p + 1.0f, 10.0f * (p + 1)}) {
-            uint8_t b[4];
-            std::memcpy(b, &value, 4);
-            file.constData.insert(file.constData.end(), b, b + 4);
-        }
-    }
+    const ptex::PtexFile file = test::constantFaces(
+        pm, 2, 2, [](int32_t p, int32_t c) { return c == 0 ? p + 1.0f : 10.0f * (p + 1); });
     std::map<int32_t, std::vector<double>> touching;
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
         const auto face = mesh.face(f);
