@@ -10,6 +10,7 @@
 #include "demo_uvwarp.h"
 #include "demo_warps.h"
 #include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -121,12 +122,7 @@ void preview(const PreviewCommand& command) {
 }
 
 std::vector<fs::path> demo(const DemoCommand& command) {
-    std::error_code ec;
-    fs::create_directories(command.outDir, ec);
-    if (ec) {
-        throw IoError(formatError(command.outDir.string(), "", "cannot create the output folder: " + ec.message(),
-                                  "a writable location"));
-    }
+    io::createFolder(command.outDir);
     const DemoAssets assets = makeDemoAssets({command.resolution});
     std::vector<fs::path> written;
     const fs::path meshPath = command.outDir / "tube.obj";

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
 #include "deformkit/ptex/ptex_mesh.h"
@@ -76,12 +77,7 @@ DemoPtex makeDemoPtex(const geom::Mesh& tube) {
 
 std::vector<fs::path> writeDemoPtex(const geom::Mesh& tube, const fs::path& outDir) {
     const fs::path dir = outDir / "ptex";
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) {
-        throw IoError(formatError(dir.string(), "", "cannot create the folder: " + ec.message(),
-                                  "a writable location"));
-    }
+    io::createFolder(dir);
     const DemoPtex demo = makeDemoPtex(tube);
     std::vector<fs::path> written;
     written.push_back(dir / "tube.obj");

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
 
@@ -97,12 +98,7 @@ io::PreviewOptions demoSlideView() {
 
 std::vector<fs::path> writeDemoSlide(const geom::Mesh& tube, const fs::path& outDir) {
     const fs::path dir = outDir / "slide";
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) {
-        throw IoError(formatError(dir.string(), "", "cannot create the folder: " + ec.message(),
-                                  "a writable location"));
-    }
+    io::createFolder(dir);
     std::vector<fs::path> written;
     const DemoSlide demo = makeDemoSlide(tube);
     written.push_back(dir / "tube_slid.obj");

@@ -85,12 +85,7 @@ std::vector<fs::path> writeDemoUvWarp(const geom::Mesh& tube, const io::Image& r
                                       const io::Image& mask, const std::map<int, io::Image>& albedo,
                                       const fs::path& outDir) {
     const fs::path dir = outDir / "uvwarp";
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) {
-        throw IoError(formatError(dir.string(), "", "cannot create the folder: " + ec.message(),
-                                  "a writable location"));
-    }
+    io::createFolder(dir);
     const DemoUvWarp demo = makeDemoUvWarp(tube, rigidity, mask, albedo.at(1001));
     std::vector<fs::path> written;
     written.push_back(dir / "tube_bent.obj");

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -147,11 +148,7 @@ std::vector<DemoWarp> makeDemoWarps(const geom::Mesh& tube) {
 std::vector<fs::path> writeDemoWarps(const geom::Mesh& tube, const io::PreviewTexture& texture, const io::Image& image,
                                      const fs::path& outDir) {
     const fs::path dir = outDir / "warps";
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) {
-        throw IoError(formatError(dir.string(), "", "cannot create the folder: " + ec.message(), "a writable location"));
-    }
+    io::createFolder(dir);
     std::vector<fs::path> written;
     io::PreviewOptions view;
     view.width = 480;

@@ -223,12 +223,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
                                     command.contactColumns, command.contactMaxWidth);
         if (command.movie) checkSize("movie frame rate", command.movieFrameRate, 1, 1000);
     }
-    std::error_code ec;
-    fs::create_directories(command.outDir, ec);
-    if (!fs::is_directory(command.outDir)) {
-        throw IoError(
-            formatError(command.outDir.string(), "", "cannot be created", "a writable output folder"));
-    }
+    io::createFolder(command.outDir);
 
     std::vector<geom::Box3> restBounds;       // per object
     std::vector<io::Image> sheets;            // per object

@@ -340,13 +340,9 @@ FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
             plan.tasks.push_back(std::move(task));
         }
     }
-    std::error_code ec;
-    fs::create_directories(plan.outDir, ec);
-    if (!fs::is_directory(plan.outDir)) {
-        throw IoError(formatError(plan.outDir.string(), "", "cannot be created", "a writable output folder"));
-    }
+    io::createFolder(plan.outDir);
     const fs::path planFile = farmPlanPath(command);
-    if (planFile.has_parent_path()) fs::create_directories(planFile.parent_path(), ec);
+    if (planFile.has_parent_path()) io::createFolder(planFile.parent_path());
     io::writeFileAtomically(planFile, formatFarmPlan(plan));
     return plan;
 }
@@ -426,10 +422,7 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
                                        "is " + listed + ", the scene makes " + made,
                                        "the outputs of the scene as planned (plan again after changing it)"));
     }
-    fs::create_directories(plan.outDir, ec);
-    if (!fs::is_directory(plan.outDir)) {
-        throw IoError(formatError(plan.outDir.string(), "", "cannot be created", "a writable output folder"));
-    }
+    io::createFolder(plan.outDir);
 
     FarmRunReport report;
     report.task = command.task;

@@ -68,6 +68,16 @@ void writeAtomically(const fs::path& path, const std::function<void(const fs::pa
     }
 }
 
+void createFolder(const fs::path& path) {
+    std::error_code ec;
+    fs::create_directories(path, ec);
+    if (!fs::is_directory(path)) {
+        throw IoError(formatError(path.string(), "",
+                                  "cannot be created" + (ec ? ": " + ec.message() : std::string()),
+                                  "a writable folder"));
+    }
+}
+
 void writeFileAtomically(const fs::path& path, std::string_view bytes) {
     writeAtomically(path, [&](const fs::path& tmp) {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

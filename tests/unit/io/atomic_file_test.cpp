@@ -13,7 +13,8 @@ namespace {
 
 size_t countEntries(const fs::path& dir) {
     size_t n = 0;
-    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir))
+        ++n;
     return n;
 }
 
@@ -48,7 +49,8 @@ TEST_CASE("a failing writer leaves the existing file intact and no temporary", "
     CHECK(test::readText(file) == "precious");
 }
 
-TEST_CASE("an unwritable or missing folder is an IoError naming it; the existing file stays", "[io][atomic][errors]") {
+TEST_CASE("an unwritable or missing folder is an IoError naming it; the existing file stays",
+          "[io][atomic][errors]") {
     test::TempDir dir;
     const fs::path locked = dir / "locked";
     fs::create_directories(locked);
@@ -70,6 +72,20 @@ TEST_CASE("an unwritable or missing folder is an IoError naming it; the existing
     ::chmod(locked.c_str(), 0755);
 
     CHECK_THROWS_AS(io::writeFileAtomically(dir / "missing" / "out.txt", "x"), IoError);
-    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "missing" / "out.txt", "x"), Catch::Contains("does not exist"));
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "missing" / "out.txt", "x"),
+                      Catch::Contains("does not exist"));
     CHECK_THROWS_WITH(io::writeFileAtomically(locked, "x"), Catch::Contains("is a folder"));
+}
+
+TEST_CASE("createFolder makes missing parents and names a path it cannot make", "[io][atomic][errors]") {
+    test::TempDir dir;
+    io::createFolder(dir / "a/b/c");
+    CHECK(fs::is_directory(dir / "a/b/c"));
+    io::createFolder(dir / "a/b/c");  // already there: nothing to do
+    test::writeText(dir / "file", "x");
+    const std::string message = test::errorOf<IoError>([&] { io::createFolder(dir / "file" / "sub"); });
+    CHECK_THAT(message, Catch::Contains((dir / "file" / "sub").string()) &&
+                            Catch::Contains("cannot be created") && Catch::Contains("a writable folder"));
+    CHECK_THAT(test::errorOf<IoError>([&] { io::createFolder(dir / "file"); }),
+               Catch::Contains("cannot be created"));
 }

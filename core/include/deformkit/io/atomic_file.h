@@ -14,6 +14,10 @@ namespace deformkit::io {
 void writeAtomically(const std::filesystem::path& path,
                      const std::function<void(const std::filesystem::path& tmp)>& write);
 
+// Creates folder `path` and its parents when missing. Throws IoError naming it (and the system's reason)
+// when it cannot be created or exists as something else.
+void createFolder(const std::filesystem::path& path);
+
 // Writes `bytes` to `path` atomically.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
