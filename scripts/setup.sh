@@ -19,6 +19,7 @@ packages=(
     python3 python3-dev pybind11-dev python3-numpy python3-pytest
     clang libclang-rt-14-dev         # libFuzzer and sanitizers
     slurm-wlm munge                  # farm tests: single-node Slurm
+    blender                          # the Blender add-on's tests (headless Blender 3.4)
 )
 
 missing=()

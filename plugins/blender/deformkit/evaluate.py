@@ -1,0 +1,274 @@
+"""Blender data -> DeformKit host-layer parameters, and the evaluation of an object's stack.
+
+The rest shape of a deformed object is kept in a point attribute of its mesh (`REST_ATTRIBUTE`), captured
+when its first entry is added; each evaluation starts from it and writes the result into the mesh's vertex
+positions. Modifiers (an Armature, say) therefore run after DeformKit, on its result.
+
+Controls are read in the deformed object's local space (its inverse world matrix times theirs), so moving the
+object moves its controls' effect with it, as Blender's own deformers behave.
+"""
+
+import bpy
+import numpy as np
+
+from .core import dk
+
+REST_ATTRIBUTE = "deformkit_rest"
+
+# Per object name: the stack, the entry signature it was built for, and the last weights set per entry.
+_cache = {}
+
+
+class DeformKitError(Exception):
+    """A problem with the Blender data (a missing control, a lattice too small): shown to the user."""
+
+
+def clear_cache():
+    _cache.clear()
+
+
+# ---- mesh data ----------------------------------------------------------------------------------------
+
+def has_rest(obj):
+    return REST_ATTRIBUTE in obj.data.attributes
+
+
+def capture_rest(obj):
+    """Stores the mesh's current vertex positions as the rest shape."""
+    mesh = obj.data
+    points = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", points)
+    attribute = mesh.attributes.get(REST_ATTRIBUTE)
+    if attribute is None:
+        attribute = mesh.attributes.new(REST_ATTRIBUTE, 'FLOAT_VECTOR', 'POINT')
+    attribute.data.foreach_set("vector", points)
+
+
+def rest_points(obj):
+    mesh = obj.data
+    attribute = mesh.attributes.get(REST_ATTRIBUTE)
+    if attribute is None:
+        raise DeformKitError(f"{obj.name}: no rest shape; add a DeformKit deformer to capture it")
+    points = np.empty(len(mesh.vertices) * 3, np.float32)
+    attribute.data.foreach_get("vector", points)
+    return points.reshape(-1, 3)
+
+
+def restore_rest(obj):
+    """Writes the rest shape back into the vertex positions."""
+    obj.data.vertices.foreach_set("co", rest_points(obj).ravel())
+    obj.data.update()
+
+
+def rest_mesh(obj):
+    mesh = obj.data
+    counts = np.empty(len(mesh.polygons), np.int32)
+    starts = np.empty(len(mesh.polygons), np.int32)
+    mesh.polygons.foreach_get("loop_total", counts)
+    mesh.polygons.foreach_get("loop_start", starts)
+    loops = np.empty(len(mesh.loops), np.int32)
+    mesh.loops.foreach_get("vertex_index", loops)
+    if len(counts) == 0:
+        raise DeformKitError(f"{obj.name}: the mesh has no faces")
+    if not np.array_equal(starts, np.concatenate(([0], np.cumsum(counts)[:-1]))):
+        loops = np.concatenate([loops[s:s + c] for s, c in zip(starts, counts)])
+    return dk.Mesh(rest_points(obj), counts, loops.astype(np.int32))
+
+
+def vertex_group_weights(obj, name):
+    group = obj.vertex_groups.get(name)
+    if group is None:
+        raise DeformKitError(f"{obj.name}: vertex group '{name}' does not exist")
+    weights = np.zeros(len(obj.data.vertices), np.float32)
+    index = group.index
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            if element.group == index:
+                weights[vertex.index] = element.weight
+                break
+    return weights
+
+
+# ---- controls -> parameters ---------------------------------------------------------------------------
+
+def _matrix(m):
+    return np.array(m, dtype=np.float64)
+
+
+def local_matrix(obj, control, depsgraph=None):
+    """The control's world matrix in `obj`'s local space (evaluated when a depsgraph is given)."""
+    if depsgraph is not None:
+        control = control.evaluated_get(depsgraph)
+        obj = obj.evaluated_get(depsgraph)
+    return np.linalg.inv(_matrix(obj.matrix_world)) @ _matrix(control.matrix_world)
+
+
+def _apply(m, points):
+    points = np.asarray(points, np.float64).reshape(-1, 3)
+    return points @ m[:3, :3].T + m[:3, 3]
+
+
+def _need(entry, attribute, what):
+    control = getattr(entry, attribute)
+    if control is None:
+        raise DeformKitError(f"{entry.name}: no {what} set")
+    return control
+
+
+def curve_points(obj, curve):
+    """A curve object's control points (the first spline), in object space of `curve`."""
+    if not curve.data.splines:
+        raise DeformKitError(f"{obj}: curve '{curve.name}' has no spline")
+    spline = curve.data.splines[0]
+    if spline.type == 'BEZIER':
+        points = [p.co[:] for p in spline.bezier_points]
+    else:
+        points = [p.co[:3] for p in spline.points]
+    if len(points) < 2:
+        raise DeformKitError(f"{obj}: curve '{curve.name}' has fewer than 2 points")
+    return np.array(points, np.float64)
+
+
+def lattice_points(lattice, deformed):
+    data = lattice.data
+    n = len(data.points)
+    points = np.empty(n * 3, np.float32)
+    data.points.foreach_get("co_deform" if deformed else "co", points)
+    return points.reshape(-1, 3).astype(np.float64)
+
+
+def entry_parameters(obj, entry, depsgraph=None):
+    """The host-layer parameters of one entry, bind-time ones first (the order hosts set them in)."""
+    t = entry.type
+    if t == "slide":
+        start = _need(entry, "start", "start locator")
+        end = _need(entry, "end", "end locator")
+        if entry.vertex >= len(obj.data.vertices):
+            raise DeformKitError(f"{entry.name}: handle vertex {entry.vertex} is not a vertex of {obj.name}")
+        a = local_matrix(obj, start, depsgraph)[:3, 3]
+        b = local_matrix(obj, end, depsgraph)[:3, 3]
+        return [("vertex", entry.vertex), ("radius", entry.radius), ("geodesic", int(entry.geodesic)),
+                ("falloff", int(entry.falloff)), ("displacement", b - a)]
+    if t in ("taper", "twist", "bend"):
+        m = local_matrix(obj, _need(entry, "frame", "handle Empty"), depsgraph)
+        params = [("handleOrigin", m[:3, 3])]
+        if t == "bend":
+            params.append(("handleX", m[:3, 0]))
+        params.append(("handleY", m[:3, 1]))
+        if t == "taper":
+            params += [("startScale", entry.start_value), ("endScale", entry.end_value)]
+        elif t == "twist":
+            params += [("startAngle", entry.start_value), ("endAngle", entry.end_value)]
+        else:
+            params.append(("curvature", entry.curvature))
+        return params + [("lowBound", entry.low_bound), ("highBound", entry.high_bound)]
+    if t == "ffd":
+        lattice = _need(entry, "lattice", "Lattice object")
+        data = lattice.data
+        sizes = (data.points_u, data.points_v, data.points_w)
+        if min(sizes) < 2:
+            raise DeformKitError(f"{entry.name}: lattice '{lattice.name}' has {sizes[0]} x {sizes[1]} x "
+                                 f"{sizes[2]} points; the FFD needs at least 2 along each axis")
+        m = local_matrix(obj, lattice, depsgraph)
+        # The rest lattice is the regular grid of the points' `co` (u fastest in Blender's order): its corner
+        # is point 0 and its edges reach the last point along each axis. Ours lists k (z) fastest.
+        rest = _apply(m, lattice_points(lattice, False))
+        last = [sizes[0] - 1, (sizes[1] - 1) * sizes[0], (sizes[2] - 1) * sizes[0] * sizes[1]]
+        origin = rest[0]
+        axes = np.concatenate([rest[i] - origin for i in last])
+        deformed = _apply(m, lattice_points(lattice, True))
+        deformed = deformed.reshape(sizes[2], sizes[1], sizes[0], 3).transpose(2, 1, 0, 3)
+        return [("basis", int(entry.basis)), ("divisions", [s - 1 for s in sizes]), ("origin", origin),
+                ("axes", axes), ("points", deformed.ravel())]
+    if t == "wires":
+        curve = _need(entry, "curve", "wire curve")
+        rest = _need(entry, "rest_curve", "rest wire curve")
+        rest_points_ = _apply(local_matrix(obj, rest, depsgraph), curve_points(entry.name, rest))
+        points = _apply(local_matrix(obj, curve, depsgraph), curve_points(entry.name, curve))
+        if len(points) != len(rest_points_):
+            raise DeformKitError(f"{entry.name}: wire '{curve.name}' has {len(points)} points, its rest "
+                                 f"'{rest.name}' {len(rest_points_)}")
+        return [("smooth", int(entry.smooth)), ("restCurve", rest_points_.ravel()), ("curveSizes", [0]),
+                ("dropoff", [entry.dropoff]), ("curve", points.ravel())]
+    if t == "meshwarp":
+        cage = _need(entry, "cage", "cage mesh")
+        rest = _need(entry, "rest_cage", "rest cage mesh")
+        if len(cage.data.vertices) != len(rest.data.vertices):
+            raise DeformKitError(f"{entry.name}: cage '{cage.name}' has {len(cage.data.vertices)} vertices, "
+                                 f"its rest '{rest.name}' {len(rest.data.vertices)}")
+        counts = [len(p.vertices) for p in rest.data.polygons]
+        indices = [i for p in rest.data.polygons for i in p.vertices]
+        rest_co = _apply(local_matrix(obj, rest, depsgraph), [v.co[:] for v in rest.data.vertices])
+        cage_co = _apply(local_matrix(obj, cage, depsgraph), [v.co[:] for v in cage.data.vertices])
+        return [("restCage", rest_co.ravel()), ("cageFaceCounts", counts), ("cageFaceIndices", indices),
+                ("cage", cage_co.ravel())]
+    raise DeformKitError(f"{entry.name}: unknown deformer type '{t}'")
+
+
+def controls(obj):
+    """The objects whose edits change `obj`'s deformation."""
+    found = set()
+    for entry in obj.deformkit.entries:
+        for attribute in ("start", "end", "frame", "lattice", "curve", "rest_curve", "cage", "rest_cage"):
+            control = getattr(entry, attribute)
+            if control is not None:
+                found.add(control.name)
+    return found
+
+
+# ---- evaluation ---------------------------------------------------------------------------------------
+
+def _stack_for(obj):
+    """The object's DeformerStack, built again only when its entries' types or labels change."""
+    signature = tuple((e.type, e.name) for e in obj.deformkit.entries)
+    cached = _cache.get(obj.name)
+    if cached is None or cached["signature"] != signature or cached["vertices"] != len(obj.data.vertices):
+        stack = dk.DeformerStack()
+        stack.set_rest(rest_mesh(obj))
+        for entry in obj.deformkit.entries:
+            stack.add(entry.type, entry.name)
+        cached = {"signature": signature, "stack": stack, "weights": {}, "vertices": len(obj.data.vertices)}
+        _cache[obj.name] = cached
+    return cached
+
+
+def evaluate_object(obj, depsgraph=None):
+    """Evaluates `obj`'s stack on its rest shape and writes the result into its vertex positions.
+
+    Raises DeformKitError for a problem with the Blender data and the module's errors (ValueError and its
+    kind) for bad parameter values, each naming the entry."""
+    settings = obj.deformkit
+    if len(settings.entries) == 0:
+        return
+    rest = rest_points(obj)
+    cached = _stack_for(obj)
+    stack = cached["stack"]
+    for i, entry in enumerate(settings.entries):
+        stack.set_envelope(i, entry.envelope if entry.enabled else 0.0)
+        if not entry.enabled or entry.envelope == 0.0:
+            continue  # a skipped entry needs no controls
+        for name, value in entry_parameters(obj, entry, depsgraph):
+            stack.set(i, name, value)
+        # Weights are set only when they change: new weights rebind the entry.
+        weights = vertex_group_weights(obj, entry.vertex_group) if entry.vertex_group else None
+        previous = cached["weights"].get(i)
+        if (weights is None) != (previous is None) or (
+                weights is not None and not np.array_equal(weights, previous)):
+            stack.set_weights(i, weights)
+            cached["weights"][i] = weights
+    out = stack.evaluate(rest)
+    obj.data.vertices.foreach_set("co", out.ravel())
+    obj.data.update()
+
+
+def evaluate_safely(obj, depsgraph=None):
+    """evaluate_object for handlers and property updates: a failure is kept in the stack's status line
+    (shown in the panel) instead of raising; returns the message, or an empty string."""
+    try:
+        evaluate_object(obj, depsgraph)
+        message = ""
+    except Exception as e:  # noqa: BLE001 - every failure reaches the panel, never only the console
+        message = str(e)
+    if obj.deformkit.status != message:
+        obj.deformkit.status = message
+    return message

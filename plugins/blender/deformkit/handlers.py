@@ -1,0 +1,66 @@
+"""Evaluation on frame change and on edits of controls (an Empty dragged, a lattice point moved)."""
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import evaluate
+
+_busy = False  # writing a mesh triggers another depsgraph update: do not react to our own writes
+
+
+def _stacked_objects(scene):
+    return [o for o in scene.objects if o.type == 'MESH' and len(o.deformkit.entries) > 0]
+
+
+@persistent
+def on_frame_change(scene, depsgraph=None):
+    global _busy
+    if _busy:
+        return
+    _busy = True
+    try:
+        for obj in _stacked_objects(scene):
+            evaluate.evaluate_safely(obj, depsgraph)
+    finally:
+        _busy = False
+
+
+@persistent
+def on_depsgraph_update(scene, depsgraph):
+    global _busy
+    if _busy:
+        return
+    objects = {u.id.original.name for u in depsgraph.updates if isinstance(u.id, bpy.types.Object)}
+    data = {u.id.original.name for u in depsgraph.updates
+            if isinstance(u.id, (bpy.types.Lattice, bpy.types.Curve, bpy.types.Mesh))}
+    if not objects and not data:
+        return
+    _busy = True
+    try:
+        for obj in _stacked_objects(scene):
+            controls = evaluate.controls(obj)
+            control_data = {bpy.data.objects[c].data.name for c in controls
+                            if c in bpy.data.objects and bpy.data.objects[c].data is not None}
+            if controls & objects or control_data & data:
+                evaluate.evaluate_safely(obj, depsgraph)
+    finally:
+        _busy = False
+
+
+@persistent
+def on_load(_):
+    evaluate.clear_cache()
+
+
+def register():
+    bpy.app.handlers.frame_change_post.append(on_frame_change)
+    bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
+    bpy.app.handlers.load_post.append(on_load)
+
+
+def unregister():
+    for handlers, function in ((bpy.app.handlers.frame_change_post, on_frame_change),
+                               (bpy.app.handlers.depsgraph_update_post, on_depsgraph_update),
+                               (bpy.app.handlers.load_post, on_load)):
+        if function in handlers:
+            handlers.remove(function)

@@ -1,0 +1,276 @@
+"""Operators: add, remove and reorder stack entries (creating their controls), evaluate, reset the rest
+shape. Failures are operator reports."""
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty
+from mathutils import Euler, Matrix, Vector
+
+from . import evaluate
+from .props import DEFORMER_TYPES
+
+
+def _mesh_object(context):
+    obj = context.object
+    return obj if obj is not None and obj.type == 'MESH' else None
+
+
+def _link(context, obj, like):
+    collection = like.users_collection[0] if like.users_collection else context.scene.collection
+    collection.objects.link(obj)
+    return obj
+
+
+def _new_empty(context, owner, name, world_location, display='PLAIN_AXES', size=0.25):
+    empty = bpy.data.objects.new(name, None)
+    empty.empty_display_type = display
+    empty.empty_display_size = size
+    empty.location = world_location
+    return _link(context, empty, owner)
+
+
+def _unique_label(settings, base):
+    labels = {e.name for e in settings.entries}
+    if base not in labels:
+        return base
+    n = 2
+    while f"{base}{n}" in labels:
+        n += 1
+    return f"{base}{n}"
+
+
+def _bounds(points):
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return lo, hi, np.maximum(hi - lo, 1e-3)
+
+
+def _world(obj, local):
+    m = np.array(obj.matrix_world, np.float64)
+    return tuple(m[:3, :3] @ np.asarray(local, np.float64) + m[:3, 3])
+
+
+def _handle_vertex(context, obj, rest):
+    """The active vertex in edit mode, else the vertex nearest the 3D cursor."""
+    mesh = obj.data
+    if obj.mode == 'EDIT':
+        obj.update_from_editmode()
+    selected = np.zeros(len(mesh.vertices), bool)
+    mesh.vertices.foreach_get("select", selected)
+    if obj.mode == 'EDIT' and selected.any():
+        return int(np.flatnonzero(selected)[0])
+    m = np.array(obj.matrix_world, np.float64)
+    cursor = np.linalg.inv(m) @ np.append(np.array(context.scene.cursor.location, np.float64), 1.0)
+    return int(np.argmin(((rest - cursor[:3]) ** 2).sum(axis=1)))
+
+
+def setup_controls(context, obj, entry):
+    """Creates the controls a new entry of entry.type needs, placed around the object's rest shape."""
+    rest = evaluate.rest_points(obj).astype(np.float64)
+    lo, hi, size = _bounds(rest)
+    centre = 0.5 * (lo + hi)
+    t = entry.type
+    if t == "slide":
+        entry.vertex = _handle_vertex(context, obj, rest)
+        at = _world(obj, rest[entry.vertex])
+        entry.radius = float(0.25 * size.max())
+        entry.start = _new_empty(context, obj, f"{obj.name}_{entry.name}_start", at, 'SPHERE', 0.05 * size.max())
+        entry.end = _new_empty(context, obj, f"{obj.name}_{entry.name}_end", at, 'PLAIN_AXES', 0.1 * size.max())
+    elif t in ("taper", "twist", "bend"):
+        # The handle's Y axis along the object's longest side, its units half that side.
+        axis = int(np.argmax(size))
+        frame = _new_empty(context, obj, f"{obj.name}_{entry.name}_handle", (0.0, 0.0, 0.0), 'ARROWS', 1.0)
+        rotation = [(0.0, 0.0, -np.pi / 2), (0.0, 0.0, 0.0), (np.pi / 2, 0.0, 0.0)][axis]
+        units = 0.5 * float(size[axis])
+        frame.matrix_world = obj.matrix_world @ (Matrix.Translation(Vector(centre)) @
+                                                 Euler(rotation).to_matrix().to_4x4() @
+                                                 Matrix.Diagonal((units, units, units, 1.0)))
+        entry.frame = frame
+        if t == "twist":
+            entry.start_value, entry.end_value = 0.0, 1.0
+        elif t == "taper":
+            entry.start_value, entry.end_value = 1.0, 0.5
+    elif t == "ffd":
+        data = bpy.data.lattices.new(f"{obj.name}_{entry.name}")
+        data.points_u = data.points_v = data.points_w = 3
+        lattice = bpy.data.objects.new(f"{obj.name}_{entry.name}_lattice", data)
+        lattice.matrix_world = obj.matrix_world @ (Matrix.Translation(Vector(centre)) @
+                                                   Matrix.Diagonal((*(1.02 * size), 1.0)))
+        entry.lattice = _link(context, lattice, obj)
+    elif t == "wires":
+        # A wire along the object's longest side, and its hidden rest copy.
+        axis = int(np.argmax(size))
+        curve_data = bpy.data.curves.new(f"{obj.name}_{entry.name}", 'CURVE')
+        curve_data.dimensions = '3D'
+        spline = curve_data.splines.new('POLY')
+        spline.points.add(4)
+        for i, p in enumerate(spline.points):
+            co = centre.copy()
+            co[axis] = lo[axis] + size[axis] * i / 4.0
+            p.co = (*co, 1.0)
+        wire = _link(context, bpy.data.objects.new(f"{obj.name}_{entry.name}_wire", curve_data), obj)
+        wire.matrix_world = obj.matrix_world.copy()
+        rest_wire = _link(context, bpy.data.objects.new(f"{obj.name}_{entry.name}_wire_rest",
+                                                        curve_data.copy()), obj)
+        rest_wire.matrix_world = obj.matrix_world.copy()
+        rest_wire.hide_set(True)
+        entry.curve, entry.rest_curve = wire, rest_wire
+        entry.dropoff = float(0.3 * size.max())
+    elif t == "meshwarp":
+        # A box cage a little larger than the object, and its hidden rest copy.
+        cage_mesh = bpy.data.meshes.new(f"{obj.name}_{entry.name}_cage")
+        a, b = lo - 0.05 * size, hi + 0.05 * size
+        corners = [(x, y, z) for z in (a[2], b[2]) for y in (a[1], b[1]) for x in (a[0], b[0])]
+        faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+        cage_mesh.from_pydata(corners, [], faces)
+        cage = _link(context, bpy.data.objects.new(f"{obj.name}_{entry.name}_cage", cage_mesh), obj)
+        cage.matrix_world = obj.matrix_world.copy()
+        cage.display_type = 'WIRE'
+        rest_cage = _link(context, bpy.data.objects.new(f"{obj.name}_{entry.name}_cage_rest",
+                                                        cage_mesh.copy()), obj)
+        rest_cage.matrix_world = obj.matrix_world.copy()
+        rest_cage.hide_set(True)
+        entry.cage, entry.rest_cage = cage, rest_cage
+
+
+class DEFORMKIT_OT_add(bpy.types.Operator):
+    """Add a DeformKit deformer to the active mesh, with its controls"""
+    bl_idname = "deformkit.add"
+    bl_label = "Add DeformKit Deformer"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    type: EnumProperty(name="Type", items=[t[:3] for t in DEFORMER_TYPES])
+
+    @classmethod
+    def poll(cls, context):
+        return _mesh_object(context) is not None
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        settings = obj.deformkit
+        try:
+            if not evaluate.has_rest(obj):
+                evaluate.capture_rest(obj)
+            entry = settings.entries.add()
+            # Set the label and type before anything triggers an evaluation of a half-made entry.
+            entry["name"] = _unique_label(settings, self.type)
+            entry["type"] = [t[0] for t in DEFORMER_TYPES].index(self.type)
+            entry["envelope"] = 0.0
+            setup_controls(context, obj, entry)
+            entry.envelope = 1.0
+            settings.active_index = len(settings.entries) - 1
+        except Exception as e:  # noqa: BLE001 - reported to the user
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        message = evaluate.evaluate_safely(obj)
+        if message:
+            self.report({'WARNING'}, message)
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_remove(bpy.types.Operator):
+    """Remove the active DeformKit deformer (its controls stay in the scene)"""
+    bl_idname = "deformkit.remove"
+    bl_label = "Remove DeformKit Deformer"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and len(obj.deformkit.entries) > 0
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        settings = obj.deformkit
+        settings.entries.remove(settings.active_index)
+        settings.active_index = max(0, min(settings.active_index, len(settings.entries) - 1))
+        if len(settings.entries) == 0:
+            evaluate.restore_rest(obj)
+            settings.status = ""
+            return {'FINISHED'}
+        message = evaluate.evaluate_safely(obj)
+        if message:
+            self.report({'WARNING'}, message)
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_move(bpy.types.Operator):
+    """Move the active DeformKit deformer up or down the stack (the stack runs top to bottom)"""
+    bl_idname = "deformkit.move"
+    bl_label = "Move DeformKit Deformer"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    direction: EnumProperty(items=[("UP", "Up", ""), ("DOWN", "Down", "")])
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and len(obj.deformkit.entries) > 1
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        settings = obj.deformkit
+        i = settings.active_index
+        j = i - 1 if self.direction == 'UP' else i + 1
+        if not 0 <= j < len(settings.entries):
+            return {'CANCELLED'}
+        settings.entries.move(i, j)
+        settings.active_index = j
+        message = evaluate.evaluate_safely(obj)
+        if message:
+            self.report({'WARNING'}, message)
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_evaluate(bpy.types.Operator):
+    """Evaluate the active object's DeformKit stack now"""
+    bl_idname = "deformkit.evaluate"
+    bl_label = "Evaluate DeformKit Stack"
+
+    @classmethod
+    def poll(cls, context):
+        return _mesh_object(context) is not None
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        message = evaluate.evaluate_safely(obj, context.evaluated_depsgraph_get())
+        if message:
+            self.report({'ERROR'}, message)
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
+    """Take the mesh's rest shape from its current shape after restoring it (for edits made with the stack
+    off): the deformers rebind to it"""
+    bl_idname = "deformkit.reset_rest"
+    bl_label = "Reset Rest Shape"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and evaluate.has_rest(obj)
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        evaluate.restore_rest(obj)
+        evaluate.capture_rest(obj)
+        evaluate.clear_cache()
+        message = evaluate.evaluate_safely(obj)
+        if message:
+            self.report({'WARNING'}, message)
+        return {'FINISHED'}
+
+
+_classes = (DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
+            DEFORMKIT_OT_reset_rest)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)

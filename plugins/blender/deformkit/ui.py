@@ -1,0 +1,105 @@
+"""The DeformKit panel in the Properties editor's Modifiers tab: the stack, and the active entry's controls."""
+
+import bpy
+
+from .props import DEFORMER_TYPES, TYPE_ICONS
+
+
+class DEFORMKIT_UL_stack(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        row = layout.row(align=True)
+        row.prop(item, "enabled", text="")
+        row.label(text=item.name, icon=TYPE_ICONS.get(item.type, 'MODIFIER'))
+        row.prop(item, "envelope", text="", slider=True)
+
+
+class DEFORMKIT_MT_add(bpy.types.Menu):
+    bl_label = "Add DeformKit Deformer"
+    bl_idname = "DEFORMKIT_MT_add"
+
+    def draw(self, context):
+        for identifier, label, _, icon in DEFORMER_TYPES:
+            self.layout.operator("deformkit.add", text=label, icon=icon).type = identifier
+
+
+def _draw_entry(layout, obj, entry):
+    col = layout.column()
+    col.prop(entry, "name")
+    col.prop(entry, "envelope", slider=True)
+    col.prop_search(entry, "vertex_group", obj, "vertex_groups")
+    t = entry.type
+    if t == "slide":
+        col.prop(entry, "start")
+        col.prop(entry, "end")
+        col.prop(entry, "vertex")
+        col.prop(entry, "radius")
+        col.prop(entry, "geodesic")
+        col.prop(entry, "falloff")
+    elif t in ("taper", "twist", "bend"):
+        col.prop(entry, "frame")
+        if t == "bend":
+            col.prop(entry, "curvature")
+        else:
+            col.prop(entry, "start_value", text="Start Scale" if t == "taper" else "Start Angle")
+            col.prop(entry, "end_value", text="End Scale" if t == "taper" else "End Angle")
+        row = col.row(align=True)
+        row.prop(entry, "low_bound")
+        row.prop(entry, "high_bound")
+    elif t == "ffd":
+        col.prop(entry, "lattice")
+        col.prop(entry, "basis")
+    elif t == "wires":
+        col.prop(entry, "curve")
+        col.prop(entry, "rest_curve")
+        col.prop(entry, "dropoff")
+        col.prop(entry, "smooth")
+    elif t == "meshwarp":
+        col.prop(entry, "cage")
+        col.prop(entry, "rest_cage")
+
+
+class DEFORMKIT_PT_stack(bpy.types.Panel):
+    bl_label = "DeformKit"
+    bl_idname = "DEFORMKIT_PT_stack"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "modifier"
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.type == 'MESH'
+
+    def draw(self, context):
+        obj = context.object
+        settings = obj.deformkit
+        layout = self.layout
+        row = layout.row()
+        row.template_list("DEFORMKIT_UL_stack", "", settings, "entries", settings, "active_index", rows=3)
+        buttons = row.column(align=True)
+        buttons.menu("DEFORMKIT_MT_add", icon='ADD', text="")
+        buttons.operator("deformkit.remove", icon='REMOVE', text="")
+        buttons.separator()
+        buttons.operator("deformkit.move", icon='TRIA_UP', text="").direction = 'UP'
+        buttons.operator("deformkit.move", icon='TRIA_DOWN', text="").direction = 'DOWN'
+        if settings.status:
+            box = layout.box()
+            box.alert = True
+            box.label(text=settings.status, icon='ERROR')
+        if 0 <= settings.active_index < len(settings.entries):
+            _draw_entry(layout.box(), obj, settings.entries[settings.active_index])
+        row = layout.row(align=True)
+        row.operator("deformkit.evaluate", icon='FILE_REFRESH', text="Evaluate")
+        row.operator("deformkit.reset_rest", text="Reset Rest")
+
+
+_classes = (DEFORMKIT_UL_stack, DEFORMKIT_MT_add, DEFORMKIT_PT_stack)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,273 @@
+"""The DeformKit add-on in real Blender, headless:
+
+    blender -b --factory-startup --python-exit-code 1 --python test_addon.py -- ADDON_STAGE_DIR
+
+Each test builds a scene, drives the add-on as a user would (operators, moving Empties and lattice points,
+changing frames) and compares the mesh's vertex positions with the same deformation computed through the
+`deformkit` Python module directly, from values the test sets itself.
+"""
+
+import os
+import sys
+import traceback
+import zipfile
+
+import bpy
+import numpy as np
+
+STAGE = sys.argv[sys.argv.index("--") + 1]
+sys.path.insert(0, STAGE)
+import deformkit as addon  # noqa: E402  (the add-on package; its compiled module is addon.core.dk)
+
+addon.register()
+dk = addon.core.dk
+
+N = 21  # grid vertices per side, [-1, 1]^2 in the z = 0 plane: vertex (i, j) is j * N + i
+CENTRE = (N // 2) * N + N // 2
+
+
+def fresh():
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.lattices, bpy.data.curves):
+        for block in list(collection):
+            collection.remove(block)
+    addon.evaluate.clear_cache()
+    bpy.context.scene.frame_set(1)
+    bpy.context.scene.cursor.location = (0.0, 0.0, 0.0)
+
+
+def grid_object(name="grid"):
+    xs = np.linspace(-1.0, 1.0, N, dtype=np.float32)
+    points = [(x, y, 0.0) for y in xs for x in xs]
+    faces = [(j * N + i, j * N + i + 1, (j + 1) * N + i + 1, (j + 1) * N + i)
+             for j in range(N - 1) for i in range(N - 1)]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(points, [], faces)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
+def positions(obj):
+    out = np.empty(len(obj.data.vertices) * 3, np.float32)
+    obj.data.vertices.foreach_get("co", out)
+    return out.reshape(-1, 3)
+
+
+def direct_stack(obj, rest):
+    """A DeformerStack on the object's rest mesh, built through the module (not the add-on)."""
+    counts = np.full(len(obj.data.polygons), 4, np.int32)
+    indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
+    stack = dk.DeformerStack()
+    stack.set_rest(dk.Mesh(rest, counts, indices))
+    return stack
+
+
+def z_up(empty):
+    """Places an Empty at the origin, unscaled, its Y axis along world Z: the quaternion (1/2, 1/2, 1/2, 1/2)
+    (120 degrees about (1, 1, 1)) whose matrix has exact entries, so the handle is exactly (0, 0, 1)."""
+    empty.location = (0.0, 0.0, 0.0)
+    empty.scale = (1.0, 1.0, 1.0)
+    empty.rotation_mode = 'QUATERNION'
+    empty.rotation_quaternion = (0.5, 0.5, 0.5, 0.5)
+
+
+def add(kind):
+    result = bpy.ops.deformkit.add(type=kind)
+    assert result == {'FINISHED'}, result
+    return bpy.context.object.deformkit.entries[-1]
+
+
+def assert_same(actual, expected, what):
+    # The add-on and the direct stack run the same kernels on the same float32 rest points with the same
+    # parameter values (the test picks values exact in float32), so they agree to the last bit; 1e-6 leaves
+    # room only for a different order of float operations.
+    err = float(np.abs(actual - expected).max())
+    assert err <= 1e-6, f"{what}: differs by {err}"
+
+
+# ---- tests ------------------------------------------------------------------------------------------------
+
+def test_the_addon_is_registered_and_zipped():
+    assert hasattr(bpy.types, "DEFORMKIT_PT_stack")
+    assert bpy.types.DEFORMKIT_PT_stack.bl_space_type == 'PROPERTIES'
+    assert addon.bl_info["blender"] == (3, 4, 0)
+    with zipfile.ZipFile(os.path.join(STAGE, "deformkit-blender.zip")) as z:
+        names = set(z.namelist())
+    assert "deformkit/__init__.py" in names
+    assert any(n.startswith("deformkit/deformkit.") and n.endswith(".so") for n in names), names
+
+
+def test_slide_follows_the_end_empty():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    entry = add("slide")
+    assert entry.vertex == CENTRE  # nearest the 3D cursor at the origin
+    assert entry.start is not None and entry.end is not None
+    assert np.array_equal(positions(obj), rest)  # start == end: no slide yet
+
+    entry.end.location = (0.25, 0.125, 0.0)  # the animator drags the end Empty
+    bpy.context.view_layer.update()  # the depsgraph handler sees the control edit
+    stack = direct_stack(obj, rest)
+    stack.add("slide", "s")
+    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("falloff", 0),
+                        ("displacement", (0.25, 0.125, 0.0))]:
+        stack.set(0, name, value)
+    expected = stack.evaluate(rest)
+    assert np.abs(expected - rest).max() > 0.1
+    assert_same(positions(obj), expected, "slide after dragging the end Empty")
+    assert obj.deformkit.status == ""
+
+
+def test_frame_changes_follow_an_animated_empty():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    entry = add("slide")
+    end = entry.end
+    end.location = (0.0, 0.0, 0.0)
+    end.keyframe_insert("location", frame=1)
+    end.location = (0.5, 0.0, 0.0)
+    end.keyframe_insert("location", frame=11)
+    for curve in end.animation_data.action.fcurves:
+        for key in curve.keyframe_points:
+            key.interpolation = 'LINEAR'
+    bpy.context.scene.frame_set(6)  # half way: (0.25, 0, 0)
+    stack = direct_stack(obj, rest)
+    stack.add("slide", "s")
+    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))]:
+        stack.set(0, name, value)
+    assert_same(positions(obj), stack.evaluate(rest), "slide at frame 6")
+    bpy.context.scene.frame_set(1)
+    assert_same(positions(obj), rest, "slide at frame 1 (no displacement)")
+
+
+def test_twist_about_an_empty_and_vertex_group_weights():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    entry = add("twist")
+    z_up(entry.frame)
+    entry.start_value, entry.end_value = 0.0, 1.5
+    bpy.context.view_layer.update()
+    params = [("handleOrigin", (0, 0, 0)), ("handleY", (0, 0, 1)), ("startAngle", 0.0), ("endAngle", 1.5),
+              ("lowBound", -1.0), ("highBound", 1.0)]
+    # Handle Y is the world Z axis: the twist turns the grid about Z.
+    stack = direct_stack(obj, rest)
+    stack.add("twist", "t")
+    for name, value in params:
+        stack.set(0, name, value)
+    assert_same(positions(obj), stack.evaluate(rest), "twist about the Empty's Y axis")
+
+    group = obj.vertex_groups.new(name="paint")
+    weights = np.where(rest[:, 0] > 0.0, 0.25, 1.0).astype(np.float32)
+    for v, w in enumerate(weights):
+        group.add([v], float(w), 'REPLACE')
+    entry.vertex_group = "paint"
+    stack.set_weights(0, weights)
+    assert_same(positions(obj), stack.evaluate(rest), "twist with vertex-group weights")
+    entry.envelope = 0.5
+    stack.set_envelope(0, 0.5)
+    assert_same(positions(obj), stack.evaluate(rest), "twist at envelope 0.5")
+
+
+def test_ffd_follows_lattice_points():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    entry = add("ffd")
+    lattice = entry.lattice
+    assert (lattice.data.points_u, lattice.data.points_v, lattice.data.points_w) == (3, 3, 3)
+    lattice.location, lattice.rotation_euler, lattice.scale = (0, 0, 0), (0, 0, 0), (2.5, 2.5, 1.0)
+    # A new 3-point lattice spans [-1, 1] of its object space, so [-2.5, 2.5]^2 x [-1, 1] here. Lift the
+    # centre point by 0.5 and push the (2, 2, 2) corner by 0.25 of the object's space along x (Blender lists
+    # points u fastest).
+    assert tuple(lattice.data.points[0].co) == (-1.0, -1.0, -1.0)
+    centre = (1 * 3 + 1) * 3 + 1
+    lattice.data.points[centre].co_deform = (0.0, 0.0, 0.5)
+    corner = (2 * 3 + 2) * 3 + 2
+    lattice.data.points[corner].co_deform = (1.25, 1.0, 1.0)
+    lattice.data.update_tag()
+    bpy.context.view_layer.update()
+    # Reference lattice written in our order (k fastest): control (i, j, k) at origin + (i, j, k) / 2 * edge.
+    origin, edge = np.array([-2.5, -2.5, -1.0]), np.array([5.0, 5.0, 2.0])
+    points = np.array([origin + np.array([i, j, k]) / 2.0 * edge
+                       for i in range(3) for j in range(3) for k in range(3)])
+    points[(1 * 3 + 1) * 3 + 1] += (0.0, 0.0, 0.5)
+    points[(2 * 3 + 2) * 3 + 2] += (0.25 * 2.5, 0.0, 0.0)
+    stack = direct_stack(obj, rest)
+    stack.add("ffd", "f")
+    for name, value in [("basis", 0), ("divisions", (2, 2, 2)), ("origin", origin),
+                        ("axes", (5.0, 0, 0, 0, 5.0, 0, 0, 0, 2.0)), ("points", points.ravel())]:
+        stack.set(0, name, value)
+    expected = stack.evaluate(rest)
+    assert np.abs(expected[:, 2]).max() > 0.05  # the grid's centre rises by 0.5 B(1/2)^3 = 1/16
+    assert_same(positions(obj), expected, "FFD from the lattice")
+
+
+def test_reorder_and_remove():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    twist = add("twist")
+    z_up(twist.frame)
+    twist.start_value, twist.end_value = 0.0, 1.0
+    slide = add("slide")
+    slide.end.location = (0.25, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    assert [e.type for e in obj.deformkit.entries] == ["twist", "slide"]
+    bpy.ops.deformkit.move(direction='UP')  # the slide (active) moves above the twist
+
+    stack = direct_stack(obj, rest)
+    stack.add("slide", "s")
+    stack.add("twist", "t")
+    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))]:
+        stack.set(0, name, value)
+    for name, value in [("handleY", (0, 0, 1)), ("startAngle", 0.0), ("endAngle", 1.0)]:
+        stack.set(1, name, value)
+    assert [e.type for e in obj.deformkit.entries] == ["slide", "twist"]
+    assert_same(positions(obj), stack.evaluate(rest), "slide then twist")
+
+    bpy.ops.deformkit.remove()
+    bpy.ops.deformkit.remove()
+    assert len(obj.deformkit.entries) == 0
+    assert np.array_equal(positions(obj), rest)  # the rest shape is back
+
+
+def test_errors_reach_the_user_as_reports():
+    fresh()
+    obj = grid_object()
+    entry = add("bend")
+    before = positions(obj).copy()
+    entry.frame.scale = (1.0, 2.0, 1.0)  # X and Y not as long: no circular arc
+    bpy.context.view_layer.update()
+    assert "handle scale" in obj.deformkit.status, obj.deformkit.status
+    assert np.array_equal(positions(obj), before)  # the last good result stays
+    try:
+        bpy.ops.deformkit.evaluate()
+        raise AssertionError("evaluate did not report the error")
+    except RuntimeError as e:
+        assert "handle scale" in str(e), str(e)
+
+    entry.frame = None
+    assert "no handle Empty set" in obj.deformkit.status, obj.deformkit.status
+
+
+def main():
+    failures = 0
+    tests = [(name, f) for name, f in sorted(globals().items()) if name.startswith("test_") and callable(f)]
+    for name, test in tests:
+        try:
+            test()
+            print(f"PASS {name}")
+        except Exception:  # noqa: BLE001
+            failures += 1
+            print(f"FAIL {name}")
+            traceback.print_exc()
+    print(f"{len(tests) - failures} of {len(tests)} Blender tests passed")
+    if failures:
+        sys.exit(1)
+
+
+main()
