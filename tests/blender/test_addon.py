@@ -206,6 +206,73 @@ def test_ffd_follows_lattice_points():
     assert_same(positions(obj), expected, "FFD from the lattice")
 
 
+def test_taper_and_bend_about_an_empty():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    taper = add("taper")
+    z_up(taper.frame)
+    taper.frame.location = (0.0, 0.0, -1.0)
+    taper.start_value, taper.end_value = 1.0, 0.5
+    bend = add("bend")
+    bend.frame.location, bend.frame.rotation_euler, bend.frame.scale = (0, 0, 0), (0, 0, 0), (1, 1, 1)
+    bend.curvature = 0.75
+    bpy.context.view_layer.update()
+    stack = direct_stack(obj, rest)
+    stack.add("taper", "t")
+    stack.add("bend", "b")
+    for name, value in [("handleOrigin", (0, 0, -1)), ("handleY", (0, 0, 1)), ("startScale", 1.0),
+                        ("endScale", 0.5)]:
+        stack.set(0, name, value)
+    stack.set(1, "curvature", 0.75)  # handle: the world axes at the origin, the defaults
+    expected = stack.evaluate(rest)
+    assert np.abs(expected - rest).max() > 0.1
+    assert_same(positions(obj), expected, "taper then bend")
+
+
+def test_wire_curve_and_cage_mesh():
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    wire = add("wires")
+    wire.dropoff = 0.5
+    wire.smooth = True
+    rest_wire = np.array([(-1.0 + 0.5 * i, 0.0, 0.0) for i in range(5)])  # along x, the grid's first axis
+    assert np.array_equal(np.array([p.co[:3] for p in wire.rest_curve.data.splines[0].points]), rest_wire)
+    wire.curve.data.splines[0].points[2].co = (0.0, 0.0, 0.25, 1.0)  # lift the wire's middle point
+    wire.curve.data.update_tag()
+    bpy.context.view_layer.update()
+    moved = rest_wire.copy()
+    moved[2, 2] = 0.25
+    stack = direct_stack(obj, rest)
+    stack.add("wires", "w")
+    for name, value in [("smooth", 1), ("restCurve", rest_wire.ravel()), ("curveSizes", [0]),
+                        ("dropoff", [0.5]), ("curve", moved.ravel())]:
+        stack.set(0, name, value)
+    expected = stack.evaluate(rest)
+    assert np.abs(expected[:, 2]).max() > 0.1
+    assert_same(positions(obj), expected, "wire")
+
+    cage = add("meshwarp")
+    corners = np.array([v.co[:] for v in cage.rest_cage.data.vertices])
+    # A box around the grid padded by 0.05 of its size (2) on every axis.
+    assert np.allclose(np.abs(corners), [1.1, 1.1, 0.1], atol=1e-6)
+    top = int(np.flatnonzero((corners > 0).all(axis=1))[0])  # the (+x, +y, +z) corner
+    cage.cage.data.vertices[top].co.z += 0.25
+    cage.cage.data.update_tag()
+    bpy.context.view_layer.update()
+    deformed = corners.copy()
+    deformed[top, 2] += np.float32(0.25)
+    stack.add("meshwarp", "m")
+    faces = [list(p.vertices) for p in cage.rest_cage.data.polygons]
+    for name, value in [("restCage", corners.ravel()), ("cageFaceCounts", [len(f) for f in faces]),
+                        ("cageFaceIndices", [i for f in faces for i in f]), ("cage", deformed.ravel())]:
+        stack.set(1, name, value)
+    expected2 = stack.evaluate(rest)
+    assert np.abs(expected2 - expected).max() > 0.01
+    assert_same(positions(obj), expected2, "wire then cage")
+
+
 def test_reorder_and_remove():
     fresh()
     obj = grid_object()

@@ -118,7 +118,8 @@ def setup_controls(context, obj, entry):
     elif t == "meshwarp":
         # A box cage a little larger than the object, and its hidden rest copy.
         cage_mesh = bpy.data.meshes.new(f"{obj.name}_{entry.name}_cage")
-        a, b = lo - 0.05 * size, hi + 0.05 * size
+        pad = 0.05 * size.max()  # on every axis, so a flat object gets a cage with volume
+        a, b = lo - pad, hi + pad
         corners = [(x, y, z) for z in (a[2], b[2]) for y in (a[1], b[1]) for x in (a[0], b[0])]
         faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
         cage_mesh.from_pydata(corners, [], faces)
