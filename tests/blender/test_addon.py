@@ -8,7 +8,9 @@ changing frames) and compares the mesh's vertex positions with the same deformat
 """
 
 import os
+import shutil
 import sys
+import tempfile
 import traceback
 import zipfile
 
@@ -319,6 +321,76 @@ def test_errors_reach_the_user_as_reports():
 
     entry.frame = None
     assert "no handle Empty set" in obj.deformkit.status, obj.deformkit.status
+
+
+def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
+    fresh()
+    obj = grid_object()
+    layer = obj.data.uv_layers.new(name="UVMap")
+    corners = np.array([obj.data.vertices[l.vertex_index].co[:2] for l in obj.data.loops], np.float32)
+    layer.data.foreach_set("uv", ((corners + 1.0) / 2.0).ravel())  # the grid fills tile 1001
+    rest = positions(obj).copy()
+    entry = add("slide")
+    entry.end.location = (0.0, 0.0, 0.0)
+    entry.end.keyframe_insert("location", frame=1)
+    entry.end.location = (0.25, 0.0, 0.0)
+    entry.end.keyframe_insert("location", frame=3)
+    # A rigid disk painted in a 32 x 32 float image (Blender rows bottom-up).
+    size = 32
+    ys, xs = np.mgrid[0:size, 0:size]
+    disk = (((xs + 0.5) / size - 0.5) ** 2 + ((ys + 0.5) / size - 0.5) ** 2 < 0.2 ** 2).astype(np.float32)
+    image = bpy.data.images.new("rigidity", size, size, float_buffer=True)
+    rgba = np.zeros((size, size, 4), np.float32)
+    rgba[..., 0] = disk
+    rgba[..., 3] = 1.0
+    image.pixels.foreach_set(rgba.ravel())
+    obj.deformkit.uv_rigidity = image
+    out = tempfile.mkdtemp()
+    obj.deformkit.uv_output = out
+    assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3) == {'FINISHED'}
+    files = sorted(os.listdir(out))
+    assert files == [f"redirect.1001.{f:04d}.exr" for f in (1, 2, 3)], files
+
+    # The same solve through the module: the mesh's own positions at each frame, the painted disk (row 0 at
+    # v = 1, so Blender's bottom-up rows flipped), warm-started frame after frame: the same bytes.
+    counts = np.full(len(obj.data.polygons), 4, np.int32)
+    indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
+    uv_indices = np.arange(len(indices), dtype=np.int32)
+    uvs = (rest[indices][:, :2] + 1.0) / 2.0
+    solver = dk.UvWarpSolver(rest, counts, indices, uvs.astype(np.float32), uv_indices, 1001,
+                             np.ascontiguousarray(disk[::-1]))
+    for frame in (1, 2, 3):
+        bpy.context.scene.frame_set(frame)
+        solver.solve(positions(obj))
+        baked = dk.read_image(os.path.join(out, f"redirect.1001.{frame:04d}.exr"))
+        assert np.array_equal(baked[:, :, :2], solver.redirect_map()), f"frame {frame}"
+    assert np.abs(solver.redirect_map() - dk.read_image(os.path.join(out, "redirect.1001.0001.exr"))[:, :, :2]
+                  ).max() > 1e-4  # the slide at frame 3 does warp the texture
+
+    material = bpy.data.materials.new("skin")
+    material.use_nodes = True
+    albedo = material.node_tree.nodes.new('ShaderNodeTexImage')
+    obj.data.materials.append(material)
+    assert bpy.ops.deformkit.redirect_material(frame_start=1, frame_end=3) == {'FINISHED'}
+    group = bpy.data.node_groups["DeformKit Redirect"]
+    assert [s.name for s in group.inputs] == ["UV", "Redirect"] and [s.name for s in group.outputs] == ["UV"]
+    links = albedo.inputs["Vector"].links
+    assert len(links) == 1 and links[0].from_node.type == 'GROUP'
+    redirect = [n for n in material.node_tree.nodes if n.label == "DeformKit Redirect"][0]
+    assert redirect.image.source == 'SEQUENCE' and redirect.image_user.frame_duration == 3
+    bpy.data.images.remove(redirect.image)
+    shutil.rmtree(out, ignore_errors=True)
+
+
+def test_bake_errors_are_reports():
+    fresh()
+    obj = grid_object()
+    add("slide")
+    try:
+        bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=2)
+        raise AssertionError("a bake without UVs did not report")
+    except RuntimeError as e:
+        assert "no UV map" in str(e), str(e)
 
 
 def main():

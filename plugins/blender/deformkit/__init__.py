@@ -16,7 +16,7 @@ bl_info = {
     "category": "Rigging",
 }
 
-from . import evaluate, handlers, ops, props, ui  # noqa: E402
+from . import evaluate, handlers, ops, props, ui, uvwarp  # noqa: E402,F401
 
 _modules = (props, ops, ui, handlers)
 

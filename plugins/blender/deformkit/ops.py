@@ -1,12 +1,14 @@
 """Operators: add, remove and reorder stack entries (creating their controls), evaluate, reset the rest
 shape. Failures are operator reports."""
 
+import os
+
 import bpy
 import numpy as np
-from bpy.props import EnumProperty
+from bpy.props import EnumProperty, IntProperty
 from mathutils import Euler, Matrix, Vector
 
-from . import evaluate
+from . import evaluate, uvwarp
 from .props import DEFORMER_TYPES
 
 
@@ -263,7 +265,74 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
+class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
+    """Solve the content-aware UV warp of the active mesh over a frame range and write its redirect maps"""
+    bl_idname = "deformkit.bake_redirect"
+    bl_label = "Bake DeformKit Redirect Maps"
+
+    frame_start: IntProperty(name="Start", default=1)
+    frame_end: IntProperty(name="End", default=1)
+
+    @classmethod
+    def poll(cls, context):
+        return _mesh_object(context) is not None
+
+    def invoke(self, context, event):
+        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
+        return self.execute(context)
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        settings = obj.deformkit
+        if self.frame_end < self.frame_start:
+            self.report({'ERROR'}, f"frame range {self.frame_start}-{self.frame_end} is empty")
+            return {'CANCELLED'}
+        wm = context.window_manager
+        frames = range(self.frame_start, self.frame_end + 1)
+        wm.progress_begin(0.0, 1.0)
+        try:
+            written = uvwarp.bake_redirect_maps(context, obj, settings.uv_rigidity, settings.uv_mask, frames,
+                                                bpy.path.abspath(settings.uv_output), settings.uv_resolution,
+                                                wm.progress_update)
+        except Exception as e:  # noqa: BLE001 - reported to the user
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        finally:
+            wm.progress_end()
+        self.report({'INFO'}, f"wrote {len(written)} redirect maps to {settings.uv_output}")
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
+    """Read every image texture of the active material through the baked redirect maps (tile 1001)"""
+    bl_idname = "deformkit.redirect_material"
+    bl_label = "Add DeformKit Redirect Nodes"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    frame_start: IntProperty(name="Start", default=1)
+    frame_end: IntProperty(name="End", default=1)
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and obj.active_material is not None
+
+    def invoke(self, context, event):
+        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
+        return self.execute(context)
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        first = os.path.join(bpy.path.abspath(obj.deformkit.uv_output), uvwarp.redirect_name(1001, self.frame_start))
+        if not os.path.exists(first):
+            self.report({'ERROR'}, f"no redirect map {first}; bake the redirect maps first")
+            return {'CANCELLED'}
+        uvwarp.add_redirect_nodes(obj.active_material, first, self.frame_start,
+                                  self.frame_end - self.frame_start + 1)
+        return {'FINISHED'}
+
+
+_classes = (DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
             DEFORMKIT_OT_reset_rest)
 
 

@@ -99,6 +99,15 @@ class DeformKitStack(bpy.types.PropertyGroup):
     entries: CollectionProperty(type=DeformKitEntry)
     active_index: IntProperty(name="Active Entry", default=0)
     status: StringProperty(name="Status", description="The last evaluation's error, empty when it succeeded")
+    # The UV warp (texture space, after the stack and the object's modifiers)
+    uv_rigidity: PointerProperty(name="Rigidity", type=bpy.types.Image,
+                                 description="Painted rigidity map: 1 keeps the detail at its rest size")
+    uv_mask: PointerProperty(name="Mask", type=bpy.types.Image,
+                             description="Warp mask: 1 may warp (none: derived from the UV charts)")
+    uv_output: StringProperty(name="Output", subtype='DIR_PATH', default="//deformkit_redirect/",
+                              description="Folder of the redirect maps (redirect.<tile>.<frame>.exr)")
+    uv_resolution: IntProperty(name="Resolution", default=0, min=0,
+                               description="Solver grid cells per side, a power of two (0: the map's texels)")
 
 
 _classes = (DeformKitEntry, DeformKitStack)

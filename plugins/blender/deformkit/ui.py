@@ -91,6 +91,17 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         row.operator("deformkit.evaluate", icon='FILE_REFRESH', text="Evaluate")
         row.operator("deformkit.reset_rest", text="Reset Rest")
 
+        box = layout.box()
+        box.label(text="UV Warp", icon='UV')
+        col = box.column()
+        col.template_ID(settings, "uv_rigidity", open="image.open")
+        col.template_ID(settings, "uv_mask", open="image.open")
+        col.prop(settings, "uv_output")
+        col.prop(settings, "uv_resolution")
+        row = col.row(align=True)
+        row.operator("deformkit.bake_redirect", icon='RENDER_ANIMATION', text="Bake Redirect Maps")
+        row.operator("deformkit.redirect_material", icon='NODETREE', text="Redirect Material")
+
 
 _classes = (DEFORMKIT_UL_stack, DEFORMKIT_MT_add, DEFORMKIT_PT_stack)
 
