@@ -121,6 +121,14 @@ def test_slide_follows_the_end_empty():
     assert_same(positions(obj), expected, "slide after dragging the end Empty")
     assert obj.deformkit.status == ""
 
+    # A frame change that moves no control evaluates nothing: a marker written into the mesh stays.
+    obj.data.vertices[0].co.z = 7.0
+    bpy.context.scene.frame_set(2)
+    assert obj.data.vertices[0].co.z == 7.0
+    entry.end.location = (0.25, 0.25, 0.0)  # a control edit does evaluate
+    bpy.context.view_layer.update()
+    assert obj.data.vertices[0].co.z == 0.0
+
 
 def test_frame_changes_follow_an_animated_empty():
     fresh()

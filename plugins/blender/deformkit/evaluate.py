@@ -227,45 +227,82 @@ def _stack_for(obj):
         stack.set_rest(rest_mesh(obj))
         for entry in obj.deformkit.entries:
             stack.add(entry.type, entry.name)
-        cached = {"signature": signature, "stack": stack, "weights": {}, "vertices": len(obj.data.vertices)}
+        cached = {"signature": signature, "stack": stack, "weights": {}, "group_weights": {}, "stale_weights": {},
+                  "vertices": len(obj.data.vertices)}
         _cache[obj.name] = cached
     return cached
 
 
-def evaluate_object(obj, depsgraph=None):
-    """Evaluates `obj`'s stack on its rest shape and writes the result into its vertex positions.
+def mark_weights_changed(obj):
+    """Vertex-group weights are read again at the next evaluation (after weight painting)."""
+    cached = _cache.get(obj.name)
+    if cached is not None:
+        cached["stale_weights"] = dict(cached["group_weights"])
+        cached["group_weights"].clear()
+
+
+def _weights(obj, cached, name):
+    # Reading a vertex group walks every vertex in Python: done once per group until the weights are
+    # marked changed (the handlers do when the object is edited in Weight Paint mode).
+    if name not in cached["group_weights"]:
+        weights = vertex_group_weights(obj, name)
+        stale = cached["stale_weights"].get(name)
+        # Unchanged weights keep their array, so the evaluation sees no change and writes nothing.
+        cached["group_weights"][name] = stale if stale is not None and np.array_equal(stale, weights) else weights
+    return cached["group_weights"][name]
+
+
+def _same(a, b):
+    return a is not None and b is not None and len(a) == len(b) and all(
+        x[0] == y[0] and x[1] == y[1] and np.array_equal(x[2], y[2]) for x, y in zip(a, b))
+
+
+def evaluate_object(obj, depsgraph=None, force=False):
+    """Evaluates `obj`'s stack on its rest shape and writes the result into its vertex positions; does
+    nothing when no input changed since the last evaluation (a frame change that moves no control).
 
     Raises DeformKitError for a problem with the Blender data and the module's errors (ValueError and its
     kind) for bad parameter values, each naming the entry."""
     settings = obj.deformkit
     if len(settings.entries) == 0:
         return
-    rest = rest_points(obj)
     cached = _stack_for(obj)
     stack = cached["stack"]
+    inputs = []
     for i, entry in enumerate(settings.entries):
-        stack.set_envelope(i, entry.envelope if entry.enabled else 0.0)
+        inputs.append((i, "envelope", np.array([entry.envelope if entry.enabled else 0.0])))
         if not entry.enabled or entry.envelope == 0.0:
             continue  # a skipped entry needs no controls
         for name, value in entry_parameters(obj, entry, depsgraph):
+            inputs.append((i, name, np.asarray(value, np.float64).ravel()))
+        inputs.append((i, "weights", np.array([id(_weights(obj, cached, entry.vertex_group))])
+                       if entry.vertex_group else np.zeros(0)))
+    if not force and _same(inputs, cached.get("inputs")):
+        return
+    for i, entry in enumerate(settings.entries):
+        stack.set_envelope(i, entry.envelope if entry.enabled else 0.0)
+    for i, name, value in inputs:
+        if name == "weights":
+            # Set only on a change: new weights rebind the entry.
+            entry = settings.entries[i]
+            weights = _weights(obj, cached, entry.vertex_group) if entry.vertex_group else None
+            previous = cached["weights"].get(i)
+            if weights is not previous:
+                stack.set_weights(i, weights)
+                cached["weights"][i] = weights
+        elif name != "envelope":
             stack.set(i, name, value)
-        # Weights are set only when they change: new weights rebind the entry.
-        weights = vertex_group_weights(obj, entry.vertex_group) if entry.vertex_group else None
-        previous = cached["weights"].get(i)
-        if (weights is None) != (previous is None) or (
-                weights is not None and not np.array_equal(weights, previous)):
-            stack.set_weights(i, weights)
-            cached["weights"][i] = weights
-    out = stack.evaluate(rest)
+    out = stack.evaluate(rest_points(obj))
     obj.data.vertices.foreach_set("co", out.ravel())
     obj.data.update()
+    cached["inputs"] = inputs
 
 
-def evaluate_safely(obj, depsgraph=None):
+def evaluate_safely(obj, depsgraph=None, force=False):
     """evaluate_object for handlers and property updates: a failure is kept in the stack's status line
     (shown in the panel) instead of raising; returns the message, or an empty string."""
     try:
-        evaluate_object(obj, depsgraph)
+        evaluate_object(obj, depsgraph, force)
         message = ""
     except Exception as e:  # noqa: BLE001 - every failure reaches the panel, never only the console
         message = str(e)

@@ -38,6 +38,10 @@ def on_depsgraph_update(scene, depsgraph):
     _busy = True
     try:
         for obj in _stacked_objects(scene):
+            if obj.mode == 'WEIGHT_PAINT' and obj.name in objects:
+                evaluate.mark_weights_changed(obj)
+                evaluate.evaluate_safely(obj, depsgraph)
+                continue
             controls = evaluate.controls(obj)
             control_data = {bpy.data.objects[c].data.name for c in controls
                             if c in bpy.data.objects and bpy.data.objects[c].data is not None}
@@ -48,7 +52,8 @@ def on_depsgraph_update(scene, depsgraph):
 
 
 @persistent
-def on_load(_):
+def on_load(*_):
+    # A loaded file, an undo or a redo brings other data: the cached stacks and inputs no longer apply.
     evaluate.clear_cache()
 
 
@@ -56,11 +61,14 @@ def register():
     bpy.app.handlers.frame_change_post.append(on_frame_change)
     bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
     bpy.app.handlers.load_post.append(on_load)
+    bpy.app.handlers.undo_post.append(on_load)
+    bpy.app.handlers.redo_post.append(on_load)
 
 
 def unregister():
     for handlers, function in ((bpy.app.handlers.frame_change_post, on_frame_change),
                                (bpy.app.handlers.depsgraph_update_post, on_depsgraph_update),
-                               (bpy.app.handlers.load_post, on_load)):
+                               (bpy.app.handlers.load_post, on_load), (bpy.app.handlers.undo_post, on_load),
+                               (bpy.app.handlers.redo_post, on_load)):
         if function in handlers:
             handlers.remove(function)

@@ -235,7 +235,8 @@ class DEFORMKIT_OT_evaluate(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        message = evaluate.evaluate_safely(obj, context.evaluated_depsgraph_get())
+        evaluate.mark_weights_changed(obj)
+        message = evaluate.evaluate_safely(obj, context.evaluated_depsgraph_get(), force=True)
         if message:
             self.report({'ERROR'}, message)
             return {'CANCELLED'}
