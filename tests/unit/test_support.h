@@ -79,6 +79,9 @@ std::string errorOf(const std::function<void()>& body) {
 inline bool sameBits(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
+inline bool sameBits(std::span<const float> a, std::span<const float> b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
 
 // True when the process can bypass file permissions (root): permission tests are skipped then.
 inline bool runningAsRoot() { return ::geteuid() == 0; }

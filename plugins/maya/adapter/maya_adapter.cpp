@@ -250,4 +250,16 @@ void NodeCore::evaluate(std::span<glm::vec3> points, double envelope) {
     stack_.evaluate(points);
 }
 
+RedirectCore::RedirectCore(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+                           const uvwarp::TileWarpOptions& options, const std::string& source)
+    : warp_(rest, tile, rigidity, mask, options, {}, source) {}
+
+io::Image RedirectCore::solve(int frame, std::span<const glm::vec3> deformedPoints) {
+    warm_ = last_ && frame == *last_ + 1;
+    if (!warm_) warp_.reset();
+    (void)warp_.solve(deformedPoints);
+    last_ = frame;
+    return warp_.redirect();
+}
+
 }  // namespace deformkit::maya

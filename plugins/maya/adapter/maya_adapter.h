@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -11,6 +12,8 @@
 
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/stack.h"
+#include "deformkit/io/image.h"
+#include "deformkit/uvwarp/tile_warp.h"
 
 // The Maya plugin's translation layer, free of Maya headers so it is built and tested everywhere: Maya's
 // conventions (row-vector matrices, ramp attributes, world-space controls) turned into host-layer
@@ -134,6 +137,24 @@ class NodeCore {
   private:
     host::DeformerStack stack_;
     std::vector<float> weights_;
+};
+
+// What the dkUvRedirect node keeps: one UDIM tile's UV-warp solver over the rest mesh. Frames solved in
+// order warm-start from the previous one; any other frame (a jump, scrubbing backwards, the first one)
+// starts cold, so a frame's map depends only on the frames played before it in order, as in
+// `deformkit eval` runs that start at that frame.
+class RedirectCore {
+  public:
+    RedirectCore(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+                 const uvwarp::TileWarpOptions& options, const std::string& source);
+    // The redirect map (T x T x 2) for `frame` with the deformed points.
+    [[nodiscard]] io::Image solve(int frame, std::span<const glm::vec3> deformedPoints);
+    [[nodiscard]] bool warmStarted() const { return warm_; }
+
+  private:
+    uvwarp::TileWarp warp_;
+    std::optional<int> last_;
+    bool warm_ = false;
 };
 
 }  // namespace deformkit::maya

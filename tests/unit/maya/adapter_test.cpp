@@ -9,6 +9,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
+#include "deformkit/uvwarp/tile_warp.h"
 #include "maya_adapter.h"
 #include "test_support.h"
 
@@ -193,4 +194,37 @@ TEST_CASE("maya adapter: the node core rebinds only for new rest geometry and ap
     std::vector<glm::vec3> again(moved.points().begin(), moved.points().end());
     core.evaluate(again, 1.0);
     CHECK(core.bindCount() == 2);
+}
+
+TEST_CASE("maya adapter: the redirect core warm-starts frames in order and starts cold after a jump",
+          "[maya]") {
+    // Reference: TileWarp driven directly. Frames 1, 2, 3 in order are one warm-started sequence; frame 7
+    // after them is a jump, which must equal a fresh solver's single solve (a cold start), bit for bit.
+    const geom::Mesh mesh = geom::makeGrid({8, 8, 1.0f, 1.0f});
+    io::Image rigidity(32, 32, 1);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+            rigidity.at(x, y, 0) = std::hypot(x - 15.5, y - 15.5) < 6.0 ? 1.0f : 0.0f;
+    uvwarp::TileWarpOptions options;
+    options.solver.iterations = 4;
+    const auto pose = [&](int frame) {
+        std::vector<glm::vec3> p(mesh.points().begin(), mesh.points().end());
+        for (glm::vec3& q : p)
+            q.x *= 1.0f + 0.05f * static_cast<float>(frame);
+        return p;
+    };
+    maya::RedirectCore core(mesh, 1001, rigidity, {}, options, "rig");
+    uvwarp::TileWarp sequence(mesh, 1001, rigidity, {}, options, {}, "rig");
+    for (int frame : {1, 2, 3}) {
+        const io::Image map = core.solve(frame, pose(frame));
+        (void)sequence.solve(pose(frame));
+        CHECK(core.warmStarted() == (frame > 1));
+        CHECK(test::sameBits(map.pixels, sequence.redirect().pixels));
+    }
+    const io::Image jumped = core.solve(7, pose(7));
+    CHECK_FALSE(core.warmStarted());
+    uvwarp::TileWarp cold(mesh, 1001, rigidity, {}, options, {}, "rig");
+    (void)cold.solve(pose(7));
+    CHECK(test::sameBits(jumped.pixels, cold.redirect().pixels));
+    CHECK_FALSE(test::sameBits(jumped.pixels, core.solve(1, pose(1)).pixels));  // the maps do change
 }
