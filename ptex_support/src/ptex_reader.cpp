@@ -1,8 +1,5 @@
 // Ptex reader. Every size field is checked against the bytes that remain before it is used, and every
 // zipped block against zlib's largest ratio before its output is allocated.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -12,6 +9,7 @@
 #include <system_error>
 
 #include "deformkit/error.h"
+#include "deformkit/io/read_file.h"
 #include "deformkit/ptex/ptex_file.h"
 #include "format.h"
 
@@ -771,41 +769,6 @@ class Reader {
     uint64_t editDataPos_ = 0;
 };
 
-std::vector<uint8_t> readWholeFile(const std::filesystem::path& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) {
-        const int err = errno;
-        throw IoError(formatError(path.string(), "", "cannot open: " + std::system_category().message(err),
-                                  "an existing, readable Ptex file"));
-    }
-    struct Closer {
-        int fd;
-        ~Closer() { ::close(fd); }
-    } closer{fd};
-    struct stat info {};
-    if (::fstat(fd, &info) != 0 || S_ISDIR(info.st_mode)) {
-        throw IoError(
-            formatError(path.string(), "", "is a folder or cannot be examined", "a readable Ptex file"));
-    }
-    std::vector<uint8_t> bytes(S_ISREG(info.st_mode) ? static_cast<size_t>(info.st_size) + 1 : 65536);
-    size_t size = 0;
-    while (true) {
-        if (size == bytes.size()) bytes.resize(bytes.size() * 2);
-        const ssize_t got = ::read(fd, bytes.data() + size, bytes.size() - size);
-        if (got == 0) break;
-        if (got < 0) {
-            if (errno == EINTR) continue;
-            const int err = errno;
-            throw IoError(formatError(path.string(), "",
-                                      "cannot read: " + std::system_category().message(err),
-                                      "a readable Ptex file"));
-        }
-        size += static_cast<size_t>(got);
-    }
-    bytes.resize(size);
-    return bytes;
-}
-
 }  // namespace
 
 PtexFile readPtex(std::span<const uint8_t> bytes, const std::string& source, const ReadOptions& options) {
@@ -813,8 +776,9 @@ PtexFile readPtex(std::span<const uint8_t> bytes, const std::string& source, con
 }
 
 PtexFile readPtex(const std::filesystem::path& path, const ReadOptions& options) {
-    const std::vector<uint8_t> bytes = readWholeFile(path);
-    return readPtex(bytes, path.string(), options);
+    const std::string bytes = io::readFile(path, "Ptex file");
+    return readPtex(std::span(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()), path.string(),
+                    options);
 }
 
 }  // namespace deformkit::ptex

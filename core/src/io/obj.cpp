@@ -15,6 +15,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/read_file.h"
 
 namespace deformkit::io {
 namespace fs = std::filesystem;
@@ -474,42 +475,6 @@ class ObjParser {
     std::vector<int32_t> scratch_;
 };
 
-std::string readWholeFile(const fs::path& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) {
-        const int err = errno;
-        throw IoError(formatError(path.string(), "", "cannot open: " + std::system_category().message(err),
-                                  "an existing, readable OBJ file"));
-    }
-    struct Closer {
-        int fd;
-        ~Closer() { ::close(fd); }
-    } closer{fd};
-    struct stat info {};
-    if (::fstat(fd, &info) != 0 || S_ISDIR(info.st_mode)) {
-        throw IoError(
-            formatError(path.string(), "", "is a folder or cannot be examined", "a readable OBJ file"));
-    }
-    std::string bytes;
-    size_t size = 0;
-    bytes.resize(S_ISREG(info.st_mode) ? static_cast<size_t>(info.st_size) + 1 : 65536);
-    while (true) {
-        if (size == bytes.size()) bytes.resize(bytes.size() * 2);
-        const ssize_t got = ::read(fd, bytes.data() + size, bytes.size() - size);
-        if (got == 0) break;
-        if (got < 0) {
-            if (errno == EINTR) continue;
-            const int err = errno;
-            throw IoError(formatError(path.string(), "",
-                                      "cannot read: " + std::system_category().message(err),
-                                      "a readable OBJ file"));
-        }
-        size += static_cast<size_t>(got);
-    }
-    bytes.resize(size);
-    return bytes;
-}
-
 // Text output without iostreams: numbers through to_chars.
 class ObjText {
   public:
@@ -558,7 +523,7 @@ ObjContent parseObj(std::string_view text, const std::string& source) {
 }
 
 ObjContent readObj(const fs::path& path) {
-    const std::string bytes = readWholeFile(path);
+    const std::string bytes = readFile(path, "OBJ file");
     return parseObj(bytes, path.string());
 }
 
