@@ -1,16 +1,10 @@
 #include "deformkit/io/obj.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <system_error>
 #include <unordered_map>
 
 #include "deformkit/error.h"
