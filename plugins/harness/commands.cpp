@@ -9,6 +9,7 @@
 #include "demo_slide.h"
 #include "demo_uvwarp.h"
 #include "demo_warps.h"
+#include "slide_command.h"
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/geom/half_edge.h"
@@ -117,7 +118,20 @@ void preview(const PreviewCommand& command) {
     const io::ObjContent obj = io::readObj(command.mesh);
     std::optional<io::PreviewTexture> texture;
     if (command.texture) texture = io::loadPreviewTexture(*command.texture);
-    const io::Image image = io::renderPreview(obj.mesh, command.options, texture ? &*texture : nullptr);
+    if (command.weights && command.weightsPtex) {
+        throw InvalidInput(formatError("--weights-ptex", "", "is given with --weights", "one weights source"));
+    }
+    io::PreviewOptions options = command.options;
+    if (command.weights || command.weightsPtex) {
+        const std::vector<float> weights =
+            command.weights ? readWeights(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
+                            : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
+                                                    "--weights-ptex");
+        options.vertexColors.clear();
+        for (float w : weights)
+            options.vertexColors.push_back(io::weightColor(w));
+    }
+    const io::Image image = io::renderPreview(obj.mesh, options, texture ? &*texture : nullptr);
     io::writeImage(command.out, image);
 }
 

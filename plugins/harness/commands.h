@@ -22,6 +22,11 @@ void describe(const std::filesystem::path& file, std::ostream& out);
 struct PreviewCommand {
     std::filesystem::path mesh;
     std::optional<std::filesystem::path> texture;  // image or UDIM pattern
+    // Painted weights shown as colours (io::weightColor): a JSON weights file, or a Ptex map of the mesh
+    // (its per-vertex values of channel weightsChannel). At most one.
+    std::optional<std::filesystem::path> weights;
+    std::optional<std::filesystem::path> weightsPtex;
+    int32_t weightsChannel = 0;
     std::filesystem::path out;                     // PNG (or any image format by extension)
     io::PreviewOptions options;
 };

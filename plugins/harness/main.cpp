@@ -12,6 +12,7 @@
 #include "deformkit/version.h"
 #include "eval_command.h"
 #include "farm_command.h"
+#include "ptex_command.h"
 #include "slide_command.h"
 #include "uvwarp_command.h"
 #include "warp_command.h"
@@ -54,6 +55,11 @@ int main(int argc, char** argv) {
     preview->add_option("--height", previewCommand.options.height, "pixels")->capture_default_str();
     preview->add_option("--view", previewView, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
     preview->add_flag("--edges", previewCommand.options.drawEdges, "draw polygon edges");
+    std::string previewWeights, previewWeightsPtex;
+    preview->add_option("--weights", previewWeights, "show painted weights (JSON array, one per vertex) as colours");
+    preview->add_option("--weights-ptex", previewWeightsPtex, "show a Ptex map's per-vertex values as colours");
+    preview->add_option("--weights-channel", previewCommand.weightsChannel, "the Ptex map's channel")
+        ->capture_default_str();
 
     harness::DemoCommand demoCommand;
     std::string demoOut = demoCommand.outDir.string();
@@ -152,6 +158,11 @@ int main(int argc, char** argv) {
                      "smooth, linear, or ramp samples v0,v1,... over distance/radius")
         ->capture_default_str();
     slideApp->add_option("--weights", slideWeights, "painted weights: a JSON array of one number per vertex");
+    std::string slideWeightsPtex;
+    slideApp->add_option("--weights-ptex", slideWeightsPtex,
+                         "painted weights from a Ptex map of the mesh (per-vertex values)");
+    slideApp->add_option("--weights-channel", slideCommand.weightsChannel, "the Ptex map's channel")
+        ->capture_default_str();
     slideApp->add_option("--envelope", slideCommand.envelope, "scales every slide")->capture_default_str();
     slideApp->add_option("--region", slideRegion, "euclidean (3D distance) or geodesic (over the surface)")
         ->check(CLI::IsMember({"euclidean", "geodesic"}))
@@ -235,6 +246,41 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
 
+    auto* ptexApp = app.add_subcommand("ptex", "Ptex files: describe, per-vertex values, UDIM conversions");
+    ptexApp->require_subcommand(1);
+    std::string ptexInfoFile;
+    auto* ptexInfoApp = ptexApp->add_subcommand("info", "Header, faces and resolutions, metadata of a Ptex file");
+    ptexInfoApp->add_option("FILE", ptexInfoFile, "Ptex file (.ptx)")->required();
+    harness::PtexToVertexCommand ptexToVertex;
+    std::string ptexToVertexFile, ptexToVertexMesh, ptexToVertexOut;
+    auto* ptexToVertexApp =
+        ptexApp->add_subcommand("to-vertex", "Per-vertex values of a Ptex map as a JSON weights file");
+    ptexToVertexApp->add_option("FILE", ptexToVertexFile, "Ptex file painted on MESH")->required();
+    ptexToVertexApp->add_option("MESH", ptexToVertexMesh, "mesh (.obj)")->required();
+    ptexToVertexApp->add_option("--out", ptexToVertexOut, "weights file (.json)")->required();
+    ptexToVertexApp->add_option("--channel", ptexToVertex.channel, "channel")->capture_default_str();
+    harness::PtexToUdimCommand ptexToUdim;
+    std::string ptexToUdimFile, ptexToUdimMesh, ptexToUdimTiles;
+    auto* ptexToUdimApp =
+        ptexApp->add_subcommand("to-udim", "Render a Ptex map into UDIM tile images through the mesh's UVs");
+    ptexToUdimApp->add_option("FILE", ptexToUdimFile, "Ptex file painted on MESH")->required();
+    ptexToUdimApp->add_option("MESH", ptexToUdimMesh, "mesh (.obj) with UVs")->required();
+    ptexToUdimApp->add_option("--out", ptexToUdim.out, "UDIM pattern, such as 'map.<UDIM>.exr'")->required();
+    ptexToUdimApp->add_option("--resolution", ptexToUdim.resolution, "pixels per tile side")
+        ->capture_default_str();
+    ptexToUdimApp->add_option("--tiles", ptexToUdimTiles, "tiles to write (default: every tile of the mesh)");
+    harness::PtexFromUdimCommand ptexFromUdim;
+    std::string ptexFromUdimMesh, ptexFromUdimOut, ptexFaceRes = "auto", ptexType = "float";
+    auto* ptexFromUdimApp =
+        ptexApp->add_subcommand("from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs");
+    ptexFromUdimApp->add_option("PATTERN", ptexFromUdim.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'")
+        ->required();
+    ptexFromUdimApp->add_option("MESH", ptexFromUdimMesh, "mesh (.obj) with UVs")->required();
+    ptexFromUdimApp->add_option("--out", ptexFromUdimOut, "Ptex file (.ptx)")->required();
+    ptexFromUdimApp->add_option("--face-res", ptexFaceRes, "texels per face side: auto or a power of two")
+        ->capture_default_str();
+    ptexFromUdimApp->add_option("--type", ptexType, "u8, u16, half or float")->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -252,6 +298,8 @@ int main(int argc, char** argv) {
             previewCommand.out = previewOut;
             if (!previewTexture.empty()) previewCommand.texture = previewTexture;
             if (!previewView.empty()) previewCommand.options.viewDirection = parseVec3(previewView);
+            if (!previewWeights.empty()) previewCommand.weights = previewWeights;
+            if (!previewWeightsPtex.empty()) previewCommand.weightsPtex = previewWeightsPtex;
             harness::preview(previewCommand);
             std::cout << "wrote " << previewOut << "\n";
         } else if (*warpImageApp) {
@@ -271,6 +319,7 @@ int main(int argc, char** argv) {
             slideCommand.to = harness::parsePoint(slideTo, "--to");
             slideCommand.falloff = harness::parseFalloff(slideFalloff);
             if (!slideWeights.empty()) slideCommand.weights = slideWeights;
+            if (!slideWeightsPtex.empty()) slideCommand.weightsPtex = slideWeightsPtex;
             slideCommand.handle.region =
                 slideRegion == "geodesic" ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean;
             slideCommand.options.surface =
@@ -328,6 +377,27 @@ int main(int argc, char** argv) {
                 std::cerr << "deformkit: error: " << e.what() << "\n";
                 return harness::farmExitCode(e);
             }
+        } else if (*ptexInfoApp) {
+            harness::ptexInfo(ptexInfoFile, std::cout);
+        } else if (*ptexToVertexApp) {
+            ptexToVertex.ptex = ptexToVertexFile;
+            ptexToVertex.mesh = ptexToVertexMesh;
+            ptexToVertex.out = ptexToVertexOut;
+            const size_t count = harness::ptexToVertexCommand(ptexToVertex);
+            std::cout << "wrote " << ptexToVertexOut << ": " << count << " vertex values\n";
+        } else if (*ptexToUdimApp) {
+            ptexToUdim.ptex = ptexToUdimFile;
+            ptexToUdim.mesh = ptexToUdimMesh;
+            if (!ptexToUdimTiles.empty()) ptexToUdim.tiles = harness::parseTiles(ptexToUdimTiles);
+            for (const auto& f : harness::ptexToUdimCommand(ptexToUdim))
+                std::cout << "wrote " << f.string() << "\n";
+        } else if (*ptexFromUdimApp) {
+            ptexFromUdim.mesh = ptexFromUdimMesh;
+            ptexFromUdim.out = ptexFromUdimOut;
+            ptexFromUdim.faceLog2 = harness::parseFaceResolution(ptexFaceRes);
+            ptexFromUdim.type = harness::parsePtexType(ptexType);
+            harness::ptexFromUdimCommand(ptexFromUdim);
+            std::cout << "wrote " << ptexFromUdimOut << "\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);

@@ -9,6 +9,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/ptex/ptex_mesh.h"
 
 namespace deformkit::harness {
 namespace {
@@ -116,8 +117,15 @@ std::vector<float> readWeights(const fs::path& path, size_t count) {
 slide::SlideResult slideCommand(const SlideCommand& command) {
     io::ObjContent obj = io::readObj(command.mesh);
     const size_t count = static_cast<size_t>(obj.mesh.numVertices());
+    if (command.weights && command.weightsPtex) {
+        throw InvalidInput(formatError("--weights-ptex", "", "is given with --weights",
+                                       "one source of painted weights"));
+    }
     const std::vector<float> weights =
-        command.weights ? readWeights(*command.weights, count) : std::vector<float>{};
+        command.weights       ? readWeights(*command.weights, count)
+        : command.weightsPtex ? ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
+                                                      "--weights-ptex")
+                              : std::vector<float>{};
     slide::Slider slider(obj.mesh, {command.handle}, command.options, command.mesh.string());
     const std::vector<slide::SlideDrive> drives = {{command.to - command.from, command.falloff}};
     std::vector<glm::vec3> points(obj.mesh.points().begin(), obj.mesh.points().end());

@@ -65,6 +65,40 @@ for pair in "tube.obj before" "slide/tube_slid.obj after"; do
     cmp -s "$work/slide_$2.png" "$work/demo/slide/$2.png" ||
         { echo "FAIL slide-preview-$2: differs from the demo's slide/$2.png"; failures=$((failures + 1)); }
 done
+# docs/ptex.md's commands remake the demo's Ptex pictures byte for byte, and each ptex subcommand runs.
+for pair in "ptex/tube.obj before" "ptex/tube_slid.obj after"; do
+    set -- $pair
+    expect "ptex-preview-$2" 0 "$dk" preview "$work/demo/$1" --weights-ptex "$work/demo/ptex/falloff.ptx" \
+        --width 480 --height 480 --view -0.45,-0.3,-1 --out "$work/ptex_$2.png"
+    cmp -s "$work/ptex_$2.png" "$work/demo/ptex/$2.png" ||
+        { echo "FAIL ptex-preview-$2: differs from the demo's ptex/$2.png"; failures=$((failures + 1)); }
+done
+expect ptex-info 0 "$dk" ptex info "$work/demo/ptex/falloff.ptx"
+contains ptex-info "$work/out" "resolution  8x8: 23040 faces"
+contains ptex-info "$work/out" "mesh data   yes"
+expect ptex-to-vertex 0 "$dk" ptex to-vertex "$work/demo/ptex/falloff.ptx" "$work/demo/ptex/tube.obj" \
+    --out "$work/falloff.json"
+contains ptex-to-vertex "$work/out" "22242 vertex values"
+expect ptex-slide 0 "$dk" slide "$work/demo/ptex/tube.obj" --handle 9627 --from 0,2,0 --to 0,2.3,0.4 \
+    --radius 1.2 --weights-ptex "$work/demo/ptex/falloff.ptx" --out "$work/ptex_slid.obj"
+expect ptex-slide-json 0 "$dk" slide "$work/demo/ptex/tube.obj" --handle 9627 --from 0,2,0 --to 0,2.3,0.4 \
+    --radius 1.2 --weights "$work/falloff.json" --out "$work/json_slid.obj"
+cmp -s "$work/ptex_slid.obj" "$work/json_slid.obj" ||
+    { echo "FAIL ptex-slide: --weights-ptex and the to-vertex weights file differ"; failures=$((failures + 1)); }
+expect ptex-from-udim 0 "$dk" ptex from-udim "$work/demo/albedo.<UDIM>.png" "$work/demo/tube.obj" \
+    --out "$work/albedo.ptx" --face-res 4 --type u8
+expect ptex-to-udim 0 "$dk" ptex to-udim "$work/albedo.ptx" "$work/demo/tube.obj" --out "$work/back.<UDIM>.png" \
+    --resolution 64
+[ -s "$work/back.1001.png" ] && [ -s "$work/back.1002.png" ] ||
+    { echo "FAIL ptex-to-udim: tiles missing"; failures=$((failures + 1)); }
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >"$work/quad.obj"
+expect ptex-wrong-mesh 2 "$dk" ptex to-vertex "$work/demo/ptex/falloff.ptx" "$work/quad.obj" --out "$work/x.json"
+contains ptex-wrong-mesh "$work/err" "has 23040 faces"
+printf 'not a ptex file, just some text that is long enough to hold a header of sixty-four bytes\n' >"$work/bad.ptx"
+expect ptex-bad-file 2 "$dk" ptex info "$work/bad.ptx"
+contains ptex-bad-file "$work/err" "bad.ptx"
+expect ptex-bad-type 2 "$dk" ptex from-udim "$work/demo/albedo.<UDIM>.png" "$work/demo/tube.obj" \
+    --out "$work/x.ptx" --type f64
 expect info-mesh 0 "$dk" info "$work/demo/tube.obj"
 contains info-mesh "$work/out" "vertices    22242"
 contains info-mesh "$work/out" "UDIM tiles 1001 1002"

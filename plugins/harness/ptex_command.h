@@ -1,0 +1,56 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "deformkit/ptex/ptex_file.h"
+
+// `deformkit ptex ...`: Ptex files on the command line. Each throws deformkit::Error on bad input (main()
+// prints it and exits 2); outputs are written atomically.
+namespace deformkit::harness {
+
+// `deformkit ptex info FILE`: header, faces and their resolutions, flags, metadata, mesh metadata.
+void ptexInfo(const std::filesystem::path& file, std::ostream& out);
+
+// `deformkit ptex to-vertex FILE MESH --out weights.json [--channel C]`: the per-vertex values of one
+// channel (ptex::vertexValues) as a JSON array, the weights file the slide, the scenes and every command
+// read. Returns the vertex count.
+struct PtexToVertexCommand {
+    std::filesystem::path ptex;
+    std::filesystem::path mesh;  // OBJ
+    std::filesystem::path out;
+    int32_t channel = 0;
+};
+size_t ptexToVertexCommand(const PtexToVertexCommand& command);
+
+// `deformkit ptex to-udim FILE MESH --out 'map.<UDIM>.exr' [--resolution N] [--tiles 1001,1002]`: the map
+// rendered into one image per UDIM tile through the mesh's UVs (ptex::ptexToUdim). Returns the files.
+struct PtexToUdimCommand {
+    std::filesystem::path ptex;
+    std::filesystem::path mesh;
+    std::string out;  // a UDIM pattern
+    int32_t resolution = 1024;
+    std::vector<int> tiles;  // empty: every tile of the mesh
+};
+std::vector<std::filesystem::path> ptexToUdimCommand(const PtexToUdimCommand& command);
+
+// `deformkit ptex from-udim 'map.<UDIM>.exr' MESH --out FILE.ptx [--face-res auto|N] [--type ...]`: the
+// tiles sampled into a Ptex file of the mesh (ptex::udimToPtex), with the mesh metadata.
+struct PtexFromUdimCommand {
+    std::string pattern;
+    std::filesystem::path mesh;
+    std::filesystem::path out;
+    int8_t faceLog2 = -1;  // -1: per face from its size in tile texels
+    ptex::DataType type = ptex::DataType::Float;
+};
+void ptexFromUdimCommand(const PtexFromUdimCommand& command);
+
+// "u8", "u16", "half" or "float"; InvalidInput naming --type otherwise.
+[[nodiscard]] ptex::DataType parsePtexType(const std::string& text);
+// "auto" (-1) or a face size 1, 2, 4, ... 32768 (its log2); InvalidInput naming --face-res otherwise.
+[[nodiscard]] int8_t parseFaceResolution(const std::string& text);
+
+}  // namespace deformkit::harness
