@@ -4,8 +4,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -14,6 +16,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/mesh.h"
+#include "deformkit/ptex/ptex_mesh.h"
 #include "deformkit/slide/slider.h"
 #include "numpy_support.h"
 
@@ -320,15 +323,22 @@ void bindSlide(py::module_& m) {
         [](const FloatArray& points, const IntArray& counts, const IntArray& indices, int64_t handle,
            const FloatArray& displacement, double radius, py::object falloff,
            const std::optional<FloatArray>& weights, float envelope, const std::string& region,
-           const std::string& surface) {
+           const std::string& surface, const std::optional<std::filesystem::path>& weightsPtex,
+           int32_t weightsChannel) {
             const std::string source = "slide";
             const geom::Mesh mesh = meshOf(points, counts, indices, source);
+            if (weights && weightsPtex) {
+                throw InvalidInput(formatError(source, "weights_ptex", "is given with weights",
+                                               "one source of painted weights"));
+            }
             const std::vector<SlideHandle> handles = {
                 {vertexOf(handle, source, "handle"), radius, regionOf(region, source, "region")}};
             const slide::SlideOptions options = optionsOf(surface, 4096, source);
             const std::vector<SlideDrive> drives = {
                 {displacementsOf(displacement, 1, source)[0], falloffOf(falloff, source, "falloff")}};
-            const std::vector<float> w = weightsOf(weights, static_cast<size_t>(mesh.numVertices()), source);
+            const std::vector<float> w =
+                weightsPtex ? ptex::weightsFromPtex(mesh, *weightsPtex, weightsChannel, "slide: weights_ptex")
+                            : weightsOf(weights, static_cast<size_t>(mesh.numVertices()), source);
             std::vector<glm::vec3> out(mesh.points().begin(), mesh.points().end());
             {
                 py::gil_scoped_release release;
@@ -340,7 +350,7 @@ void bindSlide(py::module_& m) {
         py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("handle"),
         py::arg("displacement"), py::arg("radius"), py::arg("falloff") = "smooth",
         py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("region") = "euclidean",
-        py::arg("surface") = "cage",
+        py::arg("surface") = "cage", py::arg("weights_ptex") = py::none(), py::arg("weights_channel") = 0,
         "Slide vertices over the surface (Pinskiy, 'Sliding deformation'): the region within `radius` of "
         "the\n"
         "`handle` vertex moves by `displacement` (3,) times the falloff, along the surface, so the shape "
@@ -348,7 +358,8 @@ void bindSlide(py::module_& m) {
         "and the texture travels. points (N, 3) float32; face_counts (F,) int32; face_indices (sum of "
         "counts,)\n"
         "int32; radius in scene units; falloff 'smooth' (1 - 3x^2 + 2x^3), 'linear' or ramp samples at\n"
-        "x = i / (n - 1) of distance / radius; weights (N,) painted, envelope scalar; region 'euclidean' or\n"
+        "x = i / (n - 1) of distance / radius; weights (N,) painted, or weights_ptex: a Ptex file painted on the\n"
+        "mesh (its per-vertex values of weights_channel); envelope scalar; region 'euclidean' or\n"
         "'geodesic'; surface 'cage' or 'limit' (Catmull-Clark). Returns the slid points (N, 3) float32.");
 
     py::class_<PySlideResult>(m, "SlideResult", "The slid points and, per moved vertex, where it landed.")

@@ -14,5 +14,6 @@ void bindWarpEngine(pybind11::module_& m);
 void bindSlide(pybind11::module_& m);
 void bindUvWarp(pybind11::module_& m);
 void bindHost(pybind11::module_& m);
+void bindPtex(pybind11::module_& m);
 
 }  // namespace deformkit::python

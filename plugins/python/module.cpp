@@ -215,6 +215,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindSlide(m);
     python::bindUvWarp(m);
     python::bindHost(m);
+    python::bindPtex(m);
 
     m.def("make_capped_tube", [] { return geom::makeCappedTube(); }, "The demo's capped tube (UDIM 1001-1002).");
 }

@@ -1,0 +1,301 @@
+// Ptex files from Python: read_ptex, write_ptex, ptex_vertex_values.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "deformkit/error.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/ptex/ptex_mesh.h"
+#include "numpy_support.h"
+
+namespace py = pybind11;
+
+namespace deformkit::python {
+namespace {
+
+using ptex::DataType;
+
+const char* typeName(DataType type) {
+    switch (type) {
+        case DataType::UInt8:
+            return "u8";
+        case DataType::UInt16:
+            return "u16";
+        case DataType::Half:
+            return "half";
+        case DataType::Float:
+            return "float";
+    }
+    return "?";
+}
+
+py::dtype dtypeOf(DataType type) {
+    switch (type) {
+        case DataType::UInt8:
+            return py::dtype("uint8");
+        case DataType::UInt16:
+            return py::dtype("uint16");
+        case DataType::Half:
+            return py::dtype("float16");
+        case DataType::Float:
+            return py::dtype("float32");
+    }
+    return py::dtype("uint8");
+}
+
+DataType typeOfDtype(const py::dtype& dtype, const std::string& source) {
+    if (dtype.is(py::dtype("uint8"))) return DataType::UInt8;
+    if (dtype.is(py::dtype("uint16"))) return DataType::UInt16;
+    if (dtype.is(py::dtype("float16"))) return DataType::Half;
+    if (dtype.is(py::dtype("float32"))) return DataType::Float;
+    throw InvalidInput(formatError(source, "data",
+                                   "has dtype " + py::str(static_cast<py::handle>(dtype)).cast<std::string>(),
+                                   "uint8, uint16, float16 or float32 texels"));
+}
+
+template <class T>
+py::array arrayOf(const std::vector<T>& values) {
+    py::array_t<T> out(static_cast<py::ssize_t>(values.size()));
+    if (!values.empty()) std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+    return out;
+}
+
+py::object metaValue(const ptex::MetaValue& m) {
+    switch (m.type) {
+        case ptex::MetaType::String:
+            return py::str(m.string);
+        case ptex::MetaType::Int8:
+            return arrayOf(m.int8s);
+        case ptex::MetaType::Int16:
+            return arrayOf(m.int16s);
+        case ptex::MetaType::Int32:
+            return arrayOf(m.int32s);
+        case ptex::MetaType::Float:
+            return arrayOf(m.floats);
+        case ptex::MetaType::Double:
+            return arrayOf(m.doubles);
+    }
+    return py::none();
+}
+
+ptex::MetaValue metaFrom(const std::string& key, py::handle value, const std::string& source) {
+    if (py::isinstance<py::str>(value)) return ptex::MetaValue::ofString(key, value.cast<std::string>());
+    const py::array a = py::array::ensure(value);
+    if (!a) {
+        throw InvalidInput(formatError(source, "metadata '" + key + "'", "is not a string or an array",
+                                       "a string or a 1-D int8/int16/int32/float32/float64 array"));
+    }
+    const py::dtype dt = a.dtype();
+    const auto values = [&](auto tag) {
+        using T = decltype(tag);
+        const auto typed = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+        return std::vector<T>(typed.data(), typed.data() + typed.size());
+    };
+    if (dt.is(py::dtype("int8"))) return ptex::MetaValue::ofInt8(key, values(int8_t{}));
+    if (dt.is(py::dtype("int16"))) return ptex::MetaValue::ofInt16(key, values(int16_t{}));
+    if (dt.is(py::dtype("int32"))) return ptex::MetaValue::ofInt32(key, values(int32_t{}));
+    if (dt.is(py::dtype("float32"))) return ptex::MetaValue::ofFloat(key, values(float{}));
+    if (dt.is(py::dtype("float64"))) return ptex::MetaValue::ofDouble(key, values(double{}));
+    throw InvalidInput(formatError(source, "metadata '" + key + "'",
+                                   "has dtype " + py::str(static_cast<py::handle>(dt)).cast<std::string>(),
+                                   "int8, int16, int32, float32 or float64"));
+}
+
+py::dict toDict(const ptex::PtexFile& file) {
+    py::dict out;
+    out["mesh_type"] = file.meshType == ptex::MeshType::Quad ? "quad" : "triangle";
+    out["data_type"] = typeName(file.dataType);
+    out["channels"] = file.channels;
+    out["alpha_channel"] = file.alphaChannel;
+    py::list faces, data;
+    for (size_t f = 0; f < file.faces.size(); ++f) {
+        const ptex::FaceInfo& info = file.faces[f];
+        py::dict face;
+        face["res"] = py::make_tuple(info.ures(), info.vres());
+        face["adj_faces"] =
+            py::make_tuple(info.adjFaces[0], info.adjFaces[1], info.adjFaces[2], info.adjFaces[3]);
+        face["adj_edges"] =
+            py::make_tuple(info.adjEdges[0], info.adjEdges[1], info.adjEdges[2], info.adjEdges[3]);
+        face["constant"] = info.constant;
+        face["subface"] = info.subface;
+        faces.append(face);
+        const std::vector<uint8_t> texels = ptex::expandedTexels(file, f);
+        py::array a(dtypeOf(file.dataType),
+                    std::vector<py::ssize_t>{info.vres(), info.ures(), file.channels});
+        std::memcpy(a.mutable_data(), texels.data(), texels.size());
+        data.append(a);
+    }
+    out["faces"] = faces;
+    out["data"] = data;
+    py::dict metadata;
+    for (const ptex::MetaValue& m : file.metadata)
+        metadata[py::str(m.key)] = metaValue(m);
+    out["metadata"] = metadata;
+    return out;
+}
+
+int8_t log2Of(py::ssize_t n, const std::string& source, const std::string& element) {
+    int8_t log2 = 0;
+    while (log2 < 16 && (py::ssize_t{1} << log2) < n)
+        ++log2;
+    if (n < 1 || log2 > 15 || (py::ssize_t{1} << log2) != n) {
+        throw InvalidInput(formatError(source, element, "is " + std::to_string(n) + " texels across",
+                                       "a power of two from 1 to 32768"));
+    }
+    return log2;
+}
+
+// A PtexFile from read_ptex's dict (data required; faces, metadata, alpha_channel optional). With a mesh,
+// the faces' adjacency and sub-face flags are the mesh's and its standard metadata is written.
+ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh, const std::string& source) {
+    if (!d.contains("data")) {
+        throw InvalidInput(formatError(source, "ptex", "has no 'data'", "a list of (vres, ures, C) arrays"));
+    }
+    const py::list data = d["data"].cast<py::list>();
+    ptex::PtexFile file;
+    file.faces.resize(data.size());
+    file.texels.resize(data.size());
+    for (size_t f = 0; f < data.size(); ++f) {
+        const py::array a = py::array::ensure(data[f]);
+        const std::string element = "data[" + std::to_string(f) + "]";
+        if (!a || (a.ndim() != 2 && a.ndim() != 3)) {
+            throw InvalidInput(
+                formatError(source, element, "is not a 2-D or 3-D array", "(vres, ures[, C])"));
+        }
+        const DataType type = typeOfDtype(a.dtype(), source);
+        const auto channels = static_cast<int32_t>(a.ndim() == 3 ? a.shape(2) : 1);
+        if (f == 0) {
+            file.dataType = type;
+            file.channels = channels;
+        } else if (type != file.dataType || channels != file.channels) {
+            throw InvalidInput(formatError(source, element, "differs from data[0] in dtype or channels",
+                                           "every face with data[0]'s dtype and channel count"));
+        }
+        file.faces[f].vlog2 = log2Of(a.shape(0), source, element + " rows");
+        file.faces[f].ulog2 = log2Of(a.shape(1), source, element + " columns");
+        const py::array c = py::array::ensure(a, py::array::c_style);
+        file.texels[f].assign(static_cast<const uint8_t*>(c.data()),
+                              static_cast<const uint8_t*>(c.data()) + c.nbytes());
+    }
+    file.constData.assign(file.faces.size() * file.pixelSize(), 0);
+    if (d.contains("alpha_channel")) file.alphaChannel = d["alpha_channel"].cast<int32_t>();
+    if (mesh) {
+        const ptex::PtexMesh pm(*mesh, source);
+        const std::vector<ptex::FaceInfo> infos = pm.faceInfos(0, 0);
+        if (infos.size() != file.faces.size()) {
+            throw InvalidInput(formatError(source, "data",
+                                           "has " + std::to_string(file.faces.size()) + " faces",
+                                           std::to_string(infos.size()) + " Ptex faces of the mesh"));
+        }
+        for (size_t f = 0; f < infos.size(); ++f) {
+            file.faces[f].adjFaces = infos[f].adjFaces;
+            file.faces[f].adjEdges = infos[f].adjEdges;
+            file.faces[f].subface = infos[f].subface;
+        }
+    } else if (d.contains("faces")) {
+        const py::list faces = d["faces"].cast<py::list>();
+        for (size_t f = 0; f < std::min(faces.size(), file.faces.size()); ++f) {
+            const py::dict face = faces[f].cast<py::dict>();
+            if (face.contains("adj_faces")) {
+                const auto adj = face["adj_faces"].cast<std::vector<int32_t>>();
+                const auto edges = face["adj_edges"].cast<std::vector<int32_t>>();
+                for (size_t e = 0; e < 4 && e < adj.size() && e < edges.size(); ++e) {
+                    file.faces[f].adjFaces[e] = adj[e];
+                    file.faces[f].adjEdges[e] = static_cast<uint8_t>(edges[e]);
+                }
+            }
+            if (face.contains("subface")) file.faces[f].subface = face["subface"].cast<bool>();
+        }
+    }
+    if (d.contains("metadata")) {
+        for (const auto& [key, value] : d["metadata"].cast<py::dict>()) {
+            const std::string k = key.cast<std::string>();
+            if (mesh && (k == "PtexFaceVertCounts" || k == "PtexFaceVertIndices" || k == "PtexVertPositions"))
+                continue;  // written from the mesh
+            file.metadata.push_back(metaFrom(k, value, source));
+        }
+    }
+    return file;
+}
+
+geom::Mesh meshFrom(py::handle mesh) {
+    if (py::isinstance<geom::Mesh>(mesh)) return mesh.cast<geom::Mesh>();
+    return io::readObj(mesh.cast<std::filesystem::path>()).mesh;
+}
+
+}  // namespace
+
+void bindPtex(py::module_& m) {
+    m.def(
+        "read_ptex",
+        [](const std::filesystem::path& path) {
+            ptex::PtexFile file;
+            {
+                py::gil_scoped_release release;
+                file = ptex::readPtex(path);
+            }
+            return toDict(file);
+        },
+        py::arg("path"),
+        "Read a Ptex file as a dict: mesh_type ('quad'/'triangle'), data_type ('u8', 'u16', 'half', "
+        "'float'),\n"
+        "channels, alpha_channel (-1: none), faces (per face a dict: res (ures, vres), adj_faces and\n"
+        "adj_edges (4 each, edges bottom, right, top, left; -1: none), constant, subface), data (per face a\n"
+        "(vres, ures, channels) array in the file's dtype: uint8, uint16, float16, float32; row 0 at v = 0;\n"
+        "constant faces expanded) and metadata (key -> str or 1-D array).");
+    m.def(
+        "write_ptex",
+        [](const std::filesystem::path& path, const py::dict& ptex, py::object mesh, int compression,
+           bool reductions) {
+            std::optional<geom::Mesh> m;
+            if (!mesh.is_none()) m = meshFrom(mesh);
+            const ptex::PtexFile file = fromDict(ptex, m, "write_ptex");
+            ptex::WriteOptions options;
+            options.compressionLevel = compression;
+            options.reductions = reductions;
+            if (m) options.mesh = ptex::meshData(*m);
+            py::gil_scoped_release release;
+            ptex::writePtex(path, file, options);
+        },
+        py::arg("path"), py::arg("ptex"), py::arg("mesh") = py::none(), py::arg("compression") = 6,
+        py::arg("reductions") = true,
+        "Write a Ptex file atomically from a dict as read_ptex returns (only 'data' is required: per face a\n"
+        "(vres, ures[, C]) uint8 / uint16 / float16 / float32 array, power-of-two sizes; optional 'faces'\n"
+        "with adjacency and sub-face flags, 'metadata', 'alpha_channel'). With mesh (a deformkit.Mesh or an\n"
+        "OBJ path) the faces' adjacency and sub-face flags are the mesh's (OpenSubdiv's Ptex faces) and its\n"
+        "face and vertex data are written as the standard mesh metadata.");
+    m.def(
+        "ptex_vertex_values",
+        [](py::object mesh, py::object ptex) {
+            const geom::Mesh m = meshFrom(mesh);
+            const ptex::PtexFile file =
+                py::isinstance<py::dict>(ptex)
+                    ? fromDict(ptex.cast<py::dict>(), std::nullopt, "ptex_vertex_values")
+                    : ptex::readPtex(ptex.cast<std::filesystem::path>());
+            const std::string source = py::isinstance<py::dict>(ptex)
+                                           ? std::string("ptex")
+                                           : ptex.cast<std::filesystem::path>().string();
+            std::vector<float> values;
+            {
+                py::gil_scoped_release release;
+                values = ptex::vertexValues(ptex::PtexMesh(m, "mesh"), file, source);
+            }
+            py::array_t<float> out(std::vector<py::ssize_t>{m.numVertices(), file.channels});
+            std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(float));
+            return out;
+        },
+        py::arg("mesh"), py::arg("ptex"),
+        "Per-vertex values (V, C) float32 of a Ptex map painted on mesh (a deformkit.Mesh or an OBJ path;\n"
+        "ptex a path or read_ptex's dict): each vertex the mean, over the Ptex faces meeting at it, of the\n"
+        "texel in that corner; u8 and u16 read as [0, 1]. Painted weights for the slide and every warp.");
+}
+
+}  // namespace deformkit::python

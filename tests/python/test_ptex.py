@@ -1,0 +1,110 @@
+"""deformkit.read_ptex / write_ptex / ptex_vertex_values and slide(weights_ptex=...): round trips bit for
+bit per dtype, per-vertex values against a numpy reference, adjacency from a mesh, errors."""
+import numpy as np
+import pytest
+
+import deformkit as dk
+
+
+def grid(n=4, with_triangle=False):
+    """n x n unit quads (vertex (i, j) = j (n + 1) + i); optionally one more triangle on the right edge."""
+    j, i = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    points = np.stack([i.ravel(), j.ravel(), np.zeros(i.size)], axis=1).astype(np.float32)
+    a = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
+    faces = [list(f) for f in np.stack([a, a + 1, a + n + 2, a + n + 1], axis=1)]
+    if with_triangle:
+        points = np.vstack([points, [[n + 1.0, 0.5, 0.0]]]).astype(np.float32)
+        faces.append([n, len(points) - 1, 2 * n + 1])
+    counts = np.array([len(f) for f in faces], np.int32)
+    return dk.Mesh(points, counts, np.concatenate(faces).astype(np.int32))
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float16, np.float32])
+def test_write_then_read_gives_the_same_texels(tmp_path, dtype):
+    rng = np.random.default_rng(3)
+    shapes = [(4, 8, 3), (1, 1, 3), (16, 2, 3), (2, 2, 3)]
+    if np.issubdtype(dtype, np.integer):
+        data = [rng.integers(0, np.iinfo(dtype).max, size=s, dtype=dtype) for s in shapes]
+    else:
+        data = [rng.uniform(-2, 2, size=s).astype(dtype) for s in shapes]
+    data[3][:] = data[3][0, 0]  # a constant face
+    meta = {"author": "painter", "gains": np.array([0.5, 2.0], np.float64), "ids": np.arange(3, dtype=np.int32)}
+    dk.write_ptex(tmp_path / "t.ptx", {"data": data, "metadata": meta})
+    back = dk.read_ptex(tmp_path / "t.ptx")
+    assert back["channels"] == 3 and back["mesh_type"] == "quad"
+    assert back["data_type"] == {np.uint8: "u8", np.uint16: "u16", np.float16: "half", np.float32: "float"}[dtype]
+    for a, b in zip(data, back["data"]):
+        assert b.dtype == a.dtype and b.shape == a.shape
+        assert a.tobytes() == b.tobytes()  # bit for bit
+    assert [f["res"] for f in back["faces"]] == [(8, 4), (1, 1), (2, 16), (2, 2)]
+    assert back["faces"][3]["constant"] and not back["faces"][0]["constant"]
+    assert back["metadata"]["author"] == "painter"
+    np.testing.assert_array_equal(back["metadata"]["gains"], meta["gains"])
+    np.testing.assert_array_equal(back["metadata"]["ids"], meta["ids"])
+
+
+def test_vertex_values_are_the_mean_of_the_corner_texels_around_each_vertex(tmp_path):
+    mesh = grid(4, with_triangle=True)
+    # 16 quads (one Ptex face each) then the triangle (3 sub-faces): face p is 4 x 4, texel (i, j) = p + i / 8 + j.
+    data = []
+    for p in range(16 + 3):
+        j, i = np.meshgrid(np.arange(4), np.arange(4), indexing="ij")
+        data.append((p + i / 8.0 + j).astype(np.float32)[:, :, None])
+    dk.write_ptex(tmp_path / "m.ptx", {"data": data}, mesh=mesh)
+    values = dk.ptex_vertex_values(mesh, tmp_path / "m.ptx")
+    assert values.shape == (mesh.num_vertices, 1)
+    # Reference: corner k of a quad reads texel (0,0), (3,0), (3,3), (0,3) as (column, row); sub-face k of the
+    # triangle (Ptex face 16 + k) reads its (0, 0) at corner k.
+    sums = np.zeros(mesh.num_vertices)
+    counts = np.zeros(mesh.num_vertices)
+    corner = [(0, 0), (3, 0), (3, 3), (0, 3)]
+    offset = 0
+    for f, n in enumerate(mesh.face_counts):
+        verts = mesh.face_indices[offset:offset + n]
+        offset += n
+        for k, v in enumerate(verts):
+            p, (i, j) = (f, corner[k]) if n == 4 else (16 + k, (0, 0))
+            sums[v] += data[p][j, i, 0]
+            counts[v] += 1
+    np.testing.assert_allclose(values[:, 0], sums / counts, rtol=0, atol=1e-6)  # float means of small values
+    # The same from the dict, and a file of another mesh is refused naming both counts.
+    np.testing.assert_array_equal(dk.ptex_vertex_values(mesh, dk.read_ptex(tmp_path / "m.ptx")), values)
+    with pytest.raises(dk.InvalidInput, match="has 19 faces.*16 Ptex faces"):
+        dk.ptex_vertex_values(grid(4), tmp_path / "m.ptx")
+
+
+def test_write_with_a_mesh_gives_opensubdiv_adjacency_and_the_mesh_metadata(tmp_path):
+    mesh = grid(2)
+    dk.write_ptex(tmp_path / "a.ptx", {"data": [np.zeros((1, 1, 1), np.float32)] * 4}, mesh=mesh)
+    back = dk.read_ptex(tmp_path / "a.ptx")
+    # Face 0 (bottom left) has face 1 to its right (edge 1) and face 2 above (edge 2); the others are the
+    # boundary. The neighbours' edges point back: face 1's left (3), face 2's bottom (0).
+    assert back["faces"][0]["adj_faces"] == (-1, 1, 2, -1)
+    assert back["faces"][0]["adj_edges"][1:3] == (3, 0)
+    np.testing.assert_array_equal(back["metadata"]["PtexFaceVertCounts"], [4, 4, 4, 4])
+    np.testing.assert_array_equal(back["metadata"]["PtexFaceVertIndices"], mesh.face_indices)
+    np.testing.assert_array_equal(back["metadata"]["PtexVertPositions"], mesh.points.ravel())
+
+
+def test_slide_takes_weights_from_a_ptex_map(tmp_path):
+    mesh = grid(8)
+    rng = np.random.default_rng(1)
+    data = [np.full((2, 2, 1), rng.uniform(), np.float32) for _ in range(64)]
+    dk.write_ptex(tmp_path / "w.ptx", {"data": data}, mesh=mesh)
+    weights = dk.ptex_vertex_values(mesh, tmp_path / "w.ptx")[:, 0]
+    args = (mesh.points, mesh.face_counts, mesh.face_indices, 40, (0.5, 0.25, 0.0), 3.0)
+    from_ptex = dk.slide(*args, weights_ptex=tmp_path / "w.ptx")
+    np.testing.assert_array_equal(from_ptex, dk.slide(*args, weights=weights))
+    assert np.abs(from_ptex - mesh.points).max() > 0.1
+    with pytest.raises(dk.InvalidInput, match="weights_ptex"):
+        dk.slide(*args, weights=weights, weights_ptex=tmp_path / "w.ptx")
+
+
+def test_bad_input_names_the_problem(tmp_path):
+    with pytest.raises(dk.InvalidInput, match="power of two"):
+        dk.write_ptex(tmp_path / "x.ptx", {"data": [np.zeros((3, 4, 1), np.float32)]})
+    with pytest.raises(dk.InvalidInput, match="float64"):
+        dk.write_ptex(tmp_path / "x.ptx", {"data": [np.zeros((4, 4, 1), np.float64)]})
+    (tmp_path / "bad.ptx").write_bytes(b"x" * 100)
+    with pytest.raises(dk.ParseError, match="bad.ptx"):
+        dk.read_ptex(tmp_path / "bad.ptx")
