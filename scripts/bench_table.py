@@ -27,6 +27,11 @@ REFERENCES = {
     # A 100-frame, 2-tile shot: its farm plan's tasks run one after the other in one process, against one
     # eval of the whole shot (the cost of cutting it into tasks: scene loading, cold starts per task).
     "BM_FarmRunPlan": ("BM_FarmEval", "farm tasks / one eval, frames per second"),
+    # Ptex (issue 7): a 50k-face float RGB file read whole against a plain read of its bytes, and zlib
+    # alone inflating the same texels as one stream against the whole read (zlib's share of it).
+    "BM_PtexRead": ("BM_PtexPlainRead", "Ptex read / plain read of the file's bytes, same texel bytes"),
+    "BM_PtexZlibInflate": ("BM_PtexRead", "zlib inflate alone / whole Ptex read, same texel bytes"),
+    "BM_PtexVertexValues": ("BM_PtexCornerLoop", "vertex values / minimal corner loop, 1M vertices"),
 }
 
 # Issue 5: paper Table 1 (GTX Titan GPU), ms, and the targets for a 2048^2 solve on a 2-core machine:

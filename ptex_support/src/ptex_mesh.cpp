@@ -123,6 +123,32 @@ void requireAdjacency(std::span<const FaceInfo> faces, const std::string& source
     }
 }
 
+// The file's channel count and texel buffers as the look-ups read them (a file built in memory may be
+// inconsistent; one read from disk never is).
+void requireBuffers(const PtexFile& file, const std::string& source) {
+    if (file.channels < 1 || file.channels > 64) {
+        throw InvalidInput(formatError(source, "header", "has " + std::to_string(file.channels) + " channels",
+                                       "1 to 64 channels"));
+    }
+    if (file.texels.size() != file.faces.size() ||
+        file.constData.size() != file.faces.size() * file.pixelSize()) {
+        throw InvalidInput(formatError(
+            source, "",
+            "has texels for " + std::to_string(file.texels.size()) + " faces and " +
+                std::to_string(file.constData.size()) + " bytes of constant data",
+            "texels and constant data for each of its " + std::to_string(file.faces.size()) + " faces"));
+    }
+    for (size_t f = 0; f < file.faces.size(); ++f) {
+        const size_t expected = file.faces[f].texelCount() * file.pixelSize();
+        if (!file.texels[f].empty() && file.texels[f].size() != expected) {
+            throw InvalidInput(
+                formatError(source, "face " + std::to_string(f),
+                            "has " + std::to_string(file.texels[f].size()) + " bytes of texels",
+                            std::to_string(expected) + " bytes"));
+        }
+    }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------------
@@ -238,18 +264,8 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
         throw InvalidInput(formatError(source, "header", "is a triangle-mesh Ptex file",
                                        "a quad-mesh Ptex file for filtered look-ups"));
     }
-    if (channels_ < 1 || channels_ > 64) {
-        throw InvalidInput(formatError(source, "header", "has " + std::to_string(channels_) + " channels",
-                                       "1 to 64 channels"));
-    }
-    if (file.texels.size() != faces_.size() || file.constData.size() != faces_.size() * file.pixelSize()) {
-        throw InvalidInput(formatError(
-            source, "",
-            "has texels for " + std::to_string(file.texels.size()) + " faces and " +
-                std::to_string(file.constData.size()) + " bytes of constant data",
-            "texels and constant data for each of its " + std::to_string(faces_.size()) + " faces"));
-    }
     requireAdjacency(faces_, source);
+    requireBuffers(file, source);
     const size_t pixel = file.pixelSize(), bytes = bytesPerChannel(file.dataType);
     offsets_.resize(faces_.size() + 1);
     size_t total = 0;
@@ -263,11 +279,6 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
         float* out = values_.data() + offsets_[f];
         const size_t count = faces_[f].texelCount() * static_cast<size_t>(channels_);
         const std::vector<uint8_t>& texels = file.texels[f];
-        if (!texels.empty() && texels.size() != faces_[f].texelCount() * pixel) {
-            throw InvalidInput(formatError(source, "face " + std::to_string(f),
-                                           "has " + std::to_string(texels.size()) + " bytes of texels",
-                                           std::to_string(faces_[f].texelCount() * pixel) + " bytes"));
-        }
         if (texels.empty()) {  // constant face
             for (size_t t = 0; t < count; ++t)
                 out[t] =
@@ -378,11 +389,22 @@ void PtexSampler::sample(int32_t f, double u, double v, std::span<float> out) co
     const double fx = std::floor(x), fy = std::floor(y);
     const auto i0 = static_cast<int32_t>(fx), j0 = static_cast<int32_t>(fy);
     const double wx = x - fx, wy = y - fy;
-    float t00[64], t10[64], t01[64], t11[64];
-    ghost(f, i0, j0, t00);
-    ghost(f, i0 + 1, j0, t10);
-    ghost(f, i0, j0 + 1, t01);
-    ghost(f, i0 + 1, j0 + 1, t11);
+    const float *t00, *t10, *t01, *t11;
+    float g00[64], g10[64], g01[64], g11[64];
+    if (i0 >= 0 && j0 >= 0 && i0 + 1 < info.ures() && j0 + 1 < info.vres()) {
+        // All four texels inside the face (the common case): read them in place.
+        const size_t row = static_cast<size_t>(info.ures()) * channels_;
+        t00 = &values_[offsets_[f] + ((static_cast<size_t>(j0) << info.ulog2) + i0) * channels_];
+        t10 = t00 + channels_;
+        t01 = t00 + row;
+        t11 = t01 + channels_;
+    } else {
+        ghost(f, i0, j0, g00);
+        ghost(f, i0 + 1, j0, g10);
+        ghost(f, i0, j0 + 1, g01);
+        ghost(f, i0 + 1, j0 + 1, g11);
+        t00 = g00, t10 = g10, t01 = g01, t11 = g11;
+    }
     for (int32_t c = 0; c < channels_; ++c) {
         const double bottom = t00[c] + wx * (static_cast<double>(t10[c]) - t00[c]);
         const double top = t01[c] + wx * (static_cast<double>(t11[c]) - t01[c]);
@@ -393,22 +415,30 @@ void PtexSampler::sample(int32_t f, double u, double v, std::span<float> out) co
 // ---------------------------------------------------------------------------------------------------------
 // Per-vertex values and baking
 
-std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, const std::string& fileSource) {
-    mesh.requireMatches(file, fileSource);
-    const PtexSampler sampler(file, fileSource);
-    const int32_t channels = sampler.channels();
-    std::vector<double> sum(static_cast<size_t>(mesh.numVertices()) * channels, 0.0);
-    std::vector<int32_t> count(static_cast<size_t>(mesh.numVertices()), 0);
+namespace {
+
+// Sums of the corner texels at each vertex and their counts, for one data type (read without a per-value
+// switch).
+template <DataType Type>
+void sumCorners(const PtexMesh& mesh, const PtexFile& file, std::vector<double>& sum,
+                std::vector<int32_t>& count) {
+    const int32_t channels = file.channels;
+    const size_t bytes = bytesPerChannel(Type), pixel = file.pixelSize();
     const auto add = [&](int32_t vertex, int32_t p, int32_t i, int32_t j) {
+        const uint8_t* texel =
+            file.texels[p].empty()
+                ? file.constData.data() + static_cast<size_t>(p) * pixel
+                : file.texels[p].data() + ((static_cast<size_t>(j) << file.faces[p].ulog2) + i) * pixel;
+        double* out = sum.data() + static_cast<size_t>(vertex) * channels;
         for (int32_t c = 0; c < channels; ++c)
-            sum[static_cast<size_t>(vertex) * channels + c] += sampler.texel(p, i, j, c);
+            out[c] += loadValue(texel + c * bytes, Type);
         ++count[static_cast<size_t>(vertex)];
     };
     for (int32_t f = 0; f < mesh.numMeshFaces(); ++f) {
         const auto corners = mesh.faceVertices(f);
         const int32_t p = mesh.firstPtexFace(f);
         if (corners.size() == 4) {
-            const int32_t iu = sampler.face(p).ures() - 1, jv = sampler.face(p).vres() - 1;
+            const int32_t iu = file.faces[p].ures() - 1, jv = file.faces[p].vres() - 1;
             add(corners[0], p, 0, 0);
             add(corners[1], p, iu, 0);
             add(corners[2], p, iu, jv);
@@ -417,6 +447,31 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
             for (size_t k = 0; k < corners.size(); ++k)
                 add(corners[k], p + static_cast<int32_t>(k), 0, 0);
         }
+    }
+}
+
+}  // namespace
+
+std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, const std::string& fileSource) {
+    mesh.requireMatches(file, fileSource);
+    requireBuffers(file, fileSource);
+    // Only the corner texels are read, straight from the file's bytes.
+    const int32_t channels = file.channels;
+    std::vector<double> sum(static_cast<size_t>(mesh.numVertices()) * channels, 0.0);
+    std::vector<int32_t> count(static_cast<size_t>(mesh.numVertices()), 0);
+    switch (file.dataType) {
+        case DataType::UInt8:
+            sumCorners<DataType::UInt8>(mesh, file, sum, count);
+            break;
+        case DataType::UInt16:
+            sumCorners<DataType::UInt16>(mesh, file, sum, count);
+            break;
+        case DataType::Half:
+            sumCorners<DataType::Half>(mesh, file, sum, count);
+            break;
+        case DataType::Float:
+            sumCorners<DataType::Float>(mesh, file, sum, count);
+            break;
     }
     std::vector<float> values(sum.size(), 0.0f);
     for (size_t v = 0; v < count.size(); ++v) {
