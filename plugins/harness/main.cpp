@@ -280,6 +280,18 @@ int main(int argc, char** argv) {
     ptexFromUdimApp->add_option("--face-res", ptexFaceRes, "texels per face side: auto or a power of two")
         ->capture_default_str();
     ptexFromUdimApp->add_option("--type", ptexType, "u8, u16, half or float")->capture_default_str();
+    harness::PtexFromVertexCommand ptexFromVertex;
+    std::string ptexFromVertexWeights, ptexFromVertexMesh, ptexFromVertexOut, ptexVertexFaceRes = "16",
+                                                                              ptexVertexType = "float";
+    auto* ptexFromVertexApp =
+        ptexApp->add_subcommand("from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file");
+    ptexFromVertexApp->add_option("WEIGHTS", ptexFromVertexWeights, "weights file (.json), one per vertex")
+        ->required();
+    ptexFromVertexApp->add_option("MESH", ptexFromVertexMesh, "mesh (.obj)")->required();
+    ptexFromVertexApp->add_option("--out", ptexFromVertexOut, "Ptex file (.ptx)")->required();
+    ptexFromVertexApp->add_option("--face-res", ptexVertexFaceRes, "texels per face side, a power of two")
+        ->capture_default_str();
+    ptexFromVertexApp->add_option("--type", ptexVertexType, "u8, u16, half or float")->capture_default_str();
 
     try {
         app.parse(argc, argv);
@@ -398,6 +410,14 @@ int main(int argc, char** argv) {
             ptexFromUdim.type = harness::parsePtexType(ptexType);
             harness::ptexFromUdimCommand(ptexFromUdim);
             std::cout << "wrote " << ptexFromUdimOut << "\n";
+        } else if (*ptexFromVertexApp) {
+            ptexFromVertex.weights = ptexFromVertexWeights;
+            ptexFromVertex.mesh = ptexFromVertexMesh;
+            ptexFromVertex.out = ptexFromVertexOut;
+            ptexFromVertex.faceLog2 = harness::parseFaceResolution(ptexVertexFaceRes);
+            ptexFromVertex.type = harness::parsePtexType(ptexVertexType);
+            harness::ptexFromVertexCommand(ptexFromVertex);
+            std::cout << "wrote " << ptexFromVertexOut << "\n";
         } else if (*demo) {
             demoCommand.outDir = demoOut;
             const auto files = harness::demo(demoCommand);

@@ -9,6 +9,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "slide_command.h"
 
 namespace deformkit::harness {
 namespace fs = std::filesystem;
@@ -145,6 +146,20 @@ void ptexFromUdimCommand(const PtexFromUdimCommand& command) {
     options.ulog2 = options.vlog2 = command.faceLog2;
     options.dataType = command.type;
     const ptex::PtexFile file = ptex::udimToPtex(ptexMesh, mesh, tiles, options);
+    ptex::WriteOptions write;
+    write.mesh = ptex::meshData(mesh);
+    ptex::writePtex(command.out, file, write);
+}
+
+void ptexFromVertexCommand(const PtexFromVertexCommand& command) {
+    if (command.faceLog2 < 0) {
+        throw InvalidInput(formatError("--face-res", "", "is auto", "a power of two (texels per face side)"));
+    }
+    const geom::Mesh mesh = io::readObj(command.mesh).mesh;
+    const std::vector<float> weights = readWeights(command.weights, static_cast<size_t>(mesh.numVertices()));
+    const ptex::PtexMesh ptexMesh(mesh, command.mesh.string());
+    const ptex::PtexFile file =
+        ptex::bakeVertexValues(ptexMesh, weights, 1, {command.faceLog2, command.faceLog2, command.type});
     ptex::WriteOptions write;
     write.mesh = ptex::meshData(mesh);
     ptex::writePtex(command.out, file, write);

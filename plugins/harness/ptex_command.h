@@ -48,6 +48,18 @@ struct PtexFromUdimCommand {
 };
 void ptexFromUdimCommand(const PtexFromUdimCommand& command);
 
+// `deformkit ptex from-vertex weights.json MESH --out FILE.ptx [--face-res N] [--type ...]`: per-vertex
+// weights (the JSON weights file) baked into a Ptex file of the mesh (ptex::bakeVertexValues): each texel
+// interpolates the weights of its face's corners; with adjacency and the mesh metadata.
+struct PtexFromVertexCommand {
+    std::filesystem::path weights;
+    std::filesystem::path mesh;
+    std::filesystem::path out;
+    int8_t faceLog2 = 4;
+    ptex::DataType type = ptex::DataType::Float;
+};
+void ptexFromVertexCommand(const PtexFromVertexCommand& command);
+
 // "u8", "u16", "half" or "float"; InvalidInput naming --type otherwise.
 [[nodiscard]] ptex::DataType parsePtexType(const std::string& text);
 // "auto" (-1) or a face size 1, 2, 4, ... 32768 (its log2); InvalidInput naming --face-res otherwise.

@@ -85,6 +85,10 @@ expect ptex-slide-json 0 "$dk" slide "$work/demo/ptex/tube.obj" --handle 9627 --
     --radius 1.2 --weights "$work/falloff.json" --out "$work/json_slid.obj"
 cmp -s "$work/ptex_slid.obj" "$work/json_slid.obj" ||
     { echo "FAIL ptex-slide: --weights-ptex and the to-vertex weights file differ"; failures=$((failures + 1)); }
+expect ptex-from-vertex 0 "$dk" ptex from-vertex "$work/falloff.json" "$work/demo/ptex/tube.obj" \
+    --out "$work/baked.ptx" --face-res 2
+expect ptex-baked-info 0 "$dk" ptex info "$work/baked.ptx"
+contains ptex-baked-info "$work/out" "2x2: 23040 faces"
 expect ptex-from-udim 0 "$dk" ptex from-udim "$work/demo/albedo.<UDIM>.png" "$work/demo/tube.obj" \
     --out "$work/albedo.ptx" --face-res 4 --type u8
 expect ptex-to-udim 0 "$dk" ptex to-udim "$work/albedo.ptx" "$work/demo/tube.obj" --out "$work/back.<UDIM>.png" \

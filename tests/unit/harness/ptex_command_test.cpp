@@ -200,3 +200,39 @@ TEST_CASE("ptex command: from-udim then to-udim gives back a linear painting", "
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::ptexToUdimCommand(to); }),
                Contains("--out") && Contains("UDIM"));
 }
+
+TEST_CASE("ptex command: from-vertex bakes weights that interpolate the face's corners", "[harness][ptex]") {
+    // Weights w = x / 2 (linear over the [0, 2]^2 grid): each texel of a unit-square face holds the
+    // bilinear blend of its corners' weights, which for a linear field is w at the texel centre.
+    Fixture f;
+    std::string json = "[";
+    for (int32_t v = 0; v < f.mesh.numVertices(); ++v)
+        json += (v ? ", " : "") + std::to_string(f.mesh.points()[v].x / 2.0);
+    test::writeText(f.dir / "w.json", json + "]");
+    harness::PtexFromVertexCommand command{f.dir / "w.json", f.dir / "grid.obj", f.dir / "w.ptx",
+                                           harness::parseFaceResolution("4"), ptex::DataType::Float};
+    harness::ptexFromVertexCommand(command);
+    const ptex::PtexFile file = ptex::readPtex(f.dir / "w.ptx");
+    REQUIRE(file.faces.size() == 64);
+    double worst = 0.0;
+    for (int32_t face = 0; face < 64; ++face) {
+        const auto c = f.mesh.face(face);
+        const auto P = [&](int k) { return glm::dvec3(f.mesh.points()[c[k]]); };
+        const std::vector<uint8_t> texels = ptex::expandedTexels(file, static_cast<size_t>(face));
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                float value = 0.0f;
+                std::memcpy(&value, texels.data() + 4 * (j * 4 + i), 4);
+                const double u = (i + 0.5) / 4, v = (j + 0.5) / 4;  // the texel centre on the quad
+                const glm::dvec3 at =
+                    (1 - u) * (1 - v) * P(0) + u * (1 - v) * P(1) + u * v * P(2) + (1 - u) * v * P(3);
+                worst = std::max(worst, std::abs(value - at.x / 2.0));
+            }
+    }
+    CHECK(worst < 1e-6);  // float texels and the weights' 6-digit text
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   command.faceLog2 = -1;
+                   harness::ptexFromVertexCommand(command);
+               }),
+               Contains("--face-res"));
+}
