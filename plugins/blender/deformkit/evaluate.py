@@ -60,7 +60,8 @@ def restore_rest(obj):
     obj.data.update()
 
 
-def rest_mesh(obj):
+def topology(obj):
+    """(face counts, vertex indices face by face, the loop index of each face corner) of the object's mesh."""
     mesh = obj.data
     counts = np.empty(len(mesh.polygons), np.int32)
     starts = np.empty(len(mesh.polygons), np.int32)
@@ -70,9 +71,16 @@ def rest_mesh(obj):
     mesh.loops.foreach_get("vertex_index", loops)
     if len(counts) == 0:
         raise DeformKitError(f"{obj.name}: the mesh has no faces")
-    if not np.array_equal(starts, np.concatenate(([0], np.cumsum(counts)[:-1]))):
-        loops = np.concatenate([loops[s:s + c] for s, c in zip(starts, counts)])
-    return dk.Mesh(rest_points(obj), counts, loops.astype(np.int32))
+    if np.array_equal(starts, np.concatenate(([0], np.cumsum(counts)[:-1]))):
+        order = np.arange(len(loops), dtype=np.int32)  # polygons' loops in order, as usual
+    else:
+        order = np.concatenate([np.arange(s, s + c) for s, c in zip(starts, counts)]).astype(np.int32)
+    return counts, loops[order], order
+
+
+def rest_mesh(obj):
+    counts, indices, _ = topology(obj)
+    return dk.Mesh(rest_points(obj), counts, indices)
 
 
 def vertex_group_weights(obj, name):

@@ -31,16 +31,11 @@ def mesh_with_uvs(obj, points):
     layer = mesh.uv_layers.active
     if layer is None:
         raise UvWarpError(f"{obj.name}: the mesh has no UV map")
-    counts = np.empty(len(mesh.polygons), np.int32)
-    starts = np.empty(len(mesh.polygons), np.int32)
-    mesh.polygons.foreach_get("loop_total", counts)
-    mesh.polygons.foreach_get("loop_start", starts)
-    loops = np.empty(len(mesh.loops), np.int32)
-    mesh.loops.foreach_get("vertex_index", loops)
+    counts, indices, order = evaluate.topology(obj)
     uvs = np.empty(len(mesh.loops) * 2, np.float32)
     layer.data.foreach_get("uv", uvs)
-    order = np.concatenate([np.arange(s, s + c) for s, c in zip(starts, counts)]).astype(np.int64)
-    return points, counts, loops[order].astype(np.int32), uvs.reshape(-1, 2), order.astype(np.int32)
+    # One UV per face corner: corner k of the list is loop order[k].
+    return points, counts, indices, uvs.reshape(-1, 2), order
 
 
 def uv_tiles(counts, uvs, uv_indices):

@@ -21,6 +21,7 @@
 #include <maya/MRampAttribute.h>
 
 #include "deformkit/error.h"
+#include "maya_mesh.h"
 
 namespace deformkit::maya {
 
@@ -40,25 +41,8 @@ glm::dvec3 translation(const MayaMatrix& m) {
     return {m.m[3][0], m.m[3][1], m.m[3][2]};
 }
 
-// A mesh's points (object space of the mesh data, which Maya gives deformers in the shape's space) and faces.
 geom::Mesh meshOf(const MObject& data, const std::string& what) {
-    MFnMesh fn(data);
-    MPointArray points;
-    fn.getPoints(points, MSpace::kObject);
-    MIntArray counts, indices;
-    fn.getVertices(counts, indices);
-    geom::Mesh::Data d;
-    d.points.reserve(points.length());
-    for (unsigned i = 0; i < points.length(); ++i)
-        d.points.emplace_back(static_cast<float>(points[i].x), static_cast<float>(points[i].y),
-                              static_cast<float>(points[i].z));
-    d.faceCounts.assign(counts.length(), 0);
-    for (unsigned i = 0; i < counts.length(); ++i)
-        d.faceCounts[i] = counts[i];
-    d.faceIndices.assign(indices.length(), 0);
-    for (unsigned i = 0; i < indices.length(); ++i)
-        d.faceIndices[i] = indices[i];
-    return geom::Mesh(std::move(d), what);
+    return geom::Mesh(meshDataOf(data, false), what);
 }
 
 std::vector<glm::dvec3> worldPoints(const MObject& data, MSpace::Space space) {

@@ -18,35 +18,14 @@
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/udim.h"
+#include "maya_mesh.h"
 
 namespace deformkit::maya {
 
 namespace {
 
-// A Maya mesh with its current UV set as a DeformKit mesh (UVs per face corner).
 geom::Mesh meshWithUVs(const MObject& data, const std::string& what) {
-    MFnMesh fn(data);
-    MPointArray points;
-    fn.getPoints(points, MSpace::kObject);
-    MIntArray counts, indices;
-    fn.getVertices(counts, indices);
-    MFloatArray us, vs;
-    fn.getUVs(us, vs);
-    MIntArray uvCounts, uvIds;
-    fn.getAssignedUVs(uvCounts, uvIds);
-    geom::Mesh::Data d;
-    for (unsigned i = 0; i < points.length(); ++i)
-        d.points.emplace_back(static_cast<float>(points[i].x), static_cast<float>(points[i].y),
-                              static_cast<float>(points[i].z));
-    for (unsigned i = 0; i < counts.length(); ++i)
-        d.faceCounts.push_back(counts[i]);
-    for (unsigned i = 0; i < indices.length(); ++i)
-        d.faceIndices.push_back(indices[i]);
-    for (unsigned i = 0; i < us.length(); ++i)
-        d.uvs.emplace_back(us[i], vs[i]);
-    for (unsigned i = 0; i < uvIds.length(); ++i)
-        d.uvIndices.push_back(uvIds[i]);
-    return geom::Mesh(std::move(d), what);
+    return geom::Mesh(meshDataOf(data, true), what);
 }
 
 std::string withFrame(std::string pattern, int frame) {
