@@ -29,6 +29,9 @@ constexpr std::array<EdgeType, 4> kEdgeTypes = {{
 // Loops over fewer rows than this run on one thread: coarse levels are tiny, and a fork and barrier per
 // tiny loop costs more than the loop (badly so when the machine is oversubscribed).
 constexpr int64_t kParallelRows = 64;
+// Lanes per vector iteration of the SIMD kernels: 8 floats per AVX2 register (two SSE ones in the baseline
+// build). The projection pads its runs to a multiple of it.
+constexpr int32_t kLaneBlock = 8;
 
 // Rows per block of the row-wavefront schedule (sweep, regularise). A block's rows are processed in order;
 // blocks of one parity never touch a point another block of that parity reads or moves (a row reads at most
@@ -55,15 +58,21 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
 // Largest grid: f_D offsets fit 32 bits (sampleImage).
 constexpr int32_t kMaxCells = 32768;
 
+// Level::rigidity of a point that may not move.
+constexpr float kFixed = -1.0f;
+
 // 3x3 Gaussian kernel K_G (Eq. 5 and 7): (1 2 1) x (1 2 1) / 16.
 constexpr std::array<float, 3> kGauss = {0.25f, 0.5f, 0.25f};
 
 struct Level {
     int32_t cells = 0;   // cells per side at this level
     int32_t stride = 1;  // fine-grid points between neighbouring points of this level
+    // R (Eq. 7 on coarser levels) where the point may move; kFixed where it may not (masked, Eq. 8, or on
+    // the tile border). One float map rather than a float and a byte map: the SIMD kernels then hold only
+    // 32-bit values, so their vector loops run 8 lanes per AVX2 iteration, not 32 (a byte map made GCC
+    // choose 32 lanes, which left every run shorter than 32 segments to the scalar remainder loop).
     std::vector<float> rigidity;
     std::vector<float> orientation;           // empty without an orientation map (1 everywhere)
-    std::vector<uint8_t> movable;             // mask and not on the tile border
     std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)
     // Per row of cells j, runs [spans[2r], spans[2r + 1]) of cells, r in [spanBegin[j], spanBegin[j + 1]),
     // outside which no cell has a movable corner of rigidity > 0: no segment there is projected (§4.2), so
@@ -72,6 +81,7 @@ struct Level {
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
     [[nodiscard]] size_t index(int32_t i, int32_t j) const { return static_cast<size_t>(j) * side() + i; }
+    [[nodiscard]] bool movable(size_t k) const { return rigidity[k] >= 0.0f; }
 };
 
 constexpr int32_t kSpanGap = 8;
@@ -257,10 +267,11 @@ struct Solver::Impl {
     }
 
     void regulariseRun(const Level& level, int32_t j, int32_t first) {
+        const bool fine = level.stride == 1;
         if (kHasAvx2) {
-            regulariseRunAvx2(level, j, first);
+            fine ? regulariseRunAvx2<true>(level, j, first) : regulariseRunAvx2<false>(level, j, first);
         } else {
-            regulariseRunBase(level, j, first);
+            fine ? regulariseRunBase<true>(level, j, first) : regulariseRunBase<false>(level, j, first);
         }
     }
 
@@ -313,6 +324,24 @@ struct Solver::Impl {
         }
     }
 
+    // Triangles (both splittings) at or below nearZero area in the `cells` cells of a row starting at u, v
+    // (points `spacing` apart, the next row `rowStep` on); Spacing != 0 fixes the spacing at compile time.
+    template <int32_t Spacing>
+    static int32_t countNearZero(const float* u, const float* v, size_t rowStep, size_t spacing,
+                                 int32_t cells, float nearZero) {
+        const size_t s = Spacing != 0 ? Spacing : spacing;
+        int32_t count = 0;
+#pragma omp simd reduction(+ : count)
+        for (int32_t i = 0; i < cells; ++i) {
+            const size_t a = static_cast<size_t>(i) * s, b = a + s, d = a + rowStep, e = d + s;
+            count += (orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero ? 1 : 0) +
+                     (orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0) +
+                     (orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero ? 1 : 0) +
+                     (orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0);
+        }
+        return count;
+    }
+
     // One scan over the level's cells (4 orientation tests per cell, vectorisable) finds the triangles at
     // or near zero area; their corners are the candidates, each checked exactly before it moves. After
     // that only the neighbourhoods of moved points are looked at again, in ascending order (deterministic,
@@ -330,17 +359,10 @@ struct Solver::Impl {
         int32_t* counts = rowFolds.data();
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
         for (int32_t j = 0; j < c; ++j) {
-            int32_t count = 0;
             const size_t base = static_cast<size_t>(j) * rowStep;
-#pragma omp simd reduction(+ : count)
-            for (int32_t i = 0; i < c; ++i) {
-                const size_t a = base + static_cast<size_t>(i) * s, b = a + s, d = a + rowStep, e = d + s;
-                count += (orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero ? 1 : 0) +
-                         (orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0) +
-                         (orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero ? 1 : 0) +
-                         (orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0);
-            }
-            counts[j] = count;
+            // The finest level's points are contiguous: a constant spacing gives vector loads.
+            counts[j] = s == 1 ? countNearZero<1>(u + base, v + base, rowStep, 1, c, nearZero)
+                               : countNearZero<0>(u + base, v + base, rowStep, s, c, nearZero);
         }
         std::vector<int32_t>& work = untangleWork;
         work.clear();
@@ -358,7 +380,7 @@ struct Solver::Impl {
             next.clear();
             for (int32_t id : work) {
                 const int32_t i = id % (c + 1), j = id / (c + 1);
-                if (!level.movable[level.index(i, j)] || !isFolded(level, i, j)) continue;
+                if (!level.movable(level.index(i, j)) || !isFolded(level, i, j)) continue;
                 const size_t k = fine(level, i, j);
                 const size_t n[8] = {k + s, k + s + row, k + row, k - s + row,
                                      k - s, k - s - row, k - row, k + s - row};
@@ -408,12 +430,12 @@ struct Solver::Impl {
             const ptrdiff_t finerRow = static_cast<ptrdiff_t>(finer.stride) * side();
             float* u = grid.u.data() + jj * finerRow;
             float* v = grid.v.data() + jj * finerRow;
-            const uint8_t* movable = finer.movable.data() + finer.index(0, jj);
+            const float* rigidity = finer.rigidity.data() + finer.index(0, jj);
             const int32_t fs = finer.stride;
-            // Coarse points (both indices even) are moved by their own level: on an even row only the odd
-            // points are new.
-            const auto move = [&](int32_t ii) {
-                const int32_t i0 = ii >> 1, i1 = std::min(i0 + (ii & 1), c);
+            // Point ii of the finer row lies between coarse points i0 = ii / 2 and i1 = (ii + 1) / 2 (the
+            // same point for even ii). The loops run over m with ii = 2m or 2m + 1, so every index is affine
+            // in m (vector loads at a fixed stride, not one address computed per lane).
+            const auto move = [&](int32_t ii, int32_t i0, int32_t i1) {
                 float du = 0.0f, dv = 0.0f;
                 du += 0.25f * (u0[i0 * cs] - su0[i0]);
                 dv += 0.25f * (v0[i0 * cs] - sv0[i0]);
@@ -423,20 +445,21 @@ struct Solver::Impl {
                 dv += 0.25f * (v1[i0 * cs] - sv1[i0]);
                 du += 0.25f * (u1[i1 * cs] - su1[i1]);
                 dv += 0.25f * (v1[i1 * cs] - sv1[i1]);
-                const float m = static_cast<float>(movable[ii]);  // 0 or 1
+                const float m = rigidity[ii] >= 0.0f ? 1.0f : 0.0f;  // fixed points: kFixed < 0
                 const int32_t k = ii * fs;
                 u[k] += m * du;
                 v[k] += m * dv;
             };
+            // Coarse points (both indices even) are moved by their own level: on an even row only the odd
+            // points are new.
             if (jj & 1) {
 #pragma omp simd
-                for (int32_t ii = 0; ii <= finer.cells; ++ii)
-                    move(ii);
-            } else {
-#pragma omp simd
-                for (int32_t ii = 1; ii <= finer.cells; ii += 2)
-                    move(ii);
+                for (int32_t m = 0; m <= c; ++m)
+                    move(2 * m, m, m);
             }
+#pragma omp simd
+            for (int32_t m = 0; m < c; ++m)
+                move(2 * m + 1, m, m + 1);
         }
     }
 
@@ -539,15 +562,21 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         } else {
             level.orientation.assign(count, 1.0f);
         }
-        level.movable.assign(count, 0);
     }
+    // Per point of the level being built from: may it move (mask, Eq. 8, and not on the tile border)?
+    // Written into Level::rigidity as kFixed once the next level's blur (Eq. 7) has read the level's R.
+    std::vector<uint8_t> movable(static_cast<size_t>(side()) * side()), coarser;
+    const auto markFixed = [](Level& level, const std::vector<uint8_t>& canMove) {
+        for (size_t k = 0; k < canMove.size(); ++k)
+            if (canMove[k] == 0) level.rigidity[k] = kFixed;
+    };
     Level& finest = levels[0];
     for (int32_t j = 0; j <= cells; ++j) {
         for (int32_t i = 0; i <= cells; ++i) {
             const size_t k = finest.index(i, j);
             const bool border = i == 0 || j == 0 || i == cells || j == cells;
             finest.rigidity[k] = rigidity.values[k];
-            finest.movable[k] = (!border && mask.values[k] >= 0.5f) ? 1 : 0;
+            movable[k] = (!border && mask.values[k] >= 0.5f) ? 1 : 0;
             if (!finest.orientation.empty())
                 finest.orientation[k] = std::clamp(orientation.values[k], 0.0f, 1.0f);
         }
@@ -558,6 +587,7 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         Level& to = levels[l];
         const int32_t fc = from.cells;
         const bool mapped = !from.orientation.empty();
+        coarser.assign(static_cast<size_t>(to.side()) * to.side(), 0);
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(to.cells))
         for (int32_t j = 0; j <= to.cells; ++j) {
             for (int32_t i = 0; i <= to.cells; ++i) {
@@ -570,17 +600,20 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
                         const float w = kGauss[di + 1] * kGauss[dj + 1];
                         r += w * from.rigidity[q];
                         if (mapped) o += w * from.orientation[q];
-                        m = std::min(m, from.movable[q]);
+                        m = std::min(m, movable[q]);
                     }
                 }
                 const size_t k = to.index(i, j);
                 const bool border = i == 0 || j == 0 || i == to.cells || j == to.cells;
                 to.rigidity[k] = r;
                 if (mapped) to.orientation[k] = o;
-                to.movable[k] = border ? 0 : m;
+                coarser[k] = border ? 0 : m;
             }
         }
+        markFixed(levels[l - 1], movable);
+        movable.swap(coarser);
     }
+    markFixed(levels.back(), movable);
     for (Level& level : levels)
         findSpans(level);
 }
@@ -589,7 +622,7 @@ void Solver::Impl::findSpans(Level& level) {
     const int32_t c = level.cells;
     auto pointActive = [&](int32_t i, int32_t j) {
         const size_t k = level.index(i, j);
-        return level.movable[k] != 0 && level.rigidity[k] > 0.0f;
+        return level.rigidity[k] > 0.0f;  // movable (kFixed < 0) and rigid
     };
     level.spanBegin.assign(static_cast<size_t>(c) + 1, 0);
     level.spans.clear();
