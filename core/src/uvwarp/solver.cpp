@@ -103,18 +103,51 @@ Rows3 rowsAround(const float* u, const float* v, ptrdiff_t centre, ptrdiff_t row
     return {u + centre - row, u + centre, u + centre + row, v + centre - row, v + centre, v + centre + row};
 }
 
-// The clamp of §4.2 and the fold check of every move, for the point at offset k of the centre row (point
-// spacing s in fine points; the point and its 8 neighbours inside the grid): (x, y) is clamped to the
-// bounding box of the point's 8 neighbours; returns whether it keeps the 12 triangles around the point
-// (both diagonal splittings of its 4 cells) positively oriented. Branch-free, with 32-bit offsets, so loops
+// The 8 neighbours of a point, counter-clockwise from east: E, NE, N, NW, W, SW, S, SE.
+struct Ring {
+    float u[8], v[8];
+};
+constexpr std::array<int32_t, 8> kRingDi = {1, 1, 0, -1, -1, -1, 0, 1};
+constexpr std::array<int32_t, 8> kRingDj = {0, 1, 1, 1, 0, -1, -1, -1};
+
+// The ring slot of the neighbour at offset (di, dj).
+constexpr int32_t ringSlot(int32_t di, int32_t dj) {
+    for (int32_t q = 0; q < 8; ++q)
+        if (kRingDi[q] == di && kRingDj[q] == dj) return q;
+    return -1;
+}
+
+// The ring of the point at offset k of the centre row (point spacing s in fine points).
+[[gnu::always_inline]] inline Ring ringAround(const Rows3& r, int32_t k, int32_t s) {
+    return {{r.uC[k + s], r.uN[k + s], r.uN[k], r.uN[k - s], r.uC[k - s], r.uS[k - s], r.uS[k], r.uS[k + s]},
+            {r.vC[k + s], r.vN[k + s], r.vN[k], r.vN[k - s], r.vC[k - s], r.vS[k - s], r.vS[k], r.vS[k + s]}};
+}
+
+// Neighbour q of the point at offset k of the centre row (point spacing s); q a constant after unrolling.
+[[gnu::always_inline]] inline void ringLoad(const Rows3& r, int32_t k, int32_t s, int32_t q, float& pu,
+                                            float& pv) {
+    const float* uRow = kRingDj[q] > 0 ? r.uN : kRingDj[q] < 0 ? r.uS : r.uC;
+    const float* vRow = kRingDj[q] > 0 ? r.vN : kRingDj[q] < 0 ? r.vS : r.vC;
+    pu = uRow[k + kRingDi[q] * s];
+    pv = vRow[k + kRingDi[q] * s];
+}
+
+// For a segment of type e: the slot of end A's ring that holds neighbour q of end B, or -1 when that
+// neighbour is A itself or not one of A's neighbours.
+constexpr int32_t sharedSlot(const EdgeType& e, int32_t q) {
+    const int32_t di = e.bi + kRingDi[q] - e.ai, dj = e.bj + kRingDj[q] - e.aj;
+    return di == 0 && dj == 0 ? -1 : ringSlot(di, dj);
+}
+
+// The clamp of §4.2 and the fold check of every move, for a point whose 8 neighbours (inside the grid) are
+// n: (x, y) is clamped to the bounding box of the neighbours; returns whether it keeps the 12 triangles
+// around the point (both diagonal splittings of its 4 cells) positively oriented. Branch-free, so loops
 // over independent points vectorise 8 lanes wide.
-[[gnu::always_inline]] inline bool clampKeepsOrientation(const Rows3& r, int32_t k, int32_t s, float& x,
-                                                         float& y) {
-    // Neighbours counter-clockwise from east.
-    const float eu = r.uC[k + s], ev = r.vC[k + s], neu = r.uN[k + s], nev = r.vN[k + s];
-    const float nu = r.uN[k], nv = r.vN[k], nwu = r.uN[k - s], nwv = r.vN[k - s];
-    const float wu = r.uC[k - s], wv = r.vC[k - s], swu = r.uS[k - s], swv = r.vS[k - s];
-    const float su = r.uS[k], sv = r.vS[k], seu = r.uS[k + s], sev = r.vS[k + s];
+[[gnu::always_inline]] inline bool clampKeepsOrientation(const Ring& n, float& x, float& y) {
+    const float eu = n.u[0], ev = n.v[0], neu = n.u[1], nev = n.v[1];
+    const float nu = n.u[2], nv = n.v[2], nwu = n.u[3], nwv = n.v[3];
+    const float wu = n.u[4], wv = n.v[4], swu = n.u[5], swv = n.v[5];
+    const float su = n.u[6], sv = n.v[6], seu = n.u[7], sev = n.v[7];
     const float minU = std::min(std::min(std::min(eu, neu), std::min(nu, nwu)),
                                 std::min(std::min(wu, swu), std::min(su, seu)));
     const float maxU = std::max(std::max(std::max(eu, neu), std::max(nu, nwu)),
