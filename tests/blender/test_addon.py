@@ -65,6 +65,12 @@ def direct_stack(obj, rest):
     return stack
 
 
+def set_all(stack, index, params):
+    """Sets each (name, value) of params on entry `index` of a module DeformerStack."""
+    for name, value in params:
+        stack.set(index, name, value)
+
+
 def z_up(empty):
     """Places an Empty at the origin, unscaled, its Y axis along world Z: the quaternion (1/2, 1/2, 1/2, 1/2)
     (120 degrees about (1, 1, 1)) whose matrix has exact entries, so the handle is exactly (0, 0, 1)."""
@@ -113,9 +119,8 @@ def test_slide_follows_the_end_empty():
     bpy.context.view_layer.update()  # the depsgraph handler sees the control edit
     stack = direct_stack(obj, rest)
     stack.add("slide", "s")
-    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("falloff", 0),
-                        ("displacement", (0.25, 0.125, 0.0))]:
-        stack.set(0, name, value)
+    set_all(stack, 0, [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("falloff", 0),
+                       ("displacement", (0.25, 0.125, 0.0))])
     expected = stack.evaluate(rest)
     assert np.abs(expected - rest).max() > 0.1
     assert_same(positions(obj), expected, "slide after dragging the end Empty")
@@ -146,8 +151,7 @@ def test_frame_changes_follow_an_animated_empty():
     bpy.context.scene.frame_set(6)  # half way: (0.25, 0, 0)
     stack = direct_stack(obj, rest)
     stack.add("slide", "s")
-    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))]:
-        stack.set(0, name, value)
+    set_all(stack, 0, [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))])
     assert_same(positions(obj), stack.evaluate(rest), "slide at frame 6")
     bpy.context.scene.frame_set(1)
     assert_same(positions(obj), rest, "slide at frame 1 (no displacement)")
@@ -166,8 +170,7 @@ def test_twist_about_an_empty_and_vertex_group_weights():
     # Handle Y is the world Z axis: the twist turns the grid about Z.
     stack = direct_stack(obj, rest)
     stack.add("twist", "t")
-    for name, value in params:
-        stack.set(0, name, value)
+    set_all(stack, 0, params)
     assert_same(positions(obj), stack.evaluate(rest), "twist about the Empty's Y axis")
 
     group = obj.vertex_groups.new(name="paint")
@@ -208,9 +211,8 @@ def test_ffd_follows_lattice_points():
     points[(2 * 3 + 2) * 3 + 2] += (0.25 * 2.5, 0.0, 0.0)
     stack = direct_stack(obj, rest)
     stack.add("ffd", "f")
-    for name, value in [("basis", 0), ("divisions", (2, 2, 2)), ("origin", origin),
-                        ("axes", (5.0, 0, 0, 0, 5.0, 0, 0, 0, 2.0)), ("points", points.ravel())]:
-        stack.set(0, name, value)
+    set_all(stack, 0, [("basis", 0), ("divisions", (2, 2, 2)), ("origin", origin),
+                       ("axes", (5.0, 0, 0, 0, 5.0, 0, 0, 0, 2.0)), ("points", points.ravel())])
     expected = stack.evaluate(rest)
     assert np.abs(expected[:, 2]).max() > 0.05  # the grid's centre rises by 0.5 B(1/2)^3 = 1/16
     assert_same(positions(obj), expected, "FFD from the lattice")
@@ -231,9 +233,8 @@ def test_taper_and_bend_about_an_empty():
     stack = direct_stack(obj, rest)
     stack.add("taper", "t")
     stack.add("bend", "b")
-    for name, value in [("handleOrigin", (0, 0, -1)), ("handleY", (0, 0, 1)), ("startScale", 1.0),
-                        ("endScale", 0.5)]:
-        stack.set(0, name, value)
+    set_all(stack, 0, [("handleOrigin", (0, 0, -1)), ("handleY", (0, 0, 1)), ("startScale", 1.0),
+                       ("endScale", 0.5)])
     stack.set(1, "curvature", 0.75)  # handle: the world axes at the origin, the defaults
     expected = stack.evaluate(rest)
     assert np.abs(expected - rest).max() > 0.1
@@ -256,9 +257,8 @@ def test_wire_curve_and_cage_mesh():
     moved[2, 2] = 0.25
     stack = direct_stack(obj, rest)
     stack.add("wires", "w")
-    for name, value in [("smooth", 1), ("restCurve", rest_wire.ravel()), ("curveSizes", [0]),
-                        ("dropoff", [0.5]), ("curve", moved.ravel())]:
-        stack.set(0, name, value)
+    set_all(stack, 0, [("smooth", 1), ("restCurve", rest_wire.ravel()), ("curveSizes", [0]),
+                       ("dropoff", [0.5]), ("curve", moved.ravel())])
     expected = stack.evaluate(rest)
     assert np.abs(expected[:, 2]).max() > 0.1
     assert_same(positions(obj), expected, "wire")
@@ -275,9 +275,8 @@ def test_wire_curve_and_cage_mesh():
     deformed[top, 2] += np.float32(0.25)
     stack.add("meshwarp", "m")
     faces = [list(p.vertices) for p in cage.rest_cage.data.polygons]
-    for name, value in [("restCage", corners.ravel()), ("cageFaceCounts", [len(f) for f in faces]),
-                        ("cageFaceIndices", [i for f in faces for i in f]), ("cage", deformed.ravel())]:
-        stack.set(1, name, value)
+    set_all(stack, 1, [("restCage", corners.ravel()), ("cageFaceCounts", [len(f) for f in faces]),
+                       ("cageFaceIndices", [i for f in faces for i in f]), ("cage", deformed.ravel())])
     expected2 = stack.evaluate(rest)
     assert np.abs(expected2 - expected).max() > 0.01
     assert_same(positions(obj), expected2, "wire then cage")
@@ -299,10 +298,8 @@ def test_reorder_and_remove():
     stack = direct_stack(obj, rest)
     stack.add("slide", "s")
     stack.add("twist", "t")
-    for name, value in [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))]:
-        stack.set(0, name, value)
-    for name, value in [("handleY", (0, 0, 1)), ("startAngle", 0.0), ("endAngle", 1.0)]:
-        stack.set(1, name, value)
+    set_all(stack, 0, [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("displacement", (0.25, 0, 0))])
+    set_all(stack, 1, [("handleY", (0, 0, 1)), ("startAngle", 0.0), ("endAngle", 1.0)])
     assert [e.type for e in obj.deformkit.entries] == ["slide", "twist"]
     assert_same(positions(obj), stack.evaluate(rest), "slide then twist")
 
