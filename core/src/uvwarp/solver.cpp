@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <utility>
+
+#include <immintrin.h>
 
 #include "deformkit/error.h"
 
@@ -55,7 +58,7 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     }
 }
 
-// Largest grid: f_D offsets fit 32 bits (sampleImage).
+// Largest grid: f_D offsets fit 32 bits (imageCell).
 constexpr int32_t kMaxCells = 32768;
 
 // Level::rigidity of a point that may not move.
@@ -167,10 +170,11 @@ constexpr int32_t sharedSlot(const EdgeType& e, int32_t q) {
            (orient(x, y, seu, sev, eu, ev) > 0.0f) & (orient(x, y, su, sv, eu, ev) > 0.0f);
 }
 
-// f_D(u, v): bilinear look-up in a geometry image of `cells` cells (3 floats per point), clamped to the
-// tile. Branch-free.
-[[gnu::always_inline]] inline void sampleImage(const float* image, int32_t cells, float u, float v, float& x0,
-                                               float& x1, float& x2) {
+// f_D(u, v), a bilinear look-up in a geometry image of `cells` cells (3 floats per point) clamped to the
+// tile, in two steps: the cell (offset of its lower-left corner's first float, and the fractions), then the
+// blend of its four corners. Branch-free.
+[[gnu::always_inline]] inline void imageCell(int32_t cells, float u, float v, uint32_t& p00, float& fx,
+                                             float& fy) {
     const float n = static_cast<float>(cells);
     float x = u * n, y = v * n;  // clamped to [0, n]: the same as clamping (u, v) to [0, 1] first
     x = x < 0.0f ? 0.0f : x;
@@ -179,16 +183,85 @@ constexpr int32_t sharedSlot(const EdgeType& e, int32_t q) {
     y = y > n ? n : y;
     const int32_t i = std::min(static_cast<int32_t>(x), cells - 1);
     const int32_t j = std::min(static_cast<int32_t>(y), cells - 1);
-    const float fx = x - static_cast<float>(i), fy = y - static_cast<float>(j);
-    // 32-bit offsets (SIMD gathers need them; 3 (n + 1)^2 < 2^32 up to n = 32768, the largest grid).
-    const uint32_t p00 =
-        3u * (static_cast<uint32_t>(j) * static_cast<uint32_t>(cells + 1) + static_cast<uint32_t>(i));
+    fx = x - static_cast<float>(i);
+    fy = y - static_cast<float>(j);
+    // 32-bit offsets (3 (n + 1)^2 < 2^32 up to n = 32768, the largest grid).
+    p00 = 3u * (static_cast<uint32_t>(j) * static_cast<uint32_t>(cells + 1) + static_cast<uint32_t>(i));
+}
+
+[[gnu::always_inline]] inline void blendCell(const float* image, int32_t cells, uint32_t p00, float fx,
+                                             float fy, float& x0, float& x1, float& x2) {
     const uint32_t p10 = p00 + 3u, p01 = p00 + 3u * static_cast<uint32_t>(cells + 1), p11 = p01 + 3u;
     const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
     x0 = w00 * image[p00] + w10 * image[p10] + w01 * image[p01] + w11 * image[p11];
     x1 = w00 * image[p00 + 1] + w10 * image[p10 + 1] + w01 * image[p01 + 1] + w11 * image[p11 + 1];
     x2 = w00 * image[p00 + 2] + w10 * image[p10 + 2] + w01 * image[p01 + 2] + w11 * image[p11 + 2];
 }
+
+// blendCell for kLaneBlock look-ups, lane l of every array one look-up (the baseline kernels' version).
+void blendCellsBase(const float* image, int32_t cells, const uint32_t* p00, const float* fx, const float* fy,
+                    float* x0, float* x1, float* x2) {
+#pragma omp simd
+    for (int32_t l = 0; l < kLaneBlock; ++l)
+        blendCell(image, cells, p00[l], fx[l], fy[l], x0[l], x1[l], x2[l]);
+}
+
+#define DEFORMKIT_AVX2 __attribute__((target("avx2,prefer-vector-width=256"), always_inline)) inline
+
+// Lanes l and l + 4 of the 4-float loads at `at[l]` floats into the image.
+DEFORMKIT_AVX2 __m256 loadPair(const float* image, const uint32_t* at, int32_t l) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(image + at[l])),
+                                _mm_loadu_ps(image + at[l + 4]), 1);
+}
+
+// One cell row of 8 look-ups: `image` points at the row's left corners (minus the lanes' offsets p00),
+// c[0..5] = x, y, z of the left corner, then of the right one.
+DEFORMKIT_AVX2 void cellRowValues(const float* image, const uint32_t* p00, __m256* c) {
+    const __m256 a0 = loadPair(image, p00, 0), a1 = loadPair(image, p00, 1);
+    const __m256 a2 = loadPair(image, p00, 2), a3 = loadPair(image, p00, 3);
+    const __m256 lo01 = _mm256_unpacklo_ps(a0, a1), hi01 = _mm256_unpackhi_ps(a0, a1);
+    const __m256 lo23 = _mm256_unpacklo_ps(a2, a3), hi23 = _mm256_unpackhi_ps(a2, a3);
+    c[0] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(1, 0, 1, 0));
+    c[1] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(3, 2, 3, 2));
+    c[2] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(1, 0, 1, 0));
+    c[3] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2));
+    const float* shifted = image + 2;  // (z00 x10 y10 z10): the right corner's y and z
+    const __m256 b0 = loadPair(shifted, p00, 0), b1 = loadPair(shifted, p00, 1);
+    const __m256 b2 = loadPair(shifted, p00, 2), b3 = loadPair(shifted, p00, 3);
+    const __m256 bh01 = _mm256_unpackhi_ps(b0, b1), bh23 = _mm256_unpackhi_ps(b2, b3);
+    c[4] = _mm256_shuffle_ps(bh01, bh23, _MM_SHUFFLE(1, 0, 1, 0));
+    c[5] = _mm256_shuffle_ps(bh01, bh23, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+// blendCellsBase for AVX2, with the same arithmetic (so the same bits). A vectorised blendCell reads its 24
+// corner values one lane at a time (12 emulated gathers of 8 scalar loads and inserts each); here each
+// lane's two cell rows are read as 128-bit loads, (x00 y00 z00 x10) and (z00 x10 y10 z10) on each row, and
+// transposed into one vector per corner and channel: 32 loads and 28 shuffles instead of 96 and 96.
+// [p00 + 2, p00 + 6) ends at the last float of the corner p10 (p11 on the upper row): never past the image.
+__attribute__((target("avx2,prefer-vector-width=256"))) void blendCellsAvx2(const float* image, int32_t cells,
+                                                                            const uint32_t* p00,
+                                                                            const float* fx, const float* fy,
+                                                                            float* x0, float* x1, float* x2) {
+    static_assert(kLaneBlock == 8, "one AVX2 register of lanes");
+    __m256 lower[6], upper[6];
+    cellRowValues(image, p00, lower);
+    cellRowValues(image + 3 * (static_cast<size_t>(cells) + 1), p00, upper);
+    const __m256 one = _mm256_set1_ps(1.0f);
+    const __m256 vx = _mm256_loadu_ps(fx), vy = _mm256_loadu_ps(fy);
+    const __m256 ox = _mm256_sub_ps(one, vx), oy = _mm256_sub_ps(one, vy);
+    const __m256 w00 = _mm256_mul_ps(ox, oy), w10 = _mm256_mul_ps(vx, oy);
+    const __m256 w01 = _mm256_mul_ps(ox, vy), w11 = _mm256_mul_ps(vx, vy);
+    float* out[3] = {x0, x1, x2};
+    for (int32_t ch = 0; ch < 3; ++ch) {
+        __m256 sum = _mm256_mul_ps(w00, lower[ch]);
+        sum = _mm256_add_ps(sum, _mm256_mul_ps(w10, lower[3 + ch]));
+        sum = _mm256_add_ps(sum, _mm256_mul_ps(w01, upper[ch]));
+        sum = _mm256_add_ps(sum, _mm256_mul_ps(w11, upper[3 + ch]));
+        _mm256_storeu_ps(out[ch], sum);
+    }
+}
+
+#undef DEFORMKIT_AVX2
 
 }  // namespace
 
