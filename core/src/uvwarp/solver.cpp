@@ -261,6 +261,50 @@ __attribute__((target("avx2,prefer-vector-width=256"))) void blendCellsAvx2(cons
     }
 }
 
+// The windows of a block of kLaneBlock segments on the finest level (points one apart), one window row:
+// p points at column i - 1 of lane 0's segment, lanes are Step points apart, and out[col * kLaneBlock + l]
+// = p[l * Step + col] for the columns i - 1 .. i + 2 (Step 4) or i - 1 .. i + 1 (Step 2, vertical
+// segments; lane l's column i + 1 is lane l + 1's i - 1). Reads p[0, kLaneBlock * Step + 1) at most.
+template <int32_t Step>
+void loadWindowsBase(const float* p, float* out) {
+    constexpr int32_t cols = Step == 4 ? 4 : 3;
+    for (int32_t col = 0; col < cols; ++col)
+        for (int32_t l = 0; l < kLaneBlock; ++l)
+            out[col * kLaneBlock + l] = p[l * Step + col];
+}
+
+// The same with 128-bit loads and in-register transposes (8 shuffles for 4 columns) instead of one scalar
+// load and insert per value.
+template <int32_t Step>
+DEFORMKIT_AVX2 void loadWindowsAvx2(const float* p, float* out) {
+    if constexpr (Step == 4) {
+        // Lane l's 4 columns are p[4l, 4l + 4): registers hold lanes (k, k + 4), then the 4x4 transposes
+        // of each 128-bit half give one register per column, lanes in order.
+        __m256 m[4];
+        for (int32_t k = 0; k < 4; ++k)
+            m[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4 * k)),
+                                        _mm_loadu_ps(p + 16 + 4 * k), 1);
+        const __m256 lo01 = _mm256_unpacklo_ps(m[0], m[1]), hi01 = _mm256_unpackhi_ps(m[0], m[1]);
+        const __m256 lo23 = _mm256_unpacklo_ps(m[2], m[3]), hi23 = _mm256_unpackhi_ps(m[2], m[3]);
+        _mm256_store_ps(out, _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(1, 0, 1, 0)));
+        _mm256_store_ps(out + 8, _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(3, 2, 3, 2)));
+        _mm256_store_ps(out + 16, _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(1, 0, 1, 0)));
+        _mm256_store_ps(out + 24, _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2)));
+    } else {
+        static_assert(Step == 2);
+        // Lane l's columns i - 1, i are p[2l], p[2l + 1]; its column i + 1 is p[2l + 2].
+        const __m256 m0 =
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 8), 1);
+        const __m256 m1 =
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4)), _mm_loadu_ps(p + 12), 1);
+        const __m256 west = _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(2, 0, 2, 0));
+        _mm256_store_ps(out, west);
+        _mm256_store_ps(out + 8, _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(3, 1, 3, 1)));
+        const __m256 next = _mm256_permutevar8x32_ps(west, _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 7));
+        _mm256_store_ps(out + 16, _mm256_blend_ps(next, _mm256_broadcast_ss(p + 16), 0x80));
+    }
+}
+
 #undef DEFORMKIT_AVX2
 
 }  // namespace
