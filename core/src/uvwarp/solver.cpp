@@ -170,6 +170,26 @@ constexpr int32_t sharedSlot(const EdgeType& e, int32_t q) {
            (orient(x, y, seu, sev, eu, ev) > 0.0f) & (orient(x, y, su, sv, eu, ev) > 0.0f);
 }
 
+// Eq. 4-5 for one point at (pu, pv) of rigidity r (kFixed: does not move) with 8 neighbours n: the blend
+// with K_G by b = M((1 - R) + R s), the clamp to the neighbours' box and the fold check. (x, y) = where the
+// point ends up.
+[[gnu::always_inline]] inline void regularisePoint(const Ring& n, float pu, float pv, float r,
+                                                   float smoothing, float& x, float& y) {
+    const float blend = (1.0f - r) + r * smoothing;
+    // K_G's rows south (SW S SE), centre (W . E), north (NW N NE); ring slots E NE N NW W SW S SE.
+    const float gu = kGauss[0] * (kGauss[0] * n.u[5] + kGauss[1] * n.u[6] + kGauss[2] * n.u[7]) +
+                     kGauss[1] * (kGauss[0] * n.u[4] + kGauss[1] * pu + kGauss[2] * n.u[0]) +
+                     kGauss[2] * (kGauss[0] * n.u[3] + kGauss[1] * n.u[2] + kGauss[2] * n.u[1]);
+    const float gv = kGauss[0] * (kGauss[0] * n.v[5] + kGauss[1] * n.v[6] + kGauss[2] * n.v[7]) +
+                     kGauss[1] * (kGauss[0] * n.v[4] + kGauss[1] * pv + kGauss[2] * n.v[0]) +
+                     kGauss[2] * (kGauss[0] * n.v[3] + kGauss[1] * n.v[2] + kGauss[2] * n.v[1]);
+    float nx = (1.0f - blend) * pu + blend * gu;
+    float ny = (1.0f - blend) * pv + blend * gv;
+    const bool ok = (r >= 0.0f) & (blend > 0.0f) & clampKeepsOrientation(n, nx, ny);
+    x = ok ? nx : pu;
+    y = ok ? ny : pv;
+}
+
 // f_D(u, v), a bilinear look-up in a geometry image of `cells` cells (3 floats per point) clamped to the
 // tile, in two steps: the cell (offset of its lower-left corner's first float, and the fractions), then the
 // blend of its four corners. Branch-free.
@@ -303,6 +323,23 @@ DEFORMKIT_AVX2 void loadWindowsAvx2(const float* p, float* out) {
         const __m256 next = _mm256_permutevar8x32_ps(west, _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 7));
         _mm256_store_ps(out + 16, _mm256_blend_ps(next, _mm256_broadcast_ss(p + 16), 0x80));
     }
+}
+
+// p[2l] = even[l], p[2l + 1] = odd[l] for the kLaneBlock lanes.
+inline void storeInterleavedBase(float* p, const float* even, const float* odd) {
+    for (int32_t l = 0; l < kLaneBlock; ++l) {
+        p[2 * l] = even[l];
+        p[2 * l + 1] = odd[l];
+    }
+}
+
+DEFORMKIT_AVX2 void storeInterleavedAvx2(float* p, const float* even, const float* odd) {
+    const __m256 e = _mm256_load_ps(even), o = _mm256_load_ps(odd);
+    const __m256 lo = _mm256_unpacklo_ps(e, o), hi = _mm256_unpackhi_ps(e, o);  // lanes 0 1 | 4 5, 2 3 | 6 7
+    _mm_storeu_ps(p, _mm256_castps256_ps128(lo));
+    _mm_storeu_ps(p + 4, _mm256_castps256_ps128(hi));
+    _mm_storeu_ps(p + 8, _mm256_extractf128_ps(lo, 1));
+    _mm_storeu_ps(p + 12, _mm256_extractf128_ps(hi, 1));
 }
 
 #undef DEFORMKIT_AVX2
