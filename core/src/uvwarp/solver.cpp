@@ -39,8 +39,12 @@ constexpr int32_t kLaneBlock = 8;
 // Rows per block of the row-wavefront schedule (sweep, regularise). A block's rows are processed in order;
 // blocks of one parity never touch a point another block of that parity reads or moves (a row reads at most
 // one row beyond its block on each side), so they run in parallel. Blocks depend on the grid size alone, so
-// the result does not depend on the thread count.
+// the result does not depend on the thread count, nor on which thread runs a block: blocks (and the rows
+// of the other parallel loops) are handed out dynamically, so a thread the machine delays or a row block
+// with more rigid detail does not hold the other threads at the next barrier.
 constexpr int32_t kBlockRows = 16;
+// Points per chunk of the loops over every point (prediction, integration).
+constexpr size_t kPointChunk = 32768;
 
 // Runs rowFn(j) for j in [first, last): blocks of kBlockRows rows, even blocks (in parallel), then odd ones.
 template <class RowFn>
@@ -49,7 +53,7 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     if (rows <= 0) return;
     const int32_t blocks = (rows + kBlockRows - 1) / kBlockRows;
     for (int32_t parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(rows))
+#pragma omp parallel for schedule(dynamic, 1) if (kParallelRows < static_cast <int64_t>(rows))
         for (int32_t b = parity; b < blocks; b += 2) {
             const int32_t end = std::min(last, first + (b + 1) * kBlockRows);
             for (int32_t j = first + b * kBlockRows; j < end; ++j)
@@ -544,7 +548,7 @@ struct Solver::Impl {
         const float* u = grid.u.data();
         const float* v = grid.v.data();
         int32_t* counts = rowFolds.data();
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(c))
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
         for (int32_t j = 0; j < c; ++j) {
             const size_t base = static_cast<size_t>(j) * rowStep;
             // The finest level's points are contiguous: a constant spacing gives vector loads.
@@ -600,7 +604,7 @@ struct Solver::Impl {
     // the mean of the displacements of the 2 or 4 coarse points around each (bilinear at the midpoints).
     void propagate(const Level& coarse, const Level& finer) {
         const int32_t c = coarse.cells;
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(finer.cells))
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(finer.cells))
         for (int32_t jj = 0; jj <= finer.cells; ++jj) {
             const int32_t j0 = jj >> 1, j1 = std::min(j0 + (jj & 1), c);
             // Coarse rows j0 and j1: positions in the fine arrays, and their snapshots.
@@ -652,7 +656,7 @@ struct Solver::Impl {
 
     void snapshot(Level& level) {
         const int32_t n = level.side();
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
         for (int32_t j = 0; j < n; ++j) {
             for (int32_t i = 0; i < n; ++i) {
                 const size_t k = fine(level, i, j);
@@ -671,7 +675,7 @@ struct Solver::Impl {
         const size_t n = grid.u.size();
         const float keep = 1.0f - options.damping;
         // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force).
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
+#pragma omp parallel for schedule(dynamic, kPointChunk) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
             const float du = keep * velU[k], dv = keep * velV[k];
             velU[k] = grid.u[k];  // the position before prediction, until integration
@@ -700,7 +704,7 @@ struct Solver::Impl {
         // Step 4: regularisation (Eq. 4-5) on the finest grid.
         regulariseAll(levels[0], false);
         // Step 5: integration.
-#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(n))
+#pragma omp parallel for schedule(dynamic, kPointChunk) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
             velU[k] = grid.u[k] - velU[k];
             velV[k] = grid.v[k] - velV[k];
