@@ -130,22 +130,6 @@ constexpr int32_t ringSlot(int32_t di, int32_t dj) {
             {r.vC[k + s], r.vN[k + s], r.vN[k], r.vN[k - s], r.vC[k - s], r.vS[k - s], r.vS[k], r.vS[k + s]}};
 }
 
-// Neighbour q of the point at offset k of the centre row (point spacing s); q a constant after unrolling.
-[[gnu::always_inline]] inline void ringLoad(const Rows3& r, int32_t k, int32_t s, int32_t q, float& pu,
-                                            float& pv) {
-    const float* uRow = kRingDj[q] > 0 ? r.uN : kRingDj[q] < 0 ? r.uS : r.uC;
-    const float* vRow = kRingDj[q] > 0 ? r.vN : kRingDj[q] < 0 ? r.vS : r.vC;
-    pu = uRow[k + kRingDi[q] * s];
-    pv = vRow[k + kRingDi[q] * s];
-}
-
-// For a segment of type e: the slot of end A's ring that holds neighbour q of end B, or -1 when that
-// neighbour is A itself or not one of A's neighbours.
-constexpr int32_t sharedSlot(const EdgeType& e, int32_t q) {
-    const int32_t di = e.bi + kRingDi[q] - e.ai, dj = e.bj + kRingDj[q] - e.aj;
-    return di == 0 && dj == 0 ? -1 : ringSlot(di, dj);
-}
-
 // The clamp of §4.2 and the fold check of every move, for a point whose 8 neighbours (inside the grid) are
 // n: (x, y) is clamped to the bounding box of the neighbours; returns whether it keeps the 12 triangles
 // around the point (both diagonal splittings of its 4 cells) positively oriented. Branch-free, so loops
@@ -232,29 +216,34 @@ void blendCellsBase(const float* image, int32_t cells, const uint32_t* p00, cons
 
 #define DEFORMKIT_AVX2 __attribute__((target("avx2,prefer-vector-width=256"), always_inline)) inline
 
-// Lanes l and l + 4 of the 4-float loads at `at[l]` floats into the image.
-DEFORMKIT_AVX2 __m256 loadPair(const float* image, const uint32_t* at, int32_t l) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(image + at[l])),
-                                _mm_loadu_ps(image + at[l + 4]), 1);
+// One register from two 4-float loads: lo in lanes 0-3, hi in lanes 4-7.
+DEFORMKIT_AVX2 __m256 loadHalves(const float* lo, const float* hi) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1);
+}
+
+// m[k] holds lane k's 4 values in its low half and lane k + 4's in its high half; out[c] = value c of
+// lanes 0..7, in order (a 4x4 transpose in each half: 8 shuffles).
+DEFORMKIT_AVX2 void transposeHalves(const __m256* m, __m256* out) {
+    const __m256 lo01 = _mm256_unpacklo_ps(m[0], m[1]), hi01 = _mm256_unpackhi_ps(m[0], m[1]);
+    const __m256 lo23 = _mm256_unpacklo_ps(m[2], m[3]), hi23 = _mm256_unpackhi_ps(m[2], m[3]);
+    out[0] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(1, 0, 1, 0));
+    out[1] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(3, 2, 3, 2));
+    out[2] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(1, 0, 1, 0));
+    out[3] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
 // One cell row of 8 look-ups: `image` points at the row's left corners (minus the lanes' offsets p00),
 // c[0..5] = x, y, z of the left corner, then of the right one.
 DEFORMKIT_AVX2 void cellRowValues(const float* image, const uint32_t* p00, __m256* c) {
-    const __m256 a0 = loadPair(image, p00, 0), a1 = loadPair(image, p00, 1);
-    const __m256 a2 = loadPair(image, p00, 2), a3 = loadPair(image, p00, 3);
-    const __m256 lo01 = _mm256_unpacklo_ps(a0, a1), hi01 = _mm256_unpackhi_ps(a0, a1);
-    const __m256 lo23 = _mm256_unpacklo_ps(a2, a3), hi23 = _mm256_unpackhi_ps(a2, a3);
-    c[0] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(1, 0, 1, 0));
-    c[1] = _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(3, 2, 3, 2));
-    c[2] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(1, 0, 1, 0));
-    c[3] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2));
-    const float* shifted = image + 2;  // (z00 x10 y10 z10): the right corner's y and z
-    const __m256 b0 = loadPair(shifted, p00, 0), b1 = loadPair(shifted, p00, 1);
-    const __m256 b2 = loadPair(shifted, p00, 2), b3 = loadPair(shifted, p00, 3);
-    const __m256 bh01 = _mm256_unpackhi_ps(b0, b1), bh23 = _mm256_unpackhi_ps(b2, b3);
-    c[4] = _mm256_shuffle_ps(bh01, bh23, _MM_SHUFFLE(1, 0, 1, 0));
-    c[5] = _mm256_shuffle_ps(bh01, bh23, _MM_SHUFFLE(3, 2, 3, 2));
+    __m256 m[4], shifted[4];
+    for (int32_t k = 0; k < 4; ++k)
+        m[k] = loadHalves(image + p00[k], image + p00[k + 4]);
+    transposeHalves(m, c);  // x00 y00 z00 x10
+    for (int32_t k = 0; k < 4; ++k)
+        m[k] = loadHalves(image + p00[k] + 2, image + p00[k + 4] + 2);
+    transposeHalves(m, shifted);  // z00 x10 y10 z10: the right corner's y and z
+    c[4] = shifted[2];
+    c[5] = shifted[3];
 }
 
 // blendCellsBase for AVX2, with the same arithmetic (so the same bits). A vectorised blendCell reads its 24
@@ -302,25 +291,17 @@ void loadWindowsBase(const float* p, float* out) {
 template <int32_t Step>
 DEFORMKIT_AVX2 void loadWindowsAvx2(const float* p, float* out) {
     if constexpr (Step == 4) {
-        // Lane l's 4 columns are p[4l, 4l + 4): registers hold lanes (k, k + 4), then the 4x4 transposes
-        // of each 128-bit half give one register per column, lanes in order.
-        __m256 m[4];
+        // Lane l's 4 columns are p[4l, 4l + 4).
+        __m256 m[4], column[4];
         for (int32_t k = 0; k < 4; ++k)
-            m[k] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4 * k)),
-                                        _mm_loadu_ps(p + 16 + 4 * k), 1);
-        const __m256 lo01 = _mm256_unpacklo_ps(m[0], m[1]), hi01 = _mm256_unpackhi_ps(m[0], m[1]);
-        const __m256 lo23 = _mm256_unpacklo_ps(m[2], m[3]), hi23 = _mm256_unpackhi_ps(m[2], m[3]);
-        _mm256_store_ps(out, _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(1, 0, 1, 0)));
-        _mm256_store_ps(out + 8, _mm256_shuffle_ps(lo01, lo23, _MM_SHUFFLE(3, 2, 3, 2)));
-        _mm256_store_ps(out + 16, _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(1, 0, 1, 0)));
-        _mm256_store_ps(out + 24, _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2)));
+            m[k] = loadHalves(p + 4 * k, p + 16 + 4 * k);
+        transposeHalves(m, column);
+        for (int32_t col = 0; col < 4; ++col)
+            _mm256_store_ps(out + col * kLaneBlock, column[col]);
     } else {
         static_assert(Step == 2);
         // Lane l's columns i - 1, i are p[2l], p[2l + 1]; its column i + 1 is p[2l + 2].
-        const __m256 m0 =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 8), 1);
-        const __m256 m1 =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4)), _mm_loadu_ps(p + 12), 1);
+        const __m256 m0 = loadHalves(p, p + 8), m1 = loadHalves(p + 4, p + 12);
         const __m256 west = _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(2, 0, 2, 0));
         _mm256_store_ps(out, west);
         _mm256_store_ps(out + 8, _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(3, 1, 3, 1)));
