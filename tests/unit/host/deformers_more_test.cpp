@@ -21,6 +21,7 @@
 #include "deformkit/warp/ffd_frames.h"
 #include "deformkit/warp/mesh_warp.h"
 #include "deformkit/warp/wires.h"
+#include "host/host_test_support.h"
 #include "slide/slide_test_support.h"
 #include "test_support.h"
 
@@ -33,34 +34,11 @@ using Catch::Contains;
 using host::Deformer;
 using host::makeDeformer;
 
+using test::flatten;
+using test::maxDistance;
+using test::restOf;
+
 namespace {
-
-std::vector<glm::vec3> restOf(const geom::Mesh& mesh) {
-    return {mesh.points().begin(), mesh.points().end()};
-}
-
-// The adapter alone: bind when it needs it, evaluate from the rest positions.
-std::vector<glm::vec3> run(Deformer& d, const geom::Mesh& rest) {
-    if (d.needsBind()) d.bind(rest);
-    const std::vector<glm::vec3> in = restOf(rest);
-    std::vector<glm::vec3> out(in.size());
-    d.evaluate(in, out);
-    return out;
-}
-
-float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
-}
-
-std::vector<double> flatten(const std::vector<glm::vec3>& points) {
-    std::vector<double> out;
-    for (const glm::vec3& p : points)
-        out.insert(out.end(), {p.x, p.y, p.z});
-    return out;
-}
 
 // An open tube about the z axis, radius 0.8, z in [0, 2].
 geom::Mesh tube(int around = 16, int rows = 8) {
@@ -99,10 +77,10 @@ template <class Make>
 void checkThreadCounts(const Make& make, const geom::Mesh& rest) {
     omp_set_num_threads(1);
     const auto one = make();
-    const std::vector<glm::vec3> a = run(*one, rest);
+    const std::vector<glm::vec3> a = test::runAlone(*one, rest);
     omp_set_num_threads(2);
     const auto two = make();
-    const std::vector<glm::vec3> b = run(*two, rest);
+    const std::vector<glm::vec3> b = test::runAlone(*two, rest);
     omp_set_num_threads(omp_get_num_procs());
     CHECK(test::sameBits(a, b));
     CHECK(maxDistance(a, restOf(rest)) > 0.01f);  // the comparison is of a real deformation
@@ -313,7 +291,7 @@ TEST_CASE("ffdframes adapter equals warp::FfdFrames called directly", "[host][de
     CHECK(d->parameter("points").components == 3 * 3 * 2 * 3);
 
     const auto hosted = setup.make();
-    const std::vector<glm::vec3> out = run(*hosted, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*hosted, rest);
     // The same core calls on the same float values: bit-identical.
     CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
     CHECK(maxDistance(out, restOf(rest)) > 0.05f);
@@ -338,7 +316,7 @@ TEST_CASE("ffdframes: a rigid motion of every frame moves the model rigidly, ide
     const auto d = setup.make();
     d->set("points", flatten(moved));
     d->set("frames", bases);
-    const std::vector<glm::vec3> out = run(*d, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*d, rest);
     const auto in = rest.points();
     double worst = 0.0;
     for (size_t u = 0; u < out.size(); ++u)
@@ -358,7 +336,7 @@ TEST_CASE("ffdframes: a rigid motion of every frame moves the model rigidly, ide
     ffd->set("origin", std::vector<double>{-1, -1, -0.25});
     ffd->set("axes", std::vector<double>{2, 0, 0, 0, 2, 0, 0, 0, 2.5});
     ffd->set("points", setup.points());
-    const std::vector<glm::vec3> a = run(*frames, rest), b = run(*ffd, rest);
+    const std::vector<glm::vec3> a = test::runAlone(*frames, rest), b = test::runAlone(*ffd, rest);
     CHECK(maxDistance(a, b) < 1e-6f);
     CHECK(maxDistance(a, restOf(rest)) > 0.05f);
 }
@@ -368,7 +346,7 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     const geom::Mesh rest = tube();
     const FramesSetup setup;
     const auto d = setup.make();
-    const std::vector<glm::vec3> first = run(*d, rest);
+    const std::vector<glm::vec3> first = test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
 
     FramesSetup turned = setup;
@@ -376,14 +354,14 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     d->set("frames", turned.bases());
     d->set("points", turned.points());
     CHECK_FALSE(d->needsBind());
-    const std::vector<glm::vec3> second = run(*d, rest);
+    const std::vector<glm::vec3> second = test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
     CHECK(test::sameBits(second, turned.direct(rest, restOf(rest))));
     CHECK(maxDistance(first, second) > 0.01f);
 
     d->set("outside", 1.0);
     CHECK(d->needsBind());
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 2);
     // A lattice change rebinds and puts the controls back at rest: the identity, bit for bit.
     d->set("origin", std::vector<double>{-1.5, -1, -0.25});
@@ -391,7 +369,7 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     shifted.origin.x = -1.5f;
     CHECK(d->get("points") == flatten(shifted.controlPoints()));
     CHECK(d->get("frames")[9 * 5 + 4] == 1.0);
-    CHECK(test::sameBits(run(*d, rest), restOf(rest)));
+    CHECK(test::sameBits(test::runAlone(*d, rest), restOf(rest)));
     CHECK(d->bindCount() == 3);
 }
 
@@ -421,7 +399,7 @@ TEST_CASE("beierneely adapter equals the core warp through the engine, both vari
     const FeatureSetup setup;
     for (int global : {0, 1}) {
         const auto d = setup.make(global);
-        const std::vector<glm::vec3> out = run(*d, rest);
+        const std::vector<glm::vec3> out = test::runAlone(*d, rest);
         CHECK(test::sameBits(out, setup.direct(global, rest)));
         CHECK(maxDistance(out, restOf(rest)) > 0.05f);
         // A 2-D warp: z is kept bit for bit.
@@ -446,7 +424,7 @@ TEST_CASE("beierneely: one feature is a similarity, the closed form", "[host][de
     // Default: one feature (0, 0) -> (1, 0); moved to (1, 1) -> (1, 2) it is a quarter turn and a shift:
     // (x, y) -> (1 - y, 1 + x), whatever the weight.
     d->set("features", std::vector<double>{1, 1, 1, 2});
-    const std::vector<glm::vec3> out = run(*d, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*d, rest);
     const auto in = rest.points();
     double worst = 0.0;
     for (size_t u = 0; u < out.size(); ++u) {
@@ -462,22 +440,22 @@ TEST_CASE("beierneely: deformed features do not rebind, rest features and consta
     const geom::Mesh rest = plane();
     FeatureSetup setup;
     const auto d = setup.make(0);
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
     setup.moved[5] += 0.2;
     d->set("features", setup.moved);
     CHECK_FALSE(d->needsBind());
-    CHECK(test::sameBits(run(*d, rest), setup.direct(0, rest)));
+    CHECK(test::sameBits(test::runAlone(*d, rest), setup.direct(0, rest)));
     CHECK(d->bindCount() == 1);
 
     d->set("b", 1.5);  // the value it has: nothing changes
     CHECK_FALSE(d->needsBind());
     d->set("a", 0.7);
     CHECK(d->needsBind());
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 2);
     d->set("global", 1.0);
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 3);
 
     // A rest change resets the deformed features to it (the identity), with a third feature.
@@ -485,7 +463,7 @@ TEST_CASE("beierneely: deformed features do not rebind, rest features and consta
     d->set("restFeatures", three);
     CHECK(d->get("features") == three);
     CHECK(d->parameter("features").components == 12);
-    CHECK(maxDistance(run(*d, rest), restOf(rest)) < 1e-6f);  // identity maps, float rounding only
+    CHECK(maxDistance(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // identity maps, float rounding only
     CHECK(d->bindCount() == 4);
 }
 
@@ -529,11 +507,11 @@ TEST_CASE("meshwarp adapter equals warp::MeshWarp through the engine", "[host][d
     CHECK_FALSE(params[7].rebinds);
     // The default cage is the unit cube, at rest: the identity.
     const geom::Mesh small = test::planeGrid(4, 4, 0.25f, glm::mat3(1.0f), glm::vec3(0.0f, 0.0f, 0.5f));
-    CHECK(maxDistance(run(*d, small), restOf(small)) < 1e-6f);
+    CHECK(maxDistance(test::runAlone(*d, small), restOf(small)) < 1e-6f);
     CHECK(d->get("restCage") == flatten(BoxCage({0, 0, 0}, {1, 1, 1}).points));
 
     const auto hosted = setup.make();
-    const std::vector<glm::vec3> out = run(*hosted, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*hosted, rest);
     CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
     CHECK(maxDistance(out, restOf(rest)) > 0.05f);
 }
@@ -551,7 +529,7 @@ TEST_CASE("meshwarp: a rigid motion of a box cage moves the tube inside rigidly"
         moved.push_back(glm::vec3(r * glm::dvec3(p) + t));
     const auto d = setup.make();
     d->set("cage", flatten(moved));
-    const std::vector<glm::vec3> out = run(*d, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*d, rest);
     const auto in = rest.points();
     double worst = 0.0;
     for (size_t u = 0; u < out.size(); ++u)
@@ -566,30 +544,30 @@ TEST_CASE("meshwarp: the deformed cage does not rebind, the rest cage and weight
     const geom::Mesh rest = tube();
     CageSetup setup;
     const auto d = setup.make();
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
     setup.target[4] += glm::vec3(-0.2f, -0.1f, 0.1f);
     d->set("cage", flatten(setup.target));
     CHECK_FALSE(d->needsBind());
-    CHECK(test::sameBits(run(*d, rest), setup.direct(rest, restOf(rest))));
+    CHECK(test::sameBits(test::runAlone(*d, rest), setup.direct(rest, restOf(rest))));
     CHECK(d->bindCount() == 1);
 
     d->set("mu", 1.1);
     CHECK(d->needsBind());
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 2);
     // The same first face, started at another corner: new connectivity, one rebind.
     std::vector<double> indices = setup.box.indices;
     std::rotate(indices.begin(), indices.begin() + 1, indices.begin() + 4);
     d->set("cageFaceIndices", indices);
     CHECK(d->needsBind());
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 3);
     // A rest cage change resets the deformed cage to it.
     const BoxCage bigger({-1.1f, -1.1f, -0.3f}, {1.1f, 1.1f, 2.3f});
     d->set("restCage", flatten(bigger.points));
     CHECK(d->get("cage") == flatten(bigger.points));
-    CHECK(maxDistance(run(*d, rest), restOf(rest)) < 1e-6f);  // the identity, to float rounding
+    CHECK(maxDistance(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // the identity, to float rounding
     CHECK(d->bindCount() == 4);
 }
 
@@ -652,7 +630,7 @@ TEST_CASE("wires adapter with two wires equals warp::Wires called directly", "[h
     const TwoWires setup;
     for (int smooth : {0, 1}) {
         const auto d = setup.make(smooth);
-        const std::vector<glm::vec3> out = run(*d, rest);
+        const std::vector<glm::vec3> out = test::runAlone(*d, rest);
         CHECK(test::sameBits(out, setup.direct(smooth, rest)));
         CHECK(maxDistance(out, restOf(rest)) > 0.1f);
     }
@@ -661,7 +639,7 @@ TEST_CASE("wires adapter with two wires equals warp::Wires called directly", "[h
     d->set("dropoff", 0.55);
     TwoWires same = setup;
     same.first.radius = same.second.radius = 0.55f;
-    CHECK(test::sameBits(run(*d, rest), same.direct(0, rest)));
+    CHECK(test::sameBits(test::runAlone(*d, rest), same.direct(0, rest)));
 }
 
 TEST_CASE("wires: a second wire at rest with scale 1 has no say", "[host][deformers][wires]") {
@@ -684,7 +662,7 @@ TEST_CASE("wires: a second wire at rest with scale 1 has no say", "[host][deform
     one.bind(rest.points());
     std::vector<glm::vec3> expected = restOf(rest);
     one.evaluate(expected);
-    const std::vector<glm::vec3> out = run(*d, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*d, rest);
     CHECK(maxDistance(out, expected) < 1e-6f);
     CHECK(maxDistance(expected, restOf(rest)) > 0.1f);
 }
@@ -694,7 +672,7 @@ TEST_CASE("wires: curves do not rebind, sizes and dropoffs do", "[host][deformer
     TwoWires setup;
     const auto d = setup.make(0);
     CHECK(d->get("curveSizes") == std::vector<double>{3, 2});
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
     setup.second.wire[1] += glm::vec3(0.1f, 0.1f, 0.2f);
     std::vector<double> curve = flatten(setup.first.wire);
@@ -702,18 +680,18 @@ TEST_CASE("wires: curves do not rebind, sizes and dropoffs do", "[host][deformer
     curve.insert(curve.end(), second.begin(), second.end());
     d->set("curve", curve);
     CHECK_FALSE(d->needsBind());
-    CHECK(test::sameBits(run(*d, rest), setup.direct(0, rest)));
+    CHECK(test::sameBits(test::runAlone(*d, rest), setup.direct(0, rest)));
     CHECK(d->bindCount() == 1);
 
     d->set("dropoff", std::vector<double>{0.6, 0.45});
     CHECK(d->needsBind());
-    (void)run(*d, rest);
+    (void)test::runAlone(*d, rest);
     CHECK(d->bindCount() == 2);
     // Five points as one wire: a different deformation, one rebind.
     d->set("curveSizes", 0.0);
     d->set("dropoff", 0.6);
     d->set("scale", 1.0);
-    const std::vector<glm::vec3> joined = run(*d, rest);
+    const std::vector<glm::vec3> joined = test::runAlone(*d, rest);
     CHECK(d->bindCount() == 3);
     CHECK(maxDistance(joined, setup.direct(0, rest)) > 1e-3f);
 }

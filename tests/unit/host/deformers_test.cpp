@@ -15,6 +15,7 @@
 #include "deformkit/warp/barr_host.h"
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/wires.h"
+#include "host/host_test_support.h"
 #include "slide/slide_test_support.h"
 #include "test_support.h"
 
@@ -23,27 +24,10 @@ using Catch::Contains;
 using host::Deformer;
 using host::makeDeformer;
 
+using test::maxDistance;
+using test::restOf;
+
 namespace {
-
-std::vector<glm::vec3> restOf(const geom::Mesh& mesh) {
-    return {mesh.points().begin(), mesh.points().end()};
-}
-
-// The adapter alone: bind to the rest mesh, evaluate from the rest positions.
-std::vector<glm::vec3> run(Deformer& d, const geom::Mesh& rest) {
-    if (d.needsBind()) d.bind(rest);
-    const std::vector<glm::vec3> in = restOf(rest);
-    std::vector<glm::vec3> out(in.size());
-    d.evaluate(in, out);
-    return out;
-}
-
-float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
-}
 
 // A 2 x 2 plane of 8 x 8 quads, lifted to z = 0.1 so no coordinate is exactly 0.
 geom::Mesh testPlane() {
@@ -105,7 +89,7 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
         CHECK(resetPoints[3 * c + 2] == targets[c].z);
     }
     // At rest the lattice is the identity, bit for bit (every translation is 0).
-    CHECK(test::sameBits(run(*d, rest), restOf(rest)));
+    CHECK(test::sameBits(test::runAlone(*d, rest), restOf(rest)));
 
     targets[lattice.index(1, 1, 2)] += glm::vec3(0.3f, -0.2f, 0.5f);
     targets[lattice.index(2, 0, 1)] += glm::vec3(-0.1f, 0.4f, 0.2f);
@@ -113,7 +97,7 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
     for (const glm::vec3& t : targets)
         flat.insert(flat.end(), {t.x, t.y, t.z});
     d->set("points", flat);
-    const std::vector<glm::vec3> hosted = run(*d, rest);
+    const std::vector<glm::vec3> hosted = test::runAlone(*d, rest);
 
     warp::Ffd ffd(lattice);
     ffd.setTargets(targets);
@@ -133,7 +117,7 @@ TEST_CASE("twist adapter: Maya's twist, equal to the core and to the closed form
     d->set("handleY", std::vector<double>{2, 0, 0});  // axis along +x, scale 2: bounds -1..1 are x in [-1, 3]
     d->set("startAngle", 0.0);
     d->set("endAngle", std::numbers::pi);
-    const std::vector<glm::vec3> hosted = run(*d, rest);
+    const std::vector<glm::vec3> hosted = test::runAlone(*d, rest);
 
     warp::MayaTwist maya;
     maya.handleOrigin = {1, 1, 0};
@@ -170,7 +154,7 @@ TEST_CASE("taper adapter: scales across the handle axis linearly between the bou
     d->set("handleY", std::vector<double>{0, 2, 0});  // bounds -1..1 are y in [-2, 2]
     d->set("startScale", 1.0);
     d->set("endScale", 3.0);
-    const std::vector<glm::vec3> out = run(*d, rest);
+    const std::vector<glm::vec3> out = test::runAlone(*d, rest);
     // f(y) = 2 + y / 2 on [-2, 2], 1 below, 3 above; x and z multiplied by f. Hand values; the profile is
     // a float cubic that is exactly linear here, so 1e-6 covers its rounding.
     const std::vector<glm::vec3> expected = {
@@ -197,7 +181,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         d->set("handleY", std::vector<double>{1, 0, 0});
         d->set("curvature", 0.8);
         d->set("lowBound", -0.5);
-        const std::vector<glm::vec3> hosted = run(*d, rest);
+        const std::vector<glm::vec3> hosted = test::runAlone(*d, rest);
         warp::MayaBend maya;
         maya.handleOrigin = {1, 1, 0};
         maya.handleX = {0, 0, 1};
@@ -220,7 +204,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         CHECK(d->get("curve") == restCurve);  // reset to the rest curve
         d->set("curve", std::vector<double>{0, 1, 0.1, 1, 1.2, 0.5, 2, 1, 0.1});
         d->set("dropoff", 0.6);
-        const std::vector<glm::vec3> hosted = run(*d, rest);
+        const std::vector<glm::vec3> hosted = test::runAlone(*d, rest);
         warp::Wire wire;
         wire.reference = {{0, 1, 0.1f}, {1, 1.1f, 0.1f}, {2, 1, 0.1f}};
         wire.wire = {{0, 1, 0.1f}, {1, 1.2f, 0.5f}, {2, 1, 0.1f}};
@@ -240,7 +224,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         d->set("displacement", std::vector<double>{0.2, 0.1, 0.0});
         d->set("falloff", 2.0);
         d->set("falloffRamp", std::vector<double>{1, 0.5, 0});
-        const std::vector<glm::vec3> hosted = run(*d, rest);
+        const std::vector<glm::vec3> hosted = test::runAlone(*d, rest);
         slide::Slider slider(rest, {{40, 0.7}});
         const std::vector<float> ramp{1, 0.5f, 0};
         const std::vector<slide::SlideDrive> drives{{glm::dvec3(0.2, 0.1, 0.0), slide::Falloff::ramp(ramp)}};

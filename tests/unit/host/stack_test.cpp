@@ -18,6 +18,7 @@
 #include "deformkit/warp/barr.h"
 #include "deformkit/warp/barr_host.h"
 #include "deformkit/warp/ffd.h"
+#include "host/host_test_support.h"
 #include "slide/slide_test_support.h"
 #include "test_support.h"
 
@@ -26,28 +27,14 @@ using Catch::Contains;
 using host::DeformerStack;
 using host::makeDeformer;
 
-namespace {
+using test::flatten;
+using test::maxDistance;
+using test::restOf;
 
-std::vector<glm::vec3> restOf(const geom::Mesh& mesh) {
-    return {mesh.points().begin(), mesh.points().end()};
-}
+namespace {
 
 bool sameBits(const glm::vec3& a, const glm::vec3& b) {
     return std::memcmp(&a, &b, sizeof(glm::vec3)) == 0;
-}
-
-float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
-}
-
-std::vector<double> flatten(const std::vector<glm::vec3>& points) {
-    std::vector<double> out;
-    for (const glm::vec3& p : points)
-        out.insert(out.end(), {p.x, p.y, p.z});
-    return out;
 }
 
 // The scene of the comparison test: a 2 x 2 plane (n x n quads) at z = 0.1, a 2 x 2 x 1 lattice around
