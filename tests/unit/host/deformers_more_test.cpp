@@ -35,7 +35,7 @@ using host::Deformer;
 using host::makeDeformer;
 
 using test::flatten;
-using test::maxDistance;
+using test::maxError;
 using test::restOf;
 
 namespace {
@@ -83,7 +83,7 @@ void checkThreadCounts(const Make& make, const geom::Mesh& rest) {
     const std::vector<glm::vec3> b = test::runAlone(*two, rest);
     omp_set_num_threads(omp_get_num_procs());
     CHECK(test::sameBits(a, b));
-    CHECK(maxDistance(a, restOf(rest)) > 0.01f);  // the comparison is of a real deformation
+    CHECK(maxError(a, restOf(rest)) > 0.01f);  // the comparison is of a real deformation
 }
 
 // ---- ffdframes fixture: a 2 x 1 x 2 lattice around the tube ----
@@ -294,7 +294,7 @@ TEST_CASE("ffdframes adapter equals warp::FfdFrames called directly", "[host][de
     const std::vector<glm::vec3> out = test::runAlone(*hosted, rest);
     // The same core calls on the same float values: bit-identical.
     CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
-    CHECK(maxDistance(out, restOf(rest)) > 0.05f);
+    CHECK(maxError(out, restOf(rest)) > 0.05f);
 }
 
 TEST_CASE("ffdframes: a rigid motion of every frame moves the model rigidly, identity bases are ffd",
@@ -337,8 +337,8 @@ TEST_CASE("ffdframes: a rigid motion of every frame moves the model rigidly, ide
     ffd->set("axes", std::vector<double>{2, 0, 0, 0, 2, 0, 0, 0, 2.5});
     ffd->set("points", setup.points());
     const std::vector<glm::vec3> a = test::runAlone(*frames, rest), b = test::runAlone(*ffd, rest);
-    CHECK(maxDistance(a, b) < 1e-6f);
-    CHECK(maxDistance(a, restOf(rest)) > 0.05f);
+    CHECK(maxError(a, b) < 1e-6f);
+    CHECK(maxError(a, restOf(rest)) > 0.05f);
 }
 
 TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the controls",
@@ -357,7 +357,7 @@ TEST_CASE("ffdframes: controls do not rebind, the lattice does, and resets the c
     const std::vector<glm::vec3> second = test::runAlone(*d, rest);
     CHECK(d->bindCount() == 1);
     CHECK(test::sameBits(second, turned.direct(rest, restOf(rest))));
-    CHECK(maxDistance(first, second) > 0.01f);
+    CHECK(maxError(first, second) > 0.01f);
 
     d->set("outside", 1.0);
     CHECK(d->needsBind());
@@ -401,7 +401,7 @@ TEST_CASE("beierneely adapter equals the core warp through the engine, both vari
         const auto d = setup.make(global);
         const std::vector<glm::vec3> out = test::runAlone(*d, rest);
         CHECK(test::sameBits(out, setup.direct(global, rest)));
-        CHECK(maxDistance(out, restOf(rest)) > 0.05f);
+        CHECK(maxError(out, restOf(rest)) > 0.05f);
         // A 2-D warp: z is kept bit for bit.
         bool zKept = true;
         for (size_t u = 0; u < out.size(); ++u)
@@ -409,7 +409,7 @@ TEST_CASE("beierneely adapter equals the core warp through the engine, both vari
         CHECK(zKept);
     }
     // The variants differ on this input (the features turn opposite ways).
-    CHECK(maxDistance(setup.direct(0, rest), setup.direct(1, rest)) > 1e-2f);
+    CHECK(maxError(setup.direct(0, rest), setup.direct(1, rest)) > 1e-2f);
 }
 
 TEST_CASE("beierneely: one feature is a similarity, the closed form", "[host][deformers][beierneely]") {
@@ -463,7 +463,7 @@ TEST_CASE("beierneely: deformed features do not rebind, rest features and consta
     d->set("restFeatures", three);
     CHECK(d->get("features") == three);
     CHECK(d->parameter("features").components == 12);
-    CHECK(maxDistance(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // identity maps, float rounding only
+    CHECK(maxError(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // identity maps, float rounding only
     CHECK(d->bindCount() == 4);
 }
 
@@ -507,13 +507,13 @@ TEST_CASE("meshwarp adapter equals warp::MeshWarp through the engine", "[host][d
     CHECK_FALSE(params[7].rebinds);
     // The default cage is the unit cube, at rest: the identity.
     const geom::Mesh small = test::planeGrid(4, 4, 0.25f, glm::mat3(1.0f), glm::vec3(0.0f, 0.0f, 0.5f));
-    CHECK(maxDistance(test::runAlone(*d, small), restOf(small)) < 1e-6f);
+    CHECK(maxError(test::runAlone(*d, small), restOf(small)) < 1e-6f);
     CHECK(d->get("restCage") == flatten(BoxCage({0, 0, 0}, {1, 1, 1}).points));
 
     const auto hosted = setup.make();
     const std::vector<glm::vec3> out = test::runAlone(*hosted, rest);
     CHECK(test::sameBits(out, setup.direct(rest, restOf(rest))));
-    CHECK(maxDistance(out, restOf(rest)) > 0.05f);
+    CHECK(maxError(out, restOf(rest)) > 0.05f);
 }
 
 TEST_CASE("meshwarp: a rigid motion of a box cage moves the tube inside rigidly",
@@ -567,7 +567,7 @@ TEST_CASE("meshwarp: the deformed cage does not rebind, the rest cage and weight
     const BoxCage bigger({-1.1f, -1.1f, -0.3f}, {1.1f, 1.1f, 2.3f});
     d->set("restCage", flatten(bigger.points));
     CHECK(d->get("cage") == flatten(bigger.points));
-    CHECK(maxDistance(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // the identity, to float rounding
+    CHECK(maxError(test::runAlone(*d, rest), restOf(rest)) < 1e-6f);  // the identity, to float rounding
     CHECK(d->bindCount() == 4);
 }
 
@@ -632,7 +632,7 @@ TEST_CASE("wires adapter with two wires equals warp::Wires called directly", "[h
         const auto d = setup.make(smooth);
         const std::vector<glm::vec3> out = test::runAlone(*d, rest);
         CHECK(test::sameBits(out, setup.direct(smooth, rest)));
-        CHECK(maxDistance(out, restOf(rest)) > 0.1f);
+        CHECK(maxError(out, restOf(rest)) > 0.1f);
     }
     // One dropoff for both wires.
     const auto d = setup.make(0);
@@ -663,8 +663,8 @@ TEST_CASE("wires: a second wire at rest with scale 1 has no say", "[host][deform
     std::vector<glm::vec3> expected = restOf(rest);
     one.evaluate(expected);
     const std::vector<glm::vec3> out = test::runAlone(*d, rest);
-    CHECK(maxDistance(out, expected) < 1e-6f);
-    CHECK(maxDistance(expected, restOf(rest)) > 0.1f);
+    CHECK(maxError(out, expected) < 1e-6f);
+    CHECK(maxError(expected, restOf(rest)) > 0.1f);
 }
 
 TEST_CASE("wires: curves do not rebind, sizes and dropoffs do", "[host][deformers][wires]") {
@@ -693,7 +693,7 @@ TEST_CASE("wires: curves do not rebind, sizes and dropoffs do", "[host][deformer
     d->set("scale", 1.0);
     const std::vector<glm::vec3> joined = test::runAlone(*d, rest);
     CHECK(d->bindCount() == 3);
-    CHECK(maxDistance(joined, setup.direct(0, rest)) > 1e-3f);
+    CHECK(maxError(joined, setup.direct(0, rest)) > 1e-3f);
 }
 
 TEST_CASE("wires: bad sizes, counts and values are named", "[host][deformers][wires][errors]") {
@@ -794,7 +794,7 @@ TEST_CASE("a stack of ffdframes then meshwarp with weights 0.5 follows Maya's ru
     const std::vector<glm::vec3> expected = blend(first, cage.direct(rest, first));
     // The same float operations in the same order: bit for bit.
     CHECK(test::sameBits(points, expected));
-    CHECK(maxDistance(points, first) > 0.02f);
-    CHECK(maxDistance(first, restOf(rest)) > 0.02f);
+    CHECK(maxError(points, first) > 0.02f);
+    CHECK(maxError(first, restOf(rest)) > 0.02f);
     CHECK(stack.bindCount() == 2);
 }

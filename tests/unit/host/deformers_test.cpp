@@ -24,7 +24,7 @@ using Catch::Contains;
 using host::Deformer;
 using host::makeDeformer;
 
-using test::maxDistance;
+using test::maxError;
 using test::restOf;
 
 namespace {
@@ -106,7 +106,7 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
     ffd.evaluate(direct);
     // The adapter makes the same core calls on the same float values: bit-identical.
     CHECK(test::sameBits(hosted, direct));
-    CHECK(maxDistance(direct, restOf(rest)) > 0.05f);  // the lattice moved something
+    CHECK(maxError(direct, restOf(rest)) > 0.05f);  // the lattice moved something
 }
 
 TEST_CASE("twist adapter: Maya's twist, equal to the core and to the closed form",
@@ -195,7 +195,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         std::vector<glm::vec3> direct(hosted.size());
         bend.evaluate(rest.points(), direct);
         CHECK(test::sameBits(hosted, direct));
-        CHECK(maxDistance(direct, restOf(rest)) > 0.05f);
+        CHECK(maxError(direct, restOf(rest)) > 0.05f);
     }
     SECTION("wires") {
         const auto d = makeDeformer("wires", "wr");
@@ -214,7 +214,7 @@ TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][d
         std::vector<glm::vec3> direct = restOf(rest);
         wires.evaluate(direct);
         CHECK(test::sameBits(hosted, direct));
-        CHECK(maxDistance(direct, restOf(rest)) > 0.1f);
+        CHECK(maxError(direct, restOf(rest)) > 0.1f);
     }
     SECTION("slide") {
         const auto d = makeDeformer("slide", "sl");

@@ -1,16 +1,15 @@
 #pragma once
 
-// Helpers shared by the host layer's tests: a mesh's rest positions, one adapter run on its own, and
-// comparisons of point lists.
+// Helpers shared by the host layer's tests: a mesh's rest positions, one adapter run on its own, and point
+// lists as parameters (maxError of warp_test_support.h compares point lists).
 
-#include <algorithm>
 #include <vector>
 
-#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/deformers.h"
+#include "warp/warp_test_support.h"
 
 namespace deformkit::test {
 
@@ -25,13 +24,6 @@ inline std::vector<glm::vec3> runAlone(host::Deformer& d, const geom::Mesh& rest
     std::vector<glm::vec3> out(in.size());
     d.evaluate(in, out);
     return out;
-}
-
-inline float maxDistance(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-    float e = 0.0f;
-    for (size_t i = 0; i < a.size(); ++i)
-        e = std::max(e, glm::length(a[i] - b[i]));
-    return e;
 }
 
 // x, y, z of every point in turn: the form of a deformer's point-list parameters.

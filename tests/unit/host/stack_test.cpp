@@ -28,7 +28,7 @@ using host::DeformerStack;
 using host::makeDeformer;
 
 using test::flatten;
-using test::maxDistance;
+using test::maxError;
 using test::restOf;
 
 namespace {
@@ -115,7 +115,7 @@ TEST_CASE("a stack of two warps and a slide equals the same core calls made dire
     // Envelope 1 and no painted weights: each stage's output is its core deformer's, bit for bit (the blend
     // passes a weight of exactly 1 through untouched).
     CHECK(test::sameBits(points, expected));
-    CHECK(maxDistance(points, restOf(scene.rest)) > 0.1f);  // every stage did something
+    CHECK(maxError(points, restOf(scene.rest)) > 0.1f);  // every stage did something
     CHECK(stack.bindCount() == 3);
 
     // Evaluating again from the rest positions repeats the result bit for bit, without binding.
@@ -304,7 +304,7 @@ TEST_CASE("dirty tracking: controls never rebind, rest and bind-time inputs do",
     stack.evaluate(points);
     CHECK(bindCounts() == std::vector<int64_t>{1, 1, 1, 1, 1, 1});
     CHECK(stack.bindCount() == 6);
-    CHECK(maxDistance(points, first) > 0.05f);
+    CHECK(maxError(points, first) > 0.05f);
 
     // A bind-time parameter of one entry rebinds that entry only.
     stack.set(0, "origin", std::vector<double>{-0.2, -0.1, -0.5});
@@ -477,7 +477,7 @@ TEST_CASE("the stack gives bit-identical output for 1 and 2 threads", "[host][st
     stack.evaluate(two);
     omp_set_num_threads(threads);
     CHECK(test::sameBits(one, two));
-    CHECK(maxDistance(one, restOf(scene.rest)) > 0.1f);
+    CHECK(maxError(one, restOf(scene.rest)) > 0.1f);
 }
 
 TEST_CASE("evaluate(in, out) gives the in-place result for 0 to 3 active entries", "[host][stack]") {
