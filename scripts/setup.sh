@@ -8,7 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
-    build-essential cmake pkg-config git
+    build-essential cmake ninja-build pkg-config git
+    clang-format                     # the formatting check (tests/format)
     libosd-dev                       # OpenSubdiv
     libopenimageio-dev openimageio-tools
     libopenexr-dev libimath-dev      # OpenEXR
@@ -43,6 +44,9 @@ if [ "${1:-}" = "--deps" ]; then exit 0; fi
 jobs=$(nproc 2>/dev/null || echo 2)
 # Build the Python module for Debian's own interpreter (the one Blender embeds), whatever python3
 # comes first on PATH.
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+# Ninja for a new build folder (it keeps both cores busy across targets); an existing one keeps its generator.
+generator=()
+if [ ! -f build/CMakeCache.txt ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j "$jobs"
 echo "setup: built into ./build (CLI: ./build/bin/deformkit, Python module: ./build/python)"

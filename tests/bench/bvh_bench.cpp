@@ -16,6 +16,7 @@
 #include "deformkit/geom/bvh.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
 
 namespace {

@@ -1,4 +1,5 @@
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 
 #include <algorithm>
 #include <string>

@@ -10,6 +10,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/normals.h"
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
 #include "deformkit/io/udim.h"
 

@@ -8,6 +8,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 #include "lookup.h"
 #include "tile_uvs.h"
 

@@ -6,6 +6,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {

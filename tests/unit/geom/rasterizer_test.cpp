@@ -9,6 +9,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/geom/rasterizer.h"
+#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
 
 using namespace deformkit::geom;

@@ -6,7 +6,6 @@
 #include <vector>
 
 #include <glm/vec2.hpp>
-#include <glm/vec3.hpp>
 
 namespace deformkit::geom {
 
@@ -17,16 +16,6 @@ struct RasterGrid {
     int32_t width = 0;
     int32_t height = 0;
 };
-
-// Calls visit(x, y, barycentric) for every pixel whose centre lies inside triangle (p0, p1, p2), given in
-// raster coordinates, either winding; barycentric (b0, b1, b2) sums to 1 and reproduces the centre.
-// Pixel centres on an edge follow the top-left rule, so a pixel is visited exactly once by a set of
-// triangles that tile a region without overlap (shared edges are never drawn twice or skipped).
-// Degenerate (zero-area) triangles and pixels outside the grid are skipped. Vertex coordinates are snapped
-// to 1/256 pixel, as GPUs do, which makes the rule exact.
-template <class Visit>
-void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
-                       Visit&& visit);
 
 // Per-pixel result of rasterizeAttributes.
 struct AttributeRaster {
@@ -45,5 +34,3 @@ void rasterizeAttributes(const RasterGrid& grid, std::span<const glm::vec2> posi
                          int32_t channels, AttributeRaster& out);
 
 }  // namespace deformkit::geom
-
-#include "deformkit/geom/rasterizer_impl.h"

@@ -1,6 +1,7 @@
 #pragma once
 
-// Definition of rasterizeTriangle, included at the end of rasterizer.h.
+// The triangle rasteriser under rasterizeAttributes, the UV-warp geometry images, masks and inversion,
+// and previews: a template over the per-pixel visitor, so it stays private to the library.
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/rasterizer.h"
 
 namespace deformkit::geom {
 
@@ -63,6 +65,12 @@ inline int64_t lastCentreAtOrBelow(int64_t v) {
 
 }  // namespace rasterizer_detail
 
+// Calls visit(x, y, barycentric) for every pixel whose centre lies inside triangle (p0, p1, p2), given in
+// raster coordinates, either winding; barycentric (b0, b1, b2) sums to 1 and reproduces the centre.
+// Pixel centres on an edge follow the top-left rule, so a pixel is visited exactly once by a set of
+// triangles that tile a region without overlap (shared edges are never drawn twice or skipped).
+// Degenerate (zero-area) triangles and pixels outside the grid are skipped. Vertex coordinates are snapped
+// to 1/256 pixel, as GPUs do, which makes the rule exact.
 template <class Visit>
 void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
                        Visit&& visit) {
