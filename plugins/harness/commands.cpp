@@ -4,19 +4,19 @@
 #include <iomanip>
 #include <map>
 
+#include "deformkit/error.h"
+#include "deformkit/geom/half_edge.h"
+#include "deformkit/io/atomic_file.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/io/udim.h"
+#include "deformkit/ptex/ptex_mesh.h"
 #include "demo_assets.h"
 #include "demo_ptex.h"
 #include "demo_slide.h"
 #include "demo_uvwarp.h"
 #include "demo_warps.h"
 #include "slide_command.h"
-#include "deformkit/error.h"
-#include "deformkit/io/atomic_file.h"
-#include "deformkit/geom/half_edge.h"
-#include "deformkit/io/image.h"
-#include "deformkit/io/obj.h"
-#include "deformkit/io/udim.h"
-#include "deformkit/ptex/ptex_mesh.h"
 
 namespace deformkit::harness {
 namespace fs = std::filesystem;
@@ -33,27 +33,30 @@ void describeMesh(const fs::path& file, std::ostream& out) {
     const io::ObjContent obj = io::readObj(file);
     const geom::Mesh& m = obj.mesh;
     std::map<int32_t, int32_t> sizes;
-    for (int32_t c : m.faceCounts()) ++sizes[std::min(c, 5)];
+    for (int32_t c : m.faceCounts())
+        ++sizes[std::min(c, 5)];
     const geom::Box3 box = m.bounds();
     const geom::ManifoldReport& r = m.halfEdges().report();
 
     out << "mesh        " << file.string() << "\n";
     out << "vertices    " << m.numVertices() << "\n";
-    out << "faces       " << m.numFaces() << " (triangles " << sizes[3] << ", quads " << sizes[4] << ", n-gons "
-        << sizes[5] << ")\n";
+    out << "faces       " << m.numFaces() << " (triangles " << sizes[3] << ", quads " << sizes[4]
+        << ", n-gons " << sizes[5] << ")\n";
     out << "edges       " << m.halfEdges().numEdges() << "\n";
-    out << std::setprecision(6) << "bounds      (" << box.min.x << ", " << box.min.y << ", " << box.min.z << ") - ("
-        << box.max.x << ", " << box.max.y << ", " << box.max.z << ")\n";
+    out << std::setprecision(6) << "bounds      (" << box.min.x << ", " << box.min.y << ", " << box.min.z
+        << ") - (" << box.max.x << ", " << box.max.y << ", " << box.max.z << ")\n";
     if (m.hasUVs()) {
         out << "uvs         " << m.numUVs() << ", UDIM tiles";
-        for (int t : m.udimTiles()) out << " " << t;
+        for (int t : m.udimTiles())
+            out << " " << t;
         out << "\n";
     } else {
         out << "uvs         none\n";
     }
     if (!obj.groups.empty()) {
         out << "groups      " << obj.groups.size() << ":";
-        for (const auto& g : obj.groups) out << " " << g.name << " (" << g.faces.size() << ")";
+        for (const auto& g : obj.groups)
+            out << " " << g.name << " (" << g.faces.size() << ")";
         out << "\n";
     }
     out << "components  " << r.components << "\n";
@@ -74,25 +77,28 @@ void describeImage(const fs::path& file, std::ostream& out) {
     out << "channels    " << info.channels;
     if (!info.channelNames.empty()) {
         out << " (";
-        for (size_t i = 0; i < info.channelNames.size(); ++i) out << (i ? ", " : "") << info.channelNames[i];
+        for (size_t i = 0; i < info.channelNames.size(); ++i)
+            out << (i ? ", " : "") << info.channelNames[i];
         out << ")";
     }
     out << "\n";
     out << "type        " << info.pixelType << "\n";
     out << "format      " << info.format << "\n";
-    for (const auto& [key, value] : info.attributes) out << "attribute   " << key << " = " << value << "\n";
+    for (const auto& [key, value] : info.attributes)
+        out << "attribute   " << key << " = " << value << "\n";
 }
 
 void describeUdim(const fs::path& pattern, std::ostream& out) {
     const std::vector<io::UdimFile> files = io::findUdimFiles(pattern);
     out << "udim        " << pattern.string() << "\n";
     out << "tiles       " << files.size() << ":";
-    for (const auto& f : files) out << " " << f.tile;
+    for (const auto& f : files)
+        out << " " << f.tile;
     out << "\n";
     for (const auto& f : files) {
         const io::ImageInfo info = io::readImageInfo(f.path);
-        out << "  " << f.tile << "  " << f.path.filename().string() << "  " << info.width << " x " << info.height
-            << ", " << info.channels << " channels, " << info.pixelType << "\n";
+        out << "  " << f.tile << "  " << f.path.filename().string() << "  " << info.width << " x "
+            << info.height << ", " << info.channels << " channels, " << info.pixelType << "\n";
     }
 }
 
@@ -105,7 +111,8 @@ void describe(const fs::path& file, std::ostream& out) {
     }
     std::error_code ec;
     if (!fs::exists(file, ec)) {
-        throw IoError(formatError(file.string(), "", "no such file", "an existing mesh, image or UDIM pattern"));
+        throw IoError(
+            formatError(file.string(), "", "no such file", "an existing mesh, image or UDIM pattern"));
     }
     if (isMeshPath(file)) {
         describeMesh(file, out);
@@ -119,7 +126,8 @@ void preview(const PreviewCommand& command) {
     std::optional<io::PreviewTexture> texture;
     if (command.texture) texture = io::loadPreviewTexture(*command.texture);
     if (command.weights && command.weightsPtex) {
-        throw InvalidInput(formatError("--weights-ptex", "", "is given with --weights", "one weights source"));
+        throw InvalidInput(
+            formatError("--weights-ptex", "", "is given with --weights", "one weights source"));
     }
     io::PreviewOptions options = command.options;
     if (command.weights || command.weightsPtex) {
@@ -173,8 +181,8 @@ std::vector<fs::path> demo(const DemoCommand& command) {
     for (fs::path& f : writeDemoPtex(assets.mesh, command.outDir)) {
         written.push_back(std::move(f));
     }
-    for (fs::path& f : writeDemoUvWarp(assets.mesh, assets.rigidity.at(1001), assets.mask.at(1001), assets.albedo,
-                                       command.outDir)) {
+    for (fs::path& f : writeDemoUvWarp(assets.mesh, assets.rigidity.at(1001), assets.mask.at(1001),
+                                       assets.albedo, command.outDir)) {
         written.push_back(std::move(f));
     }
     return written;

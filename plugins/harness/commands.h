@@ -27,7 +27,7 @@ struct PreviewCommand {
     std::optional<std::filesystem::path> weights;
     std::optional<std::filesystem::path> weightsPtex;
     int32_t weightsChannel = 0;
-    std::filesystem::path out;                     // PNG (or any image format by extension)
+    std::filesystem::path out;  // PNG (or any image format by extension)
     io::PreviewOptions options;
 };
 // `deformkit preview`: renders and writes atomically.

@@ -18,7 +18,9 @@ namespace {
 // Signed distance (tile-local UV units, negative inside) of every feature of a tile, combined by min.
 using Sdf = std::function<float(glm::vec2)>;
 
-float circle(glm::vec2 p, glm::vec2 c, float r) { return glm::length(p - c) - r; }
+float circle(glm::vec2 p, glm::vec2 c, float r) {
+    return glm::length(p - c) - r;
+}
 
 // Distance along u wraps at the tube's seam, so features may straddle it.
 glm::vec2 wrapU(glm::vec2 p, glm::vec2 c) {
@@ -39,10 +41,12 @@ Sdf sideFeatures() {
         state = state * 1664525u + 1013904223u;
         return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
     };
-    for (int i = 0; i < 14; ++i) disks.push_back({{next(), 0.06f + 0.32f * next()}, 0.025f + 0.03f * next()});
+    for (int i = 0; i < 14; ++i)
+        disks.push_back({{next(), 0.06f + 0.32f * next()}, 0.025f + 0.03f * next()});
     return [disks](glm::vec2 p) {
         float d = std::abs(p.y - 0.485f) - 0.035f;  // armour band around the tube
-        for (const Disk& k : disks) d = std::min(d, circle(wrapU(p, k.c), k.c, k.r));
+        for (const Disk& k : disks)
+            d = std::min(d, circle(wrapU(p, k.c), k.c, k.r));
         // Scales: staggered rows of small ellipses in v in [0.62, 0.94].
         if (p.y > 0.6f && p.y < 0.96f) {
             const float rowH = 0.04f, colW = 0.05f;
@@ -69,7 +73,7 @@ Sdf capFeatures() {
         for (const float cx : {0.25f, 0.75f}) {
             const glm::vec2 c(cx, 0.5f);
             d = std::min(d, std::abs(glm::length(p - c) - 0.165f) - 0.018f);  // ring
-            d = std::min(d, circle(p, c, 0.05f));                               // central boss
+            d = std::min(d, circle(p, c, 0.05f));                             // central boss
         }
         return d;
     };
@@ -117,7 +121,8 @@ io::Image chartWarpMask(const geom::Mesh& mesh, int tile, int32_t resolution, in
 
     // Erode the coverage by a square of radius borderTexels (separable min: rows, then columns).
     std::vector<uint8_t> covered(coverage.triangle.size()), rows(coverage.triangle.size());
-    for (size_t i = 0; i < covered.size(); ++i) covered[i] = coverage.triangle[i] >= 0 ? 1 : 0;
+    for (size_t i = 0; i < covered.size(); ++i)
+        covered[i] = coverage.triangle[i] >= 0 ? 1 : 0;
     const int32_t n = resolution, b = borderTexels;
     for (int32_t y = 0; y < n; ++y) {
         for (int32_t x = 0; x < n; ++x) {
@@ -160,7 +165,8 @@ DemoAssets makeDemoAssets(const DemoOptions& options) {
                 // A thin grid makes stretch visible; features take the armour colour.
                 const bool line = (x % cell) == 0 || (y % cell) == 0;
                 const glm::vec3 c = glm::mix(skin, armour, rigidity.at(x, y, 0)) * (line ? 0.7f : 1.0f);
-                for (int k = 0; k < 3; ++k) albedo.at(x, y, k) = c[k];
+                for (int k = 0; k < 3; ++k)
+                    albedo.at(x, y, k) = c[k];
             }
         }
         assets.mask.emplace(tile, chartWarpMask(assets.mesh, tile, n, options.borderTexels));

@@ -29,6 +29,7 @@ struct DemoOptions {
 
 // Warp mask of `tile` for `mesh`'s UV charts: 1 where a UV triangle covers the texel centre and every
 // texel within `borderTexels` (Chebyshev distance) is covered too; 0 elsewhere.
-[[nodiscard]] io::Image chartWarpMask(const geom::Mesh& mesh, int tile, int32_t resolution, int32_t borderTexels);
+[[nodiscard]] io::Image chartWarpMask(const geom::Mesh& mesh, int tile, int32_t resolution,
+                                      int32_t borderTexels);
 
 }  // namespace deformkit::harness

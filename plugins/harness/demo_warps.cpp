@@ -4,8 +4,8 @@
 #include <numbers>
 
 #include "deformkit/error.h"
-#include "deformkit/io/atomic_file.h"
 #include "deformkit/geom/primitives.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/warp/barr.h"
@@ -63,7 +63,8 @@ std::vector<glm::vec3> ffdFramesTwist(const geom::Mesh& tube) {
     warp::FfdFrames ffd(lattice);
     std::vector<warp::Frame> targets(ffd.targetFrames().begin(), ffd.targetFrames().end());
     const float a = 1.2f;
-    const glm::mat3 rot(glm::vec3(std::cos(a), 0, -std::sin(a)), glm::vec3(0, 1, 0), glm::vec3(std::sin(a), 0, std::cos(a)));
+    const glm::mat3 rot(glm::vec3(std::cos(a), 0, -std::sin(a)), glm::vec3(0, 1, 0),
+                        glm::vec3(std::sin(a), 0, std::cos(a)));
     for (int i = 0; i <= 2; ++i) {
         for (int k = 0; k <= 2; ++k) {
             warp::Frame& f = targets[lattice.index(i, 2, k)];
@@ -110,7 +111,8 @@ std::vector<glm::vec3> meshCage(const geom::Mesh& tube) {
     // A coarse tube enclosing the surface; its top ring is scaled and shifted sideways.
     const geom::Mesh cage = geom::makeCappedTube({1.25f, 4.4f, 8, 4, 1});
     std::vector<glm::vec3> rest(cage.points().begin(), cage.points().end());
-    for (auto& p : rest) p.y -= 0.2f;
+    for (auto& p : rest)
+        p.y -= 0.2f;
     const geom::Mesh restCage = withPoints(cage, rest);
     std::vector<glm::vec3> target = rest;
     for (auto& p : target) {
@@ -145,8 +147,8 @@ std::vector<DemoWarp> makeDemoWarps(const geom::Mesh& tube) {
     return out;
 }
 
-std::vector<fs::path> writeDemoWarps(const geom::Mesh& tube, const io::PreviewTexture& texture, const io::Image& image,
-                                     const fs::path& outDir) {
+std::vector<fs::path> writeDemoWarps(const geom::Mesh& tube, const io::PreviewTexture& texture,
+                                     const io::Image& image, const fs::path& outDir) {
     const fs::path dir = outDir / "warps";
     io::createFolder(dir);
     std::vector<fs::path> written;

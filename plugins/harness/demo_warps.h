@@ -11,8 +11,8 @@ namespace deformkit::harness {
 
 // One warp of the demo applied to the demo tube: its name and the deformed mesh.
 struct DemoWarp {
-    std::string name;   // "ffd", "twist", ...
-    geom::Mesh mesh;    // the tube after the warp
+    std::string name;  // "ffd", "twist", ...
+    geom::Mesh mesh;   // the tube after the warp
 };
 
 // Each 3-D warp of the framework (FFD, FFD with frames, taper, twist, bend, Wires, smooth Wires, mesh
@@ -23,6 +23,7 @@ struct DemoWarp {
 // Writes warps/<name>.obj and warps/<name>.png (textured preview) for each demo warp, and
 // warps/beier_neely.png (the Beier-Neely global variant applied to `image`); returns the files written.
 std::vector<std::filesystem::path> writeDemoWarps(const geom::Mesh& tube, const io::PreviewTexture& texture,
-                                                  const io::Image& image, const std::filesystem::path& outDir);
+                                                  const io::Image& image,
+                                                  const std::filesystem::path& outDir);
 
 }  // namespace deformkit::harness

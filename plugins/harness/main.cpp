@@ -56,8 +56,10 @@ int main(int argc, char** argv) {
     preview->add_option("--view", previewView, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
     preview->add_flag("--edges", previewCommand.options.drawEdges, "draw polygon edges");
     std::string previewWeights, previewWeightsPtex;
-    preview->add_option("--weights", previewWeights, "show painted weights (JSON array, one per vertex) as colours");
-    preview->add_option("--weights-ptex", previewWeightsPtex, "show a Ptex map's per-vertex values as colours");
+    preview->add_option("--weights", previewWeights,
+                        "show painted weights (JSON array, one per vertex) as colours");
+    preview->add_option("--weights-ptex", previewWeightsPtex,
+                        "show a Ptex map's per-vertex values as colours");
     preview->add_option("--weights-channel", previewCommand.weightsChannel, "the Ptex map's channel")
         ->capture_default_str();
 
@@ -249,7 +251,8 @@ int main(int argc, char** argv) {
     auto* ptexApp = app.add_subcommand("ptex", "Ptex files: describe, per-vertex values, UDIM conversions");
     ptexApp->require_subcommand(1);
     std::string ptexInfoFile;
-    auto* ptexInfoApp = ptexApp->add_subcommand("info", "Header, faces and resolutions, metadata of a Ptex file");
+    auto* ptexInfoApp =
+        ptexApp->add_subcommand("info", "Header, faces and resolutions, metadata of a Ptex file");
     ptexInfoApp->add_option("FILE", ptexInfoFile, "Ptex file (.ptx)")->required();
     harness::PtexToVertexCommand ptexToVertex;
     std::string ptexToVertexFile, ptexToVertexMesh, ptexToVertexOut;
@@ -271,8 +274,8 @@ int main(int argc, char** argv) {
     ptexToUdimApp->add_option("--tiles", ptexToUdimTiles, "tiles to write (default: every tile of the mesh)");
     harness::PtexFromUdimCommand ptexFromUdim;
     std::string ptexFromUdimMesh, ptexFromUdimOut, ptexFaceRes = "auto", ptexType = "float";
-    auto* ptexFromUdimApp =
-        ptexApp->add_subcommand("from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs");
+    auto* ptexFromUdimApp = ptexApp->add_subcommand(
+        "from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs");
     ptexFromUdimApp->add_option("PATTERN", ptexFromUdim.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'")
         ->required();
     ptexFromUdimApp->add_option("MESH", ptexFromUdimMesh, "mesh (.obj) with UVs")->required();
@@ -283,8 +286,8 @@ int main(int argc, char** argv) {
     harness::PtexFromVertexCommand ptexFromVertex;
     std::string ptexFromVertexWeights, ptexFromVertexMesh, ptexFromVertexOut, ptexVertexFaceRes = "16",
                                                                               ptexVertexType = "float";
-    auto* ptexFromVertexApp =
-        ptexApp->add_subcommand("from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file");
+    auto* ptexFromVertexApp = ptexApp->add_subcommand(
+        "from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file");
     ptexFromVertexApp->add_option("WEIGHTS", ptexFromVertexWeights, "weights file (.json), one per vertex")
         ->required();
     ptexFromVertexApp->add_option("MESH", ptexFromVertexMesh, "mesh (.obj)")->required();

@@ -118,14 +118,14 @@ slide::SlideResult slideCommand(const SlideCommand& command) {
     io::ObjContent obj = io::readObj(command.mesh);
     const size_t count = static_cast<size_t>(obj.mesh.numVertices());
     if (command.weights && command.weightsPtex) {
-        throw InvalidInput(formatError("--weights-ptex", "", "is given with --weights",
-                                       "one source of painted weights"));
+        throw InvalidInput(
+            formatError("--weights-ptex", "", "is given with --weights", "one source of painted weights"));
     }
     const std::vector<float> weights =
-        command.weights       ? readWeights(*command.weights, count)
-        : command.weightsPtex ? ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
-                                                      "--weights-ptex")
-                              : std::vector<float>{};
+        command.weights ? readWeights(*command.weights, count)
+        : command.weightsPtex
+            ? ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel, "--weights-ptex")
+            : std::vector<float>{};
     slide::Slider slider(obj.mesh, {command.handle}, command.options, command.mesh.string());
     const std::vector<slide::SlideDrive> drives = {{command.to - command.from, command.falloff}};
     std::vector<glm::vec3> points(obj.mesh.points().begin(), obj.mesh.points().end());

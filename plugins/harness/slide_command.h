@@ -15,7 +15,8 @@
 // Options:
 // --falloff smooth|linear|v0,v1,... (ramp samples at x = i / (n - 1) of distance / radius), --weights FILE
 // (a JSON array of one number per vertex) or --weights-ptex FILE [--weights-channel C] (a Ptex map painted on
-// the mesh: per-vertex values, docs/ptex.md), --envelope E, --region euclidean|geodesic, --surface cage|limit,
+// the mesh: per-vertex values, docs/ptex.md), --envelope E, --region euclidean|geodesic, --surface
+// cage|limit,
 // --max-walk N. UVs and groups of MESH are kept; only positions change.
 namespace deformkit::harness {
 
@@ -25,9 +26,9 @@ struct SlideCommand {
     slide::SlideHandle handle;      // vertex, radius (scene units), region metric
     glm::dvec3 from{0.0}, to{0.0};  // start and end locators: the displacement is to - from
     slide::Falloff falloff = slide::Falloff::smooth();
-    std::optional<std::filesystem::path> weights;  // JSON array, one number per vertex
+    std::optional<std::filesystem::path> weights;      // JSON array, one number per vertex
     std::optional<std::filesystem::path> weightsPtex;  // or a Ptex map of the mesh (its per-vertex values)
-    int32_t weightsChannel = 0;                         // the Ptex map's channel
+    int32_t weightsChannel = 0;                        // the Ptex map's channel
     float envelope = 1.0f;
     slide::SlideOptions options;
 };

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "deformkit/warp/beier_neely.h"
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/image_warp.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/ffd_frames.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 

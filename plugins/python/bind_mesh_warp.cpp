@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/mesh.h"
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/mesh_warp.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 

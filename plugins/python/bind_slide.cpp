@@ -358,7 +358,8 @@ void bindSlide(py::module_& m) {
         "and the texture travels. points (N, 3) float32; face_counts (F,) int32; face_indices (sum of "
         "counts,)\n"
         "int32; radius in scene units; falloff 'smooth' (1 - 3x^2 + 2x^3), 'linear' or ramp samples at\n"
-        "x = i / (n - 1) of distance / radius; weights (N,) painted, or weights_ptex: a Ptex file painted on the\n"
+        "x = i / (n - 1) of distance / radius; weights (N,) painted, or weights_ptex: a Ptex file painted on "
+        "the\n"
         "mesh (its per-vertex values of weights_channel); envelope scalar; region 'euclidean' or\n"
         "'geodesic'; surface 'cage' or 'limit' (Catmull-Clark). Returns the slid points (N, 3) float32.");
 

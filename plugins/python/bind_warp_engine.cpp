@@ -1,10 +1,10 @@
 // deformkit.warp_engine: the framework's Eq. (3) on dense per-point fields, for studio prototypes.
 #include <pybind11/numpy.h>
 
-#include "numpy_support.h"
 #include "bindings.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/engine.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 
@@ -22,7 +22,8 @@ void requireShape(const FloatArray& a, const char* name, std::initializer_list<p
     }
     if (!ok) {
         std::string got = "(";
-        for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
+        for (py::ssize_t i = 0; i < a.ndim(); ++i)
+            got += (i ? ", " : "") + std::to_string(a.shape(i));
         throw InvalidInput(formatError("warp_engine", name, "has shape " + got + ")", want + ")"));
     }
 }
@@ -47,7 +48,8 @@ void bindWarpEngine(py::module_& m) {
             for (py::ssize_t i = 0; i < k; ++i) {
                 warp::Affine a;
                 for (int r = 0; r < 3; ++r) {
-                    for (int c = 0; c < 3; ++c) a.linear[c][r] = transforms.at(i, r, c);
+                    for (int c = 0; c < 3; ++c)
+                        a.linear[c][r] = transforms.at(i, r, c);
                     a.translation[r] = transforms.at(i, r, 3);
                 }
                 t.affine.push_back(a);

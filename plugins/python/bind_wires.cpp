@@ -10,10 +10,10 @@
 #include <variant>
 #include <vector>
 
-#include "numpy_support.h"
 #include "deformkit/error.h"
 #include "deformkit/warp/curve.h"
 #include "deformkit/warp/wires.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
 

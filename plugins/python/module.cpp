@@ -29,7 +29,8 @@ using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>
 // A numpy view of `count` rows of `cols` values owned by `owner` (kept alive by the array).
 template <class T>
 py::array view(const T* data, size_t count, size_t cols, py::handle owner, bool writeable) {
-    std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(count)}, strides{static_cast<py::ssize_t>(sizeof(T) * cols)};
+    std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(count)},
+        strides{static_cast<py::ssize_t>(sizeof(T) * cols)};
     if (cols > 1) {
         shape.push_back(static_cast<py::ssize_t>(cols));
         strides.push_back(sizeof(T));
@@ -43,8 +44,10 @@ template <class V, int N>
 std::vector<V> rows(const FloatArray& a, const char* name) {
     if (a.ndim() != 2 || a.shape(1) != N) {
         std::string shape = "(";
-        for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
-        throw InvalidInput(formatError("Mesh", name, "has shape " + shape + ")", "(n, " + std::to_string(N) + ")"));
+        for (py::ssize_t i = 0; i < a.ndim(); ++i)
+            shape += (i ? ", " : "") + std::to_string(a.shape(i));
+        throw InvalidInput(
+            formatError("Mesh", name, "has shape " + shape + ")", "(n, " + std::to_string(N) + ")"));
     }
     std::vector<V> out(static_cast<size_t>(a.shape(0)));
     std::memcpy(out.data(), a.data(), out.size() * sizeof(V));
@@ -53,7 +56,8 @@ std::vector<V> rows(const FloatArray& a, const char* name) {
 
 std::vector<int32_t> ints(const IntArray& a, const char* name) {
     if (a.ndim() != 1) {
-        throw InvalidInput(formatError("Mesh", name, "has " + std::to_string(a.ndim()) + " dimensions", "a 1-D int array"));
+        throw InvalidInput(
+            formatError("Mesh", name, "has " + std::to_string(a.ndim()) + " dimensions", "a 1-D int array"));
     }
     return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
 }
@@ -94,7 +98,8 @@ py::array toNumpy(io::Image&& image) {
 
 io::Image fromNumpy(const FloatArray& a) {
     if (a.ndim() != 2 && a.ndim() != 3) {
-        throw InvalidInput(formatError("write_image", "array", "has " + std::to_string(a.ndim()) + " dimensions",
+        throw InvalidInput(formatError("write_image", "array",
+                                       "has " + std::to_string(a.ndim()) + " dimensions",
                                        "(H, W) or (H, W, C)"));
     }
     const int32_t c = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
@@ -115,33 +120,48 @@ PYBIND11_MODULE(deformkit, m) {
     auto invalid = py::register_exception<InvalidInput>(m, "InvalidInput", error.ptr());
     py::register_exception<TopologyError>(m, "TopologyError", invalid.ptr());
 
-    py::class_<geom::Mesh>(m, "Mesh", "A polygon mesh: float32 points, faces as counts + indices, optional face-varying UVs.")
+    py::class_<geom::Mesh>(
+        m, "Mesh", "A polygon mesh: float32 points, faces as counts + indices, optional face-varying UVs.")
         .def(py::init(&makeMesh), py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
              py::arg("uvs") = py::none(), py::arg("uv_indices") = py::none(),
              "points (N, 3) float32; face_counts (F,) int32; face_indices (sum of counts,) int32;\n"
              "uvs (K, 2) float32 and uv_indices (sum of counts,) int32, both or neither.")
-        .def_property_readonly("points", [](py::object self) {
-            auto& mesh = self.cast<geom::Mesh&>();
-            return view(reinterpret_cast<const float*>(mesh.points().data()), mesh.points().size(), 3, self, true);
-        }, "(N, 3) float32 view of the positions; writable, the mesh sees the changes")
-        .def_property_readonly("face_counts", [](py::object self) {
-            const auto& mesh = self.cast<const geom::Mesh&>();
-            return view(mesh.faceCounts().data(), mesh.faceCounts().size(), 1, self, false);
-        })
-        .def_property_readonly("face_indices", [](py::object self) {
-            const auto& mesh = self.cast<const geom::Mesh&>();
-            return view(mesh.faceIndices().data(), mesh.faceIndices().size(), 1, self, false);
-        })
-        .def_property_readonly("uvs", [](py::object self) -> py::object {
-            auto& mesh = self.cast<geom::Mesh&>();
-            if (!mesh.hasUVs()) return py::none();
-            return view(reinterpret_cast<const float*>(mesh.uvs().data()), mesh.uvs().size(), 2, self, true);
-        }, "(K, 2) float32 view of the UVs, or None")
-        .def_property_readonly("uv_indices", [](py::object self) -> py::object {
-            const auto& mesh = self.cast<const geom::Mesh&>();
-            if (!mesh.hasUVs()) return py::none();
-            return view(mesh.uvIndices().data(), mesh.uvIndices().size(), 1, self, false);
-        })
+        .def_property_readonly(
+            "points",
+            [](py::object self) {
+                auto& mesh = self.cast<geom::Mesh&>();
+                return view(reinterpret_cast<const float*>(mesh.points().data()), mesh.points().size(), 3,
+                            self, true);
+            },
+            "(N, 3) float32 view of the positions; writable, the mesh sees the changes")
+        .def_property_readonly("face_counts",
+                               [](py::object self) {
+                                   const auto& mesh = self.cast<const geom::Mesh&>();
+                                   return view(mesh.faceCounts().data(), mesh.faceCounts().size(), 1, self,
+                                               false);
+                               })
+        .def_property_readonly("face_indices",
+                               [](py::object self) {
+                                   const auto& mesh = self.cast<const geom::Mesh&>();
+                                   return view(mesh.faceIndices().data(), mesh.faceIndices().size(), 1, self,
+                                               false);
+                               })
+        .def_property_readonly(
+            "uvs",
+            [](py::object self) -> py::object {
+                auto& mesh = self.cast<geom::Mesh&>();
+                if (!mesh.hasUVs()) return py::none();
+                return view(reinterpret_cast<const float*>(mesh.uvs().data()), mesh.uvs().size(), 2, self,
+                            true);
+            },
+            "(K, 2) float32 view of the UVs, or None")
+        .def_property_readonly("uv_indices",
+                               [](py::object self) -> py::object {
+                                   const auto& mesh = self.cast<const geom::Mesh&>();
+                                   if (!mesh.hasUVs()) return py::none();
+                                   return view(mesh.uvIndices().data(), mesh.uvIndices().size(), 1, self,
+                                               false);
+                               })
         .def_property_readonly("num_vertices", &geom::Mesh::numVertices)
         .def_property_readonly("num_faces", &geom::Mesh::numFaces)
         .def("udim_tiles", &geom::Mesh::udimTiles, "UDIM tiles the UV faces touch")
@@ -151,61 +171,84 @@ PYBIND11_MODULE(deformkit, m) {
                    std::to_string(mesh.numFaces()) + " faces" + (mesh.hasUVs() ? ", uvs>" : ">");
         });
 
-    m.def("read_mesh", [](const std::filesystem::path& path) {
-        py::gil_scoped_release release;
-        return io::readObj(path).mesh;
-    }, py::arg("path"), "Read an OBJ file.");
-    m.def("write_mesh", [](const std::filesystem::path& path, const geom::Mesh& mesh) {
-        py::gil_scoped_release release;
-        io::writeObj(path, mesh);
-    }, py::arg("path"), py::arg("mesh"), "Write an OBJ file atomically.");
-
-    m.def("read_image", [](const std::filesystem::path& path, int32_t channels) {
-        io::Image img;
-        {
+    m.def(
+        "read_mesh",
+        [](const std::filesystem::path& path) {
             py::gil_scoped_release release;
-            img = io::readImage(path, {channels, ""});
-        }
-        return toNumpy(std::move(img));
-    }, py::arg("path"), py::arg("channels") = 0,
-          "Read an image as a (H, W, C) float32 array; channels > 0 requires that count.");
-    m.def("write_image", [](const std::filesystem::path& path, const FloatArray& array, const std::string& type,
-                            const std::map<std::string, std::string>& attributes) {
-        io::ImageWriteOptions options;
-        options.type = pixelType(type);
-        options.attributes.assign(attributes.begin(), attributes.end());
-        io::Image img = fromNumpy(array);
-        py::gil_scoped_release release;
-        io::writeImage(path, img, options);
-    }, py::arg("path"), py::arg("array"), py::arg("type") = "auto",
-          py::arg("attributes") = std::map<std::string, std::string>{},
-          "Write a (H, W) or (H, W, C) float array atomically; type: auto, uint8, uint16, half, float.");
-    m.def("udim_tiles", [](const std::filesystem::path& pattern) {
-        py::dict out;
-        for (const auto& f : io::findUdimFiles(pattern)) out[py::int_(f.tile)] = f.path.string();
-        return out;
-    }, py::arg("pattern"), "Existing tiles of a UDIM pattern as {tile: path}, sorted by tile.");
+            return io::readObj(path).mesh;
+        },
+        py::arg("path"), "Read an OBJ file.");
+    m.def(
+        "write_mesh",
+        [](const std::filesystem::path& path, const geom::Mesh& mesh) {
+            py::gil_scoped_release release;
+            io::writeObj(path, mesh);
+        },
+        py::arg("path"), py::arg("mesh"), "Write an OBJ file atomically.");
+
+    m.def(
+        "read_image",
+        [](const std::filesystem::path& path, int32_t channels) {
+            io::Image img;
+            {
+                py::gil_scoped_release release;
+                img = io::readImage(path, {channels, ""});
+            }
+            return toNumpy(std::move(img));
+        },
+        py::arg("path"), py::arg("channels") = 0,
+        "Read an image as a (H, W, C) float32 array; channels > 0 requires that count.");
+    m.def(
+        "write_image",
+        [](const std::filesystem::path& path, const FloatArray& array, const std::string& type,
+           const std::map<std::string, std::string>& attributes) {
+            io::ImageWriteOptions options;
+            options.type = pixelType(type);
+            options.attributes.assign(attributes.begin(), attributes.end());
+            io::Image img = fromNumpy(array);
+            py::gil_scoped_release release;
+            io::writeImage(path, img, options);
+        },
+        py::arg("path"), py::arg("array"), py::arg("type") = "auto",
+        py::arg("attributes") = std::map<std::string, std::string>{},
+        "Write a (H, W) or (H, W, C) float array atomically; type: auto, uint8, uint16, half, float.");
+    m.def(
+        "udim_tiles",
+        [](const std::filesystem::path& pattern) {
+            py::dict out;
+            for (const auto& f : io::findUdimFiles(pattern))
+                out[py::int_(f.tile)] = f.path.string();
+            return out;
+        },
+        py::arg("pattern"), "Existing tiles of a UDIM pattern as {tile: path}, sorted by tile.");
     m.def("expand_udim", &io::expandUdim, py::arg("pattern"), py::arg("tile"));
 
-    m.def("render_preview", [](const geom::Mesh& mesh, std::optional<std::string> texture, int32_t width,
-                               int32_t height, bool edges) {
-        io::PreviewOptions options;
-        options.width = width;
-        options.height = height;
-        options.drawEdges = edges;
-        io::Image img;
-        {
-            py::gil_scoped_release release;
-            std::optional<io::PreviewTexture> tex;
-            if (texture) tex = io::loadPreviewTexture(*texture);
-            img = io::renderPreview(mesh, options, tex ? &*tex : nullptr);
-        }
-        return toNumpy(std::move(img));
-    }, py::arg("mesh"), py::arg("texture") = py::none(), py::arg("width") = 960, py::arg("height") = 720,
-          py::arg("edges") = false, "Render a shaded preview; returns (H, W, 3) float32.");
+    m.def(
+        "render_preview",
+        [](const geom::Mesh& mesh, std::optional<std::string> texture, int32_t width, int32_t height,
+           bool edges) {
+            io::PreviewOptions options;
+            options.width = width;
+            options.height = height;
+            options.drawEdges = edges;
+            io::Image img;
+            {
+                py::gil_scoped_release release;
+                std::optional<io::PreviewTexture> tex;
+                if (texture) tex = io::loadPreviewTexture(*texture);
+                img = io::renderPreview(mesh, options, tex ? &*tex : nullptr);
+            }
+            return toNumpy(std::move(img));
+        },
+        py::arg("mesh"), py::arg("texture") = py::none(), py::arg("width") = 960, py::arg("height") = 720,
+        py::arg("edges") = false, "Render a shaded preview; returns (H, W, 3) float32.");
 
-    m.def("make_grid", [](int32_t cx, int32_t cy, float sx, float sy) { return geom::makeGrid({cx, cy, sx, sy}); },
-          py::arg("cells_x") = 16, py::arg("cells_y") = 16, py::arg("size_x") = 1.0f, py::arg("size_y") = 1.0f);
+    m.def(
+        "make_grid",
+        [](int32_t cx, int32_t cy, float sx, float sy) {
+            return geom::makeGrid({cx, cy, sx, sy});
+        },
+        py::arg("cells_x") = 16, py::arg("cells_y") = 16, py::arg("size_x") = 1.0f, py::arg("size_y") = 1.0f);
     python::bindWarpEngine(m);
     python::bindFfd(m);
     python::bindBarr(m);
@@ -217,5 +260,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindHost(m);
     python::bindPtex(m);
 
-    m.def("make_capped_tube", [] { return geom::makeCappedTube(); }, "The demo's capped tube (UDIM 1001-1002).");
+    m.def(
+        "make_capped_tube", [] { return geom::makeCappedTube(); },
+        "The demo's capped tube (UDIM 1001-1002).");
 }

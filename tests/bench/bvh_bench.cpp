@@ -16,8 +16,8 @@
 #include "deformkit/geom/bvh.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/geom/rasterizer.h"
-#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
+#include "geom/rasterize_triangle.h"
 
 namespace {
 

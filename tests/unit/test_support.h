@@ -22,7 +22,7 @@ namespace deformkit::test {
 
 // A fresh, empty folder under the system temp folder, removed (with its contents) on destruction.
 class TempDir {
-public:
+  public:
     TempDir() {
         static std::atomic<int> counter{0};
         path_ = std::filesystem::temp_directory_path() /
@@ -41,7 +41,7 @@ public:
     [[nodiscard]] const std::filesystem::path& path() const { return path_; }
     [[nodiscard]] std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
 
-private:
+  private:
     std::filesystem::path path_;
 };
 
@@ -84,7 +84,9 @@ inline bool sameBits(std::span<const float> a, std::span<const float> b) {
 }
 
 // True when the process can bypass file permissions (root): permission tests are skipped then.
-inline bool runningAsRoot() { return ::geteuid() == 0; }
+inline bool runningAsRoot() {
+    return ::geteuid() == 0;
+}
 
 }  // namespace deformkit::test
 

@@ -13,7 +13,8 @@ struct UnionFind {
     std::vector<int32_t> parent;
     explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
     int32_t find(int32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        while (parent[x] != x)
+            x = parent[x] = parent[parent[x]];
         return x;
     }
     void unite(int32_t a, int32_t b) {
@@ -27,11 +28,13 @@ struct UnionFind {
 void bucket(const std::vector<int32_t>& keyOfItem, int32_t numKeys, std::vector<int32_t>& offsets,
             std::vector<int32_t>& items) {
     offsets.assign(numKeys + 1, 0);
-    for (int32_t k : keyOfItem) ++offsets[k + 1];
+    for (int32_t k : keyOfItem)
+        ++offsets[k + 1];
     std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
     items.resize(keyOfItem.size());
     std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (int32_t i = 0; i < static_cast<int32_t>(keyOfItem.size()); ++i) items[fill[keyOfItem[i]]++] = i;
+    for (int32_t i = 0; i < static_cast<int32_t>(keyOfItem.size()); ++i)
+        items[fill[keyOfItem[i]]++] = i;
 }
 
 }  // namespace
@@ -73,7 +76,8 @@ HalfEdgeMesh::HalfEdgeMesh(const Mesh& mesh) {
     for (int32_t i = 0; i < numCorners;) {
         int32_t j = i;
         const uint64_t k = key(order[i]);
-        while (j < numCorners && key(order[j]) == k) ++j;
+        while (j < numCorners && key(order[j]) == k)
+            ++j;
         const int32_t e = static_cast<int32_t>(edgeVertices_.size());
         edgeVertices_.push_back({static_cast<int32_t>(k >> 32), static_cast<int32_t>(k & 0xffffffffu)});
         for (int32_t t = i; t < j; ++t) {
@@ -146,9 +150,11 @@ HalfEdgeMesh::HalfEdgeMesh(const Mesh& mesh) {
     }
 
     UnionFind vertexSets(numVerts);
-    for (int32_t h = 0; h < numCorners; ++h) vertexSets.unite(tail_[h], tail_[next_[h]]);
+    for (int32_t h = 0; h < numCorners; ++h)
+        vertexSets.unite(tail_[h], tail_[next_[h]]);
     for (int32_t v = 0; v < numVerts; ++v) {
-        if (vertexCornerOffsets_[v + 1] > vertexCornerOffsets_[v] && vertexSets.find(v) == v) ++report_.components;
+        if (vertexCornerOffsets_[v + 1] > vertexCornerOffsets_[v] && vertexSets.find(v) == v)
+            ++report_.components;
     }
 }
 
@@ -161,11 +167,11 @@ void requireManifold(const Mesh& mesh, const std::string& source) {
     };
     if (!r.nonManifoldEdges.empty()) {
         const int32_t e = r.nonManifoldEdges.front();
-        throw TopologyError(formatError(
-            source, edgeName(e),
-            "is shared by " + std::to_string(he.edgeHalfEdges(e).size()) + " faces (" +
-                std::to_string(r.nonManifoldEdges.size()) + " non-manifold edges in all)",
-            "a manifold mesh: at most two faces per edge"));
+        throw TopologyError(formatError(source, edgeName(e),
+                                        "is shared by " + std::to_string(he.edgeHalfEdges(e).size()) +
+                                            " faces (" + std::to_string(r.nonManifoldEdges.size()) +
+                                            " non-manifold edges in all)",
+                                        "a manifold mesh: at most two faces per edge"));
     }
     if (!r.inconsistentEdges.empty()) {
         const int32_t e = r.inconsistentEdges.front();

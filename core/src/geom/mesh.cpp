@@ -17,8 +17,12 @@ struct Mesh::TopologyCache {
 
 namespace {
 
-bool finite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
-bool finite(const glm::vec2& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+bool finite(const glm::vec3& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+bool finite(const glm::vec2& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y);
+}
 
 }  // namespace
 
@@ -33,14 +37,14 @@ Mesh::Mesh(Data data, const std::string& source)
       topology_(std::make_shared<TopologyCache>()) {
     for (size_t v = 0; v < points_.size(); ++v) {
         if (!finite(points_[v])) {
-            throw InvalidInput(formatError(source, "vertex " + std::to_string(v), "has a NaN or infinite coordinate",
-                                           "finite coordinates"));
+            throw InvalidInput(formatError(source, "vertex " + std::to_string(v),
+                                           "has a NaN or infinite coordinate", "finite coordinates"));
         }
     }
     for (size_t t = 0; t < uvs_.size(); ++t) {
         if (!finite(uvs_[t])) {
-            throw InvalidInput(formatError(source, "uv " + std::to_string(t), "has a NaN or infinite coordinate",
-                                           "finite texture coordinates"));
+            throw InvalidInput(formatError(source, "uv " + std::to_string(t),
+                                           "has a NaN or infinite coordinate", "finite texture coordinates"));
         }
     }
     faceOffsets_.resize(faceCounts_.size() + 1);
@@ -69,7 +73,8 @@ Mesh::Mesh(Data data, const std::string& source)
         for (size_t k = 0; k < corners.size(); ++k) {
             const int32_t v = corners[k];
             if (v < 0 || v >= nv) {
-                throw InvalidInput(formatError(source, "face " + std::to_string(f) + " corner " + std::to_string(k),
+                throw InvalidInput(formatError(source,
+                                               "face " + std::to_string(f) + " corner " + std::to_string(k),
                                                "vertex index " + std::to_string(v) + " is out of range",
                                                "an index in [0, " + std::to_string(nv) + ")"));
             }
@@ -93,9 +98,10 @@ Mesh::Mesh(Data data, const std::string& source)
         const int32_t nt = numUVs();
         for (size_t c = 0; c < uvIndices_.size(); ++c) {
             if (uvIndices_[c] < 0 || uvIndices_[c] >= nt) {
-                throw InvalidInput(formatError(source, "face corner " + std::to_string(c),
-                                               "uv index " + std::to_string(uvIndices_[c]) + " is out of range",
-                                               "an index in [0, " + std::to_string(nt) + ")"));
+                throw InvalidInput(
+                    formatError(source, "face corner " + std::to_string(c),
+                                "uv index " + std::to_string(uvIndices_[c]) + " is out of range",
+                                "an index in [0, " + std::to_string(nt) + ")"));
             }
         }
     }
@@ -109,8 +115,8 @@ void Mesh::setPoints(std::span<const glm::vec3> points) {
     }
     for (size_t v = 0; v < points.size(); ++v) {
         if (!finite(points[v])) {
-            throw InvalidInput(formatError("mesh", "vertex " + std::to_string(v), "has a NaN or infinite coordinate",
-                                           "finite coordinates"));
+            throw InvalidInput(formatError("mesh", "vertex " + std::to_string(v),
+                                           "has a NaN or infinite coordinate", "finite coordinates"));
         }
     }
     std::copy(points.begin(), points.end(), points_.begin());
@@ -118,7 +124,8 @@ void Mesh::setPoints(std::span<const glm::vec3> points) {
 
 Box3 Mesh::bounds() const {
     Box3 box;
-    for (const auto& p : points_) box.extend(p);
+    for (const auto& p : points_)
+        box.extend(p);
     return box;
 }
 
@@ -130,14 +137,16 @@ std::vector<int> Mesh::udimTiles() const {
     std::set<int> tiles;
     for (int32_t f = 0; f < numFaces() && hasUVs(); ++f) {
         glm::vec2 centroid(0.0f);
-        for (int32_t t : faceUVIndices(f)) centroid += uvs_[t];
+        for (int32_t t : faceUVIndices(f))
+            centroid += uvs_[t];
         tiles.insert(udimTileOf(centroid / static_cast<float>(faceCounts_[f])));
     }
     return {tiles.begin(), tiles.end()};
 }
 
 const HalfEdgeMesh& Mesh::halfEdges() const {
-    std::call_once(topology_->once, [this] { topology_->value = std::make_unique<const HalfEdgeMesh>(*this); });
+    std::call_once(topology_->once,
+                   [this] { topology_->value = std::make_unique<const HalfEdgeMesh>(*this); });
     return *topology_->value;
 }
 

@@ -57,8 +57,8 @@ Mesh makeSphere(const SphereOptions& o) {
         const float polar = std::numbers::pi_v<float> * j / o.rings;
         for (int32_t i = 0; i < s; ++i) {
             const float az = kTwoPi * i / s;
-            d.points.emplace_back(o.radius * std::sin(polar) * std::cos(az), o.radius * std::sin(polar) * std::sin(az),
-                                  o.radius * std::cos(polar));
+            d.points.emplace_back(o.radius * std::sin(polar) * std::cos(az),
+                                  o.radius * std::sin(polar) * std::sin(az), o.radius * std::cos(polar));
         }
     }
     const int32_t south = static_cast<int32_t>(d.points.size());
@@ -67,15 +67,19 @@ Mesh makeSphere(const SphereOptions& o) {
 
     // UVs: s + 1 columns per latitude row (seam), plus one pole UV per segment at each pole.
     for (int32_t j = 1; j < o.rings; ++j) {
-        for (int32_t i = 0; i <= s; ++i) d.uvs.emplace_back(static_cast<float>(i) / s, 1.0f - static_cast<float>(j) / o.rings);
+        for (int32_t i = 0; i <= s; ++i)
+            d.uvs.emplace_back(static_cast<float>(i) / s, 1.0f - static_cast<float>(j) / o.rings);
     }
     const int32_t northUV = static_cast<int32_t>(d.uvs.size());
-    for (int32_t i = 0; i < s; ++i) d.uvs.emplace_back((i + 0.5f) / s, 1.0f);
+    for (int32_t i = 0; i < s; ++i)
+        d.uvs.emplace_back((i + 0.5f) / s, 1.0f);
     const int32_t southUV = static_cast<int32_t>(d.uvs.size());
-    for (int32_t i = 0; i < s; ++i) d.uvs.emplace_back((i + 0.5f) / s, 0.0f);
+    for (int32_t i = 0; i < s; ++i)
+        d.uvs.emplace_back((i + 0.5f) / s, 0.0f);
     auto uv = [&](int32_t j, int32_t i) { return (j - 1) * (s + 1) + i; };
 
-    for (int32_t i = 0; i < s; ++i) addFace(d, {0, vert(1, i), vert(1, i + 1)}, {northUV + i, uv(1, i), uv(1, i + 1)});
+    for (int32_t i = 0; i < s; ++i)
+        addFace(d, {0, vert(1, i), vert(1, i + 1)}, {northUV + i, uv(1, i), uv(1, i + 1)});
     for (int32_t j = 1; j + 1 < o.rings; ++j) {
         for (int32_t i = 0; i < s; ++i) {
             addFace(d, {vert(j, i), vert(j + 1, i), vert(j + 1, i + 1), vert(j, i + 1)},
@@ -104,7 +108,8 @@ Mesh makeCappedTube(const CappedTubeOptions& o) {
             d.points.emplace_back(o.radius * std::cos(a), y, o.radius * std::sin(a));
         }
         // u runs against the angle so the layout is unmirrored seen from outside.
-        for (int32_t i = 0; i <= s; ++i) d.uvs.emplace_back(static_cast<float>(s - i) / s, static_cast<float>(j) / o.rows);
+        for (int32_t i = 0; i <= s; ++i)
+            d.uvs.emplace_back(static_cast<float>(s - i) / s, static_cast<float>(j) / o.rows);
     }
     auto sideVert = [&](int32_t j, int32_t i) { return j * s + (i % s); };
     auto sideUV = [&](int32_t j, int32_t i) { return j * (s + 1) + i; };

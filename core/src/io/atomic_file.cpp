@@ -40,11 +40,13 @@ void writeAtomically(const fs::path& path, const std::function<void(const fs::pa
     const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
     std::error_code ec;
     if (!fs::is_directory(folder, ec)) {
-        throw IoError(formatError(path.string(), "", "cannot write: folder '" + folder.string() + "' does not exist",
+        throw IoError(formatError(path.string(), "",
+                                  "cannot write: folder '" + folder.string() + "' does not exist",
                                   "an existing, writable folder"));
     }
     if (::access(folder.c_str(), W_OK) != 0) {
-        throw IoError(formatError(path.string(), "", "cannot write: folder '" + folder.string() + "' is not writable",
+        throw IoError(formatError(path.string(), "",
+                                  "cannot write: folder '" + folder.string() + "' is not writable",
                                   "a writable folder"));
     }
     if (fs::is_directory(path, ec)) {
@@ -82,13 +84,15 @@ void writeFileAtomically(const fs::path& path, std::string_view bytes) {
     writeAtomically(path, [&](const fs::path& tmp) {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         if (!out) {
-            throw IoError(formatError(path.string(), "", std::string("cannot create file: ") + std::strerror(errno),
+            throw IoError(formatError(path.string(), "",
+                                      std::string("cannot create file: ") + std::strerror(errno),
                                       "a writable folder"));
         }
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         out.flush();
         if (!out) {
-            throw IoError(formatError(path.string(), "", "write failed (disk full?)", "enough space to write"));
+            throw IoError(
+                formatError(path.string(), "", "write failed (disk full?)", "enough space to write"));
         }
     });
 }

@@ -118,7 +118,8 @@ void requireCompletePng(const fs::path& path) {
         const std::string type(bytes.data() + pos + 4, 4);
         if (length > bytes.size() - pos - 12) {
             throw ParseError(formatError(path.string(), "chunk " + type + " at byte " + std::to_string(pos),
-                                         "declares " + std::to_string(length) + " bytes but the file ends after " +
+                                         "declares " + std::to_string(length) +
+                                             " bytes but the file ends after " +
                                              std::to_string(bytes.size() - pos - 12) + " (truncated PNG)",
                                          "a complete PNG"));
         }

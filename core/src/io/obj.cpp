@@ -50,9 +50,8 @@ bool isIgnoredStatement(std::string_view keyword) {
 // else (an upper-case typo, binary bytes from a file that is not an OBJ) is an error.
 bool isExtensionKeyword(std::string_view keyword) {
     if (keyword.empty() || !(keyword[0] >= 'a' && keyword[0] <= 'z')) return false;
-    return std::all_of(keyword.begin(), keyword.end(), [](char c) {
-        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-    });
+    return std::all_of(keyword.begin(), keyword.end(),
+                       [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; });
 }
 
 // A token as shown in messages: at most 40 bytes, anything unprintable as \xNN.

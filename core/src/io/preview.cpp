@@ -10,9 +10,9 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/normals.h"
 #include "deformkit/geom/rasterizer.h"
-#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
 #include "deformkit/io/udim.h"
+#include "geom/rasterize_triangle.h"
 
 namespace deformkit::io {
 namespace {
@@ -32,7 +32,8 @@ glm::vec3 sampleBilinear(const Image& img, float s, float t) {
     auto at = [&](int32_t x, int32_t y) {
         return texel(img, std::clamp(x, 0, img.width - 1), std::clamp(y, 0, img.height - 1));
     };
-    return glm::mix(glm::mix(at(x0, y0), at(x0 + 1, y0), ax), glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), ax), ay);
+    return glm::mix(glm::mix(at(x0, y0), at(x0 + 1, y0), ax),
+                    glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), ax), ay);
 }
 
 std::optional<glm::vec3> sampleTexture(const PreviewTexture& tex, const glm::vec2& uv) {
@@ -48,7 +49,8 @@ std::optional<glm::vec3> sampleTexture(const PreviewTexture& tex, const glm::vec
 PreviewTexture loadPreviewTexture(const std::filesystem::path& pathOrPattern) {
     PreviewTexture tex;
     if (hasUdimToken(pathOrPattern.string())) {
-        for (const UdimFile& f : findUdimFiles(pathOrPattern)) tex.tiles.emplace(f.tile, readImage(f.path));
+        for (const UdimFile& f : findUdimFiles(pathOrPattern))
+            tex.tiles.emplace(f.tile, readImage(f.path));
     } else {
         tex.single = readImage(pathOrPattern);
     }
@@ -57,8 +59,8 @@ PreviewTexture loadPreviewTexture(const std::filesystem::path& pathOrPattern) {
 
 glm::vec3 weightColor(float weight) {
     // Piecewise linear through blue, cyan, green, yellow and red at 0, 1/4, 1/2, 3/4 and 1.
-    static constexpr glm::vec3 stops[5] = {{0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 1.0f}, {0.0f, 1.0f, 0.0f},
-                                           {1.0f, 1.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    static constexpr glm::vec3 stops[5] = {
+        {0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 1.0f}, {0.0f, 1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {1.0f, 0.0f, 0.0f}};
     const float x = std::isnan(weight) ? 0.0f : 4.0f * std::clamp(weight, 0.0f, 1.0f);
     const int i = std::min(static_cast<int>(x), 3);
     return stops[i] + (x - static_cast<float>(i)) * (stops[i + 1] - stops[i]);
@@ -69,7 +71,8 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
         throw InvalidInput(formatError("preview", "mesh", "has no faces", "a mesh with at least one face"));
     }
     if (texture && !mesh.hasUVs()) {
-        throw InvalidInput(formatError("preview", "mesh", "has no UVs but a texture was given", "a mesh with UVs"));
+        throw InvalidInput(
+            formatError("preview", "mesh", "has no UVs but a texture was given", "a mesh with UVs"));
     }
     if (!o.vertexColors.empty() && o.vertexColors.size() != static_cast<size_t>(mesh.numVertices())) {
         throw InvalidInput(formatError("preview", "vertex colours",
@@ -88,11 +91,13 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
     const float radius = std::max(0.5f * glm::length(box.extent()), 1e-6f);
     const glm::vec3 forward =
         glm::length(o.viewDirection) > 0.0f ? glm::normalize(o.viewDirection) : glm::vec3(0.0f, 0.0f, -1.0f);
-    const glm::vec3 worldUp = std::abs(forward.y) > 0.99f ? glm::vec3(0.0f, 0.0f, -1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+    const glm::vec3 worldUp =
+        std::abs(forward.y) > 0.99f ? glm::vec3(0.0f, 0.0f, -1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
     const glm::vec3 right = glm::normalize(glm::cross(forward, worldUp));
     const glm::vec3 up = glm::cross(right, forward);
     const float halfFov = 0.5f * o.fieldOfViewDegrees * std::numbers::pi_v<float> / 180.0f;
-    const float fitHalfAngle = o.width < o.height ? std::atan(std::tan(halfFov) * o.width / o.height) : halfFov;
+    const float fitHalfAngle =
+        o.width < o.height ? std::atan(std::tan(halfFov) * o.width / o.height) : halfFov;
     const float distance = 1.08f * radius / std::sin(fitHalfAngle);
     const glm::vec3 eye = centre - forward * distance;
     const float focal = 0.5f * o.height / std::tan(halfFov);
@@ -136,7 +141,8 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
         const bool edgeReal[3] = {true /* c1-c2 */, c[2] == last /* c2-c0 */, c[1] == first + 1 /* c0-c1 */};
         const glm::vec2 s0 = screen[v0], s1 = screen[v1], s2 = screen[v2];
         const float area2 = std::abs((s1.x - s0.x) * (s2.y - s0.y) - (s2.x - s0.x) * (s1.y - s0.y));
-        const glm::vec3 heights(area2 / std::max(glm::length(s2 - s1), 1e-6f), area2 / std::max(glm::length(s0 - s2), 1e-6f),
+        const glm::vec3 heights(area2 / std::max(glm::length(s2 - s1), 1e-6f),
+                                area2 / std::max(glm::length(s0 - s2), 1e-6f),
                                 area2 / std::max(glm::length(s1 - s0), 1e-6f));
 
         geom::rasterizeTriangle(grid, s0, s1, s2, [&](int32_t x, int32_t y, const glm::vec3& b) {

@@ -111,7 +111,8 @@ AxialSetup fromMayaTwist(const MayaTwist& m) {
     requireFinite(m.highBound, source, "highBound");
     const double sy = glm::length(glm::dvec3(m.handleY));
     if (!(sy > 0.0)) {
-        throw InvalidInput(formatError(source, "handle Y axis", "is a zero vector", "a non-degenerate handle"));
+        throw InvalidInput(
+            formatError(source, "handle Y axis", "is a zero vector", "a non-degenerate handle"));
     }
     if (!(m.lowBound < m.highBound)) {
         throw InvalidInput(formatError(source, "lowBound", "is not below highBound", "lowBound < highBound"));

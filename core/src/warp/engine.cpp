@@ -28,8 +28,8 @@ glm::vec3 applyScaled(const Transformations& t, int32_t i, float s, const glm::v
 
 }  // namespace
 
-void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields, const Transformations& transforms,
-                  std::span<glm::vec3> out, const EngineOptions& options) {
+void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
+                  const Transformations& transforms, std::span<glm::vec3> out, const EngineOptions& options) {
     const size_t n = points.size();
     requireSize("output points", out.size(), n);
     requireSize("field offsets", fields.offsets.size(), n + 1);
@@ -69,8 +69,8 @@ void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
     }
 }
 
-void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, std::span<const float> weights,
-                   float envelope, std::span<glm::vec3> out) {
+void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
+                   std::span<const float> weights, float envelope, std::span<glm::vec3> out) {
     requireSize("deformed points", deformed.size(), in.size());
     requireSize("output points", out.size(), in.size());
     if (!weights.empty()) requireSize("painted weights", weights.size(), in.size());
@@ -85,9 +85,9 @@ void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
     fields_.clear();
     warp_.bind(restPoints, fields_);
     if (fields_.numPoints() != static_cast<int32_t>(restPoints.size())) {
-        throw InvalidInput(formatError("warp", "bind", "produced fields for " + std::to_string(fields_.numPoints()) +
-                                                           " points",
-                                       std::to_string(restPoints.size()) + " points, one entry list per point"));
+        throw InvalidInput(formatError(
+            "warp", "bind", "produced fields for " + std::to_string(fields_.numPoints()) + " points",
+            std::to_string(restPoints.size()) + " points, one entry list per point"));
     }
     deformed_.resize(restPoints.size());
     bound_ = true;
@@ -95,7 +95,8 @@ void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
 
 void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
     if (!bound_) {
-        throw InvalidInput(formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
+        throw InvalidInput(
+            formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
     }
     requireSize("points", points.size(), deformed_.size());
     warp_.transformations(transforms_);

@@ -15,7 +15,8 @@ namespace {
 Eigen::Matrix3d toEigen(const glm::mat3& m) {
     Eigen::Matrix3d e;
     for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) e(r, c) = m[c][r];
+        for (int c = 0; c < 3; ++c)
+            e(r, c) = m[c][r];
     }
     return e;
 }
@@ -23,7 +24,8 @@ Eigen::Matrix3d toEigen(const glm::mat3& m) {
 glm::mat3 toGlm(const Eigen::Matrix3d& e) {
     glm::mat3 m;
     for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) m[c][r] = static_cast<float>(e(r, c));
+        for (int c = 0; c < 3; ++c)
+            m[c][r] = static_cast<float>(e(r, c));
     }
     return m;
 }
@@ -42,8 +44,8 @@ Affine inverse(const Affine& t) {
     const double largest = std::max({a.col(0).norm(), a.col(1).norm(), a.col(2).norm()});
     const double det = a.determinant();
     if (!(std::abs(det) > 1e-12 * largest * largest * largest)) {
-        throw InvalidInput(formatError("transformation", "linear part", "is singular (determinant " +
-                                                                            std::to_string(det) + ")",
+        throw InvalidInput(formatError("transformation", "linear part",
+                                       "is singular (determinant " + std::to_string(det) + ")",
                                        "an invertible transformation"));
     }
     const Eigen::Matrix3d inv = a.inverse();
@@ -97,10 +99,14 @@ Components decompose(const Affine& t, const glm::vec3& pivot) {
     Components c;
     c.pivot = pivot;
     const Eigen::AngleAxisd aa(q);
-    c.rotation = glm::vec3(static_cast<float>(aa.axis().x() * aa.angle()), static_cast<float>(aa.axis().y() * aa.angle()),
+    c.rotation = glm::vec3(static_cast<float>(aa.axis().x() * aa.angle()),
+                           static_cast<float>(aa.axis().y() * aa.angle()),
                            static_cast<float>(aa.axis().z() * aa.angle()));
-    c.scale = glm::vec3(static_cast<float>(u(0, 0)), static_cast<float>(u(1, 1)), static_cast<float>(u(2, 2)));
-    auto ratio = [](double num, double den) { return std::abs(den) > 1e-300 ? static_cast<float>(num / den) : 0.0f; };
+    c.scale =
+        glm::vec3(static_cast<float>(u(0, 0)), static_cast<float>(u(1, 1)), static_cast<float>(u(2, 2)));
+    auto ratio = [](double num, double den) {
+        return std::abs(den) > 1e-300 ? static_cast<float>(num / den) : 0.0f;
+    };
     c.shear = glm::vec3(ratio(u(0, 1), u(0, 0)), ratio(u(0, 2), u(0, 0)), ratio(u(1, 2), u(1, 1)));
     // t<x> = A x + b = translation + pivot + A (x - pivot)  =>  translation = b + A pivot - pivot
     c.translation = t.translation + t.linear * pivot - pivot;

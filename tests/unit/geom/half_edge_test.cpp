@@ -11,7 +11,8 @@ namespace {
 
 Mesh fromFaces(int32_t numVerts, std::vector<std::vector<int32_t>> faces) {
     Mesh::Data d;
-    for (int32_t v = 0; v < numVerts; ++v) d.points.emplace_back(static_cast<float>(v), static_cast<float>(v * v % 7), 0.0f);
+    for (int32_t v = 0; v < numVerts; ++v)
+        d.points.emplace_back(static_cast<float>(v), static_cast<float>(v * v % 7), 0.0f);
     for (const auto& f : faces) {
         d.faceCounts.push_back(static_cast<int32_t>(f.size()));
         d.faceIndices.insert(d.faceIndices.end(), f.begin(), f.end());
@@ -47,7 +48,8 @@ TEST_CASE("grid boundary: edges and vertices on the border", "[geom][half_edge]"
     CHECK(he.numEdges() == 4 * 4 + 5 * 3);
     CHECK(he.report().boundaryEdges == 2 * (4 + 3));
     int32_t boundaryVerts = 0;
-    for (int32_t v = 0; v < grid.numVertices(); ++v) boundaryVerts += he.isBoundaryVertex(v) ? 1 : 0;
+    for (int32_t v = 0; v < grid.numVertices(); ++v)
+        boundaryVerts += he.isBoundaryVertex(v) ? 1 : 0;
     CHECK(boundaryVerts == 2 * (4 + 3));
     CHECK(he.report().isManifold());
     // Interior vertex (1,1) = index 6 has four neighbours: 1, 5, 7, 11.
@@ -60,7 +62,8 @@ TEST_CASE("grid boundary: edges and vertices on the border", "[geom][half_edge]"
     CHECK(he.vertexHalfEdges(6).size() == 4);
 }
 
-TEST_CASE("non-manifold edges, flipped faces and bow-tie vertices are reported", "[geom][half_edge][errors]") {
+TEST_CASE("non-manifold edges, flipped faces and bow-tie vertices are reported",
+          "[geom][half_edge][errors]") {
     SECTION("three faces on one edge") {
         const Mesh m = fromFaces(5, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
         const auto& r = m.halfEdges().report();

@@ -87,7 +87,8 @@ TEST_CASE("mesh rejects bad connectivity and values, naming the element", "[geom
 TEST_CASE("setPoints checks the count and finiteness and keeps connectivity", "[geom][mesh]") {
     Mesh m(quadAndTriangle());
     std::vector<glm::vec3> moved(m.points().begin(), m.points().end());
-    for (auto& p : moved) p += glm::vec3(0, 0, 1);
+    for (auto& p : moved)
+        p += glm::vec3(0, 0, 1);
     m.setPoints(moved);
     CHECK(m.points()[4].z == 1.0f);
     moved.pop_back();

@@ -17,7 +17,8 @@ double signedVolume(const Mesh& m) {
     for (int32_t f = 0; f < m.numFaces(); ++f) {
         const auto c = m.face(f);
         for (size_t k = 1; k + 1 < c.size(); ++k) {
-            vol += glm::dot(glm::dvec3(p[c[0]]), glm::cross(glm::dvec3(p[c[k]]), glm::dvec3(p[c[k + 1]]))) / 6.0;
+            vol +=
+                glm::dot(glm::dvec3(p[c[0]]), glm::cross(glm::dvec3(p[c[k]]), glm::dvec3(p[c[k + 1]]))) / 6.0;
         }
     }
     return vol;
@@ -42,7 +43,8 @@ TEST_CASE("grid: counts, extent and UVs", "[geom][primitives]") {
     CHECK(g.numFaces() == 32);
     CHECK(g.bounds().max.x == Approx(2.0f));
     CHECK(g.udimTiles() == std::vector<int>{1001});
-    for (int32_t f = 0; f < g.numFaces(); ++f) CHECK(uvArea(g, f) > 0.0);
+    for (int32_t f = 0; f < g.numFaces(); ++f)
+        CHECK(uvArea(g, f) > 0.0);
 }
 
 TEST_CASE("sphere volume converges to 4/3 pi r^3 and is outward oriented", "[geom][primitives]") {
@@ -55,7 +57,8 @@ TEST_CASE("sphere volume converges to 4/3 pi r^3 and is outward oriented", "[geo
     CHECK(errFine > 0.0);
     CHECK(errFine / exact < 2e-3);
     CHECK(errFine < errCoarse / 10.0);  // second-order convergence: ~16x for 4x resolution
-    for (int32_t f = 0; f < fine.numFaces(); ++f) REQUIRE(uvArea(fine, f) > 0.0);
+    for (int32_t f = 0; f < fine.numFaces(); ++f)
+        REQUIRE(uvArea(fine, f) > 0.0);
 }
 
 TEST_CASE("capped tube: closed, outward, two UDIM tiles, demo size", "[geom][primitives]") {
@@ -67,5 +70,6 @@ TEST_CASE("capped tube: closed, outward, two UDIM tiles, demo size", "[geom][pri
     // Volume of a cylinder r = 1, h = 4, approximated by a 160-gon prism: n/2 sin(2pi/n) r^2 h.
     const double prism = 80.0 * std::sin(2.0 * std::numbers::pi / 160.0) * 4.0;
     CHECK(signedVolume(tube) == Approx(prism).epsilon(1e-5));
-    for (int32_t f = 0; f < tube.numFaces(); ++f) REQUIRE(uvArea(tube, f) > 0.0);
+    for (int32_t f = 0; f < tube.numFaces(); ++f)
+        REQUIRE(uvArea(tube, f) > 0.0);
 }

@@ -9,8 +9,8 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/geom/rasterizer.h"
-#include "geom/rasterize_triangle.h"
 #include "deformkit/geom/triangulation.h"
+#include "geom/rasterize_triangle.h"
 
 using namespace deformkit::geom;
 

@@ -3,10 +3,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "demo_assets.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/geom/primitives.h"
+#include "demo_assets.h"
 
 using namespace deformkit;
 
@@ -14,7 +14,8 @@ namespace {
 
 double meanOf(const io::Image& img) {
     double sum = 0.0;
-    for (float v : img.pixels) sum += v;
+    for (float v : img.pixels)
+        sum += v;
     return sum / static_cast<double>(img.pixels.size());
 }
 
@@ -32,7 +33,8 @@ TEST_CASE("demo assets: a 22k-vertex tube over two UDIM tiles with a map of each
         CHECK(a.rigidity.at(tile).channels == 1);
         CHECK(a.mask.at(tile).channels == 1);
         CHECK(a.albedo.at(tile).channels == 3);
-        for (float v : a.rigidity.at(tile).pixels) REQUIRE((v >= 0.0f && v <= 1.0f));
+        for (float v : a.rigidity.at(tile).pixels)
+            REQUIRE((v >= 0.0f && v <= 1.0f));
     }
     CHECK_THROWS_AS(harness::makeDemoAssets({8, 2}), InvalidInput);
 }
@@ -42,10 +44,12 @@ TEST_CASE("demo rigidity: rigid band and features on an elastic background", "[h
     const io::Image side = harness::demoRigidity(1001, n);
     // Image row y samples v = 1 - (y + 0.5) / n. The band spans v in [0.45, 0.52]: rigid along a whole row.
     const int32_t bandRow = static_cast<int32_t>((1.0f - 0.485f) * n);
-    for (int32_t x = 0; x < n; ++x) REQUIRE(side.at(x, bandRow, 0) == 1.0f);
+    for (int32_t x = 0; x < n; ++x)
+        REQUIRE(side.at(x, bandRow, 0) == 1.0f);
     // Below the disks (v < 0.05) and away from the band, the skin is fully elastic.
     const int32_t skinRow = n - 5;
-    for (int32_t x = 0; x < n; ++x) REQUIRE(side.at(x, skinRow, 0) == 0.0f);
+    for (int32_t x = 0; x < n; ++x)
+        REQUIRE(side.at(x, skinRow, 0) == 0.0f);
     // Rigid fraction: at least the band (0.07 of the tile), clearly less than half.
     const double rigid = meanOf(side);
     CHECK(rigid > 0.07);
@@ -64,7 +68,8 @@ TEST_CASE("chart warp mask: charts minus a border, zero outside", "[harness][dem
     // The side chart covers all of tile 1001: only the outer border ring is masked out.
     const io::Image side = harness::chartWarpMask(tube, 1001, n, border);
     double ones = 0.0;
-    for (float v : side.pixels) ones += v;
+    for (float v : side.pixels)
+        ones += v;
     CHECK(ones == static_cast<double>((n - 2 * border) * (n - 2 * border)));
     CHECK(side.at(border - 1, n / 2, 0) == 0.0f);
     CHECK(side.at(border, n / 2, 0) == 1.0f);
@@ -75,7 +80,8 @@ TEST_CASE("chart warp mask: charts minus a border, zero outside", "[harness][dem
     const double R = 0.24 * n;
     auto twoDisks = [](double radius) { return 2.0 * std::numbers::pi * radius * radius; };
     double capOnes = 0.0;
-    for (float v : caps.pixels) capOnes += v;
+    for (float v : caps.pixels)
+        capOnes += v;
     CHECK(capOnes > twoDisks(R - border * std::sqrt(2.0) - 1.0));
     CHECK(capOnes < twoDisks(R - border + 1.0));
     CHECK(caps.at(n / 4, n / 2, 0) == 1.0f);  // a cap centre

@@ -5,8 +5,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "demo_warps.h"
 #include "deformkit/geom/primitives.h"
+#include "demo_warps.h"
 
 using namespace deformkit;
 
@@ -36,7 +36,8 @@ TEST_CASE("demo twist: the top ring turns a quarter turn about +y, the bottom st
         const glm::vec3 p = tube.points()[v];
         // theta(y) = (pi/2) y / 4, right-handed about +y: (x, z) -> (x cos + z sin, -x sin + z cos).
         const float t = std::numbers::pi_v<float> / 2 * p.y / 4.0f;
-        const glm::vec3 expected(p.x * std::cos(t) + p.z * std::sin(t), p.y, -p.x * std::sin(t) + p.z * std::cos(t));
+        const glm::vec3 expected(p.x * std::cos(t) + p.z * std::sin(t), p.y,
+                                 -p.x * std::sin(t) + p.z * std::cos(t));
         REQUIRE(glm::length(twist.points()[v] - expected) < 1e-4f);
     }
 }

@@ -91,8 +91,8 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
         f.error(R"({"deformkit_scene": 1, "frames": [1, 5], "objects": [{"name": "tube", "meshes": "a"}]})"),
         Contains("objects[0].meshes: is not a known key"));
     CHECK_THAT(f.error(withEntry(R"({"type": "twirl"})")),
-               Contains("objects[0].stack[0].type: is \"twirl\"") &&
-                   Contains("bend, ") && Contains("twist, wires, uvwarp (last entry)"));
+               Contains("objects[0].stack[0].type: is \"twirl\"") && Contains("bend, ") &&
+                   Contains("twist, wires, uvwarp (last entry)"));
     CHECK_THAT(f.error(withEntry(twist + R"({"endangle": 1}})")),
                Contains(file + ": objects[0].stack[0].params.endangle") && Contains("endAngle"));
     CHECK_THAT(

@@ -539,8 +539,10 @@ TEST_CASE("slide: evaluations from several threads match sequential ones", "[sli
     std::vector<std::thread> threads;
     for (int i = 0; i < 8; ++i)
         threads.emplace_back([&, i] { shared.evaluate(i % 2 ? large : small, outs[i]); });
-    for (auto& t : threads) t.join();
-    for (int i = 0; i < 8; ++i) CHECK(outs[i] == (i % 2 ? expectedLarge : expectedSmall));
+    for (auto& t : threads)
+        t.join();
+    for (int i = 0; i < 8; ++i)
+        CHECK(outs[i] == (i % 2 ? expectedLarge : expectedSmall));
     CHECK(shared.expandedMapEntries() == reference.expandedMapEntries());
     CHECK(shared.expandedMapEntries() > 0);
 }

@@ -25,7 +25,9 @@ glm::vec3 rotateAbout(const glm::vec3& v, const glm::vec3& axisAngle) {
     return v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1.0f - std::cos(a));
 }
 
-bool near(const glm::vec3& a, const glm::vec3& b, float tol) { return glm::length(a - b) <= tol; }
+bool near(const glm::vec3& a, const glm::vec3& b, float tol) {
+    return glm::length(a - b) <= tol;
+}
 
 }  // namespace
 
@@ -65,8 +67,8 @@ TEST_CASE("scalar times transformation: displacement and composition methods", "
     // Displacement method: half of the displacement (1,0,0) -> (0,1,0).
     CHECK(near(scaleByDisplacement(t, 0.5f).apply(p), glm::vec3(0.5f, 0.5f, 0), 1e-6f));
     // Composition method: half the angle, so the point stays on the unit circle.
-    CHECK(near(toAffine(scaleByComposition(c, 0.5f)).apply(p),
-               glm::vec3(std::sqrt(0.5f), std::sqrt(0.5f), 0), 1e-6f));
+    CHECK(near(toAffine(scaleByComposition(c, 0.5f)).apply(p), glm::vec3(std::sqrt(0.5f), std::sqrt(0.5f), 0),
+               1e-6f));
     CHECK(near(toAffine(scaleByComposition(c, 0.0f)).apply(p), p, 0.0f));
     Components s;
     s.scale = {3, 3, 3};
@@ -92,7 +94,8 @@ TEST_CASE("engine: Eq. 3 weighted average of scaled transformations", "[warp][en
     CHECK(out[2] == points[2]);
 
     f.transform[0] = 7;
-    CHECK_THROWS_WITH(evaluateWarp(points, f, t, out), Catch::Contains("field entry 0") && Catch::Contains("[0, 2)"));
+    CHECK_THROWS_WITH(evaluateWarp(points, f, t, out),
+                      Catch::Contains("field entry 0") && Catch::Contains("[0, 2)"));
     std::vector<glm::vec3> wrong(2);
     CHECK_THROWS_AS(evaluateWarp(points, f, t, wrong), InvalidInput);
 }
@@ -116,7 +119,8 @@ TEST_CASE("engine: bit-identical for 1 and 2 threads", "[warp][engine][determini
     std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
     const int n = 20000, k = 16;
     std::vector<glm::vec3> points(n);
-    for (auto& p : points) p = {uni(rng), uni(rng), uni(rng)};
+    for (auto& p : points)
+        p = {uni(rng), uni(rng), uni(rng)};
     Transformations t;
     t.method = ScaleMethod::Composition;
     for (int i = 0; i < k; ++i) {
@@ -129,7 +133,8 @@ TEST_CASE("engine: bit-identical for 1 and 2 threads", "[warp][engine][determini
     }
     SparseFields f;
     for (int u = 0; u < n; ++u) {
-        for (int i = u % 3; i < k; i += 3) f.add(i, 0.5f + 0.5f * uni(rng), 1.0f + uni(rng));
+        for (int i = u % 3; i < k; i += 3)
+            f.add(i, 0.5f + 0.5f * uni(rng), 1.0f + uni(rng));
         f.endPoint();
     }
     std::vector<glm::vec3> one(n), two(n);
@@ -144,7 +149,7 @@ namespace {
 
 // A studio warp: translate everything within `radius` of `centre` by `offset`, fading linearly.
 class PushWarp : public Warp {
-public:
+  public:
     glm::vec3 centre{0.0f}, offset{0.0f};
     float radius = 1.0f;
     void bind(std::span<const glm::vec3> rest, SparseFields& fields) override {
@@ -162,7 +167,8 @@ public:
 
 }  // namespace
 
-TEST_CASE("a custom warp plugs into the deformer: bind once, evaluate with weights and envelope", "[warp][engine]") {
+TEST_CASE("a custom warp plugs into the deformer: bind once, evaluate with weights and envelope",
+          "[warp][engine]") {
     PushWarp push;
     push.offset = {0, 1, 0};
     WarpDeformer deformer(push);

@@ -18,17 +18,18 @@ namespace deformkit::geom {
 // thread-safe. Built once per topology; refit() updates the boxes after the points move (a deformer's
 // evaluation) without rebuilding the tree.
 class Bvh {
-public:
+  public:
     // Triangulates the mesh (fan per face); results report the source face.
     explicit Bvh(const Mesh& mesh);
     // points: #V positions; triangles: #T vertex index triples. Face ids are the triangle indices.
     Bvh(std::span<const glm::vec3> points, std::span<const std::array<int32_t, 3>> triangles);
 
-    // Positions changed, topology did not: recompute boxes bottom-up. Throws InvalidInput on a count mismatch.
+    // Positions changed, topology did not: recompute boxes bottom-up. Throws InvalidInput on a count
+    // mismatch.
     void refit(std::span<const glm::vec3> points);
 
     struct ClosestPoint {
-        glm::vec3 point{0.0f};        // closest point on the surface
+        glm::vec3 point{0.0f};  // closest point on the surface
         float distance = std::numeric_limits<float>::infinity();
         int32_t triangle = -1;        // -1 when nothing lies within maxDistance
         int32_t face = -1;            // source face of the triangle
@@ -38,24 +39,25 @@ public:
                                             float maxDistance = std::numeric_limits<float>::infinity()) const;
 
     struct RayHit {
-        float t = 0.0f;               // origin + t * direction
+        float t = 0.0f;  // origin + t * direction
         glm::vec3 point{0.0f};
         int32_t triangle = -1;
         int32_t face = -1;
         glm::vec3 barycentric{0.0f};
     };
     // Nearest hit with t in [tMin, tMax]; both sides of a triangle hit. `direction` need not be unit length.
-    [[nodiscard]] std::optional<RayHit> intersectRay(const glm::vec3& origin, const glm::vec3& direction,
-                                                     float tMin = 0.0f,
-                                                     float tMax = std::numeric_limits<float>::infinity()) const;
+    [[nodiscard]] std::optional<RayHit> intersectRay(
+        const glm::vec3& origin, const glm::vec3& direction, float tMin = 0.0f,
+        float tMax = std::numeric_limits<float>::infinity()) const;
 
     [[nodiscard]] int32_t numTriangles() const { return static_cast<int32_t>(triangles_.size()); }
     [[nodiscard]] Box3 bounds() const;
 
-private:
+  private:
     struct Node {
         Box3 box;
-        int32_t first = 0;  // leaf: first index into order_; inner: index of the left child (right = left + 1)
+        int32_t first =
+            0;  // leaf: first index into order_; inner: index of the left child (right = left + 1)
         int32_t count = 0;  // leaf: triangle count; inner: 0
     };
     void build();

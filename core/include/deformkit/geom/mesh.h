@@ -22,13 +22,13 @@ class HalfEdgeMesh;
 // (a deformer writes them), which is why the half-edge structure, built on demand and cached, depends
 // on connectivity alone and is shared by copies of the mesh.
 class Mesh {
-public:
+  public:
     struct Data {
-        std::vector<glm::vec3> points;       // #V positions, scene units
-        std::vector<int32_t> faceCounts;     // #F vertex counts, each >= 3
-        std::vector<int32_t> faceIndices;    // sum(faceCounts) vertex indices in [0, #V), face by face
-        std::vector<glm::vec2> uvs;          // #UV texture coordinates (UDIM: tile 1001 + floor(u) + 10 floor(v))
-        std::vector<int32_t> uvIndices;      // empty, or one index into uvs per face corner
+        std::vector<glm::vec3> points;     // #V positions, scene units
+        std::vector<int32_t> faceCounts;   // #F vertex counts, each >= 3
+        std::vector<int32_t> faceIndices;  // sum(faceCounts) vertex indices in [0, #V), face by face
+        std::vector<glm::vec2> uvs;      // #UV texture coordinates (UDIM: tile 1001 + floor(u) + 10 floor(v))
+        std::vector<int32_t> uvIndices;  // empty, or one index into uvs per face corner
     };
 
     Mesh();
@@ -72,7 +72,7 @@ public:
     // The half-edge connectivity, built on first use and cached (thread-safe).
     [[nodiscard]] const HalfEdgeMesh& halfEdges() const;
 
-private:
+  private:
     struct TopologyCache;
 
     std::vector<glm::vec3> points_;

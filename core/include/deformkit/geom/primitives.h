@@ -8,10 +8,10 @@ namespace deformkit::geom {
 // consistently oriented (outward normals for closed shapes, +z for the grid).
 
 struct GridOptions {
-    int32_t cellsX = 16;   // quads along x
-    int32_t cellsY = 16;   // quads along y
-    float sizeX = 1.0f;    // extent along x, scene units, starting at the origin
-    float sizeY = 1.0f;    // extent along y
+    int32_t cellsX = 16;  // quads along x
+    int32_t cellsY = 16;  // quads along y
+    float sizeX = 1.0f;   // extent along x, scene units, starting at the origin
+    float sizeY = 1.0f;   // extent along y
 };
 // A planar grid of quads in z = 0 over [0, sizeX] x [0, sizeY]; uv = (x / sizeX, y / sizeY), tile 1001.
 [[nodiscard]] Mesh makeGrid(const GridOptions& options = {});
@@ -26,10 +26,10 @@ struct SphereOptions {
 
 struct CappedTubeOptions {
     float radius = 1.0f;
-    float length = 4.0f;      // along y, from y = 0
-    int32_t segments = 160;   // around the axis
-    int32_t rows = 120;       // quads along the axis
-    int32_t capRings = 10;    // concentric rings per cap; the innermost is a triangle fan
+    float length = 4.0f;     // along y, from y = 0
+    int32_t segments = 160;  // around the axis
+    int32_t rows = 120;      // quads along the axis
+    int32_t capRings = 10;   // concentric rings per cap; the innermost is a triangle fan
 };
 // A closed tube (the demo asset): the side's UVs fill UDIM tile 1001 with a seam along one side
 // (u = 1 - angle / 2pi, v = y / length); both caps are laid out side by side in tile 1002.

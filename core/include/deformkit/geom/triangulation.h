@@ -22,6 +22,7 @@ struct Triangulation {
 [[nodiscard]] Triangulation triangulate(const Mesh& mesh);
 
 // The vertex indices of a triangulation's triangles: #T triples into Mesh::points().
-[[nodiscard]] std::vector<std::array<int32_t, 3>> triangleVertices(const Mesh& mesh, const Triangulation& tris);
+[[nodiscard]] std::vector<std::array<int32_t, 3>> triangleVertices(const Mesh& mesh,
+                                                                   const Triangulation& tris);
 
 }  // namespace deformkit::geom

@@ -36,8 +36,8 @@ struct ObjWriteOptions {
 };
 
 // Writes atomically (temporary file + rename). Groups are written as `g` statements.
-void writeObj(const std::filesystem::path& path, const geom::Mesh& mesh, const std::vector<FaceGroup>& groups = {},
-              const ObjWriteOptions& options = {});
+void writeObj(const std::filesystem::path& path, const geom::Mesh& mesh,
+              const std::vector<FaceGroup>& groups = {}, const ObjWriteOptions& options = {});
 [[nodiscard]] std::string formatObj(const geom::Mesh& mesh, const std::vector<FaceGroup>& groups = {},
                                     const ObjWriteOptions& options = {});
 

@@ -12,7 +12,7 @@ namespace deformkit::io {
 // printf style `name.%04d.obj`. Every frame must have the topology of the first one read (same face
 // counts and indices): a deformer sequence changes positions only.
 class ObjSequence {
-public:
+  public:
     // Throws InvalidInput if `pattern` has no frame token.
     explicit ObjSequence(std::filesystem::path pattern);
 
@@ -28,7 +28,7 @@ public:
     // True when `pattern` has a frame token (#... or %0Nd).
     [[nodiscard]] static bool isPattern(const std::string& pattern);
 
-private:
+  private:
     std::filesystem::path pattern_;
     std::string prefix_, suffix_;  // file name around the token
     int padding_ = 0;

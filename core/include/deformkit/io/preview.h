@@ -23,7 +23,7 @@ struct PreviewTexture {
 [[nodiscard]] PreviewTexture loadPreviewTexture(const std::filesystem::path& pathOrPattern);
 
 struct PreviewOptions {
-    int32_t width = 960;   // pixels
+    int32_t width = 960;  // pixels
     int32_t height = 720;
     // Direction the camera looks along (scene units, need not be unit length); y is up. Auto-framing:
     // the camera aims at the bounding box centre from the distance at which the box's circumscribed

@@ -60,14 +60,15 @@ struct EngineOptions {
 // weights are all zero is left where it is. points and out: #points positions (they may alias).
 // Deterministic for any thread count (OpenMP over points, no reductions across points). Throws
 // InvalidInput if sizes disagree or a field names a transformation that does not exist.
-void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields, const Transformations& transforms,
-                  std::span<glm::vec3> out, const EngineOptions& options = {});
+void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
+                  const Transformations& transforms, std::span<glm::vec3> out,
+                  const EngineOptions& options = {});
 
 // A warp's construction function (paper §3.5): turns the user's parameters into discrete
 // transformations, strength fields and weighting fields. A studio adds a warp by implementing this
 // interface alone (docs/warps/custom_warp.md).
 class Warp {
-public:
+  public:
     virtual ~Warp() = default;
     // Fields on the rest model, computed once per rest shape; may also cache per-point data the
     // warp's transformations depend on (a point's coordinate along an axis, say).
@@ -80,7 +81,7 @@ public:
 // Maya's deformer model over any Warp: bind once, evaluate many times. Painted weights (#points, or
 // empty for 1) and the envelope scale each point's displacement: P + envelope * weight * (D<P> - P).
 class WarpDeformer {
-public:
+  public:
     explicit WarpDeformer(Warp& warp) : warp_(warp) {}
 
     void bind(std::span<const glm::vec3> restPoints);
@@ -90,7 +91,7 @@ public:
     // points: the bound rest points (or the current upstream points of the same count), deformed in place.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
 
-private:
+  private:
     Warp& warp_;
     SparseFields fields_;
     Transformations transforms_;
@@ -99,7 +100,7 @@ private:
 };
 
 // Final blend of a deformer stage: out = in + envelope * weight[u] * (deformed - in). weights empty = all 1.
-void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, std::span<const float> weights,
-                   float envelope, std::span<glm::vec3> out);
+void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
+                   std::span<const float> weights, float envelope, std::span<glm::vec3> out);
 
 }  // namespace deformkit::warp

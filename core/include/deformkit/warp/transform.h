@@ -13,7 +13,9 @@ struct Affine {
 
     [[nodiscard]] glm::vec3 apply(const glm::vec3& p) const { return linear * p + translation; }
     // Composition: (a * b)<P> = a<b<P>>.
-    [[nodiscard]] Affine operator*(const Affine& b) const { return {linear * b.linear, linear * b.translation + translation}; }
+    [[nodiscard]] Affine operator*(const Affine& b) const {
+        return {linear * b.linear, linear * b.translation + translation};
+    }
 
     [[nodiscard]] static Affine identity() { return {}; }
     [[nodiscard]] static Affine translate(const glm::vec3& t) { return {glm::mat3(1.0f), t}; }
