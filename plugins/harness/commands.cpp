@@ -188,10 +188,10 @@ std::vector<fs::path> demo(const DemoCommand& command) {
     return written;
 }
 
-host::Scene readScene(const fs::path& path) {
-    host::SceneReadOptions options;
+scene::Scene readScene(const fs::path& path) {
+    scene::SceneReadOptions options;
     options.ptexWeights = ptex::weightsFromPtex;
-    return host::readScene(path, options);
+    return scene::readScene(path, options);
 }
 
 }  // namespace deformkit::harness

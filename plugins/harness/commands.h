@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/io/preview.h"
 
 // The deformkit CLI's subcommands as plain functions, so tests call them in-process. Each throws
@@ -17,7 +17,7 @@ namespace deformkit::harness {
 void describe(const std::filesystem::path& file, std::ostream& out);
 
 // Reads a scene the way every command does: all weight sources, Ptex files included.
-[[nodiscard]] host::Scene readScene(const std::filesystem::path& path);
+[[nodiscard]] scene::Scene readScene(const std::filesystem::path& path);
 
 struct PreviewCommand {
     std::filesystem::path mesh;

@@ -15,8 +15,8 @@
 #include <unistd.h>
 
 #include "deformkit/error.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -201,8 +201,8 @@ ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32
 }
 
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
-    host::SceneEvaluator evaluator(readScene(command.scene));
-    const host::Scene& scene = evaluator.scene();
+    scene::SceneEvaluator evaluator(readScene(command.scene));
+    const scene::Scene& scene = evaluator.scene();
     EvalReport report;
     if (command.frames.empty()) {
         for (int f = scene.firstFrame; f <= scene.lastFrame; ++f)
@@ -234,7 +234,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
             for (int32_t c = 0; c < 3; ++c)
                 blank.pixels[3 * i + c] = static_cast<float>(toByte(view.background[c])) / 255.0f;
         }
-        for (const host::SceneObject& object : scene.objects) {
+        for (const scene::SceneObject& object : scene.objects) {
             restBounds.push_back(object.rest.bounds());
             sheets.push_back(blank);
         }
@@ -265,7 +265,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     }
     // The UV-warp stages, object by object and tile by tile (one tile's solver in memory at a time).
     for (size_t o = 0; o < numObjects; ++o) {
-        const host::SceneObject& object = scene.objects[o];
+        const scene::SceneObject& object = scene.objects[o];
         if (!object.uvwarp || report.frames.empty()) continue;
         SceneUvWarpRun run;
         run.frames = report.frames;

@@ -21,7 +21,7 @@
 //                              tile, each tile's frames solved in order, warm-started
 //
 // Every file is written atomically; DIR is created when missing. Frames are evaluated in ascending order
-// through one host::SceneEvaluator, so each deformer binds once and animated parameters only change its
+// through one scene::SceneEvaluator, so each deformer binds once and animated parameters only change its
 // controls.
 namespace deformkit::harness {
 

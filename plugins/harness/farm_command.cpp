@@ -20,8 +20,8 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
 #include "eval_command.h"
@@ -45,11 +45,11 @@ fs::path absolutePath(const fs::path& path) {
 // The outputs of a task of `scene`: without tiles the meshes of frames first..last, frame by frame,
 // objects in scene order; with tiles the UV-warp outputs, frame by frame, objects in scene order, tiles
 // ascending (uvwarpOutputs).
-std::vector<std::string> taskOutputs(const host::Scene& scene, int first, int last,
+std::vector<std::string> taskOutputs(const scene::Scene& scene, int first, int last,
                                      const std::vector<int>& tiles) {
     std::vector<std::string> outputs;
     for (int f = first; f <= last; ++f) {
-        for (const host::SceneObject& object : scene.objects) {
+        for (const scene::SceneObject& object : scene.objects) {
             if (tiles.empty()) {
                 outputs.push_back(evalFileName(object.name, f));
                 continue;
@@ -64,9 +64,9 @@ std::vector<std::string> taskOutputs(const host::Scene& scene, int first, int la
 }
 
 // Every tile some object's UV-warp stage warps, ascending.
-std::vector<int> warpedTiles(const host::Scene& scene) {
+std::vector<int> warpedTiles(const scene::Scene& scene) {
     std::vector<int> tiles;
-    for (const host::SceneObject& object : scene.objects) {
+    for (const scene::SceneObject& object : scene.objects) {
         if (!object.uvwarp) continue;
         for (int tile : uvwarpWarpedTiles(*object.uvwarp))
             tiles.push_back(tile);
@@ -299,7 +299,7 @@ FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
                                        "a whole number of UDIM tiles per task >= 1"));
     }
     if (command.outDir.empty()) throw InvalidInput(formatError("--out", "", "is empty", "an output folder"));
-    const host::Scene scene = readScene(command.scene);
+    const scene::Scene scene = readScene(command.scene);
     std::vector<int> frames = command.frames;
     if (frames.empty()) {
         for (int f = scene.firstFrame; f <= scene.lastFrame; ++f)
@@ -408,8 +408,8 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
                                        "'" + plan.scene.string() + "' does not exist",
                                        "the scene the plan was made from"));
     }
-    host::SceneEvaluator evaluator(readScene(plan.scene));
-    const host::Scene& scene = evaluator.scene();
+    scene::SceneEvaluator evaluator(readScene(plan.scene));
+    const scene::Scene& scene = evaluator.scene();
     const std::vector<std::string> expected = taskOutputs(scene, task.firstFrame, task.lastFrame, task.tiles);
     if (expected != task.outputs) {
         size_t i = 0;

@@ -324,7 +324,7 @@ int main(int argc, char** argv) {
             warpCommand.variant =
                 warpVariant == "global" ? warp::BeierNeelyVariant::Global : warp::BeierNeelyVariant::Original;
             warpCommand.interpolation =
-                warpInterp == "bicubic" ? warp::Interpolation::Bicubic : warp::Interpolation::Bilinear;
+                warpInterp == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
             harness::warpImageCommand(warpCommand);
             std::cout << "wrote " << warpOut << "\n";
         } else if (*slideApp) {
@@ -354,7 +354,7 @@ int main(int argc, char** argv) {
             if (!uvTiles.empty()) uvwarpCommand.tiles = harness::parseTiles(uvTiles);
             if (!uvLog.empty()) uvwarpCommand.log = uvLog;
             uvwarpCommand.filter =
-                uvFilter == "bicubic" ? warp::Interpolation::Bicubic : warp::Interpolation::Bilinear;
+                uvFilter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
             // The progress bar redraws one line in place: only for a person watching a terminal.
             const harness::UvWarpReport report =
                 harness::uvwarpCommand(uvwarpCommand, ::isatty(STDERR_FILENO) ? &std::cerr : nullptr);

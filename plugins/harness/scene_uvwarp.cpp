@@ -28,12 +28,12 @@ std::string uvwarpRedirectName(const std::string& object, int tile, int frame) {
     return evalFileName(object + ".redirect." + std::to_string(tile), frame, ".exr");
 }
 
-std::string uvwarpBakeName(const host::SceneObject& object, int tile, int frame) {
+std::string uvwarpBakeName(const scene::SceneObject& object, int tile, int frame) {
     return evalFileName(object.name + ".bake." + std::to_string(tile), frame,
                         object.uvwarp->texture->extension().string());
 }
 
-std::vector<int> uvwarpWarpedTiles(const host::SceneUvWarp& stage) {
+std::vector<int> uvwarpWarpedTiles(const scene::SceneUvWarp& stage) {
     std::vector<int> tiles;
     for (int tile : stage.tiles) {
         if (fileExists(tileFile(stage.rigidity, tile))) tiles.push_back(tile);
@@ -41,9 +41,9 @@ std::vector<int> uvwarpWarpedTiles(const host::SceneUvWarp& stage) {
     return tiles;
 }
 
-std::vector<std::string> uvwarpOutputs(const host::SceneObject& object, int tile, int frame) {
+std::vector<std::string> uvwarpOutputs(const scene::SceneObject& object, int tile, int frame) {
     if (!object.uvwarp) return {};
-    const host::SceneUvWarp& stage = *object.uvwarp;
+    const scene::SceneUvWarp& stage = *object.uvwarp;
     if (!std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile) ||
         !fileExists(tileFile(stage.rigidity, tile)))
         return {};
@@ -53,14 +53,14 @@ std::vector<std::string> uvwarpOutputs(const host::SceneObject& object, int tile
     return outputs;
 }
 
-UvWarpReport runSceneUvWarp(host::SceneEvaluator& evaluator, size_t object, const SceneUvWarpRun& run) {
-    const host::Scene& scene = evaluator.scene();
-    const host::SceneObject& o = scene.objects.at(object);
+UvWarpReport runSceneUvWarp(scene::SceneEvaluator& evaluator, size_t object, const SceneUvWarpRun& run) {
+    const scene::Scene& scene = evaluator.scene();
+    const scene::SceneObject& o = scene.objects.at(object);
     if (!o.uvwarp) {
         throw InvalidInput(formatError(scene.source, o.path + ".stack", "has no UV-warp stage",
                                        "a stack whose last entry has type \"uvwarp\""));
     }
-    const host::SceneUvWarp& stage = *o.uvwarp;
+    const scene::SceneUvWarp& stage = *o.uvwarp;
     UvWarpJob job;
     job.rest = &o.rest;
     job.restName = o.meshFile.string();

@@ -14,7 +14,7 @@
 
 #include "deformkit/geom/mesh.h"
 #include "deformkit/uvwarp/tile_warp.h"
-#include "deformkit/warp/image_warp.h"
+#include "deformkit/io/sampling.h"
 
 // `deformkit uvwarp`: the content-aware UV warp (Koniaris et al.) over a shot, for every UDIM tile:
 //
@@ -61,7 +61,7 @@ struct UvWarpCommand {
     std::vector<int> tiles;                            // empty: every tile the rest mesh's UVs touch
     int32_t resolution = 0;                            // grid cells per side, a power of two; 0: map size
     uvwarp::TileWarpOptions options;                   // solver, derived mask, dilation (cells: resolution)
-    warp::Interpolation filter = warp::Interpolation::Bilinear;  // bake filter
+    io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;                    // JSON lines, appended: one per tile x frame
 };
 
@@ -104,7 +104,7 @@ struct UvWarpJob {
     // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
     std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
     uvwarp::TileWarpOptions options;  // cells: grid resolution (0: the rigidity map's size)
-    warp::Interpolation filter = warp::Interpolation::Bilinear;
+    io::SampleFilter filter = io::SampleFilter::Bilinear;
     // Existing outputs are kept and the warm start replayed (a resumed run writes an uninterrupted run's
     // bytes); false writes every output again.
     bool skipExisting = true;

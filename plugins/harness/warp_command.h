@@ -21,7 +21,7 @@ struct WarpImageCommand {
     std::filesystem::path lines;  // segment pairs, JSON as above
     std::filesystem::path out;    // written atomically, same size and channels as image
     warp::BeierNeelyVariant variant = warp::BeierNeelyVariant::Original;
-    warp::Interpolation interpolation = warp::Interpolation::Bilinear;
+    io::SampleFilter interpolation = io::SampleFilter::Bilinear;
 };
 
 // Reads IMAGE and the lines file, warps, writes OUT atomically. Throws IoError / ParseError / InvalidInput

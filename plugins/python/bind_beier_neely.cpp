@@ -25,7 +25,7 @@ namespace deformkit::python {
 namespace {
 
 using warp::BeierNeelyVariant;
-using warp::Interpolation;
+using io::SampleFilter;
 using warp::SegmentPair;
 
 constexpr const char* kSource = "beier_neely";
@@ -47,9 +47,9 @@ BeierNeelyVariant variantOf(const std::string& v) {
     throw InvalidInput(formatError(kSource, "variant", "is '" + v + "'", "'original' or 'global'"));
 }
 
-Interpolation interpOf(const std::string& v) {
-    if (v == "bilinear") return Interpolation::Bilinear;
-    if (v == "bicubic") return Interpolation::Bicubic;
+io::SampleFilter interpOf(const std::string& v) {
+    if (v == "bilinear") return io::SampleFilter::Bilinear;
+    if (v == "bicubic") return io::SampleFilter::Bicubic;
     throw InvalidInput(formatError(kSource, "interp", "is '" + v + "'", "'bilinear' or 'bicubic'"));
 }
 
@@ -124,7 +124,7 @@ class PyBeierNeely {
 
     py::array warpImage(const FloatArray& image, const std::string& interp) const {
         io::Image src = imageOf(image);
-        const Interpolation interpolation = interpOf(interp);
+        const io::SampleFilter interpolation = interpOf(interp);
         io::Image out;
         {
             py::gil_scoped_release release;

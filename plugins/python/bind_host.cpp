@@ -24,8 +24,8 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "numpy_support.h"
@@ -36,15 +36,15 @@ namespace deformkit::python {
 namespace {
 
 // Scenes read from Python take every weight source, Ptex files included (as the CLI does).
-host::Scene readSceneFile(const std::filesystem::path& path) {
-    host::SceneReadOptions options;
+scene::Scene readSceneFile(const std::filesystem::path& path) {
+    scene::SceneReadOptions options;
     options.ptexWeights = ptex::weightsFromPtex;
-    return host::readScene(path, options);
+    return scene::readScene(path, options);
 }
 
 using host::DeformerStack;
-using host::Scene;
-using host::SceneEvaluator;
+using scene::Scene;
+using scene::SceneEvaluator;
 
 struct PyStack {
     DeformerStack stack;
@@ -144,7 +144,7 @@ py::list parameterList(const std::vector<host::ParamInfo>& infos) {
     return out;
 }
 
-const host::SceneObject& sceneObject(const Scene& scene, size_t object) {
+const scene::SceneObject& sceneObject(const Scene& scene, size_t object) {
     if (object >= scene.objects.size()) {
         throw InvalidInput(formatError(scene.source, "object " + std::to_string(object), "does not exist",
                                        "an index below " + std::to_string(scene.objects.size())));
@@ -154,14 +154,14 @@ const host::SceneObject& sceneObject(const Scene& scene, size_t object) {
 
 std::vector<std::string> objectNames(const Scene& scene) {
     std::vector<std::string> names;
-    for (const host::SceneObject& o : scene.objects)
+    for (const scene::SceneObject& o : scene.objects)
         names.push_back(o.name);
     return names;
 }
 
-py::list entryList(const host::SceneObject& object) {
+py::list entryList(const scene::SceneObject& object) {
     py::list out;
-    for (const host::SceneDeformer& d : object.stack) {
+    for (const scene::SceneDeformer& d : object.stack) {
         py::dict e;
         e["type"] = d.type;
         e["label"] = d.label;

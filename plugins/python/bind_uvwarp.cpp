@@ -183,9 +183,9 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
 uvwarp::BakeOptions bakeOptionsOf(const std::string& filter, const std::string& source) {
     uvwarp::BakeOptions o;
     if (filter == "bilinear") {
-        o.filter = warp::Interpolation::Bilinear;
+        o.filter = io::SampleFilter::Bilinear;
     } else if (filter == "bicubic") {
-        o.filter = warp::Interpolation::Bicubic;
+        o.filter = io::SampleFilter::Bicubic;
     } else {
         throw InvalidInput(formatError(source, "filter", "is '" + filter + "'", "'bilinear' or 'bicubic'"));
     }

@@ -14,7 +14,7 @@
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/ptex/half.h"
-#include "deformkit/warp/image_warp.h"
+#include "deformkit/io/sampling.h"
 
 namespace deformkit::ptex {
 
@@ -718,7 +718,7 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
                     ptexUV(ptexMesh, mesh, p, (i + 0.5) / info.ures(), (j + 0.5) / info.vres(), weights);
                 const glm::vec2 pixel(static_cast<float>((uv.x - origin.u) * image.width),
                                       static_cast<float>((1.0 - (uv.y - origin.v)) * image.height));
-                warp::sampleImage(image, pixel, warp::Interpolation::Bilinear, value);
+                io::sampleImage(image, pixel, io::SampleFilter::Bilinear, value);
                 for (int32_t c = 0; c < channels; ++c) {
                     const size_t at = ((static_cast<size_t>(j) * info.ures() + i) * channels + c) * bytes;
                     storeValue(value[c], options.dataType, texels.data() + at);

@@ -73,7 +73,7 @@ void BM_BeierNeelyMapPowB1024(benchmark::State& s) {
     mapBench(s, BeierNeelyVariant::Original, false, 1.5f, 1024);
 }
 
-void resampleBench(benchmark::State& state, Interpolation interpolation, bool oneThread) {
+void resampleBench(benchmark::State& state, io::SampleFilter interpolation, bool oneThread) {
     const BeierNeelyWarp warp(segments(kSize), {});
     std::vector<glm::vec2> map(static_cast<size_t>(kSize) * kSize);
     warp.mapPixelCentres(kSize, kSize, map);
@@ -91,13 +91,13 @@ void resampleBench(benchmark::State& state, Interpolation interpolation, bool on
 }
 
 void BM_ResampleBilinear(benchmark::State& s) {
-    resampleBench(s, Interpolation::Bilinear, false);
+    resampleBench(s, io::SampleFilter::Bilinear, false);
 }
 void BM_ResampleBicubic(benchmark::State& s) {
-    resampleBench(s, Interpolation::Bicubic, false);
+    resampleBench(s, io::SampleFilter::Bicubic, false);
 }
 void BM_ResampleBicubic_1Thread(benchmark::State& s) {
-    resampleBench(s, Interpolation::Bicubic, true);
+    resampleBench(s, io::SampleFilter::Bicubic, true);
 }
 
 // Reference: the same warp through the generic engine (fields bound once, evaluate timed) on 256 x 256.

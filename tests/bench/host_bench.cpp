@@ -1,5 +1,5 @@
 // The host layer's cost per frame over direct core calls (target: at most 5% more). A 1,001,000-vertex grid
-// under keyframed Maya-style deformers, evaluated frame after frame by host::SceneEvaluator (curves,
+// under keyframed Maya-style deformers, evaluated frame after frame by scene::SceneEvaluator (curves,
 // parameters by name, the stack's envelope and weights rule, dirty tracking), against a hand-written host
 // doing the same work through the core: the same curves evaluated, fromMayaTwist / fromMayaBend, new
 // controls pushed into the bound warps, evaluate from the rest positions into an output buffer.
@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "deformkit/geom/primitives.h"
-#include "deformkit/host/anim_curve.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/anim_curve.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/warp/barr.h"
 #include "deformkit/warp/barr_host.h"
 
@@ -33,20 +33,20 @@ const geom::Mesh& grid() {
 }
 
 // endAngle: 0 at frame 1 to 3 at frame 100; curvature: 0.2 to 0.9 (auto-clamped Bezier).
-host::AnimCurve curve(double from, double to) {
-    return host::AnimCurve({{1.0, from}, {static_cast<double>(kFrames), to}}, "bench");
+scene::AnimCurve curve(double from, double to) {
+    return scene::AnimCurve({{1.0, from}, {static_cast<double>(kFrames), to}}, "bench");
 }
 
-host::SceneParameter constant(const char* name, std::vector<double> value) {
-    host::SceneParameter p;
+scene::SceneParameter constant(const char* name, std::vector<double> value) {
+    scene::SceneParameter p;
     p.name = name;
     p.value.constant = std::move(value);
     p.path = name;
     return p;
 }
 
-host::SceneParameter animated(const char* name, const host::AnimCurve& c) {
-    host::SceneParameter p;
+scene::SceneParameter animated(const char* name, const scene::AnimCurve& c) {
+    scene::SceneParameter p;
     p.name = name;
     p.value.curves = {c};
     p.path = name;
@@ -55,16 +55,16 @@ host::SceneParameter animated(const char* name, const host::AnimCurve& c) {
 
 // The handle: origin at the grid's centre, Y along the grid's long side, 2 units per handle unit (bounds
 // -1..1 cover x in [0, 4]); the bend's X out of the grid's plane.
-host::Scene scene(int deformers) {
-    host::Scene s;
+scene::Scene scene(int deformers) {
+    scene::Scene s;
     s.source = "bench";
     s.firstFrame = 1;
     s.lastFrame = kFrames;
-    host::SceneObject o;
+    scene::SceneObject o;
     o.name = "grid";
     o.rest = grid();
     o.path = "objects[0]";
-    host::SceneDeformer twist;
+    scene::SceneDeformer twist;
     twist.type = "twist";
     twist.label = "twist1";
     twist.envelope.constant = {1.0};
@@ -72,7 +72,7 @@ host::Scene scene(int deformers) {
                     animated("endAngle", curve(0.0, 3.0))};
     o.stack.push_back(twist);
     if (deformers > 1) {
-        host::SceneDeformer bend;
+        scene::SceneDeformer bend;
         bend.type = "bend";
         bend.label = "bend1";
         bend.envelope.constant = {1.0};
@@ -85,7 +85,7 @@ host::Scene scene(int deformers) {
 }
 
 void BM_HostEvaluate(benchmark::State& state) {
-    host::SceneEvaluator evaluator(scene(static_cast<int>(state.range(0))));
+    scene::SceneEvaluator evaluator(scene(static_cast<int>(state.range(0))));
     int frame = 0;
     for (auto _ : state) {
         const geom::Mesh& mesh = evaluator.evaluate(0, 1 + frame++ % kFrames);
@@ -133,7 +133,7 @@ class DirectHost {
   private:
     bool bend_;
     std::span<const glm::vec3> rest_;
-    host::AnimCurve angle_, curvature_;
+    scene::AnimCurve angle_, curvature_;
     warp::MayaTwist mt_;
     warp::MayaBend mb_;
     std::unique_ptr<warp::TwistWarp> twist_;
@@ -157,7 +157,7 @@ void BM_HostDirect(benchmark::State& state) {
 void BM_HostOverheadPaired(benchmark::State& state) {
     using Clock = std::chrono::steady_clock;
     DirectHost direct(state.range(0) > 1);
-    host::SceneEvaluator evaluator(scene(static_cast<int>(state.range(0))));
+    scene::SceneEvaluator evaluator(scene(static_cast<int>(state.range(0))));
     double directSeconds = 0.0, hostSeconds = 0.0;
     std::vector<double> ratios;
     ratios.reserve(4096);

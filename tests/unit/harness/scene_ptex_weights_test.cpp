@@ -10,8 +10,8 @@
 #include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
@@ -56,7 +56,7 @@ TEST_CASE("scene ptex weights: a Ptex channel gives each vertex the mean of its 
     ptex::writePtex(dir / "w.ptx", constantFaces(tube));
     test::writeText(dir / "shot.json", sceneWith(R"({"ptex": "w.ptx", "channel": 1})"));
 
-    const host::Scene scene = harness::readScene(dir / "shot.json");
+    const scene::Scene scene = harness::readScene(dir / "shot.json");
     const std::vector<float>& weights = scene.objects[0].stack[0].weights;
     REQUIRE(weights.size() == static_cast<size_t>(tube.numVertices()));
     CHECK(scene.objects[0].stack[0].weightsFile == dir / "w.ptx");
@@ -76,7 +76,7 @@ TEST_CASE("scene ptex weights: a Ptex channel gives each vertex the mean of its 
     }
 
     // Evaluated like any other weights: bit-identical to the stack set directly with them.
-    host::SceneEvaluator evaluator(scene);
+    scene::SceneEvaluator evaluator(scene);
     const geom::Mesh& out = evaluator.evaluate(0, 1);
     host::DeformerStack direct;
     direct.setRest(tube);
@@ -119,6 +119,6 @@ TEST_CASE("scene ptex weights: bad files and keys name the JSON path and the fil
                    Contains(std::to_string(tube.numFaces()) + " Ptex faces"));
 
     // The core reader alone has no Ptex support and says so.
-    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)host::readScene(scene(R"({"ptex": "w.ptx"})")); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)scene::readScene(scene(R"({"ptex": "w.ptx"})")); }),
                Contains("weights.ptex") && Contains("cannot read"));
 }

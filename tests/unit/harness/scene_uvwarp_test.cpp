@@ -14,7 +14,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -117,9 +117,9 @@ std::vector<glm::vec3> stackPoints(const geom::Mesh& rest, int frame) {
 TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space stage",
           "[harness][uvwarp]") {
     Shot shot;
-    const host::Scene scene = host::readScene(shot.scene);
+    const scene::Scene scene = scene::readScene(shot.scene);
     REQUIRE(scene.objects.size() == 1);
-    const host::SceneObject& object = scene.objects[0];
+    const scene::SceneObject& object = scene.objects[0];
     CHECK(object.stack.size() == 1);  // the taper; the UV warp is not a geometric deformer
     REQUIRE(object.uvwarp.has_value());
     CHECK(object.uvwarp->label == "uvwarp2");
@@ -177,7 +177,7 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
         CAPTURE(c.stack);
         const std::string text = head + c.mesh + R"(", "stack": )" + c.stack + "}]}";
         const std::string what =
-            test::errorOf<InvalidInput>([&] { (void)host::parseScene(text, shot.dir / "bad.json"); });
+            test::errorOf<InvalidInput>([&] { (void)scene::parseScene(text, shot.dir / "bad.json"); });
         CHECK_THAT(what, Contains((shot.dir / "bad.json").string() + c.message) ||
                              (Contains((shot.dir / "bad.json").string()) && Contains(c.message)));
     }

@@ -41,7 +41,7 @@ TEST_CASE("baking through the identity redirect reproduces the texture", "[uvwar
     for (float& p : texture.pixels)
         p = value(rng);
     const io::Image redirect = invertWarp(WarpGrid::identity(size), size);
-    for (const auto filter : {warp::Interpolation::Bilinear, warp::Interpolation::Bicubic}) {
+    for (const auto filter : {io::SampleFilter::Bilinear, io::SampleFilter::Bicubic}) {
         BakeOptions options;
         options.filter = filter;
         const io::Image baked = bakeTexture(texture, redirect, options);
@@ -51,7 +51,7 @@ TEST_CASE("baking through the identity redirect reproduces the texture", "[uvwar
         // texel itself: bitwise equal.
         CHECK(baked.pixels == texture.pixels);
     }
-    // Any channel count: 70 channels (more than warp::sampleImage takes).
+    // Any channel count: 70 channels (more than io::sampleImage takes).
     io::Image wide(8, 8, 70);
     for (float& p : wide.pixels)
         p = value(rng);
@@ -73,7 +73,7 @@ TEST_CASE("baking a ramp through a shifted redirect gives the shifted ramp", "[u
     const double lo = 0.5 / size, hi = 1.0 - 0.5 / size;
     const io::Image bilinear = bakeTexture(texture, redirect);
     BakeOptions cubic;
-    cubic.filter = warp::Interpolation::Bicubic;
+    cubic.filter = io::SampleFilter::Bicubic;
     const io::Image bicubic = bakeTexture(texture, redirect, cubic);
     int cubicChecked = 0;
     for (int32_t y = 0; y < size; ++y) {
@@ -123,8 +123,8 @@ TEST_CASE("a redirect of another size is sampled bilinearly", "[uvwarp][bake]") 
     CHECK(reduced.at(3, 9, 1) == Approx(ramp(3.5 / small, 1.0 - 9.5 / small, 1)).margin(2e-5));
 }
 
-TEST_CASE("baking samples as warp::sampleImage does", "[uvwarp][bake]") {
-    // Reference: one warp::sampleImage call per texel at the redirected position, for a random texture and
+TEST_CASE("baking samples as io::sampleImage does", "[uvwarp][bake]") {
+    // Reference: one io::sampleImage call per texel at the redirected position, for a random texture and
     // a redirect that also reaches past the tile border (clamped).
     const int32_t size = 48, redirectSize = 32;
     std::mt19937 rng(11);
@@ -139,7 +139,7 @@ TEST_CASE("baking samples as warp::sampleImage does", "[uvwarp][bake]") {
             redirect.at(x, y, 1) = 1.0f - (y + 0.5f) / redirectSize + shift(rng);
         }
     }
-    for (const auto filter : {warp::Interpolation::Bilinear, warp::Interpolation::Bicubic}) {
+    for (const auto filter : {io::SampleFilter::Bilinear, io::SampleFilter::Bicubic}) {
         BakeOptions options;
         options.filter = filter;
         options.width = redirectSize;  // direct redirect look-ups
@@ -150,7 +150,7 @@ TEST_CASE("baking samples as warp::sampleImage does", "[uvwarp][bake]") {
         for (int32_t y = 0; y < redirectSize; ++y) {
             for (int32_t x = 0; x < redirectSize; ++x) {
                 const glm::vec2 position(redirect.at(x, y, 0) * size, (1.0f - redirect.at(x, y, 1)) * size);
-                warp::sampleImage(texture, position, filter, expected);
+                io::sampleImage(texture, position, filter, expected);
                 for (int c = 0; c < 4; ++c)
                     worst = std::max(worst, static_cast<double>(std::abs(baked.at(x, y, c) - expected[c])));
             }
@@ -167,7 +167,7 @@ TEST_CASE("baking is bit-identical for 1 and 2 threads", "[uvwarp][bake]") {
     });
     const io::Image redirect = invertWarp(warp, 64);
     BakeOptions options;
-    options.filter = warp::Interpolation::Bicubic;
+    options.filter = io::SampleFilter::Bicubic;
     const auto run = [&] { return bakeTexture(texture, redirect, options).pixels; };
     CHECK(test::withThreads(1, run) == test::withThreads(2, run));
 }

@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "deformkit/io/image.h"
-#include "deformkit/warp/image_warp.h"
+#include "deformkit/io/sampling.h"
 
 namespace deformkit::uvwarp {
 
@@ -16,8 +16,8 @@ namespace deformkit::uvwarp {
 struct BakeOptions {
     // Bilinear (2 x 2 taps, exact for textures linear in u and v) or Bicubic: Catmull-Rom, i.e. Keys'
     // cubic convolution with a = -0.5 (4 x 4 taps, interpolating, may overshoot near sharp edges; not
-    // clamped). The same filters as warp::sampleImage, with the same results.
-    warp::Interpolation filter = warp::Interpolation::Bilinear;
+    // clamped). io::sampleImage's filters, with the same results.
+    io::SampleFilter filter = io::SampleFilter::Bilinear;
     // Output size in texels; 0 takes the texture's. When it differs from the redirect map's size, the
     // redirect is sampled bilinearly (clamped to its edge texels) at each output texel's uv.
     int32_t width = 0;

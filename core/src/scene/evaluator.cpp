@@ -1,4 +1,4 @@
-#include "deformkit/host/evaluator.h"
+#include "deformkit/scene/evaluator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "deformkit/host/deformers.h"
 #include "deformkit/io/obj.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 namespace {
 
 std::string frameText(double frame) {
@@ -31,13 +31,13 @@ SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
         for (size_t i = 0; i < so.stack.size(); ++i) {
             const SceneDeformer& sd = so.stack[i];
             try {
-                const size_t index = ob.stack.add(makeDeformer(sd.type, sd.label));
+                const size_t index = ob.stack.add(host::makeDeformer(sd.type, sd.label));
                 if (!sd.weights.empty()) ob.stack.setWeights(index, sd.weights);
             } catch (const Error& e) {
                 throw InvalidInput(formatError(scene_.source, sd.path, e.what()));
             }
             bool animatedBind = false;
-            const Deformer& d = ob.stack.deformer(i);
+            const host::Deformer& d = ob.stack.deformer(i);
             for (const SceneParameter& p : sd.params)
                 animatedBind = animatedBind || (p.value.animated() && d.parameter(p.name).rebinds);
             ob.setAll.push_back(animatedBind);
@@ -134,7 +134,7 @@ void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3>
     std::copy(m.points().begin(), m.points().end(), points.begin());
 }
 
-DeformerStack& SceneEvaluator::stack(size_t object) {
+host::DeformerStack& SceneEvaluator::stack(size_t object) {
     if (object >= objects_.size()) {
         throw InvalidInput(formatError(scene_.source, "object " + std::to_string(object), "does not exist",
                                        "an index below " + std::to_string(objects_.size())));
@@ -142,8 +142,8 @@ DeformerStack& SceneEvaluator::stack(size_t object) {
     return objects_[object].stack;
 }
 
-const DeformerStack& SceneEvaluator::stack(size_t object) const {
+const host::DeformerStack& SceneEvaluator::stack(size_t object) const {
     return const_cast<SceneEvaluator&>(*this).stack(object);
 }
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

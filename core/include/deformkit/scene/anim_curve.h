@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace deformkit::host {
+namespace deformkit::scene {
 
 // How the segment that starts at a key is interpolated, up to the next key.
 enum class Interpolation {
@@ -84,4 +84,4 @@ class AnimCurve {
     bool constant_ = true;
 };
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

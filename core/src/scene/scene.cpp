@@ -1,4 +1,4 @@
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,12 +12,12 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/weight_maps.h"
+#include "deformkit/scene/weight_maps.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/grid.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 
 std::vector<double> SceneValue::at(double frame) const {
     if (curves.empty()) return constant;
@@ -300,7 +300,7 @@ class Reader {
         if (!v.contains("type")) fail(path + ".type", "is missing", "one of: " + known);
         d.type = string(v.at("type"), path + ".type", "one of: " + known);
         bool typeKnown = false;
-        for (std::string_view t : deformerTypes())
+        for (std::string_view t : host::deformerTypes())
             typeKnown = typeKnown || t == d.type;
         if (!typeKnown) fail(path + ".type", "is \"" + d.type + "\"", "one of: " + known);
         d.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
@@ -316,7 +316,7 @@ class Reader {
 
         // Parameters are checked by a probe deformer's own set(), in its parameters() order (bind-time
         // inputs first, as a host sets them): the constant, or every key's value.
-        std::unique_ptr<Deformer> probe = makeDeformer(d.type, d.label);
+        std::unique_ptr<host::Deformer> probe = host::makeDeformer(d.type, d.label);
         const std::string paramsPath = path + ".params";
         if (v.contains("params")) {
             const json& params = v.at("params");
@@ -330,7 +330,7 @@ class Reader {
                     }
                 }
             }
-            for (const ParamInfo& info : probe->parameters()) {
+            for (const host::ParamInfo& info : probe->parameters()) {
                 if (!params.contains(info.name)) continue;
                 SceneParameter p;
                 p.name = info.name;
@@ -366,7 +366,7 @@ class Reader {
     // The deformer types and the UV-warp stage, for messages.
     static std::string knownTypes() {
         std::string known;
-        for (std::string_view t : deformerTypes())
+        for (std::string_view t : host::deformerTypes())
             known += (known.empty() ? "" : ", ") + std::string(t);
         return known + ", uvwarp (last entry)";
     }
@@ -442,9 +442,9 @@ class Reader {
         if (v.contains("filter")) {
             const std::string f = string(v.at("filter"), path + ".filter", "\"bilinear\" or \"bicubic\"");
             if (f == "bilinear") {
-                u.filter = warp::Interpolation::Bilinear;
+                u.filter = io::SampleFilter::Bilinear;
             } else if (f == "bicubic") {
-                u.filter = warp::Interpolation::Bicubic;
+                u.filter = io::SampleFilter::Bicubic;
             } else {
                 fail(path + ".filter", "is \"" + f + "\"", "\"bilinear\" or \"bicubic\"");
             }
@@ -647,4 +647,4 @@ Scene readScene(const fs::path& path, const SceneReadOptions& options) {
     return parseScene(text.str(), path, options);
 }
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "deformkit/error.h"
-#include "deformkit/host/scene.h"
-#include "deformkit/host/weight_maps.h"
+#include "deformkit/scene/scene.h"
+#include "deformkit/scene/weight_maps.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "test_support.h"
@@ -80,7 +80,7 @@ TEST_CASE("weight maps: per-tile maps sampled through the UVs reproduce a linear
     writeFloat(dir / "w.1001.exr", linearMap(0.0));
     writeFloat(dir / "w.1012.exr", linearMap(0.1));  // tile 1012: u in [1, 2], v in [1, 2]
     const geom::Mesh mesh = grids({1001, 1012});
-    const std::vector<float> w = host::weightsFromMaps(mesh, dir / "w.<UDIM>.exr", 1, "test");
+    const std::vector<float> w = scene::weightsFromMaps(mesh, dir / "w.<UDIM>.exr", 1, "test");
     REQUIRE(w.size() == static_cast<size_t>(mesh.numVertices()));
     for (int32_t v = 0; v < mesh.numVertices(); ++v) {
         const glm::vec2 uv = mesh.uvs()[static_cast<size_t>(v)];  // uv index = vertex index here
@@ -93,7 +93,7 @@ TEST_CASE("weight maps: per-tile maps sampled through the UVs reproduce a linear
     }
     // Without a UDIM token one image serves tile 1001.
     const geom::Mesh one = grids({1001});
-    CHECK(host::weightsFromMaps(one, dir / "w.1001.exr", 1, "test") ==
+    CHECK(scene::weightsFromMaps(one, dir / "w.1001.exr", 1, "test") ==
           std::vector<float>(w.begin(), w.begin() + one.numVertices()));
 }
 
@@ -108,7 +108,7 @@ TEST_CASE("weight maps: a vertex on a UV seam gets the mean of its corners' samp
     d.uvs = {{0.1f, 0.1f}, {0.4f, 0.1f}, {0.1f, 0.4f}, {0.6f, 0.6f}, {0.9f, 0.6f}, {0.6f, 0.9f}};
     d.uvIndices = {0, 1, 2, 3, 4, 5};
     const geom::Mesh mesh(std::move(d), "seam");
-    const std::vector<float> w = host::weightsFromMaps(mesh, dir / "w.exr", 1, "test");
+    const std::vector<float> w = scene::weightsFromMaps(mesh, dir / "w.exr", 1, "test");
     auto g = [](glm::vec2 uv) { return linear(uv.x, uv.y, 0.0); };
     const glm::vec2 uvs[6] = {{0.1f, 0.1f}, {0.4f, 0.1f}, {0.1f, 0.4f},
                               {0.6f, 0.6f}, {0.9f, 0.6f}, {0.6f, 0.9f}};
@@ -124,20 +124,20 @@ TEST_CASE("weight maps: bad input names the source, the file and what was expect
     writeFloat(dir / "w.1001.exr", linearMap(0.0));
     const geom::Mesh two = grids({1001, 1002});
     CHECK_THAT(
-        test::errorOf<InvalidInput>([&] { (void)host::weightsFromMaps(two, dir / "w.1001.exr", 0, "src"); }),
+        test::errorOf<InvalidInput>([&] { (void)scene::weightsFromMaps(two, dir / "w.1001.exr", 0, "src"); }),
         Contains("src: ") && Contains("face 16 has its UVs in tile 1002"));
     CHECK_THAT(test::errorOf<InvalidInput>(
-                   [&] { (void)host::weightsFromMaps(grids({1001}), dir / "w.1001.exr", 2, "src"); }),
+                   [&] { (void)scene::weightsFromMaps(grids({1001}), dir / "w.1001.exr", 2, "src"); }),
                Contains("w.1001.exr: has 2 channels, channel 2 asked (expected a channel from 0 to 1)"));
     CHECK_THAT(
-        test::errorOf<Error>([&] { (void)host::weightsFromMaps(two, dir / "w.<UDIM>.exr", 0, "src"); }),
+        test::errorOf<Error>([&] { (void)scene::weightsFromMaps(two, dir / "w.<UDIM>.exr", 0, "src"); }),
         Contains("w.1002.exr"));
     geom::Mesh::Data d;
     d.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     d.faceCounts = {3};
     d.faceIndices = {0, 1, 2};
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)host::weightsFromMaps(geom::Mesh(std::move(d), "m"), dir / "w.1001.exr", 0, "src");
+                   (void)scene::weightsFromMaps(geom::Mesh(std::move(d), "m"), dir / "w.1001.exr", 0, "src");
                }),
                Contains("a weight map for a mesh without UVs"));
 }
@@ -151,23 +151,23 @@ TEST_CASE("weight maps: a scene's weights may be an image sampled through the UV
     const std::string head =
         R"({"deformkit_scene": 1, "frames": [1, 1], "objects": [{"name": "g", "mesh": "grid.obj",
       "stack": [{"type": "twist", "weights": )";
-    const host::Scene scene =
-        host::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 1}}]}]})", dir / "shot.json");
-    const std::vector<float> expected = host::weightsFromMaps(mesh, dir / "w.<UDIM>.exr", 1, "x");
+    const scene::Scene scene =
+        scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 1}}]}]})", dir / "shot.json");
+    const std::vector<float> expected = scene::weightsFromMaps(mesh, dir / "w.<UDIM>.exr", 1, "x");
     CHECK(scene.objects[0].stack[0].weights == expected);
     CHECK(scene.objects[0].stack[0].weightsFile == dir / "w.<UDIM>.exr");
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)host::parseScene(head + R"({"image": "w.<UDIM>.exr", "chanel": 1}}]}]})",
+                   (void)scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "chanel": 1}}]}]})",
                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.chanel: is not a known key"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)host::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 5}}]}]})",
+                   (void)scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 5}}]}]})",
                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("channel 5 asked"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)host::parseScene(head + R"({"image": "v.<UDIM>.exr"}}]}]})", dir / "shot.json");
+                   (void)scene::parseScene(head + R"({"image": "v.<UDIM>.exr"}}]}]})", dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("v.1001.exr"));
 }

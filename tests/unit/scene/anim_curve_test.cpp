@@ -5,12 +5,12 @@
 #include <vector>
 
 #include "deformkit/error.h"
-#include "deformkit/host/anim_curve.h"
+#include "deformkit/scene/anim_curve.h"
 
-using deformkit::host::AnimCurve;
-using deformkit::host::Interpolation;
-using deformkit::host::Key;
-using deformkit::host::TangentMode;
+using deformkit::scene::AnimCurve;
+using deformkit::scene::Interpolation;
+using deformkit::scene::Key;
+using deformkit::scene::TangentMode;
 
 namespace {
 

@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "deformkit/geom/mesh.h"
-#include "deformkit/host/anim_curve.h"
+#include "deformkit/scene/anim_curve.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/tile_warp.h"
-#include "deformkit/warp/image_warp.h"
+#include "deformkit/io/sampling.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 
 // The scene format version parseScene reads.
 inline constexpr int kSceneVersion = 1;
@@ -62,7 +62,7 @@ struct SceneUvWarp {
     std::optional<std::filesystem::path> mask, orientation, texture;  // UDIM patterns
     std::vector<int> tiles;  // ascending; every tile of the rest mesh's UVs when the scene gives none
     uvwarp::TileWarpOptions options;  // options.cells: the grid resolution (0: the rigidity map's size)
-    warp::Interpolation filter = warp::Interpolation::Bilinear;  // of the bake
+    io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
     std::string path;                                            // "objects[0].stack[2]"
 };
 
@@ -116,4 +116,4 @@ struct SceneReadOptions {
 [[nodiscard]] Scene readScene(const std::filesystem::path& path, const struct SceneReadOptions& options);
 [[nodiscard]] Scene readScene(const std::filesystem::path& path);
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

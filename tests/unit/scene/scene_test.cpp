@@ -5,8 +5,8 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj.h"
 #include "mesh_support.h"
@@ -22,8 +22,8 @@ struct Fixture {
     test::TempDir dir;
     Fixture() { io::writeObj(dir / "tube.obj", test::tube()); }
     [[nodiscard]] std::filesystem::path scenePath() const { return dir / "shot.json"; }
-    [[nodiscard]] host::Scene parse(const std::string& text) const {
-        return host::parseScene(text, scenePath());
+    [[nodiscard]] scene::Scene parse(const std::string& text) const {
+        return scene::parseScene(text, scenePath());
     }
     // The message of the error parsing `text` raises, or "no error".
     [[nodiscard]] std::string error(const std::string& text) const {
@@ -49,7 +49,7 @@ std::vector<glm::vec3> pointsOf(const geom::Mesh& mesh) {
 
 TEST_CASE("scene: a valid scene parses with its defaults", "[host][scene]") {
     Fixture f;
-    const host::Scene s = f.parse(withEntry(
+    const scene::Scene s = f.parse(withEntry(
         R"({"type": "twist", "params": {"handleY": [0, 2, 0], "endAngle": {"keys": [{"frame": 1, "value": 0},
             {"frame": 5, "value": 1.2, "interpolation": "linear"}]}}},
            {"type": "taper", "label": "flare", "envelope": 0.5, "params": {"endScale": 2}})"));
@@ -57,7 +57,7 @@ TEST_CASE("scene: a valid scene parses with its defaults", "[host][scene]") {
     CHECK(s.firstFrame == 1);
     CHECK(s.lastFrame == 5);
     REQUIRE(s.objects.size() == 1);
-    const host::SceneObject& o = s.objects[0];
+    const scene::SceneObject& o = s.objects[0];
     CHECK(o.name == "tube");
     CHECK(o.rest.numVertices() == 40);
     CHECK(o.rest.numFaces() == 32);
@@ -137,7 +137,7 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
                Contains("objects[0].stack[0].weights"));
 
     CHECK_THROWS_AS(f.parse("{\"deformkit_scene\": 1,"), ParseError);
-    CHECK_THROWS_AS(host::readScene(f.dir / "none.json"), IoError);
+    CHECK_THROWS_AS(scene::readScene(f.dir / "none.json"), IoError);
 }
 
 TEST_CASE("scene: a linearly keyed twist equals the twist set directly", "[host][scene]") {
@@ -149,7 +149,7 @@ TEST_CASE("scene: a linearly keyed twist equals the twist set directly", "[host]
         weightsText += (i ? ", " : "") + std::to_string(weights[i]);
     }
     test::writeText(f.dir / "w.json", weightsText + "]}");
-    host::SceneEvaluator evaluator(f.parse(withEntry(
+    scene::SceneEvaluator evaluator(f.parse(withEntry(
         R"({"type": "twist", "label": "t", "envelope": 0.75, "weights": "w.json",
             "params": {"handleY": [0, 1, 0], "endAngle": {"keys": [{"frame": 1, "value": 0, "interpolation": "linear"},
             {"frame": 5, "value": 1.2}]}}})")));
@@ -175,7 +175,7 @@ TEST_CASE("scene: a linearly keyed twist equals the twist set directly", "[host]
 
 TEST_CASE("scene: Bezier auto keys and vector keys evaluate as hand-computed curves", "[host][scene]") {
     Fixture f;
-    host::SceneEvaluator evaluator(f.parse(withEntry(
+    scene::SceneEvaluator evaluator(f.parse(withEntry(
         R"({"type": "twist", "params": {"endAngle": {"keys": [{"frame": 1, "value": 0}, {"frame": 3, "value": 1},
             {"frame": 7, "value": 3}]}}},
            {"type": "taper", "params": {"endScale": {"keys": [{"frame": 0, "value": 1, "tangent": "explicit",
@@ -212,7 +212,7 @@ TEST_CASE("scene: Bezier auto keys and vector keys evaluate as hand-computed cur
     CHECK(stack.get(1, "endScale")[0] == Approx(hermite(0.5, 1, 1, 4, 2, 0)).margin(1e-12));
     CHECK(stack.get(1, "endScale")[0] == Approx(2.0).margin(1e-12));
     // Vector keys: one curve per component; constant holds [0, 0, 0] until frame 10.
-    const host::SceneParameter& d = evaluator.scene().objects[0].stack[2].params[0];
+    const scene::SceneParameter& d = evaluator.scene().objects[0].stack[2].params[0];
     CHECK(d.value.at(9.999) == std::vector<double>{0, 0, 0});
     CHECK(d.value.at(10) == std::vector<double>{1, 2, 3});
 }

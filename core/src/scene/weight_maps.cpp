@@ -1,4 +1,4 @@
-#include "deformkit/host/weight_maps.h"
+#include "deformkit/scene/weight_maps.h"
 
 #include <cmath>
 #include <map>
@@ -6,9 +6,9 @@
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/udim.h"
-#include "deformkit/warp/image_warp.h"
+#include "deformkit/io/sampling.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 
 std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem::path& pattern,
                                    int32_t channel, const std::string& source) {
@@ -59,7 +59,7 @@ std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem
             const glm::vec2 uv = uvs[cornerUVs[c]];
             const glm::vec2 pixel((uv.x - tileU) * static_cast<float>(image.width),
                                   (1.0f - (uv.y - tileV)) * static_cast<float>(image.height));
-            warp::sampleImage(image, pixel, warp::Interpolation::Bilinear, sample);
+            io::sampleImage(image, pixel, io::SampleFilter::Bilinear, sample);
             sum[static_cast<size_t>(corners[c])] += sample[static_cast<size_t>(channel)];
             ++count[static_cast<size_t>(corners[c])];
         }
@@ -78,4 +78,4 @@ std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem
     return weights;
 }
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

@@ -1,4 +1,4 @@
-#include "deformkit/host/anim_curve.h"
+#include "deformkit/scene/anim_curve.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "deformkit/error.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 namespace {
 
 std::string keyName(size_t k) {
@@ -156,4 +156,4 @@ double AnimCurve::evaluate(double time) const {
     return h00 * k0.value + h10 * dt * outSlopes_[k] + h01 * k1.value + h11 * dt * inSlopes_[k + 1];
 }
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene

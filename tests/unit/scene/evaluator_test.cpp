@@ -6,8 +6,8 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/io/obj.h"
 #include "mesh_support.h"
 #include "test_support.h"
@@ -29,7 +29,7 @@ const char* kAnimated = R"({"deformkit_scene": 1, "frames": [1, 10], "objects": 
 TEST_CASE("evaluator: animated controls bind once per deformer over 10 frames", "[host][evaluator]") {
     test::TempDir dir;
     io::writeObj(dir / "tube.obj", test::tube());
-    host::SceneEvaluator evaluator(host::parseScene(kAnimated, dir / "shot.json"));
+    scene::SceneEvaluator evaluator(scene::parseScene(kAnimated, dir / "shot.json"));
     host::DeformerStack& stack = evaluator.stack(0);
     std::vector<glm::vec3> previous;
     for (int frame = 1; frame <= 10; ++frame) {
@@ -59,10 +59,10 @@ TEST_CASE("evaluator: animated controls bind once per deformer over 10 frames", 
 TEST_CASE("evaluator: a frame's result does not depend on the frames evaluated before", "[host][evaluator]") {
     test::TempDir dir;
     io::writeObj(dir / "tube.obj", test::tube());
-    host::SceneEvaluator played(host::parseScene(kAnimated, dir / "shot.json"));
+    scene::SceneEvaluator played(scene::parseScene(kAnimated, dir / "shot.json"));
     for (int frame = 1; frame <= 7; ++frame)
         (void)played.evaluate(0, frame);
-    host::SceneEvaluator alone(host::parseScene(kAnimated, dir / "shot.json"));
+    scene::SceneEvaluator alone(scene::parseScene(kAnimated, dir / "shot.json"));
     // Same values set on stacks bound to the same rest mesh: bit-identical (a farm job at frame 7 alone).
     CHECK(test::sameBits(played.evaluate(0, 7).points(), alone.evaluate(0, 7).points()));
     CHECK(alone.stack(0).bindCount() == 2);
@@ -75,7 +75,7 @@ TEST_CASE("evaluator: an animated bind-time parameter rebinds when its value mov
         "mesh": "tube.obj", "stack": [{"type": "twist", "params": {"handleOrigin": {"keys": [
         {"frame": 1, "value": [0, 0, 0]}, {"frame": 4, "value": [0, 0.5, 0], "interpolation": "constant"}]},
         "endAngle": 1}}]}]})";
-    host::SceneEvaluator evaluator(host::parseScene(text, dir / "shot.json"));
+    scene::SceneEvaluator evaluator(scene::parseScene(text, dir / "shot.json"));
     for (int frame = 1; frame <= 10; ++frame)
         (void)evaluator.evaluate(0, frame);
     // The origin moves on frames 2, 3 and 4 (Bezier from 1 to 4, then held): binds at 1, 2, 3, 4.
@@ -90,7 +90,7 @@ TEST_CASE("evaluator: constraints checked at bind name the scene, path and frame
     const std::string text = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "tube",
         "mesh": "tube.obj", "stack": [{"type": "twist", "params": {"lowBound": 1, "highBound": {"keys": [
         {"frame": 1, "value": 2, "interpolation": "linear"}, {"frame": 3, "value": 0}]}}}]}]})";
-    host::SceneEvaluator evaluator(host::parseScene(text, dir / "shot.json"));
+    scene::SceneEvaluator evaluator(scene::parseScene(text, dir / "shot.json"));
     CHECK_NOTHROW(evaluator.evaluate(0, 1));
     try {
         (void)evaluator.evaluate(0, 3);

@@ -6,8 +6,8 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/host/evaluator.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj.h"
 #include "mesh_support.h"
@@ -30,7 +30,7 @@ geom::Mesh tubeAt(int frame, int rings = 5, int sides = 8) {
     return geom::Mesh(std::move(d), "tube");
 }
 
-std::string scene(const std::string& objectExtra) {
+std::string sceneText(const std::string& objectExtra) {
     return R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "tube", "mesh": "anim.####.obj", )" +
            objectExtra + R"("stack": [
       {"type": "twist", "envelope": 0.5, "params": {"endAngle": {"keys": [{"frame": 1, "value": 0.2, "interpolation": "linear"},
@@ -47,7 +47,7 @@ TEST_CASE("sequence input: each frame's positions enter the stack bound to the r
     for (int restFrame : {1, 2}) {
         CAPTURE(restFrame);
         const std::string extra = restFrame == 1 ? "" : R"("restFrame": 2, )";
-        host::SceneEvaluator evaluator(host::parseScene(scene(extra), dir / "shot.json"));
+        scene::SceneEvaluator evaluator(scene::parseScene(sceneText(extra), dir / "shot.json"));
         CHECK(evaluator.scene().objects[0].meshFile ==
               dir / ("anim.000" + std::to_string(restFrame) + ".obj"));
         // The reference: a stack bound to the rest frame's mesh, evaluated on each frame's positions.
@@ -77,7 +77,7 @@ TEST_CASE("sequence input: missing, fractional and mismatched frames name the sc
     for (int f = 1; f <= 2; ++f)
         io::writeObj(dir / ("anim.000" + std::to_string(f) + ".obj"), tubeAt(f));
     io::writeObj(dir / "anim.0003.obj", tubeAt(3, 4, 8));  // one ring fewer
-    host::SceneEvaluator evaluator(host::parseScene(scene(""), dir / "shot.json"));
+    scene::SceneEvaluator evaluator(scene::parseScene(sceneText(""), dir / "shot.json"));
     const std::string source = (dir / "shot.json").string();
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 4); }),
                Contains(source + ": objects[0].mesh: frame 4: ") && Contains("anim.0004.obj"));
@@ -91,13 +91,13 @@ TEST_CASE("sequence input: missing, fractional and mismatched frames name the sc
 
     io::writeObj(dir / "tube.obj", tubeAt(1));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)host::parseScene(
+                   (void)scene::parseScene(
                        R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "t",
                         "mesh": "tube.obj", "restFrame": 2, "stack": []}]})",
                        dir / "shot.json");
                }),
                Contains(source + ": objects[0].restFrame: is given for the single mesh "));
     CHECK_THAT(test::errorOf<InvalidInput>(
-                   [&] { (void)host::parseScene(scene(R"("restFrame": 9, )"), dir / "shot.json"); }),
+                   [&] { (void)scene::parseScene(sceneText(R"("restFrame": 9, )"), dir / "shot.json"); }),
                Contains(source + ": objects[0].mesh: names the sequence ") && Contains("rest frame 9"));
 }

@@ -8,11 +8,11 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
-#include "deformkit/host/scene.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj_sequence.h"
 
-namespace deformkit::host {
+namespace deformkit::scene {
 
 // Evaluates a scene frame after frame the way a DCC does: one DeformerStack per object, built once (rest
 // mesh, deformers, painted weights, constant parameters), then at each frame every animated parameter and
@@ -42,12 +42,12 @@ class SceneEvaluator {
     const geom::Mesh& evaluate(size_t object, double frame);
 
     // The object's stack, for inspection (bind counts) and host changes (setRest, setWeights).
-    [[nodiscard]] DeformerStack& stack(size_t object);
-    [[nodiscard]] const DeformerStack& stack(size_t object) const;
+    [[nodiscard]] host::DeformerStack& stack(size_t object);
+    [[nodiscard]] const host::DeformerStack& stack(size_t object) const;
 
   private:
     struct Object {
-        DeformerStack stack;
+        host::DeformerStack stack;
         geom::Mesh deformed;
         // Per stack entry: set every parameter each frame (an animated [bind] parameter can reset an
         // animated counterpart that the scene holds constant), or only the animated ones.
@@ -67,4 +67,4 @@ class SceneEvaluator {
     std::vector<Object> objects_;
 };
 
-}  // namespace deformkit::host
+}  // namespace deformkit::scene
