@@ -19,6 +19,7 @@ packages=(
     libcli11-dev nlohmann-json3-dev
     python3 python3-dev pybind11-dev python3-numpy python3-pytest
     clang libclang-rt-14-dev         # libFuzzer and sanitizers
+    g++-aarch64-linux-gnu            # tests/build: the SIMD sources compile for a non-x86 target
     slurm-wlm munge                  # farm tests: single-node Slurm
     blender                          # the Blender add-on's tests (headless Blender 3.4)
 )

@@ -5,15 +5,12 @@
 #include <cstring>
 #include <string>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define DEFORMKIT_FFD_AVX2 1
-#endif
-
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 
 #include "deformkit/error.h"
+#include "ffd_kernels.h"
+#include "simd/cpu.h"
 
 namespace deformkit::warp {
 namespace {
@@ -120,102 +117,15 @@ void windowSum(const float* data, int32_t ny, int32_t nz, const int32_t* first, 
     }
 }
 
-// ---- Bernstein 4x4x4 kernels (divisions 3, 3, 3; translations) ----
-// The cubic lattice of issue 3's benchmark. Every point is reached by all 64 controls, so every point reads
-// the same translations: eight points are evaluated together in SoA form (one lane per point), each
-// translation component broadcast once per block. The sum order is the per-point path's
-// (windowSum): over (i, j) first with the k weights applied at the end. One kernel per instruction set.
-
-constexpr int kBlock = 8;  // points per SoA block: one AVX register of floats
-
-// Eight points' local coordinates (lattice units, x = s l) in SoA; lanes past the end are 0.
-struct LocalBlock {
-    alignas(32) float x[kBlock], y[kBlock], z[kBlock];
-};
-// Their displacements D(p), SoA.
-struct DisplacementBlock {
-    alignas(32) float x[kBlock], y[kBlock], z[kBlock];
-};
-
-// Portable: GCC/Clang vector extension, 8 floats; on plain x86-64 the compiler emits two SSE2 operations per
-// line, elsewhere whatever the target has. No FMA (ISO C++ mode contracts nothing).
-typedef float Float8 __attribute__((vector_size(32)));
-
-void bernstein444Portable(const LocalBlock& in, const float* deltas, DisplacementBlock& out) {
-    Float8 w[3][4];
-    const float* coords[3] = {in.x, in.y, in.z};
-    for (int a = 0; a < 3; ++a) {
-        Float8 x;  // copied in, not returned: an 8-float vector return is AVX ABI (-Wpsabi)
-        std::memcpy(&x, coords[a], sizeof(x));
-        const Float8 s = x / 3.0f, r = 1.0f - s;  // as basisWeights' closed-form cubic
-        w[a][0] = r * r * r;
-        w[a][1] = 3.0f * s * r * r;
-        w[a][2] = 3.0f * s * s * r;
-        w[a][3] = s * s * s;
-    }
-    Float8 acc[12] = {};  // control k of the (i, j) run, component e: acc[3 k + e]
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) {
-            const Float8 wij = w[0][i] * w[1][j];
-            const float* row = deltas + (i * 4 + j) * 12;
-            for (int v = 0; v < 12; ++v)
-                acc[v] += wij * row[v];
-        }
-    }
-    const Float8 d[3] = {w[2][0] * acc[0] + w[2][1] * acc[3] + w[2][2] * acc[6] + w[2][3] * acc[9],
-                         w[2][0] * acc[1] + w[2][1] * acc[4] + w[2][2] * acc[7] + w[2][3] * acc[10],
-                         w[2][0] * acc[2] + w[2][1] * acc[5] + w[2][2] * acc[8] + w[2][3] * acc[11]};
-    std::memcpy(out.x, &d[0], sizeof(out.x));
-    std::memcpy(out.y, &d[1], sizeof(out.y));
-    std::memcpy(out.z, &d[2], sizeof(out.z));
-}
-
-#ifdef DEFORMKIT_FFD_AVX2
-// AVX2 + FMA: the same sums with fused multiply-adds. Compiled for AVX2 by the target attribute alone and
-// only called when the CPU reports AVX2 and FMA (ffdHasAvx2Kernel), so the library still runs on any x86-64.
-__attribute__((target("avx2,fma"))) void bernstein444Avx2(const LocalBlock& in, const float* deltas,
-                                                          DisplacementBlock& out) {
-    const __m256 one = _mm256_set1_ps(1.0f), three = _mm256_set1_ps(3.0f);
-    __m256 w[3][4];
-    const float* coords[3] = {in.x, in.y, in.z};
-    for (int a = 0; a < 3; ++a) {
-        const __m256 s = _mm256_div_ps(_mm256_load_ps(coords[a]), three), r = _mm256_sub_ps(one, s);
-        const __m256 rr = _mm256_mul_ps(r, r), ss = _mm256_mul_ps(s, s), s3 = _mm256_mul_ps(three, s);
-        w[a][0] = _mm256_mul_ps(rr, r);
-        w[a][1] = _mm256_mul_ps(s3, rr);
-        w[a][2] = _mm256_mul_ps(_mm256_mul_ps(s3, s), r);
-        w[a][3] = _mm256_mul_ps(ss, s);
-    }
-    __m256 acc[12];
-    for (int v = 0; v < 12; ++v)
-        acc[v] = _mm256_setzero_ps();
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j) {
-            const __m256 wij = _mm256_mul_ps(w[0][i], w[1][j]);
-            const float* row = deltas + (i * 4 + j) * 12;
-            for (int v = 0; v < 12; ++v)
-                acc[v] = _mm256_fmadd_ps(wij, _mm256_broadcast_ss(row + v), acc[v]);
-        }
-    }
-    float* d[3] = {out.x, out.y, out.z};
-    for (int e = 0; e < 3; ++e) {
-        __m256 sum = _mm256_mul_ps(w[2][0], acc[e]);
-        sum = _mm256_fmadd_ps(w[2][1], acc[3 + e], sum);
-        sum = _mm256_fmadd_ps(w[2][2], acc[6 + e], sum);
-        sum = _mm256_fmadd_ps(w[2][3], acc[9 + e], sum);
-        _mm256_store_ps(d[e], sum);
-    }
-}
-#endif
-
-using Bernstein444Kernel = void (*)(const LocalBlock&, const float*, DisplacementBlock&);
+// The Bernstein 4x4x4 kernel (ffd_kernels.h) for this CPU; Portable forces the baseline build.
+using Bernstein444Kernel = void (*)(const detail::LocalBlock&, const float*, detail::DisplacementBlock&);
 
 Bernstein444Kernel bernstein444Kernel(FfdKernel choice) {
-#ifdef DEFORMKIT_FFD_AVX2
-    if (choice == FfdKernel::Auto && ffdHasAvx2Kernel()) return bernstein444Avx2;
+#ifdef DEFORMKIT_SIMD_X86
+    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::bernstein444Avx2;
 #endif
     (void)choice;
-    return bernstein444Portable;
+    return detail::bernstein444Baseline;
 }
 
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
@@ -275,12 +185,7 @@ inline int32_t basisWeights(FfdBasis basis, int32_t d, const float* binomial, fl
 }  // namespace
 
 bool ffdHasAvx2Kernel() {
-#ifdef DEFORMKIT_FFD_AVX2
-    static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    return has;
-#else
-    return false;
-#endif
+    return simd::activeIsa() == simd::Isa::Avx2;
 }
 
 glm::vec3 Lattice::controlPoint(int32_t i, int32_t j, int32_t k) const {
@@ -468,20 +373,21 @@ void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* tr
                                     std::span<const float> weights, float envelope) const {
     const Bernstein444Kernel kernel = bernstein444Kernel(options_.kernel);
     const int64_t n = numBoundPoints();
+    constexpr int kBlock = detail::kBlock;
     const int64_t blocks = (n + kBlock - 1) / kBlock;
     // Each block reads and writes its own points only: the output does not depend on the schedule.
 #pragma omp parallel for schedule(dynamic, 512)
     for (int64_t b = 0; b < blocks; ++b) {
         const int64_t begin = b * kBlock;
         const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
-        LocalBlock in{};
+        detail::LocalBlock in{};
         for (int lane = 0; lane < count; ++lane) {
             const glm::vec3& l = local_[begin + lane];
             in.x[lane] = l.x;
             in.y[lane] = l.y;
             in.z[lane] = l.z;
         }
-        DisplacementBlock d;
+        detail::DisplacementBlock d;
         kernel(in, translations, d);
         for (int lane = 0; lane < count; ++lane) {
             const int64_t u = begin + lane;

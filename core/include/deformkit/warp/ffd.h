@@ -50,9 +50,10 @@ inline constexpr int32_t kMaxFfdDivisions = 1024;
 inline constexpr int32_t kMaxBernsteinDegree = 64;
 
 // Which kernel the fast path may use for the common Bernstein 4x4x4 lattice (divisions 3, 3, 3). Auto takes
-// the AVX2+FMA kernel when the CPU has it (checked at run time; the build sets no -march), else the portable
-// one. Portable forces the portable kernel: for tests and benchmarks that compare the two. Results of the
-// two agree to float rounding (FMA), not bit for bit; each is bit-identical for any thread count.
+// the AVX2 kernel when the CPU has it (checked at run time; the build sets no -march) and the environment
+// variable DEFORMKIT_SIMD is not "baseline", else the portable one. Portable forces the portable kernel: for
+// tests and benchmarks that compare the two. Neither uses fused multiply-add: both give the same bytes, on
+// any CPU and for any thread count.
 enum class FfdKernel { Auto, Portable };
 
 struct FfdOptions {
@@ -61,7 +62,7 @@ struct FfdOptions {
     FfdKernel kernel = FfdKernel::Auto;
 };
 
-// True when this CPU runs the AVX2+FMA kernel under FfdKernel::Auto.
+// True when FfdKernel::Auto runs the AVX2 kernel in this process.
 [[nodiscard]] bool ffdHasAvx2Kernel();
 
 // The lattice geometry, its weighting fields and the bind cache (each point's local coordinates), shared

@@ -1,0 +1,175 @@
+// The UV-warp solver's fold repair (untangle) and the fold count of a warp.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "deformkit/uvwarp/solver.h"
+#include "solver_kernels.h"
+#include "solver_state.h"
+
+namespace deformkit::uvwarp {
+
+namespace detail {
+namespace {
+
+// True when moving level point (i, j) to (x, y) keeps all 12 triangles around it (both splittings of its
+// four cells) positively oriented. Only called for movable points, which are never on the border.
+bool keepsOrientation(const SolverState& state, const Level& level, int32_t i, int32_t j, float x, float y) {
+    const size_t s = static_cast<size_t>(level.stride);
+    const size_t row = s * static_cast<size_t>(state.side());
+    const size_t k = state.fine(level, i, j);
+    const float* u = state.grid.u.data();
+    const float* v = state.grid.v.data();
+    // Neighbours counter-clockwise from east.
+    const size_t n[8] = {k + s, k + s + row, k + row, k - s + row, k - s, k - s - row, k - row, k + s - row};
+    for (int q = 0; q < 4; ++q) {  // cell between neighbours 2q (edge), 2q+1 (diagonal), 2q+2 (edge)
+        const size_t a = n[2 * q], d = n[2 * q + 1], b = n[(2 * q + 2) % 8];
+        if (orient(x, y, u[a], v[a], u[d], v[d]) <= 0.0f) return false;
+        if (orient(x, y, u[d], v[d], u[b], v[b]) <= 0.0f) return false;
+        if (orient(x, y, u[a], v[a], u[b], v[b]) <= 0.0f) return false;
+    }
+    return true;
+}
+
+bool isFolded(const SolverState& state, const Level& level, int32_t i, int32_t j) {
+    const size_t k = state.fine(level, i, j);
+    return !keepsOrientation(state, level, i, j, state.grid.u[k], state.grid.v[k]);
+}
+
+// Pushes the interior corners of cell (i, j)'s triangles (both splittings) at or below `nearZero` area.
+void collectFolded(const SolverState& state, const Level& level, int32_t i, int32_t j, float nearZero,
+                   std::vector<int32_t>& out) {
+    const int32_t c = level.cells;
+    const size_t s = static_cast<size_t>(level.stride);
+    const size_t a = state.fine(level, i, j), b = a + s, d = a + s * static_cast<size_t>(state.side()),
+                 e = d + s;
+    const float* u = state.grid.u.data();
+    const float* v = state.grid.v.data();
+    // Corners 0..3 = (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1); the four triangles of the cell.
+    const bool bad[4] = {orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero,
+                         orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero,
+                         orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero,
+                         orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero};
+    constexpr int32_t kCorners[4][3] = {{0, 1, 2}, {0, 2, 3}, {0, 1, 3}, {1, 2, 3}};
+    constexpr int32_t kDi[4] = {0, 1, 1, 0}, kDj[4] = {0, 0, 1, 1};
+    for (int t = 0; t < 4; ++t) {
+        if (!bad[t]) continue;
+        for (int32_t corner : kCorners[t]) {
+            const int32_t ci = i + kDi[corner], cj = j + kDj[corner];
+            if (ci > 0 && cj > 0 && ci < c && cj < c) out.push_back(cj * (c + 1) + ci);
+        }
+    }
+}
+
+// Triangles (both splittings) at or below nearZero area in the `cells` cells of a row starting at u, v
+// (points `spacing` apart, the next row `rowStep` on); Spacing != 0 fixes the spacing at compile time.
+template <int32_t Spacing>
+int32_t countNearZero(const float* u, const float* v, size_t rowStep, size_t spacing, int32_t cells,
+                      float nearZero) {
+    const size_t s = Spacing != 0 ? Spacing : spacing;
+    int32_t count = 0;
+#pragma omp simd reduction(+ : count)
+    for (int32_t i = 0; i < cells; ++i) {
+        const size_t a = static_cast<size_t>(i) * s, b = a + s, d = a + rowStep, e = d + s;
+        count += (orient(u[a], v[a], u[b], v[b], u[e], v[e]) <= nearZero ? 1 : 0) +
+                 (orient(u[a], v[a], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0) +
+                 (orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= nearZero ? 1 : 0) +
+                 (orient(u[b], v[b], u[e], v[e], u[d], v[d]) <= nearZero ? 1 : 0);
+    }
+    return count;
+}
+
+}  // namespace
+
+// One scan over the level's cells (4 orientation tests per cell, vectorisable) finds the triangles at or
+// near zero area; their corners are the candidates, each checked exactly before it moves. After that only
+// the neighbourhoods of moved points are looked at again, in ascending order (deterministic, serial: the
+// list is short in normal use).
+int32_t untangle(SolverState& state, const Level& level) {
+    const int32_t c = level.cells;
+    const size_t s = static_cast<size_t>(level.stride);
+    const size_t rowStep = s * static_cast<size_t>(state.side());
+    // Below a thousandth of a cell's area a triangle is a candidate: far above the rounding of orient() on
+    // unit-square coordinates, far below any triangle of a sound grid.
+    const float cellSize = static_cast<float>(level.stride) / static_cast<float>(state.cells);
+    const float nearZero = 1e-3f * cellSize * cellSize;
+    WarpGrid& grid = state.grid;
+    const float* u = grid.u.data();
+    const float* v = grid.v.data();
+    int32_t* counts = state.rowFolds.data();
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
+    for (int32_t j = 0; j < c; ++j) {
+        const size_t base = static_cast<size_t>(j) * rowStep;
+        // The finest level's points are contiguous: a constant spacing gives vector loads.
+        counts[j] = s == 1 ? countNearZero<1>(u + base, v + base, rowStep, 1, c, nearZero)
+                           : countNearZero<0>(u + base, v + base, rowStep, s, c, nearZero);
+    }
+    std::vector<int32_t>& work = state.untangleWork;
+    work.clear();
+    for (int32_t j = 0; j < c; ++j) {
+        if (counts[j] == 0) continue;
+        for (int32_t i = 0; i < c; ++i)
+            collectFolded(state, level, i, j, nearZero, work);
+    }
+    std::sort(work.begin(), work.end());
+    work.erase(std::unique(work.begin(), work.end()), work.end());
+    int32_t moved = 0;
+    const size_t row = rowStep;
+    std::vector<int32_t>& next = state.untangleNext;
+    for (int pass = 0; pass < 64 && !work.empty(); ++pass) {
+        next.clear();
+        for (int32_t id : work) {
+            const int32_t i = id % (c + 1), j = id / (c + 1);
+            if (!level.movable(level.index(i, j)) || !isFolded(state, level, i, j)) continue;
+            const size_t k = state.fine(level, i, j);
+            const size_t n[8] = {k + s, k + s + row, k + row, k - s + row,
+                                 k - s, k - s - row, k - row, k + s - row};
+            float mu = 0.0f, mv = 0.0f;
+            for (size_t q : n) {
+                mu += grid.u[q] / 8.0f;
+                mv += grid.v[q] / 8.0f;
+            }
+            grid.u[k] = mu;  // the neighbours' mean repairs most folds at once
+            grid.v[k] = mv;
+            ++moved;
+            for (int32_t dj = -1; dj <= 1; ++dj) {
+                for (int32_t di = -1; di <= 1; ++di) {
+                    const int32_t ni = i + di, nj = j + dj;
+                    if (ni > 0 && nj > 0 && ni < c && nj < c) next.push_back(nj * (c + 1) + ni);
+                }
+            }
+        }
+        std::sort(next.begin(), next.end());
+        next.erase(std::unique(next.begin(), next.end()), next.end());
+        work.clear();
+        for (int32_t id : next) {
+            if (isFolded(state, level, id % (c + 1), id / (c + 1))) work.push_back(id);
+        }
+    }
+    return moved;
+}
+
+}  // namespace detail
+
+int32_t countFolds(const WarpGrid& warp) {
+    using detail::kParallelRows;
+    using detail::orient;
+    const int32_t n = warp.cells, side = n + 1;
+    int32_t folds = 0;
+#pragma omp parallel for schedule(static) reduction(+ : folds) if (kParallelRows < static_cast <int64_t>(n))
+    for (int32_t j = 0; j < n; ++j) {
+        for (int32_t i = 0; i < n; ++i) {
+            const size_t a = static_cast<size_t>(j) * side + i, b = a + 1, c = a + side + 1, d = a + side;
+            const float* u = warp.u.data();
+            const float* v = warp.v.data();
+            folds += orient(u[a], v[a], u[b], v[b], u[c], v[c]) <= 0.0f ? 1 : 0;  // (i,j)-(i+1,j+1) split
+            folds += orient(u[a], v[a], u[c], v[c], u[d], v[d]) <= 0.0f ? 1 : 0;
+            folds += orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= 0.0f ? 1 : 0;  // (i+1,j)-(i,j+1) split
+            folds += orient(u[b], v[b], u[c], v[c], u[d], v[d]) <= 0.0f ? 1 : 0;
+        }
+    }
+    return folds;
+}
+
+}  // namespace deformkit::uvwarp

@@ -1,0 +1,77 @@
+#pragma once
+
+// Private to the UV-warp solver: its state, shared by the API and hierarchy (solver.cpp) and the fold
+// repair (solver_folds.cpp). The kernels see it through solver_kernels.h's plain views.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/solver.h"
+
+namespace deformkit::uvwarp::detail {
+
+// Loops over fewer rows than this run on one thread: coarse levels are tiny, and a fork and barrier per
+// tiny loop costs more than the loop (badly so when the machine is oversubscribed).
+constexpr int64_t kParallelRows = 64;
+
+// Rows per block of the row-wavefront schedule (sweep, regularise). A block's rows are processed in order;
+// blocks of one parity never touch a point another block of that parity reads or moves (a row reads at most
+// one row beyond its block on each side), so they run in parallel. Blocks depend on the grid size alone, so
+// the result does not depend on the thread count, nor on which thread runs a block: blocks (and the rows
+// of the other parallel loops) are handed out dynamically, so a thread the machine delays or a row block
+// with more rigid detail does not hold the other threads at the next barrier.
+constexpr int32_t kBlockRows = 16;
+
+// Level::rigidity of a point that may not move.
+constexpr float kFixed = -1.0f;
+
+struct Level {
+    int32_t cells = 0;   // cells per side at this level
+    int32_t stride = 1;  // fine-grid points between neighbouring points of this level
+    // R (Eq. 7 on coarser levels) where the point may move; kFixed where it may not (masked, Eq. 8, or on
+    // the tile border). One float map rather than a float and a byte map: the SIMD kernels then hold only
+    // 32-bit values, so their vector loops run 8 lanes per AVX2 iteration, not 32 (a byte map made GCC
+    // choose 32 lanes, which left every run shorter than 32 segments to the scalar remainder loop).
+    std::vector<float> rigidity;
+    std::vector<float> orientation;           // empty without an orientation map (1 everywhere)
+    std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)
+    // Per row of cells j, runs [spans[2r], spans[2r + 1]) of cells, r in [spanBegin[j], spanBegin[j + 1]),
+    // outside which no cell has a movable corner of rigidity > 0: no segment there is projected (§4.2), so
+    // sweeps skip them. Runs closer than kSpanGap cells are merged.
+    std::vector<int32_t> spanBegin, spans;
+
+    [[nodiscard]] int32_t side() const { return cells + 1; }
+    [[nodiscard]] size_t index(int32_t i, int32_t j) const { return static_cast<size_t>(j) * side() + i; }
+    [[nodiscard]] bool movable(size_t k) const { return rigidity[k] >= 0.0f; }
+};
+
+struct SolverState {
+    std::string source;
+    SolverOptions options;
+    int32_t cells = 0;
+    std::vector<Level> levels;
+    WarpGrid grid;
+    // Velocities; between prediction and integration they hold the positions before the prediction.
+    std::vector<float> velU, velV;
+    PointField rest;                    // f_O: rest lengths (Eq. 1) are measured through it when needed
+    const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
+    std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
+    std::vector<int32_t> untangleNext;
+    std::vector<int32_t> rowFolds;  // per cell row of the scan: triangles at or near zero area
+    SolveStats stats;
+
+    [[nodiscard]] int32_t side() const { return cells + 1; }
+    [[nodiscard]] size_t fine(const Level& level, int32_t i, int32_t j) const {
+        return static_cast<size_t>(j) * level.stride * side() + static_cast<size_t>(i) * level.stride;
+    }
+};
+
+// Repairs folds a propagation or prediction step may have made on `level` (solver_folds.cpp): a movable
+// point with a non-positive triangle around it moves to the mean of its 8 neighbours. Returns the number of
+// moves.
+int32_t untangle(SolverState& state, const Level& level);
+
+}  // namespace deformkit::uvwarp::detail

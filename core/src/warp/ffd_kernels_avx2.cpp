@@ -1,0 +1,17 @@
+// The AVX2 build of the FFD kernels: compiled with -mavx2 (core/CMakeLists.txt), called only when
+// simd::activeIsa() says so. Empty on other architectures.
+#include "ffd_kernels.h"
+
+#ifdef DEFORMKIT_SIMD_X86
+#ifndef __AVX2__
+#error "compile with -mavx2 (core/CMakeLists.txt)"
+#endif
+
+namespace deformkit::warp::detail {
+
+void bernstein444Avx2(const LocalBlock& in, const float* translations, DisplacementBlock& out) {
+    bernstein444(in, translations, out);
+}
+
+}  // namespace deformkit::warp::detail
+#endif
