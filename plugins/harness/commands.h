@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "deformkit/scene/scene.h"
 #include "deformkit/io/preview.h"
+#include "deformkit/scene/scene.h"
 
 // The deformkit CLI's subcommands as plain functions, so tests call them in-process. Each throws
 // deformkit::Error on bad input; main() turns that into one line on stderr and exit code 2.

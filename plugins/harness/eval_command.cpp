@@ -15,12 +15,12 @@
 #include <unistd.h>
 
 #include "deformkit/error.h"
-#include "deformkit/scene/evaluator.h"
-#include "deformkit/scene/scene.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "scene_uvwarp.h"
 
 namespace deformkit::harness {

@@ -20,10 +20,10 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/scene/evaluator.h"
-#include "deformkit/scene/scene.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "eval_command.h"
 #include "scene_uvwarp.h"
 

@@ -13,8 +13,8 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
-#include "deformkit/uvwarp/tile_warp.h"
 #include "deformkit/io/sampling.h"
+#include "deformkit/uvwarp/tile_warp.h"
 
 // `deformkit uvwarp`: the content-aware UV warp (Koniaris et al.) over a shot, for every UDIM tile:
 //
@@ -62,7 +62,7 @@ struct UvWarpCommand {
     int32_t resolution = 0;                            // grid cells per side, a power of two; 0: map size
     uvwarp::TileWarpOptions options;                   // solver, derived mask, dilation (cells: resolution)
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
-    std::optional<std::filesystem::path> log;                    // JSON lines, appended: one per tile x frame
+    std::optional<std::filesystem::path> log;              // JSON lines, appended: one per tile x frame
 };
 
 struct UvWarpTileReport {

@@ -24,8 +24,8 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-using warp::BeierNeelyVariant;
 using io::SampleFilter;
+using warp::BeierNeelyVariant;
 using warp::SegmentPair;
 
 constexpr const char* kSource = "beier_neely";

@@ -24,10 +24,10 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/scene/evaluator.h"
-#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
 #include "numpy_support.h"
 
 namespace py = pybind11;
@@ -180,8 +180,8 @@ void bindHost(py::module_& m) {
         "deformer_types",
         [] {
             std::vector<std::string> out;
-            for (std::string_view t : host::deformerTypes())
-                out.emplace_back(t);
+            for (const host::DeformerType& t : host::deformerTypes())
+                out.emplace_back(t.name);
             return out;
         },
         "The deformer type names DeformerStack.add takes, in alphabetical order.");

@@ -12,9 +12,9 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
+#include "deformkit/io/sampling.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/ptex/half.h"
-#include "deformkit/io/sampling.h"
 
 namespace deformkit::ptex {
 

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 
 namespace deformkit::host {
 namespace {
@@ -43,7 +44,9 @@ std::string withContext(const std::string& context, const char* message) {
 Deformer::Deformer(std::string type, std::string label)
     : type_(std::move(type)), label_(std::move(label)), context_(type_ + " '" + label_ + "'") {}
 
-size_t Deformer::addParameter(ParamInfo info, std::vector<double> initial) {
+size_t Deformer::addParameter(ParamSpec spec, std::vector<double> initial) {
+    ParamInfo info;
+    static_cast<ParamSpec&>(info) = std::move(spec);
     info.components = static_cast<int32_t>(initial.size());
     infos_.push_back(std::move(info));
     values_.push_back(std::move(initial));
@@ -70,6 +73,9 @@ void Deformer::set(std::string_view name, std::span<const double> value) {
     const size_t index = static_cast<size_t>(&parameter(name) - infos_.data());
     const ParamInfo& info = infos_[index];
     const size_t count = value.size();
+    // An unchanged value changes nothing: no validation (an FFD validates a whole lattice), no rebind.
+    std::vector<double>& current = values_[index];
+    if (current.size() == count && std::equal(current.begin(), current.end(), value.begin())) return;
     if (info.stride > 0) {
         if (count == 0 || count % static_cast<size_t>(info.stride) != 0) {
             fail(index, "has " + std::to_string(count) + " values",
@@ -87,11 +93,10 @@ void Deformer::set(std::string_view name, std::span<const double> value) {
         }
     }
     validate(index, value);
-    std::vector<double>& current = values_[index];
-    if (current.size() == count && std::equal(current.begin(), current.end(), value.begin())) return;
     current.assign(value.begin(), value.end());
     infos_[index].components = static_cast<int32_t>(count);
     if (info.rebinds) dirty_ = true;
+    controlsDirty_ = true;
     changed(index);
 }
 
@@ -107,6 +112,8 @@ void Deformer::assign(size_t index, std::vector<double> value) {
 void Deformer::validate(size_t, std::span<const double>) const {}
 
 void Deformer::changed(size_t) {}
+
+void Deformer::pushControls() {}
 
 void Deformer::deformWeighted(std::span<const glm::vec3>, std::span<glm::vec3>, std::span<const float>,
                               double) {
@@ -143,11 +150,12 @@ void Deformer::bind(const geom::Mesh& rest, std::span<const float> weights) {
         rethrowWithContext(context_);
     }
     dirty_ = false;
+    controlsDirty_ = true;
     boundVertices_ = rest.numVertices();
     ++bindCount_;
 }
 
-void Deformer::checkSizes(size_t in, size_t out) const {
+void Deformer::prepare(size_t in, size_t out) {
     if (dirty_) {
         throw InvalidInput(formatError(context_, "evaluate", "called before a needed bind",
                                        "bind() after the rest mesh or a bind-time parameter changed"));
@@ -159,10 +167,18 @@ void Deformer::checkSizes(size_t in, size_t out) const {
                         "has " + std::to_string(in) + " inputs and " + std::to_string(out) + " outputs",
                         std::to_string(n) + " each, the bound mesh's vertex count"));
     }
+    if (controlsDirty_) {
+        try {
+            pushControls();
+        } catch (const Error&) {
+            rethrowWithContext(context_);
+        }
+        controlsDirty_ = false;
+    }
 }
 
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out) {
-    checkSizes(in.size(), out.size());
+    prepare(in.size(), out.size());
     try {
         deform(in, out);
     } catch (const Error&) {
@@ -172,7 +188,7 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out)
 
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
                         std::span<const float> weights, double envelope) {
-    checkSizes(in.size(), out.size());
+    prepare(in.size(), out.size());
     if (!weights.empty() && weights.size() != in.size()) {
         throw InvalidInput(formatError(context_, "weights",
                                        "has " + std::to_string(weights.size()) + " values",
@@ -188,28 +204,10 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
         } else {
             deform(in, out);
             // k = 1 everywhere gives the deformed positions bit for bit: no pass needed.
-            if (!weights.empty() || envelope != 1.0) blendDeformation(in, out, weights, envelope, out);
+            if (!weights.empty() || envelope != 1.0) warp::applyEnvelope(in, out, weights, envelope, out);
         }
     } catch (const Error&) {
         rethrowWithContext(context_);
-    }
-}
-
-void blendDeformation(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
-                      std::span<const float> weights, double envelope, std::span<glm::vec3> out) {
-    const auto n = static_cast<int64_t>(in.size());
-    const bool painted = !weights.empty();
-#pragma omp parallel for schedule(static)
-    for (int64_t u = 0; u < n; ++u) {
-        const double k = painted ? envelope * static_cast<double>(weights[u]) : envelope;
-        if (k == 1.0) {
-            out[u] = deformed[u];
-        } else if (k == 0.0) {
-            out[u] = in[u];
-        } else {
-            const glm::dvec3 a(in[u]);
-            out[u] = glm::vec3(a + k * (glm::dvec3(deformed[u]) - a));
-        }
     }
 }
 

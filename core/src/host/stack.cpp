@@ -83,9 +83,11 @@ std::string DeformerStack::entryName(size_t index) const {
 std::vector<ParamInfo> DeformerStack::parameters(size_t index) const {
     const Deformer& d = deformer(index);
     std::vector<ParamInfo> out;
-    out.push_back({kEnvelope, 1, false,
-                   "scales this entry's displacement: 0 = off (skipped), 1 = full; animatable, not clamped",
-                   0});
+    ParamInfo envelope;
+    envelope.name = kEnvelope;
+    envelope.doc = "scales this entry's displacement: 0 = off (skipped), 1 = full; animatable, not clamped";
+    envelope.components = 1;
+    out.push_back(std::move(envelope));
     out.insert(out.end(), d.parameters().begin(), d.parameters().end());
     return out;
 }

@@ -62,8 +62,10 @@ inline void sampleBicubic(const Image& image, float px, float py, int32_t channe
     const float* rows[4];
     size_t xs[4];
     for (int32_t i = 0; i < 4; ++i) {
-        xs[i] = static_cast<size_t>(std::clamp(static_cast<int32_t>(x0f) - 1 + i, 0, image.width - 1)) * stride;
-        const auto y = static_cast<size_t>(std::clamp(static_cast<int32_t>(y0f) - 1 + i, 0, image.height - 1));
+        xs[i] =
+            static_cast<size_t>(std::clamp(static_cast<int32_t>(x0f) - 1 + i, 0, image.width - 1)) * stride;
+        const auto y =
+            static_cast<size_t>(std::clamp(static_cast<int32_t>(y0f) - 1 + i, 0, image.height - 1));
         rows[i] = &image.pixels[y * static_cast<size_t>(image.width) * stride];
     }
     for (int32_t k = 0; k < channels; ++k) {
@@ -78,7 +80,8 @@ inline void sampleBicubic(const Image& image, float px, float py, int32_t channe
     }
 }
 
-inline void sample(const Image& image, float px, float py, SampleFilter filter, int32_t channels, float* out) {
+inline void sample(const Image& image, float px, float py, SampleFilter filter, int32_t channels,
+                   float* out) {
     if (filter == SampleFilter::Bicubic) {
         sampleBicubic(image, px, py, channels, out);
     } else {

@@ -19,11 +19,13 @@ void sampleImage(const Image& image, glm::vec2 position, SampleFilter filter, st
                                        "at least 1 x 1 pixels, 1 channel, width * height * channels values"));
     }
     if (out.size() != static_cast<size_t>(image.channels)) {
-        throw InvalidInput(formatError("sampleImage", "output", "has " + std::to_string(out.size()) + " values",
+        throw InvalidInput(formatError("sampleImage", "output",
+                                       "has " + std::to_string(out.size()) + " values",
                                        std::to_string(image.channels) + " (one per channel)"));
     }
     if (!std::isfinite(position.x) || !std::isfinite(position.y)) {
-        throw InvalidInput(formatError("sampleImage", "position", "is not finite", "finite pixel coordinates"));
+        throw InvalidInput(
+            formatError("sampleImage", "position", "is not finite", "finite pixel coordinates"));
     }
     detail::sample(image, position.x, position.y, filter, image.channels, out.data());
 }

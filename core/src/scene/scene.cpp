@@ -12,9 +12,9 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/scene/weight_maps.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
+#include "deformkit/scene/weight_maps.h"
 #include "deformkit/uvwarp/grid.h"
 
 namespace deformkit::scene {
@@ -300,8 +300,8 @@ class Reader {
         if (!v.contains("type")) fail(path + ".type", "is missing", "one of: " + known);
         d.type = string(v.at("type"), path + ".type", "one of: " + known);
         bool typeKnown = false;
-        for (std::string_view t : host::deformerTypes())
-            typeKnown = typeKnown || t == d.type;
+        for (const host::DeformerType& t : host::deformerTypes())
+            typeKnown = typeKnown || t.name == d.type;
         if (!typeKnown) fail(path + ".type", "is \"" + d.type + "\"", "one of: " + known);
         d.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
                                       : d.type + std::to_string(entry + 1);
@@ -366,8 +366,8 @@ class Reader {
     // The deformer types and the UV-warp stage, for messages.
     static std::string knownTypes() {
         std::string known;
-        for (std::string_view t : host::deformerTypes())
-            known += (known.empty() ? "" : ", ") + std::string(t);
+        for (const host::DeformerType& t : host::deformerTypes())
+            known += (known.empty() ? "" : ", ") + std::string(t.name);
         return known + ", uvwarp (last entry)";
     }
 

@@ -5,8 +5,8 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
-#include "deformkit/io/udim.h"
 #include "deformkit/io/sampling.h"
+#include "deformkit/io/udim.h"
 
 namespace deformkit::scene {
 

@@ -8,6 +8,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 
 namespace deformkit::warp {
 namespace {

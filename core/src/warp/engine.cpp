@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 
 namespace deformkit::warp {
 namespace {
@@ -69,19 +70,8 @@ void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
     }
 }
 
-void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
-                   std::span<const float> weights, float envelope, std::span<glm::vec3> out) {
-    requireSize("deformed points", deformed.size(), in.size());
-    requireSize("output points", out.size(), in.size());
-    if (!weights.empty()) requireSize("painted weights", weights.size(), in.size());
-#pragma omp parallel for schedule(static)
-    for (int64_t u = 0; u < static_cast<int64_t>(in.size()); ++u) {
-        const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-        out[u] = in[u] + k * (deformed[u] - in[u]);
-    }
-}
-
 void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
+    bound_ = false;
     fields_.clear();
     warp_.bind(restPoints, fields_);
     if (fields_.numPoints() != static_cast<int32_t>(restPoints.size())) {
@@ -93,13 +83,26 @@ void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
     bound_ = true;
 }
 
-void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
+void WarpDeformer::requireBound(size_t points) const {
     if (!bound_) {
         throw InvalidInput(
             formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
     }
-    requireSize("points", points.size(), deformed_.size());
+    requireSize("points", points, deformed_.size());
+}
+
+void WarpDeformer::update() {
     warp_.transformations(transforms_);
+}
+
+void WarpDeformer::apply(std::span<const glm::vec3> in, std::span<glm::vec3> out) const {
+    requireBound(in.size());
+    evaluateWarp(in, fields_, transforms_, out, warp_.engineOptions());
+}
+
+void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
+    requireBound(points.size());
+    update();
     evaluateWarp(points, fields_, transforms_, deformed_, warp_.engineOptions());
     applyEnvelope(points, deformed_, weights, envelope, points);
 }

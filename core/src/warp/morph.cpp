@@ -5,6 +5,7 @@
 #include <string>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 
 namespace deformkit::warp {
 namespace {

@@ -14,10 +14,10 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
-#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "eval_command.h"

@@ -39,8 +39,12 @@ geom::Mesh testPlane() {
 TEST_CASE("the factory knows nine types and names the unknown ones", "[host][deformers]") {
     const auto types = host::deformerTypes();
     REQUIRE(types.size() == 9);
-    CHECK(std::is_sorted(types.begin(), types.end()));
-    for (std::string_view t : types) {
+    CHECK(std::is_sorted(
+        types.begin(), types.end(),
+        [](const host::DeformerType& a, const host::DeformerType& b) { return a.name < b.name; }));
+    for (const host::DeformerType& type : types) {
+        const std::string_view t = type.name;
+        CHECK(!type.summary.empty());
         const auto d = makeDeformer(t, "a");
         CHECK(d->type() == t);
         CHECK(d->label() == "a");

@@ -239,7 +239,7 @@ namespace {
 class WeightSumLift final : public host::Deformer {
   public:
     WeightSumLift() : Deformer("lift", "lift1") {
-        gain_ = addParameter({"gain", 1, false, "multiplies the lift"}, {1.0});
+        gain_ = addParameter({.name = "gain", .doc = "multiplies the lift"}, {1.0});
     }
     [[nodiscard]] bool weightsAffectBinding() const override { return true; }
 

@@ -94,8 +94,9 @@ TEST_CASE("sampling: bad input names what is wrong", "[io][sampling][errors]") {
     CHECK_THROWS_WITH(io::sampleImage(io::Image(), {1.0f, 1.0f}, io::SampleFilter::Bilinear, out),
                       Catch::Contains("image") && Catch::Contains("0 x 0"));
     std::vector<float> three(3);
-    CHECK_THROWS_WITH(io::sampleImage(image, {1.0f, 1.0f}, io::SampleFilter::Bicubic, three),
-                      Catch::Contains("output") && Catch::Contains("has 3 values") && Catch::Contains("2 (one"));
+    CHECK_THROWS_WITH(
+        io::sampleImage(image, {1.0f, 1.0f}, io::SampleFilter::Bicubic, three),
+        Catch::Contains("output") && Catch::Contains("has 3 values") && Catch::Contains("2 (one"));
     CHECK_THROWS_WITH(io::sampleImage(image, {std::nanf(""), 1.0f}, io::SampleFilter::Bilinear, out),
                       Catch::Contains("position") && Catch::Contains("not finite"));
     io::Image broken = image;

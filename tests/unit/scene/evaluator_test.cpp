@@ -6,9 +6,9 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
-#include "deformkit/io/obj.h"
 #include "mesh_support.h"
 #include "test_support.h"
 

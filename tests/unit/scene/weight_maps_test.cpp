@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "deformkit/error.h"
-#include "deformkit/scene/scene.h"
-#include "deformkit/scene/weight_maps.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/scene/scene.h"
+#include "deformkit/scene/weight_maps.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -158,12 +158,12 @@ TEST_CASE("weight maps: a scene's weights may be an image sampled through the UV
     CHECK(scene.objects[0].stack[0].weightsFile == dir / "w.<UDIM>.exr");
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "chanel": 1}}]}]})",
-                                          dir / "shot.json");
+                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.chanel: is not a known key"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 5}}]}]})",
-                                          dir / "shot.json");
+                                           dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("channel 5 asked"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {

@@ -17,8 +17,8 @@
 #include "deformkit/error.h"
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/ffd.h"
-#include "warp_test_support.h"
 #include "deformkit/warp/ffd_frames.h"
+#include "warp_test_support.h"
 
 using namespace deformkit;
 using namespace deformkit::warp;

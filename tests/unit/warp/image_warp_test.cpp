@@ -29,7 +29,6 @@ io::Image makeImage(int w, int h, int c, F f) {
     return image;
 }
 
-
 }  // namespace
 
 TEST_CASE("image warp: multichannel layout through a flip map", "[warp][beier_neely][image_warp]") {

@@ -13,18 +13,23 @@
 
 namespace deformkit::host {
 
-// One named parameter of a deformer, as hosts and the scene parser address it.
-struct ParamInfo {
+// How a deformer declares one of its parameters, with designated initialisers:
+//   addParameter({.name = "radius", .rebinds = true, .doc = "support radius, scene units, > 0"}, {1.0});
+// The default value given beside it sets how many values the parameter takes (unless it is resizable).
+struct ParamSpec {
     std::string name;
-    // How many values set() takes now. It can change: an FFD's `points` follows its `divisions`, and a
-    // resizable parameter (stride > 0) takes the length of the last value set.
-    int32_t components = 1;
-    // True when a new value needs a new bind (a lattice's rest box, a slide handle's vertex or radius);
-    // false for animatable controls (lattice points, angles, displacements), which never rebind.
+    // True when a new value needs a new bind ("[bind]": a lattice's rest box, a slide handle's vertex or
+    // radius); false for animatable controls (lattice points, angles, displacements), which never rebind.
     bool rebinds = false;
-    std::string doc;  // units, shape and range, for help text
-    // > 0: resizable; set() takes any positive multiple of `stride` values (the doc gives the minimum).
+    // > 0: resizable; set() takes any positive multiple of `stride` values. 0: exactly as many values as
+    // the parameter has now (an FFD's `points` follow its `divisions`).
     int32_t stride = 0;
+    std::string doc;  // units, shape and range: the parameter reference and help text are made from it
+};
+
+// One parameter as hosts and the scene parser see it: its declaration and how many values it takes now.
+struct ParamInfo : ParamSpec {
+    int32_t components = 1;
 };
 
 // How a deformer takes painted weights and the envelope.
@@ -41,16 +46,19 @@ enum class WeightMode {
 // times with new controls. The host layer (DeformerStack) binds it only when needsBind() says so: before
 // the first evaluation, after a rest mesh change, and after a change to a parameter with rebinds = true.
 //
-// Parameters are addressed by name with double values (integers and flags as whole numbers). set()
-// validates the count, finiteness (and float range: the core works in float32) and the deformer's own
-// ranges, and throws InvalidInput naming context() and "parameter 'name'"; the deformer is unchanged
-// then. Setting a parameter to the value it already has changes nothing (no rebind). Constraints between
-// parameters (a low bound below a high bound) are checked when they are used, at bind or evaluation, so
-// the parameters can be set one at a time in any order; parameters() lists them in a good setting order
-// (bind-time inputs first: a rest-shape change resets its animated counterpart, see deformers.h).
+// Parameters are addressed by name with double values (integers and flags as whole numbers). Setting a
+// parameter to the value it already has returns at once: nothing is validated, rebound or pushed. Otherwise
+// set() validates the count, finiteness (and float range: the core works in float32) and the deformer's own
+// ranges, and throws InvalidInput naming context() and "parameter 'name'"; the deformer is unchanged then.
+// Constraints between parameters (a low bound below a high bound) are checked when they are used, at bind
+// or evaluation, so the parameters can be set one at a time in any order; parameters() lists them in a
+// good setting order (bind-time inputs first: a rest-shape change resets its animated counterpart).
 //
-// Implementations (deformers.h; a studio adds its own by deriving from this class) declare their
-// parameters in their constructor with addParameter and implement bindRest and deform.
+// Implementations (the built-in ones in deformers.h; a studio adds its own by deriving from this class)
+// declare their parameters in their constructor with addParameter and implement three steps: bindRest
+// builds the core objects from the parameters, pushControls hands the animatable controls to them (called
+// before an evaluation whenever a control changed since the last push, and after every bind), and deform
+// runs them.
 class Deformer {
   public:
     virtual ~Deformer() = default;
@@ -94,16 +102,15 @@ class Deformer {
     // naming context() if the deformer needs a bind or a size differs.
     void evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out);
     // With painted weights (#V, or empty for all 1) and the envelope applied as weightMode() says: Blend
-    // deformers evaluate and then blendDeformation(); Native ones take them into their evaluation.
+    // deformers evaluate and then warp::applyEnvelope(); Native ones take them into their evaluation.
     void evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> weights,
                   double envelope);
 
   protected:
     Deformer(std::string type, std::string label);
 
-    // Declares a parameter with its default value (info.components is set from it). Returns its index,
-    // which the accessors below take.
-    size_t addParameter(ParamInfo info, std::vector<double> initial);
+    // Declares a parameter with its default value. Returns its index, which the accessors below take.
+    size_t addParameter(ParamSpec spec, std::vector<double> initial);
     [[nodiscard]] const std::vector<double>& value(size_t index) const { return values_[index]; }
     // Replaces a value without validation and without marking a rebind (for a parameter that follows
     // another: FFD points reset to the rest lattice when the lattice changes); resizes the parameter.
@@ -112,11 +119,14 @@ class Deformer {
     // The deformer's own checks of a candidate value (count and finiteness already checked): call fail()
     // to reject it.
     virtual void validate(size_t index, std::span<const double> value) const;
-    // Called after parameter `index` took a new value.
+    // Called after parameter `index` took a new value (to reset a parameter that follows it).
     virtual void changed(size_t index);
     // The bind work: read the parameters, build the core objects from scratch, bind them to `rest`.
     virtual void bindRest(const geom::Mesh& rest, std::span<const float> weights) = 0;
-    // Full deformation of in into out (sizes checked, the deformer bound).
+    // Hands the animatable controls (parameters with rebinds = false) to the bound core objects. The
+    // default does nothing, for a deformer that reads its controls in deform().
+    virtual void pushControls();
+    // Full deformation of in into out (sizes checked, the deformer bound, its controls pushed).
     virtual void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) = 0;
     // Native weight mode only: the deformation with weights and envelope taken in.
     virtual void deformWeighted(std::span<const glm::vec3> in, std::span<glm::vec3> out,
@@ -128,21 +138,16 @@ class Deformer {
     void requireIntegers(size_t index, std::span<const double> value, double lo, double hi) const;
 
   private:
-    void checkSizes(size_t in, size_t out) const;
+    // Checks the sizes and pushes the controls if one changed: what every evaluation starts with.
+    void prepare(size_t in, size_t out);
 
     std::string type_, label_, context_;
     std::vector<ParamInfo> infos_;
     std::vector<std::vector<double>> values_;
-    bool dirty_ = true;
+    bool dirty_ = true;          // a bind is needed
+    bool controlsDirty_ = true;  // a control changed since the last pushControls()
     int64_t bindCount_ = 0;
     int32_t boundVertices_ = 0;
 };
-
-// Maya's painted-weight and envelope rule, per vertex u with k = envelope w_u (w_u = 1 when weights is
-// empty): out_u = in_u + k (deformed_u - in_u), computed in double and rounded to float once. k = 1 gives
-// deformed_u and k = 0 gives in_u bit for bit. in, deformed, out: #V positions; out may alias deformed.
-// OpenMP over vertices, bit-identical for any thread count. Sizes are the caller's to check.
-void blendDeformation(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
-                      std::span<const float> weights, double envelope, std::span<glm::vec3> out);
 
 }  // namespace deformkit::host

@@ -27,7 +27,7 @@ namespace deformkit::host {
 // - Evaluation runs the entries in order, each on the previous one's output. An entry with envelope 0,
 //   or painted weights that are all 0, is skipped (its input passes through bit for bit, and it is not
 //   bound). Otherwise weights and envelope apply as the deformer's weightMode() says: Maya's
-//   out = in + envelope w (deformed - in) (blendDeformation) or the deformer's own (the slide).
+//   out = in + envelope w (deformed - in) (warp::applyEnvelope) or the deformer's own (the slide).
 // - Errors are InvalidInput (or a subclass) naming the entry, "stack entry 2 (ffd 'lattice1')" (entries
 //   count from 0), and the parameter or input; evaluate() writes nothing to `points` when it throws.
 //

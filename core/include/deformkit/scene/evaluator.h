@@ -8,9 +8,9 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
-#include "deformkit/scene/scene.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/obj_sequence.h"
+#include "deformkit/scene/scene.h"
 
 namespace deformkit::scene {
 

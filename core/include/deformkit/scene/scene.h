@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "deformkit/geom/mesh.h"
-#include "deformkit/scene/anim_curve.h"
 #include "deformkit/io/obj.h"
-#include "deformkit/uvwarp/tile_warp.h"
 #include "deformkit/io/sampling.h"
+#include "deformkit/scene/anim_curve.h"
+#include "deformkit/uvwarp/tile_warp.h"
 
 namespace deformkit::scene {
 
@@ -63,7 +63,7 @@ struct SceneUvWarp {
     std::vector<int> tiles;  // ascending; every tile of the rest mesh's UVs when the scene gives none
     uvwarp::TileWarpOptions options;  // options.cells: the grid resolution (0: the rigidity map's size)
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
-    std::string path;                                            // "objects[0].stack[2]"
+    std::string path;                                      // "objects[0].stack[2]"
 };
 
 struct SceneObject {

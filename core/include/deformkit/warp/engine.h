@@ -78,29 +78,35 @@ class Warp {
     [[nodiscard]] virtual EngineOptions engineOptions() const { return {}; }
 };
 
-// Maya's deformer model over any Warp: bind once, evaluate many times. Painted weights (#points, or
-// empty for 1) and the envelope scale each point's displacement: P + envelope * weight * (D<P> - P).
+// Maya's deformer model over any Warp: bind once (the fields on the rest model), then evaluate many times.
+// update() takes the warp's current controls (recomputes its transformations); apply() runs Eq. (3) with
+// them. The host layer's engine-backed deformers (beierneely, meshwarp) are this class behind parameters.
 class WarpDeformer {
   public:
     explicit WarpDeformer(Warp& warp) : warp_(warp) {}
 
+    // Fields on the rest points. Throws InvalidInput when the warp's fields do not cover every point once.
     void bind(std::span<const glm::vec3> restPoints);
     [[nodiscard]] bool isBound() const { return bound_; }
     [[nodiscard]] const SparseFields& fields() const { return fields_; }
 
-    // points: the bound rest points (or the current upstream points of the same count), deformed in place.
+    // The warp's transformations for its current controls.
+    void update();
+    // Eq. (3) with the transformations of the last update(): in (the bound points, or upstream points of the
+    // same count) deformed into out (#points; may alias in). Allocates nothing.
+    void apply(std::span<const glm::vec3> in, std::span<glm::vec3> out) const;
+    // update() and apply() in place, then painted weights (#points, or empty for 1) and the envelope as
+    // applyEnvelope (warp/envelope.h) says.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
 
   private:
+    void requireBound(size_t points) const;
+
     Warp& warp_;
     SparseFields fields_;
     Transformations transforms_;
     std::vector<glm::vec3> deformed_;
     bool bound_ = false;
 };
-
-// Final blend of a deformer stage: out = in + envelope * weight[u] * (deformed - in). weights empty = all 1.
-void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
-                   std::span<const float> weights, float envelope, std::span<glm::vec3> out);
 
 }  // namespace deformkit::warp

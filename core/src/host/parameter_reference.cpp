@@ -1,0 +1,72 @@
+#include "deformkit/host/parameter_reference.h"
+
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/host/deformers.h"
+
+namespace deformkit::host {
+namespace {
+
+// How many values a parameter takes: "3", or "3n" for a resizable one (any positive multiple of 3).
+std::string countText(const ParamInfo& info) {
+    if (info.stride == 0) return std::to_string(info.components);
+    return info.stride == 1 ? "n" : std::to_string(info.stride) + "n";
+}
+
+// The default values, or their count when there are many.
+std::string defaultText(const std::vector<double>& values) {
+    constexpr size_t kMaxShown = 9;
+    if (values.size() > kMaxShown) return std::to_string(values.size()) + " values";
+    std::string out;
+    for (double v : values)
+        out += (out.empty() ? "" : " ") + numberText(v);
+    return out;
+}
+
+}  // namespace
+
+std::string parameterReference(ReferenceFormat format) {
+    const bool markdown = format == ReferenceFormat::Markdown;
+    std::ostringstream out;
+    const std::string envelope =
+        "Every stack entry also has `envelope` (1 value, default 1): it scales the entry's displacement, "
+        "0 = off; animatable.";
+    if (markdown) {
+        out << "Parameters marked [bind] rebind the deformer when they change; the others are animatable "
+               "controls. Values: how many numbers a parameter takes (`3n`: any positive multiple of 3).\n"
+            << envelope << "\n";
+    } else {
+        out << "Parameters marked [bind] rebind the deformer when they change; the others are animatable.\n"
+            << "Values: how many numbers a parameter takes (3n: any positive multiple of 3).\n"
+            << envelope << "\n";
+    }
+    for (const DeformerType& type : deformerTypes()) {
+        const std::unique_ptr<Deformer> d = type.make("reference");
+        if (markdown) {
+            out << "\n### `" << type.name << "`\n\n"
+                << type.summary << "\n\n"
+                << "| parameter | values | default | meaning |\n"
+                << "| --- | --- | --- | --- |\n";
+        } else {
+            out << "\n" << type.name << ": " << type.summary << "\n";
+        }
+        for (const ParamInfo& info : d->parameters()) {
+            const std::string name = info.name + (info.rebinds ? " [bind]" : "");
+            const std::string values = countText(info), value = defaultText(d->get(info.name));
+            if (markdown) {
+                out << "| `" << info.name << "`" << (info.rebinds ? " [bind]" : "") << " | " << values
+                    << " | " << value << " | " << info.doc << " |\n";
+            } else {
+                out << "  " << name << "  (" << values << " values; default " << value << ")\n"
+                    << "      " << info.doc << "\n";
+            }
+        }
+    }
+    return out.str();
+}
+
+}  // namespace deformkit::host
