@@ -308,3 +308,83 @@ TEST_CASE("parameters are validated and named", "[host][deformers][errors]") {
     bend->set("handleX", std::vector<double>{2, 0, 0});
     CHECK_THROWS_WITH(bend->bind(rest), Contains("bend 'b': Maya bend: handle scale"));
 }
+
+namespace {
+
+// Counts what the host layer asks of a deformer: validations, control pushes and binds.
+class CountingDeformer final : public Deformer {
+  public:
+    CountingDeformer() : Deformer("counting", "c") {
+        size_ = addParameter({.name = "size", .rebinds = true, .doc = "bind-time"}, {1.0});
+        gain_ = addParameter({.name = "gain", .doc = "a control"}, {1.0});
+    }
+    mutable int validations = 0;  // validate() is const
+    int pushes = 0, binds = 0;
+    double pushedGain = 0.0;
+
+  protected:
+    void validate(size_t, std::span<const double>) const override { ++validations; }
+    void bindRest(const geom::Mesh&, std::span<const float>) override { ++binds; }
+    void pushControls() override {
+        ++pushes;
+        pushedGain = value(gain_)[0];
+    }
+    void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
+        for (size_t u = 0; u < in.size(); ++u)
+            out[u] = in[u] * static_cast<float>(pushedGain);
+    }
+
+  private:
+    size_t size_, gain_;
+};
+
+}  // namespace
+
+TEST_CASE("set: an unchanged value returns before validation; changed controls are pushed once",
+          "[host][deformers]") {
+    const geom::Mesh plane = testPlane();
+    const std::vector<glm::vec3> rest = restOf(plane);
+    std::vector<glm::vec3> out(rest.size());
+    CountingDeformer d;
+    d.set("gain", 1.0);  // the default: nothing happens
+    d.set("size", 1.0);
+    CHECK(d.validations == 0);
+    CHECK(d.needsBind());
+    d.bind(plane);
+    CHECK(d.binds == 1);
+    d.evaluate(rest, out);  // a bind is followed by one push
+    d.evaluate(rest, out);
+    CHECK(d.pushes == 1);
+    d.set("gain", 2.0);
+    CHECK(d.validations == 1);
+    CHECK(!d.needsBind());  // a control never rebinds
+    d.set("gain", 2.0);     // unchanged again
+    CHECK(d.validations == 1);
+    d.evaluate(rest, out);
+    d.evaluate(rest, out);
+    CHECK(d.pushes == 2);
+    CHECK(out[5] == rest[5] * 2.0f);
+    d.set("size", 3.0);  // bind-time: a new bind, then the controls again
+    CHECK(d.needsBind());
+    d.bind(plane);
+    d.evaluate(rest, out);
+    CHECK(d.binds == 2);
+    CHECK(d.pushes == 3);
+}
+
+TEST_CASE("an FFD does not rebuild its lattice to validate an unchanged value", "[host][deformers]") {
+    // divisions (4, 4, 4) with the Bernstein basis is valid; setting the same value again must not run the
+    // lattice check, so it stays cheap for hosts that push every parameter every frame.
+    const auto ffd = makeDeformer("ffd", "lattice");
+    const std::vector<double> divisions = {4, 4, 4};
+    ffd->set("divisions", divisions);
+    const std::vector<double> points = ffd->get("points");
+    const std::vector<double> moved = [&] {
+        std::vector<double> p = points;
+        p[0] += 0.25;
+        return p;
+    }();
+    ffd->set("points", moved);
+    ffd->set("divisions", divisions);  // unchanged: the moved points are kept (a change would reset them)
+    CHECK(ffd->get("points") == moved);
+}
