@@ -1,4 +1,7 @@
 #include "eval_command.h"
+#include <iostream>
+#include "cli.h"
+#include "uvwarp_command.h"
 
 #include "commands.h"
 
@@ -21,7 +24,7 @@
 #include "deformkit/io/preview.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
-#include "scene_uvwarp.h"
+#include "deformkit/scene/uvwarp_stage.h"
 
 namespace deformkit::harness {
 
@@ -168,13 +171,6 @@ void checkSize(const char* what, int32_t value, int32_t lo, int32_t hi) {
 
 }  // namespace
 
-std::string evalFileName(const std::string& object, int frame, const std::string& extension) {
-    char digits[32];
-    std::snprintf(digits, sizeof(digits), "%s%04lld", frame < 0 ? "-" : "",
-                  std::llabs(static_cast<long long>(frame)));
-    return object + "." + digits + extension;
-}
-
 ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32_t previewHeight,
                                       int32_t maxColumns, int32_t maxWidth) {
     checkSize("contact sheet tiles", tiles, 1, 1 << 30);
@@ -241,42 +237,52 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         pngs.resize(numObjects);
     }
 
+    // The UV-warp stages: one shot solver per object with a stage, fed the frame the OBJ is written from.
+    std::vector<std::optional<uvwarp::ShotSolver>> stages(numObjects);
+    for (size_t o = 0; o < numObjects; ++o) {
+        const scene::SceneObject& object = scene.objects[o];
+        if (!object.uvwarp || report.frames.empty()) continue;
+        scene::UvWarpStageRun run;
+        run.frames = report.frames;
+        run.tiles = object.uvwarp->tiles;
+        run.outDir = command.outDir;
+        stages[o] = scene::uvwarpStageSolver(scene, o, run);
+    }
+
     for (size_t i = 0; i < report.frames.size(); ++i) {
         const int frame = report.frames[i];
         for (size_t o = 0; o < numObjects; ++o) {
             const geom::Mesh& mesh = evaluator.evaluate(o, frame);
-            const fs::path file = command.outDir / evalFileName(scene.objects[o].name, frame);
+            const fs::path file = command.outDir / scene::frameFileName(scene.objects[o].name, frame);
             io::writeObj(file, mesh, scene.objects[o].groups);
             report.files.push_back(file);
-            if (!previews) continue;
-            io::PreviewOptions frameView = view;
-            frameView.frame = framingBox(restBounds[o], mesh.bounds());
-            const fs::path png = command.outDir / evalFileName(scene.objects[o].name, frame, ".png");
-            io::writeImage(png, io::renderPreview(mesh, frameView));
-            report.files.push_back(png);
-            pngs[o].push_back(png);
-            // The sheet is made from the file as written (8-bit), so a tile is reproducible from the preview.
-            pasteTile(sheets[o], io::readImage(png, {3, "preview"}), layout, static_cast<int32_t>(i));
+            if (previews) {
+                io::PreviewOptions frameView = view;
+                frameView.frame = framingBox(restBounds[o], mesh.bounds());
+                const fs::path png =
+                    command.outDir / scene::frameFileName(scene.objects[o].name, frame, ".png");
+                io::writeImage(png, io::renderPreview(mesh, frameView));
+                report.files.push_back(png);
+                pngs[o].push_back(png);
+                // The sheet is made from the file as written (8-bit), so a tile is reproducible from the
+                // preview.
+                pasteTile(sheets[o], io::readImage(png, {3, "preview"}), layout, static_cast<int32_t>(i));
+            }
+            if (stages[o]) scene::solveStageFrame(*stages[o], scene, o, frame, mesh.points());
         }
         if (progress) {
             *progress << "eval: frame " << frame << " (" << (i + 1) << "/" << report.frames.size()
                       << "): " << numObjects << (numObjects == 1 ? " object" : " objects") << " written\n";
         }
     }
-    // The UV-warp stages, object by object and tile by tile (one tile's solver in memory at a time).
     for (size_t o = 0; o < numObjects; ++o) {
-        const scene::SceneObject& object = scene.objects[o];
-        if (!object.uvwarp || report.frames.empty()) continue;
-        SceneUvWarpRun run;
-        run.frames = report.frames;
-        run.tiles = object.uvwarp->tiles;
-        run.outDir = command.outDir;
-        const UvWarpReport warped = runSceneUvWarp(evaluator, o, run);
-        for (const UvWarpTileReport& tile : warped.tiles)
+        if (!stages[o]) continue;
+        const uvwarp::ShotReport warped = stages[o]->finish();
+        for (const uvwarp::ShotTileReport& tile : warped.tiles)
             report.files.insert(report.files.end(), tile.files.begin(), tile.files.end());
-        for (const std::string& line : uvwarpSummary(warped)) {
-            if (progress) *progress << "eval: " << object.name << " uvwarp " << line << "\n";
-            report.uvwarpLines.push_back(object.name + " " + line);
+        for (const std::string& line : uvwarp::shotSummary(warped)) {
+            if (progress) *progress << "eval: " << scene.objects[o].name << " uvwarp " << line << "\n";
+            report.uvwarpLines.push_back(scene.objects[o].name + " " + line);
         }
     }
     for (size_t o = 0; o < numObjects; ++o)
@@ -302,6 +308,44 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         }
     }
     return report;
+}
+
+void addEvalCommand(CommandLine& cli) {
+    struct Options {
+        EvalCommand command;
+        std::string scene, frames, out;
+        bool noPreviews = false;
+    };
+    auto o = std::make_shared<Options>();
+    o->out = o->command.outDir.string();
+    CLI::App* eval = cli.add(
+        cli.app(), "eval",
+        "Evaluate a scene's deformer stacks frame by frame and write one OBJ per object and frame", [o] {
+            EvalCommand& c = o->command;
+            c.scene = o->scene;
+            c.outDir = o->out;
+            if (!o->frames.empty()) c.frames = parseFrames(o->frames);
+            c.previews = !o->noPreviews;
+            const EvalReport report = evalCommand(c, &std::cout);
+            std::cout << "eval: wrote " << report.files.size() << " files to " << o->out << "/\n";
+            for (const std::string& note : report.notes)
+                std::cout << "eval: " << note << "\n";
+            return 0;
+        });
+    eval->add_option("SCENE", o->scene, "scene (.json, docs/scene.md)")->required();
+    eval->add_option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15; default: the scene's");
+    eval->add_option("--out", o->out,
+                     "output folder: <object>.<frame>.obj and .png, <object>.contact.png, <object>.mp4")
+        ->capture_default_str();
+    eval->add_flag("--no-previews", o->noPreviews,
+                   "write only the OBJs (no PNG previews, contact sheets or movies)");
+    eval->add_option("--preview-width", o->command.previewWidth, "preview width in pixels")
+        ->capture_default_str();
+    eval->add_option("--preview-height", o->command.previewHeight, "preview height in pixels")
+        ->capture_default_str();
+    eval->add_flag("--movie", o->command.movie,
+                   "also encode <object>.mp4 from the previews when ffmpeg is on PATH");
+    eval->add_option("--fps", o->command.movieFrameRate, "movie frame rate")->capture_default_str();
 }
 
 }  // namespace deformkit::harness

@@ -17,12 +17,13 @@
 //                              (contactSheetLayout)
 //   DIR/<object>.mp4           with `movie`, when ffmpeg is on PATH: the previews at `movieFrameRate`
 //   DIR/<object>.redirect.<tile>.<frame>.exr, DIR/<object>.bake.<tile>.<frame>.<ext>
-//                              the UV-warp stage of an object that has one (scene_uvwarp.h), tile after
-//                              tile, each tile's frames solved in order, warm-started
+//                              the UV-warp stage of an object that has one (scene/uvwarp_stage.h): every
+//                              tile's frames solved in order, warm-started
 //
 // Every file is written atomically; DIR is created when missing. Frames are evaluated in ascending order
 // through one scene::SceneEvaluator, so each deformer binds once and animated parameters only change its
-// controls.
+// controls; each object is evaluated once per frame, and that mesh feeds its OBJ, its preview and every
+// tile of its UV-warp stage.
 namespace deformkit::harness {
 
 struct EvalCommand {
@@ -50,7 +51,7 @@ struct EvalReport {
     std::vector<std::filesystem::path> files;
     std::vector<int64_t> binds;      // per object: binds done by its stack over the run
     std::vector<std::string> notes;  // things not done that are not errors (no ffmpeg on PATH)
-    // Per object with a UV-warp stage, uvwarpSummary's lines prefixed with the object's name.
+    // Per object with a UV-warp stage, uvwarp::shotSummary's lines prefixed with the object's name.
     std::vector<std::string> uvwarpLines;
 };
 
@@ -59,10 +60,6 @@ struct EvalReport {
 // bad preview or contact sheet sizes are InvalidInput, checked before anything is written; a failing
 // ffmpeg is IoError naming the command.
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress = nullptr);
-
-// "<object>.<frame><extension>" with the frame zero padded to 4 digits, a sign before the padding.
-[[nodiscard]] std::string evalFileName(const std::string& object, int frame,
-                                       const std::string& extension = ".obj");
 
 // Contact sheet grid for `tiles` previews of previewWidth x previewHeight pixels:
 //   columns = min(tiles, maxColumns), rows = ceil(tiles / columns);

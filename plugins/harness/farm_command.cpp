@@ -1,4 +1,7 @@
 #include "farm_command.h"
+#include <iostream>
+#include "cli.h"
+#include "uvwarp_command.h"
 
 #include "commands.h"
 
@@ -24,8 +27,8 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "eval_command.h"
-#include "scene_uvwarp.h"
 
 extern char** environ;
 
@@ -51,11 +54,11 @@ std::vector<std::string> taskOutputs(const scene::Scene& scene, int first, int l
     for (int f = first; f <= last; ++f) {
         for (const scene::SceneObject& object : scene.objects) {
             if (tiles.empty()) {
-                outputs.push_back(evalFileName(object.name, f));
+                outputs.push_back(scene::frameFileName(object.name, f));
                 continue;
             }
             for (int tile : tiles) {
-                for (std::string& name : uvwarpOutputs(object, tile, f))
+                for (std::string& name : scene::uvwarpOutputs(object, tile, f))
                     outputs.push_back(std::move(name));
             }
         }
@@ -68,7 +71,7 @@ std::vector<int> warpedTiles(const scene::Scene& scene) {
     std::vector<int> tiles;
     for (const scene::SceneObject& object : scene.objects) {
         if (!object.uvwarp) continue;
-        for (int tile : uvwarpWarpedTiles(*object.uvwarp))
+        for (int tile : scene::uvwarpWarpedTiles(*object.uvwarp))
             tiles.push_back(tile);
     }
     std::sort(tiles.begin(), tiles.end());
@@ -436,7 +439,7 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
                 all = all && fs::exists(plan.outDir / name, ec);
             (all ? report.skipped : report.written).push_back(frame);
         }
-        SceneUvWarpRun run;
+        scene::UvWarpStageRun run;
         for (int frame = task.firstFrame; frame <= task.lastFrame; ++frame)
             run.frames.push_back(frame);
         run.tiles = task.tiles;
@@ -446,8 +449,8 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
         run.logTask = command.task;
         for (size_t o = 0; o < numObjects; ++o) {
             if (!scene.objects[o].uvwarp) continue;
-            const UvWarpReport warped = runSceneUvWarp(evaluator, o, run);
-            for (const UvWarpTileReport& tile : warped.tiles)
+            const uvwarp::ShotReport warped = scene::runUvWarpStage(evaluator, o, run);
+            for (const uvwarp::ShotTileReport& tile : warped.tiles)
                 report.files.insert(report.files.end(), tile.files.begin(), tile.files.end());
         }
         return report;
@@ -456,7 +459,7 @@ FarmRunReport farmRunCommand(const FarmRunCommand& command, std::ostream* log) {
         const Clock::time_point start = Clock::now();
         bool wrote = false;
         for (size_t o = 0; o < numObjects; ++o) {
-            const fs::path file = plan.outDir / evalFileName(scene.objects[o].name, frame);
+            const fs::path file = plan.outDir / scene::frameFileName(scene.objects[o].name, frame);
             // An output that exists is complete: every write is atomic.
             if (fs::exists(file, ec)) continue;
             io::writeObj(file, evaluator.evaluate(o, frame), scene.objects[o].groups);
@@ -568,6 +571,89 @@ std::vector<std::string> splitArguments(std::string_view text, const std::string
     }
     if (inWord) args.push_back(std::move(current));
     return args;
+}
+
+void addFarmCommands(CommandLine& cli) {
+    CLI::App* farm = cli.app().add_subcommand(
+        "farm",
+        "Cut a scene's evaluation into render-farm tasks, run one task, or submit them (docs/farm.md)");
+    farm->require_subcommand(1);
+
+    struct PlanOptions {
+        FarmPlanCommand command;
+        std::string scene, frames, out, plan;
+    };
+    auto p = std::make_shared<PlanOptions>();
+    CLI::App* plan =
+        cli.add(*farm, "plan", "Write a plan: tasks of at most --chunk frames with their output files", [p] {
+            FarmPlanCommand& c = p->command;
+            c.scene = p->scene;
+            c.outDir = p->out;
+            c.plan = p->plan;
+            if (!p->frames.empty()) c.frames = parseFrames(p->frames);
+            const FarmPlan made = farmPlanCommand(c);
+            std::cout << "farm: wrote " << farmPlanPath(c).string() << ": " << made.tasks.size()
+                      << (made.tasks.size() == 1 ? " task" : " tasks") << "\n";
+            return 0;
+        });
+    plan->add_option("SCENE", p->scene, "scene (.json, docs/scene.md)")->required();
+    plan->add_option("--frames", p->frames, "frames: 1-240, or a list such as 1-10,15; default: the scene's");
+    plan->add_option("--chunk", p->command.chunk, "frames per task at most")->capture_default_str();
+    plan->add_option("--tiles-per-task", p->command.tilesPerTask,
+                     "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
+        ->capture_default_str();
+    plan->add_option("--out", p->out, "output folder of the tasks: <object>.<frame 4 digits>.obj")
+        ->required();
+    plan->add_option("--plan", p->plan, "plan file to write; default: <out>/farm_plan.json");
+
+    // Exit codes a farm manager acts on: 2 bad input (no retry), 1 anything else (worth a retry).
+    const auto farmExit = [](const std::function<void()>& work) {
+        try {
+            work();
+            return 0;
+        } catch (const std::exception& e) {
+            std::cerr << "deformkit: error: " << e.what() << "\n";
+            return farmExitCode(e);
+        }
+    };
+    struct RunOptions {
+        FarmRunCommand command;
+        std::string plan;
+    };
+    auto r = std::make_shared<RunOptions>();
+    CLI::App* run =
+        cli.add(*farm, "run",
+                "Run one task of a plan, skipping frames already written; JSON lines on stdout. Exit 0 "
+                "done, 2 bad input, 1 worth a retry",
+                [r, farmExit] {
+                    return farmExit([&] {
+                        r->command.plan = r->plan;
+                        (void)farmRunCommand(r->command, &std::cout);
+                    });
+                });
+    run->add_option("PLAN", r->plan, "plan (.json) from deformkit farm plan")->required();
+    run->add_option("--task", r->command.task, "task index, from 0")->required();
+
+    struct SubmitOptions {
+        FarmSubmitCommand command;
+        std::string plan, sbatchArgs;
+        bool slurm = false;
+    };
+    auto s = std::make_shared<SubmitOptions>();
+    CLI::App* submit =
+        cli.add(*farm, "submit", "Submit a plan as a job array, one element per task; prints the job id",
+                [s, farmExit] {
+                    return farmExit([&] {
+                        s->command.plan = s->plan;
+                        s->command.sbatchArgs = splitArguments(s->sbatchArgs, "--sbatch-args");
+                        std::cout << farmSubmitCommand(s->command) << "\n";
+                    });
+                });
+    submit->add_flag("--slurm", s->slurm, "submit with Slurm's sbatch (the one scheduler supported)")
+        ->required();
+    submit->add_option("PLAN", s->plan, "plan (.json) from deformkit farm plan")->required();
+    submit->add_option("--sbatch-args", s->sbatchArgs,
+                       "extra sbatch options, e.g. \"--partition=batch --time=1:00:00\"");
 }
 
 }  // namespace deformkit::harness

@@ -1,4 +1,8 @@
 #include "uvwarp_command.h"
+#include <unistd.h>
+#include <iostream>
+#include "cli.h"
+#include "progress_bar.h"
 
 #include <algorithm>
 #include <charconv>
@@ -29,10 +33,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int64_t kMaxFrames = 1000000;
 
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // A decimal integer at text[pos] (an optional leading '-'), advancing pos; false when there is none.
 bool parseInteger(std::string_view text, size_t& pos, int64_t& value) {
     const char* begin = text.data() + pos;
@@ -54,77 +54,6 @@ void forEachItem(std::string_view text, Item&& item) {
     }
 }
 
-// A float option as JSON: the shortest decimal that reads back as the float (0.05, not 0.0500000007).
-double tidy(float value) {
-    char text[32];
-    const auto [end, ec] = std::to_chars(text, text + sizeof(text), value);
-    return ec == std::errc() ? std::strtod(std::string(text, end).c_str(), nullptr)
-                             : static_cast<double>(value);
-}
-
-std::string clockText(double seconds) {
-    const auto total = static_cast<int64_t>(seconds + 0.5);
-    const int64_t h = total / 3600, m = (total / 60) % 60, s = total % 60;
-    std::ostringstream out;
-    if (h > 0) out << h << ":" << (m < 10 ? "0" : "");
-    out << m << ":" << (s < 10 ? "0" : "") << s;
-    return out.str();
-}
-
-// Frames x tiles on one line, redrawn in place. The ETA extrapolates the time per solved frame over the
-// solves still planned: frames skipped because their outputs exist take no time.
-class ProgressBar {
-  public:
-    ProgressBar(std::ostream* out, int64_t steps, int64_t plannedSolves)
-        : out_(out), steps_(steps), plannedSolves_(plannedSolves), start_(Clock::now()) {}
-    ProgressBar(const ProgressBar&) = delete;
-    ProgressBar& operator=(const ProgressBar&) = delete;
-    ~ProgressBar() {
-        if (out_ && drawn_) *out_ << "\n" << std::flush;
-    }
-
-    void step(int tile, int frame, bool solved) {
-        ++done_;
-        if (solved) ++solved_;
-        if (!out_) return;
-        const double elapsed = secondsSince(start_);
-        const int64_t remaining = std::max<int64_t>(plannedSolves_ - solved_, 0);
-        const double eta =
-            solved_ > 0 ? elapsed / static_cast<double>(solved_) * static_cast<double>(remaining) : 0.0;
-        constexpr int64_t kWidth = 24;
-        const int64_t filled = steps_ > 0 ? kWidth * done_ / steps_ : kWidth;
-        *out_ << "\ruvwarp [" << std::string(static_cast<size_t>(filled), '#')
-              << std::string(static_cast<size_t>(kWidth - filled), '-') << "] " << done_ << "/" << steps_
-              << "  tile " << tile << " frame " << frame << "  elapsed " << clockText(elapsed) << "  ETA "
-              << (solved_ > 0 || remaining == 0 ? clockText(eta) : "-") << "   " << std::flush;
-        drawn_ = true;
-    }
-
-  private:
-    std::ostream* out_;
-    int64_t steps_, plannedSolves_, done_ = 0, solved_ = 0;
-    Clock::time_point start_;
-    bool drawn_ = false;
-};
-
-// What a run does for one tile, worked out before anything is written.
-struct TilePlan {
-    int tile = 0;
-    fs::path rigidity;
-    std::optional<fs::path> mask;         // an existing mask file
-    std::optional<fs::path> orientation;  // an existing orientation map
-    std::optional<fs::path> texture;      // an existing texture file, baked
-    std::vector<fs::path> outPaths, bakePaths;
-    std::vector<bool> needed;  // per frame: an output to write
-    int lastNeeded = -1;       // index of the last needed frame
-    UvWarpTileReport report;
-};
-
-bool fileExists(const fs::path& path) {
-    std::error_code ec;
-    return fs::exists(path, ec);
-}
-
 void requireOutputPattern(const fs::path& pattern, const std::string& option) {
     const std::string text = pattern.string();
     if (!io::hasUdimToken(text)) {
@@ -135,67 +64,6 @@ void requireOutputPattern(const fs::path& pattern, const std::string& option) {
         throw InvalidInput(formatError(option, text, "has no frame token in its file name",
                                        "one token such as #### (one # per digit) or %04d"));
     }
-}
-
-// Header-only checks of a tile's maps, so that a wrong size stops the run before anything is written.
-int32_t checkRigidityHeader(const fs::path& path, int32_t resolution) {
-    const io::ImageInfo info = io::readImageInfo(path);
-    if (info.width != info.height || info.width < 2) {
-        throw InvalidInput(
-            formatError(path.string(), "rigidity map",
-                        std::to_string(info.width) + " x " + std::to_string(info.height) + " texels",
-                        "a square map of at least 2 x 2 texels"));
-    }
-    if (resolution == 0 && !uvwarp::isPowerOfTwo(info.width)) {
-        throw InvalidInput(formatError(path.string(), "rigidity map",
-                                       std::to_string(info.width) + " texels per side, not a power of two",
-                                       "a power-of-two size, or --resolution to set the grid"));
-    }
-    return info.width;
-}
-
-// A map that must have the rigidity map's size (`what`: "warp mask", "orientation map").
-void checkMapHeader(const fs::path& path, const char* what, int32_t texels, const fs::path& rigidity) {
-    const io::ImageInfo info = io::readImageInfo(path);
-    if (info.width != texels || info.height != texels) {
-        throw InvalidInput(formatError(
-            path.string(), what, std::to_string(info.width) + " x " + std::to_string(info.height) + " texels",
-            std::to_string(texels) + " x " + std::to_string(texels) + ", the size of '" + rigidity.string() +
-                "'"));
-    }
-}
-
-json metricsJson(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
-    return {{"rigid_stretch_error", m.rigidStretchError},
-            {"identity_stretch_error", m.identityStretchError},
-            {"rigid_edges", m.rigidEdges},
-            {"skipped_edges", m.skippedEdges},
-            {"fold_overs", m.foldOvers},
-            {"max_masked_displacement", m.maxMaskedDisplacement},
-            {"max_border_displacement", m.maxBorderDisplacement},
-            {"points_outside", m.pointsOutside},
-            {"iterations", s.iterations},
-            {"levels", s.levels},
-            {"untangled_points", s.untangledPoints},
-            {"remaining_folds", s.remainingFolds}};
-}
-
-json solverJson(const uvwarp::TileWarpOptions& o, int32_t cells, int32_t texels, int32_t levelsUsed,
-                bool derivedMask) {
-    json j = {{"cells", cells},
-              {"texels", texels},
-              {"levels", o.solver.levels},
-              {"levelsUsed", levelsUsed},
-              {"iterations", o.solver.iterations},
-              {"sweepsPerLevel", o.solver.sweepsPerLevel},
-              {"orientationPreservation", tidy(o.solver.orientationPreservation)},
-              {"smoothing", tidy(o.solver.smoothing)},
-              {"damping", tidy(o.solver.damping)},
-              {"coarseStiffness", tidy(o.solver.coarseStiffness)},
-              {"dilationRings", o.dilationRings},
-              {"warmStart", true}};
-    if (derivedMask) j["derivedMaskBorderWidth"] = o.derivedMask.borderWidth;
-    return j;
 }
 
 }  // namespace
@@ -251,11 +119,7 @@ std::vector<int> parseTiles(std::string_view text, const std::string& option) {
     return tiles;
 }
 
-fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {
-    return io::ObjSequence(io::expandUdim(pattern.string(), tile)).framePath(frame);
-}
-
-UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress) {
+uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* interrupter) {
     // Everything that can be checked without solving is checked before the first output is written.
     if (command.frames.empty())
         throw InvalidInput(formatError("--frames", "", "no frames", "at least one frame"));
@@ -319,40 +183,35 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
     io::ObjSequence sequence(command.deformed);
     for (int frame : command.frames) {
         const fs::path path = sequence.framePath(frame);
-        if (!fileExists(path)) {
+        std::error_code ec;
+        if (!fs::exists(path, ec)) {
             throw IoError(
                 formatError(path.string(), "frame " + std::to_string(frame), "is missing",
                             "a file for every frame of '" + command.deformed.string() + "' in --frames"));
         }
     }
 
-    UvWarpJob job;
+    uvwarp::ShotJob job;
     job.rest = &rest;
     job.restName = command.rest.string();
     job.frames = command.frames;
-    job.tiles = tiles;
-    job.rigidity = command.rigidity;
-    job.mask = command.mask;
-    job.orientation = command.orientation;
-    job.texture = command.texture;
-    job.outPath = [&](int tile, int frame) { return tileFramePath(command.out, tile, frame); };
+    job.tiles = command.tiles;
+    job.rigidity.pattern = command.rigidity;
+    if (command.mask) job.mask.pattern = *command.mask;
+    if (command.orientation) job.orientation.pattern = *command.orientation;
+    if (command.texture) job.texture.pattern = *command.texture;
+    job.rigidityOption = "--rigidity";
+    job.outPath = [&](int tile, int frame) { return uvwarp::tileFramePath(command.out, tile, frame); };
     if (command.bake) {
-        job.bakePath = [&](int tile, int frame) { return tileFramePath(*command.bake, tile, frame); };
+        job.bakePath = [&](int tile, int frame) { return uvwarp::tileFramePath(*command.bake, tile, frame); };
     }
     job.options = command.options;
     job.options.cells = command.resolution;
     job.filter = command.filter;
     io::ObjContent deformed;
-    job.deformed = [&](int frame, std::string& name) -> std::span<const glm::vec3> {
-        const fs::path framePath = sequence.framePath(frame);
-        name = framePath.string();
+    const uvwarp::DeformedFrames frames = [&](int frame, std::string& name) -> std::span<const glm::vec3> {
+        name = sequence.framePath(frame).string();
         deformed = sequence.read(frame);
-        if (deformed.mesh.numVertices() != rest.numVertices()) {
-            throw InvalidInput(formatError(
-                framePath.string(), "", "has " + std::to_string(deformed.mesh.numVertices()) + " vertices",
-                std::to_string(rest.numVertices()) + ", the vertex count of the rest mesh '" +
-                    command.rest.string() + "'"));
-        }
         return deformed.mesh.points();
     };
     std::ofstream logFile;
@@ -364,236 +223,106 @@ UvWarpReport uvwarpCommand(const UvWarpCommand& command, std::ostream* progress)
         }
         job.log = &logFile;
     }
-    UvWarpReport report = runUvWarpJob(job, progress);
+    uvwarp::ShotReport report = uvwarp::runShotJob(job, frames, interrupter);
     if (command.log && !logFile.flush()) {
         throw IoError(formatError(command.log->string(), "", "cannot write the log", "a writable file"));
     }
     return report;
 }
 
-UvWarpReport runUvWarpJob(const UvWarpJob& job, std::ostream* progress) {
-    if (!job.rest || job.frames.empty() || !job.outPath || !job.deformed ||
-        (job.texture.has_value() && !job.bakePath)) {
-        throw InvalidInput(formatError("uvwarp", "job", "incomplete",
-                                       "a rest mesh, frames, an output path, deformed positions, and a bake "
-                                       "path with a texture"));
-    }
-    const geom::Mesh& rest = *job.rest;
-    const int32_t resolution = job.options.cells;
-    const bool wantBake = job.texture.has_value();
-    std::vector<TilePlan> plans;
-    int64_t plannedSolves = 0;
-    for (int tile : job.tiles) {
-        TilePlan plan;
-        plan.tile = tile;
-        plan.report.tile = tile;
-        plan.rigidity = io::expandUdim(job.rigidity.string(), tile);
-        std::vector<fs::path> folders = {job.outPath(tile, job.frames.front()).parent_path()};
-        if (wantBake) folders.push_back(job.bakePath(tile, job.frames.front()).parent_path());
-        for (const fs::path& folder : folders) {
-            std::error_code ec;
-            if (!folder.empty() && !fs::is_directory(folder, ec)) {
-                throw IoError(formatError(folder.string(), "output folder", "does not exist",
-                                          "an existing folder for the outputs"));
-            }
-        }
-        if (!fileExists(plan.rigidity)) {
-            plan.report.warped = false;
-            plan.report.notes.push_back("left unwarped: no rigidity map '" + plan.rigidity.string() + "'");
-            plans.push_back(std::move(plan));
-            continue;
-        }
-        const int32_t texels = checkRigidityHeader(plan.rigidity, resolution);
-        if (job.mask) {
-            const fs::path mask = io::expandUdim(job.mask->string(), tile);
-            if (fileExists(mask)) {
-                checkMapHeader(mask, "warp mask", texels, plan.rigidity);
-                plan.mask = mask;
-            } else {
-                plan.report.notes.push_back("no warp mask '" + mask.string() + "': derived from the UVs");
-            }
-        }
-        if (job.orientation) {
-            const fs::path orientation = io::expandUdim(job.orientation->string(), tile);
-            if (fileExists(orientation)) {
-                checkMapHeader(orientation, "orientation map", texels, plan.rigidity);
-                plan.orientation = orientation;
-            } else {
-                plan.report.notes.push_back("no orientation map '" + orientation.string() +
-                                            "': orientation preservation as given everywhere");
-            }
-        }
-        if (job.texture) {
-            const fs::path texture = io::expandUdim(job.texture->string(), tile);
-            if (fileExists(texture)) {
-                (void)io::readImageInfo(texture);  // readable
-                plan.texture = texture;
-            } else {
-                plan.report.notes.push_back("no texture '" + texture.string() + "': not baked");
-            }
-        }
-        for (size_t k = 0; k < job.frames.size(); ++k) {
-            const int frame = job.frames[k];
-            plan.outPaths.push_back(job.outPath(tile, frame));
-            plan.bakePaths.push_back(plan.texture ? job.bakePath(tile, frame) : fs::path());
-            const bool needed = !job.skipExisting || !fileExists(plan.outPaths.back()) ||
-                                (plan.texture && !fileExists(plan.bakePaths.back()));
-            plan.needed.push_back(needed);
-            if (needed) plan.lastNeeded = static_cast<int>(k);
-        }
-        plannedSolves += plan.lastNeeded + 1;
-        plans.push_back(std::move(plan));
-    }
-    if (!plans.empty() &&
-        std::none_of(plans.begin(), plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
-        std::string list;
-        for (const TilePlan& p : plans)
-            list += (list.empty() ? "'" : ", '") + p.rigidity.string() + "'";
-        throw IoError(formatError(job.rigidityOption, job.rigidity.string(), "no tile has a rigidity map",
-                                  "at least one of " + list));
-    }
-
-    auto writeLog = [&](json line) {
-        if (!job.log) return;
-        if (job.logTask >= 0) line["task"] = job.logTask;
-        if (!job.logObject.empty()) line["object"] = job.logObject;
-        *job.log << line.dump() << "\n" << std::flush;
+void addUvWarpCommand(CommandLine& cli) {
+    struct Options {
+        UvWarpCommand command;
+        std::string frames, tiles, mask, orientation, texture, bake, log, filter = "bilinear", rest, deformed,
+                                                                          rigidity, out;
     };
-    ProgressBar bar(progress, static_cast<int64_t>(plans.size() * job.frames.size()), plannedSolves);
-    UvWarpReport report;
-    for (TilePlan& plan : plans) {
-        UvWarpTileReport& r = plan.report;
-        auto baseLine = [&](size_t k, const char* status) {
-            json line = {{"tile", plan.tile}, {"frame", job.frames[k]}, {"status", status}};
-            if (!plan.outPaths.empty()) line["redirect"] = plan.outPaths[k].string();
-            if (plan.texture) line["bake"] = plan.bakePaths[k].string();
-            return line;
-        };
-        if (!r.warped) {
-            for (size_t k = 0; k < job.frames.size(); ++k) {
-                json line = baseLine(k, "unwarped");
-                line["reason"] = "no rigidity map '" + plan.rigidity.string() + "'";
-                writeLog(line);
-                bar.step(plan.tile, job.frames[k], false);
-            }
-            report.tiles.push_back(std::move(r));
-            continue;
-        }
-        std::optional<uvwarp::TileWarp> warp;
-        io::Image texture, redirect, baked;
-        if (plan.lastNeeded >= 0) {
-            const io::Image rigidity = uvwarp::readRigidityMap(plan.rigidity, plan.tile);
-            const io::Image mask = plan.mask ? uvwarp::readWarpMask(*plan.mask, plan.tile) : io::Image{};
-            // In [0, 1] and finite, as a rigidity map; errors name the file and texel.
-            const io::Image orientation =
-                plan.orientation ? uvwarp::readRigidityMap(*plan.orientation, plan.tile, "orientation map")
-                                 : io::Image{};
-            if (plan.texture) texture = io::readImage(*plan.texture);
-            warp.emplace(rest, plan.tile, rigidity, mask, job.options, orientation, job.restName);
-        }
-        const json inputs = {
-            {"rest", job.restName},
-            {"rigidity", plan.rigidity.string()},
-            {"mask", plan.mask ? plan.mask->string() : std::string("derived")},
-            {"orientation", plan.orientation ? plan.orientation->string() : std::string("none")}};
-        for (size_t k = 0; k < job.frames.size(); ++k) {
-            const int frame = job.frames[k];
-            if (static_cast<int>(k) > plan.lastNeeded) {
-                ++r.skipped;
-                writeLog(baseLine(k, "skipped"));
-                bar.step(plan.tile, frame, false);
-                continue;
-            }
-            const Clock::time_point start = Clock::now();
-            std::string frameName;
-            const std::span<const glm::vec3> points = job.deformed(frame, frameName);
-            const double readSeconds = secondsSince(start);
-            Clock::time_point t = Clock::now();
-            warp->solve(points);
-            const double solveSeconds = secondsSince(t);
-            const uvwarp::WarpMetrics metrics = warp->metrics();
-            r.lastMetrics = metrics;
-            r.lastFrame = frame;
-            json seconds = {{"read", readSeconds}, {"solve", solveSeconds}};
-            const bool needed = plan.needed[k];
-            if (needed) {
-                t = Clock::now();
-                warp->redirect(redirect);
-                seconds["invert"] = secondsSince(t);
-                io::ImageWriteOptions attributes;
-                json frameInputs = inputs;
-                frameInputs["deformed"] = frameName;
-                attributes.attributes = {
-                    {"deformkit:version", kVersionString},
-                    {"deformkit:uvwarp:tile", std::to_string(plan.tile)},
-                    {"deformkit:uvwarp:frame", std::to_string(frame)},
-                    {"deformkit:uvwarp:solver",
-                     solverJson(job.options, warp->cells(), warp->texels(), warp->stats().levels, !plan.mask)
-                         .dump()},
-                    {"deformkit:uvwarp:inputs", frameInputs.dump()}};
-                t = Clock::now();
-                if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
-                    io::ImageWriteOptions write = attributes;
-                    write.type = io::PixelType::Float;
-                    io::writeImage(plan.outPaths[k], redirect, write);
-                    r.files.push_back(plan.outPaths[k]);
-                }
-                double writeSeconds = secondsSince(t);
-                if (plan.texture && (!job.skipExisting || !fileExists(plan.bakePaths[k]))) {
-                    t = Clock::now();
-                    uvwarp::BakeOptions bakeOptions;
-                    bakeOptions.filter = job.filter;
-                    uvwarp::bakeTexture(texture, redirect, baked, bakeOptions);
-                    seconds["bake"] = secondsSince(t);
-                    std::string extension = plan.bakePaths[k].extension().string();
-                    std::transform(extension.begin(), extension.end(), extension.begin(),
-                                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-                    // Only EXR keeps arbitrary header attributes; other formats get the pixels alone.
-                    t = Clock::now();
-                    io::writeImage(plan.bakePaths[k], baked,
-                                   extension == ".exr" ? attributes : io::ImageWriteOptions{});
-                    r.files.push_back(plan.bakePaths[k]);
-                    writeSeconds += secondsSince(t);
-                    ++r.baked;
-                }
-                seconds["write"] = writeSeconds;
-                ++r.written;
-            } else {
-                ++r.replayed;
-            }
-            seconds["total"] = secondsSince(start);
-            json line = baseLine(k, needed ? "written" : "replayed");
-            line["metrics"] = metricsJson(metrics, warp->stats());
-            line["seconds"] = seconds;
-            writeLog(line);
-            bar.step(plan.tile, frame, true);
-        }
-        report.tiles.push_back(std::move(r));
-    }
-    return report;
-}
-
-std::vector<std::string> uvwarpSummary(const UvWarpReport& report) {
-    std::vector<std::string> lines;
-    for (const UvWarpTileReport& t : report.tiles) {
-        const std::string tile = "tile " + std::to_string(t.tile) + ": ";
-        if (t.warped) {
-            std::ostringstream line;
-            line.precision(3);
-            line << tile << t.written << (t.written == 1 ? " frame" : " frames") << " written";
-            if (t.baked > 0) line << " (" << t.baked << " baked)";
-            line << ", " << t.replayed << " replayed, " << t.skipped << " skipped (outputs exist)";
-            if (t.written + t.replayed > 0) {
-                line << "; frame " << t.lastFrame << ": rigid stretch error "
-                     << t.lastMetrics.rigidStretchError << " (identity " << t.lastMetrics.identityStretchError
-                     << "), " << t.lastMetrics.foldOvers << " fold-overs";
-            }
-            lines.push_back(line.str());
-        }
-        for (const std::string& note : t.notes)
-            lines.push_back(tile + note);
-    }
-    return lines;
+    auto o = std::make_shared<Options>();
+    CLI::App* uvwarp = cli.add(
+        cli.app(), "uvwarp",
+        "Content-aware UV warp over a shot: per UDIM tile and frame a redirect map (and a baked texture)",
+        [o] {
+            UvWarpCommand& c = o->command;
+            c.rest = o->rest;
+            c.deformed = o->deformed;
+            c.frames = parseFrames(o->frames);
+            c.rigidity = o->rigidity;
+            c.out = o->out;
+            if (!o->mask.empty()) c.mask = o->mask;
+            if (!o->orientation.empty()) c.orientation = o->orientation;
+            if (!o->texture.empty()) c.texture = o->texture;
+            if (!o->bake.empty()) c.bake = o->bake;
+            if (!o->tiles.empty()) c.tiles = parseTiles(o->tiles);
+            if (!o->log.empty()) c.log = o->log;
+            c.filter = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
+            // The progress bar redraws one line in place: only for a person watching a terminal.
+            ProgressBar bar(std::cerr);
+            const uvwarp::ShotReport report = uvwarpCommand(c, ::isatty(STDERR_FILENO) ? &bar : nullptr);
+            for (const std::string& line : uvwarp::shotSummary(report))
+                std::cout << "uvwarp: " << line << "\n";
+            return 0;
+        });
+    uvwarp::SolverOptions& solver = o->command.options.solver;
+    uvwarp->add_option("--rest", o->rest, "rest mesh with UVs (.obj)")->required();
+    uvwarp
+        ->add_option("--deformed", o->deformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
+        ->required();
+    uvwarp->add_option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15")->required();
+    uvwarp->add_option("--rigidity", o->rigidity, "rigidity maps, e.g. 'rig.<UDIM>.exr' (1 = rigid)")
+        ->required();
+    uvwarp->add_option("--mask", o->mask,
+                       "warp masks, e.g. 'mask.<UDIM>.exr' (>= 0.5 may warp); default: from the UVs");
+    uvwarp->add_option("--orientation", o->orientation,
+                       "orientation-preservation maps, e.g. 'orient.<UDIM>.exr' (in [0, 1], scales "
+                       "--orientation-preservation per texel)");
+    CLI::Option* texture =
+        uvwarp->add_option("--texture", o->texture, "texture to bake, e.g. 'col.<UDIM>.exr' (needs --bake)");
+    uvwarp
+        ->add_option("--out", o->out,
+                     "redirect maps, e.g. 'out/redirect.<UDIM>.####.exr' (2-channel float EXR)")
+        ->required();
+    CLI::Option* bake = uvwarp->add_option(
+        "--bake", o->bake, "baked textures, e.g. 'out/col.<UDIM>.####.exr' (needs --texture)");
+    texture->needs(bake);
+    bake->needs(texture);
+    uvwarp->add_option("--tiles", o->tiles,
+                       "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
+    uvwarp
+        ->add_option("--resolution", o->command.resolution,
+                     "grid cells per side, a power of two; 0: the rigidity map's size")
+        ->capture_default_str();
+    uvwarp->add_option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
+    uvwarp->add_option("--filter", o->filter, "bake filter: bilinear or bicubic")
+        ->check(CLI::IsMember({"bilinear", "bicubic"}))
+        ->capture_default_str();
+    uvwarp->add_option("--iterations", solver.iterations, "PBD iterations per frame")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarp->add_option("--levels", solver.levels, "hierarchy levels; 0: automatic")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarp
+        ->add_option("--sweeps", solver.sweepsPerLevel,
+                     "constraint sweeps per iteration and level, finest first")
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    uvwarp->add_option("--orientation-preservation", solver.orientationPreservation, "in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarp->add_option("--smoothing", solver.smoothing, "smoothing of rigid points, in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarp->add_option("--damping", solver.damping, "velocity damping, in [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
+    uvwarp->add_option("--coarse-stiffness", solver.coarseStiffness, "per coarser level, in (0, 1]")
+        ->check(CLI::Range(1e-6f, 1.0f))
+        ->capture_default_str();
+    uvwarp
+        ->add_option("--border-width", o->command.options.derivedMask.borderWidth,
+                     "texels of chart border kept fixed by a derived mask")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
 }
 
 }  // namespace deformkit::harness

@@ -3,6 +3,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -24,6 +25,27 @@ std::string defaultText(const std::vector<double>& values) {
     std::string out;
     for (double v : values)
         out += (out.empty() ? "" : " ") + numberText(v);
+    return out;
+}
+
+// `text` wrapped at 100 columns, each line indented by `indent` spaces.
+std::string wrapped(std::string_view text, size_t indent) {
+    constexpr size_t kColumns = 100;
+    std::string out, line;
+    size_t start = 0;
+    while (start < text.size()) {
+        const size_t space = text.find(' ', start);
+        const std::string_view word =
+            text.substr(start, space == std::string_view::npos ? space : space - start);
+        if (!line.empty() && indent + line.size() + 1 + word.size() > kColumns) {
+            out += std::string(indent, ' ') + line + "\n";
+            line.clear();
+        }
+        line += (line.empty() ? "" : " ") + std::string(word);
+        if (space == std::string_view::npos) break;
+        start = space + 1;
+    }
+    if (!line.empty()) out += std::string(indent, ' ') + line + "\n";
     return out;
 }
 
@@ -52,7 +74,7 @@ std::string parameterReference(ReferenceFormat format) {
                 << "| parameter | values | default | meaning |\n"
                 << "| --- | --- | --- | --- |\n";
         } else {
-            out << "\n" << type.name << ": " << type.summary << "\n";
+            out << "\n" << type.name << "\n" << wrapped(type.summary, 2);
         }
         for (const ParamInfo& info : d->parameters()) {
             const std::string name = info.name + (info.rebinds ? " [bind]" : "");
@@ -61,8 +83,9 @@ std::string parameterReference(ReferenceFormat format) {
                 out << "| `" << info.name << "`" << (info.rebinds ? " [bind]" : "") << " | " << values
                     << " | " << value << " | " << info.doc << " |\n";
             } else {
-                out << "  " << name << "  (" << values << " values; default " << value << ")\n"
-                    << "      " << info.doc << "\n";
+                out << "  " << name << ": " << values << (values == "1" ? " value" : " values")
+                    << ", default " << value << "\n"
+                    << wrapped(info.doc, 6);
             }
         }
     }

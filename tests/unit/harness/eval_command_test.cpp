@@ -16,6 +16,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "eval_command.h"
 #include "mesh_support.h"
 #include "test_support.h"
@@ -39,10 +40,10 @@ const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
 }  // namespace
 
 TEST_CASE("eval command: file names pad the frame to 4 digits after the sign", "[harness][eval]") {
-    CHECK(harness::evalFileName("tube", 7) == "tube.0007.obj");
-    CHECK(harness::evalFileName("tube", 12345) == "tube.12345.obj");
-    CHECK(harness::evalFileName("tube", -3) == "tube.-0003.obj");
-    CHECK(harness::evalFileName("tube", -3, ".png") == "tube.-0003.png");
+    CHECK(scene::frameFileName("tube", 7) == "tube.0007.obj");
+    CHECK(scene::frameFileName("tube", 12345) == "tube.12345.obj");
+    CHECK(scene::frameFileName("tube", -3) == "tube.-0003.obj");
+    CHECK(scene::frameFileName("tube", -3, ".png") == "tube.-0003.png");
 }
 
 TEST_CASE("eval command: writes every object at every frame, equal to the stack evaluated directly",
@@ -61,8 +62,8 @@ TEST_CASE("eval command: writes every object at every frame, equal to the stack 
     CHECK(report.frames == std::vector<int>{1, 2, 3});
     REQUIRE(report.files.size() == 6);
     for (int frame = 1; frame <= 3; ++frame) {
-        CHECK(std::filesystem::is_regular_file(command.outDir / harness::evalFileName("tube", frame)));
-        CHECK(std::filesystem::is_regular_file(command.outDir / harness::evalFileName("still", frame)));
+        CHECK(std::filesystem::is_regular_file(command.outDir / scene::frameFileName("tube", frame)));
+        CHECK(std::filesystem::is_regular_file(command.outDir / scene::frameFileName("still", frame)));
     }
     // No temporaries left behind by the atomic writes.
     CHECK(std::distance(std::filesystem::directory_iterator(command.outDir), {}) == 6);
@@ -199,7 +200,7 @@ TEST_CASE("eval command: previews of the rest pose equal the renderer's view of 
     for (const char* name : {"tube", "still"}) {
         for (int frame = 1; frame <= 3; ++frame) {
             const io::ImageInfo info =
-                io::readImageInfo(command.outDir / harness::evalFileName(name, frame, ".png"));
+                io::readImageInfo(command.outDir / scene::frameFileName(name, frame, ".png"));
             CHECK(info.width == 480);
             CHECK(info.height == 360);
             CHECK(info.channels == 3);
@@ -215,7 +216,7 @@ TEST_CASE("eval command: previews of the rest pose equal the renderer's view of 
     const std::vector<int> rest = bytesOf(io::readImage(dir / "rest.png"));
     // The object without deformers, at every frame.
     for (int frame = 1; frame <= 3; ++frame)
-        CHECK(bytesOf(io::readImage(command.outDir / harness::evalFileName("still", frame, ".png"))) == rest);
+        CHECK(bytesOf(io::readImage(command.outDir / scene::frameFileName("still", frame, ".png"))) == rest);
     // Frame 1 of the deformed object: twist angle 0 and bend envelope 0 leave the rest positions exactly.
     const io::ObjContent first = io::readObj(command.outDir / "tube.0001.obj");
     REQUIRE(std::equal(first.mesh.points().begin(), first.mesh.points().end(), tube.points().begin()));
@@ -276,7 +277,7 @@ TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a 
     // 8-bit values both ways).
     for (size_t t = 0; t < command.frames.size(); ++t) {
         const std::vector<int> preview =
-            bytesOf(io::readImage(command.outDir / harness::evalFileName("tube", command.frames[t], ".png")));
+            bytesOf(io::readImage(command.outDir / scene::frameFileName("tube", command.frames[t], ".png")));
         const int x0 = static_cast<int>(t % columns) * tileW, y0 = static_cast<int>(t / columns) * tileH;
         CHECK(crop(sheetBytes, sheet.width, x0, y0, tileW, tileH) == boxDown(preview, 481, 361, factor));
     }

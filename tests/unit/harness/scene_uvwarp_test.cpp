@@ -18,12 +18,12 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/scene/scene.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "eval_command.h"
 #include "farm_command.h"
 #include "mesh_support.h"
-#include "scene_uvwarp.h"
 #include "test_support.h"
 
 // The UV-warp stage of scenes: parsing, `deformkit eval` and farm tasks, checked against TileWarp driven
@@ -128,12 +128,12 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     CHECK(object.uvwarp->rigidity == shot.dir / "rig.<UDIM>.exr");
     CHECK(object.uvwarp->options.solver.iterations == 6);
     CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
-    CHECK(harness::uvwarpWarpedTiles(*object.uvwarp) == std::vector<int>{1001, 1002});
-    CHECK(harness::uvwarpOutputs(object, 1001, 7) ==
+    CHECK(scene::uvwarpWarpedTiles(*object.uvwarp) == std::vector<int>{1001, 1002});
+    CHECK(scene::uvwarpOutputs(object, 1001, 7) ==
           std::vector<std::string>{"tubes.redirect.1001.0007.exr", "tubes.bake.1001.0007.exr"});
-    CHECK(harness::uvwarpOutputs(object, 1002, -2) ==
+    CHECK(scene::uvwarpOutputs(object, 1002, -2) ==
           std::vector<std::string>{"tubes.redirect.1002.-0002.exr"});
-    CHECK(harness::uvwarpOutputs(object, 1003, 1).empty());
+    CHECK(scene::uvwarpOutputs(object, 1003, 1).empty());
 }
 
 TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON path",
@@ -205,7 +205,7 @@ TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed
             const std::vector<glm::vec3> points = stackPoints(shot.rest, frame);
             warp.solve(points);
             const io::Image expected = warp.redirect();
-            const fs::path file = command.outDir / harness::uvwarpRedirectName("tubes", tile, frame);
+            const fs::path file = command.outDir / scene::uvwarpRedirectName("tubes", tile, frame);
             const io::Image written = io::readImage(file);
             REQUIRE(written.width == expected.width);
             REQUIRE(written.channels == 2);

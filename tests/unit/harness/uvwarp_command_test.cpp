@@ -12,6 +12,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/tile_warp.h"
+#include "progress_bar.h"
 #include "test_support.h"
 #include "uvwarp_command.h"
 
@@ -152,8 +153,8 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
     CHECK(harness::parseTiles("1002,1001,1002") == std::vector<int>{1001, 1002});
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1001,1000"); }),
                Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));
-    CHECK(harness::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
-    CHECK(harness::tileFramePath("r_<UVTILE>.%03d.exr", 1012, -4) == fs::path("r_u2_v2.-004.exr"));
+    CHECK(uvwarp::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
+    CHECK(uvwarp::tileFramePath("r_<UVTILE>.%03d.exr", 1012, -4) == fs::path("r_u2_v2.-004.exr"));
 }
 
 TEST_CASE("uvwarp command: redirect maps and bakes per frame, identity for the undeformed frame",
@@ -163,7 +164,8 @@ TEST_CASE("uvwarp command: redirect maps and bakes per frame, identity for the u
     s.command.bake = s.dir / "out/col.<UDIM>.####.exr";
     s.command.log = s.dir / "log.jsonl";
     std::ostringstream progress;
-    const harness::UvWarpReport report = harness::uvwarpCommand(s.command, &progress);
+    harness::ProgressBar bar(progress);
+    const uvwarp::ShotReport report = harness::uvwarpCommand(s.command, &bar);
     REQUIRE(report.tiles.size() == 1);
     CHECK(report.tiles[0].tile == 1001);
     CHECK(report.tiles[0].warped);
@@ -230,7 +232,7 @@ TEST_CASE("uvwarp command: a rerun skips existing outputs and replays the warm s
     const std::string frame2 = test::readText(s.redirect(2)), frame3 = test::readText(s.redirect(3));
     const auto stamp = fs::last_write_time(s.redirect(3));
 
-    harness::UvWarpReport again = harness::uvwarpCommand(s.command);
+    uvwarp::ShotReport again = harness::uvwarpCommand(s.command);
     CHECK(again.tiles[0].written == 0);
     CHECK(again.tiles[0].replayed == 0);
     CHECK(again.tiles[0].skipped == 3);
@@ -336,7 +338,7 @@ TEST_CASE("uvwarp command: a tile without a rigidity map is left unwarped and re
           "[harness][uvwarp]") {
     Scene s({0, 1});  // charts in tiles 1001 and 1002, rigidity for 1001 only
     s.command.log = s.dir / "log.jsonl";
-    const harness::UvWarpReport report = harness::uvwarpCommand(s.command);
+    const uvwarp::ShotReport report = harness::uvwarpCommand(s.command);
     REQUIRE(report.tiles.size() == 2);
     CHECK(report.tiles[0].written == 3);
     CHECK_FALSE(report.tiles[1].warped);
@@ -350,7 +352,7 @@ TEST_CASE("uvwarp command: a tile without a rigidity map is left unwarped and re
     REQUIRE(lines.size() == 6);
     CHECK(lines[3].at("tile") == 1002);
     CHECK(lines[3].at("status") == "unwarped");
-    const std::vector<std::string> summary = harness::uvwarpSummary(report);
+    const std::vector<std::string> summary = uvwarp::shotSummary(report);
     REQUIRE(summary.size() == 2);
     CHECK_THAT(summary[0], Catch::StartsWith("tile 1001: 3 frames written"));
     CHECK_THAT(summary[1], Catch::StartsWith("tile 1002: left unwarped: no rigidity map"));
@@ -372,7 +374,7 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
             io::writeImage(s.dir / "orient.1001.exr", *map, {io::PixelType::Float, {}});
             s.command.orientation = s.dir / "orient.<UDIM>.exr";
         }
-        const harness::UvWarpReport report = harness::uvwarpCommand(s.command, nullptr);
+        const uvwarp::ShotReport report = harness::uvwarpCommand(s.command, nullptr);
         REQUIRE(report.tiles.size() == 1);
         CHECK(report.tiles[0].notes.empty());
         return io::readImage(s.redirect(3));
@@ -389,7 +391,7 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     // naming the file.
     Scene missing;
     missing.command.orientation = missing.dir / "orient.<UDIM>.exr";
-    const harness::UvWarpReport report = harness::uvwarpCommand(missing.command, nullptr);
+    const uvwarp::ShotReport report = harness::uvwarpCommand(missing.command, nullptr);
     REQUIRE(report.tiles.size() == 1);
     REQUIRE(report.tiles[0].notes.size() == 1);
     CHECK_THAT(report.tiles[0].notes[0], Catch::Contains("no orientation map"));

@@ -1,22 +1,16 @@
-#include "commands.h"
-
+// `deformkit info FILE`: a mesh, an image or the tiles of a UDIM pattern.
 #include <algorithm>
 #include <iomanip>
+#include <iostream>
 #include <map>
 
+#include "cli.h"
+#include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
-#include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
-#include "deformkit/ptex/ptex_mesh.h"
-#include "demo_assets.h"
-#include "demo_ptex.h"
-#include "demo_slide.h"
-#include "demo_uvwarp.h"
-#include "demo_warps.h"
-#include "slide_command.h"
 
 namespace deformkit::harness {
 namespace fs = std::filesystem;
@@ -121,77 +115,15 @@ void describe(const fs::path& file, std::ostream& out) {
     }
 }
 
-void preview(const PreviewCommand& command) {
-    const io::ObjContent obj = io::readObj(command.mesh);
-    std::optional<io::PreviewTexture> texture;
-    if (command.texture) texture = io::loadPreviewTexture(*command.texture);
-    if (command.weights && command.weightsPtex) {
-        throw InvalidInput(
-            formatError("--weights-ptex", "", "is given with --weights", "one weights source"));
-    }
-    io::PreviewOptions options = command.options;
-    if (command.weights || command.weightsPtex) {
-        const std::vector<float> weights =
-            command.weights ? readWeights(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
-                            : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
-                                                    "--weights-ptex");
-        options.vertexColors.clear();
-        for (float w : weights)
-            options.vertexColors.push_back(io::weightColor(w));
-    }
-    const io::Image image = io::renderPreview(obj.mesh, options, texture ? &*texture : nullptr);
-    io::writeImage(command.out, image);
-}
-
-std::vector<fs::path> demo(const DemoCommand& command) {
-    io::createFolder(command.outDir);
-    const DemoAssets assets = makeDemoAssets({command.resolution});
-    std::vector<fs::path> written;
-    const fs::path meshPath = command.outDir / "tube.obj";
-    io::writeObj(meshPath, assets.mesh);
-    written.push_back(meshPath);
-
-    io::ImageWriteOptions maps;
-    maps.type = io::PixelType::Half;
-    maps.attributes = {{"deformkit:asset", "demo"}};
-    for (const auto& [tile, image] : assets.rigidity) {
-        written.push_back(command.outDir / io::expandUdim("rigidity.<UDIM>.exr", tile));
-        io::writeImage(written.back(), image, maps);
-    }
-    for (const auto& [tile, image] : assets.mask) {
-        written.push_back(command.outDir / io::expandUdim("mask.<UDIM>.exr", tile));
-        io::writeImage(written.back(), image, maps);
-    }
-    io::PreviewTexture texture;
-    for (const auto& [tile, image] : assets.albedo) {
-        written.push_back(command.outDir / io::expandUdim("albedo.<UDIM>.png", tile));
-        io::writeImage(written.back(), image);
-        texture.tiles.emplace(tile, image);
-    }
-    io::PreviewOptions view;
-    view.drawEdges = false;
-    written.push_back(command.outDir / "preview.png");
-    io::writeImage(written.back(), io::renderPreview(assets.mesh, view, &texture));
-    for (fs::path& f : writeDemoWarps(assets.mesh, texture, assets.albedo.at(1001), command.outDir)) {
-        written.push_back(std::move(f));
-    }
-    for (fs::path& f : writeDemoSlide(assets.mesh, command.outDir)) {
-        written.push_back(std::move(f));
-    }
-    for (fs::path& f : writeDemoPtex(assets.mesh, command.outDir)) {
-        written.push_back(std::move(f));
-    }
-    for (fs::path& f : writeDemoUvWarp(assets.mesh, assets.rigidity.at(1001), assets.mask.at(1001),
-                                       assets.albedo, command.outDir)) {
-        written.push_back(std::move(f));
-    }
-    return written;
-}
-
-scene::Scene readScene(const fs::path& path) {
-    scene::SceneReadOptions options;
-    options.ptexWeights = ptex::weightsFromPtex;
-    return scene::readScene(path, options);
+void addInfoCommand(CommandLine& cli) {
+    auto file = std::make_shared<std::string>();
+    CLI::App* info = cli.add(cli.app(), "info",
+                             "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern", [file] {
+                                 describe(*file, std::cout);
+                                 return 0;
+                             });
+    info->add_option("FILE", *file, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
+        ->required();
 }
 
 }  // namespace deformkit::harness

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/interrupter.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/scene.h"
+#include "deformkit/uvwarp/shot_job.h"
+
+// The files a scene evaluation writes, and the UV-warp stage of a scene object (SceneUvWarp, docs/scene.md)
+// as `deformkit eval` and farm tasks run it: the shot job (uvwarp/shot_job.h) fed with the object's stack
+// output at each frame. Files in the output folder:
+//
+//   <object>.<frame>.obj                      the deformed mesh (frameFileName)
+//   <object>.redirect.<tile>.<frame>.exr      the redirect map W^-1 (2 float channels, header attributes)
+//   <object>.bake.<tile>.<frame><extension>   the texture baked through it, the texture's file extension
+//
+// Within one run the frames of a tile are solved in ascending order, each warm-started from the previous
+// one; a run starts cold at its first frame. So a farm task writes the bytes `deformkit eval` writes over
+// the task's frame range.
+namespace deformkit::scene {
+
+// "<object>.<frame><extension>" with the frame zero padded to 4 digits, a sign before the padding
+// ("body.0012.obj", "body.-0003.obj").
+[[nodiscard]] std::string frameFileName(const std::string& object, int frame,
+                                        const std::string& extension = ".obj");
+
+// "<object>.redirect.<tile>.<frame>.exr".
+[[nodiscard]] std::string uvwarpRedirectName(const std::string& object, int tile, int frame);
+// "<object>.bake.<tile>.<frame><texture extension>" (the stage must have a texture).
+[[nodiscard]] std::string uvwarpBakeName(const SceneObject& object, int tile, int frame);
+
+// The stage's tiles that are warped: those with a rigidity map on disk, ascending. A tile without one is
+// left unwarped (no outputs).
+[[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage);
+
+// The files the object's stage writes for `tile` at `frame`: the redirect map, then the bake when the
+// stage has a texture and the tile's texture exists. Empty without a stage or for a tile it does not warp.
+[[nodiscard]] std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame);
+
+struct UvWarpStageRun {
+    std::vector<int> frames;  // ascending
+    std::vector<int> tiles;   // ascending; tiles the stage does not warp are ignored
+    std::filesystem::path outDir;
+    bool skipExisting = false;    // true: keep existing outputs and replay the warm start (farm tasks)
+    std::ostream* log = nullptr;  // JSON lines per tile x frame (ShotJob::log)
+    int logTask = -1;
+};
+
+// The shot job of object `object`'s UV-warp stage (it must have one) over the run, its outputs named as
+// above. Throws InvalidInput naming the scene and the object when it has no stage.
+[[nodiscard]] uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpStageRun& run);
+
+// The stage's shot solver, with messages naming the scene and the stage's JSON path: feed it the object's
+// evaluated frames in order (ShotSolver::solveFrame with frameFileName as the input's name). Empty when
+// the run has no frame or none of its tiles is the stage's.
+[[nodiscard]] std::optional<uvwarp::ShotSolver> uvwarpStageSolver(const Scene& scene, size_t object,
+                                                                  const UvWarpStageRun& run);
+
+// Feeds `solver` (uvwarpStageSolver's) object `object`'s deformed positions at `frame`, the run's next frame,
+// unless the solver needs no more frames; errors name the scene and the stage's JSON path.
+void solveStageFrame(uvwarp::ShotSolver& solver, const Scene& scene, size_t object, int frame,
+                     std::span<const glm::vec3> deformed, Interrupter* interrupter = nullptr);
+
+// The whole stage over the run: each needed frame evaluated once and fed to every tile.
+uvwarp::ShotReport runUvWarpStage(SceneEvaluator& evaluator, size_t object, const UvWarpStageRun& run,
+                                  Interrupter* interrupter = nullptr);
+
+}  // namespace deformkit::scene

@@ -1,0 +1,149 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/interrupter.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/sampling.h"
+#include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/tile_warp.h"
+
+namespace deformkit::uvwarp {
+
+// The content-aware UV warp over a shot: for every UDIM tile and frame, the redirect map W^-1 (and the
+// tile's texture baked through it), written as files with their provenance. The one implementation behind
+// `deformkit uvwarp`, the UV-warp stage of scenes (`deformkit eval`, farm tasks), the Python module's
+// `uvwarp_shot` and the Blender add-on's bake.
+//
+// - Per tile one TileWarp is bound (rest mesh, rigidity map, mask map or a mask derived from the UVs,
+//   orientation map) and solved frame after frame in ascending order, each frame warm-started from the
+//   previous one; a job starts cold at its first frame. Tiles are solved frame by frame together, so each
+//   frame's deformed positions are asked for once; memory is one solver per tile of the job (a farm task
+//   bounds it with its tile count).
+// - Outputs per tile and frame: the redirect map as a 2-channel float EXR (the rigidity map's size) whose
+//   header records how it was made (deformkit:version, deformkit:uvwarp:tile, deformkit:uvwarp:frame,
+//   deformkit:uvwarp:solver and deformkit:uvwarp:inputs, the last two JSON); with a texture, the bake
+//   (an EXR bake gets the same attributes). Every file is written atomically.
+// - Resuming (skipExisting): an output that exists is not written again. So that a resumed job writes the
+//   bytes an uninterrupted one would have, the warm start is replayed: each tile solves every frame up to
+//   its last missing output, frames whose outputs exist only to carry the warm start ("replayed"), and no
+//   frame after it ("skipped"). A tile whose outputs all exist is not bound.
+// - Checks before anything is written: output folders exist; per tile the maps' sizes (square, equal, a
+//   power of two when the grid takes the map's size). A tile without a rigidity map is left unwarped (no
+//   outputs) and reported, unless no tile has one (an error). A missing mask tile is derived from the UVs, a
+//   missing orientation tile means 1 everywhere, a missing texture tile is not baked; each is reported.
+
+// A per-tile map: a UDIM pattern of files ("rig.<UDIM>.exr", io/udim.h tokens) or images a host holds in
+// memory (painted maps), by tile. Images are T x T (channel 0 used), rows from the top (io::Image).
+struct TileMapSource {
+    std::filesystem::path pattern;    // empty when the maps are `images`
+    std::map<int, io::Image> images;  // tile -> map, used when there is no pattern
+    std::string name;                 // how messages and headers name the source; empty: the pattern
+
+    [[nodiscard]] bool given() const { return !pattern.empty() || !images.empty(); }
+};
+
+struct ShotJob {
+    const geom::Mesh* rest = nullptr;  // with UVs; must outlive the job
+    std::string restName;              // names the rest mesh in messages and EXR headers
+    std::vector<int> frames;           // ascending, at least one
+    std::vector<int> tiles;            // tiles of the rest mesh's UVs, ascending; empty: every tile of them
+    TileMapSource rigidity;            // required; channel 0 in [0, 1], 1 = rigid
+    TileMapSource mask;                // optional; channel 0 >= 0.5 may warp
+    TileMapSource orientation;         // optional; channel 0 in [0, 1] scales the orientation preservation
+    TileMapSource texture;             // optional; baked through each redirect map (needs bakePath)
+    // How messages name the rigidity input when no tile has a map ("--rigidity", a scene's JSON path).
+    std::string rigidityOption = "rigidity";
+    // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
+    std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
+    TileWarpOptions options;  // cells: the grid resolution (0: the rigidity map's size)
+    io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
+    // Keep existing outputs and replay the warm start (a resumed job writes an uninterrupted job's bytes);
+    // false writes every output again.
+    bool skipExisting = true;
+    // JSON lines, one per tile and frame: {"tile", "frame", "status" (written, replayed, skipped, unwarped),
+    // "redirect", "bake", "metrics", "seconds"}; with "task" when logTask >= 0 and "object" when logObject is
+    // not empty.
+    std::ostream* log = nullptr;
+    int logTask = -1;
+    std::string logObject;
+};
+
+struct ShotTileReport {
+    int tile = 0;
+    bool warped = true;                        // false: no rigidity map, no outputs
+    std::vector<std::string> notes;            // why unwarped, a derived mask, a texture not baked
+    int32_t written = 0;                       // frames whose redirect or bake was written
+    int32_t baked = 0;                         // bakes written
+    int32_t replayed = 0;                      // outputs existed; solved to carry the warm start
+    int32_t skipped = 0;                       // outputs existed; not solved
+    int lastFrame = 0;                         // the last frame solved (replayed or written)
+    WarpMetrics lastMetrics;                   // of lastFrame
+    std::vector<std::filesystem::path> files;  // written, in order
+};
+
+struct ShotReport {
+    std::vector<ShotTileReport> tiles;  // ascending
+};
+
+// A shot job fed frame by frame, for a caller that makes the deformed positions itself (a scene evaluated
+// once per frame for its meshes and every tile). Not thread-safe; each tile's solve runs in parallel inside.
+class ShotSolver {
+  public:
+    // Plans the job and checks every input it can before anything is written. Throws InvalidInput for an
+    // incomplete job, a tile the rest mesh's UVs do not touch or a map of the wrong size; IoError for a
+    // missing output folder or when no tile has a rigidity map; ParseError for an unreadable map header.
+    explicit ShotSolver(ShotJob job);
+    ~ShotSolver();
+    ShotSolver(ShotSolver&&) noexcept;
+    ShotSolver& operator=(ShotSolver&&) noexcept;
+
+    // Progress units of the job: tiles x frames.
+    [[nodiscard]] int64_t units() const;
+    // The last frame whose deformed positions some tile needs; frames after it need no evaluation. None
+    // when every output exists.
+    [[nodiscard]] std::optional<int> lastNeededFrame() const;
+    // Frame `frame`, the job's next frame in order: solves every tile that needs it from `deformed` (#V
+    // positions of the rest mesh's vertices) and writes its outputs. `inputName` is what the headers record
+    // as the frame's input ("anim.0007.obj"). After each tile the interrupter, when given, is told and may
+    // cancel (Cancelled). Throws InvalidInput for a frame out of order or a vertex count that differs.
+    void solveFrame(int frame, std::span<const glm::vec3> deformed, const std::string& inputName,
+                    Interrupter* interrupter = nullptr);
+    // Logs the frames not given (after lastNeededFrame) and returns the report.
+    [[nodiscard]] ShotReport finish();
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// The deformed positions of the rest mesh's vertices at `frame`; sets `name` to what the headers record as
+// the frame's input. The span must stay valid until the next call.
+using DeformedFrames = std::function<std::span<const glm::vec3>(int frame, std::string& name)>;
+
+// The whole job: ShotSolver fed by `deformed`, asked once per frame up to the last needed one. The
+// interrupter, when given, is started with the job's units, told after each tile and frame, and ended.
+ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interrupter* interrupter = nullptr);
+
+// The file of `tile` and `frame` for a pattern with a UDIM token and a frame token in its file name
+// ("out/redirect.<UDIM>.####.exr"; frame tokens as io::ObjSequence).
+[[nodiscard]] std::filesystem::path tileFramePath(const std::filesystem::path& pattern, int tile, int frame);
+
+// One line per warped tile ("tile 1001: 24 frames written (24 baked), 0 replayed, 0 skipped (outputs exist);
+// frame 24: rigid stretch error 0.041 (identity 0.262), 0 fold-overs") and one per note ("tile 1002: left
+// unwarped: no rigidity map 'rig.1002.exr'").
+[[nodiscard]] std::vector<std::string> shotSummary(const ShotReport& report);
+
+}  // namespace deformkit::uvwarp

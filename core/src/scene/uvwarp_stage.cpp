@@ -1,0 +1,158 @@
+#include "deformkit/scene/uvwarp_stage.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <system_error>
+#include <utility>
+
+#include "deformkit/error.h"
+#include "deformkit/io/udim.h"
+
+namespace deformkit::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool fileExists(const fs::path& path) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+}
+
+fs::path tileFile(const fs::path& pattern, int tile) {
+    return io::expandUdim(pattern.string(), tile);
+}
+
+const SceneObject& stageObject(const Scene& scene, size_t object) {
+    const SceneObject& o = scene.objects.at(object);
+    if (!o.uvwarp) {
+        throw InvalidInput(formatError(scene.source, o.path + ".stack", "has no UV-warp stage",
+                                       "a stack whose last entry has type \"uvwarp\""));
+    }
+    return o;
+}
+
+// Runs `work`, naming the scene and the stage's JSON path in an InvalidInput that does not name the scene.
+template <class Work>
+auto inStage(const Scene& scene, const SceneUvWarp& stage, Work&& work) {
+    try {
+        return work();
+    } catch (const InvalidInput& e) {
+        const std::string what = e.what();
+        if (what.rfind(scene.source, 0) == 0) throw;
+        throw InvalidInput(formatError(scene.source, stage.path, what, ""));
+    }
+}
+
+}  // namespace
+
+std::string frameFileName(const std::string& object, int frame, const std::string& extension) {
+    char digits[32];
+    std::snprintf(digits, sizeof(digits), "%s%04lld", frame < 0 ? "-" : "",
+                  std::llabs(static_cast<long long>(frame)));
+    return object + "." + digits + extension;
+}
+
+std::string uvwarpRedirectName(const std::string& object, int tile, int frame) {
+    return frameFileName(object + ".redirect." + std::to_string(tile), frame, ".exr");
+}
+
+std::string uvwarpBakeName(const SceneObject& object, int tile, int frame) {
+    return frameFileName(object.name + ".bake." + std::to_string(tile), frame,
+                         object.uvwarp->texture->extension().string());
+}
+
+std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage) {
+    std::vector<int> tiles;
+    for (int tile : stage.tiles) {
+        if (fileExists(tileFile(stage.rigidity, tile))) tiles.push_back(tile);
+    }
+    return tiles;
+}
+
+std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame) {
+    if (!object.uvwarp) return {};
+    const SceneUvWarp& stage = *object.uvwarp;
+    if (!std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile) ||
+        !fileExists(tileFile(stage.rigidity, tile)))
+        return {};
+    std::vector<std::string> outputs = {uvwarpRedirectName(object.name, tile, frame)};
+    if (stage.texture && fileExists(tileFile(*stage.texture, tile)))
+        outputs.push_back(uvwarpBakeName(object, tile, frame));
+    return outputs;
+}
+
+uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpStageRun& run) {
+    const SceneObject& o = stageObject(scene, object);
+    const SceneUvWarp& stage = *o.uvwarp;
+    uvwarp::ShotJob job;
+    job.rest = &o.rest;
+    job.restName = o.meshFile.string();
+    job.frames = run.frames;
+    for (int tile : run.tiles) {
+        if (std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile)) job.tiles.push_back(tile);
+    }
+    job.rigidity.pattern = stage.rigidity;
+    if (stage.mask) job.mask.pattern = *stage.mask;
+    if (stage.orientation) job.orientation.pattern = *stage.orientation;
+    if (stage.texture) job.texture.pattern = *stage.texture;
+    job.rigidityOption = scene.source + ": " + stage.path + ".rigidity";
+    const std::string name = o.name;
+    const fs::path outDir = run.outDir;
+    job.outPath = [name, outDir](int tile, int frame) {
+        return outDir / uvwarpRedirectName(name, tile, frame);
+    };
+    if (stage.texture) {
+        const std::string extension = stage.texture->extension().string();
+        job.bakePath = [name, outDir, extension](int tile, int frame) {
+            return outDir / frameFileName(name + ".bake." + std::to_string(tile), frame, extension);
+        };
+    }
+    job.options = stage.options;
+    job.filter = stage.filter;
+    job.skipExisting = run.skipExisting;
+    job.log = run.log;
+    job.logTask = run.logTask;
+    job.logObject = name;
+    return job;
+}
+
+std::optional<uvwarp::ShotSolver> uvwarpStageSolver(const Scene& scene, size_t object,
+                                                    const UvWarpStageRun& run) {
+    uvwarp::ShotJob job = uvwarpStageJob(scene, object, run);
+    if (job.tiles.empty() || job.frames.empty()) return std::nullopt;
+    return inStage(scene, *scene.objects[object].uvwarp,
+                   [&] { return std::optional<uvwarp::ShotSolver>(std::in_place, std::move(job)); });
+}
+
+void solveStageFrame(uvwarp::ShotSolver& solver, const Scene& scene, size_t object, int frame,
+                     std::span<const glm::vec3> deformed, Interrupter* interrupter) {
+    const SceneObject& o = stageObject(scene, object);
+    const std::optional<int> last = solver.lastNeededFrame();
+    if (!last || frame > *last) return;
+    inStage(scene, *o.uvwarp,
+            [&] { solver.solveFrame(frame, deformed, frameFileName(o.name, frame), interrupter); });
+}
+
+uvwarp::ShotReport runUvWarpStage(SceneEvaluator& evaluator, size_t object, const UvWarpStageRun& run,
+                                  Interrupter* interrupter) {
+    const Scene& scene = evaluator.scene();
+    std::optional<uvwarp::ShotSolver> solver = uvwarpStageSolver(scene, object, run);
+    if (!solver) return {};
+    const std::optional<int> last = solver->lastNeededFrame();
+    if (interrupter) interrupter->start("uvwarp", solver->units());
+    struct EndOnExit {
+        Interrupter* interrupter;
+        ~EndOnExit() {
+            if (interrupter) interrupter->end();
+        }
+    } endOnExit{interrupter};
+    for (int frame : run.frames) {
+        if (!last || frame > *last) break;
+        solveStageFrame(*solver, scene, object, frame, evaluator.evaluate(object, frame).points(),
+                        interrupter);
+    }
+    return solver->finish();
+}
+
+}  // namespace deformkit::scene

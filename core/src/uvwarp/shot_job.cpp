@@ -1,0 +1,496 @@
+#include "deformkit/uvwarp/shot_job.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cstdlib>
+#include <optional>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj_sequence.h"
+#include "deformkit/io/udim.h"
+#include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/mask.h"
+#include "deformkit/version.h"
+
+namespace deformkit::uvwarp {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool fileExists(const fs::path& path) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+}
+
+// A float option as JSON: the shortest decimal that reads back as the float (0.05, not 0.0500000007).
+double tidy(float value) {
+    char text[32];
+    const auto [end, ec] = std::to_chars(text, text + sizeof(text), value);
+    return ec == std::errc() ? std::strtod(std::string(text, end).c_str(), nullptr)
+                             : static_cast<double>(value);
+}
+
+json metricsJson(const WarpMetrics& m, const SolveStats& s) {
+    return {{"rigid_stretch_error", m.rigidStretchError},
+            {"identity_stretch_error", m.identityStretchError},
+            {"rigid_edges", m.rigidEdges},
+            {"skipped_edges", m.skippedEdges},
+            {"fold_overs", m.foldOvers},
+            {"max_masked_displacement", m.maxMaskedDisplacement},
+            {"max_border_displacement", m.maxBorderDisplacement},
+            {"points_outside", m.pointsOutside},
+            {"iterations", s.iterations},
+            {"levels", s.levels},
+            {"untangled_points", s.untangledPoints},
+            {"remaining_folds", s.remainingFolds}};
+}
+
+json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t levelsUsed,
+                bool derivedMask) {
+    json j = {{"cells", cells},
+              {"texels", texels},
+              {"levels", o.solver.levels},
+              {"levelsUsed", levelsUsed},
+              {"iterations", o.solver.iterations},
+              {"sweepsPerLevel", o.solver.sweepsPerLevel},
+              {"orientationPreservation", tidy(o.solver.orientationPreservation)},
+              {"smoothing", tidy(o.solver.smoothing)},
+              {"damping", tidy(o.solver.damping)},
+              {"coarseStiffness", tidy(o.solver.coarseStiffness)},
+              {"dilationRings", o.dilationRings},
+              {"warmStart", true}};
+    if (derivedMask) j["derivedMaskBorderWidth"] = o.derivedMask.borderWidth;
+    return j;
+}
+
+std::string sizeText(int32_t width, int32_t height) {
+    return std::to_string(width) + " x " + std::to_string(height) + " texels";
+}
+
+// One tile's map from its source: a file of the pattern or an image in memory. `name` says where it came
+// from, for messages and headers.
+struct TileMap {
+    std::optional<fs::path> file;
+    const io::Image* image = nullptr;
+    std::string name;
+    int32_t width = 0, height = 0;
+
+    [[nodiscard]] bool found() const { return file.has_value() || image != nullptr; }
+};
+
+// Finds `tile` in `source` and reads its size (a file's header only, so a wrong size stops the job before
+// anything is written).
+TileMap findTileMap(const TileMapSource& source, int tile) {
+    TileMap map;
+    if (!source.pattern.empty()) {
+        const fs::path path = io::expandUdim(source.pattern.string(), tile);
+        map.name = path.string();
+        if (!fileExists(path)) return map;
+        const io::ImageInfo info = io::readImageInfo(path);
+        map.file = path;
+        map.width = info.width;
+        map.height = info.height;
+        return map;
+    }
+    map.name = (source.name.empty() ? std::string("map") : source.name) + " tile " + std::to_string(tile);
+    const auto it = source.images.find(tile);
+    if (it == source.images.end()) return map;
+    map.image = &it->second;
+    map.width = it->second.width;
+    map.height = it->second.height;
+    return map;
+}
+
+// What a job does for one tile, worked out before anything is written.
+struct TilePlan {
+    int tile = 0;
+    TileMap rigidity, mask, orientation, texture;
+    std::vector<fs::path> outPaths, bakePaths;  // per frame
+    std::vector<bool> needed;                   // per frame: an output to write
+    int lastNeeded = -1;                        // index of the last needed frame
+    std::optional<TileWarp> warp;               // bound at the first frame it solves
+    io::Image texturePixels, redirect, baked;
+    json inputs;
+    ShotTileReport report;
+};
+
+}  // namespace
+
+struct ShotSolver::Impl {
+    ShotJob job;
+    std::vector<TilePlan> plans;
+    size_t nextFrame = 0;  // index of the next frame in job.frames
+    int64_t unitsDone = 0;
+
+    void writeLog(json line) const {
+        if (!job.log) return;
+        if (job.logTask >= 0) line["task"] = job.logTask;
+        if (!job.logObject.empty()) line["object"] = job.logObject;
+        *job.log << line.dump() << "\n" << std::flush;
+    }
+    json baseLine(const TilePlan& plan, size_t k, const char* status) const {
+        json line = {{"tile", plan.tile}, {"frame", job.frames[k]}, {"status", status}};
+        if (!plan.outPaths.empty()) line["redirect"] = plan.outPaths[k].string();
+        if (plan.texture.found()) line["bake"] = plan.bakePaths[k].string();
+        return line;
+    }
+    // The units of frame k that need no solve: unwarped tiles and frames after a tile's last needed one.
+    void logUnsolved(TilePlan& plan, size_t k) {
+        if (!plan.report.warped) {
+            json line = baseLine(plan, k, "unwarped");
+            line["reason"] = "no rigidity map '" + plan.rigidity.name + "'";
+            writeLog(line);
+        } else {
+            ++plan.report.skipped;
+            writeLog(baseLine(plan, k, "skipped"));
+        }
+    }
+    void bind(TilePlan& plan);
+    void solveTile(TilePlan& plan, size_t k, std::span<const glm::vec3> deformed,
+                   const std::string& inputName);
+};
+
+ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
+    Impl& s = *impl_;
+    s.job = std::move(job);
+    const ShotJob& j = s.job;
+    if (!j.rest || j.frames.empty() || !j.outPath || !j.rigidity.given() ||
+        (j.texture.given() && !j.bakePath)) {
+        throw InvalidInput(formatError("uvwarp", "job", "is incomplete",
+                                       "a rest mesh, frames, a rigidity map, an output path, and a bake path "
+                                       "with a texture"));
+    }
+    if (!std::is_sorted(j.frames.begin(), j.frames.end()) ||
+        std::adjacent_find(j.frames.begin(), j.frames.end()) != j.frames.end()) {
+        throw InvalidInput(formatError("uvwarp", "frames", "are not ascending", "frames in ascending order"));
+    }
+    const geom::Mesh& rest = *j.rest;
+    if (!rest.hasUVs()) {
+        throw InvalidInput(formatError(j.restName, "", "has no UVs",
+                                       "a rest mesh with texture coordinates (vt) on its faces"));
+    }
+    const std::vector<int> meshTiles = rest.udimTiles();
+    std::vector<int> tiles = j.tiles.empty() ? meshTiles : j.tiles;
+    for (int tile : tiles) {
+        if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile)) {
+            std::string have;
+            for (int t : meshTiles)
+                have.append(have.empty() ? "" : " ").append(std::to_string(t));
+            throw InvalidInput(formatError("tiles", "tile " + std::to_string(tile),
+                                           "the rest mesh '" + j.restName + "' has no UV face in it",
+                                           "tiles of the rest mesh: " + have));
+        }
+    }
+    const int32_t resolution = j.options.cells;
+    const bool wantBake = j.texture.given();
+    for (int tile : tiles) {
+        TilePlan plan;
+        plan.tile = tile;
+        plan.report.tile = tile;
+        std::vector<fs::path> folders = {j.outPath(tile, j.frames.front()).parent_path()};
+        if (wantBake) folders.push_back(j.bakePath(tile, j.frames.front()).parent_path());
+        for (const fs::path& folder : folders) {
+            std::error_code ec;
+            if (!folder.empty() && !fs::is_directory(folder, ec)) {
+                throw IoError(formatError(folder.string(), "output folder", "does not exist",
+                                          "an existing folder for the outputs"));
+            }
+        }
+        plan.rigidity = findTileMap(j.rigidity, tile);
+        if (!plan.rigidity.found()) {
+            plan.report.warped = false;
+            plan.report.notes.push_back("left unwarped: no rigidity map '" + plan.rigidity.name + "'");
+            s.plans.push_back(std::move(plan));
+            continue;
+        }
+        const TileMap& r = plan.rigidity;
+        if (r.width != r.height || r.width < 2) {
+            throw InvalidInput(formatError(r.name, "rigidity map", sizeText(r.width, r.height),
+                                           "a square map of at least 2 x 2 texels"));
+        }
+        if (resolution == 0 && !isPowerOfTwo(r.width)) {
+            throw InvalidInput(formatError(r.name, "rigidity map",
+                                           std::to_string(r.width) + " texels per side, not a power of two",
+                                           "a power-of-two size, or a grid resolution"));
+        }
+        // Maps that must have the rigidity map's size.
+        const auto sameSize = [&](const TileMap& map, const char* what) {
+            if (map.width != r.width || map.height != r.height) {
+                throw InvalidInput(formatError(map.name, what, sizeText(map.width, map.height),
+                                               std::to_string(r.width) + " x " + std::to_string(r.height) +
+                                                   ", the size of '" + r.name + "'"));
+            }
+        };
+        if (j.mask.given()) {
+            plan.mask = findTileMap(j.mask, tile);
+            if (plan.mask.found()) {
+                sameSize(plan.mask, "warp mask");
+            } else {
+                plan.report.notes.push_back("no warp mask '" + plan.mask.name + "': derived from the UVs");
+            }
+        }
+        if (j.orientation.given()) {
+            plan.orientation = findTileMap(j.orientation, tile);
+            if (plan.orientation.found()) {
+                sameSize(plan.orientation, "orientation map");
+            } else {
+                plan.report.notes.push_back("no orientation map '" + plan.orientation.name +
+                                            "': orientation preservation as given everywhere");
+            }
+        }
+        if (wantBake) {
+            plan.texture = findTileMap(j.texture, tile);
+            if (!plan.texture.found())
+                plan.report.notes.push_back("no texture '" + plan.texture.name + "': not baked");
+        }
+        for (size_t k = 0; k < j.frames.size(); ++k) {
+            const int frame = j.frames[k];
+            plan.outPaths.push_back(j.outPath(tile, frame));
+            plan.bakePaths.push_back(plan.texture.found() ? j.bakePath(tile, frame) : fs::path());
+            const bool needed = !j.skipExisting || !fileExists(plan.outPaths.back()) ||
+                                (plan.texture.found() && !fileExists(plan.bakePaths.back()));
+            plan.needed.push_back(needed);
+            if (needed) plan.lastNeeded = static_cast<int>(k);
+        }
+        plan.inputs = {
+            {"rest", j.restName},
+            {"rigidity", plan.rigidity.name},
+            {"mask", plan.mask.found() ? plan.mask.name : std::string("derived")},
+            {"orientation", plan.orientation.found() ? plan.orientation.name : std::string("none")}};
+        s.plans.push_back(std::move(plan));
+    }
+    if (!s.plans.empty() &&
+        std::none_of(s.plans.begin(), s.plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
+        std::string list;
+        for (const TilePlan& p : s.plans)
+            list += (list.empty() ? "'" : ", '") + p.rigidity.name + "'";
+        const std::string source = j.rigidity.pattern.empty() ? j.rigidity.name : j.rigidity.pattern.string();
+        throw IoError(
+            formatError(j.rigidityOption, source, "no tile has a rigidity map", "at least one of " + list));
+    }
+}
+
+ShotSolver::~ShotSolver() = default;
+ShotSolver::ShotSolver(ShotSolver&&) noexcept = default;
+ShotSolver& ShotSolver::operator=(ShotSolver&&) noexcept = default;
+
+int64_t ShotSolver::units() const {
+    return static_cast<int64_t>(impl_->plans.size() * impl_->job.frames.size());
+}
+
+std::optional<int> ShotSolver::lastNeededFrame() const {
+    int last = -1;
+    for (const TilePlan& p : impl_->plans)
+        last = std::max(last, p.lastNeeded);
+    if (last < 0) return std::nullopt;
+    return impl_->job.frames[static_cast<size_t>(last)];
+}
+
+void ShotSolver::Impl::bind(TilePlan& plan) {
+    const auto read = [&](const TileMap& map, const char* role) -> io::Image {
+        // Files are checked as they are read (values in [0, 1], finite), naming the file and texel; maps in
+        // memory by TileWarp, naming the source.
+        if (map.file) {
+            if (std::string_view(role) == "warp mask") return readWarpMask(*map.file, plan.tile);
+            return readRigidityMap(*map.file, plan.tile, role);
+        }
+        return map.image ? *map.image : io::Image{};
+    };
+    const io::Image rigidity = read(plan.rigidity, "rigidity map");
+    const io::Image mask = read(plan.mask, "warp mask");
+    const io::Image orientation = read(plan.orientation, "orientation map");
+    if (plan.texture.file) {
+        plan.texturePixels = io::readImage(*plan.texture.file);
+    } else if (plan.texture.image) {
+        plan.texturePixels = *plan.texture.image;
+    }
+    plan.warp.emplace(*job.rest, plan.tile, rigidity, mask, job.options, orientation, job.restName);
+}
+
+void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::vec3> deformed,
+                                 const std::string& inputName) {
+    ShotTileReport& r = plan.report;
+    const int frame = job.frames[k];
+    const Clock::time_point start = Clock::now();
+    if (!plan.warp) bind(plan);
+    TileWarp& warp = *plan.warp;
+    Clock::time_point t = Clock::now();
+    warp.solve(deformed);
+    const double solveSeconds = secondsSince(t);
+    const WarpMetrics metrics = warp.metrics();
+    r.lastMetrics = metrics;
+    r.lastFrame = frame;
+    json seconds = {{"solve", solveSeconds}};
+    const bool needed = plan.needed[k];
+    if (needed) {
+        t = Clock::now();
+        warp.redirect(plan.redirect);
+        seconds["invert"] = secondsSince(t);
+        io::ImageWriteOptions attributes;
+        json frameInputs = plan.inputs;
+        frameInputs["deformed"] = inputName;
+        attributes.attributes = {
+            {"deformkit:version", kVersionString},
+            {"deformkit:uvwarp:tile", std::to_string(plan.tile)},
+            {"deformkit:uvwarp:frame", std::to_string(frame)},
+            {"deformkit:uvwarp:solver",
+             solverJson(job.options, warp.cells(), warp.texels(), warp.stats().levels, !plan.mask.found())
+                 .dump()},
+            {"deformkit:uvwarp:inputs", frameInputs.dump()}};
+        t = Clock::now();
+        if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
+            io::ImageWriteOptions write = attributes;
+            write.type = io::PixelType::Float;
+            io::writeImage(plan.outPaths[k], plan.redirect, write);
+            r.files.push_back(plan.outPaths[k]);
+        }
+        double writeSeconds = secondsSince(t);
+        if (plan.texture.found() && (!job.skipExisting || !fileExists(plan.bakePaths[k]))) {
+            t = Clock::now();
+            BakeOptions bakeOptions;
+            bakeOptions.filter = job.filter;
+            bakeTexture(plan.texturePixels, plan.redirect, plan.baked, bakeOptions);
+            seconds["bake"] = secondsSince(t);
+            std::string extension = plan.bakePaths[k].extension().string();
+            std::transform(extension.begin(), extension.end(), extension.begin(),
+                           [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+            // Only EXR keeps arbitrary header attributes; other formats get the pixels alone.
+            t = Clock::now();
+            io::writeImage(plan.bakePaths[k], plan.baked,
+                           extension == ".exr" ? attributes : io::ImageWriteOptions{});
+            r.files.push_back(plan.bakePaths[k]);
+            writeSeconds += secondsSince(t);
+            ++r.baked;
+        }
+        seconds["write"] = writeSeconds;
+        ++r.written;
+    } else {
+        ++r.replayed;
+    }
+    seconds["total"] = secondsSince(start);
+    json line = baseLine(plan, k, needed ? "written" : "replayed");
+    line["metrics"] = metricsJson(metrics, warp.stats());
+    line["seconds"] = seconds;
+    writeLog(line);
+}
+
+void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, const std::string& inputName,
+                            Interrupter* interrupter) {
+    Impl& s = *impl_;
+    const std::vector<int>& frames = s.job.frames;
+    if (s.nextFrame >= frames.size() || frames[s.nextFrame] != frame) {
+        const std::string expected =
+            s.nextFrame < frames.size()
+                ? "frame " + std::to_string(frames[s.nextFrame]) + ", the next of the job"
+                : "no more frames: the job's last is " + std::to_string(frames.back());
+        throw InvalidInput(
+            formatError("uvwarp", "frame " + std::to_string(frame), "is out of order", expected));
+    }
+    const auto vertices = static_cast<size_t>(s.job.rest->numVertices());
+    if (deformed.size() != vertices) {
+        throw InvalidInput(formatError(
+            inputName, "", "has " + std::to_string(deformed.size()) + " vertices",
+            std::to_string(vertices) + ", the vertex count of the rest mesh '" + s.job.restName + "'"));
+    }
+    const size_t k = s.nextFrame++;
+    for (TilePlan& plan : s.plans) {
+        const bool solves = plan.report.warped && static_cast<int>(k) <= plan.lastNeeded;
+        if (solves) {
+            s.solveTile(plan, k, deformed, inputName);
+        } else {
+            s.logUnsolved(plan, k);
+        }
+        ++s.unitsDone;
+        if (interrupter) {
+            const char* status = !plan.report.warped ? "unwarped"
+                                 : !solves           ? "skipped"
+                                 : plan.needed[k]    ? "written"
+                                                     : "replayed";
+            const std::string unit =
+                "tile " + std::to_string(plan.tile) + " frame " + std::to_string(frame) + " " + status;
+            if (interrupter->wasInterrupted(s.unitsDone, units(), unit)) {
+                throw Cancelled(formatError("uvwarp", "frame " + std::to_string(frame), "cancelled",
+                                            "outputs written so far are complete; a rerun resumes"));
+            }
+        }
+    }
+}
+
+ShotReport ShotSolver::finish() {
+    Impl& s = *impl_;
+    for (; s.nextFrame < s.job.frames.size(); ++s.nextFrame) {
+        for (TilePlan& plan : s.plans)
+            s.logUnsolved(plan, s.nextFrame);
+    }
+    ShotReport report;
+    for (TilePlan& plan : s.plans)
+        report.tiles.push_back(plan.report);
+    return report;
+}
+
+ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interrupter* interrupter) {
+    if (!deformed) {
+        throw InvalidInput(
+            formatError("uvwarp", "job", "has no deformed positions", "a DeformedFrames function"));
+    }
+    ShotSolver solver(job);
+    const std::optional<int> last = solver.lastNeededFrame();
+    if (interrupter) interrupter->start("uvwarp", solver.units());
+    struct EndOnExit {
+        Interrupter* interrupter;
+        ~EndOnExit() {
+            if (interrupter) interrupter->end();
+        }
+    } endOnExit{interrupter};
+    for (int frame : job.frames) {
+        if (!last || frame > *last) break;
+        std::string name;
+        const std::span<const glm::vec3> points = deformed(frame, name);
+        solver.solveFrame(frame, points, name, interrupter);
+    }
+    return solver.finish();
+}
+
+fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {
+    return io::ObjSequence(io::expandUdim(pattern.string(), tile)).framePath(frame);
+}
+
+std::vector<std::string> shotSummary(const ShotReport& report) {
+    std::vector<std::string> lines;
+    for (const ShotTileReport& t : report.tiles) {
+        const std::string tile = "tile " + std::to_string(t.tile) + ": ";
+        if (t.warped) {
+            std::ostringstream line;
+            line.precision(3);
+            line << tile << t.written << (t.written == 1 ? " frame" : " frames") << " written";
+            if (t.baked > 0) line << " (" << t.baked << " baked)";
+            line << ", " << t.replayed << " replayed, " << t.skipped << " skipped (outputs exist)";
+            if (t.written + t.replayed > 0) {
+                line << "; frame " << t.lastFrame << ": rigid stretch error "
+                     << t.lastMetrics.rigidStretchError << " (identity " << t.lastMetrics.identityStretchError
+                     << "), " << t.lastMetrics.foldOvers << " fold-overs";
+            }
+            lines.push_back(line.str());
+        }
+        for (const std::string& note : t.notes)
+            lines.push_back(tile + note);
+    }
+    return lines;
+}
+
+}  // namespace deformkit::uvwarp

@@ -1,0 +1,88 @@
+// `deformkit preview MESH --out FILE`: a shaded, optionally textured or weight-coloured view of a mesh.
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <vector>
+
+#include "cli.h"
+#include "commands.h"
+#include "deformkit/error.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/ptex/ptex_mesh.h"
+#include "slide_command.h"
+
+namespace deformkit::harness {
+namespace fs = std::filesystem;
+
+namespace {
+
+// "x,y,z" -> vec3, for --view.
+glm::vec3 parseVec3(const std::string& text) {
+    glm::vec3 v;
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3) {
+        throw InvalidInput(
+            formatError("--view", "", "'" + text + "' is not a direction", "three numbers: x,y,z"));
+    }
+    return v;
+}
+
+}  // namespace
+
+void preview(const PreviewCommand& command) {
+    const io::ObjContent obj = io::readObj(command.mesh);
+    std::optional<io::PreviewTexture> texture;
+    if (command.texture) texture = io::loadPreviewTexture(*command.texture);
+    if (command.weights && command.weightsPtex) {
+        throw InvalidInput(
+            formatError("--weights-ptex", "", "is given with --weights", "one weights source"));
+    }
+    io::PreviewOptions options = command.options;
+    if (command.weights || command.weightsPtex) {
+        const std::vector<float> weights =
+            command.weights ? readWeights(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
+                            : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
+                                                    "--weights-ptex");
+        options.vertexColors.clear();
+        for (float w : weights)
+            options.vertexColors.push_back(io::weightColor(w));
+    }
+    const io::Image image = io::renderPreview(obj.mesh, options, texture ? &*texture : nullptr);
+    io::writeImage(command.out, image);
+}
+
+void addPreviewCommand(CommandLine& cli) {
+    struct Options {
+        PreviewCommand command;
+        std::string mesh, texture, out, view, weights, weightsPtex;
+    };
+    auto o = std::make_shared<Options>();
+    CLI::App* preview =
+        cli.add(cli.app(), "preview", "Render a shaded, optionally textured view of a mesh to an image", [o] {
+            PreviewCommand& c = o->command;
+            c.mesh = o->mesh;
+            c.out = o->out;
+            if (!o->texture.empty()) c.texture = o->texture;
+            if (!o->view.empty()) c.options.viewDirection = parseVec3(o->view);
+            if (!o->weights.empty()) c.weights = o->weights;
+            if (!o->weightsPtex.empty()) c.weightsPtex = o->weightsPtex;
+            harness::preview(c);
+            std::cout << "wrote " << o->out << "\n";
+            return 0;
+        });
+    preview->add_option("MESH", o->mesh, "mesh (.obj)")->required();
+    preview->add_option("--texture", o->texture, "image, or UDIM pattern such as albedo.<UDIM>.png");
+    preview->add_option("--out", o->out, "output image (.png)")->required();
+    preview->add_option("--width", o->command.options.width, "pixels")->capture_default_str();
+    preview->add_option("--height", o->command.options.height, "pixels")->capture_default_str();
+    preview->add_option("--view", o->view, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
+    preview->add_flag("--edges", o->command.options.drawEdges, "draw polygon edges");
+    preview->add_option("--weights", o->weights,
+                        "show painted weights (JSON array, one per vertex) as colours");
+    preview->add_option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");
+    preview->add_option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel")
+        ->capture_default_str();
+}
+
+}  // namespace deformkit::harness
