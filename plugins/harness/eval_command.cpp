@@ -287,6 +287,8 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     }
     for (size_t o = 0; o < numObjects; ++o)
         report.binds.push_back(evaluator.stack(o).bindCount());
+    for (size_t o = 0; o < numObjects; ++o)
+        report.evaluations.push_back(evaluator.evaluations(o));
     if (!previews) return report;
 
     for (size_t o = 0; o < numObjects; ++o) {

@@ -78,6 +78,7 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
     }
     setFrame(object, frame, false);
     Object& ob = objects_[object];
+    ++ob.evaluations;
     const geom::Mesh& rest = ob.stack.rest();
     std::span<glm::vec3> points = ob.deformed.points();
     if (ob.restVersion != ob.stack.restVersion()) {

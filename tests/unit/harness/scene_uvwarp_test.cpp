@@ -193,6 +193,8 @@ TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed
     const harness::EvalReport report = harness::evalCommand(command);
     REQUIRE(report.uvwarpLines.size() >= 2);
     CHECK_THAT(report.uvwarpLines[0], Contains("tubes tile 1001: 3 frames written (3 baked)"));
+    // Each frame's stack is evaluated once and feeds the OBJ and both tiles.
+    CHECK(report.evaluations == std::vector<int64_t>{3});
 
     // The reference: one TileWarp per tile, solved over frames 1..3 in order with the same options,
     // fed by the stack built by hand.

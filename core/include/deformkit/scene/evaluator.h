@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -41,6 +42,10 @@ class SceneEvaluator {
     // or of another connectivity.
     const geom::Mesh& evaluate(size_t object, double frame);
 
+    // evaluate() calls for the object so far: a host feeding one evaluation to several consumers (a mesh
+    // writer and every UV-warp tile) shows with it that a frame is evaluated once.
+    [[nodiscard]] int64_t evaluations(size_t object) const { return objects_.at(object).evaluations; }
+
     // The object's stack, for inspection (bind counts) and host changes (setRest, setWeights).
     [[nodiscard]] host::DeformerStack& stack(size_t object);
     [[nodiscard]] const host::DeformerStack& stack(size_t object) const;
@@ -57,6 +62,7 @@ class SceneEvaluator {
         std::vector<glm::vec3> input;   // the sequence's positions at the frame evaluated
         uint64_t restVersion = 0;       // the stack's rest version `deformed` was copied from
         uint64_t sceneRestVersion = 0;  // the stack's rest version holding the scene's rest mesh
+        int64_t evaluations = 0;
     };
 
     void setFrame(size_t object, double frame, bool all);

@@ -1,0 +1,255 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/interrupter.h"
+#include "deformkit/io/image.h"
+#include "deformkit/uvwarp/shot_job.h"
+#include "deformkit/uvwarp/tile_warp.h"
+#include "test_support.h"
+#include "uvwarp_test_support.h"
+
+using namespace deformkit;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kTexels = 32;
+constexpr int kFrames = 4;
+
+// Two charts, one per tile (1001 and 1002), 12 x 12 quads each; the rest positions are the tile-local UVs
+// (the second chart lifted to z = 1).
+geom::Mesh twoTiles() {
+    const auto chart = [](glm::vec2 lo, float z) {
+        return test::planarChart(lo, lo + glm::vec2(1.0f), 12, 12,
+                                 [lo, z](glm::vec2 uv) { return glm::vec3(uv - lo, z); });
+    };
+    const geom::Mesh a = chart({0.0f, 0.0f}, 0.0f), b = chart({1.0f, 0.0f}, 1.0f);
+    geom::Mesh::Data data;
+    for (const geom::Mesh* m : {&a, &b}) {
+        const auto offset = static_cast<int32_t>(data.points.size());
+        const auto uvOffset = static_cast<int32_t>(data.uvs.size());
+        data.points.insert(data.points.end(), m->points().begin(), m->points().end());
+        data.uvs.insert(data.uvs.end(), m->uvs().begin(), m->uvs().end());
+        data.faceCounts.insert(data.faceCounts.end(), m->faceCounts().begin(), m->faceCounts().end());
+        for (int32_t i : m->faceIndices())
+            data.faceIndices.push_back(i + offset);
+        for (int32_t i : m->uvIndices())
+            data.uvIndices.push_back(i + uvOffset);
+    }
+    return geom::Mesh(std::move(data), "two tiles");
+}
+
+// Frame f stretches u by 1 + 0.15 (f - 1) and bends the sheet slightly, so every frame differs.
+std::vector<glm::vec3> deformedAt(const geom::Mesh& rest, int frame) {
+    std::vector<glm::vec3> points(rest.points().begin(), rest.points().end());
+    const float s = 1.0f + 0.15f * static_cast<float>(frame - 1);
+    for (glm::vec3& p : points) {
+        p.x *= s;
+        p.z += 0.05f * static_cast<float>(frame - 1) * p.x * p.x;
+    }
+    return points;
+}
+
+// Rigid disks in the middle of a tile's map.
+io::Image disks() {
+    io::Image image(kTexels, kTexels, 1);
+    for (int y = 0; y < kTexels; ++y)
+        for (int x = 0; x < kTexels; ++x)
+            for (double c : {0.3, 0.7})
+                if (std::hypot((x + 0.5) / kTexels - c, 1.0 - (y + 0.5) / kTexels - 0.5) < 0.12)
+                    image.at(x, y, 0) = 1.0f;
+    return image;
+}
+
+struct Shot {
+    test::TempDir dir;
+    geom::Mesh rest = twoTiles();
+    uvwarp::ShotJob job;
+    int asked = 0;  // deformed-frame requests
+    std::vector<glm::vec3> frame;
+
+    Shot() {
+        job.rest = &rest;
+        job.restName = "two tiles";
+        job.frames = {1, 2, 3, 4};
+        job.rigidity.images = {{1001, disks()}, {1002, disks()}};
+        job.rigidity.name = "painted rigidity";
+        job.outPath = [this](int tile, int f) {
+            return dir / ("redirect." + std::to_string(tile) + "." + std::to_string(f) + ".exr");
+        };
+    }
+    [[nodiscard]] uvwarp::DeformedFrames frames() {
+        return [this](int f, std::string& name) -> std::span<const glm::vec3> {
+            ++asked;
+            name = "frame " + std::to_string(f);
+            frame = deformedAt(rest, f);
+            return frame;
+        };
+    }
+    [[nodiscard]] fs::path out(int tile, int f) const { return job.outPath(tile, f); }
+};
+
+// Cancels after `after` units; records what the job reported.
+class CancelAfter final : public Interrupter {
+  public:
+    explicit CancelAfter(int64_t after) : after_(after) {}
+    void start(std::string_view name, int64_t total) override {
+        started = std::string(name);
+        this->total = total;
+    }
+    void end() override { ++ends; }
+    bool wasInterrupted(int64_t done, int64_t total, std::string_view unit) override {
+        CHECK(total == this->total);
+        CHECK(done == last + 1);
+        last = done;
+        units.emplace_back(unit);
+        return done >= after_;
+    }
+    std::string started;
+    int64_t total = -1, last = 0;
+    int ends = 0;
+    std::vector<std::string> units;
+
+  private:
+    int64_t after_;
+};
+
+}  // namespace
+
+TEST_CASE("shot job: each tile equals a TileWarp solved frame by frame; each frame is asked for once",
+          "[uvwarp][shot_job]") {
+    Shot shot;
+    std::ostringstream log;
+    shot.job.log = &log;
+    const uvwarp::ShotReport report = uvwarp::runShotJob(shot.job, shot.frames());
+    CHECK(shot.asked == kFrames);  // not frames x tiles
+    REQUIRE(report.tiles.size() == 2);
+    for (const int tile : {1001, 1002}) {
+        uvwarp::TileWarp reference(shot.rest, tile, disks());
+        for (int f = 1; f <= kFrames; ++f) {
+            reference.solve(deformedAt(shot.rest, f));
+            const io::Image written = io::readImage(shot.out(tile, f));
+            CHECK(test::sameBits(written.pixels, reference.redirect().pixels));
+        }
+    }
+    for (const uvwarp::ShotTileReport& t : report.tiles) {
+        CHECK(t.written == kFrames);
+        CHECK(t.files.size() == static_cast<size_t>(kFrames));
+        CHECK(t.lastFrame == kFrames);
+        CHECK(t.lastMetrics.foldOvers == 0);
+    }
+    // Provenance of a map from memory names the source it was given.
+    const io::ImageInfo info = io::readImageInfo(shot.out(1002, 3));
+    std::map<std::string, std::string> attributes(info.attributes.begin(), info.attributes.end());
+    CHECK(attributes["deformkit:uvwarp:tile"] == "1002");
+    CHECK(attributes["deformkit:uvwarp:frame"] == "3");
+    CHECK_THAT(attributes["deformkit:uvwarp:inputs"],
+               Contains("painted rigidity tile 1002") && Contains("\"deformed\":\"frame 3\""));
+    // Frame-major log: frame 1 of both tiles first.
+    std::istringstream lines(log.str());
+    std::string first, second;
+    std::getline(lines, first);
+    std::getline(lines, second);
+    CHECK_THAT(first, Contains("\"tile\":1001") && Contains("\"frame\":1"));
+    CHECK_THAT(second, Contains("\"tile\":1002") && Contains("\"frame\":1"));
+}
+
+TEST_CASE("shot job: maps from files give the pixels of the same maps in memory", "[uvwarp][shot_job]") {
+    Shot memory, files;
+    io::writeImage(files.dir / "rig.1001.exr", disks(), {io::PixelType::Float, {}});
+    io::writeImage(files.dir / "rig.1002.exr", disks(), {io::PixelType::Float, {}});
+    files.job.rigidity = {};
+    files.job.rigidity.pattern = files.dir / "rig.<UDIM>.exr";
+    (void)uvwarp::runShotJob(memory.job, memory.frames());
+    (void)uvwarp::runShotJob(files.job, files.frames());
+    for (const int tile : {1001, 1002}) {
+        for (int f = 1; f <= kFrames; ++f) {
+            CHECK(test::sameBits(io::readImage(memory.out(tile, f)).pixels,
+                                 io::readImage(files.out(tile, f)).pixels));
+        }
+    }
+}
+
+TEST_CASE("shot job: a cancelled job leaves complete files and a rerun writes an uninterrupted job's bytes",
+          "[uvwarp][shot_job]") {
+    Shot whole;
+    (void)uvwarp::runShotJob(whole.job, whole.frames());
+
+    Shot cut;
+    CancelAfter cancel(3);  // frame 1 of both tiles, frame 2 of tile 1001
+    CHECK_THROWS_AS(uvwarp::runShotJob(cut.job, cut.frames(), &cancel), Cancelled);
+    CHECK(cancel.started == "uvwarp");
+    CHECK(cancel.total == 2 * kFrames);
+    CHECK(cancel.ends == 1);
+    CHECK(cancel.units.front() == "tile 1001 frame 1 written");
+    CHECK(test::filesIn(cut.dir.path()).size() == 3);
+    for (const auto& [tile, f] : std::vector<std::pair<int, int>>{{1001, 1}, {1002, 1}, {1001, 2}})
+        CHECK(test::readText(cut.out(tile, f)) == test::readText(whole.out(tile, f)));
+
+    // The rerun replays the warm start where outputs exist and writes the rest.
+    CancelAfter never(1000);
+    const uvwarp::ShotReport again = uvwarp::runShotJob(cut.job, cut.frames(), &never);
+    CHECK(never.last == 2 * kFrames);
+    CHECK(again.tiles[0].replayed == 2);
+    CHECK(again.tiles[0].written == 2);
+    CHECK(again.tiles[1].replayed == 1);
+    CHECK(again.tiles[1].written == 3);
+    for (const int tile : {1001, 1002})
+        for (int f = 1; f <= kFrames; ++f)
+            CHECK(test::readText(cut.out(tile, f)) == test::readText(whole.out(tile, f)));
+
+    // Everything exists: nothing is asked for, every frame skipped.
+    cut.asked = 0;
+    const uvwarp::ShotReport done = uvwarp::runShotJob(cut.job, cut.frames());
+    CHECK(cut.asked == 0);
+    CHECK(done.tiles[0].skipped == kFrames);
+    CHECK(uvwarp::shotSummary(done)[0] ==
+          "tile 1001: 0 frames written, 0 replayed, 4 skipped (outputs exist)");
+}
+
+TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp][shot_job][errors]") {
+    Shot shot;
+    uvwarp::ShotSolver solver(shot.job);
+    CHECK(solver.units() == 2 * kFrames);
+    CHECK(solver.lastNeededFrame() == kFrames);
+    const std::vector<glm::vec3> second = deformedAt(shot.rest, 2);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { solver.solveFrame(2, second, "f2"); }),
+               Contains("frame 2") && Contains("out of order") && Contains("frame 1"));
+    const std::vector<glm::vec3> few(10);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { solver.solveFrame(1, few, "anim.0001.obj"); }),
+               Contains("anim.0001.obj") && Contains("has 10 vertices") && Contains("'two tiles'"));
+
+    Shot mask;
+    mask.job.mask.images = {{1001, io::Image(16, 16, 1, 1.0f)}};
+    mask.job.mask.name = "painted mask";
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { uvwarp::ShotSolver s(mask.job); }),
+               Contains("painted mask tile 1001") && Contains("16 x 16") && Contains("32 x 32"));
+    CHECK(test::filesIn(mask.dir.path()).empty());
+
+    Shot none;
+    none.job.rigidity.images.clear();
+    none.job.rigidity.pattern = none.dir / "rig.<UDIM>.exr";
+    none.job.rigidityOption = "--rigidity";
+    CHECK_THAT(test::errorOf<IoError>([&] { uvwarp::ShotSolver s(none.job); }),
+               Contains("--rigidity") && Contains("no tile has a rigidity map"));
+
+    Shot folder;
+    folder.job.outPath = [&](int tile, int f) {
+        return folder.dir / "missing" / ("r." + std::to_string(tile) + "." + std::to_string(f) + ".exr");
+    };
+    CHECK_THAT(test::errorOf<IoError>([&] { uvwarp::ShotSolver s(folder.job); }),
+               Contains("missing") && Contains("does not exist"));
+
+    Shot tiles;
+    tiles.job.tiles = {1003};
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { uvwarp::ShotSolver s(tiles.job); }),
+               Contains("tile 1003") && Contains("1001 1002"));
+}
