@@ -4,6 +4,7 @@
 #include "uvwarp_command.h"
 
 #include "commands.h"
+#include "process.h"
 
 #include <algorithm>
 #include <cmath>
@@ -84,29 +85,6 @@ void pasteTile(io::Image& sheet, const io::Image& preview, const ContactSheetLay
             }
         }
     }
-}
-
-std::optional<fs::path> findOnPath(const std::string& program) {
-    const char* path = std::getenv("PATH");
-    if (!path) return std::nullopt;
-    std::string_view rest(path);
-    while (true) {
-        const size_t colon = rest.find(':');
-        const std::string_view dir = rest.substr(0, colon);
-        const fs::path candidate = (dir.empty() ? fs::path(".") : fs::path(dir)) / program;
-        std::error_code ec;
-        if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0) return candidate;
-        if (colon == std::string_view::npos) return std::nullopt;
-        rest.remove_prefix(colon + 1);
-    }
-}
-
-// Single-quoted for the POSIX shell: nothing inside is expanded; a quote becomes '\''.
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s)
-        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
 }
 
 // Removes a folder and its contents when leaving scope, on success or error.
@@ -297,14 +275,14 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         report.files.push_back(sheet);
     }
     if (command.movie) {
-        const std::optional<fs::path> ffmpeg = findOnPath("ffmpeg");
-        if (!ffmpeg) {
+        const fs::path ffmpeg = findProgram("ffmpeg");
+        if (ffmpeg.empty()) {
             report.notes.push_back("no ffmpeg on PATH: movies not written");
             return report;
         }
         for (size_t o = 0; o < numObjects; ++o) {
             const fs::path movie = command.outDir / (scene.objects[o].name + ".mp4");
-            encodeMovie(*ffmpeg, pngs[o], movie, command.movieFrameRate);
+            encodeMovie(ffmpeg, pngs[o], movie, command.movieFrameRate);
             report.files.push_back(movie);
             if (progress) *progress << "eval: movie " << movie.string() << " written\n";
         }

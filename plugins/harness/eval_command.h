@@ -51,7 +51,7 @@ struct EvalReport {
     std::vector<std::filesystem::path> files;
     std::vector<int64_t> binds;        // per object: binds done by its stack over the run
     std::vector<int64_t> evaluations;  // per object: stack evaluations over the run (one per frame)
-    std::vector<std::string> notes;  // things not done that are not errors (no ffmpeg on PATH)
+    std::vector<std::string> notes;    // things not done that are not errors (no ffmpeg on PATH)
     // Per object with a UV-warp stage, uvwarp::shotSummary's lines prefixed with the object's name.
     std::vector<std::string> uvwarpLines;
 };

@@ -10,7 +10,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
-#include "slide_command.h"
+#include "deformkit/scene/weights_file.h"
 
 namespace deformkit::harness {
 namespace fs = std::filesystem;
@@ -41,9 +41,10 @@ void preview(const PreviewCommand& command) {
     io::PreviewOptions options = command.options;
     if (command.weights || command.weightsPtex) {
         const std::vector<float> weights =
-            command.weights ? readWeights(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
-                            : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
-                                                    "--weights-ptex");
+            command.weights
+                ? scene::readWeightsFile(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
+                : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
+                                        "--weights-ptex");
         options.vertexColors.clear();
         for (float w : weights)
             options.vertexColors.push_back(io::weightColor(w));

@@ -12,6 +12,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "deformkit/scene/weights_file.h"
 #include "slide_command.h"
 
 namespace deformkit::harness {
@@ -68,13 +69,6 @@ std::string metaText(const ptex::MetaValue& m) {
     return "";
 }
 
-// The shortest text that reads back as the same float.
-std::string floatText(float value) {
-    char buffer[32];
-    const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
-    return std::string(buffer, end);
-}
-
 }  // namespace
 
 void ptexInfo(const fs::path& file, std::ostream& out) {
@@ -109,13 +103,7 @@ size_t ptexToVertexCommand(const PtexToVertexCommand& command) {
     const geom::Mesh mesh = io::readObj(command.mesh).mesh;
     const std::vector<float> weights =
         ptex::weightsFromPtex(mesh, command.ptex, command.channel, command.ptex.string());
-    std::string text = "[";
-    for (size_t v = 0; v < weights.size(); ++v) {
-        if (v > 0) text += ", ";
-        text += floatText(weights[v]);
-    }
-    text += "]\n";
-    io::writeFileAtomically(command.out, text);
+    io::writeFileAtomically(command.out, scene::formatWeightsFile(weights));
     return weights.size();
 }
 
@@ -159,7 +147,8 @@ void ptexFromVertexCommand(const PtexFromVertexCommand& command) {
         throw InvalidInput(formatError("--face-res", "", "is auto", "a power of two (texels per face side)"));
     }
     const geom::Mesh mesh = io::readObj(command.mesh).mesh;
-    const std::vector<float> weights = readWeights(command.weights, static_cast<size_t>(mesh.numVertices()));
+    const std::vector<float> weights =
+        scene::readWeightsFile(command.weights, static_cast<size_t>(mesh.numVertices()));
     const ptex::PtexMesh ptexMesh(mesh, command.mesh.string());
     const ptex::PtexFile file =
         ptex::bakeVertexValues(ptexMesh, weights, 1, {command.faceLog2, command.faceLog2, command.type});

@@ -7,17 +7,15 @@
 #include <fstream>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
 #include "deformkit/error.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "deformkit/scene/weights_file.h"
 
 namespace deformkit::harness {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 // Comma-separated numbers; false when a field is empty, not a number, or not finite.
 bool parseNumbers(std::string_view text, std::vector<double>& out) {
@@ -38,15 +36,6 @@ bool parseNumbers(std::string_view text, std::vector<double>& out) {
         if (comma == std::string_view::npos) return true;
         start = comma + 1;
     }
-}
-
-std::string typeName(const json& v) {
-    if (v.is_null()) return "null";
-    if (v.is_boolean()) return "a boolean";
-    if (v.is_number()) return "a number";
-    if (v.is_string()) return "a string";
-    if (v.is_array()) return "an array of " + std::to_string(v.size());
-    return "an object";
 }
 
 }  // namespace
@@ -72,50 +61,6 @@ slide::Falloff parseFalloff(std::string_view text, const std::string& option) {
     return slide::Falloff::ramp(samples, option);
 }
 
-std::vector<float> parseWeights(std::string_view text, size_t count, const std::string& source) {
-    json root;
-    try {
-        root = json::parse(text.begin(), text.end());
-    } catch (const json::exception& e) {
-        // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: ...": keep the part
-        // after the bracketed id.
-        std::string what = e.what();
-        const size_t at = what.find("] ");
-        throw ParseError(formatError(source, "", at == std::string::npos ? what : what.substr(at + 2),
-                                     "a JSON array of one number per vertex"));
-    }
-    if (!root.is_array()) {
-        throw InvalidInput(
-            formatError(source, "(top level)", "is " + typeName(root), "an array of one number per vertex"));
-    }
-    if (root.size() != count) {
-        throw InvalidInput(formatError(source, "", "has " + std::to_string(root.size()) + " weights",
-                                       std::to_string(count) + ", one per vertex of the mesh"));
-    }
-    std::vector<float> weights(count);
-    for (size_t i = 0; i < count; ++i) {
-        const json& v = root[i];
-        const std::string path = std::string("[").append(std::to_string(i)).append("]");
-        if (!v.is_number()) throw InvalidInput(formatError(source, path, "is " + typeName(v), "a number"));
-        const double d = v.get<double>();
-        if (!std::isfinite(d) || std::abs(d) > 3.0e38) {
-            throw InvalidInput(
-                formatError(source, path, "is " + v.dump(), "a finite number, normally in [0, 1]"));
-        }
-        weights[i] = static_cast<float>(d);
-    }
-    return weights;
-}
-
-std::vector<float> readWeights(const fs::path& path, size_t count) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw IoError(formatError(path.string(), "", "cannot open the weights file", "a readable JSON file"));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseWeights(text.str(), count, path.string());
-}
-
 slide::SlideResult slideCommand(const SlideCommand& command) {
     io::ObjContent obj = io::readObj(command.mesh);
     const size_t count = static_cast<size_t>(obj.mesh.numVertices());
@@ -124,7 +69,7 @@ slide::SlideResult slideCommand(const SlideCommand& command) {
             formatError("--weights-ptex", "", "is given with --weights", "one source of painted weights"));
     }
     const std::vector<float> weights =
-        command.weights ? readWeights(*command.weights, count)
+        command.weights ? scene::readWeightsFile(*command.weights, count)
         : command.weightsPtex
             ? ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel, "--weights-ptex")
             : std::vector<float>{};

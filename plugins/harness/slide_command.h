@@ -48,9 +48,4 @@ slide::SlideResult slideCommand(const SlideCommand& command);
 // sample otherwise.
 [[nodiscard]] slide::Falloff parseFalloff(std::string_view text, const std::string& option = "--falloff");
 
-// Painted weights: a JSON array of `count` finite numbers. ParseError for malformed JSON (file, line,
-// column); InvalidInput naming the index of a bad value or the wrong count.
-[[nodiscard]] std::vector<float> readWeights(const std::filesystem::path& path, size_t count);
-[[nodiscard]] std::vector<float> parseWeights(std::string_view json, size_t count, const std::string& source);
-
 }  // namespace deformkit::harness

@@ -12,8 +12,6 @@
 #include <sstream>
 #include <system_error>
 
-#include <nlohmann/json.hpp>
-
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -28,7 +26,6 @@ namespace deformkit::harness {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 constexpr int64_t kMaxFrames = 1000000;

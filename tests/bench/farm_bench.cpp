@@ -99,7 +99,7 @@ void BM_FarmRunPlan(benchmark::State& state) {
     plan.scene = shot().scene;
     plan.chunk = 10;
     plan.outDir = shot().dir / "farm";
-    const harness::FarmPlan made = harness::farmPlanCommand(plan);
+    const scene::FarmPlan made = harness::farmPlanCommand(plan);
     const fs::path planFile = harness::farmPlanPath(plan);
     for (auto _ : state) {
         state.PauseTiming();

@@ -8,14 +8,15 @@
 #include <sstream>
 #include <utility>
 
-#include <nlohmann/json.hpp>
-
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
 #include "deformkit/io/obj_sequence.h"
+#include "deformkit/io/read_file.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/scene/weight_maps.h"
+#include "deformkit/scene/weights_file.h"
 #include "deformkit/uvwarp/grid.h"
+#include "scene/json_reading.h"
 
 namespace deformkit::scene {
 
@@ -30,20 +31,7 @@ std::vector<double> SceneValue::at(double frame) const {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
-
-std::string typeName(const json& v) {
-    if (v.is_null()) return "null";
-    if (v.is_boolean()) return "a boolean";
-    if (v.is_number()) return "a number";
-    if (v.is_string()) return "a string";
-    if (v.is_array()) return "an array of " + std::to_string(v.size());
-    return "an object";
-}
-
-std::string index(const std::string& path, size_t i) {
-    return path + "[" + std::to_string(i) + "]";
-}
+using detail::json;
 
 // Reads one scene: every reader names the JSON path of what it reads.
 class Reader {
@@ -57,7 +45,7 @@ class Reader {
     }
 
     void requireObject(const json& v, const std::string& path, const std::string& expected) const {
-        if (!v.is_object()) fail(path, "is " + typeName(v), expected);
+        if (!v.is_object()) fail(path, "is " + detail::jsonKind(v), expected);
     }
 
     // Rejects keys outside `known` (a typo would otherwise be ignored silently).
@@ -77,7 +65,7 @@ class Reader {
     }
 
     double number(const json& v, const std::string& path) const {
-        if (!v.is_number()) fail(path, "is " + typeName(v), "a number");
+        if (!v.is_number()) fail(path, "is " + detail::jsonKind(v), "a number");
         const double d = v.get<double>();
         if (!std::isfinite(d)) fail(path, "is " + v.dump(), "a finite number");
         return d;
@@ -90,7 +78,7 @@ class Reader {
     }
 
     std::string string(const json& v, const std::string& path, const std::string& expected) const {
-        if (!v.is_string() || v.get<std::string>().empty()) fail(path, "is " + typeName(v), expected);
+        if (!v.is_string() || v.get<std::string>().empty()) fail(path, "is " + detail::jsonKind(v), expected);
         return v.get<std::string>();
     }
 
@@ -98,10 +86,10 @@ class Reader {
     std::vector<double> numbers(const json& v, const std::string& path) const {
         if (v.is_number()) return {number(v, path)};
         if (!v.is_array() || v.empty())
-            fail(path, "is " + typeName(v), "a number or a non-empty array of numbers");
+            fail(path, "is " + detail::jsonKind(v), "a number or a non-empty array of numbers");
         std::vector<double> out(v.size());
         for (size_t i = 0; i < v.size(); ++i)
-            out[i] = number(v[i], index(path, i));
+            out[i] = number(v[i], detail::jsonIndex(path, i));
         return out;
     }
 
@@ -117,10 +105,10 @@ class Reader {
         const json& keys = v.at("keys");
         const std::string keysPath = path + ".keys";
         if (!keys.is_array() || keys.empty())
-            fail(keysPath, "is " + typeName(keys), "a non-empty array of keys");
+            fail(keysPath, "is " + detail::jsonKind(keys), "a non-empty array of keys");
         std::vector<std::vector<Key>> perComponent;
         for (size_t k = 0; k < keys.size(); ++k) {
-            const std::string kp = index(keysPath, k);
+            const std::string kp = detail::jsonIndex(keysPath, k);
             const json& key = keys[k];
             requireObject(key, kp, "{\"frame\": ..., \"value\": ...}");
             onlyKeys(key, kp, {"frame", "value", "interpolation", "tangent", "in", "out"});
@@ -254,40 +242,13 @@ class Reader {
             }
         }
         file = this->file(v, path, "a weights file name (JSON), or {\"image\": ...}");
-        std::ifstream in(file, std::ios::binary);
-        if (!in)
-            fail(path, "names " + file.string() + ", which cannot be read", "a readable JSON weights file");
-        std::ostringstream text;
-        text << in.rdbuf();
-        json root;
+        // The file's own messages name it; the scene's add the JSON path. Every error is InvalidInput here:
+        // the scene is what is wrong, whatever the file's problem.
         try {
-            root = json::parse(text.str());
-        } catch (const json::exception& e) {
-            std::string what = e.what();
-            const size_t at = what.find("] ");
-            fail(path, file.string() + ": " + (at == std::string::npos ? what : what.substr(at + 2)),
-                 "a JSON array of weights or {\"weights\": [...]}");
+            return readWeightsFile(file, static_cast<size_t>(count));
+        } catch (const Error& e) {
+            fail(path, e.what(), "a JSON weights file with one finite number per vertex of the rest mesh");
         }
-        const json* array = &root;
-        if (root.is_object() && root.contains("weights")) array = &root.at("weights");
-        if (!array->is_array()) {
-            fail(path, file.string() + " holds " + typeName(root),
-                 "a JSON array of weights or {\"weights\": [...]}");
-        }
-        if (array->size() != static_cast<size_t>(count)) {
-            fail(path, file.string() + " has " + std::to_string(array->size()) + " weights",
-                 std::to_string(count) + ", one per vertex of the rest mesh");
-        }
-        std::vector<float> w(array->size());
-        for (size_t i = 0; i < w.size(); ++i) {
-            const json& x = (*array)[i];
-            if (!x.is_number() || !std::isfinite(x.get<double>()) || std::abs(x.get<double>()) > 3.0e38) {
-                fail(path, file.string() + ": weight " + std::to_string(i) + " is " + x.dump(),
-                     "a finite number");
-            }
-            w[i] = static_cast<float>(x.get<double>());
-        }
-        return w;
     }
 
     SceneDeformer deformer(const json& v, const std::string& path, size_t entry,
@@ -348,7 +309,7 @@ class Reader {
                             try {
                                 probe->set(p.name, x);
                             } catch (const Error& e) {
-                                fail(index(p.path + ".keys", k) + ".value", e.what(), "");
+                                fail(detail::jsonIndex(p.path + ".keys", k) + ".value", e.what(), "");
                             }
                         }
                     }
@@ -412,12 +373,13 @@ class Reader {
         if (v.contains("tiles")) {
             const json& tiles = v.at("tiles");
             if (!tiles.is_array() || tiles.empty())
-                fail(path + ".tiles", "is " + typeName(tiles), "a non-empty array of UDIM tile numbers");
+                fail(path + ".tiles", "is " + detail::jsonKind(tiles),
+                     "a non-empty array of UDIM tile numbers");
             std::string have;
             for (int t : meshTiles)
                 have.append(have.empty() ? "" : " ").append(std::to_string(t));
             for (size_t i = 0; i < tiles.size(); ++i) {
-                const std::string tp = index(path + ".tiles", i);
+                const std::string tp = detail::jsonIndex(path + ".tiles", i);
                 const int tile =
                     static_cast<int>(ranged(tiles[i], tp, 1001, 9999, true, "a UDIM tile, 1001..9999"));
                 if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile))
@@ -469,11 +431,11 @@ class Reader {
             if (const json* x = get("sweepsPerLevel")) {
                 const std::string sp = pp + ".sweepsPerLevel";
                 if (!x->is_array() || x->empty())
-                    fail(sp, "is " + typeName(*x), "a non-empty array of sweep counts");
+                    fail(sp, "is " + detail::jsonKind(*x), "a non-empty array of sweep counts");
                 o.sweepsPerLevel.clear();
                 for (size_t i = 0; i < x->size(); ++i)
-                    o.sweepsPerLevel.push_back(
-                        static_cast<int32_t>(ranged((*x)[i], index(sp, i), 1, 1000, true, "1 to 1000")));
+                    o.sweepsPerLevel.push_back(static_cast<int32_t>(
+                        ranged((*x)[i], detail::jsonIndex(sp, i), 1, 1000, true, "1 to 1000")));
             }
             if (const json* x = get("orientationPreservation"))
                 o.orientationPreservation =
@@ -540,10 +502,11 @@ class Reader {
         }
         if (!v.contains("stack")) fail(path + ".stack", "is missing", "an array of deformers");
         const json& stack = v.at("stack");
-        if (!stack.is_array()) fail(path + ".stack", "is " + typeName(stack), "an array of deformers");
+        if (!stack.is_array())
+            fail(path + ".stack", "is " + detail::jsonKind(stack), "an array of deformers");
         std::set<std::string> labels;
         for (size_t i = 0; i < stack.size(); ++i) {
-            const std::string entryPath = index(path + ".stack", i);
+            const std::string entryPath = detail::jsonIndex(path + ".stack", i);
             if (stack[i].is_object() && stack[i].contains("type") && stack[i].at("type") == "uvwarp") {
                 if (i + 1 != stack.size()) {
                     fail(
@@ -585,7 +548,7 @@ class Reader {
         if (!root.contains("frames")) fail("frames", "is missing", "[first, last]");
         const json& frames = root.at("frames");
         if (!frames.is_array() || frames.size() != 2)
-            fail("frames", "is " + typeName(frames), "[first, last]");
+            fail("frames", "is " + detail::jsonKind(frames), "[first, last]");
         s.firstFrame = integer(frames[0], "frames[0]");
         s.lastFrame = integer(frames[1], "frames[1]");
         if (s.lastFrame < s.firstFrame) {
@@ -593,13 +556,13 @@ class Reader {
         }
         if (!root.contains("objects")) fail("objects", "is missing", "an array of objects");
         const json& objects = root.at("objects");
-        if (!objects.is_array()) fail("objects", "is " + typeName(objects), "an array of objects");
+        if (!objects.is_array()) fail("objects", "is " + detail::jsonKind(objects), "an array of objects");
         std::set<std::string> names;
         for (size_t i = 0; i < objects.size(); ++i) {
-            SceneObject o = object(objects[i], index("objects", i), s.firstFrame);
+            SceneObject o = object(objects[i], detail::jsonIndex("objects", i), s.firstFrame);
             if (!names.insert(o.name).second) {
-                fail(index("objects", i) + ".name", "is \"" + o.name + "\", used by an earlier object",
-                     "a unique name");
+                fail(detail::jsonIndex("objects", i) + ".name",
+                     "is \"" + o.name + "\", used by an earlier object", "a unique name");
             }
             s.objects.push_back(std::move(o));
         }
@@ -619,18 +582,7 @@ Scene parseScene(std::string_view text, const fs::path& source) {
 }
 
 Scene parseScene(std::string_view text, const fs::path& source, const SceneReadOptions& options) {
-    json root;
-    try {
-        root = json::parse(text.begin(), text.end());
-    } catch (const json::exception& e) {
-        // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: ...": keep the part
-        // after the bracketed id.
-        std::string what = e.what();
-        const size_t at = what.find("] ");
-        throw ParseError(formatError(source.string(), "",
-                                     at == std::string::npos ? what : what.substr(at + 2),
-                                     "a JSON scene (docs/scene.md)"));
-    }
+    const json root = detail::parseJson(text, source.string(), "a JSON scene (docs/scene.md)");
     return Reader(source.string(), source.parent_path(), options).scene(root);
 }
 
@@ -639,12 +591,7 @@ Scene readScene(const fs::path& path) {
 }
 
 Scene readScene(const fs::path& path, const SceneReadOptions& options) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw IoError(formatError(path.string(), "", "cannot open the scene file", "a readable JSON file"));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseScene(text.str(), path, options);
+    return parseScene(io::readFile(path, "JSON scene file"), path, options);
 }
 
 }  // namespace deformkit::scene

@@ -15,6 +15,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/scene/farm_plan.h"
 #include "eval_command.h"
 #include "farm_command.h"
 #include "mesh_support.h"
@@ -66,7 +67,7 @@ TEST_CASE("farm plan: 7 frames in chunks of 3 make tasks 1-3, 4-6, 7-7 with ever
     command.scene = shot.scene;
     command.chunk = 3;
     command.outDir = shot.dir / "out";  // created
-    const harness::FarmPlan plan = harness::farmPlanCommand(command);
+    const scene::FarmPlan plan = harness::farmPlanCommand(command);
 
     REQUIRE(plan.tasks.size() == 3);
     const int ranges[3][2] = {{1, 3}, {4, 6}, {7, 7}};
@@ -99,13 +100,13 @@ TEST_CASE("farm plan: 7 frames in chunks of 3 make tasks 1-3, 4-6, 7-7 with ever
     // --plan elsewhere; a frame list never makes a task across its gap.
     command.plan = shot.dir / "plans" / "p.json";
     command.frames = {1, 2, 3, 4, 7};
-    const harness::FarmPlan gaps = harness::farmPlanCommand(command);
+    const scene::FarmPlan gaps = harness::farmPlanCommand(command);
     REQUIRE(gaps.tasks.size() == 3);
     CHECK(gaps.tasks[1].firstFrame == 4);
     CHECK(gaps.tasks[1].lastFrame == 4);
     CHECK(gaps.tasks[2].firstFrame == 7);
     CHECK(fs::is_regular_file(shot.dir / "plans" / "p.json"));
-    const harness::FarmPlan reread = harness::readFarmPlan(shot.dir / "plans" / "p.json");
+    const scene::FarmPlan reread = scene::readFarmPlan(shot.dir / "plans" / "p.json");
     CHECK(reread.tasks.size() == 3);
     CHECK(reread.tasks[0].outputs == namesOf(1, 3));
 
@@ -132,7 +133,7 @@ TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun sk
     std::vector<std::string> lines;
     for (int k = 0; k < 3; ++k) {
         std::ostringstream log;
-        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        const scene::FarmTaskReport report = harness::farmRunCommand({planFile, k}, &log);
         CHECK(report.skipped.empty());
         CHECK(report.files.size() == 2 * report.written.size());
         std::istringstream in(log.str());
@@ -170,7 +171,7 @@ TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun sk
         fs::last_write_time(shot.dir / "farm" / name, past);
     for (int k = 0; k < 3; ++k) {
         std::ostringstream log;
-        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        const scene::FarmTaskReport report = harness::farmRunCommand({planFile, k}, &log);
         CHECK(report.written.empty());
         CHECK(report.files.empty());
         CHECK(report.skipped.size() == (k < 2 ? 3u : 1u));
@@ -181,7 +182,7 @@ TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun sk
 
     // One output gone: its frame is written again (that object only), with the same bytes.
     fs::remove(shot.dir / "farm" / "bent.0005.obj");
-    const harness::FarmRunReport again = harness::farmRunCommand({planFile, 1});
+    const scene::FarmTaskReport again = harness::farmRunCommand({planFile, 1});
     CHECK(again.written == std::vector<int>{5});
     CHECK(again.skipped == std::vector<int>{4, 6});
     REQUIRE(again.files.size() == 1);
@@ -279,7 +280,7 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
     planCommand.scene = shot.scene;
     planCommand.chunk = 2;  // 7 frames: 4 tasks
     planCommand.outDir = shot.dir / "farm";
-    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
     const fs::path planFile = harness::farmPlanPath(planCommand);
     const fs::path planAbs = fs::absolute(planFile).lexically_normal();
 

@@ -14,6 +14,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "deformkit/scene/weights_file.h"
 #include "ptex/ptex_mesh_support.h"
 #include "ptex_command.h"
 #include "slide_command.h"
@@ -96,7 +97,7 @@ TEST_CASE("ptex command: to-vertex writes each vertex's mean over its faces as a
         for (size_t v = 0; v < expected.size(); ++v)
             CHECK(json[v].get<double>() == Approx(expected[v]).margin(1e-7));  // float means of exact values
         // The file is the weights format every command reads: the same floats come back.
-        const std::vector<float> read = harness::readWeights(f.dir / "w.json", 81);
+        const std::vector<float> read = scene::readWeightsFile(f.dir / "w.json", 81);
         for (size_t v = 0; v < expected.size(); ++v)
             CHECK(read[v] == json[v].get<float>());
     }

@@ -17,6 +17,7 @@
 #include "deformkit/host/stack.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/scene/farm_plan.h"
 #include "deformkit/scene/scene.h"
 #include "deformkit/scene/uvwarp_stage.h"
 #include "deformkit/uvwarp/bake.h"
@@ -246,7 +247,7 @@ TEST_CASE(
     planCommand.scene = shot.scene;
     planCommand.chunk = 2;  // frames 1-2 and 3
     planCommand.outDir = shot.dir / "farm";
-    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
     const fs::path planFile = harness::farmPlanPath(planCommand);
     // 2 mesh tasks, then 2 ranges x 2 tiles.
     REQUIRE(plan.tasks.size() == 6);
@@ -261,13 +262,13 @@ TEST_CASE(
     CHECK(plan.tasks[3].tiles == std::vector<int>{1002});
     CHECK(plan.tasks[5].outputs == std::vector<std::string>{"tubes.redirect.1002.0003.exr"});
     // The plan file reads back the same.
-    const harness::FarmPlan read = harness::readFarmPlan(planFile);
+    const scene::FarmPlan read = scene::readFarmPlan(planFile);
     REQUIRE(read.tasks.size() == 6);
     CHECK(read.tasks[4].tiles == std::vector<int>{1001});
 
     for (int k = 0; k < 6; ++k) {
         std::ostringstream log;
-        const harness::FarmRunReport report = harness::farmRunCommand({planFile, k}, &log);
+        const scene::FarmTaskReport report = harness::farmRunCommand({planFile, k}, &log);
         CHECK(report.skipped.empty());
         if (k >= 2) {
             // One JSON line per tile and frame, naming task, object and tile.
@@ -295,7 +296,7 @@ TEST_CASE(
     eval3.outDir = shot.dir / "eval3";
     (void)harness::evalCommand(eval3);
     std::vector<fs::path> expected{"farm_plan.json"};
-    for (const harness::FarmTask& task : plan.tasks) {
+    for (const scene::FarmTask& task : plan.tasks) {
         for (const std::string& name : task.outputs) {
             expected.emplace_back(name);
             const fs::path reference = (task.firstFrame == 3 ? eval3.outDir : eval12.outDir) / name;
@@ -317,7 +318,7 @@ TEST_CASE(
     fs::last_write_time(shot.dir / "farm" / "tubes.bake.1001.0002.exr", past);
     fs::remove(lost);
     std::ostringstream log;
-    const harness::FarmRunReport again = harness::farmRunCommand({planFile, 2}, &log);
+    const scene::FarmTaskReport again = harness::farmRunCommand({planFile, 2}, &log);
     CHECK(again.written == std::vector<int>{2});
     CHECK(again.skipped == std::vector<int>{1});
     CHECK(again.files == std::vector<fs::path>{lost});
@@ -333,7 +334,7 @@ TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm]
     planCommand.chunk = 3;
     planCommand.outDir = shot.dir / "farm";
     planCommand.tilesPerTask = 2;
-    const harness::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
     REQUIRE(plan.tasks.size() == 2);
     CHECK(plan.tasks[1].tiles == std::vector<int>{1001, 1002});
     const fs::path planFile = harness::farmPlanPath(planCommand);

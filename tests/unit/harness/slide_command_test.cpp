@@ -47,8 +47,7 @@ double smoothFalloff(double x) {
 
 }  // namespace
 
-TEST_CASE("slide command: points, falloffs and weights parse, bad text names the option",
-          "[harness][slide]") {
+TEST_CASE("slide command: points and falloffs parse, bad text names the option", "[harness][slide]") {
     CHECK(harness::parsePoint("1,-2.5,3e-1", "--from") == glm::dvec3(1.0, -2.5, 0.3));
     CHECK(harness::parsePoint(" 1, 2 ,3", "--to") == glm::dvec3(1.0, 2.0, 3.0));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,2", "--from"); }),
@@ -69,18 +68,6 @@ TEST_CASE("slide command: points, falloffs and weights parse, bad text names the
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFalloff("1,2,0"); }),
                Catch::Contains("--falloff"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFalloff("1"); }), Catch::Contains("--falloff"));
-
-    CHECK(harness::parseWeights("[0, 0.5, 1]", 3, "w.json") == std::vector<float>{0.0f, 0.5f, 1.0f});
-    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, 0.5]", 3, "w.json"); }),
-               Catch::Contains("w.json") && Catch::Contains("has 2 weights") &&
-                   Catch::Contains("3, one per vertex"));
-    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, \"a\", 1]", 3, "w.json"); }),
-               Catch::Contains("w.json: [1]: is a string"));
-    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("{\"w\": 1}", 1, "w.json"); }),
-               Catch::Contains("an object"));
-    CHECK_THROWS_AS(harness::parseWeights("[0, 1", 2, "w.json"), ParseError);
-    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseWeights("[0, 1e999]", 2, "w.json"); }),
-               Catch::Contains("w.json"));
 }
 
 TEST_CASE("slide command: slides an OBJ plane by d times the falloff, keeping UVs and groups",

@@ -1,0 +1,359 @@
+#include "deformkit/scene/farm_plan.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+#include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/io/read_file.h"
+#include "deformkit/scene/evaluator.h"
+#include "deformkit/scene/uvwarp_stage.h"
+#include "scene/json_reading.h"
+
+namespace deformkit::scene {
+
+namespace fs = std::filesystem;
+using detail::json;
+
+namespace {
+
+constexpr const char* kPlanExpected = "a DeformKit farm plan (docs/farm.md)";
+
+fs::path absolutePath(const fs::path& path) {
+    return fs::absolute(path).lexically_normal();
+}
+
+// Every tile some object's UV-warp stage warps, ascending.
+std::vector<int> warpedTiles(const Scene& scene) {
+    std::vector<int> tiles;
+    for (const SceneObject& object : scene.objects) {
+        if (!object.uvwarp) continue;
+        for (int tile : uvwarpWarpedTiles(*object.uvwarp))
+            tiles.push_back(tile);
+    }
+    std::sort(tiles.begin(), tiles.end());
+    tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
+    return tiles;
+}
+
+// Checks a plan's JSON, naming the plan file and the JSON path of what is wrong.
+class PlanReader {
+  public:
+    explicit PlanReader(const fs::path& source) : source_(source) {}
+
+    FarmPlan plan(const json& root) const {
+        requireObject(root, "", {"deformkit_farm_plan", "scene", "out", "chunk", "tasks"});
+        const json& version = member(root, "", "deformkit_farm_plan");
+        if (!version.is_number_integer() || version.get<int64_t>() != kFarmPlanVersion) {
+            fail("deformkit_farm_plan", "is " + version.dump(),
+                 std::to_string(kFarmPlanVersion) + ", the plan version this deformkit reads");
+        }
+        FarmPlan plan;
+        plan.scene = path(member(root, "", "scene"), "scene");
+        plan.outDir = path(member(root, "", "out"), "out");
+        plan.chunk = integer(member(root, "", "chunk"), "chunk");
+        if (plan.chunk < 1) fail("chunk", "is " + std::to_string(plan.chunk), "a whole number >= 1");
+        const json& tasks = member(root, "", "tasks");
+        if (!tasks.is_array() || tasks.empty()) fail("tasks", "is " + describe(tasks), "a non-empty array");
+        for (size_t k = 0; k < tasks.size(); ++k)
+            plan.tasks.push_back(task(tasks[k], "tasks[" + std::to_string(k) + "]", plan.chunk));
+        return plan;
+    }
+
+  private:
+    FarmTask task(const json& j, const std::string& at, int chunk) const {
+        requireObject(j, at, {"frames", "tiles", "outputs"});
+        FarmTask task;
+        const json& frames = member(j, at, "frames");
+        if (!frames.is_array() || frames.size() != 2)
+            fail(at + ".frames", "is " + describe(frames), "[first, last]");
+        task.firstFrame = integer(frames[0], at + ".frames[0]");
+        task.lastFrame = integer(frames[1], at + ".frames[1]");
+        const int64_t count = int64_t{task.lastFrame} - task.firstFrame + 1;
+        if (count < 1 || count > chunk) {
+            fail(at + ".frames", "is " + frames.dump() + ", " + std::to_string(count) + " frames",
+                 "first <= last and at most chunk (" + std::to_string(chunk) + ") frames");
+        }
+        const json& tiles = member(j, at, "tiles");
+        if (!tiles.is_array()) fail(at + ".tiles", "is " + describe(tiles), "an array of UDIM tiles");
+        for (size_t i = 0; i < tiles.size(); ++i) {
+            const std::string element = at + ".tiles[" + std::to_string(i) + "]";
+            const int tile = integer(tiles[i], element);
+            if (tile < 1001 || tile > 9999) fail(element, "is " + tiles[i].dump(), "a UDIM tile, 1001..9999");
+            if (!task.tiles.empty() && tile <= task.tiles.back())
+                fail(element, "is " + tiles[i].dump(), "tiles in ascending order, each once");
+            task.tiles.push_back(tile);
+        }
+        const json& outputs = member(j, at, "outputs");
+        if (!outputs.is_array()) fail(at + ".outputs", "is " + describe(outputs), "an array of file names");
+        for (size_t i = 0; i < outputs.size(); ++i) {
+            const std::string element = at + ".outputs[" + std::to_string(i) + "]";
+            if (!outputs[i].is_string()) fail(element, "is " + describe(outputs[i]), "a file name");
+            const std::string name = outputs[i].get<std::string>();
+            if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
+                fail(element, "is \"" + name + "\"", "a file name in the output folder, without '/'");
+            task.outputs.push_back(name);
+        }
+        return task;
+    }
+
+    const json& member(const json& object, const std::string& at, const char* key) const {
+        const auto it = object.find(key);
+        if (it == object.end()) fail(join(at, key), "is missing", kPlanExpected);
+        return *it;
+    }
+
+    void requireObject(const json& j, const std::string& at, std::initializer_list<const char*> keys) const {
+        if (!j.is_object()) fail(at, "is " + describe(j), "an object");
+        for (const auto& item : j.items()) {
+            bool known = false;
+            for (const char* key : keys)
+                known = known || item.key() == key;
+            if (!known) fail(join(at, item.key()), "is not a plan key", kPlanExpected);
+        }
+    }
+
+    int integer(const json& j, const std::string& at) const {
+        if (!j.is_number_integer() || j.get<int64_t>() < -1000000000 || j.get<int64_t>() > 1000000000)
+            fail(at, "is " + describe(j), "a whole number");
+        return static_cast<int>(j.get<int64_t>());
+    }
+
+    fs::path path(const json& j, const std::string& at) const {
+        if (!j.is_string() || j.get<std::string>().empty()) fail(at, "is " + describe(j), "a path");
+        const fs::path p = j.get<std::string>();
+        return p.is_absolute() ? p : absolutePath(source_.parent_path() / p);
+    }
+
+    static std::string describe(const json& j) {
+        const std::string text = j.dump();
+        return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+    }
+
+    static std::string join(const std::string& at, const std::string& key) {
+        return at.empty() ? key : at + "." + key;
+    }
+
+    [[noreturn]] void fail(const std::string& at, const std::string& problem,
+                           const std::string& expected) const {
+        throw InvalidInput(formatError(source_.string(), at.empty() ? "(root)" : at, problem, expected));
+    }
+
+    fs::path source_;
+};
+
+}  // namespace
+
+std::vector<std::string> farmTaskOutputs(const Scene& scene, int first, int last,
+                                         const std::vector<int>& tiles) {
+    std::vector<std::string> outputs;
+    for (int f = first; f <= last; ++f) {
+        for (const SceneObject& object : scene.objects) {
+            if (tiles.empty()) {
+                outputs.push_back(frameFileName(object.name, f));
+                continue;
+            }
+            for (int tile : tiles) {
+                for (std::string& name : uvwarpOutputs(object, tile, f))
+                    outputs.push_back(std::move(name));
+            }
+        }
+    }
+    return outputs;
+}
+
+FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path& outDir,
+                  const FarmPlanOptions& options) {
+    if (options.chunk < 1) {
+        throw InvalidInput(formatError("farm plan", "chunk", "is " + std::to_string(options.chunk),
+                                       "a whole number of frames per task >= 1"));
+    }
+    if (options.tilesPerTask < 1) {
+        throw InvalidInput(formatError("farm plan", "tilesPerTask",
+                                       "is " + std::to_string(options.tilesPerTask),
+                                       "a whole number of UDIM tiles per task >= 1"));
+    }
+    if (outDir.empty()) throw InvalidInput(formatError("farm plan", "output folder", "is empty", "a folder"));
+    std::vector<int> frames = options.frames;
+    if (frames.empty()) {
+        for (int f = scene.firstFrame; f <= scene.lastFrame; ++f)
+            frames.push_back(f);
+    }
+    FarmPlan plan;
+    plan.scene = absolutePath(sceneFile);
+    plan.outDir = absolutePath(outDir);
+    plan.chunk = options.chunk;
+    // Runs of consecutive frames, each at most `chunk` long.
+    std::vector<std::pair<int, int>> ranges;
+    for (size_t i = 0; i < frames.size();) {
+        size_t end = i + 1;
+        while (end < frames.size() && static_cast<int>(end - i) < options.chunk &&
+               frames[end] == frames[end - 1] + 1)
+            ++end;
+        ranges.emplace_back(frames[i], frames[end - 1]);
+        i = end;
+    }
+    for (const auto& [first, last] : ranges) {
+        FarmTask task;
+        task.firstFrame = first;
+        task.lastFrame = last;
+        task.outputs = farmTaskOutputs(scene, first, last, {});
+        plan.tasks.push_back(std::move(task));
+    }
+    const std::vector<int> tiles = warpedTiles(scene);
+    for (const auto& [first, last] : ranges) {
+        for (size_t t = 0; t < tiles.size(); t += static_cast<size_t>(options.tilesPerTask)) {
+            FarmTask task;
+            task.firstFrame = first;
+            task.lastFrame = last;
+            task.tiles.assign(
+                tiles.begin() + static_cast<ptrdiff_t>(t),
+                tiles.begin() + static_cast<ptrdiff_t>(
+                                    std::min(tiles.size(), t + static_cast<size_t>(options.tilesPerTask))));
+            task.outputs = farmTaskOutputs(scene, first, last, task.tiles);
+            plan.tasks.push_back(std::move(task));
+        }
+    }
+    return plan;
+}
+
+std::string formatFarmPlan(const FarmPlan& plan) {
+    // One task per line: a plan of thousands of tasks stays readable and diffable.
+    std::ostringstream out;
+    out << "{\n  \"deformkit_farm_plan\": " << kFarmPlanVersion
+        << ",\n  \"scene\": " << json(plan.scene.string()).dump()
+        << ",\n  \"out\": " << json(plan.outDir.string()).dump() << ",\n  \"chunk\": " << plan.chunk
+        << ",\n  \"tasks\": [";
+    for (size_t k = 0; k < plan.tasks.size(); ++k) {
+        const FarmTask& t = plan.tasks[k];
+        const json task = {
+            {"frames", {t.firstFrame, t.lastFrame}}, {"tiles", t.tiles}, {"outputs", t.outputs}};
+        out << (k ? ",\n    " : "\n    ") << task.dump();
+    }
+    out << "\n  ]\n}\n";
+    return out.str();
+}
+
+void writeFarmPlan(const FarmPlan& plan, const fs::path& path) {
+    if (path.has_parent_path()) io::createFolder(path.parent_path());
+    io::writeFileAtomically(path, formatFarmPlan(plan));
+}
+
+FarmPlan parseFarmPlan(std::string_view text, const fs::path& source) {
+    return PlanReader(source).plan(detail::parseJson(text, source.string(), kPlanExpected));
+}
+
+FarmPlan readFarmPlan(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) {
+        throw InvalidInput(
+            formatError(path.string(), "", "does not exist", "a plan from deformkit farm plan"));
+    }
+    return parseFarmPlan(io::readFile(path, "farm plan"), path);
+}
+
+FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int task,
+                           const SceneReadOptions& readOptions, std::ostream* log, Interrupter* interrupter) {
+    using Clock = std::chrono::steady_clock;
+    const std::string planName = planFile.string();
+    const int numTasks = static_cast<int>(plan.tasks.size());
+    if (task < 0 || task >= numTasks) {
+        throw InvalidInput(formatError(planName, "task",
+                                       "is " + std::to_string(task) + ", the plan has " +
+                                           std::to_string(numTasks) + (numTasks == 1 ? " task" : " tasks"),
+                                       "a task index from 0 to " + std::to_string(numTasks - 1)));
+    }
+    const FarmTask& t = plan.tasks[static_cast<size_t>(task)];
+    const std::string taskPath = "tasks[" + std::to_string(task) + "]";
+    std::error_code ec;
+    if (!fs::exists(plan.scene, ec)) {
+        throw InvalidInput(formatError(planName, "scene", "'" + plan.scene.string() + "' does not exist",
+                                       "the scene the plan was made from"));
+    }
+    SceneEvaluator evaluator(readScene(plan.scene, readOptions));
+    const Scene& scene = evaluator.scene();
+    const std::vector<std::string> expected = farmTaskOutputs(scene, t.firstFrame, t.lastFrame, t.tiles);
+    if (expected != t.outputs) {
+        size_t i = 0;
+        while (i < expected.size() && i < t.outputs.size() && expected[i] == t.outputs[i])
+            ++i;
+        const std::string listed = i < t.outputs.size() ? "\"" + t.outputs[i] + "\"" : "nothing";
+        const std::string made = i < expected.size() ? "\"" + expected[i] + "\"" : "nothing";
+        throw InvalidInput(formatError(planName, taskPath + ".outputs[" + std::to_string(i) + "]",
+                                       "is " + listed + ", the scene makes " + made,
+                                       "the outputs of the scene as planned (plan again after changing it)"));
+    }
+    io::createFolder(plan.outDir);
+
+    FarmTaskReport report;
+    report.task = task;
+    const size_t numObjects = evaluator.numObjects();
+    if (!t.tiles.empty()) {
+        // Frames whose outputs all exist are reported skipped (the run may still replay them for the warm
+        // start); the others written.
+        for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame) {
+            bool all = true;
+            for (const std::string& name : farmTaskOutputs(scene, frame, frame, t.tiles))
+                all = all && fs::exists(plan.outDir / name, ec);
+            (all ? report.skipped : report.written).push_back(frame);
+        }
+        UvWarpStageRun run;
+        for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame)
+            run.frames.push_back(frame);
+        run.tiles = t.tiles;
+        run.outDir = plan.outDir;
+        run.skipExisting = true;
+        run.log = log;
+        run.logTask = task;
+        for (size_t o = 0; o < numObjects; ++o) {
+            if (!scene.objects[o].uvwarp) continue;
+            const uvwarp::ShotReport warped = runUvWarpStage(evaluator, o, run, interrupter);
+            for (const uvwarp::ShotTileReport& tile : warped.tiles)
+                report.files.insert(report.files.end(), tile.files.begin(), tile.files.end());
+        }
+        return report;
+    }
+    const int64_t frames = int64_t{t.lastFrame} - t.firstFrame + 1;
+    if (interrupter) interrupter->start("farm task", frames);
+    struct EndOnExit {
+        Interrupter* interrupter;
+        ~EndOnExit() {
+            if (interrupter) interrupter->end();
+        }
+    } endOnExit{interrupter};
+    for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame) {
+        const Clock::time_point start = Clock::now();
+        bool wrote = false;
+        for (size_t o = 0; o < numObjects; ++o) {
+            const fs::path file = plan.outDir / frameFileName(scene.objects[o].name, frame);
+            // An output that exists is complete: every write is atomic.
+            if (fs::exists(file, ec)) continue;
+            io::writeObj(file, evaluator.evaluate(o, frame), scene.objects[o].groups);
+            report.files.push_back(file);
+            wrote = true;
+        }
+        (wrote ? report.written : report.skipped).push_back(frame);
+        if (log) {
+            const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+            // In the order a person reads it: task, frame, status, seconds.
+            const nlohmann::ordered_json line = {{"task", task},
+                                                 {"frame", frame},
+                                                 {"status", wrote ? "written" : "skipped"},
+                                                 {"seconds", std::round(seconds * 1e4) / 1e4}};
+            *log << line.dump() << "\n" << std::flush;
+        }
+        const std::string unit = "frame " + std::to_string(frame) + (wrote ? " written" : " skipped");
+        if (interrupter && interrupter->wasInterrupted(frame - t.firstFrame + 1, frames, unit)) {
+            throw Cancelled(formatError(planName, taskPath, "cancelled after " + unit,
+                                        "outputs written so far are complete; a rerun resumes"));
+        }
+    }
+    return report;
+}
+
+}  // namespace deformkit::scene

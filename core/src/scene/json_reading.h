@@ -1,0 +1,49 @@
+#pragma once
+
+// The one set of JSON reading helpers of the library (scenes, weights files, feature-line files, farm
+// plans), over nlohmann/json, which stays private to the library.
+
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "deformkit/error.h"
+
+namespace deformkit::scene::detail {
+
+using nlohmann::json;
+
+// What a value is, for messages: "a number", "an array of 3", "an object".
+inline std::string jsonKind(const json& v) {
+    if (v.is_null()) return "null";
+    if (v.is_boolean()) return "a boolean";
+    if (v.is_number()) return "a number";
+    if (v.is_string()) return "a string";
+    if (v.is_array()) return "an array of " + std::to_string(v.size());
+    return "an object";
+}
+
+// Parses `text`; ParseError naming `source`, the line and column and what the file should be (`expected`).
+inline json parseJson(std::string_view text, const std::string& source, const std::string& expected) {
+    try {
+        return json::parse(text.begin(), text.end());
+    } catch (const json::exception& e) {
+        // nlohmann reports "[json.exception.parse_error.101] parse error at line L, column C: ..." (or
+        // out_of_range for a number too large): keep the part after the bracketed id.
+        const std::string what = e.what();
+        const size_t at = what.find("] ");
+        throw ParseError(
+            formatError(source, "", at == std::string::npos ? what : what.substr(at + 2), expected));
+    }
+}
+
+// "path[i]" and "path.key" (key alone at the top level).
+inline std::string jsonIndex(const std::string& path, size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+}
+inline std::string jsonMember(const std::string& path, std::string_view key) {
+    return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
+}  // namespace deformkit::scene::detail
