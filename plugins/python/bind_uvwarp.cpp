@@ -1,24 +1,34 @@
 // Python bindings of the content-aware UV warp (core/include/deformkit/uvwarp/, Koniaris et al.): the
 // UvWarpSolver class that binds one UDIM tile's maps and rest mesh once and solves frame after frame
-// (warm start), the one-off uv_warp, and apply_redirect (texture bake through a redirect map). Maps are
-// numpy float32 images in (H, W, C) layout, row 0 at v = 1 (grid.h).
+// (warm start), the one-off uv_warp, apply_redirect (texture bake through a redirect map) and uvwarp_shot
+// (the shot job of uvwarp/shot_job.h: every tile and frame written as files, resumable, cancellable). Maps
+// are numpy float32 images in (H, W, C) layout, row 0 at v = 1 (grid.h).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/mesh.h"
+#include "deformkit/interrupter.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/obj_sequence.h"
+#include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/shot_job.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "numpy_support.h"
 
@@ -79,7 +89,8 @@ io::Image optionalMapOf(const std::optional<FloatArray>& a, const std::string& s
 }
 
 // Any image: (H, W) or (H, W, C) float32.
-io::Image imageOf(const FloatArray& a, const std::string& source, const char* name, const char* expected) {
+io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
+                  const char* expected) {
     if ((a.ndim() != 2 && a.ndim() != 3) || a.shape(0) < 1 || a.shape(1) < 1 ||
         (a.ndim() == 3 && a.shape(2) < 1))
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
@@ -204,7 +215,7 @@ py::array_t<float> gridArray(const uvwarp::WarpGrid& w) {
     return out;
 }
 
-py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
+py::dict metricsDict(const uvwarp::WarpMetrics& m) {
     py::dict d;
     d["rigid_stretch_error"] = m.rigidStretchError;
     d["identity_stretch_error"] = m.identityStretchError;
@@ -214,6 +225,11 @@ py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) 
     d["max_masked_displacement"] = m.maxMaskedDisplacement;
     d["max_border_displacement"] = m.maxBorderDisplacement;
     d["points_outside"] = m.pointsOutside;
+    return d;
+}
+
+py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
+    py::dict d = metricsDict(m);
     d["iterations"] = s.iterations;
     d["levels"] = s.levels;
     d["untangled_points"] = s.untangledPoints;
@@ -327,6 +343,277 @@ py::array uvWarp(const geom::Mesh& mesh, int tile, const FloatArray& rigidity, c
     return toNumpy(std::move(out));
 }
 
+// ---- The shot job (uvwarp/shot_job.h) ----
+
+constexpr const char* kShot = "uvwarp_shot";
+constexpr const char* kUdimTokens = "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_";
+
+std::string typeName(py::handle value) {
+    return py::str(py::type::of(value).attr("__name__"));
+}
+
+bool isPath(py::handle value) {
+    return py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__");
+}
+
+// An input pattern: its UDIM token checked here, so the message names the argument.
+std::filesystem::path inputPatternOf(py::handle value, const std::string& name) {
+    const auto pattern = value.cast<std::filesystem::path>();
+    if (!io::hasUdimToken(pattern.string())) {
+        throw InvalidInput(
+            formatError(kShot, name, "'" + pattern.string() + "' has no UDIM token", kUdimTokens));
+    }
+    return pattern;
+}
+
+// An output pattern: a UDIM token and a frame token in its file name ("out/redirect.<UDIM>.####.exr").
+std::filesystem::path outputPatternOf(py::handle value, const std::string& name) {
+    if (!isPath(value)) {
+        throw InvalidInput(formatError(kShot, name, "is a " + typeName(value),
+                                       "a path pattern such as 'out/redirect.<UDIM>.####.exr'"));
+    }
+    const std::filesystem::path pattern = inputPatternOf(value, name);
+    if (!io::ObjSequence::isPattern(io::expandUdim(pattern.string(), 1001))) {
+        throw InvalidInput(formatError(kShot, name,
+                                       "'" + pattern.string() + "' has no frame token in its file name",
+                                       "one token such as #### (one # per digit) or %04d"));
+    }
+    return pattern;
+}
+
+// A per-tile map argument: a UDIM pattern of files, {tile: image} in memory (named `name` in messages and
+// headers), or (label, {tile: image}) to name it otherwise. Images are (T, T) or (T, T, C) float32, row 0
+// at v = 1; sizes and values are checked by the job, which names the tile.
+uvwarp::TileMapSource mapSourceOf(const py::object& value, const std::string& name) {
+    constexpr const char* expected =
+        "a UDIM pattern such as 'rig.<UDIM>.exr', {tile: (T, T) or (T, T, C) float32 array} or "
+        "(label, {tile: array})";
+    uvwarp::TileMapSource map;
+    if (value.is_none()) return map;
+    if (isPath(value)) {
+        map.pattern = inputPatternOf(value, name);
+        return map;
+    }
+    py::handle images = value;
+    map.name = name;
+    if (py::isinstance<py::tuple>(value)) {
+        const auto pair = py::reinterpret_borrow<py::tuple>(value);
+        if (pair.size() != 2 || !py::isinstance<py::str>(pair[0]) || !py::isinstance<py::dict>(pair[1])) {
+            throw InvalidInput(
+                formatError(kShot, name, "is a tuple but not (label, {tile: array})", expected));
+        }
+        map.name = pair[0].cast<std::string>();
+        images = pair[1];
+    }
+    if (!py::isinstance<py::dict>(images))
+        throw InvalidInput(formatError(kShot, name, "is a " + typeName(value), expected));
+    for (const auto& [key, array] : py::reinterpret_borrow<py::dict>(images)) {
+        const std::string keyText = py::repr(key);
+        const int32_t tile = intOption(key, kShot, name + " key " + keyText, 1001, "a UDIM tile, 1001..9999");
+        if (tile > 9999) {
+            throw InvalidInput(
+                formatError(kShot, name + " key " + keyText, "is not a UDIM tile", "1001..9999"));
+        }
+        const std::string element = name + "[" + std::to_string(tile) + "]";
+        const auto image = FloatArray::ensure(array);
+        if (!image) {
+            PyErr_Clear();
+            throw InvalidInput(
+                formatError(kShot, element, "is a " + typeName(array), "(T, T) or (T, T, C) float32"));
+        }
+        map.images.emplace(tile, imageOf(image, kShot, element, "(T, T) or (T, T, C) float32"));
+    }
+    if (map.images.empty()) throw InvalidInput(formatError(kShot, name, "has no tile", expected));
+    return map;
+}
+
+// Progress and cancellation from progress(done, total, unit), called with the GIL held from the job's
+// thread after every tile and frame; a true result cancels (deformkit.Cancelled). An exception it raises
+// ends the job and reaches the caller unchanged.
+class PyProgress final : public Interrupter {
+  public:
+    explicit PyProgress(const py::object& progress) : progress_(progress) {}
+
+    bool wasInterrupted(int64_t done, int64_t total, std::string_view unit) override {
+        const py::gil_scoped_acquire gil;
+        return py::bool_(progress_(done, total, py::str(unit.data(), unit.size())));
+    }
+
+  private:
+    const py::object& progress_;  // the caller's argument, alive for the call
+};
+
+py::dict tileReportDict(const uvwarp::ShotTileReport& t) {
+    py::dict d;
+    d["warped"] = t.warped;
+    d["written"] = t.written;
+    d["baked"] = t.baked;
+    d["replayed"] = t.replayed;
+    d["skipped"] = t.skipped;
+    const bool solved = t.written + t.replayed > 0;
+    d["last_frame"] = solved ? py::object(py::int_(t.lastFrame)) : py::none();
+    d["metrics"] = solved ? py::object(metricsDict(t.lastMetrics)) : py::none();
+    py::list files;
+    for (const std::filesystem::path& f : t.files)
+        files.append(f.string());
+    d["files"] = files;
+    d["notes"] = t.notes;
+    d["summary"] = uvwarp::shotSummary(uvwarp::ShotReport{{t}});
+    return d;
+}
+
+py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, const py::object& deformed,
+                    const py::object& rigidity, const py::object& out, const py::object& mask,
+                    const py::object& orientation, const py::object& texture, const py::object& bake,
+                    const std::optional<std::vector<int>>& tiles, const std::optional<int64_t>& resolution,
+                    const std::string& filter, bool skipExisting, const py::object& log,
+                    const py::object& progress, const std::string& restName, const py::kwargs& kwargs) {
+    uvwarp::ShotJob job;
+    job.options = optionsOf(resolution, kwargs, kShot);
+    job.filter = bakeOptionsOf(filter, kShot).filter;
+    if (frames.empty()) throw InvalidInput(formatError(kShot, "frames", "is empty", "at least one frame"));
+    job.rest = &rest;
+    job.restName = restName;
+    job.frames = frames;
+    if (tiles) {
+        job.tiles = *tiles;
+        std::sort(job.tiles.begin(), job.tiles.end());
+        job.tiles.erase(std::unique(job.tiles.begin(), job.tiles.end()), job.tiles.end());
+    }
+    if (rigidity.is_none())
+        throw InvalidInput(formatError(kShot, "rigidity", "is None", "the rigidity maps"));
+    job.rigidity = mapSourceOf(rigidity, "rigidity");
+    job.rigidityOption = std::string(kShot) + ": rigidity";
+    job.mask = mapSourceOf(mask, "mask");
+    job.orientation = mapSourceOf(orientation, "orientation");
+    job.texture = mapSourceOf(texture, "texture");
+    if (texture.is_none() != bake.is_none()) {
+        throw InvalidInput(formatError(kShot, texture.is_none() ? "bake" : "texture",
+                                       texture.is_none() ? "given without texture" : "given without bake",
+                                       "texture and bake together"));
+    }
+    const std::filesystem::path outPattern = outputPatternOf(out, "out");
+    std::string extension = outPattern.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (extension != ".exr") {
+        throw InvalidInput(
+            formatError(kShot, "out", "'" + outPattern.string() + "' is not an .exr file",
+                        "an OpenEXR file: the redirect map is 2 float channels with header attributes"));
+    }
+    job.outPath = [outPattern](int tile, int frame) {
+        return uvwarp::tileFramePath(outPattern, tile, frame);
+    };
+    if (!bake.is_none()) {
+        const std::filesystem::path bakePattern = outputPatternOf(bake, "bake");
+        if (bakePattern == outPattern) {
+            throw InvalidInput(formatError(kShot, "bake", "'" + bakePattern.string() + "' is the out pattern",
+                                           "another pattern"));
+        }
+        job.bakePath = [bakePattern](int tile, int frame) {
+            return uvwarp::tileFramePath(bakePattern, tile, frame);
+        };
+    }
+    job.skipExisting = skipExisting;
+
+    // The deformed positions: an OBJ sequence, or a callable (frame) -> (N, 3) or ((N, 3), name) called with
+    // the GIL held. The callable's array is copied: the job keeps it while Python code runs in progress().
+    std::optional<io::ObjSequence> sequence;
+    if (isPath(deformed)) {
+        const auto pattern = deformed.cast<std::filesystem::path>();
+        if (!io::ObjSequence::isPattern(pattern.string())) {
+            throw InvalidInput(formatError(kShot, "deformed", "'" + pattern.string() + "' has no frame token",
+                                           "a callable frame -> (N, 3) float32, or an OBJ sequence such as "
+                                           "'anim.####.obj' (one # per digit) or 'anim.%04d.obj'"));
+        }
+        sequence.emplace(pattern);
+        for (int frame : frames) {
+            const std::filesystem::path path = sequence->framePath(frame);
+            std::error_code ec;
+            if (!std::filesystem::exists(path, ec)) {
+                throw IoError(formatError(path.string(), "frame " + std::to_string(frame), "is missing",
+                                          "a file for every frame of '" + pattern.string() + "' in frames"));
+            }
+        }
+    } else if (!PyCallable_Check(deformed.ptr())) {
+        throw InvalidInput(formatError(kShot, "deformed", "is a " + typeName(deformed),
+                                       "a callable frame -> (N, 3) float32, or an OBJ sequence pattern"));
+    }
+    if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+        throw InvalidInput(formatError(kShot, "progress", "is a " + typeName(progress),
+                                       "None or a callable (done, total, unit) -> bool"));
+    }
+    std::ofstream logFile;
+    std::filesystem::path logPath;
+    if (!log.is_none()) {
+        if (!isPath(log)) {
+            throw InvalidInput(formatError(kShot, "log", "is a " + typeName(log), "None or a file path"));
+        }
+        logPath = log.cast<std::filesystem::path>();
+        logFile.open(logPath, std::ios::app | std::ios::binary);
+        if (!logFile) {
+            throw IoError(formatError(logPath.string(), "", "cannot open the log for appending",
+                                      "a writable file in an existing folder"));
+        }
+        job.log = &logFile;
+    }
+
+    const auto vertices = static_cast<py::ssize_t>(rest.numVertices());
+    io::ObjContent sequenceFrame;
+    std::vector<glm::vec3> points;
+    const uvwarp::DeformedFrames deformedFrames = [&](int frame,
+                                                      std::string& name) -> std::span<const glm::vec3> {
+        if (sequence) {
+            name = sequence->framePath(frame).string();
+            sequenceFrame = sequence->read(frame);
+            return sequenceFrame.mesh.points();
+        }
+        const py::gil_scoped_acquire gil;
+        const std::string element = "deformed(" + std::to_string(frame) + ")";
+        const char* expected = "(N, 3) float32 positions of the rest mesh's vertices, or (positions, name)";
+        py::object result = deformed(frame);
+        name = "frame " + std::to_string(frame);
+        if (py::isinstance<py::tuple>(result)) {
+            const auto pair = py::reinterpret_borrow<py::tuple>(result);
+            if (pair.size() != 2) {
+                throw InvalidInput(formatError(
+                    kShot, element, "returned a tuple of " + std::to_string(pair.size()), expected));
+            }
+            name = py::str(pair[1]);
+            result = pair[0];
+        }
+        const auto array = FloatArray::ensure(result);
+        if (!array) {
+            PyErr_Clear();
+            throw InvalidInput(formatError(kShot, element, "returned a " + typeName(result), expected));
+        }
+        if (array.ndim() != 2 || array.shape(1) != 3 || array.shape(0) != vertices) {
+            const std::string what =
+                py::isinstance<py::array>(result) ? "" : "a " + typeName(result) + " of ";
+            throw InvalidInput(formatError(kShot, element, "returned " + what + "shape " + shapeOf(array),
+                                           "(" + std::to_string(vertices) + ", 3), one row per rest vertex"));
+        }
+        points.resize(static_cast<size_t>(vertices));
+        if (!points.empty()) std::memcpy(points.data(), array.data(), points.size() * sizeof(glm::vec3));
+        return points;
+    };
+
+    std::optional<PyProgress> interrupter;
+    if (!progress.is_none()) interrupter.emplace(progress);
+    uvwarp::ShotReport report;
+    {
+        const py::gil_scoped_release release;
+        report = uvwarp::runShotJob(job, deformedFrames, interrupter ? &*interrupter : nullptr);
+    }
+    if (logFile.is_open() && !logFile.flush()) {
+        throw IoError(formatError(logPath.string(), "", "cannot write the log", "a writable file"));
+    }
+    py::dict result;
+    for (const uvwarp::ShotTileReport& t : report.tiles)
+        result[py::int_(t.tile)] = tileReportDict(t);
+    return result;
+}
+
 constexpr const char* kSolverDoc =
     "The content-aware UV warp (Koniaris et al.) of one UDIM tile, bound once to the rest mesh and the\n"
     "tile's maps, solved frame after frame: each solve warm-starts from the last warp, so a static pose\n"
@@ -350,6 +637,38 @@ constexpr const char* kSolveDoc =
     "Returns the warp grid W as (n + 1, n + 1, 2) float32: n cells per side means n + 1 grid points per\n"
     "side (deformkit/uvwarp/grid.h). [j, i] holds the tile-local (u, v) of grid point (i, j), which rests\n"
     "at (i / n, j / n): row j = 0 lies on v = 0 (unlike images, whose row 0 is v = 1).";
+
+constexpr const char* kShotDoc =
+    "The UV warp over a shot, written as files: for every UDIM tile and frame the redirect map (and the\n"
+    "tile's texture baked through it), the job of `deformkit uvwarp` and of scenes (uvwarp/shot_job.h).\n\n"
+    "uvwarp_shot(mesh, frames, deformed, rigidity, out, mask=None, orientation=None, texture=None,\n"
+    "            bake=None, tiles=None, resolution=None, filter='bilinear', skip_existing=True, log=None,\n"
+    "            progress=None, rest_name='rest mesh', **options)\n"
+    "uvwarp_shot(points, face_counts, face_indices, uvs, uv_indices, frames, deformed, rigidity, out,\n"
+    "            ...)\n\n"
+    "mesh: a deformkit.Mesh with UVs, or its arrays as UvWarpSolver takes them. frames: ascending ints.\n"
+    "deformed: a callable frame -> (N, 3) float32 positions of the rest mesh's vertices, or -> (positions,\n"
+    "name) to name the frame's input in the headers; called once per frame, in order, up to the last frame\n"
+    "an output is missing for. Or an OBJ sequence pattern ('anim.####.obj', '%04d').\n"
+    "rigidity, mask, orientation, texture: a UDIM pattern ('rig.<UDIM>.exr'), or images in memory as\n"
+    "{tile: (T, T) or (T, T, C) float32} (row 0 at v = 1, channel 0 used except for the texture), named\n"
+    "by the argument in messages and headers, or (label, {tile: array}) to name them. A tile without a\n"
+    "rigidity map is left unwarped (a note); without a mask the mask is derived from the UVs.\n"
+    "out, bake: patterns with a UDIM token and a frame token ('out/redirect.<UDIM>.####.exr'); out is a\n"
+    "2-channel float EXR, bake (with texture) any format; their folders must exist. tiles: None for every\n"
+    "tile of the UVs. resolution and options as UvWarpSolver; filter of the bake: 'bilinear', 'bicubic'.\n"
+    "skip_existing: keep outputs that exist and replay the warm start, so a rerun after a cancellation or\n"
+    "a crash writes the bytes an uninterrupted run writes; False writes every output again.\n"
+    "log: a file to append JSON lines to (one per tile and frame). progress: a callable (done, total,\n"
+    "unit) called after each tile and frame (unit: 'tile 1001 frame 12 written'); a true result cancels:\n"
+    "deformkit.Cancelled is raised and every file written is complete. The solve runs without the GIL;\n"
+    "the callables are called with it.\n\n"
+    "Every output is written atomically, with its provenance in the EXR header (deformkit:version,\n"
+    "deformkit:uvwarp:tile, deformkit:uvwarp:frame, deformkit:uvwarp:solver and deformkit:uvwarp:inputs,\n"
+    "the last two JSON; see read_image_info). Returns {tile: report}, ascending, each a dict: warped,\n"
+    "written (frames written), baked, replayed (existed, solved for the warm start), skipped (existed, not\n"
+    "solved), last_frame and metrics (of the last frame solved, or None), files (written, in order), notes\n"
+    "(an unwarped tile, a derived mask, a texture not baked) and summary (printable lines).";
 
 }  // namespace
 
@@ -442,6 +761,41 @@ void bindUvWarp(py::module_& m) {
         "as redirect_map returns it: out(texel) = texture(redirect(uv of the texel's centre)), sampled with\n"
         "filter 'bilinear' or 'bicubic' (Catmull-Rom), clamped to the tile's edge texels. Returns an array\n"
         "of the texture's shape.");
+
+    m.def("uvwarp_shot", &uvwarpShot, py::arg("mesh"), py::arg("frames"), py::arg("deformed"),
+          py::arg("rigidity"), py::arg("out"), py::arg("mask") = py::none(),
+          py::arg("orientation") = py::none(), py::arg("texture") = py::none(), py::arg("bake") = py::none(),
+          py::arg("tiles") = py::none(), py::arg("resolution") = py::none(), py::arg("filter") = "bilinear",
+          py::arg("skip_existing") = true, py::arg("log") = py::none(), py::arg("progress") = py::none(),
+          py::arg("rest_name") = "rest mesh", kShotDoc);
+    m.def(
+        "uvwarp_shot",
+        [](const FloatArray& points, const IntArray& counts, const IntArray& indices,
+           const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices,
+           const std::vector<int>& frames, const py::object& deformed, const py::object& rigidity,
+           const py::object& out, const py::object& mask, const py::object& orientation,
+           const py::object& texture, const py::object& bake, const std::optional<std::vector<int>>& tiles,
+           const std::optional<int64_t>& resolution, const std::string& filter, bool skipExisting,
+           const py::object& log, const py::object& progress, const std::string& restName,
+           const py::kwargs& kwargs) {
+            const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, kShot);
+            return uvwarpShot(mesh, frames, deformed, rigidity, out, mask, orientation, texture, bake, tiles,
+                              resolution, filter, skipExisting, log, progress, restName, kwargs);
+        },
+        py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("uvs"),
+        py::arg("uv_indices"), py::arg("frames"), py::arg("deformed"), py::arg("rigidity"), py::arg("out"),
+        py::arg("mask") = py::none(), py::arg("orientation") = py::none(), py::arg("texture") = py::none(),
+        py::arg("bake") = py::none(), py::arg("tiles") = py::none(), py::arg("resolution") = py::none(),
+        py::arg("filter") = "bilinear", py::arg("skip_existing") = true, py::arg("log") = py::none(),
+        py::arg("progress") = py::none(), py::arg("rest_name") = "rest mesh", kShotDoc);
+    m.def(
+        "tile_frame_path",
+        [](const std::filesystem::path& pattern, int tile, int frame) {
+            return uvwarp::tileFramePath(pattern, tile, frame).string();
+        },
+        py::arg("pattern"), py::arg("tile"), py::arg("frame"),
+        "The file of a tile and frame for a pattern with a UDIM and a frame token, as uvwarp_shot names its\n"
+        "outputs: tile_frame_path('out/redirect.<UDIM>.####.exr', 1001, 7) is 'out/redirect.1001.0007.exr'.");
 }
 
 }  // namespace deformkit::python

@@ -12,6 +12,7 @@
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/geom/mesh.h"
 #include "deformkit/geom/primitives.h"
+#include "deformkit/interrupter.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
@@ -119,6 +120,7 @@ PYBIND11_MODULE(deformkit, m) {
     py::register_exception<ParseError>(m, "ParseError", error.ptr());
     auto invalid = py::register_exception<InvalidInput>(m, "InvalidInput", error.ptr());
     py::register_exception<TopologyError>(m, "TopologyError", invalid.ptr());
+    py::register_exception<Cancelled>(m, "Cancelled", error.ptr());
 
     py::class_<geom::Mesh>(
         m, "Mesh", "A polygon mesh: float32 points, faces as counts + indices, optional face-varying UVs.")
@@ -198,6 +200,32 @@ PYBIND11_MODULE(deformkit, m) {
         },
         py::arg("path"), py::arg("channels") = 0,
         "Read an image as a (H, W, C) float32 array; channels > 0 requires that count.");
+    m.def(
+        "read_image_info",
+        [](const std::filesystem::path& path) {
+            io::ImageInfo info;
+            {
+                py::gil_scoped_release release;
+                info = io::readImageInfo(path);
+            }
+            py::dict attributes;
+            for (const auto& [name, value] : info.attributes)
+                attributes[py::str(name)] = value;
+            py::dict out;
+            out["width"] = info.width;
+            out["height"] = info.height;
+            out["channels"] = info.channels;
+            out["format"] = info.format;
+            out["pixel_type"] = info.pixelType;
+            out["channel_names"] = info.channelNames;
+            out["attributes"] = attributes;
+            return out;
+        },
+        py::arg("path"),
+        "Read an image's header only: a dict of width, height, channels, format (\"openexr\", \"png\", "
+        "...),\n"
+        "pixel_type (\"half\", \"float\", \"uint8\", ...), channel_names and attributes ({name: value}, the\n"
+        "header's string attributes, e.g. the provenance of a redirect map).");
     m.def(
         "write_image",
         [](const std::filesystem::path& path, const FloatArray& array, const std::string& type,

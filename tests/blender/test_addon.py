@@ -7,6 +7,7 @@ changing frames) and compares the mesh's vertex positions with the same deformat
 `deformkit` Python module directly, from values the test sets itself.
 """
 
+import json
 import os
 import shutil
 import sys
@@ -371,6 +372,52 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
         assert np.array_equal(baked[:, :, :2], solver.redirect_map()), f"frame {frame}"
     assert np.abs(solver.redirect_map() - dk.read_image(os.path.join(out, "redirect.1001.0001.exr"))[:, :, :2]
                   ).max() > 1e-4  # the slide at frame 3 does warp the texture
+
+    # Each map's header says what made it: the library's version, tile, frame, solver and inputs.
+    for frame in (1, 2, 3):
+        header = dk.read_image_info(os.path.join(out, f"redirect.1001.{frame:04d}.exr"))["attributes"]
+        assert (header["deformkit:version"], header["deformkit:uvwarp:tile"], header["deformkit:uvwarp:frame"]) == (
+            dk.__version__, "1001", str(frame)), header
+        assert json.loads(header["deformkit:uvwarp:inputs"]) == {
+            "rest": "Blender object 'grid'", "rigidity": "rigidity image 'rigidity' tile 1001", "mask": "derived",
+            "orientation": "none", "deformed": f"Blender object 'grid' evaluated at frame {frame}"}, header
+        assert json.loads(header["deformkit:uvwarp:solver"])["texels"] == size
+
+    # Resume: a bake that lost frame 2's map sets frames 1 and 2 only (the warm start replayed) and writes that
+    # map alone, the same bytes; the others are not written (they keep an old modification time set here).
+    old = 10**18  # ns: 2001
+
+    def files_now():
+        return {name: (os.stat(os.path.join(out, name)).st_mtime_ns == old,
+                       open(os.path.join(out, name), "rb").read()) for name in sorted(os.listdir(out))}
+
+    for name in os.listdir(out):
+        os.utime(os.path.join(out, name), ns=(old, old))
+    first = files_now()
+    os.remove(os.path.join(out, "redirect.1001.0002.exr"))
+    frames_set = []
+
+    def record(scene, *_):
+        frames_set.append(scene.frame_current)
+
+    bpy.context.scene.frame_set(3)
+    bpy.app.handlers.frame_change_post.append(record)
+    try:
+        assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3, resume=True) == {'FINISHED'}
+    finally:
+        bpy.app.handlers.frame_change_post.remove(record)
+    assert frames_set == [1, 2, 3], frames_set  # the last one puts the scene back on its frame
+    resumed = files_now()
+    assert {name: data for name, (_, data) in resumed.items()} == {name: data for name, (_, data) in first.items()}
+    assert [resumed[name][0] for name in sorted(first)] == [True, False, True], resumed.keys()
+    # With every map there, a resumed bake solves nothing.
+    report = addon.uvwarp.bake_redirect_maps(bpy.context, obj, image, None, range(1, 4), out, resume=True)
+    assert [report[1001][k] for k in ("written", "replayed", "skipped", "files")] == [0, 0, 3, []], report
+    # The operator's default writes every map again (a rigger re-baking after repainting), the same bytes here.
+    for name in os.listdir(out):
+        os.utime(os.path.join(out, name), ns=(old, old))
+    assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3) == {'FINISHED'}
+    assert files_now() == {name: (False, data) for name, (_, data) in first.items()}
 
     material = bpy.data.materials.new("skin")
     material.use_nodes = True

@@ -1,7 +1,12 @@
 """deformkit.UvWarpSolver, uv_warp and apply_redirect (the content-aware UV warp of Koniaris et al.) on a planar
 UV-mapped grid whose positions equal its UVs: the identity warp's rigid stretch error has a closed form computed
 here in numpy, an undeformed pose redirects every texel to its own centre, an identity redirect bakes the texture
-unchanged and a one-texel shift moves it by one texel; bad input raises deformkit.InvalidInput naming it."""
+unchanged and a one-texel shift moves it by one texel; bad input raises deformkit.InvalidInput naming it.
+uvwarp_shot (the shot job) on two tiles against UvWarpSolver driven frame by frame, its resume, cancellation and
+provenance headers."""
+import json
+import os
+
 import numpy as np
 import pytest
 
@@ -204,3 +209,231 @@ def test_bad_input_names_what_is_wrong():
     nan[3, 4, 1] = np.nan
     with pytest.raises(dk.InvalidInput, match=r"\(4, 3\)"):
         dk.apply_redirect(rig, nan)
+
+
+# ---- uvwarp_shot: the shot job ----
+
+S = 32  # texels per side of the shot tests' maps
+FRAMES = [1, 2, 3, 4]
+OPTIONS = dict(iterations=4)  # few iterations: the tests compare against the same solve, not a quality
+OUT = "redirect.<UDIM>.####.exr"
+
+
+def two_tiles(n=16):
+    """plane(n) in tile 1001 beside another in tile 1002, each with its own vertices; positions equal UVs."""
+    a, b = plane(n), plane(n, tile_origin=(1.0, 0.0))
+    b_points = b[0] + np.array([1.0, 0.0, 0.0], np.float32)
+    return (np.concatenate([a[0], b_points]), np.concatenate([a[1], b[1]]),
+            np.concatenate([a[2], b[2] + len(a[0])]), np.concatenate([a[3], b[3]]),
+            np.concatenate([a[4], b[4] + len(a[3])]))
+
+
+def shot_maps():
+    """Per tile: a rigidity map (disks; in 1002 mirrored, so the tiles differ) and an RGB texture."""
+    rng = np.random.default_rng(3)
+    rig = {1001: disks(S), 1002: np.ascontiguousarray(disks(S)[:, ::-1])}
+    tex = {tile: rng.uniform(0, 1, (S, S, 3)).astype(np.float32) for tile in rig}
+    return rig, tex
+
+
+def pose(points, frame):
+    """Frame f stretches x by 1 + 0.15 f: a different pose every frame, so the warm start matters."""
+    return stretched(points, 1.0 + 0.15 * frame)
+
+
+def file_bytes(folder):
+    return {name: (folder / name).read_bytes() for name in sorted(os.listdir(folder))}
+
+
+def test_shot_writes_the_solvers_maps_frame_by_frame_with_provenance(tmp_path):
+    mesh = two_tiles()
+    rig, tex = shot_maps()
+    asked, units = [], []
+
+    def deformed(frame):
+        asked.append(frame)
+        return pose(mesh[0], frame), f"pose {frame}"
+
+    def progress(done, total, unit):
+        units.append((done, total, unit))
+
+    report = dk.uvwarp_shot(*mesh, FRAMES, deformed, rig, str(tmp_path / OUT), texture=tex,
+                            bake=str(tmp_path / "col.<UDIM>.####.exr"), progress=progress, rest_name="two planes",
+                            **OPTIONS)
+    assert asked == FRAMES  # each frame's positions asked for once, for both tiles
+    # Units are tiles x frames, frame by frame: done counts them one by one.
+    assert units == [(k + 1, 8, f"tile {tile} frame {frame} written")
+                     for k, (frame, tile) in enumerate((f, t) for f in FRAMES for t in (1001, 1002))]
+    assert sorted(report) == [1001, 1002]
+    for tile in (1001, 1002):
+        solver = dk.UvWarpSolver(*mesh, tile, rig[tile], **OPTIONS)
+        r = report[tile]
+        outs = [str(tmp_path / f"redirect.{tile}.{f:04d}.exr") for f in FRAMES]
+        bakes = [str(tmp_path / f"col.{tile}.{f:04d}.exr") for f in FRAMES]
+        assert (r["warped"], r["written"], r["baked"], r["replayed"], r["skipped"]) == (True, 4, 4, 0, 0)
+        assert r["files"] == [p for pair in zip(outs, bakes) for p in pair] and r["notes"] == []
+        for k, frame in enumerate(FRAMES):
+            solver.solve(pose(mesh[0], frame))
+            redirect = solver.redirect_map()
+            written = dk.read_image(outs[k])
+            assert written.shape == (S, S, 2)
+            np.testing.assert_array_equal(written, redirect)  # bit for bit: float EXR
+            # The bake is the module's apply_redirect of the same map, stored as half (EXR's default).
+            expected = dk.apply_redirect(tex[tile], redirect).astype(np.float16).astype(np.float32)
+            np.testing.assert_array_equal(dk.read_image(bakes[k]), expected)
+            for path in (outs[k], bakes[k]):
+                a = dk.read_image_info(path)["attributes"]
+                assert a["deformkit:version"] == dk.__version__
+                assert (a["deformkit:uvwarp:tile"], a["deformkit:uvwarp:frame"]) == (str(tile), str(frame))
+                assert json.loads(a["deformkit:uvwarp:inputs"]) == {
+                    "rest": "two planes", "rigidity": f"rigidity tile {tile}", "mask": "derived",
+                    "orientation": "none", "deformed": f"pose {frame}"}
+                used = json.loads(a["deformkit:uvwarp:solver"])
+                assert (used["iterations"], used["cells"], used["texels"], used["warmStart"]) == (4, S, S, True)
+        metrics = solver.metrics()
+        assert r["last_frame"] == 4 and r["metrics"] == {k: metrics[k] for k in r["metrics"]}
+        assert r["summary"][0].startswith(f"tile {tile}: 4 frames written (4 baked), 0 replayed, 0 skipped")
+    assert len(os.listdir(tmp_path)) == 16  # no temporary file left beside them
+
+
+def test_shot_maps_in_memory_equal_maps_from_files(tmp_path):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    mask = {1001: np.ones((S, S), np.float32)}  # 1002 keeps a derived mask: a note
+    maps, a, b = tmp_path / "maps", tmp_path / "a", tmp_path / "b"
+    for folder in (maps, a, b):
+        folder.mkdir()
+    for tile in rig:
+        dk.write_image(maps / f"rig.{tile}.exr", rig[tile], "float")
+    dk.write_image(maps / "mask.1001.exr", mask[1001], "float")
+    for frame in FRAMES:  # the deformed frames as an OBJ sequence, and as read back for the callable
+        dk.write_mesh(str(maps / f"anim.{frame:04d}.obj"), dk.Mesh(pose(mesh[0], frame), *mesh[1:]))
+    from_files = dk.uvwarp_shot(*mesh, FRAMES, str(maps / "anim.####.obj"), maps / "rig.<UDIM>.exr",
+                                str(a / OUT), mask=str(maps / "mask.<UDIM>.exr"), **OPTIONS)
+    in_memory = dk.uvwarp_shot(*mesh, FRAMES, lambda f: dk.read_mesh(str(maps / f"anim.{f:04d}.obj")).points,
+                               rig, str(b / OUT), mask=("painted mask", mask), **OPTIONS)
+    assert sorted(os.listdir(a)) == sorted(os.listdir(b)) and len(os.listdir(a)) == 8
+    for name in os.listdir(a):
+        np.testing.assert_array_equal(dk.read_image(a / name), dk.read_image(b / name))
+    note = "no warp mask '{}': derived from the UVs"
+    assert from_files[1002]["notes"] == [note.format(maps / "mask.1002.exr")]
+    assert in_memory[1002]["notes"] == [note.format("painted mask tile 1002")]
+    # The headers name where each input came from.
+    inputs = json.loads(dk.read_image_info(a / "redirect.1001.0002.exr")["attributes"]["deformkit:uvwarp:inputs"])
+    assert inputs == {"rest": "rest mesh", "rigidity": str(maps / "rig.1001.exr"),
+                      "mask": str(maps / "mask.1001.exr"), "orientation": "none",
+                      "deformed": str(maps / "anim.0002.obj")}
+    inputs = json.loads(dk.read_image_info(b / "redirect.1001.0002.exr")["attributes"]["deformkit:uvwarp:inputs"])
+    assert (inputs["rigidity"], inputs["mask"], inputs["deformed"]) == (
+        "rigidity tile 1001", "painted mask tile 1001", "frame 2")
+
+
+def test_shot_resume_replays_the_warm_start_and_writes_the_same_bytes(tmp_path):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    out, log = str(tmp_path / OUT), tmp_path / "log.jsonl"
+    dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, out, **OPTIONS)
+    full = file_bytes(tmp_path)
+    missing = tmp_path / "redirect.1001.0003.exr"
+    missing.unlink()
+    asked = []
+
+    def deformed(frame):
+        asked.append(frame)
+        return pose(mesh[0], frame)
+
+    report = dk.uvwarp_shot(*mesh, FRAMES, deformed, rig, out, log=log, **OPTIONS)
+    assert asked == [1, 2, 3]  # nothing after the last missing output is evaluated
+    r = report[1001]
+    assert (r["written"], r["replayed"], r["skipped"], r["files"]) == (1, 2, 1, [str(missing)])
+    assert r["last_frame"] == 3
+    r = report[1002]  # every output exists: the tile is not solved at all
+    assert (r["written"], r["replayed"], r["skipped"], r["files"], r["metrics"]) == (0, 0, 4, [], None)
+    assert file_bytes(tmp_path) == {**full, "log.jsonl": log.read_bytes()}  # the same bytes as the first run
+    lines = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [(d["tile"], d["frame"], d["status"]) for d in lines] == [
+        (1001, 1, "replayed"), (1002, 1, "skipped"), (1001, 2, "replayed"), (1002, 2, "skipped"),
+        (1001, 3, "written"), (1002, 3, "skipped"), (1001, 4, "skipped"), (1002, 4, "skipped")]
+    # skip_existing=False writes every output again, the same bytes.
+    report = dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, out, skip_existing=False, **OPTIONS)
+    assert [report[t]["written"] for t in (1001, 1002)] == [4, 4]
+    assert file_bytes(tmp_path) == {**full, "log.jsonl": log.read_bytes()}
+
+
+@pytest.mark.parametrize("stop_after", [1, 3])
+def test_shot_cancelled_from_progress_leaves_complete_files_and_a_rerun_completes(tmp_path, stop_after):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    b.mkdir()
+    dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(a / OUT), **OPTIONS)
+    calls = []
+
+    def progress(done, total, unit):
+        calls.append(done)
+        return done == stop_after
+
+    with pytest.raises(dk.Cancelled, match="cancelled") as cancelled:
+        dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(b / OUT), progress=progress, **OPTIONS)
+    assert isinstance(cancelled.value, dk.Error) and calls == list(range(1, stop_after + 1))
+    # Units run frame by frame over the tiles: exactly the first stop_after outputs exist, complete.
+    done = [f"redirect.{t}.{f:04d}.exr" for f in FRAMES for t in (1001, 1002)][:stop_after]
+    assert sorted(os.listdir(b)) == sorted(done)
+    full = file_bytes(a)
+    assert all(full[name] == (b / name).read_bytes() for name in done)
+    report = dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(b / OUT), **OPTIONS)
+    assert sum(r["written"] for r in report.values()) == 8 - stop_after
+    assert file_bytes(b) == full
+
+
+def test_shot_bad_input_names_what_is_wrong(tmp_path):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    out = str(tmp_path / OUT)
+
+    def run(**changes):
+        args = dict(frames=FRAMES, deformed=lambda f: pose(mesh[0], f), rigidity=rig, out=out, **OPTIONS)
+        args.update(changes)
+        return dk.uvwarp_shot(*mesh, **args)
+
+    for changes, error, text in (
+            (dict(out=str(tmp_path / "redirect.####.exr")), dk.InvalidInput,
+             "uvwarp_shot: out: '.*' has no UDIM token"),
+            (dict(out=str(tmp_path / "redirect.<UDIM>.exr")), dk.InvalidInput, "out: '.*' has no frame token"),
+            (dict(out=str(tmp_path / "redirect.<UDIM>.####.png")), dk.InvalidInput, "out: '.*' is not an .exr file"),
+            (dict(rigidity="rig.exr"), dk.InvalidInput, "uvwarp_shot: rigidity: 'rig.exr' has no UDIM token"),
+            (dict(mask={1001: np.ones((16, 16), np.float32)}), dk.InvalidInput,
+             r"mask tile 1001: warp mask: 16 x 16 texels \(expected 32 x 32, the size of 'rigidity tile 1001'\)"),
+            (dict(mask={1001: np.ones(16, np.float32)}), dk.InvalidInput, r"mask\[1001\]: has shape \(16,\)"),
+            (dict(rigidity={"a": rig[1001]}), dk.InvalidInput, "rigidity key 'a': is a str"),
+            (dict(rigidity={1001: "x"}), dk.InvalidInput, r"rigidity\[1001\]: is a str"),
+            (dict(rigidity={}), dk.InvalidInput, "rigidity: has no tile"),
+            (dict(rigidity=None), dk.InvalidInput, "rigidity: is None"),
+            (dict(rigidity={1003: rig[1001]}), dk.IoError, "rigidity: no tile has a rigidity map"),
+            (dict(texture={1001: rig[1001]}), dk.InvalidInput, "texture: given without bake"),
+            (dict(frames=[]), dk.InvalidInput, "frames: is empty"),
+            (dict(frames=[2, 1]), dk.InvalidInput, "frames: are not ascending"),
+            (dict(tiles=[1005]), dk.InvalidInput, "tile 1005: the rest mesh 'rest mesh' has no UV face in it"),
+            (dict(deformed=7), dk.InvalidInput, "deformed: is a int"),
+            (dict(deformed="anim.obj"), dk.InvalidInput, "deformed: 'anim.obj' has no frame token"),
+            (dict(deformed=str(tmp_path / "anim.####.obj")), dk.IoError, "anim.0001.obj: frame 1: is missing"),
+            (dict(deformed=lambda f: mesh[0][:5]), dk.InvalidInput, r"deformed\(1\): returned shape \(5, 3\)"),
+            (dict(deformed=lambda f: None), dk.InvalidInput, r"deformed\(1\): returned a NoneType of shape \(\)"),
+            (dict(progress=3), dk.InvalidInput, "progress: is a int"),
+            (dict(out=str(tmp_path / "no" / OUT)), dk.IoError, "output folder: does not exist"),
+            (dict(smoothing=2.0), dk.InvalidInput, "uvwarp_shot: smoothing: is 2.0"),
+            (dict(filter="nearest"), dk.InvalidInput, "filter: is 'nearest'")):
+        with pytest.raises(error, match=text):
+            run(**changes)
+    assert os.listdir(tmp_path) == []  # every check came before the first output
+    # An exception raised in a callback reaches the caller unchanged.
+    with pytest.raises(ZeroDivisionError):
+        run(progress=lambda done, total, unit: 1 / 0)
+    with pytest.raises(KeyError):
+        run(deformed=lambda f: {}[f])
+
+
+def test_tile_frame_path_names_outputs():
+    assert dk.tile_frame_path(OUT, 1001, 7) == "redirect.1001.0007.exr"
+    assert dk.tile_frame_path("out/col.<UDIM>.%03d.exr", 1012, 24) == os.path.join("out", "col.1012.024.exr")

@@ -5,7 +5,7 @@ import os
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, IntProperty
+from bpy.props import BoolProperty, EnumProperty, IntProperty
 from mathutils import Euler, Matrix, Vector
 
 from . import evaluate, uvwarp
@@ -273,6 +273,10 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
 
     frame_start: IntProperty(name="Start", default=1)
     frame_end: IntProperty(name="End", default=1)
+    # Off by default: a rigger baking again after repainting expects new maps.
+    resume: BoolProperty(name="Resume", default=False,
+                         description="Keep the redirect maps that exist and bake only the missing ones (after an "
+                                     "interrupted bake); off: write every map again")
 
     @classmethod
     def poll(cls, context):
@@ -292,15 +296,21 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         frames = range(self.frame_start, self.frame_end + 1)
         wm.progress_begin(0.0, 1.0)
         try:
-            written = uvwarp.bake_redirect_maps(context, obj, settings.uv_rigidity, settings.uv_mask, frames,
-                                                bpy.path.abspath(settings.uv_output), settings.uv_resolution,
-                                                wm.progress_update)
+            report = uvwarp.bake_redirect_maps(context, obj, settings.uv_rigidity, settings.uv_mask, frames,
+                                               bpy.path.abspath(settings.uv_output), settings.uv_resolution,
+                                               self.resume, lambda done, total, _: wm.progress_update(done / total))
         except Exception as e:  # noqa: BLE001 - reported to the user
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
         finally:
             wm.progress_end()
-        self.report({'INFO'}, f"wrote {len(written)} redirect maps to {settings.uv_output}")
+        for tile, result in report.items():
+            for note in result["notes"]:  # a tile left unwarped, a mask derived
+                self.report({'WARNING'}, f"tile {tile}: {note}")
+        written = sum(t["written"] for t in report.values())
+        kept = sum(t["replayed"] + t["skipped"] for t in report.values())
+        self.report({'INFO'}, f"wrote {written} redirect map{'' if written == 1 else 's'} to {settings.uv_output}"
+                              + (f", kept {kept} that exist" if kept else ""))
         return {'FINISHED'}
 
 

@@ -1,9 +1,11 @@
 """The content-aware UV warp in Blender: bake redirect maps over a frame range, and the material nodes that
 read a texture through them ("DeformKit Redirect").
 
-Maps are the `deformkit uvwarp` command's: per UDIM tile and frame a 2-channel float EXR whose texel holds
-the tile-local (u', v') to read the texture at, named redirect.<tile>.<frame>.exr. Each tile's solver
-warm-starts frame after frame from a cold start at the first frame, as the command-line host does.
+The bake is the module's shot job (`uvwarp_shot`, the library's uvwarp/shot_job.h), the one `deformkit uvwarp`
+and `deformkit eval` run: per UDIM tile and frame a 2-channel float EXR whose texel holds the tile-local
+(u', v') to read the texture at, named redirect.<tile>.<frame>.exr, written atomically with its provenance in
+the header. Each tile's solver warm-starts frame after frame from a cold start at the first frame; a resumed
+bake replays the warm start and so writes the maps an uninterrupted one would.
 """
 
 import os
@@ -21,8 +23,12 @@ class UvWarpError(Exception):
     """A problem with the object, its UVs or its maps: shown to the user."""
 
 
+# The bake's output files in the output folder: redirect.1001.0007.exr (tile, frame padded to 4 digits).
+REDIRECT_PATTERN = "redirect.<UDIM>.####.exr"
+
+
 def redirect_name(tile, frame):
-    return f"redirect.{tile}.{frame:04d}.exr"
+    return dk.tile_frame_path(REDIRECT_PATTERN, tile, frame)
 
 
 def mesh_with_uvs(obj, points):
@@ -38,38 +44,24 @@ def mesh_with_uvs(obj, points):
     return points, counts, indices, uvs.reshape(-1, 2), order
 
 
-def uv_tiles(counts, uvs, uv_indices):
-    """The UDIM tiles the faces lie in (by UV centroid)."""
-    ends = np.cumsum(counts)
-    centroids = np.add.reduceat(uvs[uv_indices], ends - counts, axis=0) / counts[:, None]
-    return sorted({int(1001 + np.floor(u) + 10 * np.floor(v)) for u, v in centroids})
-
-
-def image_map(image, tile, role):
-    """One tile of a Blender image as a (T, T) float32 map, row 0 at v = 1 (channel 0)."""
+def image_map(image, role):
+    """A Blender image as uvwarp_shot takes a map. A UDIM tiled image: its file pattern (saved first when
+    painted), each tile read from its file. A single image: tile 1001, its pixels in memory as a (T, T)
+    float32 map, row 0 at v = 1 (channel 0), labelled with the image's name for messages and headers."""
     if image.source == 'TILED':
+        if not image.filepath:
+            raise UvWarpError(f"{role} image '{image.name}' is a UDIM image without files; save it first")
         if image.is_dirty:
-            if not image.filepath:
-                raise UvWarpError(f"{role} image '{image.name}' is painted but not saved; save it first")
             image.save()
-        path = bpy.path.abspath(image.filepath)
-        if "<UDIM>" not in path:
-            raise UvWarpError(f"{role} image '{image.name}': its file path has no <UDIM> token")
-        path = path.replace("<UDIM>", str(tile))
-        if not os.path.exists(path):
-            raise UvWarpError(f"{role} image '{image.name}' has no tile {tile} ({path})")
-        pixels = dk.read_image(path)
-        return np.ascontiguousarray(pixels[:, :, 0])
-    if tile != 1001:
-        raise UvWarpError(f"{role} image '{image.name}' is a single image, used for tile 1001 only; the mesh "
-                          f"has faces in tile {tile} (use a UDIM tiled image)")
+        return bpy.path.abspath(image.filepath)
     w, h = image.size
-    if w != h or w == 0:
-        raise UvWarpError(f"{role} image '{image.name}' is {w} x {h} pixels; expected a square map")
+    if w == 0 or h == 0:
+        raise UvWarpError(f"{role} image '{image.name}' has no pixels (is its file missing?)")
     pixels = np.empty(w * h * image.channels, np.float32)
     image.pixels.foreach_get(pixels)
     # Blender stores rows bottom-up; maps are row 0 at v = 1.
-    return np.ascontiguousarray(pixels.reshape(h, w, image.channels)[::-1, :, 0])
+    return (f"{role} image '{image.name}'",
+            {1001: np.ascontiguousarray(pixels.reshape(h, w, image.channels)[::-1, :, 0])})
 
 
 def evaluated_points(obj, depsgraph, count):
@@ -88,8 +80,12 @@ def evaluated_points(obj, depsgraph, count):
     return points.reshape(-1, 3)
 
 
-def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution=0, progress=None):
-    """Solves every tile over `frames` and writes the redirect maps; returns the files written."""
+def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution=0, resume=False, progress=None):
+    """Solves every UDIM tile of the object's UVs over `frames` (ascending) with the module's shot job and
+    writes REDIRECT_PATTERN's files into out_dir. Each frame is set once and the evaluated mesh read once for
+    all tiles. resume keeps the maps that exist (the warm start is replayed up to the last missing one);
+    otherwise every map is written again. progress(done, total, unit) is uvwarp_shot's. Returns the job's
+    report, {tile: dict}."""
     scene = context.scene
     if evaluate.has_rest(obj):
         rest = evaluate.rest_points(obj)
@@ -97,30 +93,26 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
         rest = np.empty(len(obj.data.vertices) * 3, np.float32)
         obj.data.vertices.foreach_get("co", rest)
         rest = rest.reshape(-1, 3)
-    points, counts, indices, uvs, uv_indices = mesh_with_uvs(obj, rest)
-    tiles = uv_tiles(counts, uvs, uv_indices)
+    mesh = mesh_with_uvs(obj, rest)
     if rigidity is None:
         raise UvWarpError(f"{obj.name}: no rigidity map set")
     os.makedirs(out_dir, exist_ok=True)
-    written = []
+    name = f"Blender object '{obj.name}'" + (f" in {bpy.data.filepath}" if bpy.data.filepath else "")
+
+    def deformed(frame):
+        scene.frame_set(frame)
+        points = evaluated_points(obj, context.evaluated_depsgraph_get(), len(rest))
+        return points, f"{name} evaluated at frame {frame}"
+
     current = scene.frame_current
     try:
-        for t, tile in enumerate(tiles):
-            solver = dk.UvWarpSolver(points, counts, indices, uvs, uv_indices, tile,
-                                     image_map(rigidity, tile, "rigidity"),
-                                     image_map(mask, tile, "mask") if mask is not None else None,
-                                     resolution or None)
-            for i, frame in enumerate(frames):
-                scene.frame_set(frame)
-                solver.solve(evaluated_points(obj, context.evaluated_depsgraph_get(), len(rest)))
-                path = os.path.join(out_dir, redirect_name(tile, frame))
-                dk.write_image(path, solver.redirect_map(), "float")
-                written.append(path)
-                if progress is not None:
-                    progress((t * len(frames) + i + 1) / (len(tiles) * len(frames)))
+        return dk.uvwarp_shot(*mesh, list(frames), deformed, image_map(rigidity, "rigidity"),
+                              os.path.join(out_dir, REDIRECT_PATTERN),
+                              mask=image_map(mask, "mask") if mask is not None else None,
+                              resolution=resolution or None, skip_existing=resume, progress=progress,
+                              rest_name=name)
     finally:
         scene.frame_set(current)
-    return written
 
 
 def redirect_group():
