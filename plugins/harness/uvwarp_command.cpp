@@ -51,18 +51,6 @@ void forEachItem(std::string_view text, Item&& item) {
     }
 }
 
-void requireOutputPattern(const fs::path& pattern, const std::string& option) {
-    const std::string text = pattern.string();
-    if (!io::hasUdimToken(text)) {
-        throw InvalidInput(
-            formatError(option, text, "has no UDIM token", "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
-    }
-    if (!io::ObjSequence::isPattern(io::expandUdim(text, 1001))) {
-        throw InvalidInput(formatError(option, text, "has no frame token in its file name",
-                                       "one token such as #### (one # per digit) or %04d"));
-    }
-}
-
 }  // namespace
 
 std::vector<int> parseFrames(std::string_view text, const std::string& option) {
@@ -129,33 +117,8 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
                                        command.bake ? "given without --texture" : "given without --bake",
                                        "--texture and --bake together"));
     }
-    if (!io::hasUdimToken(command.rigidity.string())) {
-        throw InvalidInput(formatError("--rigidity", command.rigidity.string(), "has no UDIM token",
-                                       "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
-    }
-    for (const auto& [option, pattern] :
-         {std::pair{"--mask", command.mask}, std::pair{"--orientation", command.orientation},
-          std::pair{"--texture", command.texture}}) {
-        if (pattern && !io::hasUdimToken(pattern->string())) {
-            throw InvalidInput(formatError(option, pattern->string(), "has no UDIM token",
-                                           "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
-        }
-    }
-    requireOutputPattern(command.out, "--out");
-    std::string outExtension = command.out.extension().string();
-    std::transform(outExtension.begin(), outExtension.end(), outExtension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (outExtension != ".exr") {
-        throw InvalidInput(
-            formatError("--out", command.out.string(), "is not an .exr file",
-                        "an OpenEXR file: the redirect map is 2 float channels with header attributes"));
-    }
-    if (command.bake) {
-        requireOutputPattern(*command.bake, "--bake");
-        if (*command.bake == command.out)
-            throw InvalidInput(
-                formatError("--bake", command.bake->string(), "is the --out pattern", "another pattern"));
-    }
+    uvwarp::ShotJob job;
+    uvwarp::setOutputPatterns(job, command.out, command.bake.value_or(fs::path()), "--out", "--bake");
 
     const io::ObjContent restObj = io::readObj(command.rest);
     const geom::Mesh& rest = restObj.mesh;
@@ -177,40 +140,20 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
         }
     }
 
-    io::ObjSequence sequence(command.deformed);
-    for (int frame : command.frames) {
-        const fs::path path = sequence.framePath(frame);
-        std::error_code ec;
-        if (!fs::exists(path, ec)) {
-            throw IoError(
-                formatError(path.string(), "frame " + std::to_string(frame), "is missing",
-                            "a file for every frame of '" + command.deformed.string() + "' in --frames"));
-        }
-    }
+    const uvwarp::DeformedFrames frames =
+        uvwarp::objSequenceFrames(command.deformed, command.frames, "--deformed");
 
-    uvwarp::ShotJob job;
     job.rest = &rest;
     job.restName = command.rest.string();
     job.frames = command.frames;
     job.tiles = command.tiles;
-    job.rigidity.pattern = command.rigidity;
-    if (command.mask) job.mask.pattern = *command.mask;
-    if (command.orientation) job.orientation.pattern = *command.orientation;
-    if (command.texture) job.texture.pattern = *command.texture;
-    job.rigidityOption = "--rigidity";
-    job.outPath = [&](int tile, int frame) { return uvwarp::tileFramePath(command.out, tile, frame); };
-    if (command.bake) {
-        job.bakePath = [&](int tile, int frame) { return uvwarp::tileFramePath(*command.bake, tile, frame); };
-    }
+    job.rigidity = {command.rigidity, {}, "--rigidity"};
+    if (command.mask) job.mask = {*command.mask, {}, "--mask"};
+    if (command.orientation) job.orientation = {*command.orientation, {}, "--orientation"};
+    if (command.texture) job.texture = {*command.texture, {}, "--texture"};
     job.options = command.options;
     job.options.cells = command.resolution;
     job.filter = command.filter;
-    io::ObjContent deformed;
-    const uvwarp::DeformedFrames frames = [&](int frame, std::string& name) -> std::span<const glm::vec3> {
-        name = sequence.framePath(frame).string();
-        deformed = sequence.read(frame);
-        return deformed.mesh.points();
-    };
     std::ofstream logFile;
     if (command.log) {
         logFile.open(*command.log, std::ios::app | std::ios::binary);

@@ -356,31 +356,6 @@ bool isPath(py::handle value) {
     return py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__");
 }
 
-// An input pattern: its UDIM token checked here, so the message names the argument.
-std::filesystem::path inputPatternOf(py::handle value, const std::string& name) {
-    const auto pattern = value.cast<std::filesystem::path>();
-    if (!io::hasUdimToken(pattern.string())) {
-        throw InvalidInput(
-            formatError(kShot, name, "'" + pattern.string() + "' has no UDIM token", kUdimTokens));
-    }
-    return pattern;
-}
-
-// An output pattern: a UDIM token and a frame token in its file name ("out/redirect.<UDIM>.####.exr").
-std::filesystem::path outputPatternOf(py::handle value, const std::string& name) {
-    if (!isPath(value)) {
-        throw InvalidInput(formatError(kShot, name, "is a " + typeName(value),
-                                       "a path pattern such as 'out/redirect.<UDIM>.####.exr'"));
-    }
-    const std::filesystem::path pattern = inputPatternOf(value, name);
-    if (!io::ObjSequence::isPattern(io::expandUdim(pattern.string(), 1001))) {
-        throw InvalidInput(formatError(kShot, name,
-                                       "'" + pattern.string() + "' has no frame token in its file name",
-                                       "one token such as #### (one # per digit) or %04d"));
-    }
-    return pattern;
-}
-
 // A per-tile map argument: a UDIM pattern of files, {tile: image} in memory (named `name` in messages and
 // headers), or (label, {tile: image}) to name it otherwise. Images are (T, T) or (T, T, C) float32, row 0
 // at v = 1; sizes and values are checked by the job, which names the tile.
@@ -391,7 +366,8 @@ uvwarp::TileMapSource mapSourceOf(const py::object& value, const std::string& na
     uvwarp::TileMapSource map;
     if (value.is_none()) return map;
     if (isPath(value)) {
-        map.pattern = inputPatternOf(value, name);
+        map.pattern = value.cast<std::filesystem::path>();
+        map.name = std::string(kShot) + ": " + name;  // the job checks its UDIM token
         return map;
     }
     py::handle images = value;
@@ -483,7 +459,6 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
     if (rigidity.is_none())
         throw InvalidInput(formatError(kShot, "rigidity", "is None", "the rigidity maps"));
     job.rigidity = mapSourceOf(rigidity, "rigidity");
-    job.rigidityOption = std::string(kShot) + ": rigidity";
     job.mask = mapSourceOf(mask, "mask");
     job.orientation = mapSourceOf(orientation, "orientation");
     job.texture = mapSourceOf(texture, "texture");
@@ -492,49 +467,23 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                                        texture.is_none() ? "given without texture" : "given without bake",
                                        "texture and bake together"));
     }
-    const std::filesystem::path outPattern = outputPatternOf(out, "out");
-    std::string extension = outPattern.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (extension != ".exr") {
-        throw InvalidInput(
-            formatError(kShot, "out", "'" + outPattern.string() + "' is not an .exr file",
-                        "an OpenEXR file: the redirect map is 2 float channels with header attributes"));
-    }
-    job.outPath = [outPattern](int tile, int frame) {
-        return uvwarp::tileFramePath(outPattern, tile, frame);
-    };
-    if (!bake.is_none()) {
-        const std::filesystem::path bakePattern = outputPatternOf(bake, "bake");
-        if (bakePattern == outPattern) {
-            throw InvalidInput(formatError(kShot, "bake", "'" + bakePattern.string() + "' is the out pattern",
-                                           "another pattern"));
+    for (const auto& [value, name] : {std::pair{&out, "out"}, std::pair{&bake, "bake"}}) {
+        if (!value->is_none() && !isPath(*value)) {
+            throw InvalidInput(formatError(kShot, name, "is a " + typeName(*value),
+                                           "a path pattern such as 'out/redirect.<UDIM>.####.exr'"));
         }
-        job.bakePath = [bakePattern](int tile, int frame) {
-            return uvwarp::tileFramePath(bakePattern, tile, frame);
-        };
     }
+    uvwarp::setOutputPatterns(job, out.cast<std::filesystem::path>(),
+                              bake.is_none() ? std::filesystem::path() : bake.cast<std::filesystem::path>(),
+                              std::string(kShot) + ": out", std::string(kShot) + ": bake");
     job.skipExisting = skipExisting;
 
     // The deformed positions: an OBJ sequence, or a callable (frame) -> (N, 3) or ((N, 3), name) called with
     // the GIL held. The callable's array is copied: the job keeps it while Python code runs in progress().
-    std::optional<io::ObjSequence> sequence;
+    uvwarp::DeformedFrames sequence;
     if (isPath(deformed)) {
-        const auto pattern = deformed.cast<std::filesystem::path>();
-        if (!io::ObjSequence::isPattern(pattern.string())) {
-            throw InvalidInput(formatError(kShot, "deformed", "'" + pattern.string() + "' has no frame token",
-                                           "a callable frame -> (N, 3) float32, or an OBJ sequence such as "
-                                           "'anim.####.obj' (one # per digit) or 'anim.%04d.obj'"));
-        }
-        sequence.emplace(pattern);
-        for (int frame : frames) {
-            const std::filesystem::path path = sequence->framePath(frame);
-            std::error_code ec;
-            if (!std::filesystem::exists(path, ec)) {
-                throw IoError(formatError(path.string(), "frame " + std::to_string(frame), "is missing",
-                                          "a file for every frame of '" + pattern.string() + "' in frames"));
-            }
-        }
+        sequence = uvwarp::objSequenceFrames(deformed.cast<std::filesystem::path>(), frames,
+                                             std::string(kShot) + ": deformed");
     } else if (!PyCallable_Check(deformed.ptr())) {
         throw InvalidInput(formatError(kShot, "deformed", "is a " + typeName(deformed),
                                        "a callable frame -> (N, 3) float32, or an OBJ sequence pattern"));
@@ -559,15 +508,10 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
     }
 
     const auto vertices = static_cast<py::ssize_t>(rest.numVertices());
-    io::ObjContent sequenceFrame;
     std::vector<glm::vec3> points;
     const uvwarp::DeformedFrames deformedFrames = [&](int frame,
                                                       std::string& name) -> std::span<const glm::vec3> {
-        if (sequence) {
-            name = sequence->framePath(frame).string();
-            sequenceFrame = sequence->read(frame);
-            return sequenceFrame.mesh.points();
-        }
+        if (sequence) return sequence(frame, name);
         const py::gil_scoped_acquire gil;
         const std::string element = "deformed(" + std::to_string(frame) + ")";
         const char* expected = "(N, 3) float32 positions of the rest mesh's vertices, or (positions, name)";

@@ -399,10 +399,10 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
 
     for changes, error, text in (
             (dict(out=str(tmp_path / "redirect.####.exr")), dk.InvalidInput,
-             "uvwarp_shot: out: '.*' has no UDIM token"),
-            (dict(out=str(tmp_path / "redirect.<UDIM>.exr")), dk.InvalidInput, "out: '.*' has no frame token"),
-            (dict(out=str(tmp_path / "redirect.<UDIM>.####.png")), dk.InvalidInput, "out: '.*' is not an .exr file"),
-            (dict(rigidity="rig.exr"), dk.InvalidInput, "uvwarp_shot: rigidity: 'rig.exr' has no UDIM token"),
+             "uvwarp_shot: out: .*redirect.####.exr: has no UDIM token"),
+            (dict(out=str(tmp_path / "redirect.<UDIM>.exr")), dk.InvalidInput, "out: .*redirect.<UDIM>.exr: has no frame token"),
+            (dict(out=str(tmp_path / "redirect.<UDIM>.####.png")), dk.InvalidInput, "out: .*redirect.<UDIM>.####.png: is not an .exr file"),
+            (dict(rigidity="rig.exr"), dk.InvalidInput, "uvwarp_shot: rigidity: rig.exr: has no UDIM token"),
             (dict(mask={1001: np.ones((16, 16), np.float32)}), dk.InvalidInput,
              r"mask tile 1001: warp mask: 16 x 16 texels \(expected 32 x 32, the size of 'rigidity tile 1001'\)"),
             (dict(mask={1001: np.ones(16, np.float32)}), dk.InvalidInput, r"mask\[1001\]: has shape \(16,\)"),
@@ -416,7 +416,7 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(frames=[2, 1]), dk.InvalidInput, "frames: are not ascending"),
             (dict(tiles=[1005]), dk.InvalidInput, "tile 1005: the rest mesh 'rest mesh' has no UV face in it"),
             (dict(deformed=7), dk.InvalidInput, "deformed: is a int"),
-            (dict(deformed="anim.obj"), dk.InvalidInput, "deformed: 'anim.obj' has no frame token"),
+            (dict(deformed="anim.obj"), dk.InvalidInput, "uvwarp_shot: deformed: anim.obj: has no frame token"),
             (dict(deformed=str(tmp_path / "anim.####.obj")), dk.IoError, "anim.0001.obj: frame 1: is missing"),
             (dict(deformed=lambda f: mesh[0][:5]), dk.InvalidInput, r"deformed\(1\): returned shape \(5, 3\)"),
             (dict(deformed=lambda f: None), dk.InvalidInput, r"deformed\(1\): returned a NoneType of shape \(\)"),

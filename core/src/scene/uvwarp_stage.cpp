@@ -96,7 +96,7 @@ uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpSt
     if (stage.mask) job.mask.pattern = *stage.mask;
     if (stage.orientation) job.orientation.pattern = *stage.orientation;
     if (stage.texture) job.texture.pattern = *stage.texture;
-    job.rigidityOption = scene.source + ": " + stage.path + ".rigidity";
+    job.rigidity.name = scene.source + ": " + stage.path + ".rigidity";
     const std::string name = o.name;
     const fs::path outDir = run.outDir;
     job.outPath = [name, outDir](int tile, int frame) {

@@ -14,6 +14,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
@@ -196,6 +197,15 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                            "tiles of the rest mesh: " + have));
         }
     }
+    for (const auto& [source, role] :
+         {std::pair{&j.rigidity, "rigidity"}, std::pair{&j.mask, "mask"},
+          std::pair{&j.orientation, "orientation"}, std::pair{&j.texture, "texture"}}) {
+        if (!source->pattern.empty() && !io::hasUdimToken(source->pattern.string())) {
+            throw InvalidInput(formatError(source->name.empty() ? role : source->name,
+                                           source->pattern.string(), "has no UDIM token",
+                                           "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
+        }
+    }
     const int32_t resolution = j.options.cells;
     const bool wantBake = j.texture.given();
     for (int tile : tiles) {
@@ -279,9 +289,9 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         std::string list;
         for (const TilePlan& p : s.plans)
             list += (list.empty() ? "'" : ", '") + p.rigidity.name + "'";
-        const std::string source = j.rigidity.pattern.empty() ? j.rigidity.name : j.rigidity.pattern.string();
-        throw IoError(
-            formatError(j.rigidityOption, source, "no tile has a rigidity map", "at least one of " + list));
+        throw IoError(formatError(j.rigidity.name.empty() ? "rigidity" : j.rigidity.name,
+                                  j.rigidity.pattern.string(), "no tile has a rigidity map",
+                                  "at least one of " + list));
     }
 }
 
@@ -468,6 +478,62 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
 
 fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {
     return io::ObjSequence(io::expandUdim(pattern.string(), tile)).framePath(frame);
+}
+
+void setOutputPatterns(ShotJob& job, const fs::path& out, const fs::path& bake, const std::string& outName,
+                       const std::string& bakeName) {
+    const auto check = [](const fs::path& pattern, const std::string& name) {
+        const std::string text = pattern.string();
+        if (!io::hasUdimToken(text)) {
+            throw InvalidInput(
+                formatError(name, text, "has no UDIM token", "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
+        }
+        if (!io::ObjSequence::isPattern(io::expandUdim(text, 1001))) {
+            throw InvalidInput(formatError(name, text, "has no frame token in its file name",
+                                           "one token such as #### (one # per digit) or %04d"));
+        }
+    };
+    check(out, outName);
+    std::string extension = out.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (extension != ".exr") {
+        throw InvalidInput(formatError(outName, out.string(), "is not an .exr file",
+                                       "an OpenEXR file: the redirect map is 2 float channels with header "
+                                       "attributes"));
+    }
+    job.outPath = [out](int tile, int frame) { return tileFramePath(out, tile, frame); };
+    job.bakePath = nullptr;
+    if (bake.empty()) return;
+    check(bake, bakeName);
+    if (bake == out) {
+        throw InvalidInput(
+            formatError(bakeName, bake.string(), "is the " + outName + " pattern", "another pattern"));
+    }
+    job.bakePath = [bake](int tile, int frame) { return tileFramePath(bake, tile, frame); };
+}
+
+DeformedFrames objSequenceFrames(const fs::path& pattern, const std::vector<int>& frames,
+                                 const std::string& name) {
+    if (!io::ObjSequence::isPattern(pattern.string())) {
+        throw InvalidInput(formatError(name, pattern.string(), "has no frame token",
+                                       "an OBJ sequence such as 'anim.####.obj' (one # per digit) or "
+                                       "'anim.%04d.obj'"));
+    }
+    auto sequence = std::make_shared<io::ObjSequence>(pattern);
+    for (int frame : frames) {
+        const fs::path path = sequence->framePath(frame);
+        if (!fileExists(path)) {
+            throw IoError(formatError(path.string(), "frame " + std::to_string(frame), "is missing",
+                                      "a file for every frame of '" + pattern.string() + "'"));
+        }
+    }
+    auto content = std::make_shared<io::ObjContent>();
+    return [sequence, content](int frame, std::string& frameName) -> std::span<const glm::vec3> {
+        frameName = sequence->framePath(frame).string();
+        *content = sequence->read(frame);
+        return content->mesh.points();
+    };
 }
 
 std::vector<std::string> shotSummary(const ShotReport& report) {

@@ -100,6 +100,9 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         col.prop(settings, "uv_resolution")
         row = col.row(align=True)
         row.operator("deformkit.bake_redirect", icon='RENDER_ANIMATION', text="Bake Redirect Maps")
+        # Resume keeps the maps that exist (a bake that stopped) and writes the missing ones, with the bytes an
+        # uninterrupted bake writes.
+        row.operator("deformkit.bake_redirect", icon='FILE_REFRESH', text="Resume").resume = True
         row.operator("deformkit.redirect_material", icon='NODETREE', text="Redirect Material")
 
 

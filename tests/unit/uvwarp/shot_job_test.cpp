@@ -237,7 +237,7 @@ TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp]
     Shot none;
     none.job.rigidity.images.clear();
     none.job.rigidity.pattern = none.dir / "rig.<UDIM>.exr";
-    none.job.rigidityOption = "--rigidity";
+    none.job.rigidity.name = "--rigidity";
     CHECK_THAT(test::errorOf<IoError>([&] { uvwarp::ShotSolver s(none.job); }),
                Contains("--rigidity") && Contains("no tile has a rigidity map"));
 

@@ -40,17 +40,20 @@ namespace deformkit::uvwarp {
 //   bytes an uninterrupted one would have, the warm start is replayed: each tile solves every frame up to
 //   its last missing output, frames whose outputs exist only to carry the warm start ("replayed"), and no
 //   frame after it ("skipped"). A tile whose outputs all exist is not bound.
-// - Checks before anything is written: output folders exist; per tile the maps' sizes (square, equal, a
-//   power of two when the grid takes the map's size). A tile without a rigidity map is left unwarped (no
-//   outputs) and reported, unless no tile has one (an error). A missing mask tile is derived from the UVs, a
-//   missing orientation tile means 1 everywhere, a missing texture tile is not baked; each is reported.
+// - Checks before anything is written: map patterns have a UDIM token; output folders exist; per tile the
+//   maps' sizes (square, equal, a power of two when the grid takes the map's size). A tile without a rigidity
+//   map is left unwarped (no outputs) and reported, unless no tile has one (an error). A missing mask tile is
+//   derived from the UVs, a missing orientation tile means 1 everywhere, a missing texture tile is not baked;
+//   each is reported.
 
 // A per-tile map: a UDIM pattern of files ("rig.<UDIM>.exr", io/udim.h tokens) or images a host holds in
 // memory (painted maps), by tile. Images are T x T (channel 0 used), rows from the top (io::Image).
 struct TileMapSource {
     std::filesystem::path pattern;    // empty when the maps are `images`
     std::map<int, io::Image> images;  // tile -> map, used when there is no pattern
-    std::string name;                 // how messages and headers name the source; empty: the pattern
+    // How messages name the source: an option ("--mask"), an argument, a scene's JSON path, a host's image
+    // name. Headers record a file's path, or this name and the tile for an image in memory.
+    std::string name;
 
     [[nodiscard]] bool given() const { return !pattern.empty() || !images.empty(); }
 };
@@ -64,8 +67,6 @@ struct ShotJob {
     TileMapSource mask;                // optional; channel 0 >= 0.5 may warp
     TileMapSource orientation;         // optional; channel 0 in [0, 1] scales the orientation preservation
     TileMapSource texture;             // optional; baked through each redirect map (needs bakePath)
-    // How messages name the rigidity input when no tile has a map ("--rigidity", a scene's JSON path).
-    std::string rigidityOption = "rigidity";
     // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
     std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
     TileWarpOptions options;  // cells: the grid resolution (0: the rigidity map's size)
@@ -140,6 +141,19 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
 // The file of `tile` and `frame` for a pattern with a UDIM token and a frame token in its file name
 // ("out/redirect.<UDIM>.####.exr"; frame tokens as io::ObjSequence).
 [[nodiscard]] std::filesystem::path tileFramePath(const std::filesystem::path& pattern, int tile, int frame);
+
+// Sets job.outPath (and job.bakePath when `bake` is not empty) from such patterns, checked: each has a UDIM
+// token and a frame token in its file name, `out` is an OpenEXR file (the redirect map is 2 float channels
+// with header attributes) and `bake` another pattern. `outName` and `bakeName` name them in messages (an
+// option, an argument). Throws InvalidInput.
+void setOutputPatterns(ShotJob& job, const std::filesystem::path& out, const std::filesystem::path& bake,
+                       const std::string& outName, const std::string& bakeName);
+
+// The deformed frames of an OBJ sequence ("anim.####.obj", io::ObjSequence tokens): checks now that the
+// pattern has a frame token (InvalidInput naming `name`) and that a file exists for every one of `frames`
+// (IoError naming the first missing one); then reads each frame when asked, named by its path.
+[[nodiscard]] DeformedFrames objSequenceFrames(const std::filesystem::path& pattern,
+                                               const std::vector<int>& frames, const std::string& name);
 
 // One line per warped tile ("tile 1001: 24 frames written (24 baked), 0 replayed, 0 skipped (outputs exist);
 // frame 24: rigid stretch error 0.041 (identity 0.262), 0 fold-overs") and one per note ("tile 1002: left
