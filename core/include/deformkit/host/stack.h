@@ -37,8 +37,9 @@ class DeformerStack {
   public:
     DeformerStack() = default;
 
-    // The rest mesh every entry binds to (copied; connectivity is shared, not duplicated). Marks every
-    // entry for a new bind.
+    // The rest mesh every entry binds to, copied (positions and face arrays; the half-edge structure, built
+    // on first use, is shared with `rest` and its other copies, not built again). Marks every entry for a
+    // new bind.
     void setRest(const geom::Mesh& rest);
     [[nodiscard]] bool hasRest() const { return rest_.has_value(); }
     // Counts setRest() calls: a host that caches something of the rest mesh compares it to know whether

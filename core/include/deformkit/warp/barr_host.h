@@ -10,8 +10,10 @@
 
 namespace deformkit::warp {
 
-// The parameterisations hosts expose for taper, twist and bend, mapped onto Barr's parameters
-// (barr.h). The Maya and Blender plugins call these; they hold no deformation code of their own.
+// The parameterisations hosts expose for taper, twist and bend, mapped onto Barr's parameters (barr.h).
+// The Maya mappings are the host layer's twist and bend deformers (host/deformers.h), which the Maya nodes,
+// the Blender add-on and scenes use. The Blender SimpleDeform mappings reproduce Blender's own modifier;
+// the Python module exposes them (blender_simple_deform_params), which the tests use to compare with Blender.
 // docs/decisions.md records how each mapping was derived.
 
 struct AxialSetup {  // for TaperWarp / TwistWarp

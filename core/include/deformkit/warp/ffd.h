@@ -14,7 +14,7 @@ namespace deformkit::warp {
 // Free-form deformation (paper §4.1, Sederberg and Parry 1986): point features on a uniform lattice in a
 // parallelepiped, strength 1, transformations T_ijk = P*_ijk - P_ijk, weighting fields the trivariate
 // Bernstein polynomials of the point's local coordinates. Also the local B-spline variant (§4.1, after
-// Greissmair and Purgathofer 1989). Decisions: docs/warps/ffd_decisions.md.
+// Greissmair and Purgathofer 1989). Decisions: docs/decisions.md, "FFD and FFD with frames".
 
 enum class FfdBasis {
     Bernstein,  // B^l_i(s) B^m_j(t) B^n_k(u): every control reaches every point inside the lattice
