@@ -4,6 +4,8 @@
 #
 #   ./scripts/setup.sh            install + configure + build
 #   ./scripts/setup.sh --deps     install only
+#   ./scripts/setup.sh --with-sanitized-tests    also build the sanitized unit tests (scripts/test.sh)
+#   ./scripts/setup.sh --sanitized-tests-only    only those (scripts/test.sh --sanitize)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -41,6 +43,11 @@ else
 fi
 
 if [ "${1:-}" = "--deps" ]; then exit 0; fi
+targets=()
+case "${1:-}" in
+    --with-sanitized-tests) targets=(--target all deformkit_sanitized_tests) ;;
+    --sanitized-tests-only) targets=(--target deformkit_sanitized_tests) ;;
+esac
 
 jobs=$(nproc 2>/dev/null || echo 2)
 # Build the Python module for Debian's own interpreter (the one Blender embeds), whatever python3
@@ -49,5 +56,5 @@ jobs=$(nproc 2>/dev/null || echo 2)
 generator=()
 if [ ! -f build/CMakeCache.txt ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build -j "$jobs"
+cmake --build build -j "$jobs" "${targets[@]}"
 echo "setup: built into ./build (CLI: ./build/bin/deformkit, Python module: ./build/python)"

@@ -3,7 +3,9 @@
 
 A unit-test binary is one CTest entry that runs every Catch2 case of its area, and a pytest file is one
 entry that runs every test in it; ctest's own summary would count each as one test. This prints ctest's line
-counting their cases: every Catch2 case and every pytest case, and every other entry as one case.
+counting their cases: every Catch2 case and every pytest case, and every other entry as one case. When the
+run had sanitized entries (names "sanitized:..."), their own line comes first; the line for the whole run
+is always the last.
 
     test_summary.py LAST_TEST_LOG
 """
@@ -39,24 +41,36 @@ def entry_counts(output, verdict):
     return (1, 0, "other") if entry_passed or verdict == "Skipped" else (0, 1, "other")
 
 
+def summary(results):
+    """ctest's line for `results`, a list of (passed, failed, kind, verdict) per entry."""
+    passed = sum(r[0] for r in results)
+    failed = sum(r[1] for r in results)
+    kinds = {"catch2": 0, "pytest": 0, "other": 0}
+    for p, f, kind, _ in results:
+        kinds[kind] += p + f
+    skipped = sum(r[3] == "Skipped" for r in results)
+    total = passed + failed
+    percent = 100 * passed // total if total else 0
+    detail = (f"{kinds['catch2']} Catch2 cases, {kinds['pytest']} pytest cases, {kinds['other']} other "
+              f"entries; {len(results)} CTest entries" + (f", {skipped} skipped" if skipped else ""))
+    return f"{percent}% tests passed, {failed} tests failed out of {total} ({detail})"
+
+
 def main():
     text = open(sys.argv[1], errors="replace").read()
     starts = [m for m in ENTRY.finditer(text)]
-    passed = failed = entries = skipped = 0
-    kinds = {"catch2": 0, "pytest": 0, "other": 0}
+    results, sanitized = [], []
     for i, m in enumerate(starts):
         block = text[m.end():starts[i + 1].start() if i + 1 < len(starts) else len(text)]
         out = block.split("Output:", 1)[-1].split("<end of output>", 1)[0]
         verdict = "Passed" if "Test Passed." in block else ("Skipped" if "Skipped" in block else "Failed")
-        p, f, kind = entry_counts(out, verdict)
-        passed, failed, entries = passed + p, failed + f, entries + 1
-        skipped += verdict == "Skipped"
-        kinds[kind] += p + f
-    total = passed + failed
-    percent = 100 * passed // total if total else 0
-    detail = (f"{kinds['catch2']} Catch2 cases, {kinds['pytest']} pytest cases, {kinds['other']} other "
-              f"entries; {entries} CTest entries" + (f", {skipped} skipped" if skipped else ""))
-    print(f"{percent}% tests passed, {failed} tests failed out of {total} ({detail})")
+        result = (*entry_counts(out, verdict), verdict)
+        results.append(result)
+        if m.group(1).startswith("sanitized:"):
+            sanitized.append(result)
+    if sanitized:
+        print("sanitized unit tests: " + summary(sanitized))
+    print(summary(results))
 
 
 if __name__ == "__main__":

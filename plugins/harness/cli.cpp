@@ -3,23 +3,114 @@
 #include <exception>
 #include <iostream>
 
+#include <CLI/CLI.hpp>
+
 #include "deformkit/error.h"
+#include "deformkit/version.h"
 
 namespace deformkit::harness {
 
-CLI::App* CommandLine::add(CLI::App& parent, const std::string& name, const std::string& description,
-                           std::function<int()> run) {
-    CLI::App* command = parent.add_subcommand(name, description);
+Option& Option::required() {
+    option_->required();
+    return *this;
+}
+
+Option& Option::showDefault() {
+    option_->capture_default_str();
+    return *this;
+}
+
+Option& Option::choices(std::vector<std::string> values) {
+    option_->check(CLI::IsMember(std::move(values)));
+    return *this;
+}
+
+Option& Option::range(double lo, double hi) {
+    option_->check(CLI::Range(lo, hi));
+    return *this;
+}
+
+Option& Option::nonNegative() {
+    option_->check(CLI::NonNegativeNumber);
+    return *this;
+}
+
+Option& Option::positive() {
+    option_->check(CLI::PositiveNumber);
+    return *this;
+}
+
+Option& Option::delimiter(char separator) {
+    option_->delimiter(separator);
+    return *this;
+}
+
+Option& Option::needs(const Option& other) {
+    option_->needs(other.option_);
+    return *this;
+}
+
+Option Command::option(const std::string& name, std::string& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, std::filesystem::path& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, int32_t& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, double& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, float& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, std::vector<int32_t>& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+Option Command::flag(const std::string& name, bool& target, const std::string& help) {
+    return Option(app_->add_flag(name, target, help));
+}
+
+CommandLine::CommandLine()
+    : app_(std::make_unique<CLI::App>("DeformKit: production deformers (slide, warps, content-aware UV warp)",
+                                      "deformkit")) {
+    app_->set_version_flag("--version", std::string("deformkit ") + kVersionString);
+    app_->require_subcommand(1);
+}
+
+CommandLine::~CommandLine() = default;
+
+Command CommandLine::add(const std::string& name, const std::string& description, std::function<int()> run) {
+    Command root(app_.get());
+    return add(root, name, description, std::move(run));
+}
+
+Command CommandLine::add(Command& group, const std::string& name, const std::string& description,
+                         std::function<int()> run) {
+    CLI::App* command = group.app_->add_subcommand(name, description);
     commands_.emplace_back(command, std::move(run));
-    return command;
+    return Command(command);
+}
+
+Command CommandLine::group(const std::string& name, const std::string& description) {
+    CLI::App* group = app_->add_subcommand(name, description);
+    group->require_subcommand(1);
+    return Command(group);
 }
 
 int CommandLine::run(int argc, char** argv) {
     try {
-        app_.parse(argc, argv);
+        app_->parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // Help and version print and exit 0; a usage error is one line on stderr and exit code 2.
-        if (e.get_exit_code() == 0) return app_.exit(e);
+        if (e.get_exit_code() == 0) return app_->exit(e);
         std::cerr << "deformkit: usage error: " << e.what() << " (see deformkit --help)\n";
         return 2;
     }

@@ -1,31 +1,78 @@
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
-// The deformkit command line: each command's source registers its subcommand (options and what to run)
-// through one add*Command function; main() only builds the app and runs it.
+// The deformkit command line. Each command's source declares its subcommand (options, and what to run) in
+// one add*Command function through the small interface below; cli.cpp is the one source that compiles
+// CLI11, whose templates cost seconds of compile time in every source that uses them.
 namespace deformkit::harness {
+
+// An option being declared; each modifier returns it.
+class Option {
+  public:
+    explicit Option(CLI::Option* option) : option_(option) {}
+    Option& required();
+    Option& showDefault();  // the bound variable's value now, shown in --help
+    Option& choices(std::vector<std::string> values);
+    Option& range(double lo, double hi);
+    Option& nonNegative();
+    Option& positive();
+    Option& delimiter(char separator);  // a list option takes "a,b,c" too
+    Option& needs(const Option& other);
+
+  private:
+    CLI::Option* option_;
+};
+
+// A subcommand, or a group of subcommands (`farm`, `ptex`), being declared. An option is bound to a
+// variable that must outlive the command line; NAME (upper case) is positional, --name named.
+class Command {
+  public:
+    explicit Command(CLI::App* app) : app_(app) {}
+    Option option(const std::string& name, std::string& target, const std::string& help);
+    Option option(const std::string& name, std::filesystem::path& target, const std::string& help);
+    Option option(const std::string& name, int32_t& target, const std::string& help);
+    Option option(const std::string& name, double& target, const std::string& help);
+    Option option(const std::string& name, float& target, const std::string& help);
+    Option option(const std::string& name, std::vector<int32_t>& target, const std::string& help);
+    Option flag(const std::string& name, bool& target, const std::string& help);
+
+  private:
+    friend class CommandLine;
+    CLI::App* app_;
+};
 
 class CommandLine {
   public:
-    explicit CommandLine(CLI::App& app) : app_(app) {}
+    CommandLine();
+    ~CommandLine();
+    CommandLine(const CommandLine&) = delete;
+    CommandLine& operator=(const CommandLine&) = delete;
 
-    [[nodiscard]] CLI::App& app() { return app_; }
-    // A subcommand of `parent` (the app, or a group such as `farm`); `run` is called when the user chose it,
-    // after parsing, and returns the exit code.
-    CLI::App* add(CLI::App& parent, const std::string& name, const std::string& description,
-                  std::function<int()> run);
+    // A subcommand of deformkit, or of `group`; `run` is called when the user chose it, after parsing, and
+    // returns the exit code.
+    Command add(const std::string& name, const std::string& description, std::function<int()> run);
+    Command add(Command& group, const std::string& name, const std::string& description,
+                std::function<int()> run);
+    // A group of subcommands, one of which must be given.
+    Command group(const std::string& name, const std::string& description);
     // Parses and runs the chosen command. Exit codes: 0 success; 2 a usage error or deformkit::Error (bad
     // input), with one line on stderr; 1 any other failure.
     int run(int argc, char** argv);
 
   private:
-    CLI::App& app_;
+    std::unique_ptr<CLI::App> app_;
     std::vector<std::pair<CLI::App*, std::function<int()>>> commands_;
 };
 

@@ -9,14 +9,13 @@ namespace deformkit::harness {
 
 void addDeformersCommand(CommandLine& cli) {
     auto markdown = std::make_shared<bool>(false);
-    CLI::App* deformers =
-        cli.add(cli.app(), "deformers",
-                "List every deformer type with its parameters (the parameter reference)", [markdown] {
-                    std::cout << host::parameterReference(*markdown ? host::ReferenceFormat::Markdown
-                                                                    : host::ReferenceFormat::Text);
-                    return 0;
-                });
-    deformers->add_flag("--markdown", *markdown, "as the Markdown of docs/deformers.md");
+    Command deformers = cli.add(
+        "deformers", "List every deformer type with its parameters (the parameter reference)", [markdown] {
+            std::cout << host::parameterReference(*markdown ? host::ReferenceFormat::Markdown
+                                                            : host::ReferenceFormat::Text);
+            return 0;
+        });
+    deformers.flag("--markdown", *markdown, "as the Markdown of docs/deformers.md");
 }
 
 }  // namespace deformkit::harness

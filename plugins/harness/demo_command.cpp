@@ -64,17 +64,16 @@ std::vector<fs::path> demo(const DemoCommand& command) {
 void addDemoCommand(CommandLine& cli) {
     auto command = std::make_shared<DemoCommand>();
     auto out = std::make_shared<std::string>(command->outDir.string());
-    CLI::App* demo =
-        cli.add(cli.app(), "demo", "Generate the demo assets and previews into a folder", [command, out] {
-            command->outDir = *out;
-            const std::vector<fs::path> files = harness::demo(*command);
-            std::cout << "demo: wrote " << files.size() << " files to " << command->outDir.string() << "/\n";
-            for (const fs::path& f : files)
-                std::cout << "  " << f.string() << "\n";
-            return 0;
-        });
-    demo->add_option("--out", *out, "output folder")->capture_default_str();
-    demo->add_option("--resolution", command->resolution, "texels per UDIM tile side")->capture_default_str();
+    Command demo = cli.add("demo", "Generate the demo assets and previews into a folder", [command, out] {
+        command->outDir = *out;
+        const std::vector<fs::path> files = harness::demo(*command);
+        std::cout << "demo: wrote " << files.size() << " files to " << command->outDir.string() << "/\n";
+        for (const fs::path& f : files)
+            std::cout << "  " << f.string() << "\n";
+        return 0;
+    });
+    demo.option("--out", *out, "output folder").showDefault();
+    demo.option("--resolution", command->resolution, "texels per UDIM tile side").showDefault();
 }
 
 }  // namespace deformkit::harness

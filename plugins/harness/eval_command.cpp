@@ -298,9 +298,9 @@ void addEvalCommand(CommandLine& cli) {
     };
     auto o = std::make_shared<Options>();
     o->out = o->command.outDir.string();
-    CLI::App* eval = cli.add(
-        cli.app(), "eval",
-        "Evaluate a scene's deformer stacks frame by frame and write one OBJ per object and frame", [o] {
+    Command eval = cli.add(
+        "eval", "Evaluate a scene's deformer stacks frame by frame and write one OBJ per object and frame",
+        [o] {
             EvalCommand& c = o->command;
             c.scene = o->scene;
             c.outDir = o->out;
@@ -312,20 +312,18 @@ void addEvalCommand(CommandLine& cli) {
                 std::cout << "eval: " << note << "\n";
             return 0;
         });
-    eval->add_option("SCENE", o->scene, "scene (.json, docs/scene.md)")->required();
-    eval->add_option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15; default: the scene's");
-    eval->add_option("--out", o->out,
-                     "output folder: <object>.<frame>.obj and .png, <object>.contact.png, <object>.mp4")
-        ->capture_default_str();
-    eval->add_flag("--no-previews", o->noPreviews,
-                   "write only the OBJs (no PNG previews, contact sheets or movies)");
-    eval->add_option("--preview-width", o->command.previewWidth, "preview width in pixels")
-        ->capture_default_str();
-    eval->add_option("--preview-height", o->command.previewHeight, "preview height in pixels")
-        ->capture_default_str();
-    eval->add_flag("--movie", o->command.movie,
-                   "also encode <object>.mp4 from the previews when ffmpeg is on PATH");
-    eval->add_option("--fps", o->command.movieFrameRate, "movie frame rate")->capture_default_str();
+    eval.option("SCENE", o->scene, "scene (.json, docs/scene.md)").required();
+    eval.option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15; default: the scene's");
+    eval.option("--out", o->out,
+                "output folder: <object>.<frame>.obj and .png, <object>.contact.png, <object>.mp4")
+        .showDefault();
+    eval.flag("--no-previews", o->noPreviews,
+              "write only the OBJs (no PNG previews, contact sheets or movies)");
+    eval.option("--preview-width", o->command.previewWidth, "preview width in pixels").showDefault();
+    eval.option("--preview-height", o->command.previewHeight, "preview height in pixels").showDefault();
+    eval.flag("--movie", o->command.movie,
+              "also encode <object>.mp4 from the previews when ffmpeg is on PATH");
+    eval.option("--fps", o->command.movieFrameRate, "movie frame rate").showDefault();
 }
 
 }  // namespace deformkit::harness

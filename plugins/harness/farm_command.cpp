@@ -157,18 +157,17 @@ std::vector<std::string> splitArguments(std::string_view text, const std::string
 }
 
 void addFarmCommands(CommandLine& cli) {
-    CLI::App* farm = cli.app().add_subcommand(
+    Command farm = cli.group(
         "farm",
         "Cut a scene's evaluation into render-farm tasks, run one task, or submit them (docs/farm.md)");
-    farm->require_subcommand(1);
 
     struct PlanOptions {
         FarmPlanCommand command;
         std::string scene, frames, out, plan;
     };
     auto p = std::make_shared<PlanOptions>();
-    CLI::App* plan =
-        cli.add(*farm, "plan", "Write a plan: tasks of at most --chunk frames with their output files", [p] {
+    Command plan =
+        cli.add(farm, "plan", "Write a plan: tasks of at most --chunk frames with their output files", [p] {
             FarmPlanCommand& c = p->command;
             c.scene = p->scene;
             c.outDir = p->out;
@@ -179,15 +178,14 @@ void addFarmCommands(CommandLine& cli) {
                       << (made.tasks.size() == 1 ? " task" : " tasks") << "\n";
             return 0;
         });
-    plan->add_option("SCENE", p->scene, "scene (.json, docs/scene.md)")->required();
-    plan->add_option("--frames", p->frames, "frames: 1-240, or a list such as 1-10,15; default: the scene's");
-    plan->add_option("--chunk", p->command.chunk, "frames per task at most")->capture_default_str();
-    plan->add_option("--tiles-per-task", p->command.tilesPerTask,
-                     "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
-        ->capture_default_str();
-    plan->add_option("--out", p->out, "output folder of the tasks: <object>.<frame 4 digits>.obj")
-        ->required();
-    plan->add_option("--plan", p->plan, "plan file to write; default: <out>/farm_plan.json");
+    plan.option("SCENE", p->scene, "scene (.json, docs/scene.md)").required();
+    plan.option("--frames", p->frames, "frames: 1-240, or a list such as 1-10,15; default: the scene's");
+    plan.option("--chunk", p->command.chunk, "frames per task at most").showDefault();
+    plan.option("--tiles-per-task", p->command.tilesPerTask,
+                "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
+        .showDefault();
+    plan.option("--out", p->out, "output folder of the tasks: <object>.<frame 4 digits>.obj").required();
+    plan.option("--plan", p->plan, "plan file to write; default: <out>/farm_plan.json");
 
     // Exit codes a farm manager acts on: 2 bad input (no retry), 1 anything else (worth a retry).
     const auto farmExit = [](const std::function<void()>& work) {
@@ -204,8 +202,8 @@ void addFarmCommands(CommandLine& cli) {
         std::string plan;
     };
     auto r = std::make_shared<RunOptions>();
-    CLI::App* run =
-        cli.add(*farm, "run",
+    Command run =
+        cli.add(farm, "run",
                 "Run one task of a plan, skipping frames already written; JSON lines on stdout. Exit 0 "
                 "done, 2 bad input, 1 worth a retry",
                 [r, farmExit] {
@@ -214,8 +212,8 @@ void addFarmCommands(CommandLine& cli) {
                         (void)farmRunCommand(r->command, &std::cout);
                     });
                 });
-    run->add_option("PLAN", r->plan, "plan (.json) from deformkit farm plan")->required();
-    run->add_option("--task", r->command.task, "task index, from 0")->required();
+    run.option("PLAN", r->plan, "plan (.json) from deformkit farm plan").required();
+    run.option("--task", r->command.task, "task index, from 0").required();
 
     struct SubmitOptions {
         FarmSubmitCommand command;
@@ -223,8 +221,8 @@ void addFarmCommands(CommandLine& cli) {
         bool slurm = false;
     };
     auto s = std::make_shared<SubmitOptions>();
-    CLI::App* submit =
-        cli.add(*farm, "submit", "Submit a plan as a job array, one element per task; prints the job id",
+    Command submit =
+        cli.add(farm, "submit", "Submit a plan as a job array, one element per task; prints the job id",
                 [s, farmExit] {
                     return farmExit([&] {
                         s->command.plan = s->plan;
@@ -232,11 +230,10 @@ void addFarmCommands(CommandLine& cli) {
                         std::cout << farmSubmitCommand(s->command) << "\n";
                     });
                 });
-    submit->add_flag("--slurm", s->slurm, "submit with Slurm's sbatch (the one scheduler supported)")
-        ->required();
-    submit->add_option("PLAN", s->plan, "plan (.json) from deformkit farm plan")->required();
-    submit->add_option("--sbatch-args", s->sbatchArgs,
-                       "extra sbatch options, e.g. \"--partition=batch --time=1:00:00\"");
+    submit.flag("--slurm", s->slurm, "submit with Slurm's sbatch (the one scheduler supported)").required();
+    submit.option("PLAN", s->plan, "plan (.json) from deformkit farm plan").required();
+    submit.option("--sbatch-args", s->sbatchArgs,
+                  "extra sbatch options, e.g. \"--partition=batch --time=1:00:00\"");
 }
 
 }  // namespace deformkit::harness

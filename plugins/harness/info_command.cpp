@@ -117,13 +117,13 @@ void describe(const fs::path& file, std::ostream& out) {
 
 void addInfoCommand(CommandLine& cli) {
     auto file = std::make_shared<std::string>();
-    CLI::App* info = cli.add(cli.app(), "info",
-                             "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern", [file] {
-                                 describe(*file, std::cout);
-                                 return 0;
-                             });
-    info->add_option("FILE", *file, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
-        ->required();
+    Command info =
+        cli.add("info", "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern", [file] {
+            describe(*file, std::cout);
+            return 0;
+        });
+    info.option("FILE", *file, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
+        .required();
 }
 
 }  // namespace deformkit::harness

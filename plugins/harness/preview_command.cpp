@@ -59,8 +59,8 @@ void addPreviewCommand(CommandLine& cli) {
         std::string mesh, texture, out, view, weights, weightsPtex;
     };
     auto o = std::make_shared<Options>();
-    CLI::App* preview =
-        cli.add(cli.app(), "preview", "Render a shaded, optionally textured view of a mesh to an image", [o] {
+    Command preview =
+        cli.add("preview", "Render a shaded, optionally textured view of a mesh to an image", [o] {
             PreviewCommand& c = o->command;
             c.mesh = o->mesh;
             c.out = o->out;
@@ -72,18 +72,16 @@ void addPreviewCommand(CommandLine& cli) {
             std::cout << "wrote " << o->out << "\n";
             return 0;
         });
-    preview->add_option("MESH", o->mesh, "mesh (.obj)")->required();
-    preview->add_option("--texture", o->texture, "image, or UDIM pattern such as albedo.<UDIM>.png");
-    preview->add_option("--out", o->out, "output image (.png)")->required();
-    preview->add_option("--width", o->command.options.width, "pixels")->capture_default_str();
-    preview->add_option("--height", o->command.options.height, "pixels")->capture_default_str();
-    preview->add_option("--view", o->view, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
-    preview->add_flag("--edges", o->command.options.drawEdges, "draw polygon edges");
-    preview->add_option("--weights", o->weights,
-                        "show painted weights (JSON array, one per vertex) as colours");
-    preview->add_option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");
-    preview->add_option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel")
-        ->capture_default_str();
+    preview.option("MESH", o->mesh, "mesh (.obj)").required();
+    preview.option("--texture", o->texture, "image, or UDIM pattern such as albedo.<UDIM>.png");
+    preview.option("--out", o->out, "output image (.png)").required();
+    preview.option("--width", o->command.options.width, "pixels").showDefault();
+    preview.option("--height", o->command.options.height, "pixels").showDefault();
+    preview.option("--view", o->view, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
+    preview.flag("--edges", o->command.options.drawEdges, "draw polygon edges");
+    preview.option("--weights", o->weights, "show painted weights (JSON array, one per vertex) as colours");
+    preview.option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");
+    preview.option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel").showDefault();
 }
 
 }  // namespace deformkit::harness

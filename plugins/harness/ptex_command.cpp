@@ -181,26 +181,24 @@ int8_t parseFaceResolution(const std::string& text) {
 }
 
 void addPtexCommands(CommandLine& cli) {
-    CLI::App* ptex =
-        cli.app().add_subcommand("ptex", "Ptex files: describe, per-vertex values, UDIM conversions");
-    ptex->require_subcommand(1);
+    Command ptex = cli.group("ptex", "Ptex files: describe, per-vertex values, UDIM conversions");
 
     auto infoFile = std::make_shared<std::string>();
-    cli.add(*ptex, "info", "Header, faces and resolutions, metadata of a Ptex file",
+    cli.add(ptex, "info", "Header, faces and resolutions, metadata of a Ptex file",
             [infoFile] {
                 ptexInfo(*infoFile, std::cout);
                 return 0;
             })
-        ->add_option("FILE", *infoFile, "Ptex file (.ptx)")
-        ->required();
+        .option("FILE", *infoFile, "Ptex file (.ptx)")
+        .required();
 
     struct ToVertex {
         PtexToVertexCommand command;
         std::string file, mesh, out;
     };
     auto tv = std::make_shared<ToVertex>();
-    CLI::App* toVertex =
-        cli.add(*ptex, "to-vertex", "Per-vertex values of a Ptex map as a JSON weights file", [tv] {
+    Command toVertex =
+        cli.add(ptex, "to-vertex", "Per-vertex values of a Ptex map as a JSON weights file", [tv] {
             tv->command.ptex = tv->file;
             tv->command.mesh = tv->mesh;
             tv->command.out = tv->out;
@@ -208,18 +206,18 @@ void addPtexCommands(CommandLine& cli) {
             std::cout << "wrote " << tv->out << ": " << count << " vertex values\n";
             return 0;
         });
-    toVertex->add_option("FILE", tv->file, "Ptex file painted on MESH")->required();
-    toVertex->add_option("MESH", tv->mesh, "mesh (.obj)")->required();
-    toVertex->add_option("--out", tv->out, "weights file (.json)")->required();
-    toVertex->add_option("--channel", tv->command.channel, "channel")->capture_default_str();
+    toVertex.option("FILE", tv->file, "Ptex file painted on MESH").required();
+    toVertex.option("MESH", tv->mesh, "mesh (.obj)").required();
+    toVertex.option("--out", tv->out, "weights file (.json)").required();
+    toVertex.option("--channel", tv->command.channel, "channel").showDefault();
 
     struct ToUdim {
         PtexToUdimCommand command;
         std::string file, mesh, tiles;
     };
     auto tu = std::make_shared<ToUdim>();
-    CLI::App* toUdim =
-        cli.add(*ptex, "to-udim", "Render a Ptex map into UDIM tile images through the mesh's UVs", [tu] {
+    Command toUdim =
+        cli.add(ptex, "to-udim", "Render a Ptex map into UDIM tile images through the mesh's UVs", [tu] {
             tu->command.ptex = tu->file;
             tu->command.mesh = tu->mesh;
             if (!tu->tiles.empty()) tu->command.tiles = parseTiles(tu->tiles);
@@ -227,19 +225,19 @@ void addPtexCommands(CommandLine& cli) {
                 std::cout << "wrote " << f.string() << "\n";
             return 0;
         });
-    toUdim->add_option("FILE", tu->file, "Ptex file painted on MESH")->required();
-    toUdim->add_option("MESH", tu->mesh, "mesh (.obj) with UVs")->required();
-    toUdim->add_option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'")->required();
-    toUdim->add_option("--resolution", tu->command.resolution, "pixels per tile side")->capture_default_str();
-    toUdim->add_option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
+    toUdim.option("FILE", tu->file, "Ptex file painted on MESH").required();
+    toUdim.option("MESH", tu->mesh, "mesh (.obj) with UVs").required();
+    toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
+    toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
+    toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
 
     struct FromUdim {
         PtexFromUdimCommand command;
         std::string mesh, out, faceRes = "auto", type = "float";
     };
     auto fu = std::make_shared<FromUdim>();
-    CLI::App* fromUdim =
-        cli.add(*ptex, "from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs", [fu] {
+    Command fromUdim =
+        cli.add(ptex, "from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs", [fu] {
             fu->command.mesh = fu->mesh;
             fu->command.out = fu->out;
             fu->command.faceLog2 = parseFaceResolution(fu->faceRes);
@@ -248,21 +246,19 @@ void addPtexCommands(CommandLine& cli) {
             std::cout << "wrote " << fu->out << "\n";
             return 0;
         });
-    fromUdim->add_option("PATTERN", fu->command.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'")
-        ->required();
-    fromUdim->add_option("MESH", fu->mesh, "mesh (.obj) with UVs")->required();
-    fromUdim->add_option("--out", fu->out, "Ptex file (.ptx)")->required();
-    fromUdim->add_option("--face-res", fu->faceRes, "texels per face side: auto or a power of two")
-        ->capture_default_str();
-    fromUdim->add_option("--type", fu->type, "u8, u16, half or float")->capture_default_str();
+    fromUdim.option("PATTERN", fu->command.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
+    fromUdim.option("MESH", fu->mesh, "mesh (.obj) with UVs").required();
+    fromUdim.option("--out", fu->out, "Ptex file (.ptx)").required();
+    fromUdim.option("--face-res", fu->faceRes, "texels per face side: auto or a power of two").showDefault();
+    fromUdim.option("--type", fu->type, "u8, u16, half or float").showDefault();
 
     struct FromVertex {
         PtexFromVertexCommand command;
         std::string weights, mesh, out, faceRes = "16", type = "float";
     };
     auto fv = std::make_shared<FromVertex>();
-    CLI::App* fromVertex =
-        cli.add(*ptex, "from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file", [fv] {
+    Command fromVertex =
+        cli.add(ptex, "from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file", [fv] {
             fv->command.weights = fv->weights;
             fv->command.mesh = fv->mesh;
             fv->command.out = fv->out;
@@ -272,12 +268,11 @@ void addPtexCommands(CommandLine& cli) {
             std::cout << "wrote " << fv->out << "\n";
             return 0;
         });
-    fromVertex->add_option("WEIGHTS", fv->weights, "weights file (.json), one per vertex")->required();
-    fromVertex->add_option("MESH", fv->mesh, "mesh (.obj)")->required();
-    fromVertex->add_option("--out", fv->out, "Ptex file (.ptx)")->required();
-    fromVertex->add_option("--face-res", fv->faceRes, "texels per face side, a power of two")
-        ->capture_default_str();
-    fromVertex->add_option("--type", fv->type, "u8, u16, half or float")->capture_default_str();
+    fromVertex.option("WEIGHTS", fv->weights, "weights file (.json), one per vertex").required();
+    fromVertex.option("MESH", fv->mesh, "mesh (.obj)").required();
+    fromVertex.option("--out", fv->out, "Ptex file (.ptx)").required();
+    fromVertex.option("--face-res", fv->faceRes, "texels per face side, a power of two").showDefault();
+    fromVertex.option("--type", fv->type, "u8, u16, half or float").showDefault();
 }
 
 }  // namespace deformkit::harness

@@ -97,50 +97,46 @@ void addSlideCommand(CommandLine& cli) {
                                          surface = "cage";
     };
     auto o = std::make_shared<Options>();
-    CLI::App* slide =
-        cli.add(cli.app(), "slide", "Slide vertices over the surface around a handle (Pinskiy)", [o] {
-            SlideCommand& c = o->command;
-            c.mesh = o->mesh;
-            c.out = o->out;
-            c.from = parsePoint(o->from, "--from");
-            c.to = parsePoint(o->to, "--to");
-            c.falloff = parseFalloff(o->falloff);
-            if (!o->weights.empty()) c.weights = o->weights;
-            if (!o->weightsPtex.empty()) c.weightsPtex = o->weightsPtex;
-            c.handle.region =
-                o->region == "geodesic" ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean;
-            c.options.surface = o->surface == "limit" ? slide::SurfaceMode::Limit : slide::SurfaceMode::Cage;
-            const slide::SlideResult result = slideCommand(c);
-            std::cout << slideSummary(o->out, result) << "\n";
-            return 0;
-        });
-    slide->add_option("MESH", o->mesh, "mesh (.obj)")->required();
-    slide->add_option("--handle", o->command.handle.vertex, "handle vertex index (0-based)")->required();
-    slide->add_option("--from", o->from, "start locator x,y,z")->required();
-    slide->add_option("--to", o->to, "end locator x,y,z: the handle region slides by to - from")->required();
-    slide->add_option("--radius", o->command.handle.radius, "support radius, scene units")->required();
-    slide->add_option("--out", o->out, "output mesh (.obj), UVs and groups kept")->required();
+    Command slide = cli.add("slide", "Slide vertices over the surface around a handle (Pinskiy)", [o] {
+        SlideCommand& c = o->command;
+        c.mesh = o->mesh;
+        c.out = o->out;
+        c.from = parsePoint(o->from, "--from");
+        c.to = parsePoint(o->to, "--to");
+        c.falloff = parseFalloff(o->falloff);
+        if (!o->weights.empty()) c.weights = o->weights;
+        if (!o->weightsPtex.empty()) c.weightsPtex = o->weightsPtex;
+        c.handle.region =
+            o->region == "geodesic" ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean;
+        c.options.surface = o->surface == "limit" ? slide::SurfaceMode::Limit : slide::SurfaceMode::Cage;
+        const slide::SlideResult result = slideCommand(c);
+        std::cout << slideSummary(o->out, result) << "\n";
+        return 0;
+    });
+    slide.option("MESH", o->mesh, "mesh (.obj)").required();
+    slide.option("--handle", o->command.handle.vertex, "handle vertex index (0-based)").required();
+    slide.option("--from", o->from, "start locator x,y,z").required();
+    slide.option("--to", o->to, "end locator x,y,z: the handle region slides by to - from").required();
+    slide.option("--radius", o->command.handle.radius, "support radius, scene units").required();
+    slide.option("--out", o->out, "output mesh (.obj), UVs and groups kept").required();
+    slide.option("--falloff", o->falloff, "smooth, linear, or ramp samples v0,v1,... over distance/radius")
+        .showDefault();
+    slide.option("--weights", o->weights, "painted weights: a JSON array of one number per vertex");
+    slide.option("--weights-ptex", o->weightsPtex,
+                 "painted weights from a Ptex map of the mesh (per-vertex values)");
+    slide.option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel").showDefault();
+    slide.option("--envelope", o->command.envelope, "scales every slide").showDefault();
+    slide.option("--region", o->region, "euclidean (3D distance) or geodesic (over the surface)")
+        .choices({"euclidean", "geodesic"})
+        .showDefault();
+    slide.option("--surface", o->surface, "cage (the mesh) or limit (its Catmull-Clark limit surface)")
+        .choices({"cage", "limit"})
+        .showDefault();
     slide
-        ->add_option("--falloff", o->falloff,
-                     "smooth, linear, or ramp samples v0,v1,... over distance/radius")
-        ->capture_default_str();
-    slide->add_option("--weights", o->weights, "painted weights: a JSON array of one number per vertex");
-    slide->add_option("--weights-ptex", o->weightsPtex,
-                      "painted weights from a Ptex map of the mesh (per-vertex values)");
-    slide->add_option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel")
-        ->capture_default_str();
-    slide->add_option("--envelope", o->command.envelope, "scales every slide")->capture_default_str();
-    slide->add_option("--region", o->region, "euclidean (3D distance) or geodesic (over the surface)")
-        ->check(CLI::IsMember({"euclidean", "geodesic"}))
-        ->capture_default_str();
-    slide->add_option("--surface", o->surface, "cage (the mesh) or limit (its Catmull-Clark limit surface)")
-        ->check(CLI::IsMember({"cage", "limit"}))
-        ->capture_default_str();
-    slide
-        ->add_option("--max-walk", o->command.options.maxWalkTriangles,
-                     "triangles one vertex may cross before it stops")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+        .option("--max-walk", o->command.options.maxWalkTriangles,
+                "triangles one vertex may cross before it stops")
+        .positive()
+        .showDefault();
 }
 
 }  // namespace deformkit::harness

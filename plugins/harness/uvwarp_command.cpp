@@ -177,8 +177,8 @@ void addUvWarpCommand(CommandLine& cli) {
                                                                           rigidity, out;
     };
     auto o = std::make_shared<Options>();
-    CLI::App* uvwarp = cli.add(
-        cli.app(), "uvwarp",
+    Command uvwarp = cli.add(
+        "uvwarp",
         "Content-aware UV warp over a shot: per UDIM tile and frame a redirect map (and a baked texture)",
         [o] {
             UvWarpCommand& c = o->command;
@@ -202,67 +202,55 @@ void addUvWarpCommand(CommandLine& cli) {
             return 0;
         });
     uvwarp::SolverOptions& solver = o->command.options.solver;
-    uvwarp->add_option("--rest", o->rest, "rest mesh with UVs (.obj)")->required();
+    uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj)").required();
+    uvwarp.option("--deformed", o->deformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
+        .required();
+    uvwarp.option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15").required();
+    uvwarp.option("--rigidity", o->rigidity, "rigidity maps, e.g. 'rig.<UDIM>.exr' (1 = rigid)").required();
+    uvwarp.option("--mask", o->mask,
+                  "warp masks, e.g. 'mask.<UDIM>.exr' (>= 0.5 may warp); default: from the UVs");
+    uvwarp.option("--orientation", o->orientation,
+                  "orientation-preservation maps, e.g. 'orient.<UDIM>.exr' (in [0, 1], scales "
+                  "--orientation-preservation per texel)");
+    Option texture =
+        uvwarp.option("--texture", o->texture, "texture to bake, e.g. 'col.<UDIM>.exr' (needs --bake)");
+    uvwarp.option("--out", o->out, "redirect maps, e.g. 'out/redirect.<UDIM>.####.exr' (2-channel float EXR)")
+        .required();
+    Option bake =
+        uvwarp.option("--bake", o->bake, "baked textures, e.g. 'out/col.<UDIM>.####.exr' (needs --texture)");
+    texture.needs(bake);
+    bake.needs(texture);
+    uvwarp.option("--tiles", o->tiles, "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
     uvwarp
-        ->add_option("--deformed", o->deformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
-        ->required();
-    uvwarp->add_option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15")->required();
-    uvwarp->add_option("--rigidity", o->rigidity, "rigidity maps, e.g. 'rig.<UDIM>.exr' (1 = rigid)")
-        ->required();
-    uvwarp->add_option("--mask", o->mask,
-                       "warp masks, e.g. 'mask.<UDIM>.exr' (>= 0.5 may warp); default: from the UVs");
-    uvwarp->add_option("--orientation", o->orientation,
-                       "orientation-preservation maps, e.g. 'orient.<UDIM>.exr' (in [0, 1], scales "
-                       "--orientation-preservation per texel)");
-    CLI::Option* texture =
-        uvwarp->add_option("--texture", o->texture, "texture to bake, e.g. 'col.<UDIM>.exr' (needs --bake)");
+        .option("--resolution", o->command.resolution,
+                "grid cells per side, a power of two; 0: the rigidity map's size")
+        .showDefault();
+    uvwarp.option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
+    uvwarp.option("--filter", o->filter, "bake filter: bilinear or bicubic")
+        .choices({"bilinear", "bicubic"})
+        .showDefault();
+    uvwarp.option("--iterations", solver.iterations, "PBD iterations per frame").nonNegative().showDefault();
+    uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
     uvwarp
-        ->add_option("--out", o->out,
-                     "redirect maps, e.g. 'out/redirect.<UDIM>.####.exr' (2-channel float EXR)")
-        ->required();
-    CLI::Option* bake = uvwarp->add_option(
-        "--bake", o->bake, "baked textures, e.g. 'out/col.<UDIM>.####.exr' (needs --texture)");
-    texture->needs(bake);
-    bake->needs(texture);
-    uvwarp->add_option("--tiles", o->tiles,
-                       "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
+        .option("--sweeps", solver.sweepsPerLevel, "constraint sweeps per iteration and level, finest first")
+        .delimiter(',')
+        .nonNegative()
+        .showDefault();
+    uvwarp.option("--orientation-preservation", solver.orientationPreservation, "in [0, 1]")
+        .range(0.0f, 1.0f)
+        .showDefault();
+    uvwarp.option("--smoothing", solver.smoothing, "smoothing of rigid points, in [0, 1]")
+        .range(0.0f, 1.0f)
+        .showDefault();
+    uvwarp.option("--damping", solver.damping, "velocity damping, in [0, 1]").range(0.0f, 1.0f).showDefault();
+    uvwarp.option("--coarse-stiffness", solver.coarseStiffness, "per coarser level, in (0, 1]")
+        .range(1e-6f, 1.0f)
+        .showDefault();
     uvwarp
-        ->add_option("--resolution", o->command.resolution,
-                     "grid cells per side, a power of two; 0: the rigidity map's size")
-        ->capture_default_str();
-    uvwarp->add_option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
-    uvwarp->add_option("--filter", o->filter, "bake filter: bilinear or bicubic")
-        ->check(CLI::IsMember({"bilinear", "bicubic"}))
-        ->capture_default_str();
-    uvwarp->add_option("--iterations", solver.iterations, "PBD iterations per frame")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    uvwarp->add_option("--levels", solver.levels, "hierarchy levels; 0: automatic")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    uvwarp
-        ->add_option("--sweeps", solver.sweepsPerLevel,
-                     "constraint sweeps per iteration and level, finest first")
-        ->delimiter(',')
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    uvwarp->add_option("--orientation-preservation", solver.orientationPreservation, "in [0, 1]")
-        ->check(CLI::Range(0.0f, 1.0f))
-        ->capture_default_str();
-    uvwarp->add_option("--smoothing", solver.smoothing, "smoothing of rigid points, in [0, 1]")
-        ->check(CLI::Range(0.0f, 1.0f))
-        ->capture_default_str();
-    uvwarp->add_option("--damping", solver.damping, "velocity damping, in [0, 1]")
-        ->check(CLI::Range(0.0f, 1.0f))
-        ->capture_default_str();
-    uvwarp->add_option("--coarse-stiffness", solver.coarseStiffness, "per coarser level, in (0, 1]")
-        ->check(CLI::Range(1e-6f, 1.0f))
-        ->capture_default_str();
-    uvwarp
-        ->add_option("--border-width", o->command.options.derivedMask.borderWidth,
-                     "texels of chart border kept fixed by a derived mask")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+        .option("--border-width", o->command.options.derivedMask.borderWidth,
+                "texels of chart border kept fixed by a derived mask")
+        .positive()
+        .showDefault();
 }
 
 }  // namespace deformkit::harness

@@ -32,28 +32,25 @@ void addWarpCommand(CommandLine& cli) {
         std::string image, lines, out, variant = "original", filter = "bilinear";
     };
     auto o = std::make_shared<Options>();
-    CLI::App* warp =
-        cli.add(cli.app(), "warp", "Warp an image with Beier-Neely segment pairs (inverse mapping)", [o] {
-            WarpImageCommand& c = o->command;
-            c.image = o->image;
-            c.lines = o->lines;
-            c.out = o->out;
-            c.variant =
-                o->variant == "global" ? warp::BeierNeelyVariant::Global : warp::BeierNeelyVariant::Original;
-            c.interpolation = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
-            warpImageCommand(c);
-            std::cout << "wrote " << o->out << "\n";
-            return 0;
-        });
-    warp->add_option("IMAGE", o->image, "source image")->required();
-    warp->add_option("--lines", o->lines, "segment pairs, JSON (docs/warps/beier_neely.md)")->required();
-    warp->add_option("--out", o->out, "output image, same size and channels")->required();
-    warp->add_option("--variant", o->variant, "original or global (no fold-over, paper 5.2)")
-        ->check(CLI::IsMember({"original", "global"}))
-        ->capture_default_str();
-    warp->add_option("--interp", o->filter, "bilinear or bicubic")
-        ->check(CLI::IsMember({"bilinear", "bicubic"}))
-        ->capture_default_str();
+    Command warp = cli.add("warp", "Warp an image with Beier-Neely segment pairs (inverse mapping)", [o] {
+        WarpImageCommand& c = o->command;
+        c.image = o->image;
+        c.lines = o->lines;
+        c.out = o->out;
+        c.variant =
+            o->variant == "global" ? warp::BeierNeelyVariant::Global : warp::BeierNeelyVariant::Original;
+        c.interpolation = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
+        warpImageCommand(c);
+        std::cout << "wrote " << o->out << "\n";
+        return 0;
+    });
+    warp.option("IMAGE", o->image, "source image").required();
+    warp.option("--lines", o->lines, "segment pairs, JSON (docs/warps/beier_neely.md)").required();
+    warp.option("--out", o->out, "output image, same size and channels").required();
+    warp.option("--variant", o->variant, "original or global (no fold-over, paper 5.2)")
+        .choices({"original", "global"})
+        .showDefault();
+    warp.option("--interp", o->filter, "bilinear or bicubic").choices({"bilinear", "bicubic"}).showDefault();
 }
 
 }  // namespace deformkit::harness
