@@ -1,4 +1,5 @@
 #include "deformkit/geom/bvh.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,13 +25,9 @@ constexpr float kBoxSlack = 1e-6f;
 // A triangle whose |ab x ac|^2 is below this fraction of |ab|^2 |ac|^2 has (numerically) collinear corners.
 constexpr double kCollinear = 1e-20;
 
-bool finite(const glm::vec3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
-
 void requireFinitePoints(std::span<const glm::vec3> points, const char* what) {
     for (size_t v = 0; v < points.size(); ++v) {
-        if (!finite(points[v])) {
+        if (!geom::isFinite(points[v])) {
             throw InvalidInput(formatError(what, "vertex " + std::to_string(v),
                                            "has a NaN or infinite coordinate", "finite coordinates"));
         }
@@ -346,7 +343,7 @@ Box3 Bvh::bounds() const {
 }
 
 Bvh::ClosestPoint Bvh::closestPoint(const glm::vec3& query, float maxDistance) const {
-    if (!finite(query)) {
+    if (!geom::isFinite(query)) {
         throw InvalidInput(
             formatError("bvh", "closest point query", "has a NaN or infinite coordinate", "a finite point"));
     }
@@ -411,7 +408,7 @@ Bvh::ClosestPoint Bvh::closestPoint(const glm::vec3& query, float maxDistance) c
 
 std::optional<Bvh::RayHit> Bvh::intersectRay(const glm::vec3& origin, const glm::vec3& direction, float tMin,
                                              float tMax) const {
-    if (!finite(origin) || !finite(direction) || direction == glm::vec3(0.0f)) {
+    if (!geom::isFinite(origin) || !geom::isFinite(direction) || direction == glm::vec3(0.0f)) {
         throw InvalidInput(formatError("bvh", "ray",
                                        "has a NaN or infinite origin or a zero or non-finite direction",
                                        "a finite origin and a finite, non-zero direction"));

@@ -1,4 +1,5 @@
 #include "deformkit/geom/mesh.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,16 +16,7 @@ struct Mesh::TopologyCache {
     std::unique_ptr<const HalfEdgeMesh> value;
 };
 
-namespace {
-
-bool finite(const glm::vec3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
-bool finite(const glm::vec2& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 Mesh::Mesh() : faceOffsets_{0}, topology_(std::make_shared<TopologyCache>()) {}
 
@@ -36,13 +28,13 @@ Mesh::Mesh(Data data, const std::string& source)
       uvIndices_(std::move(data.uvIndices)),
       topology_(std::make_shared<TopologyCache>()) {
     for (size_t v = 0; v < points_.size(); ++v) {
-        if (!finite(points_[v])) {
+        if (!geom::isFinite(points_[v])) {
             throw InvalidInput(formatError(source, "vertex " + std::to_string(v),
                                            "has a NaN or infinite coordinate", "finite coordinates"));
         }
     }
     for (size_t t = 0; t < uvs_.size(); ++t) {
-        if (!finite(uvs_[t])) {
+        if (!geom::isFinite(uvs_[t])) {
             throw InvalidInput(formatError(source, "uv " + std::to_string(t),
                                            "has a NaN or infinite coordinate", "finite texture coordinates"));
         }
@@ -114,7 +106,7 @@ void Mesh::setPoints(std::span<const glm::vec3> points) {
                                        std::to_string(points_.size()) + " positions, one per vertex"));
     }
     for (size_t v = 0; v < points.size(); ++v) {
-        if (!finite(points[v])) {
+        if (!geom::isFinite(points[v])) {
             throw InvalidInput(formatError("mesh", "vertex " + std::to_string(v),
                                            "has a NaN or infinite coordinate", "finite coordinates"));
         }

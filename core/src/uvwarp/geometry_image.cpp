@@ -15,7 +15,6 @@
 namespace deformkit::uvwarp {
 namespace {
 
-constexpr int32_t kMaxCells = 32768;  // (n + 1)^2 point indices stay within int32
 constexpr int32_t kMaxRings = 64;
 constexpr uint8_t kUnassigned = 255;
 // Points this close (in cells) to a chart border count as covered by the border's triangle.
@@ -105,9 +104,9 @@ std::vector<int32_t> nearestCovered(const std::vector<int32_t>& triangle, int32_
 GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                                const GeometryImageOptions& options)
     : tile_(tile), cells_(cells), numVertices_(rest.numVertices()), label_(options.label) {
-    if (!isPowerOfTwo(cells) || cells > kMaxCells) {
+    if (!isPowerOfTwo(cells) || cells > kMaxGridCells) {
         throw InvalidInput(formatError(label_, "geometry image cells", "is " + std::to_string(cells),
-                                       "a power of two from 1 to " + std::to_string(kMaxCells)));
+                                       "a power of two from 1 to " + std::to_string(kMaxGridCells)));
     }
     if (options.dilationRings < 0 || options.dilationRings > kMaxRings) {
         throw InvalidInput(formatError(label_, "dilation rings",

@@ -11,7 +11,6 @@
 namespace deformkit::uvwarp {
 namespace {
 
-constexpr int32_t kMaxCells = 32768;
 // Output rows per parallel work item: fixed, so which triangle wins an overlapped texel of a folded warp
 // does not depend on the thread count.
 constexpr int32_t kBandRows = 16;
@@ -162,9 +161,9 @@ InversionError measure(const WarpGrid& warp, const io::Image& redirect, const io
 }  // namespace
 
 void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
-    if (!isPowerOfTwo(warp.cells) || warp.cells > kMaxCells) {
+    if (!isPowerOfTwo(warp.cells) || warp.cells > kMaxGridCells) {
         throw InvalidInput(formatError(source, "cells", "is " + std::to_string(warp.cells),
-                                       "a power of two from 1 to " + std::to_string(kMaxCells)));
+                                       "a power of two from 1 to " + std::to_string(kMaxGridCells)));
     }
     const size_t count = static_cast<size_t>(warp.cells + 1) * static_cast<size_t>(warp.cells + 1);
     if (warp.u.size() != count || warp.v.size() != count) {

@@ -12,8 +12,6 @@
 namespace deformkit::uvwarp {
 namespace {
 
-constexpr int32_t kMaxCells = 32768;
-
 std::string sourceOf(const MapLabel& label) {
     return label.tile == 0 ? label.name : detail::tileSource(label.name, label.tile);
 }
@@ -41,9 +39,9 @@ void requireSquareMap(const io::Image& image, const MapLabel& label) {
 }
 
 void requireCells(int32_t cells, const MapLabel& label) {
-    if (!isPowerOfTwo(cells) || cells > kMaxCells) {
+    if (!isPowerOfTwo(cells) || cells > kMaxGridCells) {
         throw InvalidInput(formatError(sourceOf(label), "grid cells", "is " + std::to_string(cells),
-                                       "a power of two from 1 to " + std::to_string(kMaxCells)));
+                                       "a power of two from 1 to " + std::to_string(kMaxGridCells)));
     }
 }
 

@@ -9,20 +9,10 @@
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/inversion.h"
 #include "lookup.h"
+#include "uvwarp/field_checks.h"
 
 namespace deformkit::uvwarp {
 namespace {
-
-void requireField(const PointField& field, int32_t cells, int32_t channels, const char* name) {
-    const size_t expected = static_cast<size_t>(cells + 1) * static_cast<size_t>(cells + 1) * channels;
-    if (field.cells != cells || field.channels != channels || field.values.size() != expected) {
-        throw InvalidInput(formatError(
-            "warp metrics", name,
-            "has " + std::to_string(field.cells) + " cells, " + std::to_string(field.channels) +
-                " channels and " + std::to_string(field.values.size()) + " values",
-            std::to_string(cells) + " cells (the warp's) and " + std::to_string(channels) + " channel(s)"));
-    }
-}
 
 inline float distance2(const float* a, const float* b) {
     const float dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
@@ -45,10 +35,10 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
                         const PointField& rigidity, const PointField& mask, const MetricsOptions& options) {
     validateWarpGrid(warp, "warp metrics: warp grid");
     const int32_t n = warp.cells, side = n + 1;
-    requireField(rest, n, 3, "rest geometry image");
-    requireField(deformed, n, 3, "deformed geometry image");
-    requireField(rigidity, n, 1, "rigidity");
-    requireField(mask, n, 1, "mask");
+    detail::requireField(rest, n, 3, "warp metrics", "rest geometry image");
+    detail::requireField(deformed, n, 3, "warp metrics", "deformed geometry image");
+    detail::requireField(rigidity, n, 1, "warp metrics", "rigidity");
+    detail::requireField(mask, n, 1, "warp metrics", "mask");
     if (options.texels < 0) {
         throw InvalidInput(formatError("warp metrics", "texels", "is " + std::to_string(options.texels),
                                        "0 (grid cells) or a positive map size"));

@@ -79,7 +79,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
     return j;
 }
 
-std::string sizeText(int32_t width, int32_t height) {
+std::string texelsText(int32_t width, int32_t height) {
     return std::to_string(width) + " x " + std::to_string(height) + " texels";
 }
 
@@ -230,7 +230,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         }
         const TileMap& r = plan.rigidity;
         if (r.width != r.height || r.width < 2) {
-            throw InvalidInput(formatError(r.name, "rigidity map", sizeText(r.width, r.height),
+            throw InvalidInput(formatError(r.name, "rigidity map", texelsText(r.width, r.height),
                                            "a square map of at least 2 x 2 texels"));
         }
         if (resolution == 0 && !isPowerOfTwo(r.width)) {
@@ -241,7 +241,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         // Maps that must have the rigidity map's size.
         const auto sameSize = [&](const TileMap& map, const char* what) {
             if (map.width != r.width || map.height != r.height) {
-                throw InvalidInput(formatError(map.name, what, sizeText(map.width, map.height),
+                throw InvalidInput(formatError(map.name, what, texelsText(map.width, map.height),
                                                std::to_string(r.width) + " x " + std::to_string(r.height) +
                                                    ", the size of '" + r.name + "'"));
             }

@@ -9,6 +9,7 @@
 #include "simd/cpu.h"
 #include "solver_kernels.h"
 #include "solver_state.h"
+#include "uvwarp/field_checks.h"
 
 namespace deformkit::uvwarp {
 
@@ -38,9 +39,6 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
 
 // Points per chunk of the loops over every point (prediction, integration).
 constexpr size_t kPointChunk = 32768;
-
-// Largest grid: f_D offsets fit 32 bits (imageCell).
-constexpr int32_t kMaxCells = 32768;
 
 // Level::spans: runs of cells closer than this are merged.
 constexpr int32_t kSpanGap = 8;
@@ -209,28 +207,11 @@ struct Solver::Impl : detail::SolverState {
     static void findSpans(Level& level);
 };
 
-namespace {
-
-void requireField(const PointField& field, int32_t cells, int32_t channels, const std::string& source,
-                  const char* name) {
-    if (field.cells != cells || field.channels != channels ||
-        field.values.size() != static_cast<size_t>(cells + 1) * (cells + 1) * channels) {
-        throw InvalidInput(formatError(source, name,
-                                       std::to_string(field.cells) + " cells x " +
-                                           std::to_string(field.channels) + " channels, " +
-                                           std::to_string(field.values.size()) + " values",
-                                       std::to_string(cells) + " cells x " + std::to_string(channels) +
-                                           " channels on the (n + 1)^2 grid points"));
-    }
-}
-
-}  // namespace
-
 void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
                              const PointField& orientation) {
-    requireField(rigidity, cells, 1, source, "rigidity");
-    requireField(mask, cells, 1, source, "mask");
-    if (!orientation.values.empty()) requireField(orientation, cells, 1, source, "orientation map");
+    detail::requireField(rigidity, cells, 1, source, "rigidity");
+    detail::requireField(mask, cells, 1, source, "mask");
+    if (!orientation.values.empty()) detail::requireField(orientation, cells, 1, source, "orientation map");
     for (size_t k = 0; k < rigidity.values.size(); ++k) {
         const float r = rigidity.values[k];
         if (!(r >= 0.0f && r <= 1.0f)) {
@@ -350,11 +331,11 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "a power of two, at least 2"));
     }
-    if (m.cells > kMaxCells) {
+    if (m.cells > kMaxGridCells) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
-                                       "at most " + std::to_string(kMaxCells)));
+                                       "at most " + std::to_string(kMaxGridCells)));
     }
-    requireField(restGeometry, m.cells, 3, source, "rest geometry image");
+    detail::requireField(restGeometry, m.cells, 3, source, "rest geometry image");
     if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
         options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
         options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
@@ -408,7 +389,7 @@ void Solver::setMaps(const PointField& rigidity, const PointField& mask, const P
 
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
-    requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
+    detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;
     for (int32_t it = 0; it < m.options.iterations; ++it)

@@ -1,4 +1,5 @@
 #include "deformkit/warp/barr.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,23 +10,16 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
+#include "warp/point_text.h"
 
 namespace deformkit::warp {
 namespace {
 
-bool finite(const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-std::string str(const glm::vec3& v) {
-    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
-}
-
 void requireFinitePoints(std::span<const glm::vec3> points, const std::string& source, const char* what) {
     for (size_t i = 0; i < points.size(); ++i) {
-        if (!finite(points[i])) {
+        if (!geom::isFinite(points[i])) {
             throw InvalidInput(formatError(source, std::string(what) + " " + std::to_string(i),
-                                           "is " + str(points[i]), "finite coordinates"));
+                                           "is " + detail::pointText(points[i]), "finite coordinates"));
         }
     }
 }
@@ -153,12 +147,13 @@ glm::vec3 OrthoFrame::toWorld(const glm::vec3& l) const {
 
 OrthoFrame orthonormalFrame(const AxisFrame& frame, bool needUp, std::string_view sourceName) {
     const std::string source(sourceName);
-    if (!finite(frame.origin)) {
-        throw InvalidInput(
-            formatError(source, "axis_origin", "is " + str(frame.origin), "finite coordinates"));
+    if (!geom::isFinite(frame.origin)) {
+        throw InvalidInput(formatError(source, "axis_origin", "is " + detail::pointText(frame.origin),
+                                       "finite coordinates"));
     }
-    if (!finite(frame.axis)) {
-        throw InvalidInput(formatError(source, "axis_dir", "is " + str(frame.axis), "finite coordinates"));
+    if (!geom::isFinite(frame.axis)) {
+        throw InvalidInput(
+            formatError(source, "axis_dir", "is " + detail::pointText(frame.axis), "finite coordinates"));
     }
     const double axisLength = glm::length(glm::dvec3(frame.axis));
     if (!(axisLength > 1e-12)) {
@@ -168,7 +163,7 @@ OrthoFrame orthonormalFrame(const AxisFrame& frame, bool needUp, std::string_vie
     out.origin = frame.origin;
     const glm::dvec3 axis = glm::dvec3(frame.axis) / axisLength;
     glm::dvec3 up(0.0);
-    if (finite(frame.up)) {
+    if (geom::isFinite(frame.up)) {
         const glm::dvec3 u(frame.up);
         const double upLength = glm::length(u);
         // Perpendicular part; "parallel" means within about 0.06 degrees of the axis.
@@ -176,13 +171,15 @@ OrthoFrame orthonormalFrame(const AxisFrame& frame, bool needUp, std::string_vie
         if (upLength > 1e-12 && glm::length(perpendicular) > 1e-6 * upLength)
             up = glm::normalize(perpendicular);
     } else if (needUp) {
-        throw InvalidInput(formatError(source, "up_dir", "is " + str(frame.up), "finite coordinates"));
+        throw InvalidInput(
+            formatError(source, "up_dir", "is " + detail::pointText(frame.up), "finite coordinates"));
     }
     if (up == glm::dvec3(0.0)) {
         if (needUp) {
-            throw InvalidInput(formatError(
-                source, "up_dir", str(frame.up) + " is zero or parallel to axis_dir " + str(frame.axis),
-                "a direction not parallel to the axis"));
+            throw InvalidInput(formatError(source, "up_dir",
+                                           detail::pointText(frame.up) + " is zero or parallel to axis_dir " +
+                                               detail::pointText(frame.axis),
+                                           "a direction not parallel to the axis"));
         }
         // Any perpendicular: the coordinate axis least aligned with the axis, made perpendicular.
         const glm::dvec3 a = glm::abs(axis);

@@ -1,4 +1,5 @@
 #include "deformkit/warp/beier_neely.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,16 +19,12 @@ std::string str(glm::vec2 v) {
     return s.str();
 }
 
-bool finite(glm::vec2 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y);
-}
-
 // Segments shorter than this (pixels) are treated as zero-length: their frame is undefined.
 constexpr float kMinLength = 1e-6f;
 
 void checkSegment(const std::string& source, const std::string& element, const char* which, glm::vec2 p,
                   glm::vec2 q) {
-    if (!finite(p) || !finite(q)) {
+    if (!geom::isFinite(p) || !geom::isFinite(q)) {
         throw InvalidInput(
             formatError(source, element,
                         std::string(which) + " segment has a non-finite endpoint " + str(p) + " -> " + str(q),
@@ -209,7 +206,7 @@ void BeierNeelyWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& f
     fields.weight.reserve(restPoints.size() * n);
     for (size_t u = 0; u < restPoints.size(); ++u) {
         const glm::vec2 x(restPoints[u]);
-        if (!finite(x)) {
+        if (!geom::isFinite(x)) {
             throw InvalidInput(formatError("Beier-Neely warp", "rest point " + std::to_string(u),
                                            "is not finite", "finite coordinates"));
         }

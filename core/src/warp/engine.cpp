@@ -7,16 +7,10 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
+#include "warp/checks.h"
 
 namespace deformkit::warp {
 namespace {
-
-void requireSize(const char* what, size_t got, size_t expected) {
-    if (got != expected) {
-        throw InvalidInput(formatError("warp engine", what, "has " + std::to_string(got) + " entries",
-                                       std::to_string(expected) + " entries"));
-    }
-}
 
 // (s . T_i)<p> for one field entry.
 glm::vec3 applyScaled(const Transformations& t, int32_t i, float s, const glm::vec3& p) {
@@ -32,14 +26,15 @@ glm::vec3 applyScaled(const Transformations& t, int32_t i, float s, const glm::v
 void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
                   const Transformations& transforms, std::span<glm::vec3> out, const EngineOptions& options) {
     const size_t n = points.size();
-    requireSize("output points", out.size(), n);
-    requireSize("field offsets", fields.offsets.size(), n + 1);
+    detail::requireCount("warp engine", "output points", out.size(), n);
+    detail::requireCount("warp engine", "field offsets", fields.offsets.size(), n + 1);
     const size_t entries = static_cast<size_t>(fields.offsets.back());
-    requireSize("field transformation indices", fields.transform.size(), entries);
-    requireSize("strength field", fields.strength.size(), entries);
-    requireSize("weighting field", fields.weight.size(), entries);
+    detail::requireCount("warp engine", "field transformation indices", fields.transform.size(), entries);
+    detail::requireCount("warp engine", "strength field", fields.strength.size(), entries);
+    detail::requireCount("warp engine", "weighting field", fields.weight.size(), entries);
     if (transforms.method == ScaleMethod::Composition) {
-        requireSize("transformations", transforms.components.size(), static_cast<size_t>(transforms.size()));
+        detail::requireCount("warp engine", "transformations", transforms.components.size(),
+                             static_cast<size_t>(transforms.size()));
     }
     const int32_t numTransforms = transforms.size();
     for (size_t e = 0; e < entries; ++e) {
@@ -88,7 +83,7 @@ void WarpDeformer::requireBound(size_t points) const {
         throw InvalidInput(
             formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
     }
-    requireSize("points", points, deformed_.size());
+    detail::requireCount("warp engine", "points", points, deformed_.size());
 }
 
 void WarpDeformer::update() {

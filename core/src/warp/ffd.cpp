@@ -1,4 +1,5 @@
 #include "deformkit/warp/ffd.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include "deformkit/error.h"
 #include "ffd_kernels.h"
 #include "simd/cpu.h"
+#include "warp/point_text.h"
 
 namespace deformkit::warp {
 namespace {
@@ -21,14 +23,6 @@ constexpr const char* kDivisionNames[3] = {"divisions[0] (l)", "divisions[1] (m)
 // inside; they are evaluated with their unclamped coordinates, so nothing is clamped.
 constexpr double kInsideTolerance = 1e-5;
 constexpr int64_t kMaxControls = int64_t{1} << 24;
-
-bool finite(const glm::vec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-std::string vecText(const glm::vec3& v) {
-    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
-}
 
 void validate(const Lattice& lattice, const FfdOptions& options) {
     const char* source = "FFD lattice";
@@ -51,16 +45,17 @@ void validate(const Lattice& lattice, const FfdOptions& options) {
                                        "give " + std::to_string(controls) + " control points",
                                        "at most " + std::to_string(kMaxControls)));
     }
-    if (!finite(lattice.origin)) {
+    if (!geom::isFinite(lattice.origin)) {
         throw InvalidInput(
-            formatError(source, "origin", "is not finite: " + vecText(lattice.origin), "finite"));
+            formatError(source, "origin", "is not finite: " + detail::pointText(lattice.origin), "finite"));
     }
     double lengths = 1.0;
     for (int a = 0; a < 3; ++a) {
         const glm::vec3 axis = lattice.axes[a];
         const std::string element = std::string("axis ") + kAxisNames[a];
-        if (!finite(axis))
-            throw InvalidInput(formatError(source, element, "is not finite: " + vecText(axis), "finite"));
+        if (!geom::isFinite(axis))
+            throw InvalidInput(
+                formatError(source, element, "is not finite: " + detail::pointText(axis), "finite"));
         const double len = glm::length(glm::dvec3(axis));
         if (len == 0.0) {
             throw InvalidInput(formatError(source, element, "has zero length", "a non-zero edge vector"));
@@ -228,9 +223,10 @@ void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
     // Validate first: a rejected bind leaves the previous one in place.
     const int64_t n = static_cast<int64_t>(restPoints.size());
     for (int64_t u = 0; u < n; ++u) {
-        if (!finite(restPoints[u])) {
+        if (!geom::isFinite(restPoints[u])) {
             throw InvalidInput(formatError("FFD bind", "point " + std::to_string(u),
-                                           "is not finite: " + vecText(restPoints[u]), "finite positions"));
+                                           "is not finite: " + detail::pointText(restPoints[u]),
+                                           "finite positions"));
         }
     }
     local_.resize(static_cast<size_t>(n));
@@ -415,13 +411,13 @@ void Ffd::setTargets(std::span<const glm::vec3> targets) {
     }
     const int32_t ny = l.divisions.y + 1, nz = l.divisions.z + 1;
     for (size_t c = 0; c < targets.size(); ++c) {
-        if (!finite(targets[c])) {
+        if (!geom::isFinite(targets[c])) {
             const int32_t ci = static_cast<int32_t>(c);
             throw InvalidInput(formatError(
                 "FFD",
                 "target " + std::to_string(c) + " (i=" + std::to_string(ci / (ny * nz)) +
                     ", j=" + std::to_string(ci / nz % ny) + ", k=" + std::to_string(ci % nz) + ")",
-                "is not finite: " + vecText(targets[c]), "finite positions"));
+                "is not finite: " + detail::pointText(targets[c]), "finite positions"));
         }
     }
     std::copy(targets.begin(), targets.end(), target_.begin());

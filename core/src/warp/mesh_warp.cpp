@@ -1,4 +1,5 @@
 #include "deformkit/warp/mesh_warp.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,17 +13,10 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
+#include "warp/point_text.h"
 
 namespace deformkit::warp {
 namespace {
-
-bool finite(const glm::vec3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
-
-std::string str(const glm::vec3& p) {
-    return "(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")";
-}
 
 void checkOptions(const MeshWarpOptions& o, const std::string& source) {
     const auto bad = [&](const char* element, const std::string& problem, const char* expected) {
@@ -208,9 +202,10 @@ void MeshWarp::setTarget(std::span<const glm::vec3> targetCagePoints) {
                         std::to_string(rest_.size()) + " points, the rest cage's vertex count"));
     }
     for (size_t i = 0; i < targetCagePoints.size(); ++i) {
-        if (!finite(targetCagePoints[i])) {
+        if (!geom::isFinite(targetCagePoints[i])) {
             throw InvalidInput(formatError(source_, "target cage point " + std::to_string(i),
-                                           "is " + str(targetCagePoints[i]), "finite coordinates"));
+                                           "is " + detail::pointText(targetCagePoints[i]),
+                                           "finite coordinates"));
         }
     }
     target_.assign(targetCagePoints.begin(), targetCagePoints.end());
@@ -230,9 +225,9 @@ float MeshWarp::weight(int32_t i, const glm::vec3& p) const {
 void MeshWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
     const int64_t n = static_cast<int64_t>(restPoints.size());
     for (int64_t u = 0; u < n; ++u) {
-        if (!finite(restPoints[u])) {
+        if (!geom::isFinite(restPoints[u])) {
             throw InvalidInput(formatError(source_, "rest point " + std::to_string(u),
-                                           "is " + str(restPoints[u]), "finite coordinates"));
+                                           "is " + detail::pointText(restPoints[u]), "finite coordinates"));
         }
     }
     std::vector<float> radii(rest_.size());

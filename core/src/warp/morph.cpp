@@ -6,20 +6,14 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
+#include "warp/checks.h"
 
 namespace deformkit::warp {
 namespace {
 
-void requireFinite(const char* what, float t) {
+void requireFiniteParameter(const char* what, float t) {
     if (!std::isfinite(t)) {
         throw InvalidInput(formatError("morph", what, "is " + std::to_string(t), "a finite number"));
-    }
-}
-
-void requireSize(const char* what, size_t got, size_t expected) {
-    if (got != expected) {
-        throw InvalidInput(formatError("morph", what, "has " + std::to_string(got) + " entries",
-                                       std::to_string(expected) + " entries"));
     }
 }
 
@@ -27,13 +21,13 @@ void requireSize(const char* what, size_t got, size_t expected) {
 
 void morphByEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, float t,
                      std::span<glm::vec3> out) {
-    requireFinite("t", t);
+    requireFiniteParameter("t", t);
     applyEnvelope(in, deformed, {}, t, out);
 }
 
 void morphTransformations(const Transformations& in, std::span<const float> t, Transformations& out) {
     const size_t n = static_cast<size_t>(in.size());
-    if (t.size() != 1) requireSize("morph parameters t", t.size(), n);
+    if (t.size() != 1) detail::requireCount("morph", "morph parameters t", t.size(), n);
     for (size_t i = 0; i < t.size(); ++i) {
         if (!std::isfinite(t[i])) {
             throw InvalidInput(formatError("morph", "parameter t[" + std::to_string(i) + "]",
@@ -57,9 +51,9 @@ void morphTransformations(const Transformations& in, std::span<const float> t, T
 
 void morphSchedule(float time, std::span<const float> start, std::span<const float> end,
                    std::span<float> out) {
-    requireFinite("time", time);
-    requireSize("schedule ends", end.size(), start.size());
-    requireSize("schedule output", out.size(), start.size());
+    requireFiniteParameter("time", time);
+    detail::requireCount("morph", "schedule ends", end.size(), start.size());
+    detail::requireCount("morph", "schedule output", out.size(), start.size());
     for (size_t i = 0; i < start.size(); ++i) {
         if (!(std::isfinite(start[i]) && std::isfinite(end[i]) && end[i] > start[i])) {
             throw InvalidInput(
@@ -72,7 +66,7 @@ void morphSchedule(float time, std::span<const float> start, std::span<const flo
 }
 
 void morphStrengths(const SparseFields& in, float t, SparseFields& out) {
-    requireFinite("t", t);
+    requireFiniteParameter("t", t);
     out.offsets = in.offsets;
     out.transform = in.transform;
     out.weight = in.weight;
@@ -83,9 +77,9 @@ void morphStrengths(const SparseFields& in, float t, SparseFields& out) {
 
 void morphTargets(std::span<const glm::vec3> source, std::span<const glm::vec3> target, float t,
                   std::span<glm::vec3> out) {
-    requireFinite("t", t);
-    requireSize("targets", target.size(), source.size());
-    requireSize("output", out.size(), source.size());
+    requireFiniteParameter("t", t);
+    detail::requireCount("morph", "targets", target.size(), source.size());
+    detail::requireCount("morph", "output", out.size(), source.size());
     for (size_t i = 0; i < source.size(); ++i)
         out[i] = source[i] + t * (target[i] - source[i]);
 }

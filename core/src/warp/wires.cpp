@@ -1,4 +1,5 @@
 #include "deformkit/warp/wires.h"
+#include "deformkit/geom/finite.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,17 +14,13 @@ namespace {
 
 constexpr int32_t kMaxSmoothSamples = 4096;
 
-bool finite(const glm::vec3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
-
 std::string wireLabel(size_t i) {
     return "wire " + std::to_string(i);
 }
 
 void requireCurve(std::span<const glm::vec3> curve, const std::string& label) {
     for (size_t j = 0; j < curve.size(); ++j) {
-        if (!finite(curve[j])) {
+        if (!geom::isFinite(curve[j])) {
             throw InvalidInput(formatError("wires", label + " point " + std::to_string(j), "is not finite",
                                            "finite coordinates"));
         }
@@ -361,7 +358,7 @@ void Wires::bind(std::span<const glm::vec3> restPoints) {
     bound_ = false;
     const int64_t n = static_cast<int64_t>(restPoints.size());
     for (int64_t u = 0; u < n; ++u) {
-        if (!finite(restPoints[u])) {
+        if (!geom::isFinite(restPoints[u])) {
             throw InvalidInput(formatError("wires", "rest point " + std::to_string(u), "is not finite",
                                            "finite coordinates"));
         }

@@ -42,4 +42,7 @@ struct WarpGrid {
 
 [[nodiscard]] bool isPowerOfTwo(int32_t n);
 
+// The largest grid the UV warp takes, cells per side: (n + 1)^2 point indices stay within int32.
+inline constexpr int32_t kMaxGridCells = 32768;
+
 }  // namespace deformkit::uvwarp
