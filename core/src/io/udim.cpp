@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <optional>
-#include <regex>
 #include <system_error>
 
 #include "deformkit/error.h"
@@ -94,41 +93,70 @@ std::string expandSegments(const std::vector<Segment>& segments, int tile) {
     return out;
 }
 
-std::string escapeRegex(std::string_view text) {
-    static constexpr std::string_view kSpecial = R"(\^$.|?*+()[]{})";
-    std::string out;
-    for (const char ch : text) {
-        if (kSpecial.find(ch) != std::string_view::npos) out.push_back('\\');
-        out.push_back(ch);
-    }
-    return out;
+bool allDigits(std::string_view text) {
+    return !text.empty() &&
+           std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// One capture group per token: (tile) for the numeric tokens, (u)(v) for <UVTILE>. The captures only
-// propose a tile; a name is accepted when expanding the pattern with that tile gives it back exactly,
-// which rejects leading zeros, out-of-range indices and tokens that disagree with each other.
-std::regex buildMatcher(const std::vector<Segment>& segments) {
-    std::string re;
-    for (const Segment& s : segments) {
-        if (!s.token) {
-            re += escapeRegex(s.literal);
-        } else if (*s.token == Token::UvTile) {
-            re += "u([0-9]{1,2})_v([0-9]{1,4})";
-        } else {
-            re += "([0-9]{4})";
+int digitsValue(std::string_view digits) {  // at most four digits: no overflow
+    int value = 0;
+    for (const char c : digits)
+        value = 10 * value + (c - '0');
+    return value;
+}
+
+constexpr int kNoTile = 0;        // no token read yet
+constexpr int kInvalidTile = -1;  // the first token spells no UDIM tile
+
+// The tile of a file name matched against a pattern: the first token proposes a tile (four digits for the
+// numeric tokens, u<1-2 digits>_v<1-4 digits> for <UVTILE>), and a name is accepted when expanding the
+// pattern with that tile gives it back exactly, which rejects leading zeros, out-of-range indices and tokens
+// that disagree with each other. Every way of splitting the name between the tokens is tried (a pattern
+// has one or two tokens, so there are at most a few dozen).
+class TileMatcher {
+  public:
+    explicit TileMatcher(const std::vector<Segment>& segments) : segments_(segments) {}
+
+    std::optional<int> match(std::string_view name) const { return visit(0, name, kNoTile, name); }
+
+  private:
+    // Matches segments_[seg...] against `rest`; `tile` is what the first token spelled (kNoTile before it).
+    std::optional<int> visit(size_t seg, std::string_view rest, int tile, std::string_view name) const {
+        if (seg == segments_.size()) {
+            if (rest.empty() && isValidTile(tile) && expandSegments(segments_, tile) == name) return tile;
+            return std::nullopt;
         }
+        const Segment& s = segments_[seg];
+        if (!s.token) {
+            if (!rest.starts_with(s.literal)) return std::nullopt;
+            return visit(seg + 1, rest.substr(s.literal.size()), tile, name);
+        }
+        if (*s.token != Token::UvTile) {
+            if (rest.size() < 4 || !allDigits(rest.substr(0, 4))) return std::nullopt;
+            return visit(seg + 1, rest.substr(4), tile == kNoTile ? digitsValue(rest.substr(0, 4)) : tile,
+                         name);
+        }
+        if (!rest.starts_with('u')) return std::nullopt;
+        for (size_t uLength = 1; uLength <= 2; ++uLength) {
+            if (rest.size() < 1 + uLength || !allDigits(rest.substr(1, uLength))) break;
+            const std::string_view afterU = rest.substr(1 + uLength);
+            if (!afterU.starts_with("_v")) continue;
+            const int u = digitsValue(rest.substr(1, uLength));
+            for (size_t vLength = 1; vLength <= 4; ++vLength) {
+                if (afterU.size() < 2 + vLength || !allDigits(afterU.substr(2, vLength))) break;
+                const int v = digitsValue(afterU.substr(2, vLength));
+                const int spelled =
+                    (u < 1 || u > 10 || v < 1) ? kInvalidTile : kFirstTile + (u - 1) + 10 * (v - 1);
+                const std::optional<int> found =
+                    visit(seg + 1, afterU.substr(2 + vLength), tile == kNoTile ? spelled : tile, name);
+                if (found) return found;
+            }
+        }
+        return std::nullopt;
     }
-    return std::regex(re, std::regex::ECMAScript | std::regex::optimize);
-}
 
-std::optional<int> proposedTile(const std::vector<Segment>& segments, const std::smatch& match) {
-    const Segment& first =
-        *std::find_if(segments.begin(), segments.end(), [](const Segment& s) { return s.token; });
-    if (*first.token != Token::UvTile) return std::stoi(match[1].str());
-    const int u = std::stoi(match[1].str()), v = std::stoi(match[2].str());
-    if (u < 1 || u > 10 || v < 1) return std::nullopt;
-    return kFirstTile + (u - 1) + 10 * (v - 1);
-}
+    const std::vector<Segment>& segments_;
+};
 
 }  // namespace
 
@@ -171,15 +199,13 @@ std::vector<UdimFile> findUdimFiles(const fs::path& pattern) {
                                   "an existing folder"));
     }
 
-    const std::regex matcher = buildMatcher(segments);
+    const TileMatcher matcher(segments);
     std::vector<UdimFile> files;
     fs::directory_iterator it(folder, ec);
     for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {
         const std::string candidate = it->path().filename().string();
-        std::smatch match;
-        if (!std::regex_match(candidate, match, matcher)) continue;
-        const std::optional<int> tile = proposedTile(segments, match);
-        if (!tile || !isValidTile(*tile) || expandSegments(segments, *tile) != candidate) continue;
+        const std::optional<int> tile = matcher.match(candidate);
+        if (!tile) continue;
         std::error_code typeEc;
         if (!it->is_regular_file(typeEc)) continue;
         files.push_back({*tile, pattern.parent_path() / candidate});

@@ -23,6 +23,38 @@
 #include "deformkit/version.h"
 
 namespace deformkit::uvwarp {
+// The tile types ShotSolver::Impl holds, in a named namespace: a class's fields must not have types of an
+// anonymous namespace when the source is compiled as part of a unity batch (-Wsubobject-linkage).
+namespace detail {
+
+// One tile's map from its source: a file of the pattern or an image in memory. `name` says where it came
+// from, for messages and headers.
+struct TileMap {
+    std::optional<std::filesystem::path> file;
+    const io::Image* image = nullptr;
+    std::string name;
+    int32_t width = 0, height = 0;
+
+    [[nodiscard]] bool found() const { return file.has_value() || image != nullptr; }
+};
+
+// What a job does for one tile, worked out before anything is written.
+struct TilePlan {
+    int tile = 0;
+    TileMap rigidity, mask, orientation, texture;
+    std::vector<std::filesystem::path> outPaths, bakePaths;  // per frame
+    std::vector<bool> needed;                                // per frame: an output to write
+    int lastNeeded = -1;                                     // index of the last needed frame
+    std::optional<TileWarp> warp;                            // bound at the first frame it solves
+    io::Image texturePixels, redirect, baked;
+    nlohmann::json inputs;
+    ShotTileReport report;
+};
+
+}  // namespace detail
+using detail::TileMap;
+using detail::TilePlan;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -83,17 +115,6 @@ std::string texelsText(int32_t width, int32_t height) {
     return std::to_string(width) + " x " + std::to_string(height) + " texels";
 }
 
-// One tile's map from its source: a file of the pattern or an image in memory. `name` says where it came
-// from, for messages and headers.
-struct TileMap {
-    std::optional<fs::path> file;
-    const io::Image* image = nullptr;
-    std::string name;
-    int32_t width = 0, height = 0;
-
-    [[nodiscard]] bool found() const { return file.has_value() || image != nullptr; }
-};
-
 // Finds `tile` in `source` and reads its size (a file's header only, so a wrong size stops the job before
 // anything is written).
 TileMap findTileMap(const TileMapSource& source, int tile) {
@@ -116,19 +137,6 @@ TileMap findTileMap(const TileMapSource& source, int tile) {
     map.height = it->second.height;
     return map;
 }
-
-// What a job does for one tile, worked out before anything is written.
-struct TilePlan {
-    int tile = 0;
-    TileMap rigidity, mask, orientation, texture;
-    std::vector<fs::path> outPaths, bakePaths;  // per frame
-    std::vector<bool> needed;                   // per frame: an output to write
-    int lastNeeded = -1;                        // index of the last needed frame
-    std::optional<TileWarp> warp;               // bound at the first frame it solves
-    io::Image texturePixels, redirect, baked;
-    json inputs;
-    ShotTileReport report;
-};
 
 }  // namespace
 

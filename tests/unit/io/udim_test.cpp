@@ -163,6 +163,13 @@ TEST_CASE("findUdimFiles ignores decoys beside the tiles", "[io][udim]") {
         writeText(dir / "map (v2)++[a].1008.exr", "decoy");
         CHECK(tilesOf(findUdimFiles(dir / "map (v2)+[a].<UDIM>.exr")) == std::vector<int>{1005});
     }
+    SECTION("a digit after <UVTILE> is literal (the v index ends where the pattern's text begins)") {
+        TempDir dir;
+        writeText(dir / "u2_v11.exr", "x");     // tile u2 v1 then the literal 1: 1002
+        writeText(dir / "u2_v121.exr", "x");    // u2 v12: 1112
+        writeText(dir / "u2_v1.exr", "decoy");  // no literal 1 left
+        CHECK(tilesOf(findUdimFiles(dir / "<UVTILE>1.exr")) == std::vector<int>{1002, 1112});
+    }
     SECTION("two tokens must agree") {
         TempDir dir;
         writeText(dir / "1003_u3_v1.exr", "x");
