@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
@@ -16,8 +17,6 @@ namespace deformkit::harness {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr float kPi = 3.14159265358979f;
 
 // Images laid out in rows on the first image's background, `gap` pixels apart.
 io::Image sheet(const std::vector<std::vector<const io::Image*>>& rows, int32_t gap) {
@@ -61,7 +60,7 @@ DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, con
     // Bend about the axis frame's "up" (+x) over the tube's length: the bend radius 1/k ~ 1.9 puts the
     // -x side (1 unit further out) at ~1.5x stretch and the +x side at ~0.5x.
     const warp::AxisFrame axis{{0, 0, 0}, {0, 1, 0}, {1, 0, 0}};
-    warp::BendWarp bend(axis, {kPi / 2 / 3.0f, 0.5f, 0.5f, 3.5f});
+    warp::BendWarp bend(axis, {std::numbers::pi_v<float> / 2 / 3.0f, 0.5f, 0.5f, 3.5f});
     std::vector<glm::vec3> points(tube.points().begin(), tube.points().end());
     warp::SparseFields unused;
     bend.bind(points, unused);
