@@ -28,35 +28,36 @@ using io::SampleFilter;
 using warp::BeierNeelyVariant;
 using warp::SegmentPair;
 
-constexpr const char* kSource = "beier_neely";
+constexpr const char* kBeierNeely = "beier_neely";
 
 // (n, 2, 2) lines: line i from (x, y) = a[i, 0] to a[i, 1], pixels.
 std::vector<glm::vec2> linesOf(const FloatArray& a, const char* name) {
     if (a.ndim() != 3 || a.shape(1) != 2 || a.shape(2) != 2) {
-        throw InvalidInput(
-            formatError(kSource, name, "has shape " + shapeOf(a), "(n, 2, 2): n lines of 2 (x, y) points"));
+        throw InvalidInput(formatError(kBeierNeely, name, "has shape " + shapeOf(a),
+                                       "(n, 2, 2): n lines of 2 (x, y) points"));
     }
     std::vector<glm::vec2> out(static_cast<size_t>(a.shape(0)) * 2);
     std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec2));
     return out;
 }
 
-BeierNeelyVariant variantOf(const std::string& v) {
+BeierNeelyVariant beierNeelyVariantOf(const std::string& v) {
     if (v == "original") return BeierNeelyVariant::Original;
     if (v == "global") return BeierNeelyVariant::Global;
-    throw InvalidInput(formatError(kSource, "variant", "is '" + v + "'", "'original' or 'global'"));
+    throw InvalidInput(formatError(kBeierNeely, "variant", "is '" + v + "'", "'original' or 'global'"));
 }
 
 io::SampleFilter interpOf(const std::string& v) {
     if (v == "bilinear") return io::SampleFilter::Bilinear;
     if (v == "bicubic") return io::SampleFilter::Bicubic;
-    throw InvalidInput(formatError(kSource, "interp", "is '" + v + "'", "'bilinear' or 'bicubic'"));
+    throw InvalidInput(formatError(kBeierNeely, "interp", "is '" + v + "'", "'bilinear' or 'bicubic'"));
 }
 
 std::vector<SegmentPair> pairsOf(const FloatArray& src, const FloatArray& dst, float a, float b, float p) {
     const std::vector<glm::vec2> s = linesOf(src, "src_lines"), d = linesOf(dst, "dst_lines");
     if (s.size() != d.size()) {
-        throw InvalidInput(formatError(kSource, "src_lines", "has " + std::to_string(s.size() / 2) + " lines",
+        throw InvalidInput(formatError(kBeierNeely, "src_lines",
+                                       "has " + std::to_string(s.size() / 2) + " lines",
                                        "as many as dst_lines (" + std::to_string(d.size() / 2) + ")"));
     }
     std::vector<SegmentPair> pairs(s.size() / 2);
@@ -69,7 +70,7 @@ std::vector<SegmentPair> pairsOf(const FloatArray& src, const FloatArray& dst, f
         pairs[i].b = b;
         pairs[i].p = p;
     }
-    warp::validateSegmentPairs(pairs, kSource);
+    warp::validateSegmentPairs(pairs, kBeierNeely);
     return pairs;
 }
 
@@ -81,34 +82,13 @@ py::array mapToNumpy(std::vector<glm::vec2>&& map, int32_t width, int32_t height
         reinterpret_cast<const float*>(data->data()), owner);
 }
 
-io::Image imageOf(const FloatArray& a) {
-    if (a.ndim() != 2 && a.ndim() != 3) {
-        throw InvalidInput(formatError(kSource, "image", "has shape " + shapeOf(a), "(H, W) or (H, W, C)"));
-    }
-    const int32_t c = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
-    io::Image img(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), c);
-    if (img.pixels.empty()) {
-        throw InvalidInput(formatError(kSource, "image", "has shape " + shapeOf(a) + " with 0 pixels",
-                                       "at least 1 x 1 pixels and 1 channel"));
-    }
-    std::memcpy(img.pixels.data(), a.data(), img.pixels.size() * sizeof(float));
-    return img;
-}
-
-py::array imageToNumpy(io::Image&& image, bool flat) {
-    auto* pixels = new std::vector<float>(std::move(image.pixels));
-    py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
-    if (flat) return py::array_t<float>({image.height, image.width}, pixels->data(), owner);
-    return py::array_t<float>({image.height, image.width, image.channels}, pixels->data(), owner);
-}
-
 // Holds the warp; the deformer (generic engine path for 3-D points) is created on bind().
 class PyBeierNeely {
   public:
     PyBeierNeely(const FloatArray& src, const FloatArray& dst, float a, float b, float p,
                  const std::string& variant)
-        : warp_(std::make_unique<warp::BeierNeelyWarp>(pairsOf(src, dst, a, b, p),
-                                                       warp::BeierNeelyOptions{variantOf(variant)})) {}
+        : warp_(std::make_unique<warp::BeierNeelyWarp>(
+              pairsOf(src, dst, a, b, p), warp::BeierNeelyOptions{beierNeelyVariantOf(variant)})) {}
 
     void setSrcLines(const FloatArray& src) { warp_->setSourceSegments(linesOf(src, "src_lines")); }
 
@@ -123,7 +103,7 @@ class PyBeierNeely {
     }
 
     py::array warpImage(const FloatArray& image, const std::string& interp) const {
-        io::Image src = imageOf(image);
+        io::Image src = imageOf(image, kBeierNeely, "image");
         const io::SampleFilter interpolation = interpOf(interp);
         io::Image out;
         {
@@ -132,7 +112,7 @@ class PyBeierNeely {
             warp_->mapPixelCentres(src.width, src.height, map);
             out = warp::resampleImage(src, map, src.width, src.height, interpolation);
         }
-        return imageToNumpy(std::move(out), image.ndim() == 2);
+        return imageArray(std::move(out), image.ndim() == 2);
     }
 
     void bind(const FloatArray& rest) {
@@ -145,13 +125,14 @@ class PyBeierNeely {
     py::array evaluate(const FloatArray& points, const std::optional<FloatArray>& weights, float envelope) {
         if (!deformer_ || !deformer_->isBound()) {
             throw InvalidInput(
-                formatError(kSource, "evaluate", "called before bind", "bind(rest_points) first"));
+                formatError(kBeierNeely, "evaluate", "called before bind", "bind(rest_points) first"));
         }
         std::vector<glm::vec3> p = points3(points, "points");
         std::vector<float> w;
         if (weights) {
             if (weights->ndim() != 1) {
-                throw InvalidInput(formatError(kSource, "weights", "has shape " + shapeOf(*weights), "(n,)"));
+                throw InvalidInput(
+                    formatError(kBeierNeely, "weights", "has shape " + shapeOf(*weights), "(n,)"));
             }
             w.assign(weights->data(), weights->data() + weights->shape(0));
         }
@@ -167,14 +148,14 @@ class PyBeierNeely {
   private:
     static void checkSize(int32_t width, int32_t height) {
         if (width <= 0 || height <= 0) {
-            throw InvalidInput(formatError(kSource, "width, height",
+            throw InvalidInput(formatError(kBeierNeely, "width, height",
                                            "are " + std::to_string(width) + ", " + std::to_string(height),
                                            "at least 1 x 1 pixels"));
         }
     }
     static std::vector<glm::vec3> points3(const FloatArray& a, const char* name) {
         if (a.ndim() != 2 || a.shape(1) != 3) {
-            throw InvalidInput(formatError(kSource, name, "has shape " + shapeOf(a), "(n, 3) float32"));
+            throw InvalidInput(formatError(kBeierNeely, name, "has shape " + shapeOf(a), "(n, 3) float32"));
         }
         std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
         std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));

@@ -59,10 +59,6 @@ struct PyEvaluator {
 
 using Lock = std::lock_guard<std::mutex>;
 
-std::string typeName(py::handle value) {
-    return py::str(py::type::of(value).attr("__name__"));
-}
-
 // A parameter value from Python: a number, or any sequence or array of numbers (flattened in C order, so
 // an (n, 3) array of points gives x, y, z of each point in turn). nullopt for anything else.
 std::optional<std::vector<double>> valuesOf(py::handle value) {

@@ -22,20 +22,10 @@ namespace py = pybind11;
 namespace deformkit::python {
 namespace {
 
-constexpr const char* kSource = "mesh_warp";
-
-std::vector<int32_t> intsOf(const IntArray& a, const char* name) {
-    if (a.ndim() != 1)
-        throw InvalidInput(formatError(kSource, name, "has shape " + shapeOf(a), "a 1-D int array"));
-    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
-}
+constexpr const char* kMeshWarp = "mesh_warp";
 
 geom::Mesh cageOf(const FloatArray& points, const IntArray& counts, const IntArray& indices) {
-    geom::Mesh::Data d;
-    d.points = pointsOf(points, kSource, "cage_points");
-    d.faceCounts = intsOf(counts, "cage_face_counts");
-    d.faceIndices = intsOf(indices, "cage_face_indices");
-    return geom::Mesh(std::move(d), "mesh_warp cage");
+    return meshOf(points, counts, indices, std::nullopt, std::nullopt, kMeshWarp, "mesh_warp cage", "cage_");
 }
 
 warp::MeshWarpOptions optionsOf(float alpha, float beta, float gamma, float mu) {
@@ -53,11 +43,11 @@ class PyMeshWarp {
     PyMeshWarp(const FloatArray& cagePoints, const IntArray& counts, const IntArray& indices, float alpha,
                float beta, float gamma, float mu)
         : warp_(std::make_unique<warp::MeshWarp>(cageOf(cagePoints, counts, indices),
-                                                 optionsOf(alpha, beta, gamma, mu), kSource)),
+                                                 optionsOf(alpha, beta, gamma, mu), kMeshWarp)),
           deformer_(std::make_unique<warp::WarpDeformer>(*warp_)) {}
 
     void bind(const FloatArray& restPoints) {
-        rest_ = pointsOf(restPoints, kSource, "rest_points");
+        rest_ = pointsOf(restPoints, kMeshWarp, "rest_points");
         py::gil_scoped_release release;
         deformer_->bind(rest_);
     }
@@ -66,11 +56,11 @@ class PyMeshWarp {
                                 const std::optional<FloatArray>& weights, float envelope) {
         if (!deformer_->isBound()) {
             throw InvalidInput(
-                formatError(kSource, "evaluate", "called before bind", "bind(rest_points) first"));
+                formatError(kMeshWarp, "evaluate", "called before bind", "bind(rest_points) first"));
         }
-        warp_->setTarget(pointsOf(targetCage, kSource, "target_cage_points"));
-        std::vector<glm::vec3> pts = points ? pointsOf(*points, kSource, "points") : rest_;
-        const std::vector<float> w = weightsOf(weights, pts.size(), kSource);
+        warp_->setTarget(pointsOf(targetCage, kMeshWarp, "target_cage_points"));
+        std::vector<glm::vec3> pts = points ? pointsOf(*points, kMeshWarp, "points") : rest_;
+        const std::vector<float> w = weightsOf(weights, pts.size(), kMeshWarp);
         {
             py::gil_scoped_release release;
             deformer_->evaluate(pts, w, envelope);
@@ -98,10 +88,10 @@ void bindMeshWarp(py::module_& m) {
         [](const FloatArray& points, const FloatArray& cagePoints, const IntArray& counts,
            const IntArray& indices, const FloatArray& targetCage, float alpha, float beta, float gamma,
            float mu, const std::optional<FloatArray>& weights, float envelope) {
-            std::vector<glm::vec3> pts = pointsOf(points, kSource, "points");
+            std::vector<glm::vec3> pts = pointsOf(points, kMeshWarp, "points");
             const geom::Mesh cage = cageOf(cagePoints, counts, indices);
-            const std::vector<glm::vec3> target = pointsOf(targetCage, kSource, "target_cage_points");
-            const std::vector<float> w = weightsOf(weights, pts.size(), kSource);
+            const std::vector<glm::vec3> target = pointsOf(targetCage, kMeshWarp, "target_cage_points");
+            const std::vector<float> w = weightsOf(weights, pts.size(), kMeshWarp);
             {
                 py::gil_scoped_release release;
                 warp::meshWarp(pts, cage, target, optionsOf(alpha, beta, gamma, mu), w, envelope);

@@ -33,21 +33,6 @@ using slide::Slider;
 using slide::SlideResult;
 using slide::SurfaceMode;
 
-std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const char* name) {
-    if (a.ndim() != 1)
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
-    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
-}
-
-geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const IntArray& indices,
-                  const std::string& source) {
-    geom::Mesh::Data d;
-    d.points = pointsOf(points, source, "points");
-    d.faceCounts = intsOf(counts, source, "face_counts");
-    d.faceIndices = intsOf(indices, source, "face_indices");
-    return geom::Mesh(std::move(d), source + " mesh");
-}
-
 RegionMetric regionOf(const std::string& name, const std::string& source, const std::string& element) {
     if (name == "euclidean") return RegionMetric::Euclidean;
     if (name == "geodesic") return RegionMetric::Geodesic;
@@ -261,7 +246,8 @@ class PySlider {
               const std::string& region, const std::optional<std::vector<py::dict>>& handles,
               const std::string& surface, int64_t maxWalk) {
         const std::string source = "Slider";
-        const geom::Mesh mesh = meshOf(points, counts, indices, source);
+        const geom::Mesh mesh =
+            meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
         std::vector<SlideHandle> h = handlesOf(handle, radius, region, handles, source);
         const slide::SlideOptions options = optionsOf(surface, maxWalk, source);
         std::shared_ptr<Slider> bound;
@@ -326,7 +312,8 @@ void bindSlide(py::module_& m) {
            const std::string& surface, const std::optional<std::filesystem::path>& weightsPtex,
            int32_t weightsChannel) {
             const std::string source = "slide";
-            const geom::Mesh mesh = meshOf(points, counts, indices, source);
+            const geom::Mesh mesh =
+                meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
             if (weights && weightsPtex) {
                 throw InvalidInput(formatError(source, "weights_ptex", "is given with weights",
                                                "one source of painted weights"));

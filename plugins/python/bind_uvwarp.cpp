@@ -44,34 +44,6 @@ constexpr const char* kOptionNames =
     "iterations, levels, sweeps_per_level, orientation_preservation, smoothing, damping, coarse_stiffness, "
     "border_width, dilation_rings";
 
-std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const char* name) {
-    if (a.ndim() != 1)
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
-    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
-}
-
-// The rest mesh from arrays, as deformkit.Mesh takes them; uvs and uv_indices both or neither (None).
-geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const IntArray& indices,
-                  const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices,
-                  const std::string& source) {
-    geom::Mesh::Data d;
-    d.points = pointsOf(points, source, "points");
-    d.faceCounts = intsOf(counts, source, "face_counts");
-    d.faceIndices = intsOf(indices, source, "face_indices");
-    if (uvs.has_value() != uvIndices.has_value()) {
-        throw InvalidInput(formatError(source, "uvs", "given without uv_indices or the other way round",
-                                       "both uvs and uv_indices, or neither"));
-    }
-    if (uvs) {
-        if (uvs->ndim() != 2 || uvs->shape(1) != 2)
-            throw InvalidInput(formatError(source, "uvs", "has shape " + shapeOf(*uvs), "(k, 2) float32"));
-        d.uvs.resize(static_cast<size_t>(uvs->shape(0)));
-        if (!d.uvs.empty()) std::memcpy(d.uvs.data(), uvs->data(), d.uvs.size() * sizeof(glm::vec2));
-        d.uvIndices = intsOf(*uvIndices, source, "uv_indices");
-    }
-    return geom::Mesh(std::move(d), source + " mesh");
-}
-
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
 // names the texel.
 io::Image mapOf(const FloatArray& a, const std::string& source, const char* name) {
@@ -86,26 +58,6 @@ io::Image mapOf(const FloatArray& a, const std::string& source, const char* name
 
 io::Image optionalMapOf(const std::optional<FloatArray>& a, const std::string& source, const char* name) {
     return a ? mapOf(*a, source, name) : io::Image{};
-}
-
-// Any image: (H, W) or (H, W, C) float32.
-io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
-                  const char* expected) {
-    if ((a.ndim() != 2 && a.ndim() != 3) || a.shape(0) < 1 || a.shape(1) < 1 ||
-        (a.ndim() == 3 && a.shape(2) < 1))
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
-    const int32_t channels = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
-    io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), channels);
-    std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));
-    return image;
-}
-
-// Moves an Image's pixels into a numpy (H, W, C) array (or (H, W) when `flat`) without copying.
-py::array toNumpy(io::Image&& image, bool flat = false) {
-    auto* pixels = new std::vector<float>(std::move(image.pixels));
-    py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
-    if (flat) return py::array_t<float>({image.height, image.width}, pixels->data(), owner);
-    return py::array_t<float>({image.height, image.width, image.channels}, pixels->data(), owner);
 }
 
 int32_t intOption(py::handle value, const std::string& source, const std::string& name, int64_t lo,
@@ -284,7 +236,7 @@ class PyUvWarpSolver {
             const std::lock_guard<std::mutex> lock(mutex_);
             warp_->redirect(out);
         }
-        return toNumpy(std::move(out));
+        return imageArray(std::move(out));
     }
 
     py::dict metrics() const {
@@ -340,17 +292,13 @@ py::array uvWarp(const geom::Mesh& mesh, int tile, const FloatArray& rigidity, c
         warp.solve(points);
         warp.redirect(out);
     }
-    return toNumpy(std::move(out));
+    return imageArray(std::move(out));
 }
 
 // ---- The shot job (uvwarp/shot_job.h) ----
 
 constexpr const char* kShot = "uvwarp_shot";
 constexpr const char* kUdimTokens = "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_";
-
-std::string typeName(py::handle value) {
-    return py::str(py::type::of(value).attr("__name__"));
-}
 
 bool isPath(py::handle value) {
     return py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__");
@@ -627,7 +575,8 @@ void bindUvWarp(py::module_& m) {
                          int tile, const FloatArray& rigidity, const std::optional<FloatArray>& mask,
                          const std::optional<int64_t>& resolution,
                          const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
-                 const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, "UvWarpSolver");
+                 const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, "UvWarpSolver",
+                                                std::string("UvWarpSolver") + " mesh");
                  return std::make_unique<PyUvWarpSolver>(mesh, tile, rigidity, mask, resolution, orientation,
                                                          kwargs);
              }),
@@ -673,7 +622,8 @@ void bindUvWarp(py::module_& m) {
            const FloatArray& rigidity, const FloatArray& deformed, const std::optional<FloatArray>& mask,
            const std::optional<int64_t>& resolution, const std::optional<FloatArray>& orientation,
            const py::kwargs& kwargs) {
-            const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, "uv_warp");
+            const geom::Mesh mesh =
+                meshOf(points, counts, indices, uvs, uvIndices, "uv_warp", "uv_warp mesh");
             return uvWarp(mesh, tile, rigidity, deformed, mask, resolution, orientation, kwargs);
         },
         py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("uvs"),
@@ -697,7 +647,7 @@ void bindUvWarp(py::module_& m) {
                 py::gil_scoped_release release;
                 uvwarp::bakeTexture(tex, map, out, options);
             }
-            return toNumpy(std::move(out), texture.ndim() == 2);
+            return imageArray(std::move(out), texture.ndim() == 2);
         },
         py::arg("texture"), py::arg("redirect"), py::arg("filter") = "bilinear",
         "Bake texture (H, W) or (H, W, C) float32 (one UDIM tile, row 0 at v = 1) through redirect (R, R, "
@@ -722,7 +672,8 @@ void bindUvWarp(py::module_& m) {
            const std::optional<int64_t>& resolution, const std::string& filter, bool skipExisting,
            const py::object& log, const py::object& progress, const std::string& restName,
            const py::kwargs& kwargs) {
-            const geom::Mesh mesh = meshOf(points, counts, indices, uvs, uvIndices, kShot);
+            const geom::Mesh mesh =
+                meshOf(points, counts, indices, uvs, uvIndices, kShot, std::string(kShot) + " mesh");
             return uvwarpShot(mesh, frames, deformed, rigidity, out, mask, orientation, texture, bake, tiles,
                               resolution, filter, skipExisting, log, progress, restName, kwargs);
         },

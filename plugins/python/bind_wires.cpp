@@ -30,7 +30,7 @@ warp::CurveType curveType(const std::string& name) {
         formatError("wires", "curve_type", "is '" + name + "'", "'polyline', 'catmull_rom' or 'bezier'"));
 }
 
-warp::WiresVariant variantOf(const std::string& name) {
+warp::WiresVariant wiresVariantOf(const std::string& name) {
     if (name == "original") return warp::WiresVariant::Original;
     if (name == "smooth") return warp::WiresVariant::Smooth;
     throw InvalidInput(formatError("wires", "variant", "is '" + name + "'", "'original' or 'smooth'"));
@@ -91,7 +91,7 @@ class PyWires {
             const std::string& type, int32_t samplesPerSpan)
         : sampling_{curveType(type), samplesPerSpan},
           wires_(makeWires(references, std::nullopt, radius, scale, falloff, sampling_),
-                 warp::WiresOptions{variantOf(variant), m, samples}) {}
+                 warp::WiresOptions{wiresVariantOf(variant), m, samples}) {}
 
     void bind(const FloatArray& points) {
         const std::vector<glm::vec3> rest = pointsOf(points, "wires", "points");
@@ -153,7 +153,7 @@ void bindWires(py::module_& m) {
            const std::string& type, int32_t samplesPerSpan) {
             const CurveSampling sampling{curveType(type), samplesPerSpan};
             warp::Wires wires(makeWires(referenceCurves, wireCurves, radius, scale, falloff, sampling),
-                              warp::WiresOptions{variantOf(variant), exponent, samples});
+                              warp::WiresOptions{wiresVariantOf(variant), exponent, samples});
             std::vector<glm::vec3> p = pointsOf(points, "wires", "points");
             const std::vector<float> w = weightsOf(weights, p.size(), "wires");
             {

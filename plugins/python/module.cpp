@@ -18,14 +18,12 @@
 #include "deformkit/io/preview.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/version.h"
+#include "numpy_support.h"
 
 namespace py = pybind11;
-using namespace deformkit;
 
+namespace deformkit::python {
 namespace {
-
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IntArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 
 // A numpy view of `count` rows of `cols` values owned by `owner` (kept alive by the array).
 template <class T>
@@ -41,43 +39,9 @@ py::array view(const T* data, size_t count, size_t cols, py::handle owner, bool 
     return a;
 }
 
-template <class V, int N>
-std::vector<V> rows(const FloatArray& a, const char* name) {
-    if (a.ndim() != 2 || a.shape(1) != N) {
-        std::string shape = "(";
-        for (py::ssize_t i = 0; i < a.ndim(); ++i)
-            shape += (i ? ", " : "") + std::to_string(a.shape(i));
-        throw InvalidInput(
-            formatError("Mesh", name, "has shape " + shape + ")", "(n, " + std::to_string(N) + ")"));
-    }
-    std::vector<V> out(static_cast<size_t>(a.shape(0)));
-    std::memcpy(out.data(), a.data(), out.size() * sizeof(V));
-    return out;
-}
-
-std::vector<int32_t> ints(const IntArray& a, const char* name) {
-    if (a.ndim() != 1) {
-        throw InvalidInput(
-            formatError("Mesh", name, "has " + std::to_string(a.ndim()) + " dimensions", "a 1-D int array"));
-    }
-    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
-}
-
 geom::Mesh makeMesh(const FloatArray& points, const IntArray& faceCounts, const IntArray& faceIndices,
                     const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices) {
-    geom::Mesh::Data d;
-    d.points = rows<glm::vec3, 3>(points, "points");
-    d.faceCounts = ints(faceCounts, "face_counts");
-    d.faceIndices = ints(faceIndices, "face_indices");
-    if (uvs.has_value() != uvIndices.has_value()) {
-        throw InvalidInput(formatError("Mesh", "uvs", "given without uv_indices or the other way round",
-                                       "both uvs and uv_indices, or neither"));
-    }
-    if (uvs) {
-        d.uvs = rows<glm::vec2, 2>(*uvs, "uvs");
-        d.uvIndices = ints(*uvIndices, "uv_indices");
-    }
-    return geom::Mesh(std::move(d), "Mesh");
+    return meshOf(points, faceCounts, faceIndices, uvs, uvIndices, "Mesh", "Mesh");
 }
 
 io::PixelType pixelType(const std::string& name) {
@@ -90,28 +54,12 @@ io::PixelType pixelType(const std::string& name) {
                                    "auto, uint8, uint16, half or float"));
 }
 
-// Moves an Image's pixels into a numpy (H, W, C) array without copying.
-py::array toNumpy(io::Image&& image) {
-    auto* pixels = new std::vector<float>(std::move(image.pixels));
-    py::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
-    return py::array_t<float>({image.height, image.width, image.channels}, pixels->data(), owner);
-}
-
-io::Image fromNumpy(const FloatArray& a) {
-    if (a.ndim() != 2 && a.ndim() != 3) {
-        throw InvalidInput(formatError("write_image", "array",
-                                       "has " + std::to_string(a.ndim()) + " dimensions",
-                                       "(H, W) or (H, W, C)"));
-    }
-    const int32_t c = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
-    io::Image img(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), c);
-    std::memcpy(img.pixels.data(), a.data(), img.pixels.size() * sizeof(float));
-    return img;
-}
-
 }  // namespace
+}  // namespace deformkit::python
 
 PYBIND11_MODULE(deformkit, m) {
+    using namespace deformkit;
+    using namespace deformkit::python;
     m.doc() = "DeformKit: production deformers. Meshes and images as numpy float32 arrays.";
     m.attr("__version__") = kVersionString;
 
@@ -196,7 +144,7 @@ PYBIND11_MODULE(deformkit, m) {
                 py::gil_scoped_release release;
                 img = io::readImage(path, {channels, ""});
             }
-            return toNumpy(std::move(img));
+            return imageArray(std::move(img));
         },
         py::arg("path"), py::arg("channels") = 0,
         "Read an image as a (H, W, C) float32 array; channels > 0 requires that count.");
@@ -233,7 +181,7 @@ PYBIND11_MODULE(deformkit, m) {
             io::ImageWriteOptions options;
             options.type = pixelType(type);
             options.attributes.assign(attributes.begin(), attributes.end());
-            io::Image img = fromNumpy(array);
+            io::Image img = imageOf(array, "write_image", "array");
             py::gil_scoped_release release;
             io::writeImage(path, img, options);
         },
@@ -266,7 +214,7 @@ PYBIND11_MODULE(deformkit, m) {
                 if (texture) tex = io::loadPreviewTexture(*texture);
                 img = io::renderPreview(mesh, options, tex ? &*tex : nullptr);
             }
-            return toNumpy(std::move(img));
+            return imageArray(std::move(img));
         },
         py::arg("mesh"), py::arg("texture") = py::none(), py::arg("width") = 960, py::arg("height") = 720,
         py::arg("edges") = false, "Render a shaded preview; returns (H, W, 3) float32.");

@@ -12,9 +12,12 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
 
 namespace deformkit::python {
 
@@ -40,6 +43,45 @@ inline std::vector<glm::vec3> pointsOf(const FloatArray& a, const std::string& s
     return out;
 }
 
+// A 1-D int array as indices or counts.
+inline std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const std::string& name) {
+    if (a.ndim() != 1)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
+    return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
+}
+
+// A mesh from arrays, as deformkit.Mesh takes them: points, face counts and face indices, and uvs with
+// uv_indices both or neither (None). `prefix` names the arguments in messages ("cage_" gives
+// cage_points, ...); `meshName` is the mesh's name in the core's own messages.
+inline geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const IntArray& indices,
+                         const std::optional<FloatArray>& uvs, const std::optional<IntArray>& uvIndices,
+                         const std::string& source, const std::string& meshName,
+                         const std::string& prefix = "") {
+    geom::Mesh::Data d;
+    d.points = pointsOf(points, source, prefix + "points");
+    d.faceCounts = intsOf(counts, source, prefix + "face_counts");
+    d.faceIndices = intsOf(indices, source, prefix + "face_indices");
+    if (uvs.has_value() != uvIndices.has_value()) {
+        throw InvalidInput(formatError(source, prefix + "uvs",
+                                       "given without uv_indices or the other way round",
+                                       "both uvs and uv_indices, or neither"));
+    }
+    if (uvs) {
+        if (uvs->ndim() != 2 || uvs->shape(1) != 2)
+            throw InvalidInput(
+                formatError(source, prefix + "uvs", "has shape " + shapeOf(*uvs), "(k, 2) float32"));
+        d.uvs.resize(static_cast<size_t>(uvs->shape(0)));
+        if (!d.uvs.empty()) std::memcpy(d.uvs.data(), uvs->data(), d.uvs.size() * sizeof(glm::vec2));
+        d.uvIndices = intsOf(*uvIndices, source, prefix + "uv_indices");
+    }
+    return geom::Mesh(std::move(d), meshName);
+}
+
+// The Python type of a value ("list", "ndarray"), for messages.
+inline std::string typeName(pybind11::handle value) {
+    return pybind11::str(pybind11::type::of(value).attr("__name__"));
+}
+
 // Painted weights: None (all 1, returned empty) or one value per point.
 inline std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t count,
                                     const std::string& source) {
@@ -49,6 +91,27 @@ inline std::vector<float> weightsOf(const std::optional<FloatArray>& weights, si
                                        "(" + std::to_string(count) + ",), one per point"));
     }
     return std::vector<float>(weights->data(), weights->data() + count);
+}
+
+// An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.
+inline io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
+                         const std::string& expected = "(H, W) or (H, W, C) float32") {
+    if (a.ndim() != 2 && a.ndim() != 3)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
+    if (a.size() == 0)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a) + " with 0 pixels", expected));
+    const int32_t channels = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
+    io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), channels);
+    std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));
+    return image;
+}
+
+// An image's pixels moved into a numpy array without a copy: (H, W, C), or (H, W) when `flat`.
+inline pybind11::array imageArray(io::Image&& image, bool flat = false) {
+    auto* pixels = new std::vector<float>(std::move(image.pixels));
+    pybind11::capsule owner(pixels, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+    if (flat) return pybind11::array_t<float>({image.height, image.width}, pixels->data(), owner);
+    return pybind11::array_t<float>({image.height, image.width, image.channels}, pixels->data(), owner);
 }
 
 // Positions as a new (n, 3) float32 array.

@@ -99,6 +99,21 @@ def test_errors_are_deformkit_errors(tmp_path):
         dk.udim_tiles(str(tmp_path / "none.<UDIM>.exr"))
 
 
+def test_array_arguments_are_checked_alike_by_every_function(tmp_path):
+    # One set of conversions (numpy_support.h): the same shape messages from Mesh, the slide and the warps.
+    tri = (np.zeros((3, 3), np.float32), np.array([3], np.int32), np.array([0, 1, 2], np.int32))
+    with pytest.raises(dk.InvalidInput, match=r"Mesh: face_indices: has shape \(1, 3\)"):
+        dk.Mesh(tri[0], tri[1], tri[2].reshape(1, 3))
+    with pytest.raises(dk.InvalidInput, match=r"Mesh: uvs: given without uv_indices"):
+        dk.Mesh(*tri, uvs=np.zeros((3, 2), np.float32))
+    with pytest.raises(dk.InvalidInput, match=r"Mesh: uvs: has shape \(3, 3\)"):
+        dk.Mesh(*tri, uvs=np.zeros((3, 3), np.float32), uv_indices=np.array([0, 1, 2], np.int32))
+    with pytest.raises(dk.InvalidInput, match=r"write_image: array: has shape \(0, 4\) with 0 pixels"):
+        dk.write_image(tmp_path / "empty.exr", np.zeros((0, 4), np.float32))
+    with pytest.raises(dk.InvalidInput, match=r"write_image: array: has shape \(4,\)"):
+        dk.write_image(tmp_path / "flat.exr", np.zeros(4, np.float32))
+
+
 def test_preview_of_a_grid_fills_the_expected_region():
     grid = dk.make_grid(4, 4, 2.0, 2.0)
     img = dk.render_preview(grid, width=64, height=48)
