@@ -23,8 +23,10 @@ std::string defaultText(const std::vector<double>& values) {
     constexpr size_t kMaxShown = 9;
     if (values.size() > kMaxShown) return std::to_string(values.size()) + " values";
     std::string out;
-    for (double v : values)
-        out += (out.empty() ? "" : " ") + numberText(v);
+    for (double v : values) {
+        if (!out.empty()) out += ' ';
+        out += numberText(v);
+    }
     return out;
 }
 
@@ -41,7 +43,8 @@ std::string wrapped(std::string_view text, size_t indent) {
             out += std::string(indent, ' ') + line + "\n";
             line.clear();
         }
-        line += (line.empty() ? "" : " ") + std::string(word);
+        if (!line.empty()) line += ' ';
+        line += word;
         if (space == std::string_view::npos) break;
         start = space + 1;
     }

@@ -13,6 +13,22 @@
 
 namespace deformkit::slide {
 
+// Types Slider::Impl holds, in a named namespace: a class's fields must not have types of an anonymous
+// namespace when the source is compiled as part of a unity batch (-Wsubobject-linkage).
+namespace detail {
+
+enum class Stop : uint8_t { None, Reached, Boundary, Limit };
+
+struct Landing {
+    int32_t triangle = -1;
+    glm::dvec3 barycentric{0.0};  // on the triangle's corners 3t, 3t+1, 3t+2
+    Stop stop = Stop::None;
+};
+
+}  // namespace detail
+using detail::Landing;
+using detail::Stop;
+
 namespace {
 
 double cross2(const glm::dvec2& a, const glm::dvec2& b) {
@@ -33,14 +49,6 @@ glm::dvec3 clampBarycentric(glm::dvec3 b) {
     const double sum = b.x + b.y + b.z;
     return sum > 0.0 ? b / sum : glm::dvec3(1.0 / 3.0);
 }
-
-enum class Stop : uint8_t { None, Reached, Boundary, Limit };
-
-struct Landing {
-    int32_t triangle = -1;
-    glm::dvec3 barycentric{0.0};  // on the triangle's corners 3t, 3t+1, 3t+2
-    Stop stop = Stop::None;
-};
 
 // A landing on the edge of `corner` (from vertex(corner) to vertex(next(corner))) at parameter mu.
 Landing onEdge(int32_t corner, double mu, Stop stop) {

@@ -8,8 +8,16 @@
 
 namespace deformkit::warp::detail {
 
+// Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on a chain of "literal" + std::string.
 inline std::string pointText(const glm::vec3& v) {
-    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+    std::string text = "(";
+    text += std::to_string(v.x);
+    text += ", ";
+    text += std::to_string(v.y);
+    text += ", ";
+    text += std::to_string(v.z);
+    text += ")";
+    return text;
 }
 
 }  // namespace deformkit::warp::detail
