@@ -122,23 +122,8 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
 
     const io::ObjContent restObj = io::readObj(command.rest);
     const geom::Mesh& rest = restObj.mesh;
-    if (!rest.hasUVs()) {
-        throw InvalidInput(formatError(command.rest.string(), "", "has no UVs",
-                                       "a rest mesh with texture coordinates (vt) on its faces"));
-    }
-    const std::vector<int> meshTiles = rest.udimTiles();
-    std::vector<int> tiles = command.tiles.empty() ? meshTiles : command.tiles;
-    for (int tile : tiles) {
-        if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile)) {
-            std::string have;
-            for (int t : meshTiles)
-                have.append(have.empty() ? "" : " ").append(std::to_string(t));
-            throw InvalidInput(
-                formatError("--tiles", "tile " + std::to_string(tile),
-                            "the rest mesh '" + command.rest.string() + "' has no UV face in it",
-                            "tiles of the rest mesh: " + have));
-        }
-    }
+    (void)uvwarp::shotTiles(rest, command.rest.string(), command.tiles,
+                            "--tiles");  // before the frames are read
 
     const uvwarp::DeformedFrames frames =
         uvwarp::objSequenceFrames(command.deformed, command.frames, "--deformed");

@@ -188,23 +188,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         std::adjacent_find(j.frames.begin(), j.frames.end()) != j.frames.end()) {
         throw InvalidInput(formatError("uvwarp", "frames", "are not ascending", "frames in ascending order"));
     }
-    const geom::Mesh& rest = *j.rest;
-    if (!rest.hasUVs()) {
-        throw InvalidInput(formatError(j.restName, "", "has no UVs",
-                                       "a rest mesh with texture coordinates (vt) on its faces"));
-    }
-    const std::vector<int> meshTiles = rest.udimTiles();
-    std::vector<int> tiles = j.tiles.empty() ? meshTiles : j.tiles;
-    for (int tile : tiles) {
-        if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile)) {
-            std::string have;
-            for (int t : meshTiles)
-                have.append(have.empty() ? "" : " ").append(std::to_string(t));
-            throw InvalidInput(formatError("tiles", "tile " + std::to_string(tile),
-                                           "the rest mesh '" + j.restName + "' has no UV face in it",
-                                           "tiles of the rest mesh: " + have));
-        }
-    }
+    const std::vector<int> tiles = shotTiles(*j.rest, j.restName, j.tiles, "tiles");
     for (const auto& [source, role] :
          {std::pair{&j.rigidity, "rigidity"}, std::pair{&j.mask, "mask"},
           std::pair{&j.orientation, "orientation"}, std::pair{&j.texture, "texture"}}) {
@@ -519,6 +503,26 @@ void setOutputPatterns(ShotJob& job, const fs::path& out, const fs::path& bake, 
             formatError(bakeName, bake.string(), "is the " + outName + " pattern", "another pattern"));
     }
     job.bakePath = [bake](int tile, int frame) { return tileFramePath(bake, tile, frame); };
+}
+
+std::vector<int> shotTiles(const geom::Mesh& rest, const std::string& restName, const std::vector<int>& tiles,
+                           const std::string& tilesName) {
+    if (!rest.hasUVs()) {
+        throw InvalidInput(formatError(restName, "", "has no UVs",
+                                       "a rest mesh with texture coordinates (vt) on its faces"));
+    }
+    const std::vector<int> meshTiles = rest.udimTiles();
+    for (int tile : tiles) {
+        if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile)) {
+            std::string have;
+            for (int t : meshTiles)
+                have.append(have.empty() ? "" : " ").append(std::to_string(t));
+            throw InvalidInput(formatError(tilesName, "tile " + std::to_string(tile),
+                                           "the rest mesh '" + restName + "' has no UV face in it",
+                                           "tiles of the rest mesh: " + have));
+        }
+    }
+    return tiles.empty() ? meshTiles : tiles;
 }
 
 DeformedFrames objSequenceFrames(const fs::path& pattern, const std::vector<int>& frames,

@@ -6,23 +6,13 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/sampling.h"
+#include "image_support.h"
 
 using namespace deformkit;
 
 namespace {
 
-// An image whose channel k at pixel (i, j) is f(k, i, j).
-template <class F>
-io::Image makeImage(int w, int h, int c, F f) {
-    io::Image image(w, h, c);
-    for (int j = 0; j < h; ++j) {
-        for (int i = 0; i < w; ++i) {
-            for (int k = 0; k < c; ++k)
-                image.at(i, j, k) = static_cast<float>(f(k, double(i), double(j)));
-        }
-    }
-    return image;
-}
+using deformkit::test::makeImage;
 
 std::vector<float> sampleAt(const io::Image& image, glm::vec2 position, io::SampleFilter filter) {
     std::vector<float> out(image.channels);

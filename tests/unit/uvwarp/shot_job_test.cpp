@@ -253,3 +253,22 @@ TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp]
     CHECK_THAT(test::errorOf<InvalidInput>([&] { uvwarp::ShotSolver s(tiles.job); }),
                Contains("tile 1003") && Contains("1001 1002"));
 }
+
+TEST_CASE("shot job: shotTiles gives the asked tiles or every tile of the UVs, and names what is wrong",
+          "[uvwarp][shot_job][errors]") {
+    const geom::Mesh rest = twoTiles();
+    CHECK(uvwarp::shotTiles(rest, "rest.obj", {}, "--tiles") == std::vector<int>{1001, 1002});
+    CHECK(uvwarp::shotTiles(rest, "rest.obj", {1002}, "--tiles") == std::vector<int>{1002});
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)uvwarp::shotTiles(rest, "rest.obj", {1001, 1011}, "--tiles");
+               }),
+               Contains("--tiles: tile 1011") && Contains("'rest.obj' has no UV face in it") &&
+                   Contains("1001 1002"));
+    geom::Mesh::Data bare;
+    bare.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    bare.faceCounts = {3};
+    bare.faceIndices = {0, 1, 2};
+    const geom::Mesh noUvs(std::move(bare), "bare");
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)uvwarp::shotTiles(noUvs, "bare.obj", {}, "tiles"); }),
+               Contains("bare.obj") && Contains("has no UVs"));
+}

@@ -149,6 +149,12 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
 void setOutputPatterns(ShotJob& job, const std::filesystem::path& out, const std::filesystem::path& bake,
                        const std::string& outName, const std::string& bakeName);
 
+// The tiles a job on `rest` warps: `tiles`, or every tile of the rest mesh's UVs when it is empty. Throws
+// InvalidInput when the mesh has no UVs (naming `restName`) or a tile has no UV face of it (naming
+// `tilesName`: an option, an argument). ShotSolver checks its job with it; a host may check first.
+[[nodiscard]] std::vector<int> shotTiles(const geom::Mesh& rest, const std::string& restName,
+                                         const std::vector<int>& tiles, const std::string& tilesName);
+
 // The deformed frames of an OBJ sequence ("anim.####.obj", io::ObjSequence tokens): checks now that the
 // pattern has a frame token (InvalidInput naming `name`) and that a file exists for every one of `frames`
 // (IoError naming the first missing one); then reads each frame when asked, named by its path.
