@@ -185,7 +185,7 @@ struct PySlideResult {
     py::array_t<int32_t> vertices, faces, triangles;
     py::array_t<double> barycentric;
     int32_t moved = 0, boundaryStopped = 0, limitStopped = 0, unreachable = 0, withoutTangentPlane = 0,
-            degenerateTriangles = 0, chordFallbacks = 0;
+            degenerateTriangles = 0;
 };
 
 PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& r) {
@@ -215,7 +215,6 @@ PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& 
     out.unreachable = r.unreachable;
     out.withoutTangentPlane = r.withoutTangentPlane;
     out.degenerateTriangles = r.degenerateTriangles;
-    out.chordFallbacks = r.chordFallbacks;
     return out;
 }
 
@@ -371,7 +370,6 @@ void bindSlide(py::module_& m) {
                       "vertices within a radius with only degenerate triangles around: unmoved")
         .def_readonly("degenerate_triangles", &PySlideResult::degenerateTriangles,
                       "zero-area triangles touching the region: skipped")
-        .def_readonly("chord_fallbacks", &PySlideResult::chordFallbacks)
         .def("__repr__", [](const PySlideResult& r) {
             return "<deformkit.SlideResult moved " + std::to_string(r.moved) + ", boundary_stopped " +
                    std::to_string(r.boundaryStopped) + ", limit_stopped " + std::to_string(r.limitStopped) +
@@ -442,10 +440,6 @@ void bindSlide(py::module_& m) {
             "breadth-first order, 'normalized_distance' (K,) float32 = distance / radius, 'a1', 'a2' (the "
             "region\n"
             "basis at the handle), 'unreachable', 'without_tangent_plane'}.")
-        .def_property_readonly(
-            "expanded_map_entries",
-            [](const PySlider& s) { return static_cast<int64_t>(s.slider().expandedMapEntries()); },
-            "Vertices cached beyond one-rings by the local maps so far")
         .def("__repr__", [](const PySlider& s) {
             return "<deformkit.Slider " + std::to_string(s.slider().numVertices()) + " vertices, " +
                    std::to_string(s.slider().numHandles()) + " handles, " +

@@ -97,15 +97,4 @@ glm::dvec2 expMap(const SlideSurface& surface, int32_t p, int32_t q, bool* fellB
     return glm::dvec2(glm::dot(tangent, surface.tangent1(p)), glm::dot(tangent, surface.tangent2(p))) * scale;
 }
 
-glm::dvec2 LocalMap::coords(const SlideSurface& surface, int32_t p, int32_t q) {
-    for (const auto& [vertex, image] : entries_) {
-        if (vertex == q) return image;
-    }
-    bool fellBack = false;
-    const glm::dvec2 image = expMap(surface, p, q, &fellBack);
-    fallbacks_ += fellBack ? 1 : 0;
-    entries_.emplace_back(q, image);
-    return image;
-}
-
 }  // namespace deformkit::slide

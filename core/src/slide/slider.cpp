@@ -79,9 +79,8 @@ struct Slider::Impl {
     std::vector<SupportRegion> regions;
     std::vector<std::vector<int32_t>> regionSlots;  // per region, per active vertex: its slot in `active`
     std::vector<int32_t> active;                    // union of active vertices, ascending
-    std::vector<LocalMap> maps;            // per slot: the local parameterisation beyond the one-ring
-    std::vector<glm::dvec2> displacement;  // per slot: d_P in the vertex's basis (Eq. 7), scratch
-    std::vector<Landing> landings;         // per slot, scratch
+    std::vector<glm::dvec2> displacement;           // per slot: d_P in the vertex's basis (Eq. 7), scratch
+    std::vector<Landing> landings;                  // per slot, scratch
     std::unique_ptr<geom::LimitSurface> limit;
     std::vector<glm::dvec3> limitOrigin;  // per slot: the limit point under the vertex's rest position
     int32_t degenerateTriangles = 0;
@@ -96,15 +95,15 @@ struct Slider::Impl {
     std::vector<glm::dvec2> ringNext, ringPrev;
     std::vector<uint8_t> interior;  // per slot: no boundary edge at the vertex
 
-    glm::dvec2 imageOf(int32_t slot, int32_t p, LocalMap& map, int32_t q) const {
-        if (q == p) return glm::dvec2(0.0);
+    // The image of one-ring neighbour q in p's tangent space (Eq. 1-2, computed at bind).
+    glm::dvec2 ringImage(int32_t slot, int32_t p, int32_t q) const {
         const auto corners = surface.vertexCorners(p);
         const int32_t base = ringOffsets[slot];
         for (size_t k = 0; k < corners.size(); ++k) {
             if (surface.vertex(SlideSurface::next(corners[k])) == q) return ringNext[base + k];
             if (surface.vertex(SlideSurface::prev(corners[k])) == q) return ringPrev[base + k];
         }
-        return map.coords(surface, p, q);
+        return glm::dvec2(0.0);  // q == p
     }
 
     bool isInteriorVertex(int32_t p) const {
@@ -114,12 +113,10 @@ struct Slider::Impl {
         return true;
     }
 
-    // §3.3: find the triangle F' of p's local map containing target = P'new - P (coordinates in p's basis),
-    // following the segment from p and growing the map across each edge it crosses.
     // At a boundary vertex, a slide along the boundary (within kParallel radians of a boundary edge) is
     // turned kInward radians into the surface, so that rounding in the propagated direction cannot start
     // its path just outside the surface, which would stop it at once.
-    glm::dvec2 alongBoundary(int32_t slot, int32_t p, LocalMap& map, const glm::dvec2& target) const {
+    glm::dvec2 alongBoundary(int32_t slot, int32_t p, const glm::dvec2& target) const {
         constexpr double kParallel = 1e-6, kInward = 1e-9;
         const double length = glm::length(target);
         const glm::dvec2 direction = target / length;
@@ -135,39 +132,43 @@ struct Slider::Impl {
         for (int32_t c : surface.vertexCorners(p)) {
             if (surface.isDegenerate(SlideSurface::triangleOf(c))) continue;
             if (surface.opposite(c) < 0) {  // boundary edge p -> a: the surface lies counter-clockwise of it
-                const glm::dvec2 a = imageOf(slot, p, map, surface.vertex(SlideSurface::next(c)));
+                const glm::dvec2 a = ringImage(slot, p, surface.vertex(SlideSurface::next(c)));
                 if (parallel(a)) return turned(a, kInward);
             }
             if (surface.opposite(SlideSurface::prev(c)) <
                 0) {  // boundary edge b -> p: the surface lies clockwise
-                const glm::dvec2 b = imageOf(slot, p, map, surface.vertex(SlideSurface::prev(c)));
+                const glm::dvec2 b = ringImage(slot, p, surface.vertex(SlideSurface::prev(c)));
                 if (parallel(b)) return turned(b, -kInward);
             }
         }
         return target;
     }
 
-    Landing walk(int32_t slot, int32_t p, LocalMap& map, const glm::dvec2& requested) const {
-        const glm::dvec2 target = interior[slot] ? requested : alongBoundary(slot, p, map, requested);
-        // The sector at p that contains the direction of the target.
+    // §3.3: the triangle F' where p lands when it slides by `requested` (d_P in p's basis): the sector of
+    // p's one-ring map that holds the direction, then a straight walk of |d_P| across the triangles,
+    // each unfolded into the plane of the one before across the edge the walk crosses.
+    Landing walk(int32_t slot, int32_t p, const glm::dvec2& requested) const {
+        const glm::dvec2 inMap = interior[slot] ? requested : alongBoundary(slot, p, requested);
+        glm::dvec2 developed(0.0);
+        // The sector at p that contains the direction in the map.
         int32_t start = -1;
-        glm::dvec2 ca, cb;
+        glm::dvec2 ca(0.0), cb(0.0);
         bool zeroIsLeft = true;
         double bestScore = -1e300;
         int32_t best = -1;
-        glm::dvec2 bestA, bestB;
+        glm::dvec2 bestA(0.0), bestB(0.0);
         const auto corners = surface.vertexCorners(p);
         for (size_t k = 0; k < corners.size(); ++k) {
             const int32_t c = corners[k];
             if (surface.isDegenerate(SlideSurface::triangleOf(c))) continue;
             const glm::dvec2 a = ringNext[ringOffsets[slot] + k];
             const glm::dvec2 b = ringPrev[ringOffsets[slot] + k];
-            const double sa = cross2(a, target), sb = cross2(target, b);
+            const double sa = cross2(a, inMap), sb = cross2(inMap, b);
             if (sa >= 0.0 && sb >= 0.0 && cross2(a, b) > 0.0) {
                 start = c;
                 ca = a;
                 cb = b;
-                // A target exactly along an edge (a slide along a boundary or along a ring of edges) is
+                // A inMap exactly along an edge (a slide along a boundary or along a ring of edges) is
                 // read as turned a hair into this sector, so vertices on the line fall on the side the
                 // sector lies: behind the a edge they count as right of the line, behind b as left.
                 zeroIsLeft = !(sa == 0.0);
@@ -190,6 +191,28 @@ struct Slider::Impl {
             ca = bestA;
             cb = bestB;
         }
+
+        // Develop the start triangle isometrically (p at the origin, a on +x) and turn the target into it
+        // by the share of the sector's map angle it makes with a: from here on the walk unfolds each
+        // triangle it enters into this plane, so its path is a straight line of the target's length on
+        // the surface (a straightest geodesic), whatever the map of far vertices would say.
+        {
+            const glm::dvec3 P = surface.point(p);
+            const glm::dvec3 A = surface.point(surface.vertex(SlideSurface::next(start)));
+            const glm::dvec3 B = surface.point(surface.vertex(SlideSurface::prev(start)));
+            const double la = glm::length(A - P), lb = glm::length(B - P);
+            const double gamma = std::atan2(glm::length(glm::cross(A - P, B - P)), glm::dot(A - P, B - P));
+            const double mapAngle = std::atan2(cross2(ca, cb), glm::dot(ca, cb));
+            const double share =
+                mapAngle > 0.0
+                    ? std::clamp(std::atan2(cross2(ca, inMap), glm::dot(ca, inMap)) / mapAngle, 0.0, 1.0)
+                    : 0.5;
+            const double length = glm::length(inMap);
+            ca = glm::dvec2(la, 0.0);
+            cb = lb * glm::dvec2(std::cos(gamma), std::sin(gamma));
+            developed = length * glm::dvec2(std::cos(share * gamma), std::sin(share * gamma));
+        }
+        const glm::dvec2& target = developed;
 
         // Corner order of the start triangle is (p, a, b) from corner `start`.
         glm::dvec3 bary(0.0);
@@ -219,7 +242,17 @@ struct Slider::Impl {
             if (step + 1 >= options.maxWalkTriangles) return onEdge(edge, mu, Stop::Limit);
             // The entered triangle: entry runs from e1's vertex to e0's vertex; w is the third vertex.
             const int32_t wCorner = SlideSurface::prev(entry);
-            const glm::dvec2 cw = imageOf(slot, p, map, surface.vertex(wCorner));
+            // Unfold the entered triangle across the edge e0 -> e1: its third vertex lies right of it.
+            const glm::dvec3 E0 = surface.point(surface.vertex(edge));
+            const glm::dvec3 u = surface.point(surface.vertex(SlideSurface::next(edge))) - E0;
+            const glm::dvec3 toW = surface.point(surface.vertex(wCorner)) - E0;
+            const double edgeLength2 = glm::dot(u, u);
+            const glm::dvec2 along = e1 - e0;
+            const double alongLength = glm::length(along);
+            if (!(edgeLength2 > 0.0) || !(alongLength > 0.0)) return onEdge(edge, mu, Stop::Boundary);
+            const double t = glm::dot(toW, u) / edgeLength2;
+            const double h = glm::length(glm::cross(toW, u)) / std::sqrt(edgeLength2);
+            const glm::dvec2 cw = e0 + t * along + (h / alongLength) * glm::dvec2(along.y, -along.x);
             const glm::dvec2 cEntry = e1, cNext = e0;  // vertex(entry), vertex(next(entry))
             if (barycentric(cEntry, cNext, cw, target, bary) &&
                 glm::all(glm::greaterThanEqual(bary, glm::dvec3(-1e-12)))) {
@@ -239,8 +272,8 @@ struct Slider::Impl {
                 e0 = cNext;
                 e1 = cw;
             }
-            // A crossing beyond the target means the map folds here (far from p on a curved surface):
-            // the target is as good as reached in this triangle.
+            // A crossing beyond the target (only by rounding: the unfolded strip is flat) means the target
+            // is as good as reached in this triangle.
             const glm::dvec2 crossing = e0 + crossingParameter(e0, e1) * (e1 - e0);
             if (glm::dot(crossing, target) >= targetLength2) {
                 if (!barycentric(cEntry, cNext, cw, target, bary)) bary = glm::dvec3(1.0 / 3.0);
@@ -348,7 +381,6 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
             slots[k] = slotOf[region.vertices[k]];
         m.regionSlots.push_back(std::move(slots));
     }
-    m.maps.resize(m.active.size());
     m.ringOffsets.resize(m.active.size() + 1, 0);
     m.interior.resize(m.active.size());
     for (size_t i = 0; i < m.active.size(); ++i) {
@@ -422,13 +454,6 @@ std::span<const int32_t> Slider::activeVertices() const {
     return impl_->active;
 }
 
-size_t Slider::expandedMapEntries() const {
-    size_t total = 0;
-    for (const LocalMap& map : impl_->maps)
-        total += map.size();
-    return total;
-}
-
 void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                       std::span<const float> weights, float envelope, SlideResult* result) {
     Impl& m = *impl_;
@@ -491,7 +516,7 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
         Landing& landing = m.landings[i];
         landing = Landing{};
         if (target.x == 0.0 && target.y == 0.0) continue;
-        landing = m.walk(i, v, m.maps[i], target);
+        landing = m.walk(i, v, target);
         ++moved;
         boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
         limitStopped += landing.stop == Stop::Limit ? 1 : 0;
@@ -524,9 +549,6 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
             result->withoutTangentPlane += region.withoutTangentPlane;
         }
         result->degenerateTriangles = m.degenerateTriangles;
-        result->chordFallbacks = 0;
-        for (const LocalMap& map : m.maps)
-            result->chordFallbacks += map.fallbacks();
     }
 }
 

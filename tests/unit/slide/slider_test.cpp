@@ -525,10 +525,10 @@ TEST_CASE("slide on the limit surface follows the Catmull-Clark limit of the cag
 }
 
 TEST_CASE("slide: evaluations from several threads match sequential ones", "[slide]") {
-    // The on-demand expansion of local maps is shared state: concurrent evaluate calls must not corrupt it.
+    // Evaluation writes per-vertex scratch (displacements, landings): concurrent calls must not mix it.
     const geom::Mesh mesh = test::icosphere(4, 1.0f);
     const std::vector<SlideDrive> small = {{glm::dvec3(0.02, 0.05, -0.01)}};
-    const std::vector<SlideDrive> large = {{glm::dvec3(-0.2, 0.1, 0.15)}};  // grows the maps beyond one-rings
+    const std::vector<SlideDrive> large = {{glm::dvec3(-0.2, 0.1, 0.15)}};  // walks far beyond one-rings
     Slider reference(mesh, {{30, 0.6}});
     auto expectedSmall = restPoints(mesh), expectedLarge = restPoints(mesh);
     reference.evaluate(small, expectedSmall);
@@ -543,6 +543,4 @@ TEST_CASE("slide: evaluations from several threads match sequential ones", "[sli
         t.join();
     for (int i = 0; i < 8; ++i)
         CHECK(outs[i] == (i % 2 ? expectedLarge : expectedSmall));
-    CHECK(shared.expandedMapEntries() == reference.expandedMapEntries());
-    CHECK(shared.expandedMapEntries() > 0);
 }

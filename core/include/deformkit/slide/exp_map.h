@@ -2,8 +2,6 @@
 
 #include <cstdint>
 #include <optional>
-#include <utility>
-#include <vector>
 
 #include <glm/vec2.hpp>
 
@@ -24,20 +22,5 @@ namespace deformkit::slide {
 // projected on that plane. One-ring neighbours are joined to p by a triangle edge, so |alpha_pq| = |pq|.
 // Where the normal curve fails, the chord |pq| stands in and *fellBack is set.
 [[nodiscard]] glm::dvec2 expMap(const SlideSurface& surface, int32_t p, int32_t q, bool* fellBack = nullptr);
-
-// The part of p's local parameterisation beyond its one-ring, grown on demand (§3.3) and kept: each
-// vertex's image is computed once, independently of every other vertex's map, so maps of different
-// vertices can grow in parallel. One LocalMap is owned by one vertex; it is not itself synchronised.
-class LocalMap {
-  public:
-    // q's image in p's tangent space, from the cache or computed and cached.
-    glm::dvec2 coords(const SlideSurface& surface, int32_t p, int32_t q);
-    [[nodiscard]] size_t size() const { return entries_.size(); }
-    [[nodiscard]] int32_t fallbacks() const { return fallbacks_; }
-
-  private:
-    std::vector<std::pair<int32_t, glm::dvec2>> entries_;
-    int32_t fallbacks_ = 0;
-};
 
 }  // namespace deformkit::slide

@@ -59,13 +59,15 @@ struct SlideResult {
     int32_t unreachable = 0;          // within a radius but not reachable by the propagation: unmoved (bind)
     int32_t withoutTangentPlane = 0;  // within a radius but only degenerate triangles around: unmoved (bind)
     int32_t degenerateTriangles = 0;  // zero-area triangles touching an active vertex: skipped (bind)
-    int32_t chordFallbacks = 0;       // local-map vertices whose normal curve failed; the chord stood in
 };
 
 // The sliding deformer (Pinskiy, "Sliding deformation"): bind once per rest mesh and handle set, evaluate
 // per locator drag. Binding builds the rest surface, each handle's support region and propagated region
-// basis; each vertex's local parameterisation starts as its one-ring and grows on demand during
-// evaluation, and what it grows is kept for the next evaluation.
+// basis, and each active vertex's exponential map of its one-ring (Eq. 1-2). Evaluation turns each
+// vertex's displacement d_P (Eq. 7) into a direction on the surface through its one-ring map and walks
+// |d_P| along the straightest geodesic in that direction, unfolding each triangle it enters into the plane
+// of the last (§3.3): a vertex travels exactly |d_P| over the surface, so it moves at most |d_P| in space,
+// stays on the triangles it crossed, and never jumps across the mesh (docs/decisions.md).
 //
 // Several handles compose by adding their tangent displacements in each vertex's tangent space before the
 // single walk over the surface (order-independent; on a plane exactly the sum of the translations).
@@ -87,8 +89,6 @@ class Slider {
     [[nodiscard]] const SupportRegion& region(int32_t handle) const;
     // Vertices in at least one handle's region (union), ascending.
     [[nodiscard]] std::span<const int32_t> activeVertices() const;
-    // Vertices cached beyond one-rings by all local maps so far (grows with larger displacements).
-    [[nodiscard]] size_t expandedMapEntries() const;
 
     // points: #V positions, moved in place by each vertex's slide (landing - rest position); pass the rest
     // positions for a plain slide. drives: one per handle. weights: #V painted weights in [0, 1] scaling
