@@ -46,11 +46,12 @@ struct Worst {
 };
 
 // One slide of `mesh` by `d` at `handle`, checked vertex by vertex against the bound |d| falloff(dist / r).
-void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double radius, Worst& worst) {
+void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double radius, Worst& worst,
+           slide::RegionMetric region = slide::RegionMetric::Euclidean) {
     const SlideDrive drive{d, Falloff::smooth()};
     SlideResult result;
-    const std::vector<glm::vec3> out =
-        slide::slide(mesh, std::vector<SlideHandle>{{handle, radius}}, {&drive, 1}, {}, 1.0f, {}, &result);
+    const std::vector<glm::vec3> out = slide::slide(mesh, std::vector<SlideHandle>{{handle, radius, region}},
+                                                    {&drive, 1}, {}, 1.0f, {}, &result);
     const auto rest = mesh.points();
     const glm::dvec3 p0(rest[handle]);
     const double scale = diagonal(mesh);
@@ -104,6 +105,34 @@ TEST_CASE("slide on Spot: random drags keep travel, stay on the surface, stay fi
         glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
         d *= 0.03 * scale / glm::length(d);
         check(mesh, handle, d, 0.1 * scale, worst);
+    }
+    INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off surface " << worst.offSurface);
+    CHECK(worst.finite);
+    CHECK(worst.travelRatio <= 1.0);
+    CHECK(worst.offSurface < 1e-6);
+    CHECK(worst.negativeBary >= 0.0);
+    CHECK(worst.limitStopped == 0);
+}
+
+TEST_CASE("slide on Spot: large drags and geodesic regions keep the travel bound", "[slide][real]") {
+    // Drags up to two thirds of the radius (where the smooth falloff starts to fold the texture) and radii
+    // from 5% to 25% of the diagonal, with both region metrics. A geodesic distance is at least the 3D
+    // one, so the falloff of the 3D distance bounds the travel in both cases.
+    const geom::Mesh& mesh = spot();
+    const double scale = diagonal(mesh);
+    std::mt19937 rng(18);
+    std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> gauss;
+    Worst worst;
+    constexpr int kCases = 40;
+    for (int c = 0; c < kCases; ++c) {
+        const int32_t handle = vertex(rng);
+        const double radius = (0.05 + 0.2 * unit(rng)) * scale;
+        glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
+        d *= (0.05 + 0.6 * unit(rng)) * radius / glm::length(d);
+        check(mesh, handle, d, radius, worst,
+              c % 2 ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean);
     }
     INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off surface " << worst.offSurface);
     CHECK(worst.finite);
