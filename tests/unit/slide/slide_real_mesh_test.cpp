@@ -1,9 +1,11 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
+#include <omp.h>
 #include <glm/geometric.hpp>
 
 #include "deformkit/io/obj.h"
@@ -140,4 +142,19 @@ TEST_CASE("slide on Spot: large drags and geodesic regions keep the travel bound
     CHECK(worst.offSurface < 1e-6);
     CHECK(worst.negativeBary >= 0.0);
     CHECK(worst.limitStopped == 0);
+}
+
+TEST_CASE("slide on Spot gives the same bytes for 1 and 2 threads", "[slide][real]") {
+    const geom::Mesh& mesh = spot();
+    const std::vector<SlideHandle> handles = {{1858, 0.3}, {400, 0.25, slide::RegionMetric::Geodesic}};
+    const std::vector<SlideDrive> drives = {{glm::dvec3(0.05, 0.1, -0.02)}, {glm::dvec3(-0.04, 0.02, 0.06)}};
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const std::vector<glm::vec3> one = slide::slide(mesh, handles, drives);
+    omp_set_num_threads(2);
+    const std::vector<glm::vec3> two = slide::slide(mesh, handles, drives);
+    omp_set_num_threads(saved);
+    REQUIRE(one.size() == two.size());
+    CHECK(one != std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end()));
+    CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)) == 0);
 }
