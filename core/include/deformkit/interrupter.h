@@ -32,6 +32,24 @@ class Interrupter {
     }
 };
 
+// A job's start() and end() around a scope: start() at construction, end() when the scope is left
+// (finished, cancelled or failed). Both are skipped for a null interrupter.
+class InterrupterScope {
+  public:
+    InterrupterScope(Interrupter* interrupter, std::string_view name, int64_t total)
+        : interrupter_(interrupter) {
+        if (interrupter_) interrupter_->start(name, total);
+    }
+    ~InterrupterScope() {
+        if (interrupter_) interrupter_->end();
+    }
+    InterrupterScope(const InterrupterScope&) = delete;
+    InterrupterScope& operator=(const InterrupterScope&) = delete;
+
+  private:
+    Interrupter* interrupter_;
+};
+
 // A job stopped because its Interrupter asked it to. Every output it wrote is complete (outputs are written
 // atomically), so a rerun resumes where it stopped.
 class Cancelled : public Error {

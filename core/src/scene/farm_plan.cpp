@@ -319,13 +319,7 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
         return report;
     }
     const int64_t frames = int64_t{t.lastFrame} - t.firstFrame + 1;
-    if (interrupter) interrupter->start("farm task", frames);
-    struct EndOnExit {
-        Interrupter* interrupter;
-        ~EndOnExit() {
-            if (interrupter) interrupter->end();
-        }
-    } endOnExit{interrupter};
+    const InterrupterScope scope(interrupter, "farm task", frames);
     for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame) {
         const Clock::time_point start = Clock::now();
         bool wrote = false;

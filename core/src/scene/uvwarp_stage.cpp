@@ -140,13 +140,7 @@ uvwarp::ShotReport runUvWarpStage(SceneEvaluator& evaluator, size_t object, cons
     std::optional<uvwarp::ShotSolver> solver = uvwarpStageSolver(scene, object, run);
     if (!solver) return {};
     const std::optional<int> last = solver->lastNeededFrame();
-    if (interrupter) interrupter->start("uvwarp", solver->units());
-    struct EndOnExit {
-        Interrupter* interrupter;
-        ~EndOnExit() {
-            if (interrupter) interrupter->end();
-        }
-    } endOnExit{interrupter};
+    const InterrupterScope scope(interrupter, "uvwarp", solver->units());
     for (int frame : run.frames) {
         if (!last || frame > *last) break;
         solveStageFrame(*solver, scene, object, frame, evaluator.evaluate(object, frame).points(),

@@ -452,13 +452,7 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
     }
     ShotSolver solver(job);
     const std::optional<int> last = solver.lastNeededFrame();
-    if (interrupter) interrupter->start("uvwarp", solver.units());
-    struct EndOnExit {
-        Interrupter* interrupter;
-        ~EndOnExit() {
-            if (interrupter) interrupter->end();
-        }
-    } endOnExit{interrupter};
+    const InterrupterScope scope(interrupter, "uvwarp", solver.units());
     for (int frame : job.frames) {
         if (!last || frame > *last) break;
         std::string name;

@@ -78,6 +78,15 @@ void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double r
     worst.limitStopped += result.limitStopped;
 }
 
+// The invariants of every case: finite, within the travel bound, on the surface, no walk at its limit.
+void checkInvariants(const Worst& worst) {
+    CHECK(worst.finite);
+    CHECK(worst.travelRatio <= 1.0);
+    CHECK(worst.offSurface < 1e-6);
+    CHECK(worst.negativeBary >= 0.0);
+    CHECK(worst.limitStopped == 0);
+}
+
 }  // namespace
 
 TEST_CASE("slide on Spot: the tail-dimple drag moves no vertex farther than the drag", "[slide][real]") {
@@ -85,11 +94,7 @@ TEST_CASE("slide on Spot: the tail-dimple drag moves no vertex farther than the 
     // moved 0.68 (8.8 |d|) and five walks ran into the walk limit.
     Worst worst;
     check(spot(), 1858, glm::dvec3(0.0283, 0.0717, -0.0088), 0.2588, worst);
-    CHECK(worst.finite);
-    CHECK(worst.travelRatio <= 1.0);
-    CHECK(worst.offSurface < 1e-6);
-    CHECK(worst.negativeBary >= 0.0);
-    CHECK(worst.limitStopped == 0);
+    checkInvariants(worst);
 }
 
 TEST_CASE("slide on Spot: random drags keep travel, stay on the surface, stay finite", "[slide][real]") {
@@ -109,11 +114,7 @@ TEST_CASE("slide on Spot: random drags keep travel, stay on the surface, stay fi
         check(mesh, handle, d, 0.1 * scale, worst);
     }
     INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off surface " << worst.offSurface);
-    CHECK(worst.finite);
-    CHECK(worst.travelRatio <= 1.0);
-    CHECK(worst.offSurface < 1e-6);
-    CHECK(worst.negativeBary >= 0.0);
-    CHECK(worst.limitStopped == 0);
+    checkInvariants(worst);
 }
 
 TEST_CASE("slide on Spot: large drags and geodesic regions keep the travel bound", "[slide][real]") {
@@ -137,11 +138,7 @@ TEST_CASE("slide on Spot: large drags and geodesic regions keep the travel bound
               c % 2 ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean);
     }
     INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off surface " << worst.offSurface);
-    CHECK(worst.finite);
-    CHECK(worst.travelRatio <= 1.0);
-    CHECK(worst.offSurface < 1e-6);
-    CHECK(worst.negativeBary >= 0.0);
-    CHECK(worst.limitStopped == 0);
+    checkInvariants(worst);
 }
 
 TEST_CASE("slide on Spot gives the same bytes for 1 and 2 threads", "[slide][real]") {
