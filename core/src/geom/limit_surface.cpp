@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -86,10 +88,16 @@ struct LimitSurface::Impl {
     int32_t numVertices = 0;
     std::vector<int32_t> faceCounts;  // #F corner counts
     std::vector<int32_t> ptexBase;    // #F + 1: first Ptex face of each face, then the Ptex face count
-    std::unique_ptr<Far::PatchTable> patches;
-    std::unique_ptr<Far::PatchMap> patchMap;
+    // Connectivity, shared by copies and by withPoints(); the refiner only when the surface is deformable.
+    std::shared_ptr<const Far::TopologyRefiner> refiner;
+    std::shared_ptr<const Far::PatchTable> patches;
+    std::shared_ptr<const Far::PatchMap> patchMap;
+    std::vector<PtexLocation> vertexCorner;  // #V: a patch corner at each vertex (ptexFace -1: unused)
     std::vector<glm::dvec3> patchPoints;  // refined vertices of every level, then the patches' local points
     std::vector<glm::dvec3> limitPositions;  // #V
+
+    // Patch points and limit positions for cage positions `cage` (#V).
+    void setControlPoints(const Far::TopologyRefiner& topology, std::span<const glm::vec3> cage);
 
     void requireFace(int32_t face) const {
         if (face < 0 || face >= static_cast<int32_t>(faceCounts.size())) {
@@ -203,6 +211,41 @@ void LimitSurface::Impl::patchPoint(const PtexLocation& at, glm::dvec3& position
     *dPdv = scale * dv;
 }
 
+void LimitSurface::Impl::setControlPoints(const Far::TopologyRefiner& topology,
+                                          std::span<const glm::vec3> cage) {
+    // Patch control points: the cage, every adaptively refined level, then the local (end-cap) points.
+    const int numRefined = topology.GetNumVerticesTotal();
+    const int numLocal = patches->GetNumLocalPoints();
+    std::vector<Point> points(static_cast<size_t>(numRefined) + numLocal);
+    for (int32_t v = 0; v < numVertices; ++v)
+        points[v].p = glm::dvec3(cage[v]);
+    Far::PrimvarRefinerReal<double> primvars(topology);
+    Point* src = points.data();
+    for (int level = 1; level <= topology.GetMaxLevel(); ++level) {
+        Point* dst = src + topology.GetLevel(level - 1).GetNumVertices();
+        primvars.Interpolate(level, src, dst);
+        src = dst;
+    }
+    if (numLocal > 0) {
+        const Far::StencilTableReal<double>* local = patches->GetLocalPointStencilTable<double>();
+        if (local == nullptr) {
+            throw Error(formatError(source, "", "OpenSubdiv built no double-precision local point stencils"));
+        }
+        local->UpdateValues(points.data(), points.data() + numRefined);
+    }
+    patchPoints.resize(points.size());
+    std::transform(points.begin(), points.end(), patchPoints.begin(), [](const Point& p) { return p.p; });
+
+    limitPositions.resize(numVertices);
+    for (int32_t v = 0; v < numVertices; ++v) {
+        if (vertexCorner[v].ptexFace < 0) {
+            limitPositions[v] = glm::dvec3(cage[v]);
+        } else {
+            patchPoint(vertexCorner[v], limitPositions[v], nullptr, nullptr);
+        }
+    }
+}
+
 LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options, const std::string& source) {
     auto impl = std::make_shared<Impl>();
     impl->source = source;
@@ -275,7 +318,7 @@ LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options,
                                         ? Sdc::Options::VTX_BOUNDARY_EDGE_ONLY
                                         : Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
     using RefinerFactory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    std::unique_ptr<Far::TopologyRefiner> refiner(
+    std::shared_ptr<Far::TopologyRefiner> refiner(
         RefinerFactory::Create(desc, RefinerFactory::Options(Sdc::SCHEME_CATMARK, sdc)));
     if (!refiner) {
         throw TopologyError(formatError(source, "", "OpenSubdiv cannot build a subdivision topology from it",
@@ -310,51 +353,23 @@ LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options,
         }
     }
 
-    // Patch control points: the cage, every adaptively refined level, then the local (end-cap) points.
-    const int numRefined = refiner->GetNumVerticesTotal();
-    const int numLocal = impl->patches->GetNumLocalPoints();
-    std::vector<Point> points(static_cast<size_t>(numRefined) + numLocal);
-    for (int32_t v = 0; v < rest.numVertices(); ++v)
-        points[v].p = glm::dvec3(rest.points()[v]);
-    Far::PrimvarRefinerReal<double> primvars(*refiner);
-    Point* src = points.data();
-    for (int level = 1; level <= refiner->GetMaxLevel(); ++level) {
-        Point* dst = src + refiner->GetLevel(level - 1).GetNumVertices();
-        primvars.Interpolate(level, src, dst);
-        src = dst;
-    }
-    if (numLocal > 0) {
-        const Far::StencilTableReal<double>* local = impl->patches->GetLocalPointStencilTable<double>();
-        if (local == nullptr) {
-            throw Error(formatError(source, "", "OpenSubdiv built no double-precision local point stencils"));
-        }
-        local->UpdateValues(points.data(), points.data() + numRefined);
-    }
-    impl->patchPoints.resize(points.size());
-    std::transform(points.begin(), points.end(), impl->patchPoints.begin(),
-                   [](const Point& p) { return p.p; });
+    impl->patchMap = std::make_shared<Far::PatchMap>(*impl->patches);
 
-    impl->patchMap = std::make_unique<Far::PatchMap>(*impl->patches);
-
-    // Limit positions of the cage vertices: the patch corner of a face using the vertex (Gregory and
-    // B-spline patches both interpolate the exact limit position at their corners).
-    impl->limitPositions.resize(rest.numVertices());
-    std::vector<bool> done(rest.numVertices(), false);
-    for (int32_t v = 0; v < rest.numVertices(); ++v)
-        impl->limitPositions[v] = glm::dvec3(rest.points()[v]);
+    // A patch corner at each cage vertex: Gregory and B-spline patches both interpolate the exact limit
+    // position there.
+    impl->vertexCorner.assign(rest.numVertices(), PtexLocation{-1, 0.0, 0.0});
     for (int32_t f = 0; f < rest.numFaces(); ++f) {
         const auto corners = rest.face(f);
         for (int32_t k = 0; k < counts[f]; ++k) {
-            const int32_t v = corners[k];
-            if (done[v]) continue;
-            done[v] = true;
-            const PtexLocation at =
-                counts[f] == 4
-                    ? PtexLocation{impl->ptexBase[f], k == 1 || k == 2 ? 1.0 : 0.0, k >= 2 ? 1.0 : 0.0}
-                    : PtexLocation{impl->ptexBase[f] + k, 0.0, 0.0};
-            impl->patchPoint(at, impl->limitPositions[v], nullptr, nullptr);
+            PtexLocation& at = impl->vertexCorner[corners[k]];
+            if (at.ptexFace >= 0) continue;
+            at = counts[f] == 4
+                     ? PtexLocation{impl->ptexBase[f], k == 1 || k == 2 ? 1.0 : 0.0, k >= 2 ? 1.0 : 0.0}
+                     : PtexLocation{impl->ptexBase[f] + k, 0.0, 0.0};
         }
     }
+    impl->setControlPoints(*refiner, rest.points());
+    if (options.deformable) impl->refiner = std::move(refiner);
     impl_ = std::move(impl);
 }
 
@@ -405,6 +420,23 @@ LimitSample LimitSurface::evaluateAt(const PtexLocation& location) const {
     }
     return impl_->evaluate(
         {location.ptexFace, std::clamp(location.u, 0.0, 1.0), std::clamp(location.v, 0.0, 1.0)}, true);
+}
+
+LimitSurface LimitSurface::withPoints(std::span<const glm::vec3> cage) const {
+    if (!impl_->refiner) {
+        throw Error(formatError(impl_->source, "limit surface", "was not built deformable",
+                                "LimitSurfaceOptions::deformable for new control points"));
+    }
+    if (cage.size() != static_cast<size_t>(impl_->numVertices)) {
+        throw InvalidInput(formatError(impl_->source, "control points",
+                                       std::to_string(cage.size()) + " given",
+                                       std::to_string(impl_->numVertices) + ", one per cage vertex"));
+    }
+    auto impl = std::make_shared<Impl>(*impl_);
+    impl->setControlPoints(*impl->refiner, cage);
+    LimitSurface out(*this);
+    out.impl_ = std::move(impl);
+    return out;
 }
 
 glm::dvec3 LimitSurface::limitPosition(int32_t vertex) const {

@@ -25,6 +25,9 @@ struct LimitSurfaceOptions {
     // compared with 10 on a cage with unit edges and valence 3 and 5 vertices, a (u, v) lands up to 2e-3
     // away along the surface and 2e-6 off it. Each level adds a ring of patches per extraordinary vertex.
     int isolationLevel = 6;
+    // Keep the refined topology so that withPoints() can move the cage (a deformed copy of it) without
+    // rebuilding the patches. Costs the refiner's memory for the surface's lifetime.
+    bool deformable = false;
 };
 
 // A point of the limit surface with its first derivatives with respect to the Ptex face's (u, v).
@@ -88,6 +91,11 @@ class LimitSurface {
     // Limit position of cage vertex `vertex` (the cage position for a vertex no face uses). Throws
     // InvalidInput for an index out of range.
     [[nodiscard]] glm::dvec3 limitPosition(int32_t vertex) const;
+
+    // The same connectivity with the cage moved to `cage` (#V positions): patches, Ptex faces and locations
+    // are shared, control points and limit positions are recomputed. Requires options.deformable; throws
+    // InvalidInput for a wrong count.
+    [[nodiscard]] LimitSurface withPoints(std::span<const glm::vec3> cage) const;
 
   private:
     struct Impl;
