@@ -84,17 +84,25 @@ slide::SlideResult slideCommand(const SlideCommand& command) {
 }
 
 std::string slideSummary(const fs::path& out, const slide::SlideResult& result) {
-    return "wrote " + out.string() + ": moved " + std::to_string(result.moved) + ", boundary-stopped " +
-           std::to_string(result.boundaryStopped) + ", limit-stopped " + std::to_string(result.limitStopped) +
-           ", unreachable " + std::to_string(result.unreachable) + ", degenerate " +
-           std::to_string(result.degenerateTriangles);
+    std::string text =
+        "wrote " + out.string() + ": moved " + std::to_string(result.moved) + ", limited " +
+        std::to_string(result.limited) + " (boundary-stopped " + std::to_string(result.boundaryStopped) +
+        ", limit-stopped " + std::to_string(result.limitStopped) + "), flipped triangles " +
+        std::to_string(result.flippedTriangles) + ", unreachable " + std::to_string(result.unreachable) +
+        ", degenerate " + std::to_string(result.degenerateTriangles);
+    if (!result.foldScale.empty() && result.foldScale[0] < 1.0) {
+        std::ostringstream scale;
+        scale << result.foldScale[0];
+        text += ", fold limit: drag scaled to " + scale.str();
+    }
+    return text;
 }
 
 void addSlideCommand(CommandLine& cli) {
     struct Options {
         SlideCommand command;
         std::string mesh, out, from, to, falloff = "smooth", weights, weightsPtex, region = "euclidean",
-                                         surface = "cage";
+                                         surface = "cage", paintedWeights = "scale";
     };
     auto o = std::make_shared<Options>();
     Command slide = cli.add("slide", "Slide vertices over the surface around a handle (Pinskiy)", [o] {
@@ -109,6 +117,8 @@ void addSlideCommand(CommandLine& cli) {
         c.handle.region =
             o->region == "geodesic" ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean;
         c.options.surface = o->surface == "limit" ? slide::SurfaceMode::Limit : slide::SurfaceMode::Cage;
+        c.options.weights = o->paintedWeights == "falloff" ? slide::PaintedWeights::AreFalloff
+                                                           : slide::PaintedWeights::ScaleFalloff;
         const slide::SlideResult result = slideCommand(c);
         std::cout << slideSummary(o->out, result) << "\n";
         return 0;
@@ -125,6 +135,14 @@ void addSlideCommand(CommandLine& cli) {
     slide.option("--weights-ptex", o->weightsPtex,
                  "painted weights from a Ptex map of the mesh (per-vertex values)");
     slide.option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel").showDefault();
+    slide
+        .option("--painted-weights", o->paintedWeights,
+                "scale (weight x falloff) or falloff (the paper's: the weight is the falloff, the radius "
+                "only bounds the region)")
+        .choices({"scale", "falloff"})
+        .showDefault();
+    slide.flag("--fold-limit", o->command.options.foldLimit,
+               "scale the drag down so that no triangle of the region flips");
     slide.option("--envelope", o->command.envelope, "scales every slide").showDefault();
     slide.option("--region", o->region, "euclidean (3D distance) or geodesic (over the surface)")
         .choices({"euclidean", "geodesic"})

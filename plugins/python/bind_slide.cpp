@@ -43,8 +43,19 @@ const char* regionName(RegionMetric metric) {
     return metric == RegionMetric::Geodesic ? "geodesic" : "euclidean";
 }
 
-slide::SlideOptions optionsOf(const std::string& surface, int64_t maxWalk, const std::string& source) {
+slide::SlideOptions optionsOf(const std::string& surface, int64_t maxWalk, const std::string& paintedWeights,
+                              bool foldLimit, const std::string& source) {
     slide::SlideOptions o;
+    if (paintedWeights == "scale") {
+        o.weights = slide::PaintedWeights::ScaleFalloff;
+    } else if (paintedWeights == "falloff") {
+        o.weights = slide::PaintedWeights::AreFalloff;
+    } else {
+        throw InvalidInput(
+            formatError(source, "painted_weights", "is '" + paintedWeights + "'",
+                        "'scale' (weight x falloff) or 'falloff' (the weight is the falloff)"));
+    }
+    o.foldLimit = foldLimit;
     if (surface == "cage") {
         o.surface = SurfaceMode::Cage;
     } else if (surface == "limit") {
@@ -184,8 +195,9 @@ struct PySlideResult {
     py::array_t<float> points;
     py::array_t<int32_t> vertices, faces, triangles;
     py::array_t<double> barycentric;
-    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0, unreachable = 0, withoutTangentPlane = 0,
-            degenerateTriangles = 0;
+    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0, limited = 0, flippedTriangles = 0,
+            unreachable = 0, withoutTangentPlane = 0, degenerateTriangles = 0;
+    std::vector<double> foldScale;
 };
 
 PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& r) {
@@ -212,6 +224,9 @@ PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& 
     out.moved = r.moved;
     out.boundaryStopped = r.boundaryStopped;
     out.limitStopped = r.limitStopped;
+    out.limited = r.limited;
+    out.flippedTriangles = r.flippedTriangles;
+    out.foldScale = r.foldScale;
     out.unreachable = r.unreachable;
     out.withoutTangentPlane = r.withoutTangentPlane;
     out.degenerateTriangles = r.degenerateTriangles;
@@ -236,19 +251,21 @@ class PySlider {
     PySlider(const FloatArray& points, const IntArray& counts, const IntArray& indices,
              const std::optional<int64_t>& handle, const std::optional<double>& radius,
              const std::string& region, const std::optional<std::vector<py::dict>>& handles,
-             const std::string& surface, int64_t maxWalk) {
-        bind(points, counts, indices, handle, radius, region, handles, surface, maxWalk);
+             const std::string& surface, int64_t maxWalk, const std::string& paintedWeights, bool foldLimit) {
+        bind(points, counts, indices, handle, radius, region, handles, surface, maxWalk, paintedWeights,
+             foldLimit);
     }
 
     void bind(const FloatArray& points, const IntArray& counts, const IntArray& indices,
               const std::optional<int64_t>& handle, const std::optional<double>& radius,
               const std::string& region, const std::optional<std::vector<py::dict>>& handles,
-              const std::string& surface, int64_t maxWalk) {
+              const std::string& surface, int64_t maxWalk, const std::string& paintedWeights,
+              bool foldLimit) {
         const std::string source = "Slider";
         const geom::Mesh mesh =
             meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
         std::vector<SlideHandle> h = handlesOf(handle, radius, region, handles, source);
-        const slide::SlideOptions options = optionsOf(surface, maxWalk, source);
+        const slide::SlideOptions options = optionsOf(surface, maxWalk, paintedWeights, foldLimit, source);
         std::shared_ptr<Slider> bound;
         {
             py::gil_scoped_release release;
@@ -309,7 +326,7 @@ void bindSlide(py::module_& m) {
            const FloatArray& displacement, double radius, py::object falloff,
            const std::optional<FloatArray>& weights, float envelope, const std::string& region,
            const std::string& surface, const std::optional<std::filesystem::path>& weightsPtex,
-           int32_t weightsChannel) {
+           int32_t weightsChannel, const std::string& paintedWeights, bool foldLimit) {
             const std::string source = "slide";
             const geom::Mesh mesh =
                 meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
@@ -319,7 +336,7 @@ void bindSlide(py::module_& m) {
             }
             const std::vector<SlideHandle> handles = {
                 {vertexOf(handle, source, "handle"), radius, regionOf(region, source, "region")}};
-            const slide::SlideOptions options = optionsOf(surface, 4096, source);
+            const slide::SlideOptions options = optionsOf(surface, 4096, paintedWeights, foldLimit, source);
             const std::vector<SlideDrive> drives = {
                 {displacementsOf(displacement, 1, source)[0], falloffOf(falloff, source, "falloff")}};
             const std::vector<float> w =
@@ -337,6 +354,7 @@ void bindSlide(py::module_& m) {
         py::arg("displacement"), py::arg("radius"), py::arg("falloff") = "smooth",
         py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("region") = "euclidean",
         py::arg("surface") = "cage", py::arg("weights_ptex") = py::none(), py::arg("weights_channel") = 0,
+        py::arg("painted_weights") = "scale", py::arg("fold_limit") = false,
         "Slide vertices over the surface (Pinskiy, 'Sliding deformation'): the region within `radius` of "
         "the\n"
         "`handle` vertex moves by `displacement` (3,) times the falloff, along the surface, so the shape "
@@ -347,7 +365,10 @@ void bindSlide(py::module_& m) {
         "x = i / (n - 1) of distance / radius; weights (N,) painted, or weights_ptex: a Ptex file painted on "
         "the\n"
         "mesh (its per-vertex values of weights_channel); envelope scalar; region 'euclidean' or\n"
-        "'geodesic'; surface 'cage' or 'limit' (Catmull-Clark). Returns the slid points (N, 3) float32.");
+        "'geodesic'; surface 'cage' or 'limit' (Catmull-Clark); painted_weights 'scale' (weight x falloff) "
+        "or\n"
+        "'falloff' (the paper's: the weight is the falloff, the radius only bounds the region); fold_limit\n"
+        "scales the drag down so no triangle of the region flips. Returns the slid points (N, 3) float32.");
 
     py::class_<PySlideResult>(m, "SlideResult", "The slid points and, per moved vertex, where it landed.")
         .def_readonly("points", &PySlideResult::points, "(N, 3) float32 slid points")
@@ -364,6 +385,13 @@ void bindSlide(py::module_& m) {
                       "moved vertices that reached a mesh boundary and stopped on it")
         .def_readonly("limit_stopped", &PySlideResult::limitStopped,
                       "moved vertices stopped after max_walk_triangles triangles")
+        .def_readonly("limited", &PySlideResult::limited,
+                      "moved vertices that travelled less than asked (boundary_stopped + limit_stopped)")
+        .def_readonly("flipped_triangles", &PySlideResult::flippedTriangles,
+                      "triangles with a slid corner whose orientation reversed (a fold of the texture)")
+        .def_property_readonly(
+            "fold_scale", [](const PySlideResult& r) { return arrayOf<double>(r.foldScale); },
+            "(H,) float64 per handle: the share of its displacement applied (below 1 under the fold limit)")
         .def_readonly("unreachable", &PySlideResult::unreachable,
                       "vertices within a radius that the region's propagation cannot reach: unmoved")
         .def_readonly("without_tangent_plane", &PySlideResult::withoutTangentPlane,
@@ -373,7 +401,8 @@ void bindSlide(py::module_& m) {
         .def("__repr__", [](const PySlideResult& r) {
             return "<deformkit.SlideResult moved " + std::to_string(r.moved) + ", boundary_stopped " +
                    std::to_string(r.boundaryStopped) + ", limit_stopped " + std::to_string(r.limitStopped) +
-                   ", unreachable " + std::to_string(r.unreachable) + ", degenerate_triangles " +
+                   ", flipped_triangles " + std::to_string(r.flippedTriangles) + ", unreachable " +
+                   std::to_string(r.unreachable) + ", degenerate_triangles " +
                    std::to_string(r.degenerateTriangles) + ">";
         });
 
@@ -383,28 +412,33 @@ void bindSlide(py::module_& m) {
         "evaluated for many displacements.")
         .def(py::init<const FloatArray&, const IntArray&, const IntArray&, const std::optional<int64_t>&,
                       const std::optional<double>&, const std::string&,
-                      const std::optional<std::vector<py::dict>>&, const std::string&, int64_t>(),
+                      const std::optional<std::vector<py::dict>>&, const std::string&, int64_t,
+                      const std::string&, bool>(),
              py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
              py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
              py::arg("handles") = py::none(), py::arg("surface") = "cage",
-             py::arg("max_walk_triangles") = 4096,
+             py::arg("max_walk_triangles") = 4096, py::arg("painted_weights") = "scale",
+             py::arg("fold_limit") = false,
              "Bind to the rest mesh (points (N, 3), face_counts, face_indices) and one handle (handle, "
              "radius,\n"
              "region) or several: handles=[{'vertex': i, 'radius': r, 'region': 'geodesic'}, ...] ('region'\n"
              "optional, default 'euclidean'). surface 'cage' or 'limit'; max_walk_triangles bounds one "
              "vertex's\n"
-             "walk in one evaluation.")
+             "walk in one evaluation. painted_weights 'scale' or 'falloff' (the paper's rule); fold_limit\n"
+             "scales each drag down so no triangle of its region flips.")
         .def("bind", &PySlider::bind, py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
              py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
              py::arg("handles") = py::none(), py::arg("surface") = "cage",
-             py::arg("max_walk_triangles") = 4096,
+             py::arg("max_walk_triangles") = 4096, py::arg("painted_weights") = "scale",
+             py::arg("fold_limit") = false,
              "Bind again, to a new rest mesh or handle set; arguments as the constructor.")
         .def(
             "evaluate", &PySlider::evaluate, py::arg("displacement"), py::arg("falloff") = "smooth",
             py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("points") = py::none(),
             "Slide for displacement (3,) (one handle) or (H, 3) (one row per handle); falloff one value for\n"
-            "every handle or a list of one per handle; weights (N,), envelope scalar; points (N, 3) to move\n"
-            "(default: the rest points). Returns a SlideResult.")
+            "every handle or a list of one per handle; weights (N,), envelope scalar; points (N, 3): the\n"
+            "surface to slide over, a deformed copy of the rest mesh (default: the rest points), with\n"
+            "displacement in its space. Returns a SlideResult.")
         .def_property_readonly("num_vertices", [](const PySlider& s) { return s.slider().numVertices(); })
         .def_property_readonly("num_handles", [](const PySlider& s) { return s.slider().numHandles(); })
         .def_property_readonly(

@@ -161,7 +161,7 @@ awk 'BEGIN {
 }' >"$work/grid.obj"
 expect slide 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --out "$work/slid.obj"
 contains slide "$work/out" "wrote $work/slid.obj: moved "
-contains slide "$work/out" "boundary-stopped 0, limit-stopped 0, unreachable 0, degenerate 0"
+contains slide "$work/out" "limited 0 (boundary-stopped 0, limit-stopped 0), flipped triangles 0, unreachable 0, degenerate 0"
 [ "$(wc -l <"$work/out")" -eq 1 ] || { echo "FAIL slide: expected one summary line"; failures=$((failures + 1)); }
 [ "$(grep -c '^vt ' "$work/slid.obj")" -eq 121 ] || { echo "FAIL slide-uvs: UVs not kept"; failures=$((failures + 1)); }
 contains slide-group "$work/slid.obj" "g sheet"
@@ -185,6 +185,22 @@ expect slide-missing-mesh 2 "$dk" slide "$work/nope.obj" --handle 0 --from 0,0,0
 contains slide-missing-mesh "$work/err" "nope.obj"
 [ ! -e "$work/s2.obj" ] || { echo "FAIL slide errors: output written"; failures=$((failures + 1)); }
 expect slide-options 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0.05,0 --radius 0.3 --falloff 1,0.5,0 --envelope 0.5 --region geodesic --surface limit --max-walk 64 --out "$work/s3.obj"
+# A drag of the whole radius folds the smooth falloff (it folds past r / 1.5): counted, and --fold-limit scales
+# the drag to about 2/3 so nothing flips.
+expect slide-folds 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.3,0,0 --radius 0.3 --out "$work/s4.obj"
+if grep -qF "flipped triangles 0," "$work/out"; then
+    echo "FAIL slide-folds: no flipped triangle counted"; cat "$work/out"; failures=$((failures + 1))
+fi
+expect slide-fold-limit 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.3,0,0 --radius 0.3 --fold-limit --out "$work/s4.obj"
+contains slide-fold-limit "$work/out" "flipped triangles 0,"
+contains slide-fold-limit "$work/out" "fold limit: drag scaled to 0.6"
+# The paper's rule: a weight of 1 everywhere is the falloff, so vertex 61 moves the whole 0.1 (x = 0.7).
+awk 'BEGIN { printf "["; for (i = 0; i < 121; i++) printf "%s1", (i ? ", " : ""); print "]" }' >"$work/ones.json"
+expect slide-painted 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --weights "$work/ones.json" --painted-weights falloff --out "$work/s5.obj"
+awk 'NR > 0 && /^v / { n++; if (n == 62) { d = $2 - 0.7; if (d < 0) d = -d; exit !(d < 1e-6) } }' "$work/s5.obj" ||
+    { echo "FAIL slide-painted: vertex 61 is not at x = 0.7"; failures=$((failures + 1)); }
+expect slide-bad-painted 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --painted-weights paper --out "$work/s5.obj"
+contains slide-bad-painted "$work/err" "--painted-weights"
 
 # UV warp over a 2-frame shot of the grid (UVs in tile 1001) with the demo's 64 x 64 rigidity map: frame 1 is the
 # rest pose, frame 2 stretches 1.5x along x.

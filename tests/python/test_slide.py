@@ -144,11 +144,50 @@ def test_slider_evaluates_again_and_moves_given_points():
     f = smoothstep_falloff(distances(pts, HANDLE) / 0.6)
     np.testing.assert_allclose(slider.evaluate(d1).points, pts + f[:, None] * d1, atol=TOL)
     np.testing.assert_allclose(slider.evaluate(d2, envelope=0.5).points, pts + 0.5 * f[:, None] * d2, atol=TOL)
-    # points: the slide (landing - rest) is added to what is given, e.g. the output of an earlier deformer.
+    # points: the surface to slide over, e.g. the output of an earlier deformer; lifted, it slides lifted.
     lifted = pts + np.float32([0, 0, 1])
     np.testing.assert_allclose(slider.evaluate(d1, points=lifted).points, lifted + f[:, None] * d1, atol=TOL)
     np.testing.assert_array_equal(slider.evaluate(np.zeros(3, np.float32)).points, pts)
     np.testing.assert_allclose(dk.slide(pts, counts, idx, HANDLE, d1, 0.6), slider.evaluate(d1).points, atol=0)
+
+
+def test_slider_slides_over_the_points_it_is_given():
+    """Equivariance: over the rest plane turned by R and moved by t, a drag d slides like R^T d at rest, turned
+    and moved: the drag is read in the space of the given points and the result lies on them."""
+    pts, counts, idx = plane()
+    slider = dk.Slider(pts, counts, idx, handle=HANDLE, radius=0.6)
+    t = np.array([0.4, -1.0, 2.0])
+    moved = (pts.astype(np.float64) @ ROT.T + t).astype(np.float32)
+    d = ROT @ np.array([0.05, 0.03, 0.0])
+    over = slider.evaluate(d.astype(np.float32), points=moved)
+    at_rest = slider.evaluate((ROT.T @ d).astype(np.float32))
+    np.testing.assert_allclose(over.points, at_rest.points.astype(np.float64) @ ROT.T + t, atol=5e-6)
+    # On the given surface: the landing's barycentric combination of the given points.
+    rebuilt = np.einsum("mk,mkc->mc", over.barycentric, moved[over.triangles].astype(np.float64))
+    np.testing.assert_allclose(rebuilt, over.points[over.vertices], atol=1e-6)
+
+
+def test_painted_weights_rule_fold_count_and_fold_limit():
+    pts, counts, idx = plane()
+    w = np.clip(0.2 + 0.3 * pts[:, 0], 0, 1).astype(np.float32)
+    d = np.array([0.05, 0.03, 0.0], dtype=np.float32)
+    inside = distances(pts, HANDLE) <= 0.6
+    # The paper's rule: the weight is the falloff inside the radius.
+    out = dk.slide(pts, counts, idx, HANDLE, d, 0.6, weights=w, painted_weights="falloff")
+    np.testing.assert_allclose(out, pts + (w * inside)[:, None] * d, atol=TOL)
+    out = dk.slide(pts, counts, idx, HANDLE, d, 0.6, weights=w)  # default: weight x falloff
+    np.testing.assert_allclose(out, pts + (w * smoothstep_falloff(distances(pts, HANDLE) / 0.6))[:, None] * d,
+                               atol=TOL)
+    with pytest.raises(dk.InvalidInput, match="painted_weights"):
+        dk.slide(pts, counts, idx, HANDLE, d, 0.6, painted_weights="paper")
+    # A drag of 0.8 r folds the smooth falloff (it folds past r / 1.5); the fold limit scales it to about 0.833.
+    big = np.array([0.48, 0.0, 0.0], dtype=np.float32)
+    r = dk.Slider(pts, counts, idx, handle=HANDLE, radius=0.6).evaluate(big)
+    assert r.flipped_triangles > 0 and r.limited == 0
+    np.testing.assert_array_equal(r.fold_scale, [1.0])
+    r = dk.Slider(pts, counts, idx, handle=HANDLE, radius=0.6, fold_limit=True).evaluate(big)
+    assert r.flipped_triangles == 0
+    assert r.fold_scale.shape == (1,) and abs(r.fold_scale[0] - 0.4 / 0.48) < 0.04
 
 
 def test_several_handles_add_their_slides():

@@ -41,8 +41,10 @@ constexpr std::array kTypes = {
         detail::makeMeshWarpDeformer},
     DeformerType{
         "slide",
-        "Pinskiy's sliding deformer with one handle (slide/slider.h). Weights and envelope scale the "
-        "tangent displacement before the walk, so slid vertices stay on the rest surface.",
+        "Pinskiy's sliding deformer with one handle (slide/slider.h). It slides over the surface it "
+        "receives (the deformed output of the deformers before it), with the displacement in that space; "
+        "weights and envelope scale the tangent displacement before the walk, so slid vertices stay on "
+        "that surface.",
         detail::makeSlideDeformer},
     DeformerType{
         "taper",

@@ -4,7 +4,11 @@
 #include <cmath>
 #include <mutex>
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
@@ -23,6 +27,21 @@ struct Landing {
     int32_t triangle = -1;
     glm::dvec3 barycentric{0.0};  // on the triangle's corners 3t, 3t+1, 3t+2
     Stop stop = Stop::None;
+};
+
+// The Catmull-Clark limit surface over the part of the mesh the slide can reach: the faces landings may
+// fall on ("covered") and every face sharing a vertex with them, so that the patches of covered faces see
+// their whole one-ring and equal those of the whole mesh. Grows when a landing leaves the covered faces.
+struct LocalLimit {
+    std::vector<int32_t> vertexFaceOffsets, vertexFaces;  // the mesh's faces at each vertex (CSR)
+    std::vector<uint8_t> covered;                         // per mesh face
+    std::vector<int32_t> localFace;                       // per mesh face: its face in the part, or -1
+    std::vector<int32_t> vertices;                        // the part's vertices (mesh indices), ascending
+    std::vector<int32_t> localVertex;                     // per mesh vertex: its vertex in the part, or -1
+    std::unique_ptr<geom::LimitSurface> rest;             // over the rest positions
+    std::unique_ptr<geom::LimitSurface> incoming;         // over the last incoming positions
+    std::vector<glm::vec3> incomingCage;                  // those positions, per part vertex
+    const geom::LimitSurface* current = nullptr;          // rest or incoming, for this evaluation
 };
 
 }  // namespace detail
@@ -81,8 +100,13 @@ struct Slider::Impl {
     std::vector<int32_t> active;                    // union of active vertices, ascending
     std::vector<glm::dvec2> displacement;           // per slot: d_P in the vertex's basis (Eq. 7), scratch
     std::vector<Landing> landings;                  // per slot, scratch
-    std::unique_ptr<geom::LimitSurface> limit;
-    std::vector<glm::dvec3> limitOrigin;  // per slot: the limit point under the vertex's rest position
+    std::vector<int32_t> slotOf;                    // per vertex: its slot in `active`, -1 when inactive
+    std::vector<glm::dvec3> slid;                   // per slot: the slid position, scratch
+    // Triangles with an active corner (not degenerate at rest), ascending: where folds are counted. Per
+    // handle: the triangles with a corner in its region.
+    std::vector<int32_t> regionTriangles;
+    std::vector<std::vector<int32_t>> handleTriangles;
+    std::unique_ptr<detail::LocalLimit> limit;
     int32_t degenerateTriangles = 0;
     std::mutex mutex;
 
@@ -308,7 +332,269 @@ struct Slider::Impl {
         }
         for (int k = 0; k < 3; ++k)
             weights[surface.faceCorner(3 * t + k) - offset] += landing.barycentric[k];
-        return limit->evaluate(f, weights);
+        return limit->current->evaluate(limit->localFace[f], weights);
+    }
+
+    // The limit point under vertex v, taken through the same face evaluation as its landings so that a
+    // vanishing slide moves it by a vanishing amount.
+    glm::dvec3 limitOrigin(int32_t v) const {
+        return limitPoint(onEdge(surface.vertexCorners(v)[0], 0.0, Stop::Reached));
+    }
+
+    // (Re)builds the limit surface of the covered faces and their one-ring of faces.
+    void buildLocalLimit() {
+        detail::LocalLimit& L = *limit;
+        std::vector<uint8_t> inPart(L.covered.size(), 0);
+        for (size_t f = 0; f < L.covered.size(); ++f) {
+            if (!L.covered[f]) continue;
+            for (int32_t v : mesh.face(static_cast<int32_t>(f))) {
+                for (int32_t k = L.vertexFaceOffsets[v]; k < L.vertexFaceOffsets[v + 1]; ++k)
+                    inPart[L.vertexFaces[k]] = 1;
+            }
+        }
+        geom::Mesh::Data data;
+        std::fill(L.localFace.begin(), L.localFace.end(), -1);
+        std::fill(L.localVertex.begin(), L.localVertex.end(), -1);
+        L.vertices.clear();
+        for (size_t f = 0; f < inPart.size(); ++f) {
+            if (!inPart[f]) continue;
+            L.localFace[f] = static_cast<int32_t>(data.faceCounts.size());
+            const auto corners = mesh.face(static_cast<int32_t>(f));
+            data.faceCounts.push_back(static_cast<int32_t>(corners.size()));
+            for (int32_t v : corners) {
+                data.faceIndices.push_back(v);
+                L.localVertex[v] = 0;
+            }
+        }
+        // Vertices in ascending mesh order, so a face's neighbourhood is ordered alike in every part that
+        // holds it: its limit patch comes out bit for bit the same however far the part has grown.
+        for (int32_t v = 0; v < mesh.numVertices(); ++v) {
+            if (L.localVertex[v] < 0) continue;
+            L.localVertex[v] = static_cast<int32_t>(L.vertices.size());
+            L.vertices.push_back(v);
+            data.points.push_back(mesh.points()[v]);
+        }
+        for (int32_t& v : data.faceIndices)
+            v = L.localVertex[v];
+        geom::LimitSurfaceOptions options;
+        options.deformable = true;
+        L.rest = std::make_unique<geom::LimitSurface>(geom::Mesh(std::move(data), source), options, source);
+        L.incoming.reset();
+        L.incomingCage.clear();
+        L.current = L.rest.get();
+    }
+
+    void bindLimit() {
+        limit = std::make_unique<detail::LocalLimit>();
+        detail::LocalLimit& L = *limit;
+        const int32_t nv = mesh.numVertices(), nf = mesh.numFaces();
+        L.vertexFaceOffsets.assign(nv + 1, 0);
+        for (int32_t v : mesh.faceIndices())
+            ++L.vertexFaceOffsets[v + 1];
+        for (int32_t v = 0; v < nv; ++v)
+            L.vertexFaceOffsets[v + 1] += L.vertexFaceOffsets[v];
+        L.vertexFaces.resize(mesh.faceIndices().size());
+        std::vector<int32_t> fill(L.vertexFaceOffsets.begin(), L.vertexFaceOffsets.end() - 1);
+        for (int32_t f = 0; f < nf; ++f) {
+            for (int32_t v : mesh.face(f))
+                L.vertexFaces[fill[v]++] = f;
+        }
+        L.covered.assign(nf, 0);
+        L.localFace.assign(nf, -1);
+        L.localVertex.assign(nv, -1);
+        for (int32_t v : active) {
+            for (int32_t k = L.vertexFaceOffsets[v]; k < L.vertexFaceOffsets[v + 1]; ++k)
+                L.covered[L.vertexFaces[k]] = 1;
+        }
+        buildLocalLimit();
+    }
+
+    // Makes every landing's face covered, growing the limit part when one is not; true when it grew.
+    bool coverLandings() {
+        bool grew = false;
+        for (const Landing& landing : landings) {
+            if (landing.stop == Stop::None) continue;
+            const int32_t f = surface.face(landing.triangle);
+            if (!limit->covered[f]) {
+                limit->covered[f] = 1;
+                grew = true;
+            }
+        }
+        if (grew) buildLocalLimit();
+        return grew;
+    }
+
+    // The limit surface over the incoming positions: the rest one when they equal the rest positions on
+    // the part, the last one when they have not changed since.
+    void prepareLimit(std::span<const glm::vec3> in) {
+        detail::LocalLimit& L = *limit;
+        bool atRest = true;
+        for (int32_t v : L.vertices)
+            atRest = atRest && in[v] == mesh.points()[v];
+        if (atRest) {
+            L.current = L.rest.get();
+            return;
+        }
+        bool same = L.incoming && L.incomingCage.size() == L.vertices.size();
+        for (size_t i = 0; same && i < L.vertices.size(); ++i)
+            same = L.incomingCage[i] == in[L.vertices[i]];
+        if (!same) {
+            L.incomingCage.resize(L.vertices.size());
+            for (size_t i = 0; i < L.vertices.size(); ++i)
+                L.incomingCage[i] = in[L.vertices[i]];
+            L.incoming = std::make_unique<geom::LimitSurface>(L.rest->withPoints(L.incomingCage));
+        }
+        L.current = L.incoming.get();
+    }
+
+    // The rotation carrying handle h's rest frame to the incoming surface: the best rotation (Kabsch) of
+    // its one-ring edges and its normal, scaled to the ring, rest onto incoming. Identity when the ring did
+    // not move; exactly R for a ring moved rigidly by (R, t) up to rounding.
+    glm::dmat3 handleRotation(size_t h, std::span<const glm::vec3> in) const {
+        const int32_t p = handles[h].vertex;
+        bool moved = in[p] != mesh.points()[p];
+        for (int32_t q : surface.neighbors(p))
+            moved = moved || in[q] != mesh.points()[q];
+        if (!moved) return glm::dmat3(1.0);
+        const glm::dvec3 p0 = surface.point(p), p1(in[p]);
+        Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+        double scale2 = 0.0;
+        for (int32_t q : surface.neighbors(p)) {
+            const glm::dvec3 e = surface.point(q) - p0, f = glm::dvec3(in[q]) - p1;
+            H += Eigen::Vector3d(e.x, e.y, e.z) * Eigen::Vector3d(f.x, f.y, f.z).transpose();
+            scale2 += glm::dot(e, e);
+        }
+        glm::dvec3 normal(0.0);  // area-weighted incoming normal
+        for (int32_t c : surface.vertexCorners(p)) {
+            const glm::dvec3 a(in[surface.vertex(c)]), b(in[surface.vertex(SlideSurface::next(c))]),
+                d(in[surface.vertex(SlideSurface::prev(c))]);
+            normal += glm::cross(b - a, d - a);
+        }
+        const double length = glm::length(normal);
+        if (length > 0.0) {
+            const glm::dvec3 n0 = surface.normal(p) * std::sqrt(scale2),
+                             n1 = normal / length * std::sqrt(scale2);
+            H += Eigen::Vector3d(n0.x, n0.y, n0.z) * Eigen::Vector3d(n1.x, n1.y, n1.z).transpose();
+        }
+        const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        Eigen::Matrix3d R = svd.matrixV() * svd.matrixU().transpose();
+        if (R.determinant() < 0.0) {
+            Eigen::Matrix3d V = svd.matrixV();
+            V.col(2) = -V.col(2);
+            R = V * svd.matrixU().transpose();
+        }
+        glm::dmat3 out(1.0);
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c)
+                out[c][r] = R(r, c);  // glm is column-major
+        }
+        return out;
+    }
+
+    struct Counts {
+        int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
+    };
+
+    // One slide: the tangent displacements of every handle's rest-frame displacement times its scale
+    // (Eq. 5-7), the walks, and the slid position of every moved vertex over the incoming points `in`.
+    Counts slideOnce(std::span<const glm::dvec3> restDisplacement, std::span<const double> scales,
+                     std::span<const SlideDrive> drives, std::span<const glm::vec3> in,
+                     std::span<const float> weights, double envelope) {
+        std::fill(displacement.begin(), displacement.end(), glm::dvec2(0.0));
+        for (size_t h = 0; h < regions.size(); ++h) {
+            if (scales[h] == 0.0) continue;
+            const SupportRegion& region = regions[h];
+            const std::vector<int32_t>& slots = regionSlots[h];
+            const double s = scales[h] * glm::dot(restDisplacement[h], region.a1);
+            const double t = scales[h] * glm::dot(restDisplacement[h], region.a2);
+            const Falloff& falloff = drives[h].falloff;
+            const bool painted = options.weights == PaintedWeights::AreFalloff;
+            const auto count = static_cast<int32_t>(region.vertices.size());
+#pragma omp parallel for schedule(static)
+            for (int32_t k = 0; k < count; ++k) {
+                const double f = painted ? 1.0 : falloff(region.normalizedDistance[k]);
+                if (f != 0.0) displacement[slots[k]] += f * (s * region.a1Local[k] + t * region.a2Local[k]);
+            }
+        }
+
+        const auto count = static_cast<int32_t>(active.size());
+        Counts counts;
+        int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, limitStopped)
+        for (int32_t i = 0; i < count; ++i) {
+            const int32_t v = active[i];
+            const double scale = (weights.empty() ? 1.0 : static_cast<double>(weights[v])) * envelope;
+            const glm::dvec2 target = displacement[i] * scale;
+            Landing& landing = landings[i];
+            landing = Landing{};
+            if (target.x == 0.0 && target.y == 0.0) continue;
+            landing = walk(i, v, target);
+            ++moved;
+            boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
+            limitStopped += landing.stop == Stop::Limit ? 1 : 0;
+        }
+        counts = {moved, boundaryStopped, limitStopped};
+
+        if (limit) {
+            coverLandings();
+            prepareLimit(in);
+        }
+#pragma omp parallel for schedule(dynamic, 256)
+        for (int32_t i = 0; i < count; ++i) {
+            const Landing& landing = landings[i];
+            if (landing.stop == Stop::None) continue;
+            const int32_t v = active[i];
+            if (limit) {
+                slid[i] = glm::dvec3(in[v]) + (limitPoint(landing) - limitOrigin(v));
+            } else {
+                const int32_t t = landing.triangle;
+                slid[i] = landing.barycentric.x * glm::dvec3(in[surface.vertex(3 * t)]) +
+                          landing.barycentric.y * glm::dvec3(in[surface.vertex(3 * t + 1)]) +
+                          landing.barycentric.z * glm::dvec3(in[surface.vertex(3 * t + 2)]);
+            }
+        }
+        return counts;
+    }
+
+    glm::dvec3 slidPoint(int32_t v, std::span<const glm::vec3> in) const {
+        const int32_t i = slotOf[v];
+        return i >= 0 && landings[i].stop != Stop::None ? glm::vec3(slid[i]) : in[v];
+    }
+
+    // Triangles of `triangles` whose orientation after the slide opposes the incoming one.
+    int32_t countFlips(std::span<const int32_t> triangles, std::span<const glm::vec3> in) const {
+        const auto count = static_cast<int32_t>(triangles.size());
+        int32_t flipped = 0;
+#pragma omp parallel for schedule(static) reduction(+ : flipped)
+        for (int32_t k = 0; k < count; ++k) {
+            const int32_t t = triangles[k];
+            const int32_t a = surface.vertex(3 * t), b = surface.vertex(3 * t + 1),
+                          c = surface.vertex(3 * t + 2);
+            const glm::dvec3 before =
+                glm::cross(glm::dvec3(in[b]) - glm::dvec3(in[a]), glm::dvec3(in[c]) - glm::dvec3(in[a]));
+            const glm::dvec3 pa = slidPoint(a, in);
+            const glm::dvec3 after = glm::cross(slidPoint(b, in) - pa, slidPoint(c, in) - pa);
+            if (glm::dot(before, before) > 0.0 && glm::dot(before, after) <= 0.0) ++flipped;
+        }
+        return flipped;
+    }
+
+    // The largest scale in [0, 1] (to 2^-kSteps) at which slideOnce with scales `base` times it flips no
+    // triangle of `triangles`; 0 moves nothing, so it never flips.
+    double foldLimitScale(std::span<const glm::dvec3> restDisplacement, std::vector<double> base,
+                          std::span<const int32_t> triangles, std::span<const SlideDrive> drives,
+                          std::span<const glm::vec3> in, std::span<const float> weights, double envelope) {
+        constexpr int kSteps = 14;
+        double lo = 0.0, hi = 1.0;
+        std::vector<double> scales(base.size());
+        for (int step = 0; step < kSteps; ++step) {
+            const double mid = 0.5 * (lo + hi);
+            for (size_t h = 0; h < base.size(); ++h)
+                scales[h] = base[h] * mid;
+            slideOnce(restDisplacement, scales, drives, in, weights, envelope);
+            (countFlips(triangles, in) == 0 ? lo : hi) = mid;
+        }
+        return lo;
     }
 };
 
@@ -418,20 +704,30 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
         }
     }
 
-    if (options.surface == SurfaceMode::Limit) {
-        m.limit = std::make_unique<geom::LimitSurface>(rest, geom::LimitSurfaceOptions{}, source);
-        m.limitOrigin.resize(m.active.size());
-        const auto count = static_cast<int32_t>(m.active.size());
-#pragma omp parallel for schedule(static)
-        for (int32_t i = 0; i < count; ++i) {
-            const int32_t v = m.active[i];
-            // The limit point under the vertex, taken through the same face evaluation as its landings so
-            // that a vanishing slide moves it by a vanishing amount.
-            const int32_t c = m.surface.vertexCorners(v)[0];
-            Landing atVertex = onEdge(c, 0.0, Stop::Reached);
-            m.limitOrigin[i] = m.limitPoint(atVertex);
+    m.slid.resize(m.active.size());
+    m.slotOf = std::move(slotOf);
+    {
+        std::vector<uint8_t> inRegion(m.surface.numTriangles(), 0);
+        for (const SupportRegion& region : m.regions) {
+            std::vector<int32_t> triangles;
+            for (int32_t v : region.vertices) {
+                for (int32_t c : m.surface.vertexCorners(v)) {
+                    const int32_t t = SlideSurface::triangleOf(c);
+                    if (!m.surface.isDegenerate(t)) triangles.push_back(t);
+                }
+            }
+            std::sort(triangles.begin(), triangles.end());
+            triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+            for (int32_t t : triangles)
+                inRegion[t] = 1;
+            m.handleTriangles.push_back(std::move(triangles));
+        }
+        for (int32_t t = 0; t < m.surface.numTriangles(); ++t) {
+            if (inRegion[t]) m.regionTriangles.push_back(t);
         }
     }
+
+    if (options.surface == SurfaceMode::Limit) m.bindLimit();
 }
 
 Slider::~Slider() = default;
@@ -489,40 +785,52 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
             formatError(m.source, "envelope", "not finite", "a finite envelope, normally in [0, 1]"));
     }
 
-    // Eq. 5-7: every handle's (s, t) carried by its region basis, summed per vertex.
-    std::fill(m.displacement.begin(), m.displacement.end(), glm::dvec2(0.0));
-    for (size_t h = 0; h < m.regions.size(); ++h) {
-        const SupportRegion& region = m.regions[h];
-        const std::vector<int32_t>& slots = m.regionSlots[h];
-        const double s = glm::dot(drives[h].displacement, region.a1);
-        const double t = glm::dot(drives[h].displacement, region.a2);
-        const Falloff& falloff = drives[h].falloff;
-        const auto count = static_cast<int32_t>(region.vertices.size());
-#pragma omp parallel for schedule(static)
-        for (int32_t k = 0; k < count; ++k) {
-            const double f = falloff(region.normalizedDistance[k]);
-            if (f != 0.0) m.displacement[slots[k]] += f * (s * region.a1Local[k] + t * region.a2Local[k]);
+    for (size_t i = 0; i < points.size(); ++i) {
+        const glm::vec3& p = points[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(i), "not finite",
+                                           "finite x, y, z"));
+        }
+    }
+
+    // The incoming points, read while `points` is written.
+    const std::vector<glm::vec3> in(points.begin(), points.end());
+    // Each handle's displacement in its rest frame (the identity when its one-ring is at rest).
+    std::vector<glm::dvec3> restDisplacement(drives.size());
+    for (size_t h = 0; h < drives.size(); ++h)
+        restDisplacement[h] = glm::transpose(m.handleRotation(h, in)) * drives[h].displacement;
+
+    const auto numHandles = m.handles.size();
+    std::vector<double> scales(numHandles, 1.0);
+    Impl::Counts counts = m.slideOnce(restDisplacement, scales, drives, in, weights, envelope);
+    int32_t flipped = m.countFlips(m.regionTriangles, in);
+    if (m.options.foldLimit && flipped > 0) {
+        // Each handle alone first (its own region), then all together while overlapping regions still fold.
+        for (size_t h = 0; h < numHandles; ++h) {
+            std::vector<double> alone(numHandles, 0.0);
+            alone[h] = 1.0;
+            if (numHandles > 1) {
+                m.slideOnce(restDisplacement, alone, drives, in, weights, envelope);
+                if (m.countFlips(m.handleTriangles[h], in) == 0) continue;
+            }
+            scales[h] = m.foldLimitScale(restDisplacement, alone, m.handleTriangles[h], drives, in, weights,
+                                         envelope);
+        }
+        counts = m.slideOnce(restDisplacement, scales, drives, in, weights, envelope);
+        flipped = m.countFlips(m.regionTriangles, in);
+        if (flipped > 0) {
+            const double common =
+                m.foldLimitScale(restDisplacement, scales, m.regionTriangles, drives, in, weights, envelope);
+            for (double& scale : scales)
+                scale *= common;
+            counts = m.slideOnce(restDisplacement, scales, drives, in, weights, envelope);
+            flipped = m.countFlips(m.regionTriangles, in);
         }
     }
 
     const auto count = static_cast<int32_t>(m.active.size());
-    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, limitStopped)
     for (int32_t i = 0; i < count; ++i) {
-        const int32_t v = m.active[i];
-        const double scale =
-            (weights.empty() ? 1.0 : static_cast<double>(weights[v])) * static_cast<double>(envelope);
-        const glm::dvec2 target = m.displacement[i] * scale;
-        Landing& landing = m.landings[i];
-        landing = Landing{};
-        if (target.x == 0.0 && target.y == 0.0) continue;
-        landing = m.walk(i, v, target);
-        ++moved;
-        boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
-        limitStopped += landing.stop == Stop::Limit ? 1 : 0;
-        const glm::dvec3 offset =
-            m.limit ? m.limitPoint(landing) - m.limitOrigin[i] : m.cagePoint(landing) - m.surface.point(v);
-        points[v] = glm::vec3(glm::dvec3(points[v]) + offset);
+        if (m.landings[i].stop != Stop::None) points[m.active[i]] = glm::vec3(m.slid[i]);
     }
 
     if (result) {
@@ -539,9 +847,12 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
             }
             result->landings.push_back(out);
         }
-        result->moved = moved;
-        result->boundaryStopped = boundaryStopped;
-        result->limitStopped = limitStopped;
+        result->moved = counts.moved;
+        result->boundaryStopped = counts.boundaryStopped;
+        result->limitStopped = counts.limitStopped;
+        result->limited = counts.boundaryStopped + counts.limitStopped;
+        result->flippedTriangles = flipped;
+        result->foldScale = scales;
         result->unreachable = 0;
         result->withoutTangentPlane = 0;
         for (const SupportRegion& region : m.regions) {

@@ -156,6 +156,7 @@ def entry_parameters(obj, entry, depsgraph=None):
         a = local_matrix(obj, start, depsgraph)[:3, 3]
         b = local_matrix(obj, end, depsgraph)[:3, 3]
         return [("vertex", entry.vertex), ("radius", entry.radius), ("geodesic", int(entry.geodesic)),
+                ("paintedWeights", int(entry.weights_are_falloff)), ("foldLimit", int(entry.fold_limit)),
                 ("falloff", int(entry.falloff)), ("displacement", b - a)]
     if t in ("taper", "twist", "bend"):
         m = local_matrix(obj, _need(entry, "frame", "handle Empty"), depsgraph)

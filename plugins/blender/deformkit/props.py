@@ -58,6 +58,11 @@ class DeformKitEntry(bpy.types.PropertyGroup):
     geodesic: BoolProperty(name="Geodesic", description="Measure the region over the surface", default=True,
                            update=_evaluate)
     falloff: EnumProperty(name="Falloff", items=[("0", "Smooth", ""), ("1", "Linear", "")], update=_evaluate)
+    weights_are_falloff: BoolProperty(name="Weights Are Falloff", default=False, update=_evaluate,
+                                      description="The painted weights are the falloff (the paper's rule; the "
+                                      "radius only bounds the region) instead of scaling it")
+    fold_limit: BoolProperty(name="Fold Limit", default=False, update=_evaluate,
+                             description="Scale the drag down so that no triangle of the region flips")
     start: PointerProperty(name="Start", type=bpy.types.Object, poll=_poll_empty, update=_evaluate,
                            description="Start locator (the handle's rest position)")
     end: PointerProperty(name="End", type=bpy.types.Object, poll=_poll_empty, update=_evaluate,

@@ -35,6 +35,8 @@ def _draw_entry(layout, obj, entry):
         col.prop(entry, "radius")
         col.prop(entry, "geodesic")
         col.prop(entry, "falloff")
+        col.prop(entry, "weights_are_falloff")
+        col.prop(entry, "fold_limit")
     elif t in ("taper", "twist", "bend"):
         col.prop(entry, "frame")
         if t == "bend":

@@ -116,6 +116,8 @@ Parameters slideParameters(const SlideInputs& in) {
             {"radius", {in.radius}},
             {"geodesic", {in.geodesic ? 1.0 : 0.0}},
             {"limitSurface", {in.limitSurface ? 1.0 : 0.0}},
+            {"paintedWeights", {in.weightsAreFalloff ? 1.0 : 0.0}},
+            {"foldLimit", {in.foldLimit ? 1.0 : 0.0}},
             {"falloff", {2.0}},
             {"falloffRamp", sampleRamp(in.falloff, in.rampSamples)},
             {"displacement", flat(d)}};

@@ -55,6 +55,8 @@ struct SlideInputs {
     double radius = 1.0;
     bool geodesic = true;
     bool limitSurface = false;
+    bool weightsAreFalloff = false;  // the paper's rule: the painted weights are the falloff
+    bool foldLimit = false;          // scale the drag down so no triangle of the region flips
     std::vector<RampKey> falloff{{0.0, 1.0, 2}, {1.0, 0.0, 2}};
     int rampSamples = 33;
     glm::dvec3 startWorld{0.0};

@@ -147,19 +147,23 @@ MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& 
 
 const MTypeId DkSlide::id(0x0013A6C0);
 MObject DkSlide::rebind, DkSlide::vertex, DkSlide::radius, DkSlide::geodesic, DkSlide::limitSurface,
-    DkSlide::falloff, DkSlide::startMatrix, DkSlide::endMatrix;
+    DkSlide::weightsAreFalloff, DkSlide::foldLimit, DkSlide::falloff, DkSlide::startMatrix,
+    DkSlide::endMatrix;
 
 MStatus DkSlide::initialize() {
     addNumeric(vertex, "vertex", "vtx", MFnNumericData::kInt, 0.0, false);
     addNumeric(radius, "radius", "rad", MFnNumericData::kDouble, 1.0);
     addNumeric(geodesic, "geodesic", "geo", MFnNumericData::kBoolean, 1.0);
     addNumeric(limitSurface, "limitSurface", "lsf", MFnNumericData::kBoolean, 0.0);
+    addNumeric(weightsAreFalloff, "weightsAreFalloff", "waf", MFnNumericData::kBoolean, 0.0);
+    addNumeric(foldLimit, "foldLimit", "fdl", MFnNumericData::kBoolean, 0.0);
     falloff = MRampAttribute::createCurveRamp("falloff", "fof");
     addAttribute(falloff);
     addMatrix(startMatrix, "startMatrix", "stm");
     addMatrix(endMatrix, "endMatrix", "enm");
     addRebindAttribute(rebind);
-    affectsOutput({&vertex, &radius, &geodesic, &limitSurface, &falloff, &startMatrix, &endMatrix});
+    affectsOutput({&vertex, &radius, &geodesic, &limitSurface, &weightsAreFalloff, &foldLimit, &falloff,
+                   &startMatrix, &endMatrix});
     return MS::kSuccess;
 }
 
@@ -169,6 +173,8 @@ Parameters DkSlide::parameters(MDataBlock& block, const MayaMatrix& geometryWorl
     in.radius = block.inputValue(radius).asDouble();
     in.geodesic = block.inputValue(geodesic).asBool();
     in.limitSurface = block.inputValue(limitSurface).asBool();
+    in.weightsAreFalloff = block.inputValue(weightsAreFalloff).asBool();
+    in.foldLimit = block.inputValue(foldLimit).asBool();
     MRampAttribute ramp(thisMObject(), falloff);
     MIntArray indices, interpolations;
     MFloatArray positions, values;

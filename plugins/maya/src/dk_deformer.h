@@ -56,7 +56,8 @@ class DkSlide : public DkDeformer {
     MObject& accessoryAttribute() const override { return endMatrix; }
     static const MTypeId id;
     static MObject rebind;
-    static MObject vertex, radius, geodesic, limitSurface, falloff, startMatrix, endMatrix;
+    static MObject vertex, radius, geodesic, limitSurface, weightsAreFalloff, foldLimit, falloff, startMatrix,
+        endMatrix;
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }

@@ -94,6 +94,13 @@ TEST_CASE("maya adapter: each node's controls become host parameters in the shap
         CHECK(param(p, "falloff") == std::vector<double>{2});
         CHECK(param(p, "falloffRamp").size() == 33);
         CHECK(p.front().first == "vertex");  // bind-time parameters first
+        CHECK(param(p, "paintedWeights") == std::vector<double>{0});
+        CHECK(param(p, "foldLimit") == std::vector<double>{0});
+        in.weightsAreFalloff = true;
+        in.foldLimit = true;
+        const maya::Parameters q = maya::slideParameters(in);
+        CHECK(param(q, "paintedWeights") == std::vector<double>{1});
+        CHECK(param(q, "foldLimit") == std::vector<double>{1});
     }
     SECTION("dkBarr: the handle's origin and axes") {
         maya::BarrInputs in;

@@ -35,8 +35,20 @@ struct SlideDrive {
     Falloff falloff = Falloff::smooth();  // of distance / radius
 };
 
+// What painted per-vertex weights (in [0, 1]) do.
+enum class PaintedWeights {
+    ScaleFalloff,  // weight x falloff(distance / radius): the radius shapes the slide, the paint masks it
+    AreFalloff,    // the paper's rule (Pinskiy §3): the painted map is the falloff; the radius only bounds
+                   // the region (vertices beyond it never move), the falloff curve is not used
+};
+
 struct SlideOptions {
     SurfaceMode surface = SurfaceMode::Cage;
+    PaintedWeights weights = PaintedWeights::ScaleFalloff;
+    // Stop the drag at the fold limit: each handle's displacement is scaled down (never up) so that no
+    // triangle of its region flips, then all of them together if overlapping regions still fold. For a
+    // slide that never tears; SlideResult::foldScale says how much of each drag was applied.
+    bool foldLimit = false;
     // Triangles one vertex's walk may cross in one evaluation before it stops (and is counted): the
     // expansion limit for displacements many times larger than the region.
     int32_t maxWalkTriangles = 4096;
@@ -54,23 +66,35 @@ struct SlideLanding {
 struct SlideResult {
     std::vector<SlideLanding> landings;  // one per moved vertex, ascending vertex index
     int32_t moved = 0;
-    int32_t boundaryStopped = 0;      // reached a mesh boundary (or a degenerate triangle) and stopped on it
-    int32_t limitStopped = 0;         // stopped after maxWalkTriangles triangles
+    int32_t boundaryStopped = 0;  // reached a mesh boundary (or a degenerate triangle) and stopped on it
+    int32_t limitStopped = 0;     // stopped after maxWalkTriangles triangles
+    int32_t limited = 0;          // travelled less than asked: boundaryStopped + limitStopped
+    // Triangles with a slid corner whose orientation reversed against the incoming surface (a fold of the
+    // texture); after the fold limit when it is on.
+    int32_t flippedTriangles = 0;
+    std::vector<double> foldScale;    // per handle: the factor applied to its displacement (1: all of it)
     int32_t unreachable = 0;          // within a radius but not reachable by the propagation: unmoved (bind)
     int32_t withoutTangentPlane = 0;  // within a radius but only degenerate triangles around: unmoved (bind)
     int32_t degenerateTriangles = 0;  // zero-area triangles touching an active vertex: skipped (bind)
 };
 
 // The sliding deformer (Pinskiy, "Sliding deformation"): bind once per rest mesh and handle set, evaluate
-// per locator drag. Binding builds the rest surface, each handle's support region and propagated region
-// basis, and each active vertex's exponential map of its one-ring (Eq. 1-2). Evaluation turns each
-// vertex's displacement d_P (Eq. 7) into a direction on the surface through its one-ring map and walks
-// |d_P| along the straightest geodesic in that direction, unfolding each triangle it enters into the plane
-// of the last (§3.3): a vertex travels exactly |d_P| over the surface, so it moves at most |d_P| in space,
-// stays on the triangles it crossed, and never jumps across the mesh (docs/decisions.md).
+// per locator drag, on the rest mesh or on a deformed copy of it (what a deformer stack hands on). Binding
+// builds the rest surface, each handle's support region and propagated region basis, and each active vertex's
+// exponential map of its one-ring (Eq. 1-2). Evaluation turns each vertex's displacement d_P (Eq. 7) into a
+// direction on the surface through its one-ring map and walks |d_P| along the straightest geodesic in that
+// direction, unfolding each triangle it enters into the plane of the last (§3.3): a vertex travels exactly
+// |d_P| over the surface, so it moves at most |d_P| in space, stays on the triangles it crossed, and never
+// jumps across the mesh (docs/decisions.md).
 //
 // Several handles compose by adding their tangent displacements in each vertex's tangent space before the
 // single walk over the surface (order-independent; on a plane exactly the sum of the translations).
+//
+// Over a deformed input the walks still run on the rest surface, and their landings (a triangle and
+// barycentric coordinates) are applied to the incoming points, so slid vertices lie on the surface the
+// slide receives. Each handle's displacement is given in the incoming space and carried into the rest
+// frame by the rotation that best maps the handle's rest one-ring onto its incoming one-ring: for an
+// input moved rigidly by (R, t), the result is exactly (R, t) applied to the rest slide by R^T d.
 // evaluate() may be called from several threads; calls are serialised, each one runs in parallel.
 class Slider {
   public:
@@ -90,9 +114,10 @@ class Slider {
     // Vertices in at least one handle's region (union), ascending.
     [[nodiscard]] std::span<const int32_t> activeVertices() const;
 
-    // points: #V positions, moved in place by each vertex's slide (landing - rest position); pass the rest
-    // positions for a plain slide. drives: one per handle. weights: #V painted weights in [0, 1] scaling
-    // the falloff (empty: all 1). envelope scales every slide. Throws InvalidInput for a wrong count or a
+    // points: #V positions of the surface to slide over (the rest positions, or a deformed copy with the
+    // rest mesh's connectivity), replaced in place by the slid positions. drives: one per handle, the
+    // displacements in the space of `points`. weights: #V painted weights in [0, 1] (empty: all 1), acting
+    // as options.weights says. envelope scales every slide. Throws InvalidInput for a wrong count or a
     // non-finite value, naming it, before anything is written.
     void evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                   std::span<const float> weights = {}, float envelope = 1.0f, SlideResult* result = nullptr);

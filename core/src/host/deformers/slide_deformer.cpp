@@ -18,7 +18,8 @@ namespace deformkit::host::detail {
 namespace {
 
 // Weights and envelope scale the tangent displacement before the walk (WeightMode::Native), so slid
-// vertices stay on the rest surface.
+// vertices stay on the surface; the incoming points are the surface the slide moves over, and the
+// displacement is read in their space (slide/slider.h).
 class SlideDeformer final : public Deformer {
   public:
     explicit SlideDeformer(std::string label) : Deformer("slide", std::move(label)) {
@@ -35,6 +36,15 @@ class SlideDeformer final : public Deformer {
                                .rebinds = true,
                                .doc = "0 slide over the mesh, 1 over its Catmull-Clark limit surface"},
                               {0.0});
+        painted_ = addParameter({.name = "paintedWeights",
+                                 .rebinds = true,
+                                 .doc = "0 weights scale the falloff, 1 the weights are the falloff (the "
+                                        "paper's rule; the radius only bounds the region)"},
+                                {0.0});
+        foldLimit_ = addParameter({.name = "foldLimit",
+                                   .rebinds = true,
+                                   .doc = "1 scales the drag down so that no triangle of the region flips"},
+                                  {0.0});
         displacement_ = addParameter(
             {.name = "displacement", .doc = "end locator minus start locator, scene units"}, {0.0, 0.0, 0.0});
         falloff_ = addParameter({.name = "falloff", .doc = "0 smooth, 1 linear, 2 falloffRamp"}, {0.0});
@@ -51,7 +61,8 @@ class SlideDeformer final : public Deformer {
   protected:
     void validate(size_t index, std::span<const double> value) const override {
         if (index == vertex_) requireIntegers(index, value, 0, std::numeric_limits<int32_t>::max());
-        if (index == geodesic_ || index == limit_) requireIntegers(index, value, 0, 1);
+        if (index == geodesic_ || index == limit_ || index == painted_ || index == foldLimit_)
+            requireIntegers(index, value, 0, 1);
         if (index == falloff_) requireIntegers(index, value, 0, 2);
         if (index == radius_ && !(value[0] > 0.0)) fail(index, "is " + numberText(value[0]), "a number > 0");
         if (index == ramp_) {
@@ -78,6 +89,9 @@ class SlideDeformer final : public Deformer {
             value(geodesic_)[0] == 0.0 ? slide::RegionMetric::Euclidean : slide::RegionMetric::Geodesic;
         slide::SlideOptions options;
         options.surface = value(limit_)[0] == 0.0 ? slide::SurfaceMode::Cage : slide::SurfaceMode::Limit;
+        options.weights = value(painted_)[0] == 0.0 ? slide::PaintedWeights::ScaleFalloff
+                                                    : slide::PaintedWeights::AreFalloff;
+        options.foldLimit = value(foldLimit_)[0] != 0.0;
         slider_ = std::make_unique<slide::Slider>(rest, std::vector<slide::SlideHandle>{handle}, options,
                                                   context());
     }
@@ -103,7 +117,7 @@ class SlideDeformer final : public Deformer {
         return slide::Falloff::ramp(values, "samples");
     }
 
-    size_t vertex_, radius_, geodesic_, limit_, displacement_, falloff_, ramp_;
+    size_t vertex_, radius_, geodesic_, limit_, painted_, foldLimit_, displacement_, falloff_, ramp_;
     std::unique_ptr<slide::Slider> slider_;
     std::array<slide::SlideDrive, 1> drive_;
 };
