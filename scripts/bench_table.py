@@ -19,6 +19,7 @@ REFERENCES = {
     # Same active vertices, falloff and drag, 1 thread: < 1 is the share of the slide's time that a plain
     # soft translate (off the surface) would take; the rest is the cost of staying on the surface.
     "BM_SlideEvaluate1Thread": ("BM_SlideSoftTranslate1Thread", "slide / soft translate, same vertices, 1 thread"),
+    "BM_SlideFrameChangingInput": ("BM_SlideFrameSteadyInput", "changing / steady input, 100k mesh, 10k active"),
     # UV warp: the memory floor makes the same passes over the same arrays as a solve with trivial arithmetic;
     # < 1 is the floor's share of the solve's time. All-thread ratios are in the uvwarp section below.
     "BM_UvWarpSolve1Thread": ("BM_UvWarpFloor1Thread", "floor / solve, same passes, 1 thread"),

@@ -28,6 +28,22 @@ glm::vec3 parseVec3(const std::string& text) {
     return v;
 }
 
+// "x0,y0,z0,x1,y1,z1" -> the box --frame aims the camera at.
+geom::Box3 parseBox(const std::string& text) {
+    float v[6];
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%f,%f,%f,%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &tail) !=
+            6 ||
+        !(v[0] <= v[3] && v[1] <= v[4] && v[2] <= v[5])) {
+        throw InvalidInput(formatError("--frame", "", "'" + text + "' is not a box",
+                                       "six numbers: the low corner x,y,z then the high corner x,y,z"));
+    }
+    geom::Box3 box;
+    box.min = glm::vec3(v[0], v[1], v[2]);
+    box.max = glm::vec3(v[3], v[4], v[5]);
+    return box;
+}
+
 }  // namespace
 
 void preview(const PreviewCommand& command) {
@@ -56,7 +72,7 @@ void preview(const PreviewCommand& command) {
 void addPreviewCommand(CommandLine& cli) {
     struct Options {
         PreviewCommand command;
-        std::string mesh, texture, out, view, weights, weightsPtex;
+        std::string mesh, texture, out, view, frame, weights, weightsPtex;
     };
     auto o = std::make_shared<Options>();
     Command preview =
@@ -66,6 +82,7 @@ void addPreviewCommand(CommandLine& cli) {
             c.out = o->out;
             if (!o->texture.empty()) c.texture = o->texture;
             if (!o->view.empty()) c.options.viewDirection = parseVec3(o->view);
+            if (!o->frame.empty()) c.options.frame = parseBox(o->frame);
             if (!o->weights.empty()) c.weights = o->weights;
             if (!o->weightsPtex.empty()) c.weightsPtex = o->weightsPtex;
             harness::preview(c);
@@ -78,6 +95,9 @@ void addPreviewCommand(CommandLine& cli) {
     preview.option("--width", o->command.options.width, "pixels").showDefault();
     preview.option("--height", o->command.options.height, "pixels").showDefault();
     preview.option("--view", o->view, "camera direction x,y,z (y up); default -0.55,-0.45,-1");
+    preview.option("--frame", o->frame,
+                   "box the camera frames instead of the whole mesh, x0,y0,z0,x1,y1,z1 (a close-up; the same "
+                   "box for every frame of a shot)");
     preview.flag("--edges", o->command.options.drawEdges, "draw polygon edges");
     preview.option("--weights", o->weights, "show painted weights (JSON array, one per vertex) as colours");
     preview.option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");

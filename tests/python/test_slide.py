@@ -318,3 +318,35 @@ def test_concurrent_evaluations_agree():
     np.testing.assert_array_equal(out[0], out[1])
     f = smoothstep_falloff(distances(pts, handle) / 0.5)
     np.testing.assert_allclose(out[0], pts + f[:, None] * d, atol=TOL)
+
+
+def test_slide_in_a_stack_slides_over_the_bent_surface():
+    """In a DeformerStack after a bend, the slide moves over the bent plane: its result is the Slider's over the
+    bent points, every slid vertex lies on a bent triangle, and the handle follows the drag given in bent
+    space (to the bend's change of stretch across the handle's ring)."""
+    pts, counts, idx = plane()
+    mesh = dk.Mesh(pts, counts, idx)
+    stack = dk.DeformerStack()
+    stack.set_rest(mesh)
+    stack.add("bend", "bd")
+    for name, value in [("handleOrigin", [0, 0, 0]), ("handleX", [0, 0, 2]), ("handleY", [2, 0, 0]),
+                        ("curvature", 0.8), ("lowBound", 0), ("highBound", 1)]:
+        stack.set(0, name, value)
+    bent = stack.evaluate(pts)
+    assert np.abs(bent[:, 2]).max() > 0.3  # really bent
+    stack.add("slide", "sl")
+    d = np.array([0.06, 0.04, -0.02])
+    for name, value in [("vertex", HANDLE), ("radius", 0.6), ("displacement", d)]:
+        stack.set(1, name, value)
+    out = stack.evaluate(pts)
+    r = dk.Slider(pts, counts, idx, handle=HANDLE, radius=0.6).evaluate(d.astype(np.float32), points=bent)
+    np.testing.assert_allclose(out, r.points, atol=2e-7)  # one float ulp: the stack's blend runs in double
+    rebuilt = np.einsum("mk,mkc->mc", r.barycentric, bent[r.triangles].astype(np.float64))
+    np.testing.assert_allclose(rebuilt, out[r.vertices], atol=1e-6)
+    moved = out[HANDLE].astype(np.float64) - bent[HANDLE]
+    # The drag's part along the bent surface: d without its component along the bent normal at the handle.
+    ring = bent[[HANDLE + 1, HANDLE + 41, HANDLE - 1, HANDLE - 41]].astype(np.float64) - bent[HANDLE]
+    normal = np.cross(ring[0] - ring[2], ring[1] - ring[3])
+    normal /= np.linalg.norm(normal)
+    tangent = d - d.dot(normal) * normal
+    np.testing.assert_allclose(moved, tangent, atol=0.02 * np.linalg.norm(tangent))

@@ -7,8 +7,6 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <glm/geometric.hpp>
-#include <glm/mat3x3.hpp>
-#include <glm/matrix.hpp>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
@@ -447,48 +445,55 @@ struct Slider::Impl {
         L.current = L.incoming.get();
     }
 
-    // The rotation carrying handle h's rest frame to the incoming surface: the best rotation (Kabsch) of
-    // its one-ring edges and its normal, scaled to the ring, rest onto incoming. Identity when the ring did
-    // not move; exactly R for a ring moved rigidly by (R, t) up to rounding.
-    glm::dmat3 handleRotation(size_t h, std::span<const glm::vec3> in) const {
+    // A drag given in the incoming space, carried back into handle h's rest frame: through the inverse of
+    // the linear map that best takes the handle's rest one-ring edges and normal (scaled to the ring) onto
+    // the incoming ones (least squares), so the handle follows the locator on a stretched or compressed
+    // input; for a ring moved rigidly by (R, t) that map is R, up to rounding. Where the incoming ring has
+    // collapsed (the map is not invertible) the best rotation (Kabsch) of the same data is used instead.
+    // The identity when the ring did not move.
+    glm::dvec3 toRestFrame(size_t h, std::span<const glm::vec3> in, const glm::dvec3& d) const {
         const int32_t p = handles[h].vertex;
         bool moved = in[p] != mesh.points()[p];
         for (int32_t q : surface.neighbors(p))
             moved = moved || in[q] != mesh.points()[q];
-        if (!moved) return glm::dmat3(1.0);
+        if (!moved) return d;
         const glm::dvec3 p0 = surface.point(p), p1(in[p]);
-        Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+        auto column = [](const glm::dvec3& v) { return Eigen::Vector3d(v.x, v.y, v.z); };
+        Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();  // sum of incoming x rest^T
+        Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();   // sum of rest x rest^T
         double scale2 = 0.0;
         for (int32_t q : surface.neighbors(p)) {
             const glm::dvec3 e = surface.point(q) - p0, f = glm::dvec3(in[q]) - p1;
-            H += Eigen::Vector3d(e.x, e.y, e.z) * Eigen::Vector3d(f.x, f.y, f.z).transpose();
+            cross += column(f) * column(e).transpose();
+            gram += column(e) * column(e).transpose();
             scale2 += glm::dot(e, e);
         }
         glm::dvec3 normal(0.0);  // area-weighted incoming normal
         for (int32_t c : surface.vertexCorners(p)) {
             const glm::dvec3 a(in[surface.vertex(c)]), b(in[surface.vertex(SlideSurface::next(c))]),
-                d(in[surface.vertex(SlideSurface::prev(c))]);
-            normal += glm::cross(b - a, d - a);
+                e(in[surface.vertex(SlideSurface::prev(c))]);
+            normal += glm::cross(b - a, e - a);
         }
         const double length = glm::length(normal);
+        const double ring = std::sqrt(scale2 / static_cast<double>(surface.neighbors(p).size()));
         if (length > 0.0) {
-            const glm::dvec3 n0 = surface.normal(p) * std::sqrt(scale2),
-                             n1 = normal / length * std::sqrt(scale2);
-            H += Eigen::Vector3d(n0.x, n0.y, n0.z) * Eigen::Vector3d(n1.x, n1.y, n1.z).transpose();
+            const Eigen::Vector3d n0 = column(surface.normal(p)) * ring, n1 = column(normal / length) * ring;
+            cross += n1 * n0.transpose();
+            gram += n0 * n0.transpose();
         }
-        const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-        Eigen::Matrix3d R = svd.matrixV() * svd.matrixU().transpose();
-        if (R.determinant() < 0.0) {
-            Eigen::Matrix3d V = svd.matrixV();
-            V.col(2) = -V.col(2);
-            R = V * svd.matrixU().transpose();
+        const Eigen::Vector3d v = column(d);
+        Eigen::Vector3d out;
+        const Eigen::Matrix3d map = cross * gram.inverse();  // gram is positive definite: the ring spans
+        const double det = map.determinant();
+        if (std::isfinite(det) && det > 1e-6) {
+            out = map.inverse() * v;
+        } else {
+            const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
+            Eigen::Matrix3d U = svd.matrixU();
+            if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) = -U.col(2);
+            out = (U * svd.matrixV().transpose()).transpose() * v;
         }
-        glm::dmat3 out(1.0);
-        for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c)
-                out[c][r] = R(r, c);  // glm is column-major
-        }
-        return out;
+        return {out.x(), out.y(), out.z()};
     }
 
     struct Counts {
@@ -532,26 +537,26 @@ struct Slider::Impl {
             ++moved;
             boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
             limitStopped += landing.stop == Stop::Limit ? 1 : 0;
-        }
-        counts = {moved, boundaryStopped, limitStopped};
-
-        if (limit) {
-            coverLandings();
-            prepareLimit(in);
-        }
-#pragma omp parallel for schedule(dynamic, 256)
-        for (int32_t i = 0; i < count; ++i) {
-            const Landing& landing = landings[i];
-            if (landing.stop == Stop::None) continue;
-            const int32_t v = active[i];
-            if (limit) {
-                slid[i] = glm::dvec3(in[v]) + (limitPoint(landing) - limitOrigin(v));
-            } else {
+            if (!limit) {  // on the cage: the landing's combination of the incoming corners
                 const int32_t t = landing.triangle;
                 slid[i] = landing.barycentric.x * glm::dvec3(in[surface.vertex(3 * t)]) +
                           landing.barycentric.y * glm::dvec3(in[surface.vertex(3 * t + 1)]) +
                           landing.barycentric.z * glm::dvec3(in[surface.vertex(3 * t + 2)]);
             }
+        }
+        counts = {moved, boundaryStopped, limitStopped};
+        if (!limit) return counts;
+
+        // On the limit surface: once every landing's face is in the part, the incoming limit surface's
+        // offset from the point under the vertex to the point under its landing.
+        coverLandings();
+        prepareLimit(in);
+#pragma omp parallel for schedule(dynamic, 256)
+        for (int32_t i = 0; i < count; ++i) {
+            const Landing& landing = landings[i];
+            if (landing.stop == Stop::None) continue;
+            const int32_t v = active[i];
+            slid[i] = glm::dvec3(in[v]) + (limitPoint(landing) - limitOrigin(v));
         }
         return counts;
     }
@@ -785,25 +790,35 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
             formatError(m.source, "envelope", "not finite", "a finite envelope, normally in [0, 1]"));
     }
 
-    for (size_t i = 0; i < points.size(); ++i) {
-        const glm::vec3& p = points[i];
+    // The incoming points the slide reads: the active vertices and the handles' rings (landings outside
+    // them pass a non-finite corner on as any deformer does). Read in place: nothing is written until the
+    // end.
+    const std::span<const glm::vec3> in(points.data(), points.size());
+    auto requireFinite = [&](int32_t v) {
+        const glm::vec3& p = in[v];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(i), "not finite",
+            throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(v), "not finite",
                                            "finite x, y, z"));
         }
+    };
+    for (int32_t v : m.active)
+        requireFinite(v);
+    for (const SlideHandle& handle : m.handles) {
+        for (int32_t q : m.surface.neighbors(handle.vertex))
+            requireFinite(q);
     }
 
-    // The incoming points, read while `points` is written.
-    const std::vector<glm::vec3> in(points.begin(), points.end());
-    // Each handle's displacement in its rest frame (the identity when its one-ring is at rest).
+    // Each handle's displacement in its rest frame.
     std::vector<glm::dvec3> restDisplacement(drives.size());
     for (size_t h = 0; h < drives.size(); ++h)
-        restDisplacement[h] = glm::transpose(m.handleRotation(h, in)) * drives[h].displacement;
+        restDisplacement[h] = m.toRestFrame(h, in, drives[h].displacement);
 
     const auto numHandles = m.handles.size();
     std::vector<double> scales(numHandles, 1.0);
     Impl::Counts counts = m.slideOnce(restDisplacement, scales, drives, in, weights, envelope);
-    int32_t flipped = m.countFlips(m.regionTriangles, in);
+    // Folds are counted when someone reads the count or the fold limit needs it (a host's evaluation in a
+    // stack does neither and skips the pass over the region's triangles).
+    int32_t flipped = result || m.options.foldLimit ? m.countFlips(m.regionTriangles, in) : 0;
     if (m.options.foldLimit && flipped > 0) {
         // Each handle alone first (its own region), then all together while overlapping regions still fold.
         for (size_t h = 0; h < numHandles; ++h) {
@@ -829,6 +844,7 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
     }
 
     const auto count = static_cast<int32_t>(m.active.size());
+#pragma omp parallel for schedule(static)
     for (int32_t i = 0; i < count; ++i) {
         if (m.landings[i].stop != Stop::None) points[m.active[i]] = glm::vec3(m.slid[i]);
     }

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "deformkit/error.h"
 #include "deformkit/geom/bvh.h"
 #include "deformkit/geom/limit_surface.h"
 #include "deformkit/io/obj.h"
@@ -331,4 +332,56 @@ TEST_CASE("slide on the limit surface: the part around the region equals the who
     const auto freshLarge = evaluate(fresh, large, nullptr);
     CHECK(std::memcmp(grown.data(), freshLarge.data(), grown.size() * sizeof(glm::vec3)) == 0);
     CHECK(std::memcmp(out.data(), again.data(), out.size() * sizeof(glm::vec3)) == 0);
+}
+
+TEST_CASE("slide: a non-finite incoming point it reads is an error naming the vertex", "[slide][errors]") {
+    const geom::Mesh plane = test::planeGrid(10, 10, 0.1f);
+    const int32_t handle = 5 * 11 + 5;
+    slide::Slider slider(plane, {{handle, 0.3}});
+    std::vector<glm::vec3> points(plane.points().begin(), plane.points().end());
+    points[handle + 1].y = std::nanf("");
+    const SlideDrive drive{glm::dvec3(0.05, 0.0, 0.0), Falloff::smooth()};
+    const std::vector<glm::vec3> before = points;
+    try {
+        slider.evaluate({&drive, 1}, points);
+        FAIL("no error");
+    } catch (const InvalidInput& e) {
+        CHECK_THAT(e.what(), Catch::Contains("point of vertex 61") && Catch::Contains("not finite"));
+    }
+    CHECK(std::memcmp(points.data(), before.data(), points.size() * sizeof(glm::vec3)) == 0);
+    // A far vertex the slide never reads passes through untouched.
+    points = std::vector<glm::vec3>(plane.points().begin(), plane.points().end());
+    points[0].x = std::nanf("");
+    slider.evaluate({&drive, 1}, points);
+    CHECK(std::isnan(points[0].x));
+    CHECK(points[handle].x > plane.points()[handle].x);
+}
+
+TEST_CASE("slide over a stretched plane: the handle follows the locator", "[slide]") {
+    // The rest plane under an affine map A (stretch 1.5 along x, 0.8 along y, a shear, a turn, a move) is
+    // still a plane: each vertex lands at A(P + f F^-1 d) = A(P) + f d, with f the falloff of its rest
+    // distance, because the drag is carried back through A's linear part (the best fit of the handle's
+    // ring is exact for an affine map).
+    const int n = 40;
+    const geom::Mesh plane = test::planeGrid(n, n, 0.05f);
+    const int32_t handle = 20 * (n + 1) + 20;
+    const glm::dmat3 turn = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.6, glm::dvec3(0.2, 1.0, 0.4)));
+    const glm::dmat3 A = turn * glm::dmat3(1.5, 0.0, 0.0, 0.3, 0.8, 0.0, 0.0, 0.0, 1.0);  // columns
+    const glm::dvec3 move(0.3, -0.2, 1.0);
+    std::vector<glm::vec3> stretched;
+    for (const glm::vec3& p : plane.points())
+        stretched.emplace_back(A * glm::dvec3(p) + move);
+    const glm::dvec3 d = turn * glm::dvec3(0.12, -0.07, 0.0);  // in the stretched plane
+    const double r = 0.6;
+    const auto out = slideOver(plane, stretched, {handle, r}, d);
+    const Falloff smooth = Falloff::smooth();
+    const glm::dvec3 p0(plane.points()[handle]);
+    double worst = 0.0;
+    for (int32_t v = 0; v < plane.numVertices(); ++v) {
+        const double f = smooth(glm::length(glm::dvec3(plane.points()[v]) - p0) / r);
+        worst = std::max(worst, glm::length(glm::dvec3(out[v]) - glm::dvec3(stretched[v]) - f * d));
+    }
+    INFO("largest distance from A(P) + f d: " << worst);
+    CHECK(worst < 2e-6);
+    CHECK(glm::length(glm::dvec3(out[handle]) - glm::dvec3(stretched[handle]) - d) < 1e-6);
 }

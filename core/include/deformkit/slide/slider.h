@@ -93,8 +93,9 @@ struct SlideResult {
 // Over a deformed input the walks still run on the rest surface, and their landings (a triangle and
 // barycentric coordinates) are applied to the incoming points, so slid vertices lie on the surface the
 // slide receives. Each handle's displacement is given in the incoming space and carried into the rest
-// frame by the rotation that best maps the handle's rest one-ring onto its incoming one-ring: for an
-// input moved rigidly by (R, t), the result is exactly (R, t) applied to the rest slide by R^T d.
+// frame through the inverse of the linear map that best takes the handle's rest one-ring onto its
+// incoming one: the handle follows the locator on a stretched input, and for an input moved rigidly by
+// (R, t) the result is (R, t) applied to the rest slide by R^T d.
 // evaluate() may be called from several threads; calls are serialised, each one runs in parallel.
 class Slider {
   public:
