@@ -8,6 +8,9 @@
 #
 # When `blender` is on PATH, scripts/bench_blender.py also times Blender's Lattice and SimpleDeform modifiers
 # on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios (issue 3).
+# With Blender and the staged add-on ($build/blender), tests/bench/blender_slide_frame_change.py also times
+# frame changes of a 99,602-vertex mesh with and without the add-on's slide (about 500 active vertices) and
+# prints their ratio after the table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -46,4 +49,17 @@ fi
 python3 scripts/bench_table.py "${blender_json[@]}" "$out"/bench_*.json
 if [ ${#blender_json[@]} -eq 0 ]; then
     echo "Blender comparison skipped: blender is not on PATH"
+fi
+if command -v blender >/dev/null 2>&1 && [ -f "$build/blender/deformkit/__init__.py" ]; then
+    echo "running the slide's frame change in Blender (tests/bench/blender_slide_frame_change.py) ..." >&2
+    if ! blender -b --factory-startup --python-exit-code 1 \
+        --python tests/bench/blender_slide_frame_change.py -- "$build/blender" --reps "$reps" \
+        --table "$out/blender_slide.txt" >"$out/blender_slide.log" 2>&1; then
+        cat "$out/blender_slide.log" >&2
+        exit 1
+    fi
+    echo
+    cat "$out/blender_slide.txt"
+else
+    echo "Blender slide frame change skipped: blender or the staged add-on ($build/blender) is missing"
 fi
