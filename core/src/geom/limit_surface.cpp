@@ -186,8 +186,9 @@ void LimitSurface::Impl::patchPoint(const PtexLocation& at, glm::dvec3& position
                                     glm::dvec3* dPdv) const {
     const Far::PatchMap::Handle* handle = patchMap->FindPatch(at.ptexFace, at.u, at.v);
     if (handle == nullptr) {
-        // Every face of a Catmull-Clark surface without holes has patches; this is a defect, not user data.
-        throw Error(formatError(source, "Ptex face " + std::to_string(at.ptexFace), "has no limit patch"));
+        // Every face of a Catmull-Clark surface has patches except the holes the caller asked for.
+        throw InvalidInput(formatError(source, "Ptex face " + std::to_string(at.ptexFace),
+                                       "has no limit patch (a hole)", "a face that is not a hole"));
     }
     const bool derivatives = dPdu != nullptr && dPdv != nullptr;
     std::array<double, kMaxPatchPoints> wP{}, wDu{}, wDv{};
@@ -312,6 +313,20 @@ LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options,
     desc.numFaces = rest.numFaces();
     desc.numVertsPerFace = counts.data();
     desc.vertIndicesPerFace = indices.data();
+    std::vector<uint8_t> isHole(rest.numFaces(), 0);
+    for (int32_t f : options.holes) {
+        if (f < 0 || f >= rest.numFaces()) {
+            throw InvalidInput(formatError(source, "limit surface options", "hole face " + std::to_string(f),
+                                           "a face in [0, " + std::to_string(rest.numFaces()) + ")"));
+        }
+        isHole[f] = 1;
+    }
+    std::vector<int32_t> holes;
+    for (int32_t f = 0; f < rest.numFaces(); ++f) {
+        if (isHole[f]) holes.push_back(f);
+    }
+    desc.numHoles = static_cast<int>(holes.size());
+    desc.holeIndices = holes.data();
 
     Sdc::Options sdc;
     sdc.SetVtxBoundaryInterpolation(options.boundary == LimitSurfaceOptions::Boundary::EdgesOnly
@@ -359,6 +374,7 @@ LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options,
     // position there.
     impl->vertexCorner.assign(rest.numVertices(), PtexLocation{-1, 0.0, 0.0});
     for (int32_t f = 0; f < rest.numFaces(); ++f) {
+        if (isHole[f]) continue;
         const auto corners = rest.face(f);
         for (int32_t k = 0; k < counts[f]; ++k) {
             PtexLocation& at = impl->vertexCorner[corners[k]];

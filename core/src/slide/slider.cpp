@@ -48,6 +48,10 @@ using detail::Stop;
 
 namespace {
 
+// Loops over fewer items than this run on the calling thread: waking a second thread costs more than the
+// work (a 500-vertex slide takes ~0.2 ms), and far more when the other core is busy (a host's own threads).
+constexpr int32_t kParallelFrom = 4096;
+
 double cross2(const glm::dvec2& a, const glm::dvec2& b) {
     return a.x * b.y - a.y * b.x;
 }
@@ -376,6 +380,9 @@ struct Slider::Impl {
             v = L.localVertex[v];
         geom::LimitSurfaceOptions options;
         options.deformable = true;
+        for (size_t f = 0; f < inPart.size(); ++f) {  // the one-ring faces only support the covered ones
+            if (inPart[f] && !L.covered[f]) options.holes.push_back(L.localFace[f]);
+        }
         L.rest = std::make_unique<geom::LimitSurface>(geom::Mesh(std::move(data), source), options, source);
         L.incoming.reset();
         L.incomingCage.clear();
@@ -515,7 +522,7 @@ struct Slider::Impl {
             const Falloff& falloff = drives[h].falloff;
             const bool painted = options.weights == PaintedWeights::AreFalloff;
             const auto count = static_cast<int32_t>(region.vertices.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (count >= kParallelFrom)
             for (int32_t k = 0; k < count; ++k) {
                 const double f = painted ? 1.0 : falloff(region.normalizedDistance[k]);
                 if (f != 0.0) displacement[slots[k]] += f * (s * region.a1Local[k] + t * region.a2Local[k]);
@@ -525,7 +532,7 @@ struct Slider::Impl {
         const auto count = static_cast<int32_t>(active.size());
         Counts counts;
         int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, limitStopped)
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, limitStopped) if (count >= kParallelFrom)
         for (int32_t i = 0; i < count; ++i) {
             const int32_t v = active[i];
             const double scale = (weights.empty() ? 1.0 : static_cast<double>(weights[v])) * envelope;
@@ -551,7 +558,7 @@ struct Slider::Impl {
         // offset from the point under the vertex to the point under its landing.
         coverLandings();
         prepareLimit(in);
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 256) if (count >= kParallelFrom)
         for (int32_t i = 0; i < count; ++i) {
             const Landing& landing = landings[i];
             if (landing.stop == Stop::None) continue;
@@ -570,7 +577,7 @@ struct Slider::Impl {
     int32_t countFlips(std::span<const int32_t> triangles, std::span<const glm::vec3> in) const {
         const auto count = static_cast<int32_t>(triangles.size());
         int32_t flipped = 0;
-#pragma omp parallel for schedule(static) reduction(+ : flipped)
+#pragma omp parallel for schedule(static) reduction(+ : flipped) if (count >= kParallelFrom)
         for (int32_t k = 0; k < count; ++k) {
             const int32_t t = triangles[k];
             const int32_t a = surface.vertex(3 * t), b = surface.vertex(3 * t + 1),
@@ -844,7 +851,7 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
     }
 
     const auto count = static_cast<int32_t>(m.active.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (count >= kParallelFrom)
     for (int32_t i = 0; i < count; ++i) {
         if (m.landings[i].stop != Stop::None) points[m.active[i]] = glm::vec3(m.slid[i]);
     }

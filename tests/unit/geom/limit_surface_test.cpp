@@ -629,3 +629,59 @@ TEST_CASE("limit surface rejects a vertex beyond OpenSubdiv's valence limit",
     CHECK_THROWS_AS(LimitSurface(fan, {}, "fan"), TopologyError);
     CHECK_THROWS_WITH(LimitSurface(fan, {}, "fan"), Catch::Contains("fan") && Catch::Contains("vertex 0"));
 }
+
+TEST_CASE("limit surface over moved points equals a surface built from them", "[geom][limit_surface]") {
+    // withPoints() reuses the patches and recomputes the control points: it must give what a fresh build
+    // from the moved cage gives, bit for bit (the same refinement in the same order).
+    const MixedMesh mixed = mixedMesh();
+    const Mesh mesh = fromFaces(mixed.points, mixed.faces);
+    LimitSurfaceOptions options;
+    options.deformable = true;
+    const LimitSurface rest(mesh, options);
+    std::vector<glm::dvec3> movedPoints;
+    for (const glm::dvec3& p : mixed.points)
+        movedPoints.push_back(p +
+                              glm::dvec3(0.2 * std::sin(3.0 * p.y), 0.1 * p.x * p.y, 0.3 * std::cos(p.x)));
+    const Mesh movedMesh = fromFaces(movedPoints, mixed.faces);
+    const LimitSurface fresh(movedMesh);
+    const LimitSurface moved = rest.withPoints(movedMesh.points());
+    for (int32_t f = 0; f < LimitSurface(mesh).numPtexFaces(); ++f) {
+        for (const double u : {0.0, 0.3, 1.0}) {
+            for (const double v : {0.0, 0.6, 1.0}) {
+                const LimitSample a = moved.evaluateAt({f, u, v}), b = fresh.evaluateAt({f, u, v});
+                CHECK(a.position == b.position);
+                CHECK(a.dPdu == b.dPdu);
+            }
+        }
+    }
+    for (int32_t v = 0; v < mesh.numVertices(); ++v)
+        CHECK(moved.limitPosition(v) == fresh.limitPosition(v));
+    // The rest surface is unchanged, a surface not built deformable refuses, a wrong count is named.
+    CHECK(rest.limitPosition(0) == LimitSurface(mesh).limitPosition(0));
+    CHECK_THROWS_AS((void)fresh.withPoints(movedMesh.points()), deformkit::Error);
+    const std::vector<glm::vec3> tooFew(3);
+    CHECK_THROWS_WITH((void)rest.withPoints(tooFew), Catch::Contains("3 given"));
+}
+
+TEST_CASE("limit surface with holes: the other faces keep their limit exactly", "[geom][limit_surface]") {
+    // The outer ring of quads made holes: the pentagon and the inner ring, whose one-rings the holes still
+    // complete, evaluate exactly as without holes; evaluating a hole is an error naming it.
+    const MixedMesh mixed = mixedMesh();
+    const Mesh mesh = fromFaces(mixed.points, mixed.faces);
+    const LimitSurface whole(mesh);
+    LimitSurfaceOptions options;
+    for (int32_t f = 7; f < 12; ++f)
+        options.holes.push_back(f);
+    const LimitSurface holed(mesh, options);
+    for (int32_t f = 0; f < 7; ++f) {
+        const int32_t n = static_cast<int32_t>(mixed.faces[f].size());
+        for (int32_t k = 0; k < n; ++k) {
+            std::vector<double> w(n, 0.5 / (n - 1));
+            w[k] = 0.5;
+            CHECK(maxDistance(holed.evaluate(f, w), whole.evaluate(f, w)) < 1e-12);
+        }
+    }
+    CHECK_THROWS_WITH((void)holed.evaluate(8, std::vector<double>(4, 0.25)), Catch::Contains("hole"));
+    options.holes = {40};
+    CHECK_THROWS_WITH((void)LimitSurface(mesh, options), Catch::Contains("hole face 40"));
+}

@@ -177,16 +177,30 @@ TEST_CASE("slide with zero displacement or zero envelope changes nothing, bit fo
 }
 
 TEST_CASE("slide gives the same bytes for 1 and 2 threads", "[slide]") {
-    const geom::Mesh mesh = test::icosphere(4, 1.0f);
-    const std::vector<SlideHandle> handles = {{10, 0.6}, {400, 0.5, slide::RegionMetric::Geodesic}};
-    const std::vector<SlideDrive> drives = {{glm::dvec3(0.05, -0.02, 0.03)}, {glm::dvec3(-0.04, 0.01, 0.02)}};
+    // Regions of more than 4096 vertices, so the loops really run on two threads (smaller ones stay on
+    // the calling thread), with the fold count and the fold limit's bisection.
+    const geom::Mesh mesh = test::icosphere(5, 1.0f);
+    const std::vector<SlideHandle> handles = {{10, 1.2}, {400, 1.0, slide::RegionMetric::Geodesic}};
+    const std::vector<SlideDrive> drives = {{glm::dvec3(0.5, -0.2, 0.3)}, {glm::dvec3(-0.4, 0.1, 0.2)}};
+    slide::SlideOptions options;
+    options.foldLimit = true;
     const int saved = omp_get_max_threads();
-    omp_set_num_threads(1);
-    const auto one = runSlide(mesh, handles, drives);
-    omp_set_num_threads(2);
-    const auto two = runSlide(mesh, handles, drives);
+    auto run = [&](int threads, SlideResult& result) {
+        omp_set_num_threads(threads);
+        slide::Slider slider(mesh, handles, options);
+        REQUIRE(slider.activeVertices().size() > 4096);
+        std::vector<glm::vec3> points(mesh.points().begin(), mesh.points().end());
+        slider.evaluate(drives, points, {}, 1.0f, &result);
+        return points;
+    };
+    SlideResult r1, r2;
+    const auto one = run(1, r1);
+    const auto two = run(2, r2);
     omp_set_num_threads(saved);
     CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)) == 0);
+    CHECK(r1.foldScale == r2.foldScale);
+    CHECK(r1.moved == r2.moved);
+    CHECK(r1.flippedTriangles == r2.flippedTriangles);
 }
 
 TEST_CASE("slide: painted weights and the envelope scale the displacement", "[slide]") {

@@ -4,6 +4,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -28,6 +29,10 @@ struct LimitSurfaceOptions {
     // Keep the refined topology so that withPoints() can move the cage (a deformed copy of it) without
     // rebuilding the patches. Costs the refiner's memory for the surface's lifetime.
     bool deformable = false;
+    // Faces left out of the surface (OpenSubdiv holes, ascending or not): they get no patches and are not
+    // refined, but their vertices still shape the faces around them. Evaluating a hole throws InvalidInput.
+    // For the part of a mesh around a region: the region's faces exact, their neighbours only support.
+    std::vector<int32_t> holes;
 };
 
 // A point of the limit surface with its first derivatives with respect to the Ptex face's (u, v).
