@@ -179,7 +179,6 @@ struct Slider::Impl {
         // The sector at p that contains the direction in the map.
         int32_t start = -1;
         glm::dvec2 ca(0.0), cb(0.0);
-        bool zeroIsLeft = true;
         double bestScore = -1e300;
         int32_t best = -1;
         glm::dvec2 bestA(0.0), bestB(0.0);
@@ -194,10 +193,6 @@ struct Slider::Impl {
                 start = c;
                 ca = a;
                 cb = b;
-                // A inMap exactly along an edge (a slide along a boundary or along a ring of edges) is
-                // read as turned a hair into this sector, so vertices on the line fall on the side the
-                // sector lies: behind the a edge they count as right of the line, behind b as left.
-                zeroIsLeft = !(sa == 0.0);
                 break;
             }
             const double score = std::min(sa / glm::length(a), sb / glm::length(b));
@@ -229,10 +224,15 @@ struct Slider::Impl {
             const double la = glm::length(A - P), lb = glm::length(B - P);
             const double gamma = std::atan2(glm::length(glm::cross(A - P, B - P)), glm::dot(A - P, B - P));
             const double mapAngle = std::atan2(cross2(ca, cb), glm::dot(ca, cb));
+            // Strictly inside the sector: a direction along one of its edges (a slide along a ring of edges
+            // or a boundary) is turned a hair (1e-9 of the sector's angle) into it, so the line passes
+            // beside the edge's far vertex on the sector's side, as the walk below assumes (its first exit
+            // edge, a -> b, has a on the right and b on the left).
+            constexpr double kInside = 1e-9;
             const double share =
-                mapAngle > 0.0
-                    ? std::clamp(std::atan2(cross2(ca, inMap), glm::dot(ca, inMap)) / mapAngle, 0.0, 1.0)
-                    : 0.5;
+                mapAngle > 0.0 ? std::clamp(std::atan2(cross2(ca, inMap), glm::dot(ca, inMap)) / mapAngle,
+                                            kInside, 1.0 - kInside)
+                               : 0.5;
             const double length = glm::length(inMap);
             ca = glm::dvec2(la, 0.0);
             cb = lb * glm::dvec2(std::cos(gamma), std::sin(gamma));
@@ -253,16 +253,20 @@ struct Slider::Impl {
         int32_t edge = SlideSurface::next(start);  // a -> b
         glm::dvec2 e0 = ca, e1 = cb;
         const double targetLength2 = glm::dot(target, target);
-        auto isLeft = [&](const glm::dvec2& x) {
-            const double side = cross2(target, x);
-            return side > 0.0 || (side == 0.0 && zeroIsLeft);
-        };
+        // A vertex exactly on the line counts as left of it, everywhere along the walk: the line is taken
+        // as shifted a hair to the right, so it passes each such vertex on the same side.
+        auto isLeft = [&](const glm::dvec2& x) { return cross2(target, x) >= 0.0; };
         auto crossingParameter = [&](const glm::dvec2& from, const glm::dvec2& to) {
             const double s0 = cross2(target, from), s1 = cross2(target, to);
             return s0 == s1 ? 0.0 : std::clamp(s0 / (s0 - s1), 0.0, 1.0);
         };
         for (int32_t step = 0;; ++step) {
             const double mu = crossingParameter(e0, e1);
+            // The edge the walk leaves by has e0 right of the line and e1 left of it: the line crosses it.
+            // Each step keeps that (one of the entered triangle's two other edges crosses too); a start
+            // that broke it would send the walk through triangles the line never meets, so it stops here
+            // (counted) rather than wander.
+            if (isLeft(e0) || !isLeft(e1)) return onEdge(edge, mu, Stop::Limit);
             const int32_t entry = surface.opposite(edge);
             if (entry < 0) return onEdge(edge, mu, Stop::Boundary);
             if (step + 1 >= options.maxWalkTriangles) return onEdge(edge, mu, Stop::Limit);

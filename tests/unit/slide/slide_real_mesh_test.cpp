@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <random>
 #include <vector>
 
 #include <omp.h>
 #include <glm/geometric.hpp>
 
+#include "deformkit/geom/bvh.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/slide/slider.h"
 
@@ -30,6 +33,21 @@ const geom::Mesh& spot() {
     return mesh;
 }
 
+// Keenan Crane's "Bob" (tests/data/README.md): a triangle mesh with thin parts (the beak, the tail) and
+// slivers, unlike Spot's quads.
+const geom::Mesh& bob() {
+    static const geom::Mesh mesh = io::readObj(DEFORMKIT_TEST_DATA "/bob/bob_tri.obj").mesh;
+    return mesh;
+}
+
+// The rest surface as a BVH, for the distance of a slid vertex to it measured apart from the landings.
+const geom::Bvh& bvhOf(const geom::Mesh& mesh) {
+    static std::map<const geom::Mesh*, std::unique_ptr<geom::Bvh>> cache;
+    auto& bvh = cache[&mesh];
+    if (!bvh) bvh = std::make_unique<geom::Bvh>(mesh);
+    return *bvh;
+}
+
 double diagonal(const geom::Mesh& mesh) {
     glm::dvec3 lo(1e300), hi(-1e300);
     for (const glm::vec3& p : mesh.points()) {
@@ -42,6 +60,7 @@ double diagonal(const geom::Mesh& mesh) {
 struct Worst {
     double travelRatio = 0.0;   // largest |moved| / (|d| falloff) over moved vertices
     double offSurface = 0.0;    // largest distance between a moved vertex and its landing point
+    double offMesh = 0.0;       // largest distance between a moved vertex and the rest surface (BVH)
     double negativeBary = 0.0;  // most negative barycentric coordinate of a landing
     int limitStopped = 0;
     bool finite = true;
@@ -76,6 +95,11 @@ void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double r
         worst.offSurface = std::max(worst.offSurface, glm::length(at - glm::dvec3(out[l.vertex])) / scale);
     }
     worst.limitStopped += result.limitStopped;
+    const geom::Bvh& bvh = bvhOf(mesh);
+    for (const SlideLanding& l : result.landings) {
+        const glm::vec3 p = out[l.vertex];
+        worst.offMesh = std::max(worst.offMesh, static_cast<double>(bvh.closestPoint(p).distance) / scale);
+    }
 }
 
 // The invariants of every case: finite, within the travel bound, on the surface, no walk at its limit.
@@ -83,6 +107,7 @@ void checkInvariants(const Worst& worst) {
     CHECK(worst.finite);
     CHECK(worst.travelRatio <= 1.0);
     CHECK(worst.offSurface < 1e-6);
+    CHECK(worst.offMesh < 1e-6);  // float positions and a float BVH query: a few ulps of the model's size
     CHECK(worst.negativeBary >= 0.0);
     CHECK(worst.limitStopped == 0);
 }
@@ -154,4 +179,61 @@ TEST_CASE("slide on Spot gives the same bytes for 1 and 2 threads", "[slide][rea
     REQUIRE(one.size() == two.size());
     CHECK(one != std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end()));
     CHECK(std::memcmp(one.data(), two.data(), one.size() * sizeof(glm::vec3)) == 0);
+}
+
+TEST_CASE("slide on Bob (triangles): random drags keep travel, stay on the surface, stay finite",
+          "[slide][real]") {
+    // As on Spot: drags of 3% of the diagonal at radius 10%, then drags up to two thirds of radii from 5% to
+    // 25%, both region metrics (fixed seeds).
+    const geom::Mesh& mesh = bob();
+    const double scale = diagonal(mesh);
+    std::mt19937 rng(1858);
+    std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> gauss;
+    Worst worst;
+    for (int c = 0; c < 80; ++c) {
+        const bool large = c >= 40;
+        const double radius = large ? (0.05 + 0.2 * unit(rng)) * scale : 0.1 * scale;
+        glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
+        d *= (large ? (0.05 + 0.6 * unit(rng)) * radius : 0.03 * scale) / glm::length(d);
+        check(mesh, vertex(rng), d, radius, worst,
+              c % 2 ? slide::RegionMetric::Geodesic : slide::RegionMetric::Euclidean);
+    }
+    INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off surface " << worst.offSurface
+                                           << ", off the mesh " << worst.offMesh);
+    checkInvariants(worst);
+}
+
+TEST_CASE("slide on a crumpled sheet: invariants where one-ring maps fold", "[slide]") {
+    // Random heights 1.5 edge lengths high crumple a 40 x 40 grid of quads: non-planar quads whose fan
+    // triangles overlap in the tangent plane, sectors wound clockwise.
+    const int n = 40;
+    geom::Mesh::Data data;
+    std::mt19937 rng(73);
+    std::uniform_real_distribution<double> noise(-0.75, 0.75);
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            data.points.emplace_back(i, j, noise(rng));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const int a = j * (n + 1) + i;
+            data.faceCounts.push_back(4);
+            data.faceIndices.insert(data.faceIndices.end(), {a, a + 1, a + n + 2, a + n + 1});
+        }
+    const geom::Mesh sheet(std::move(data), "crumpled sheet");
+    std::uniform_int_distribution<int32_t> row(8, n - 8);
+    std::normal_distribution<double> gauss;
+    Worst worst;
+    for (int c = 0; c < 60; ++c) {
+        const int32_t handle = row(rng) * (n + 1) + row(rng);
+        glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
+        d *= 1.5 / glm::length(d);
+        check(sheet, handle, d, 5.0, worst);
+    }
+    INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off the mesh " << worst.offMesh);
+    CHECK(worst.finite);
+    CHECK(worst.travelRatio <= 1.0);
+    CHECK(worst.offMesh < 1e-6);
+    CHECK(worst.negativeBary >= 0.0);
 }
