@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <memory>
 #include <random>
 #include <vector>
@@ -40,11 +39,15 @@ const geom::Mesh& bob() {
     return mesh;
 }
 
-// The rest surface as a BVH, for the distance of a slid vertex to it measured apart from the landings.
+// The rest surface as a BVH, for the distance of a slid vertex to it measured apart from the landings;
+// the last one built is kept while the same points come again.
 const geom::Bvh& bvhOf(const geom::Mesh& mesh) {
-    static std::map<const geom::Mesh*, std::unique_ptr<geom::Bvh>> cache;
-    auto& bvh = cache[&mesh];
-    if (!bvh) bvh = std::make_unique<geom::Bvh>(mesh);
+    static std::vector<glm::vec3> points;
+    static std::unique_ptr<geom::Bvh> bvh;
+    if (!bvh || !std::equal(points.begin(), points.end(), mesh.points().begin(), mesh.points().end())) {
+        points.assign(mesh.points().begin(), mesh.points().end());
+        bvh = std::make_unique<geom::Bvh>(mesh);
+    }
     return *bvh;
 }
 
@@ -205,31 +208,35 @@ TEST_CASE("slide on Bob (triangles): random drags keep travel, stay on the surfa
     checkInvariants(worst);
 }
 
-TEST_CASE("slide on a crumpled sheet: invariants where one-ring maps fold", "[slide]") {
-    // Random heights 1.5 edge lengths high crumple a 40 x 40 grid of quads: non-planar quads whose fan
-    // triangles overlap in the tangent plane, sectors wound clockwise.
-    const int n = 40;
-    geom::Mesh::Data data;
-    std::mt19937 rng(73);
-    std::uniform_real_distribution<double> noise(-0.75, 0.75);
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i)
-            data.points.emplace_back(i, j, noise(rng));
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const int a = j * (n + 1) + i;
-            data.faceCounts.push_back(4);
-            data.faceIndices.insert(data.faceIndices.end(), {a, a + 1, a + n + 2, a + n + 1});
-        }
-    const geom::Mesh sheet(std::move(data), "crumpled sheet");
-    std::uniform_int_distribution<int32_t> row(8, n - 8);
-    std::normal_distribution<double> gauss;
+TEST_CASE("slide on crumpled sheets: invariants where one-ring maps fold", "[slide]") {
+    // Random heights up to 4 edge lengths crumple 30 x 30 grids of quads: non-planar quads whose fan
+    // triangles overlap in the tangent plane, so some one-ring maps fold and leave directions in no
+    // sector, as on scanned meshes. (Before the walk started strictly inside a sector, such starts could
+    // walk through triangles the line never meets: here 1.16 |d| falloff, on a 32k-vertex scan 73.)
+    const int n = 30;
     Worst worst;
-    for (int c = 0; c < 60; ++c) {
-        const int32_t handle = row(rng) * (n + 1) + row(rng);
-        glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
-        d *= 1.5 / glm::length(d);
-        check(sheet, handle, d, 5.0, worst);
+    std::mt19937 rng(73);
+    for (int sheetIndex = 0; sheetIndex < 12; ++sheetIndex) {
+        geom::Mesh::Data data;
+        std::uniform_real_distribution<double> noise(-4.0, 4.0);
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i)
+                data.points.emplace_back(i, j, noise(rng));
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const int a = j * (n + 1) + i;
+                data.faceCounts.push_back(4);
+                data.faceIndices.insert(data.faceIndices.end(), {a, a + 1, a + n + 2, a + n + 1});
+            }
+        const geom::Mesh sheet(std::move(data), "crumpled sheet");
+        std::uniform_int_distribution<int32_t> row(8, n - 8);
+        std::normal_distribution<double> gauss;
+        for (int c = 0; c < 20; ++c) {
+            const int32_t handle = row(rng) * (n + 1) + row(rng);
+            glm::dvec3 d(gauss(rng), gauss(rng), gauss(rng));
+            d *= 1.5 / glm::length(d);
+            check(sheet, handle, d, 5.0, worst);
+        }
     }
     INFO("largest travel / (|d| falloff) " << worst.travelRatio << ", off the mesh " << worst.offMesh);
     CHECK(worst.finite);
