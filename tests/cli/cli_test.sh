@@ -65,6 +65,31 @@ for pair in "tube.obj before" "slide/tube_slid.obj after"; do
     cmp -s "$work/slide_$2.png" "$work/demo/slide/$2.png" ||
         { echo "FAIL slide-preview-$2: differs from the demo's slide/$2.png"; failures=$((failures + 1)); }
 done
+# docs/slide.md's real-model and bent-limb pictures: its commands remake the committed images byte for byte
+# (Spot's tail-dimple drag, with and without the fold limit; the slide after a bend in a scene).
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
+spot="$repo/tests/data/spot/spot_quadrangulated.obj"
+expect slide-spot 0 "$dk" slide "$spot" --handle 1858 --from 0,0,0 --to 0.0283,0.0717,-0.0088 --radius 0.2588 \
+    --out "$work/spot_slid.obj"
+contains slide-spot "$work/out" "moved 290, limited 0"
+expect slide-spot-fold 0 "$dk" slide "$spot" --handle 1858 --from 0,0,0 --to 0.0283,0.0717,-0.0088 --radius 0.2588 \
+    --fold-limit --out "$work/spot_fold_limit.obj"
+contains slide-spot-fold "$work/out" "flipped triangles 0,"
+mkdir -p "$work/examples"
+sed 's|"../../demo-out/tube.obj"|"../demo/tube.obj"|' "$repo/docs/examples/slide_limb.json" >"$work/examples/slide_limb.json"
+expect slide-limb 0 "$dk" eval "$work/examples/slide_limb.json" --out "$work/limb-out" --no-previews
+for pair in "$spot spot_before" "$work/spot_slid.obj spot_after" "$work/spot_fold_limit.obj spot_fold_limit" \
+    "$work/limb-out/limb.0001.obj limb_before" "$work/limb-out/limb.0002.obj limb_after"; do
+    set -- $pair
+    case $2 in
+    spot*) view=(--frame -0.25,-0.35,0.8,0.3,0.2,1.1 --view 0,0,-1) ;;
+    *) view=(--view -0.45,-0.3,-1) ;;
+    esac
+    expect "slide-picture-$2" 0 "$dk" preview "$1" --texture "$work/demo/slide/checker.<UDIM>.png" --width 400 \
+        --height 400 "${view[@]}" --out "$work/$2.png"
+    cmp -s "$work/$2.png" "$repo/docs/images/slide/$2.png" ||
+        { echo "FAIL slide-picture-$2: differs from docs/images/slide/$2.png"; failures=$((failures + 1)); }
+done
 # docs/ptex.md's commands remake the demo's Ptex pictures byte for byte, and each ptex subcommand runs.
 for pair in "ptex/tube.obj before" "ptex/tube_slid.obj after"; do
     set -- $pair
