@@ -127,6 +127,23 @@ def test_slide_follows_the_end_empty():
     assert_same(positions(obj), expected, "slide after dragging the end Empty")
     assert obj.deformkit.status == ""
 
+    # The paper's painted-weights rule and the fold limit reach the stack: a drag of 0.9 the radius folds the
+    # smooth falloff, and with the fold limit the result is the stack's with foldLimit 1.
+    entry.weights_are_falloff = True
+    entry.fold_limit = True
+    entry.end.location = (0.45, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    stack = direct_stack(obj, rest)
+    stack.add("slide", "s")
+    set_all(stack, 0, [("vertex", CENTRE), ("radius", 0.5), ("geodesic", 1), ("paintedWeights", 1),
+                       ("foldLimit", 1), ("falloff", 0), ("displacement", (0.45, 0.0, 0.0))])
+    assert_same(positions(obj), stack.evaluate(rest), "slide with the paper's rule and the fold limit")
+    entry.weights_are_falloff = False
+    entry.fold_limit = False
+    entry.end.location = (0.25, 0.125, 0.0)
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), expected, "slide back to the default rules")
+
     # A frame change that moves no control evaluates nothing: a marker written into the mesh stays.
     obj.data.vertices[0].co.z = 7.0
     bpy.context.scene.frame_set(2)

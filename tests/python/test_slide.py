@@ -350,3 +350,30 @@ def test_slide_in_a_stack_slides_over_the_bent_surface():
     normal /= np.linalg.norm(normal)
     tangent = d - d.dot(normal) * normal
     np.testing.assert_allclose(moved, tangent, atol=0.02 * np.linalg.norm(tangent))
+
+
+def test_stack_slide_parameters_painted_weights_and_fold_limit():
+    """The host deformer's paintedWeights and foldLimit (what scenes, Blender and Maya set): on a plane the
+    paper's rule moves each vertex inside the radius by its weight times d; the fold limit leaves no flip."""
+    pts, counts, idx = plane()
+    w = np.clip(0.2 + 0.3 * pts[:, 0], 0, 1).astype(np.float32)
+    stack = dk.DeformerStack()
+    stack.set_rest(dk.Mesh(pts, counts, idx))
+    stack.add("slide", "s")
+    d = np.array([0.05, 0.03, 0.0])
+    for name, value in [("vertex", HANDLE), ("radius", 0.6), ("paintedWeights", 1), ("displacement", d)]:
+        stack.set(0, name, value)
+    stack.set_weights(0, w)
+    inside = distances(pts, HANDLE) <= 0.6
+    np.testing.assert_allclose(stack.evaluate(pts), pts + (w * inside)[:, None] * d, atol=TOL)
+    stack.set_weights(0, None)
+    stack.set(0, "paintedWeights", 0)
+    stack.set(0, "foldLimit", 1)
+    stack.set(0, "displacement", [0.48, 0.0, 0.0])  # 0.8 r: folds without the limit
+    out = stack.evaluate(pts)
+    limited = dk.Slider(pts, counts, idx, handle=HANDLE, radius=0.6, fold_limit=True).evaluate(
+        np.float32([0.48, 0, 0]))
+    assert limited.flipped_triangles == 0
+    np.testing.assert_allclose(out, limited.points, atol=2e-7)
+    with pytest.raises(dk.InvalidInput, match="paintedWeights"):
+        stack.set(0, "paintedWeights", 2)
