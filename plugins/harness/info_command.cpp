@@ -44,6 +44,14 @@ void describeMesh(const fs::path& file, std::ostream& out) {
         for (int t : m.udimTiles())
             out << " " << t;
         out << "\n";
+        const geom::UdimOverhang overhang = geom::udimOverhang(m);
+        if (overhang.faces > 0) {
+            out << "warning     " << overhang.faces
+                << (overhang.faces == 1 ? " face overhangs its" : " faces overhang their")
+                << " UDIM tile, by up to " << overhang.worst << " of a tile (face " << overhang.worstFace
+                << (overhang.worst > 0.1f ? "); the UV warp refuses faces past 0.1 of a tile\n"
+                                          : "); the UV warp takes them (up to 0.1 of a tile)\n");
+        }
     } else {
         out << "uvs         none\n";
     }

@@ -90,6 +90,15 @@ for pair in "$spot spot_before" "$work/spot_slid.obj spot_after" "$work/spot_fol
     cmp -s "$work/$2.png" "$repo/docs/images/slide/$2.png" ||
         { echo "FAIL slide-picture-$2: differs from docs/images/slide/$2.png"; failures=$((failures + 1)); }
 done
+# A real UV layout with corners past its tile (Spot: six faces, up to 0.052 of a tile): info warns, and the UV
+# warp takes the tile and says so once.
+expect info-overhang 0 "$dk" info "$spot"
+contains info-overhang "$work/out" "warning     6 faces overhang their UDIM tile, by up to 0.0522"
+mkdir -p "$work/spotuv/out"
+cp "$spot" "$work/spotuv/spot.0001.obj"
+expect uvwarp-spot 0 "$dk" uvwarp --rest "$spot" --deformed "$work/spotuv/spot.####.obj" \
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --frames 1 --out "$work/spotuv/out/redirect.<UDIM>.####.exr"
+contains uvwarp-spot "$work/out" "tile 1001: 6 faces overhang the tile, by up to 0.0522"
 # docs/ptex.md's commands remake the demo's Ptex pictures byte for byte, and each ptex subcommand runs.
 for pair in "ptex/tube.obj before" "ptex/tube_slid.obj after"; do
     set -- $pair

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <mutex>
 #include <set>
+#include <span>
+
+#include <glm/common.hpp>
+#include <glm/vec2.hpp>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
@@ -127,13 +131,57 @@ int udimTileOf(const glm::vec2& uv) {
 
 std::vector<int> Mesh::udimTiles() const {
     std::set<int> tiles;
-    for (int32_t f = 0; f < numFaces() && hasUVs(); ++f) {
-        glm::vec2 centroid(0.0f);
-        for (int32_t t : faceUVIndices(f))
-            centroid += uvs_[t];
-        tiles.insert(udimTileOf(centroid / static_cast<float>(faceCounts_[f])));
-    }
+    for (int32_t f = 0; f < numFaces() && hasUVs(); ++f)
+        tiles.insert(faceUdimTile(f));
     return {tiles.begin(), tiles.end()};
+}
+
+namespace {
+
+// (column, row) of face f's tile: its UV centroid's, clamped into the UDIM range.
+glm::ivec2 faceTileCell(std::span<const glm::vec2> uvs, std::span<const int32_t> corners) {
+    glm::vec2 centroid(0.0f);
+    for (int32_t t : corners)
+        centroid += uvs[t];
+    centroid /= static_cast<float>(corners.size());
+    return {std::clamp(static_cast<int>(std::floor(centroid.x)), 0, 9),
+            std::max(static_cast<int>(std::floor(centroid.y)), 0)};
+}
+
+}  // namespace
+
+int Mesh::faceUdimTile(int32_t f) const {
+    if (!hasUVs()) return 0;
+    const glm::ivec2 cell = faceTileCell(uvs_, faceUVIndices(f));
+    return 1001 + cell.x + 10 * cell.y;
+}
+
+float Mesh::faceUdimOverhang(int32_t f) const {
+    if (!hasUVs()) return 0.0f;
+    const auto corners = faceUVIndices(f);
+    const glm::vec2 lo(faceTileCell(uvs_, corners));
+    const glm::vec2 hi = lo + 1.0f;
+    float overhang = 0.0f;
+    for (int32_t t : corners) {
+        const glm::vec2 outside = glm::max(lo - uvs_[t], uvs_[t] - hi);
+        overhang = std::max({overhang, outside.x, outside.y});
+    }
+    return overhang;
+}
+
+UdimOverhang udimOverhang(const Mesh& mesh, int tile, float tolerance) {
+    UdimOverhang out;
+    for (int32_t f = 0; f < mesh.numFaces() && mesh.hasUVs(); ++f) {
+        if (tile != 0 && mesh.faceUdimTile(f) != tile) continue;
+        const float overhang = mesh.faceUdimOverhang(f);
+        if (!(overhang > tolerance)) continue;
+        ++out.faces;
+        if (overhang > out.worst) {
+            out.worst = overhang;
+            out.worstFace = f;
+        }
+    }
+    return out;
 }
 
 const HalfEdgeMesh& Mesh::halfEdges() const {

@@ -47,10 +47,7 @@ std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
         const auto corners = mesh.face(f);
         const auto cornerUVs = mesh.faceUVIndices(f);
-        glm::vec2 centroid(0.0f);
-        for (int32_t t : cornerUVs)
-            centroid += uvs[t];
-        const int tile = geom::udimTileOf(centroid / static_cast<float>(cornerUVs.size()));
+        const int tile = mesh.faceUdimTile(f);
         const io::Image& image = imageOf(tile, f);
         sample.resize(static_cast<size_t>(image.channels));
         const float tileU = static_cast<float>((tile - 1001) % 10),

@@ -220,6 +220,14 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             s.plans.push_back(std::move(plan));
             continue;
         }
+        const geom::UdimOverhang overhang = geom::udimOverhang(*j.rest, tile);
+        if (overhang.faces > 0) {
+            std::ostringstream note;
+            note << overhang.faces << (overhang.faces == 1 ? " face overhangs" : " faces overhang")
+                 << " the tile, by up to " << overhang.worst << " of a tile (face " << overhang.worstFace
+                 << "): warped as far as the tile reaches";
+            plan.report.notes.push_back(note.str());
+        }
         const TileMap& r = plan.rigidity;
         if (r.width != r.height || r.width < 2) {
             throw InvalidInput(formatError(r.name, "rigidity map", texelsText(r.width, r.height),

@@ -10,11 +10,6 @@
 namespace deformkit::uvwarp::detail {
 namespace {
 
-bool insideTile(const glm::vec2& uv, const glm::vec2& origin) {
-    return uv.x >= origin.x - kTileTolerance && uv.x <= origin.x + 1.0f + kTileTolerance &&
-           uv.y >= origin.y - kTileTolerance && uv.y <= origin.y + 1.0f + kTileTolerance;
-}
-
 // One use of a UV edge by a face: welded endpoint ids (low, high), whether the face runs low -> high.
 struct EdgeUse {
     uint64_t key;
@@ -52,32 +47,33 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
     const auto uvIndices = mesh.uvIndices();
     const auto faceIndices = mesh.faceIndices();
 
-    // The tile's faces (by UV centroid, as Mesh::udimTiles()), rejecting faces of this tile that straddle.
+    // The tile's faces (Mesh::faceUdimTile), refusing those that overhang it by more than kMaxOverhang.
     std::vector<uint8_t> inTile(static_cast<size_t>(mesh.numFaces()), 0);
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
-        const auto corners = mesh.faceUVIndices(f);
-        glm::vec2 centroid(0.0f);
-        bool touches = false;
-        for (int32_t t : corners) {
-            centroid += uvs[t];
-            touches = touches || geom::udimTileOf(uvs[t]) == tile;
-        }
-        centroid /= static_cast<float>(corners.size());
-        const int home = geom::udimTileOf(centroid);
-        if (home != tile && !touches) continue;
-        const glm::vec2 homeOrigin(std::floor(centroid.x), std::floor(centroid.y));
-        for (size_t k = 0; k < corners.size(); ++k) {
-            const glm::vec2 uv = uvs[corners[k]];
-            if (!insideTile(uv, homeOrigin)) {
-                throw InvalidInput(formatError(source, "face " + std::to_string(f),
-                                               "straddles UDIM tiles: its UV centroid lies in tile " +
-                                                   std::to_string(home) + " but corner " + std::to_string(k) +
-                                                   " (" + std::to_string(uv.x) + ", " + std::to_string(uv.y) +
-                                                   ") lies in tile " + std::to_string(geom::udimTileOf(uv)),
-                                               "all corners of a face in one tile"));
+        if (mesh.faceUdimTile(f) != tile) continue;
+        const float overhang = mesh.faceUdimOverhang(f);
+        if (overhang > kMaxOverhang + kTileTolerance) {
+            const auto corners = mesh.faceUVIndices(f);
+            size_t worst = 0;
+            float reach = -1.0f;
+            for (size_t k = 0; k < corners.size(); ++k) {
+                const glm::vec2 uv = uvs[corners[k]] - out.origin;
+                const float outside = std::max({-uv.x, uv.x - 1.0f, -uv.y, uv.y - 1.0f});
+                if (outside > reach) {
+                    reach = outside;
+                    worst = k;
+                }
             }
+            const glm::vec2 uv = uvs[corners[worst]];
+            throw InvalidInput(formatError(
+                source, "face " + std::to_string(f),
+                "overhangs the tile by " + std::to_string(overhang) + " (corner " + std::to_string(worst) +
+                    " at (" + std::to_string(uv.x) + ", " + std::to_string(uv.y) + "), in tile " +
+                    std::to_string(geom::udimTileOf(uv)) + ")",
+                "a face whose UV corners reach at most " + std::to_string(kMaxOverhang) +
+                    " of a tile past the tile of its UV centroid"));
         }
-        if (home == tile) inTile[f] = 1;
+        inTile[f] = 1;
     }
 
     const geom::Triangulation tris = geom::triangulate(mesh);

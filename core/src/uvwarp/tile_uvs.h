@@ -18,6 +18,10 @@ namespace deformkit::uvwarp::detail {
 // How far (in UV units) a face's corner may lie outside the tile of the face's UV centroid before the
 // face counts as straddling two tiles: absorbs float rounding of UVs placed on a tile border.
 inline constexpr float kTileTolerance = 1e-5f;
+// How far (UV units, tile widths) a face's corners may overhang its tile (geom::Mesh::faceUdimTile): the
+// overhang of artists' layouts (a few corners past a tile edge), rasterised as far as the tile reaches and
+// reported; beyond it a face is refused as lying in two tiles.
+inline constexpr float kMaxOverhang = 0.1f;
 
 struct TileUVs {
     int tile = 0;
@@ -39,9 +43,10 @@ struct TileUVs {
 // InvalidInput naming `label` otherwise.
 [[nodiscard]] glm::vec2 tileOrigin(int tile, std::string_view label);
 
-// The fan triangles (geom::triangulate) of the faces whose UV centroid lies in `tile`, with their chart
-// borders. Throws InvalidInput naming `label` for a mesh without UVs, and naming the face for a face of
-// this tile whose corners lie in different tiles.
+// The fan triangles (geom::triangulate) of the faces of `tile` (geom::Mesh::faceUdimTile), with their
+// chart borders; corners overhanging the tile (up to kMaxOverhang) keep their tile-local UVs outside
+// [0, 1]. Throws InvalidInput naming `label` for a mesh without UVs, and naming the face and the tile for
+// a face of this tile that overhangs it farther.
 [[nodiscard]] TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label);
 
 }  // namespace deformkit::uvwarp::detail

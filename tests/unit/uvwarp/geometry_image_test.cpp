@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/geometry_image.h"
 #include "uvwarp_test_support.h"
 
@@ -311,15 +312,41 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         CHECK_THROWS_WITH(GeometryImager(bare, 1001, 8, options),
                           Catch::Contains("rest.obj") && Catch::Contains("no UVs"));
     }
-    SECTION("a face straddling two tiles") {
-        // Face 0 runs from u = 0.5 to u = 1.25: its centroid is in tile 1001, a corner in tile 1002.
+    SECTION("a face overhanging its tile by more than a tenth of a tile") {
+        // Face 0 runs from u = 0.5 to u = 1.25: its centroid is in tile 1001, a corner 0.25 into 1002.
         const geom::Mesh straddling = test::planarChart({0.5f, 0.2f}, {2.0f, 0.6f}, 2, 1, flat);
-        CHECK_THROWS_WITH(GeometryImager(straddling, 1002, 8, options),
-                          Catch::Contains("rest.obj") && Catch::Contains("UDIM tile 1002") &&
-                              Catch::Contains("face 0") && Catch::Contains("straddles"));
-        CHECK_THROWS_WITH(GeometryImager(straddling, 1001, 8, options), Catch::Contains("face 0"));
+        CHECK_THROWS_WITH(GeometryImager(straddling, 1001, 8, options),
+                          Catch::Contains("rest.obj") && Catch::Contains("UDIM tile 1001") &&
+                              Catch::Contains("face 0") && Catch::Contains("overhangs the tile by 0.25") &&
+                              Catch::Contains("in tile 1002"));
+        // Tile 1002's own face (u 1.25 to 2) is sound; face 0 belongs to tile 1001.
+        CHECK_NOTHROW(GeometryImager(straddling, 1002, 8, options));
     }
-    SECTION("a face on the tile border does not straddle") {
+    SECTION("corners overhanging a tile by up to a tenth are taken, as far as the tile reaches") {
+        // u from -0.08 to 0.72 in two faces: face 0 (centroid u = 0.12) overhangs tile 1001's left edge
+        // by 0.08; a face whose centroid itself lies left of u = 0 stays in tile 1001 (no tile 1000).
+        const geom::Mesh overhanging = test::planarChart({-0.08f, 0.2f}, {0.72f, 0.6f}, 2, 1, flat);
+        const geom::Mesh leftOfZero = test::planarChart({-0.09f, 0.2f}, {0.05f, 0.6f}, 1, 1, flat);
+        CHECK(overhanging.udimTiles() == std::vector<int>{1001});
+        CHECK(leftOfZero.udimTiles() == std::vector<int>{1001});
+        CHECK(leftOfZero.faceUdimOverhang(0) == Approx(0.09f));
+        const geom::UdimOverhang report = geom::udimOverhang(overhanging);
+        CHECK(report.faces == 1);
+        CHECK(report.worstFace == 0);
+        CHECK(report.worst == Approx(0.08f));
+        const GeometryImager imager(overhanging, 1001, 8, options);
+        // The tile's left column (u = 0) is covered from v = 0.2 to 0.6 (points j = 2..4 of 8 cells) by the
+        // overhanging face, and the geometry image there is the face's own position (u, v, 0).
+        const PointField field = imager.sample(overhanging.points());
+        for (int32_t j = 2; j <= 4; ++j) {
+            CHECK(imager.coverage()[static_cast<size_t>(j) * 9] == 1);
+            const float* p = &field.values[3 * (static_cast<size_t>(j) * 9)];
+            CHECK(p[0] == Approx(0.0f).margin(1e-6));
+            CHECK(p[1] == Approx(j / 8.0f).margin(1e-6));
+        }
+        CHECK_NOTHROW(GeometryImager(leftOfZero, 1001, 8, options));
+    }
+    SECTION("a face on the tile border does not overhang") {
         const geom::Mesh onBorder = test::planarChart({0.5f, 0.0f}, {1.0f, 1.0f}, 1, 1, flat);
         CHECK_NOTHROW(GeometryImager(onBorder, 1001, 8, options));
     }
@@ -345,4 +372,33 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         nan[4].y = std::numeric_limits<float>::quiet_NaN();
         CHECK_THROWS_WITH(imager.sample(nan, out), Catch::Contains("vertex 4"));
     }
+}
+
+TEST_CASE("geometry image of a real layout: Spot's corners past tile 1001 are taken",
+          "[uvwarp][geometry_image]") {
+    // Keenan Crane's Spot (tests/data/spot): six faces reach past tile 1001, by up to 0.052 of a tile
+    // (left of u = 0, and above v = 1), two of them with their UV centroid left of u = 0. Counted here from
+    // the UVs alone, against the mesh's report; the tile binds and covers its charts.
+    const geom::Mesh spot = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
+    int outside = 0;
+    float reach = 0.0f;
+    for (int32_t f = 0; f < spot.numFaces(); ++f) {
+        float faceReach = 0.0f;
+        for (int32_t t : spot.faceUVIndices(f)) {
+            const glm::vec2 uv = spot.uvs()[t];
+            faceReach = std::max({faceReach, -uv.x, uv.x - 1.0f, -uv.y, uv.y - 1.0f});
+        }
+        outside += faceReach > 1e-5f ? 1 : 0;
+        reach = std::max(reach, faceReach);
+    }
+    CHECK(spot.udimTiles() == std::vector<int>{1001});
+    const geom::UdimOverhang report = geom::udimOverhang(spot);
+    CHECK(report.faces == outside);
+    CHECK(outside == 6);
+    CHECK(report.worst == reach);
+    CHECK(reach == Approx(0.0522).margin(1e-4));
+    GeometryImageOptions options;
+    options.label = "spot";
+    const GeometryImager imager(spot, 1001, 256, options);
+    CHECK(imager.numCovered() > 256 * 256 / 4);
 }

@@ -66,8 +66,15 @@ class Mesh {
     }
 
     [[nodiscard]] Box3 bounds() const;
-    // The sorted UDIM tile numbers that UV faces touch (by each face's UV centroid). Empty without UVs.
+    // The sorted UDIM tile numbers of the faces (faceUdimTile). Empty without UVs.
     [[nodiscard]] std::vector<int> udimTiles() const;
+    // The UDIM tile face f belongs to: the tile of its UV centroid, the centroid's column clamped to 0..9
+    // and its row to >= 0, so a face overhanging the left or bottom edge of the UV space stays in the tile
+    // it overhangs. 0 without UVs.
+    [[nodiscard]] int faceUdimTile(int32_t f) const;
+    // How far face f's UV corners reach outside its tile (faceUdimTile), in tile widths (UV units): 0 for
+    // a face inside its tile, and without UVs.
+    [[nodiscard]] float faceUdimOverhang(int32_t f) const;
 
     // The half-edge connectivity, built on first use and cached (thread-safe).
     [[nodiscard]] const HalfEdgeMesh& halfEdges() const;
@@ -86,5 +93,14 @@ class Mesh {
 
 // UDIM tile number of a UV coordinate: 1001 + floor(u) + 10 floor(v). Valid for u in [0, 10), v >= 0.
 [[nodiscard]] int udimTileOf(const glm::vec2& uv);
+
+// Faces whose UV corners reach outside their UDIM tile by more than `tolerance` (UV units): how many, the
+// one that reaches farthest and how far. Only faces of `tile`, or of every tile when tile is 0.
+struct UdimOverhang {
+    int32_t faces = 0;
+    int32_t worstFace = -1;
+    float worst = 0.0f;
+};
+[[nodiscard]] UdimOverhang udimOverhang(const Mesh& mesh, int tile = 0, float tolerance = 1e-5f);
 
 }  // namespace deformkit::geom

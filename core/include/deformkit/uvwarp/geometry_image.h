@@ -41,8 +41,9 @@ class GeometryImager {
   public:
     // Binds the rest mesh's UV layout in `tile` on a grid of `cells` x `cells` cells (n, a power of two,
     // at most 32768). Throws InvalidInput naming the mesh label for: a mesh without UVs, a tile number
-    // that is not a UDIM tile, a face of this tile whose UV corners lie in different tiles (naming the
-    // face), a tile holding no UV triangle, cells not a power of two, dilationRings out of range.
+    // that is not a UDIM tile, a face of this tile (geom::Mesh::faceUdimTile) whose UV corners overhang it
+    // by more than 0.1 of a tile (naming the face), a tile holding no UV triangle, cells not a power of
+    // two, dilationRings out of range.
     GeometryImager(const geom::Mesh& rest, int tile, int32_t cells, const GeometryImageOptions& options = {});
 
     [[nodiscard]] int tile() const { return tile_; }
