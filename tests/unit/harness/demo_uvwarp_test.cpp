@@ -8,18 +8,21 @@ using namespace deformkit;
 
 TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to rest size, without folds",
           "[harness]") {
-    const harness::DemoAssets assets = harness::makeDemoAssets({128, 2});
+    // The demo's own maps (1024 texels, the figures docs/uvwarp.md reports), so the test holds the docs to
+    // their number.
+    const harness::DemoAssets assets = harness::makeDemoAssets({});
     const harness::DemoUvWarp demo = harness::makeDemoUvWarp(assets.mesh, assets.rigidity.at(1001),
                                                              assets.mask.at(1001), assets.albedo.at(1001));
     const uvwarp::WarpMetrics& m = demo.metrics;
     INFO("rigid stretch error: identity " << m.identityStretchError << ", warp " << m.rigidStretchError);
     // The bend stretches the outer side ~1.5x and squashes the inner side ~0.5x; compression cannot be fully
-    // undone in a bounded tile (paper §6), so the demo asks for a clear improvement, not the plane's 80%.
-    CHECK(m.rigidStretchError < 0.75 * m.identityStretchError);
+    // undone in a bounded tile (paper §6). docs/uvwarp.md reports 45% of the error removed (0.104 -> 0.057,
+    // measured 46.5%): the test asks for at least 44%, so the docs cannot drift from what the demo does.
+    CHECK(m.rigidStretchError < 0.56 * m.identityStretchError);
     CHECK(m.foldOvers == 0);
     CHECK(m.maxMaskedDisplacement == 0.0);
     CHECK(m.maxBorderDisplacement == 0.0);
-    REQUIRE(demo.redirect.width == 128);
+    REQUIRE(demo.redirect.width == assets.rigidity.at(1001).width);
     REQUIRE(demo.warpedAlbedo.width == assets.albedo.at(1001).width);
     // The bent mesh keeps the tube's topology and UVs.
     CHECK(demo.bent.numVertices() == assets.mesh.numVertices());
