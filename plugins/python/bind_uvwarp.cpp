@@ -374,6 +374,7 @@ py::dict tileReportDict(const uvwarp::ShotTileReport& t) {
     d["baked"] = t.baked;
     d["replayed"] = t.replayed;
     d["skipped"] = t.skipped;
+    d["map_changes"] = t.mapChanges;
     const bool solved = t.written + t.replayed > 0;
     d["last_frame"] = solved ? py::object(py::int_(t.lastFrame)) : py::none();
     d["metrics"] = solved ? py::object(metricsDict(t.lastMetrics)) : py::none();

@@ -437,3 +437,30 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
 def test_tile_frame_path_names_outputs():
     assert dk.tile_frame_path(OUT, 1001, 7) == "redirect.1001.0007.exr"
     assert dk.tile_frame_path("out/col.<UDIM>.%03d.exr", 1012, 24) == os.path.join("out", "col.1012.024.exr")
+
+
+def test_shot_follows_animated_rigidity_maps(tmp_path):
+    """rig.<UDIM>.####.exr: one map per frame. The warp gets a frame's map only when it changed (here at frame
+    3, to none): frames before it are the static job's bytes, frames from it differ, and the header names the
+    frame's map."""
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    maps, a, b = tmp_path / "maps", tmp_path / "a", tmp_path / "b"
+    for folder in (maps, a, b):
+        folder.mkdir()
+    for tile in rig:
+        for frame in FRAMES:
+            dk.write_image(maps / f"rig.{tile}.{frame:04d}.exr", rig[tile] if frame < 3 else np.zeros((S, S), np.float32),
+                           "float")
+    animated = dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), str(maps / "rig.<UDIM>.####.exr"),
+                              str(a / OUT), **OPTIONS)
+    still = dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(b / OUT), **OPTIONS)
+    for tile in (1001, 1002):
+        assert animated[tile]["map_changes"] == 1 and still[tile]["map_changes"] == 0
+        assert "maps changed at 1 frame" in animated[tile]["summary"][0]
+        for frame in FRAMES:
+            name = f"redirect.{tile}.{frame:04d}.exr"
+            same = np.array_equal(dk.read_image(a / name), dk.read_image(b / name))
+            assert same == (frame < 3), (tile, frame)
+        inputs = json.loads(dk.read_image_info(a / f"redirect.{tile}.0003.exr")["attributes"]["deformkit:uvwarp:inputs"])
+        assert inputs["rigidity"] == str(maps / f"rig.{tile}.0003.exr")

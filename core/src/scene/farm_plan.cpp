@@ -28,12 +28,12 @@ fs::path absolutePath(const fs::path& path) {
     return fs::absolute(path).lexically_normal();
 }
 
-// Every tile some object's UV-warp stage warps, ascending.
-std::vector<int> warpedTiles(const Scene& scene) {
+// Every tile some object's UV-warp stage warps (animated maps: those with a map at `frame`), ascending.
+std::vector<int> warpedTiles(const Scene& scene, int frame) {
     std::vector<int> tiles;
     for (const SceneObject& object : scene.objects) {
         if (!object.uvwarp) continue;
-        for (int tile : uvwarpWarpedTiles(*object.uvwarp))
+        for (int tile : uvwarpWarpedTiles(*object.uvwarp, frame))
             tiles.push_back(tile);
     }
     std::sort(tiles.begin(), tiles.end());
@@ -205,7 +205,7 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
         task.outputs = farmTaskOutputs(scene, first, last, {});
         plan.tasks.push_back(std::move(task));
     }
-    const std::vector<int> tiles = warpedTiles(scene);
+    const std::vector<int> tiles = warpedTiles(scene, frames.front());
     for (const auto& [first, last] : ranges) {
         for (size_t t = 0; t < tiles.size(); t += static_cast<size_t>(options.tilesPerTask)) {
             FarmTask task;

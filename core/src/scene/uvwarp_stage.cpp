@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "deformkit/error.h"
+#include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 
 namespace deformkit::scene {
@@ -19,8 +20,12 @@ bool fileExists(const fs::path& path) {
     return fs::exists(path, ec);
 }
 
-fs::path tileFile(const fs::path& pattern, int tile) {
-    return io::expandUdim(pattern.string(), tile);
+// The file of a per-tile map pattern for `tile` at `frame`: an animated map (a frame token in its file name
+// as well, uvwarp::ShotJob) has one per frame.
+fs::path tileFile(const fs::path& pattern, int tile, int frame) {
+    const std::string expanded = io::expandUdim(pattern.string(), tile);
+    if (io::ObjSequence::isPattern(expanded)) return io::ObjSequence(expanded).framePath(frame);
+    return expanded;
 }
 
 const SceneObject& stageObject(const Scene& scene, size_t object) {
@@ -62,10 +67,10 @@ std::string uvwarpBakeName(const SceneObject& object, int tile, int frame) {
                          object.uvwarp->texture->extension().string());
 }
 
-std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage) {
+std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame) {
     std::vector<int> tiles;
     for (int tile : stage.tiles) {
-        if (fileExists(tileFile(stage.rigidity, tile))) tiles.push_back(tile);
+        if (fileExists(tileFile(stage.rigidity, tile, frame))) tiles.push_back(tile);
     }
     return tiles;
 }
@@ -74,10 +79,10 @@ std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int 
     if (!object.uvwarp) return {};
     const SceneUvWarp& stage = *object.uvwarp;
     if (!std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile) ||
-        !fileExists(tileFile(stage.rigidity, tile)))
+        !fileExists(tileFile(stage.rigidity, tile, frame)))
         return {};
     std::vector<std::string> outputs = {uvwarpRedirectName(object.name, tile, frame)};
-    if (stage.texture && fileExists(tileFile(*stage.texture, tile)))
+    if (stage.texture && fileExists(tileFile(*stage.texture, tile, frame)))
         outputs.push_back(uvwarpBakeName(object, tile, frame));
     return outputs;
 }

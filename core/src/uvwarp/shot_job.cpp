@@ -30,7 +30,8 @@ namespace detail {
 // One tile's map from its source: a file of the pattern or an image in memory. `name` says where it came
 // from, for messages and headers.
 struct TileMap {
-    std::optional<std::filesystem::path> file;
+    std::optional<std::filesystem::path> file;  // an animated map: its file at the job's first frame
+    std::string framePattern;  // an animated map: the tile's files, a frame token in the name
     const io::Image* image = nullptr;
     std::string name;
     int32_t width = 0, height = 0;
@@ -47,6 +48,8 @@ struct TilePlan {
     int lastNeeded = -1;                                     // index of the last needed frame
     std::optional<TileWarp> warp;                            // bound at the first frame it solves
     io::Image texturePixels, redirect, baked;
+    // Animated maps: the rigidity, mask and orientation images last given to the warp, to tell a change.
+    io::Image lastRigidity, lastMask, lastOrientation;
     nlohmann::json inputs;
     ShotTileReport report;
 };
@@ -117,10 +120,40 @@ std::string texelsText(int32_t width, int32_t height) {
 
 // Finds `tile` in `source` and reads its size (a file's header only, so a wrong size stops the job before
 // anything is written).
-TileMap findTileMap(const TileMapSource& source, int tile) {
+TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int>& frames) {
     TileMap map;
     if (!source.pattern.empty()) {
-        const fs::path path = io::expandUdim(source.pattern.string(), tile);
+        const std::string tilePattern = io::expandUdim(source.pattern.string(), tile);
+        if (io::ObjSequence::isPattern(tilePattern)) {
+            // Animated: one file per frame. Found when the first frame's is there; then every frame's must
+            // be, with the same size (headers only), before anything is written.
+            const io::ObjSequence sequence(tilePattern);
+            map.name = tilePattern;
+            const fs::path first = sequence.framePath(frames.front());
+            if (!fileExists(first)) return map;
+            const io::ImageInfo info = io::readImageInfo(first);
+            map.file = first;
+            map.framePattern = tilePattern;
+            map.width = info.width;
+            map.height = info.height;
+            for (int frame : frames) {
+                const fs::path path = sequence.framePath(frame);
+                if (!fileExists(path)) {
+                    throw IoError(
+                        formatError(path.string(), "frame " + std::to_string(frame), "does not exist",
+                                    "a map for every frame of an animated map '" + tilePattern + "'"));
+                }
+                const io::ImageInfo frameInfo = io::readImageInfo(path);
+                if (frameInfo.width != info.width || frameInfo.height != info.height) {
+                    throw InvalidInput(formatError(
+                        path.string(), "frame " + std::to_string(frame),
+                        texelsText(frameInfo.width, frameInfo.height),
+                        texelsText(info.width, info.height) + ", the size of '" + first.string() + "'"));
+                }
+            }
+            return map;
+        }
+        const fs::path path = tilePattern;
         map.name = path.string();
         if (!fileExists(path)) return map;
         const io::ImageInfo info = io::readImageInfo(path);
@@ -169,7 +202,9 @@ struct ShotSolver::Impl {
             writeLog(baseLine(plan, k, "skipped"));
         }
     }
-    void bind(TilePlan& plan);
+    void bind(TilePlan& plan, int frame);
+    // Animated maps: gives the warp the frame's maps when they differ from the last ones.
+    void animateMaps(TilePlan& plan, int frame, nlohmann::json& frameInputs);
     void solveTile(TilePlan& plan, size_t k, std::span<const glm::vec3> deformed,
                    const std::string& inputName);
 };
@@ -213,7 +248,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                           "an existing folder for the outputs"));
             }
         }
-        plan.rigidity = findTileMap(j.rigidity, tile);
+        plan.rigidity = findTileMap(j.rigidity, tile, j.frames);
         if (!plan.rigidity.found()) {
             plan.report.warped = false;
             plan.report.notes.push_back("left unwarped: no rigidity map '" + plan.rigidity.name + "'");
@@ -247,7 +282,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             }
         };
         if (j.mask.given()) {
-            plan.mask = findTileMap(j.mask, tile);
+            plan.mask = findTileMap(j.mask, tile, j.frames);
             if (plan.mask.found()) {
                 sameSize(plan.mask, "warp mask");
             } else {
@@ -255,7 +290,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             }
         }
         if (j.orientation.given()) {
-            plan.orientation = findTileMap(j.orientation, tile);
+            plan.orientation = findTileMap(j.orientation, tile, j.frames);
             if (plan.orientation.found()) {
                 sameSize(plan.orientation, "orientation map");
             } else {
@@ -264,7 +299,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             }
         }
         if (wantBake) {
-            plan.texture = findTileMap(j.texture, tile);
+            plan.texture = findTileMap(j.texture, tile, j.frames);
             if (!plan.texture.found())
                 plan.report.notes.push_back("no texture '" + plan.texture.name + "': not baked");
         }
@@ -311,25 +346,76 @@ std::optional<int> ShotSolver::lastNeededFrame() const {
     return impl_->job.frames[static_cast<size_t>(last)];
 }
 
-void ShotSolver::Impl::bind(TilePlan& plan) {
-    const auto read = [&](const TileMap& map, const char* role) -> io::Image {
-        // Files are checked as they are read (values in [0, 1], finite), naming the file and texel; maps in
-        // memory by TileWarp, naming the source.
-        if (map.file) {
-            if (std::string_view(role) == "warp mask") return readWarpMask(*map.file, plan.tile);
-            return readRigidityMap(*map.file, plan.tile, role);
-        }
-        return map.image ? *map.image : io::Image{};
-    };
-    const io::Image rigidity = read(plan.rigidity, "rigidity map");
-    const io::Image mask = read(plan.mask, "warp mask");
-    const io::Image orientation = read(plan.orientation, "orientation map");
+namespace {
+
+// The file of `map` at `frame`: its frame's file when animated, its one file otherwise.
+std::optional<fs::path> mapFile(const TileMap& map, int frame) {
+    if (!map.framePattern.empty()) return io::ObjSequence(map.framePattern).framePath(frame);
+    return map.file;
+}
+
+io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
+    // Files are checked as they are read (values in [0, 1], finite), naming the file and texel; maps in
+    // memory by TileWarp, naming the source.
+    if (const std::optional<fs::path> file = mapFile(map, frame)) {
+        if (std::string_view(role) == "warp mask") return readWarpMask(*file, tile);
+        return readRigidityMap(*file, tile, role);
+    }
+    return map.image ? *map.image : io::Image{};
+}
+
+bool samePixels(const io::Image& a, const io::Image& b) {
+    return a.width == b.width && a.height == b.height && a.channels == b.channels && a.pixels == b.pixels;
+}
+
+}  // namespace
+
+void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
+    const io::Image rigidity = readMap(plan.rigidity, frame, plan.tile, "rigidity map");
+    const io::Image mask = readMap(plan.mask, frame, plan.tile, "warp mask");
+    const io::Image orientation = readMap(plan.orientation, frame, plan.tile, "orientation map");
     if (plan.texture.file) {
-        plan.texturePixels = io::readImage(*plan.texture.file);
+        plan.texturePixels = io::readImage(*mapFile(plan.texture, frame));
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
     }
     plan.warp.emplace(*job.rest, plan.tile, rigidity, mask, job.options, orientation, job.restName);
+    if (!plan.rigidity.framePattern.empty()) plan.lastRigidity = rigidity;
+    if (!plan.mask.framePattern.empty()) plan.lastMask = mask;
+    if (!plan.orientation.framePattern.empty()) plan.lastOrientation = orientation;
+}
+
+void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame, json& frameInputs) {
+    const bool rigidityMoves = !plan.rigidity.framePattern.empty();
+    const bool maskMoves = !plan.mask.framePattern.empty();
+    const bool orientationMoves = !plan.orientation.framePattern.empty();
+    if (rigidityMoves) frameInputs["rigidity"] = mapFile(plan.rigidity, frame)->string();
+    if (maskMoves) frameInputs["mask"] = mapFile(plan.mask, frame)->string();
+    if (orientationMoves) frameInputs["orientation"] = mapFile(plan.orientation, frame)->string();
+    if (!plan.texture.framePattern.empty()) plan.texturePixels = io::readImage(*mapFile(plan.texture, frame));
+    if (!rigidityMoves && !maskMoves && !orientationMoves) return;
+    bool changed = false;
+    const auto next = [&](const TileMap& map, io::Image& last, const char* role) {
+        if (map.framePattern.empty()) return;
+        io::Image image = readMap(map, frame, plan.tile, role);
+        if (!samePixels(image, last)) {
+            last = std::move(image);
+            changed = true;
+        }
+    };
+    next(plan.rigidity, plan.lastRigidity, "rigidity map");
+    next(plan.mask, plan.lastMask, "warp mask");
+    next(plan.orientation, plan.lastOrientation, "orientation map");
+    if (!changed) return;
+    // The maps that do not move are read again from their one file (or image) to hand the warp a full set.
+    const io::Image rigidity =
+        rigidityMoves ? plan.lastRigidity : readMap(plan.rigidity, frame, plan.tile, "rigidity map");
+    const io::Image mask = maskMoves ? plan.lastMask : readMap(plan.mask, frame, plan.tile, "warp mask");
+    const io::Image orientation = orientationMoves
+                                      ? plan.lastOrientation
+                                      : readMap(plan.orientation, frame, plan.tile, "orientation map");
+    plan.warp->setMaps(rigidity, mask, orientation);
+    ++plan.report.mapChanges;
 }
 
 void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::vec3> deformed,
@@ -337,7 +423,17 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     ShotTileReport& r = plan.report;
     const int frame = job.frames[k];
     const Clock::time_point start = Clock::now();
-    if (!plan.warp) bind(plan);
+    json frameInputs = plan.inputs;
+    if (!plan.warp) {
+        bind(plan, frame);
+        if (!plan.rigidity.framePattern.empty())
+            frameInputs["rigidity"] = mapFile(plan.rigidity, frame)->string();
+        if (!plan.mask.framePattern.empty()) frameInputs["mask"] = mapFile(plan.mask, frame)->string();
+        if (!plan.orientation.framePattern.empty())
+            frameInputs["orientation"] = mapFile(plan.orientation, frame)->string();
+    } else {
+        animateMaps(plan, frame, frameInputs);
+    }
     TileWarp& warp = *plan.warp;
     Clock::time_point t = Clock::now();
     warp.solve(deformed);
@@ -352,7 +448,6 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
         warp.redirect(plan.redirect);
         seconds["invert"] = secondsSince(t);
         io::ImageWriteOptions attributes;
-        json frameInputs = plan.inputs;
         frameInputs["deformed"] = inputName;
         attributes.attributes = {
             {"deformkit:version", kVersionString},
@@ -560,6 +655,8 @@ std::vector<std::string> shotSummary(const ShotReport& report) {
             line << tile << t.written << (t.written == 1 ? " frame" : " frames") << " written";
             if (t.baked > 0) line << " (" << t.baked << " baked)";
             line << ", " << t.replayed << " replayed, " << t.skipped << " skipped (outputs exist)";
+            if (t.mapChanges > 0)
+                line << ", maps changed at " << t.mapChanges << (t.mapChanges == 1 ? " frame" : " frames");
             if (t.written + t.replayed > 0) {
                 line << "; frame " << t.lastFrame << ": rigid stretch error "
                      << t.lastMetrics.rigidStretchError << " (identity " << t.lastMetrics.identityStretchError

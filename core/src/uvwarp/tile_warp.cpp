@@ -29,6 +29,7 @@ struct TileWarp::Impl {
     int32_t cells = 0;
     std::unique_ptr<GeometryImager> imager;
     PointField deformed, rigidity, mask;  // f_O lives in the solver
+    PointField boundMask;                 // the constructor's mask (given or derived): setMaps' default
     std::unique_ptr<Solver> solver;
     bool solved = false;
 };
@@ -80,6 +81,7 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});
     }
+    m.boundMask = m.mask;
     m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
                                         orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
 }
@@ -115,6 +117,32 @@ WarpMetrics TileWarp::metrics() const {
 
 void TileWarp::reset() {
     impl_->solver->reset();
+}
+
+void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const io::Image& orientation) {
+    Impl& m = *impl_;
+    const auto sameSize = [&](const io::Image& map, const char* what) {
+        requireSquare(map, m.source, m.tile, what);
+        if (map.width != m.texels) {
+            throw InvalidInput(
+                formatError(m.source, std::string(what) + ", UDIM tile " + std::to_string(m.tile),
+                            std::to_string(map.width) + " texels per side",
+                            std::to_string(m.texels) + ", the size of the bound rigidity map"));
+        }
+    };
+    sameSize(rigidity, "rigidity map");
+    if (!mask.pixels.empty()) sameSize(mask, "warp mask");
+    if (!orientation.pixels.empty()) sameSize(orientation, "orientation map");
+    PointField newRigidity = rigidityAtPoints(rigidity, m.cells, {m.source + " rigidity map", m.tile});
+    PointField newMask =
+        mask.pixels.empty() ? m.boundMask : maskAtPoints(mask, m.cells, {m.source + " warp mask", m.tile});
+    PointField orientationAtPoints;
+    if (!orientation.pixels.empty()) {
+        orientationAtPoints = rigidityAtPoints(orientation, m.cells, {m.source + " orientation map", m.tile});
+    }
+    m.solver->setMaps(newRigidity, newMask, orientationAtPoints);
+    m.rigidity = std::move(newRigidity);
+    m.mask = std::move(newMask);
 }
 
 int TileWarp::tile() const {

@@ -129,7 +129,7 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     CHECK(object.uvwarp->rigidity == shot.dir / "rig.<UDIM>.exr");
     CHECK(object.uvwarp->options.solver.iterations == 6);
     CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
-    CHECK(scene::uvwarpWarpedTiles(*object.uvwarp) == std::vector<int>{1001, 1002});
+    CHECK(scene::uvwarpWarpedTiles(*object.uvwarp, 1) == std::vector<int>{1001, 1002});
     CHECK(scene::uvwarpOutputs(object, 1001, 7) ==
           std::vector<std::string>{"tubes.redirect.1001.0007.exr", "tubes.bake.1001.0007.exr"});
     CHECK(scene::uvwarpOutputs(object, 1002, -2) ==
@@ -325,6 +325,45 @@ TEST_CASE(
     CHECK(test::readText(lost) == before);
     CHECK(fs::last_write_time(shot.dir / "farm" / "tubes.bake.1001.0002.exr") == past);
     CHECK_THAT(log.str(), Contains("\"status\":\"replayed\""));
+}
+
+TEST_CASE("scene uvwarp: an animated rigidity map (rig.<UDIM>.####.exr) is followed frame by frame",
+          "[harness][uvwarp][eval]") {
+    // The disks at frames 1-2, rigidity 0 at frame 3: eval's maps equal a TileWarp given the new map at
+    // frame 3, and the farm plan sees the tiles of the animated map.
+    Shot shot;
+    io::ImageWriteOptions floats;
+    floats.type = io::PixelType::Float;
+    for (int tile : {1001, 1002})
+        for (int frame = 1; frame <= 3; ++frame)
+            io::writeImage(
+                shot.dir / ("rig." + std::to_string(tile) + ".000" + std::to_string(frame) + ".exr"),
+                frame <= 2 ? disks() : io::Image(kTexels, kTexels, 1), floats);
+    std::string text = kScene;
+    text.replace(text.find("rig.<UDIM>.exr"), std::string("rig.<UDIM>.exr").size(), "rig.<UDIM>.####.exr");
+    test::writeText(shot.scene, text);
+    harness::EvalCommand command;
+    command.scene = shot.scene;
+    command.outDir = shot.dir / "eval";
+    command.previews = false;
+    const harness::EvalReport report = harness::evalCommand(command);
+    REQUIRE(!report.uvwarpLines.empty());
+    CHECK_THAT(report.uvwarpLines[0], Contains("maps changed at 1 frame"));
+    uvwarp::TileWarpOptions options;
+    options.solver.iterations = 6;
+    for (int tile : {1001, 1002}) {
+        uvwarp::TileWarp warp(shot.rest, tile, disks(), {}, options);
+        for (int frame = 1; frame <= 3; ++frame) {
+            if (frame == 3) warp.setMaps(io::Image(kTexels, kTexels, 1));
+            warp.solve(stackPoints(shot.rest, frame));
+            const io::Image written =
+                io::readImage(command.outDir / scene::uvwarpRedirectName("tubes", tile, frame));
+            CHECK(written.pixels == warp.redirect().pixels);
+        }
+    }
+    const scene::Scene parsed = scene::readScene(shot.scene);
+    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, 1) == std::vector<int>{1001, 1002});
+    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, 7).empty());  // no map at frame 7
 }
 
 TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm][errors]") {

@@ -178,6 +178,76 @@ TEST_CASE("shot job: maps from files give the pixels of the same maps in memory"
     }
 }
 
+TEST_CASE("shot job: animated maps are given to the warp when they change, and only then",
+          "[uvwarp][shot_job]") {
+    // rig.<UDIM>.####.exr: the disks for frames 1 and 2, none (rigidity 0) from frame 3. The reference is a
+    // TileWarp solved frame by frame and given the new map at frame 3 (TileWarp::setMaps); frames 1-2 are
+    // the static job's bytes; rigidity 0 warps nothing, so the new map's frames drift back towards the
+    // identity instead of continuing the disks' warp.
+    Shot animated, still;
+    const io::Image none(kTexels, kTexels, 1);
+    for (const int tile : {1001, 1002}) {
+        for (int f = 1; f <= kFrames; ++f) {
+            const fs::path file = animated.dir / ("rig." + std::to_string(tile) + "." +
+                                                  std::to_string(f).insert(0, 4 - 1, '0') + ".exr");
+            io::writeImage(file, f <= 2 ? disks() : none, {io::PixelType::Float, {}});
+        }
+    }
+    animated.job.rigidity = {};
+    animated.job.rigidity.pattern = animated.dir / "rig.<UDIM>.####.exr";
+    const uvwarp::ShotReport report = uvwarp::runShotJob(animated.job, animated.frames());
+    (void)uvwarp::runShotJob(still.job, still.frames());
+    REQUIRE(report.tiles.size() == 2);
+    for (const uvwarp::ShotTileReport& t : report.tiles)
+        CHECK(t.mapChanges == 1);
+    CHECK_THAT(uvwarp::shotSummary(report)[0], Contains("maps changed at 1 frame"));
+    for (const int tile : {1001, 1002}) {
+        uvwarp::TileWarp reference(animated.rest, tile, disks());
+        for (int f = 1; f <= kFrames; ++f) {
+            if (f == 3) reference.setMaps(none);
+            reference.solve(deformedAt(animated.rest, f));
+            const io::Image written = io::readImage(animated.out(tile, f));
+            CHECK(test::sameBits(written.pixels, reference.redirect().pixels));
+            const bool same = test::sameBits(written.pixels, io::readImage(still.out(tile, f)).pixels);
+            CHECK(same == (f <= 2));
+        }
+    }
+    // The header names the frame's map.
+    const io::ImageInfo info = io::readImageInfo(animated.out(1001, 3));
+    std::map<std::string, std::string> attributes(info.attributes.begin(), info.attributes.end());
+    CHECK_THAT(attributes["deformkit:uvwarp:inputs"], Contains("rig.1001.0003.exr"));
+
+    // A frame without its map stops the job before anything is written, naming the file.
+    Shot missing;
+    for (const int tile : {1001, 1002})
+        for (const int f : {1, 2, 4})
+            io::writeImage(
+                missing.dir / ("rig." + std::to_string(tile) + ".000" + std::to_string(f) + ".exr"), disks(),
+                {io::PixelType::Float, {}});
+    missing.job.rigidity = {};
+    missing.job.rigidity.pattern = missing.dir / "rig.<UDIM>.####.exr";
+    CHECK_THAT(test::errorOf<Error>([&] { (void)uvwarp::runShotJob(missing.job, missing.frames()); }),
+               Contains("rig.1001.0003.exr") && Contains("does not exist"));
+    CHECK_FALSE(fs::exists(missing.out(1001, 1)));
+}
+
+TEST_CASE("tile warp: new maps keep the warm start; a map of another size is refused", "[uvwarp]") {
+    // setMaps with the same maps changes nothing: the next solve gives the bytes of a warp never given them
+    // (the warp and its velocities are kept, not reset).
+    const geom::Mesh rest = twoTiles();
+    uvwarp::TileWarp a(rest, 1001, disks()), b(rest, 1001, disks());
+    a.solve(deformedAt(rest, 2));
+    b.solve(deformedAt(rest, 2));
+    b.setMaps(disks());
+    CHECK(test::sameBits(a.solve(deformedAt(rest, 3)).u, b.solve(deformedAt(rest, 3)).u));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { b.setMaps(io::Image(16, 16, 1)); }),
+               Contains("rigidity map") && Contains("16 texels per side") && Contains("32"));
+    io::Image outOfRange = disks();
+    outOfRange.at(3, 4, 0) = 2.0f;
+    CHECK_THROWS_AS(b.setMaps(outOfRange), InvalidInput);
+    CHECK(test::sameBits(a.solve(deformedAt(rest, 4)).u, b.solve(deformedAt(rest, 4)).u));  // unchanged
+}
+
 TEST_CASE("shot job: a cancelled job leaves complete files and a rerun writes an uninterrupted job's bytes",
           "[uvwarp][shot_job]") {
     Shot whole;

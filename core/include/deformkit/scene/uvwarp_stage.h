@@ -38,9 +38,9 @@ namespace deformkit::scene {
 // "<object>.bake.<tile>.<frame><texture extension>" (the stage must have a texture).
 [[nodiscard]] std::string uvwarpBakeName(const SceneObject& object, int tile, int frame);
 
-// The stage's tiles that are warped: those with a rigidity map on disk, ascending. A tile without one is
-// left unwarped (no outputs).
-[[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage);
+// The stage's tiles that are warped: those with a rigidity map on disk (an animated map: its file at
+// `frame`), ascending. A tile without one is left unwarped (no outputs).
+[[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame);
 
 // The files the object's stage writes for `tile` at `frame`: the redirect map, then the bake when the
 // stage has a texture and the tile's texture exists. Empty without a stage or for a tile it does not warp.

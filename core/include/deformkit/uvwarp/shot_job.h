@@ -45,6 +45,10 @@ namespace deformkit::uvwarp {
 //   map is left unwarped (no outputs) and reported, unless no tile has one (an error). A missing mask tile is
 //   derived from the UVs, a missing orientation tile means 1 everywhere, a missing texture tile is not baked;
 //   each is reported.
+// - Animated maps: a rigidity, mask, orientation or texture pattern with a frame token in its file name as
+//   well ("rig.<UDIM>.####.exr", io::ObjSequence tokens) has one file per frame, each checked to exist with
+//   the first one's size before anything is written. The warp gets a frame's maps only when they differ
+//   from the last ones (ShotTileReport::mapChanges), rebuilding its hierarchy and keeping the warm start.
 
 // A per-tile map: a UDIM pattern of files ("rig.<UDIM>.exr", io/udim.h tokens) or images a host holds in
 // memory (painted maps), by tile. Images are T x T (channel 0 used), rows from the top (io::Image).
@@ -90,6 +94,7 @@ struct ShotTileReport {
     int32_t baked = 0;                         // bakes written
     int32_t replayed = 0;                      // outputs existed; solved to carry the warm start
     int32_t skipped = 0;                       // outputs existed; not solved
+    int32_t mapChanges = 0;                    // frames whose animated maps differed from the last (rebuilt)
     int lastFrame = 0;                         // the last frame solved (replayed or written)
     WarpMetrics lastMetrics;                   // of lastFrame
     std::vector<std::filesystem::path> files;  // written, in order

@@ -51,6 +51,11 @@ class TileWarp {
     [[nodiscard]] WarpMetrics metrics() const;
     // Back to the identity warp (a cut in the shot).
     void reset();
+    // New maps for the next frames (animated maps, a painter's edit): the same size as the bound rigidity
+    // map; an empty mask keeps the mask derived from the UVs (or the bound one), an empty orientation means
+    // 1 everywhere. Rebuilds the solver's hierarchy (Eq. 7-8) and keeps the warp, so the next solve warm-
+    // starts from it. Throws InvalidInput as the constructor does for a map of the wrong size or values.
+    void setMaps(const io::Image& rigidity, const io::Image& mask = {}, const io::Image& orientation = {});
 
     [[nodiscard]] int tile() const;
     [[nodiscard]] int32_t texels() const;
