@@ -236,6 +236,12 @@ void addUvWarpCommand(CommandLine& cli) {
                 "texels of chart border kept fixed by a derived mask")
         .positive()
         .showDefault();
+    uvwarp
+        .option("--orientation-density", o->command.options.densityOrientationRadius,
+                "without --orientation: orientation preservation from the rigidity's local density over a "
+                "window of this radius, texels (the paper's heuristic for severe compression); 0: off")
+        .nonNegative()
+        .showDefault();
 }
 
 }  // namespace deformkit::harness

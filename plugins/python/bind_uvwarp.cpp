@@ -42,7 +42,7 @@ using uvwarp::TileWarpOptions;
 
 constexpr const char* kOptionNames =
     "iterations, levels, sweeps_per_level, orientation_preservation, smoothing, damping, coarse_stiffness, "
-    "border_width, dilation_rings";
+    "border_width, dilation_rings, orientation_density";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
 // names the texel.
@@ -136,6 +136,8 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
             if (o.dilationRings > 64)
                 throw InvalidInput(
                     formatError(source, k, "is " + std::to_string(o.dilationRings), "an integer in [0, 64]"));
+        } else if (k == "orientation_density") {
+            o.densityOrientationRadius = intOption(value, source, k, 0, "0 (off) or a radius in texels");
         } else {
             throw InvalidInput(formatError(source, k, "is not an option", kOptionNames));
         }
@@ -523,7 +525,10 @@ constexpr const char* kSolverDoc =
     "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n"
     "options: iterations (12), levels (0: automatic), sweeps_per_level ([1, 2, 4], finest first),\n"
     "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
-    "border_width (1 texel, derived mask), dilation_rings (4, geometry images).";
+    "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
+    "off;\n"
+    "a radius in texels: without an orientation map, orientation preservation follows the rigidity's local\n"
+    "density, the paper's heuristic for severe compression).";
 
 constexpr const char* kSolveDoc =
     "Solve one frame: deformed_points (N, 3) float32, the rest mesh's vertices moved (scene units).\n"

@@ -415,9 +415,10 @@ class Reader {
             const json& params = v.at("params");
             const std::string pp = path + ".params";
             requireObject(params, pp, "an object of UV-warp options by name");
-            onlyKeys(params, pp,
-                     {"iterations", "levels", "sweepsPerLevel", "orientationPreservation", "smoothing",
-                      "damping", "coarseStiffness", "dilationRings", "maskBorderWidth"});
+            onlyKeys(
+                params, pp,
+                {"iterations", "levels", "sweepsPerLevel", "orientationPreservation", "smoothing", "damping",
+                 "coarseStiffness", "dilationRings", "maskBorderWidth", "orientationDensity"});
             uvwarp::SolverOptions& o = u.options.solver;
             auto get = [&](const char* name) -> const json* {
                 return params.contains(name) ? &params.at(name) : nullptr;
@@ -455,6 +456,9 @@ class Reader {
             if (const json* x = get("maskBorderWidth"))
                 u.options.derivedMask.borderWidth =
                     static_cast<int32_t>(ranged(*x, pp + ".maskBorderWidth", 1, 64, true, "1 to 64"));
+            if (const json* x = get("orientationDensity"))
+                u.options.densityOrientationRadius = static_cast<int32_t>(
+                    ranged(*x, pp + ".orientationDensity", 0, 4096, true, "0 (off) to 4096 texels"));
         }
         return u;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
@@ -228,6 +229,48 @@ PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& la
             out.values[out.index(i, j)] = value;
         }
     }
+    return out;
+}
+
+io::Image densityOrientationMap(const io::Image& rigidity, int32_t radius) {
+    if (rigidity.width <= 0 || rigidity.height <= 0 || rigidity.channels < 1) {
+        throw InvalidInput(formatError("density orientation", "rigidity map", "is empty", "an image"));
+    }
+    if (radius < 1) {
+        throw InvalidInput(
+            formatError("density orientation", "radius", "is " + std::to_string(radius), "at least 1 texel"));
+    }
+    const int32_t w = rigidity.width, h = rigidity.height;
+    // Summed-area table in double: every window sum exact enough to compare windows bit for bit.
+    std::vector<double> sat(static_cast<size_t>(w + 1) * (h + 1), 0.0);
+    for (int32_t y = 0; y < h; ++y) {
+        double row = 0.0;
+        for (int32_t x = 0; x < w; ++x) {
+            row += static_cast<double>(rigidity.at(x, y, 0));
+            sat[static_cast<size_t>(y + 1) * (w + 1) + x + 1] =
+                sat[static_cast<size_t>(y) * (w + 1) + x + 1] + row;
+        }
+    }
+    std::vector<double> mean(static_cast<size_t>(w) * h);
+    double largest = 0.0;
+    for (int32_t y = 0; y < h; ++y) {
+        const int32_t y0 = std::max(y - radius, 0), y1 = std::min(y + radius, h - 1) + 1;
+        for (int32_t x = 0; x < w; ++x) {
+            const int32_t x0 = std::max(x - radius, 0), x1 = std::min(x + radius, w - 1) + 1;
+            const auto at = [&](int32_t i, int32_t j) { return sat[static_cast<size_t>(j) * (w + 1) + i]; };
+            const double sum = at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);
+            const double m = sum / (static_cast<double>(x1 - x0) * (y1 - y0));
+            mean[static_cast<size_t>(y) * w + x] = m;
+            largest = std::max(largest, m);
+        }
+    }
+    io::Image out(w, h, 1);
+    for (int32_t y = 0; y < h; ++y)
+        for (int32_t x = 0; x < w; ++x)
+            out.at(x, y, 0) =
+                largest > 0.0
+                    ? static_cast<float>(std::clamp(mean[static_cast<size_t>(y) * w + x] / largest, 0.0, 1.0))
+                    : 0.0f;
     return out;
 }
 

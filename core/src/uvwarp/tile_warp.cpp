@@ -6,6 +6,7 @@
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/inversion.h"
+#include "deformkit/uvwarp/mask.h"
 
 namespace deformkit::uvwarp {
 
@@ -30,6 +31,7 @@ struct TileWarp::Impl {
     std::unique_ptr<GeometryImager> imager;
     PointField deformed, rigidity, mask;  // f_O lives in the solver
     PointField boundMask;                 // the constructor's mask (given or derived): setMaps' default
+    int32_t densityRadius = 0;            // TileWarpOptions::densityOrientationRadius
     std::unique_ptr<Solver> solver;
     bool solved = false;
 };
@@ -77,9 +79,18 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     } else {
         m.mask = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
     }
+    if (options.densityOrientationRadius < 0) {
+        throw InvalidInput(formatError(source, "density orientation radius",
+                                       "is " + std::to_string(options.densityOrientationRadius),
+                                       "0 (off) or a radius in texels"));
+    }
+    m.densityRadius = options.densityOrientationRadius;
     PointField orientationAtPoints;
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});
+    } else if (m.densityRadius > 0) {
+        orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
+                                               {source + " density orientation", tile});
     }
     m.boundMask = m.mask;
     m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
@@ -139,6 +150,9 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     PointField orientationAtPoints;
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {m.source + " orientation map", m.tile});
+    } else if (m.densityRadius > 0) {
+        orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
+                                               {m.source + " density orientation", m.tile});
     }
     m.solver->setMaps(newRigidity, newMask, orientationAtPoints);
     m.rigidity = std::move(newRigidity);

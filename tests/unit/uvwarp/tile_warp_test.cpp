@@ -4,6 +4,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/inversion.h"
+#include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/tile_warp.h"
 
 using namespace deformkit;
@@ -105,4 +106,53 @@ TEST_CASE("tile warp: bad maps name the tile and what was expected", "[uvwarp]")
     uvwarp::TileWarp tile(mesh, 1001, io::Image(64, 64, 1));
     const std::vector<glm::vec3> wrongCount(5);
     CHECK_THROWS_AS(tile.solve(wrongCount), InvalidInput);
+}
+
+TEST_CASE("tile warp: the density heuristic for orientation preservation", "[uvwarp][options]") {
+    // densityOrientationMap against a brute-force window mean written here: a rigid left half, a rigid disk
+    // on the right; the map is the mean over the clamped (2r + 1)^2 window divided by its largest value.
+    const int t = 32, r = 3;
+    io::Image rigidity(t, t, 1);
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x)
+            rigidity.at(x, y, 0) = x < t / 2 || std::hypot(x - 24.0, y - 16.0) < 4.0 ? 1.0f : 0.0f;
+    const io::Image density = uvwarp::densityOrientationMap(rigidity, r);
+    std::vector<double> mean(static_cast<size_t>(t) * t);
+    double largest = 0.0;
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x) {
+            double sum = 0.0;
+            int count = 0;
+            for (int wy = std::max(0, y - r); wy <= std::min(t - 1, y + r); ++wy)
+                for (int wx = std::max(0, x - r); wx <= std::min(t - 1, x + r); ++wx) {
+                    sum += rigidity.at(wx, wy, 0);
+                    ++count;
+                }
+            mean[static_cast<size_t>(y) * t + x] = sum / count;
+            largest = std::max(largest, sum / count);
+        }
+    double worst = 0.0;
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x)
+            worst = std::max(worst,
+                             std::abs(density.at(x, y, 0) - mean[static_cast<size_t>(y) * t + x] / largest));
+    CHECK(worst < 1e-6);
+    CHECK(density.at(2, 2, 0) == 1.0f);   // dense: the rigid half
+    CHECK(density.at(30, 2, 0) == 0.0f);  // sparse: nothing rigid near
+    CHECK(uvwarp::densityOrientationMap(io::Image(8, 8, 1), 2).pixels == std::vector<float>(64, 0.0f));
+    CHECK_THROWS_AS(uvwarp::densityOrientationMap(rigidity, 0), InvalidInput);
+
+    // The option is that map painted as the orientation map, bit for bit.
+    const geom::Mesh plane = uvPlane(8);
+    const std::vector<glm::vec3> squeezed = stretched(plane, 0.5f);  // severe compression
+    uvwarp::TileWarpOptions options;
+    options.densityOrientationRadius = r;
+    uvwarp::TileWarp heuristic(plane, 1001, rigidity, {}, options);
+    uvwarp::TileWarp painted(plane, 1001, rigidity, {}, {}, density);
+    uvwarp::TileWarp uniform(plane, 1001, rigidity);
+    const std::vector<float> a = heuristic.solve(squeezed).u;
+    const std::vector<float> b = painted.solve(squeezed).u;
+    const std::vector<float> c = uniform.solve(squeezed).u;
+    CHECK(a == b);
+    CHECK(a != c);
 }

@@ -56,6 +56,14 @@ void validateRigidityMap(const io::Image& rigidity, const MapLabel& label = {});
 [[nodiscard]] io::Image readRigidityMap(const std::filesystem::path& path, int tile = 0,
                                         const std::string& role = "rigidity map");
 
+// The paper's heuristic for severe compression (§6, "spatially-varying orientation preservation"): an
+// orientation-preservation map from the rigidity map's local density, high where rigid detail is dense
+// and low where it is sparse. Texel (x, y) gets the mean of channel 0 over the square window of
+// 2 radius + 1 texels around it (clamped to the tile), divided by the largest such mean (all 0 when the
+// map has no rigidity). Returns a T x T x 1 image in [0, 1]. Throws InvalidInput for an empty image or a
+// radius < 1.
+[[nodiscard]] io::Image densityOrientationMap(const io::Image& rigidity, int32_t radius);
+
 // Rigidity at the grid points of an n-cell grid (n = `cells`, a power of two; T may differ from n):
 // point (i, j) gets the bilinear sample of channel 0 at uv (i / n, j / n), texel centres as in grid.h,
 // clamped to the edge texels. Validates the map as validateRigidityMap. Returns a 1-channel PointField.

@@ -22,6 +22,9 @@ struct TileWarpOptions {
     SolverOptions solver;
     DerivedMaskOptions derivedMask;  // used when no mask map is given
     int32_t dilationRings = 4;       // geometry-image dilation past chart borders
+    // > 0: without a painted orientation map, the paper's heuristic for severe compression
+    // (densityOrientationMap of the rigidity map with this window radius, texels); 0: 1 everywhere.
+    int32_t densityOrientationRadius = 0;
 };
 
 // The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's
