@@ -230,11 +230,11 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         }
     }
     // Per point of the level being built from: may it move (mask, Eq. 8, and not on the tile border)?
-    // Written into Level::rigidity as kFixed once the next level's blur (Eq. 7) has read the level's R.
+    // Written into Level::rigidity as kFixed - R once the next level's blur (Eq. 7) has read the level's R.
     std::vector<uint8_t> movable(static_cast<size_t>(side()) * side()), coarser;
     const auto markFixed = [](Level& level, const std::vector<uint8_t>& canMove) {
         for (size_t k = 0; k < canMove.size(); ++k)
-            if (canMove[k] == 0) level.rigidity[k] = kFixed;
+            if (canMove[k] == 0) level.rigidity[k] = detail::fixedRigidity(level.rigidity[k]);
     };
     Level& finest = levels[0];
     for (int32_t j = 0; j <= cells; ++j) {

@@ -274,11 +274,17 @@ template <class Ops, int32_t Type, bool Mapped>
             const int32_t i = start + lane * step;
             const int32_t ia = i + e.ai, ib = i + e.bi;  // level columns of the ends
             const float ra = rigidityA[ia * unit], rb = rigidityB[ib * unit];
-            const float rig = ra > rb ? ra : rb;
             const bool live = (lane >= 0) & (lane < lanes);
-            // A fixed end (kFixed: masked or on the border): not projected (§4.2); both ends fully elastic:
-            // nothing to do.
-            const bool active = live & (ra >= 0.0f) & (rb >= 0.0f) & (rig > 0.0f);
+            // Both ends movable: projected when either is rigid (§4.2). Both fixed (kFixed - R: masked or on
+            // the border): nothing to do. One end fixed: the paper does not project it; here a segment rigid
+            // at both ends (R >= 0.5) is projected with the whole correction on its free end (the fixed end's
+            // mass is infinite), so rigid detail that a pinned chart border cuts keeps its lengths to the
+            // border instead of tearing from it (docs/decisions.md, UV-15).
+            const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
+            const float paintedA = fixedA ? kFixed - ra : ra, paintedB = fixedB ? kFixed - rb : rb;
+            const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
+            const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
+            const bool active = live & ((!fixedA & !fixedB & (rig > 0.0f)) | pinned);
             const int32_t ka = ia * s, kb = ib * s;  // offsets in the fine rows
             Ring ringA, ringB;                       // B's slot for A is filled once A has moved
 #pragma GCC unroll 8
@@ -307,8 +313,10 @@ template <class Ops, int32_t Type, bool Mapped>
             const float safeDef = valid ? lDef : 1.0f, safeLength = valid ? length : 1.0f;
             const float correction = stiffness * rig * length * (1.0f - lOrg / safeDef);
             const float ux = dx / safeLength, uy = dy / safeLength;
-            float nax = pax + 0.5f * correction * ux, nay = pay + 0.5f * correction * uy;
-            float nbx = pbx - 0.5f * correction * ux, nby = pby - 0.5f * correction * uy;
+            const float shareA = fixedA ? 0.0f : (fixedB ? 1.0f : 0.5f);
+            const float shareB = fixedB ? 0.0f : (fixedA ? 1.0f : 0.5f);
+            float nax = pax + shareA * correction * ux, nay = pay + shareA * correction * uy;
+            float nbx = pbx - shareB * correction * ux, nby = pby - shareB * correction * uy;
             const float preserve =
                 Mapped ? preservation * 0.5f * (orientationA[ia * unit] + orientationB[ib * unit])
                        : preservation;
@@ -321,7 +329,7 @@ template <class Ops, int32_t Type, bool Mapped>
             float tx = hx / safeHalf + preserve * (e.canonicalU - hx / safeHalf);
             float ty = hy / safeHalf + preserve * (e.canonicalV - hy / safeHalf);
             const float tl = sqrtOf(tx * tx + ty * ty);
-            const bool turn = (preserve > 0.0f) & (half > 0.0f) & (tl > 1e-6f);
+            const bool turn = (preserve > 0.0f) & (half > 0.0f) & (tl > 1e-6f) & !fixedA & !fixedB;
             const float scale = half / (turn ? tl : 1.0f);
             tx *= scale;
             ty *= scale;
@@ -331,13 +339,13 @@ template <class Ops, int32_t Type, bool Mapped>
             nby = turn ? my + ty : nby;
             // Both ends' rings are read before either end is stored; B's check sees where A ended up, as
             // when the segment's ends move one after the other.
-            const bool moveA = valid & clampKeepsOrientation(ringA, nax, nay);
+            const bool moveA = valid & !fixedA & clampKeepsOrientation(ringA, nax, nay);
             const float endAx = moveA ? nax : pax, endAy = moveA ? nay : pay;
             uA[ka] = endAx;
             vA[ka] = endAy;
             ringB.u[slotA] = endAx;
             ringB.v[slotA] = endAy;
-            const bool moveB = valid & clampKeepsOrientation(ringB, nbx, nby);
+            const bool moveB = valid & !fixedB & clampKeepsOrientation(ringB, nbx, nby);
             uB[kb] = moveB ? nbx : pbx;
             vB[kb] = moveB ? nby : pby;
         }

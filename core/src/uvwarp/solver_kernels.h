@@ -47,6 +47,10 @@ extern const SolverKernels kBaselineKernels;
 extern const SolverKernels kAvx2Kernels;
 #endif
 
+// Level rigidity of a point that may not move is kFixed - R: negative (every test of "may move" is a sign
+// test) and still telling its R, so that a rigid segment pinned at one end can keep its length (UV-15).
+constexpr float kFixed = -1.0f;
+
 // 3x3 Gaussian kernel K_G (Eq. 5 and 7): (1 2 1) x (1 2 1) / 16.
 constexpr float kGauss[3] = {0.25f, 0.5f, 0.25f};
 

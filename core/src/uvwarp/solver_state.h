@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "solver_kernels.h"
+
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/solver.h"
 
@@ -25,13 +27,15 @@ constexpr int64_t kParallelRows = 64;
 // with more rigid detail does not hold the other threads at the next barrier.
 constexpr int32_t kBlockRows = 16;
 
-// Level::rigidity of a point that may not move.
-constexpr float kFixed = -1.0f;
+// Level::rigidity of a point that may not move is kFixed - R (kFixed: solver_kernels.h).
+[[nodiscard]] inline float fixedRigidity(float r) {
+    return kFixed - r;
+}
 
 struct Level {
     int32_t cells = 0;   // cells per side at this level
     int32_t stride = 1;  // fine-grid points between neighbouring points of this level
-    // R (Eq. 7 on coarser levels) where the point may move; kFixed where it may not (masked, Eq. 8, or on
+    // R (Eq. 7 on coarser levels) where the point may move; kFixed - R where it may not (masked, Eq. 8, or on
     // the tile border). One float map rather than a float and a byte map: the SIMD kernels then hold only
     // 32-bit values, so their vector loops run 8 lanes per AVX2 iteration, not 32 (a byte map made GCC
     // choose 32 lanes, which left every run shorter than 32 segments to the scalar remainder loop).
