@@ -423,4 +423,39 @@ int32_t Solver::levels() const {
     return static_cast<int32_t>(impl_->levels.size());
 }
 
+namespace {
+
+const detail::Level& levelAt(const std::vector<detail::Level>& levels, int32_t level,
+                             const std::string& source) {
+    if (level < 0 || level >= static_cast<int32_t>(levels.size())) {
+        throw InvalidInput(formatError(source, "level " + std::to_string(level), "is out of range",
+                                       "0 to " + std::to_string(levels.size() - 1)));
+    }
+    return levels[static_cast<size_t>(level)];
+}
+
+}  // namespace
+
+PointField Solver::levelRigidity(int32_t level) const {
+    const detail::Level& l = levelAt(impl_->levels, level, impl_->source);
+    PointField out;
+    out.cells = l.cells;
+    out.channels = 1;
+    out.values.resize(l.rigidity.size());
+    for (size_t k = 0; k < l.rigidity.size(); ++k)
+        out.values[k] = l.movable(k) ? l.rigidity[k] : kFixed - l.rigidity[k];  // fixed points keep R too
+    return out;
+}
+
+PointField Solver::levelMovable(int32_t level) const {
+    const detail::Level& l = levelAt(impl_->levels, level, impl_->source);
+    PointField out;
+    out.cells = l.cells;
+    out.channels = 1;
+    out.values.resize(l.rigidity.size());
+    for (size_t k = 0; k < l.rigidity.size(); ++k)
+        out.values[k] = l.movable(k) ? 1.0f : 0.0f;
+    return out;
+}
+
 }  // namespace deformkit::uvwarp

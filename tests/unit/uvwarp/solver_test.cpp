@@ -391,3 +391,55 @@ TEST_CASE("uv warp: orientation preservation turns rigid segments back to their 
         CHECK(angle[k] < angle[k - 1]);
     CHECK(angle[3] < 0.6 * angle[0]);
 }
+
+TEST_CASE("uv warp: the hierarchy's rigidity and masks follow Eq. 7 and 8", "[uvwarp][options]") {
+    // Recomputed here from the level below, level by level: R_l = K_G * R_{l-1} at the even points (indices
+    // clamped at the tile edge); a point may move when every point of the 3x3 below it may and it is not on
+    // the tile border (Eq. 8). The finest level is the maps themselves: R as given, the mask >= 0.5 off the
+    // border. A masked stripe and the disks make every rule matter.
+    const int n = 64;
+    Scene s = stretchedPlane(n, 1.5f);
+    s.mask = field(n, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.55f) < 0.04f ? 0.0f : 1.0f; });
+    uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
+    REQUIRE(solver.levels() >= 4);
+    const PointField r0 = solver.levelRigidity(0), m0 = solver.levelMovable(0);
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            const size_t k = static_cast<size_t>(j) * (n + 1) + i;
+            const bool border = i == 0 || j == 0 || i == n || j == n;
+            CHECK(r0.values[k] == s.rigidity.values[k]);
+            CHECK(m0.values[k] == (!border && s.mask.values[k] >= 0.5f ? 1.0f : 0.0f));
+        }
+    const float gauss[3] = {0.25f, 0.5f, 0.25f};
+    int fixedByEq8 = 0;
+    for (int l = 1; l < solver.levels(); ++l) {
+        const PointField fr = solver.levelRigidity(l - 1), fm = solver.levelMovable(l - 1);
+        const PointField cr = solver.levelRigidity(l), cm = solver.levelMovable(l);
+        const int fc = fr.cells, c = cr.cells;
+        REQUIRE(c * 2 == fc);
+        double worst = 0.0;
+        for (int j = 0; j <= c; ++j)
+            for (int i = 0; i <= c; ++i) {
+                double r = 0.0;
+                bool movable = true;
+                for (int dj = -1; dj <= 1; ++dj)
+                    for (int di = -1; di <= 1; ++di) {
+                        const int si = std::clamp(2 * i + di, 0, fc), sj = std::clamp(2 * j + dj, 0, fc);
+                        const size_t q = static_cast<size_t>(sj) * (fc + 1) + si;
+                        r += gauss[di + 1] * gauss[dj + 1] * fr.values[q];
+                        movable = movable && fm.values[q] == 1.0f;
+                    }
+                const bool border = i == 0 || j == 0 || i == c || j == c;
+                const size_t k = static_cast<size_t>(j) * (c + 1) + i;
+                worst = std::max(worst, std::abs(r - cr.values[k]));
+                const bool expected = movable && !border;
+                CHECK(cm.values[k] == (expected ? 1.0f : 0.0f));
+                const size_t centre = static_cast<size_t>(2 * j) * (fc + 1) + 2 * i;
+                fixedByEq8 += !expected && !border && fm.values[centre] == 1.0f ? 1 : 0;
+            }
+        INFO("level " << l);
+        CHECK(worst < 1e-6);
+    }
+    CHECK(fixedByEq8 > 0);  // points whose own finer point may move but a neighbour may not
+    CHECK_THROWS_AS(solver.levelMovable(solver.levels()), InvalidInput);
+}

@@ -75,6 +75,13 @@ class Solver {
     [[nodiscard]] const SolveStats& stats() const;
     [[nodiscard]] int32_t cells() const;
     [[nodiscard]] int32_t levels() const;
+    // The hierarchy as built from the maps (§4.4), for tests and tools: level `level` (0 the finest, each
+    // next one every other point of the one before), its rigidity (Eq. 7: the finer level's blurred by K_G,
+    // then subsampled) and whether each point may move (Eq. 8: every point of the finer level's 3x3 around it
+    // may, and it is not on the tile border). 1-channel fields of the level's cells. Throws InvalidInput for
+    // a level out of range.
+    [[nodiscard]] PointField levelRigidity(int32_t level) const;
+    [[nodiscard]] PointField levelMovable(int32_t level) const;
 
   private:
     struct Impl;
