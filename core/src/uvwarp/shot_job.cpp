@@ -204,7 +204,7 @@ struct ShotSolver::Impl {
     }
     void bind(TilePlan& plan, int frame);
     // Animated maps: gives the warp the frame's maps when they differ from the last ones.
-    void animateMaps(TilePlan& plan, int frame, nlohmann::json& frameInputs);
+    void animateMaps(TilePlan& plan, int frame);
     void solveTile(TilePlan& plan, size_t k, std::span<const glm::vec3> deformed,
                    const std::string& inputName);
 };
@@ -364,6 +364,15 @@ io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
     return map.image ? *map.image : io::Image{};
 }
 
+// The headers name an animated map's file of the frame.
+void nameFrameMaps(const TilePlan& plan, int frame, json& inputs) {
+    for (const auto& [map, key] : {std::pair<const TileMap*, const char*>{&plan.rigidity, "rigidity"},
+                                   {&plan.mask, "mask"},
+                                   {&plan.orientation, "orientation"}}) {
+        if (!map->framePattern.empty()) inputs[key] = mapFile(*map, frame)->string();
+    }
+}
+
 bool samePixels(const io::Image& a, const io::Image& b) {
     return a.width == b.width && a.height == b.height && a.channels == b.channels && a.pixels == b.pixels;
 }
@@ -385,13 +394,10 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     if (!plan.orientation.framePattern.empty()) plan.lastOrientation = orientation;
 }
 
-void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame, json& frameInputs) {
+void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame) {
     const bool rigidityMoves = !plan.rigidity.framePattern.empty();
     const bool maskMoves = !plan.mask.framePattern.empty();
     const bool orientationMoves = !plan.orientation.framePattern.empty();
-    if (rigidityMoves) frameInputs["rigidity"] = mapFile(plan.rigidity, frame)->string();
-    if (maskMoves) frameInputs["mask"] = mapFile(plan.mask, frame)->string();
-    if (orientationMoves) frameInputs["orientation"] = mapFile(plan.orientation, frame)->string();
     if (!plan.texture.framePattern.empty()) plan.texturePixels = io::readImage(*mapFile(plan.texture, frame));
     if (!rigidityMoves && !maskMoves && !orientationMoves) return;
     bool changed = false;
@@ -424,15 +430,11 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     const int frame = job.frames[k];
     const Clock::time_point start = Clock::now();
     json frameInputs = plan.inputs;
+    nameFrameMaps(plan, frame, frameInputs);
     if (!plan.warp) {
         bind(plan, frame);
-        if (!plan.rigidity.framePattern.empty())
-            frameInputs["rigidity"] = mapFile(plan.rigidity, frame)->string();
-        if (!plan.mask.framePattern.empty()) frameInputs["mask"] = mapFile(plan.mask, frame)->string();
-        if (!plan.orientation.framePattern.empty())
-            frameInputs["orientation"] = mapFile(plan.orientation, frame)->string();
     } else {
-        animateMaps(plan, frame, frameInputs);
+        animateMaps(plan, frame);
     }
     TileWarp& warp = *plan.warp;
     Clock::time_point t = Clock::now();

@@ -425,37 +425,36 @@ int32_t Solver::levels() const {
 
 namespace {
 
-const detail::Level& levelAt(const std::vector<detail::Level>& levels, int32_t level,
-                             const std::string& source) {
+// A 1-channel field of level `level`'s points, value(level, k) at point k.
+template <class Value>
+PointField levelField(const std::vector<detail::Level>& levels, int32_t level, const std::string& source,
+                      Value value) {
     if (level < 0 || level >= static_cast<int32_t>(levels.size())) {
         throw InvalidInput(formatError(source, "level " + std::to_string(level), "is out of range",
                                        "0 to " + std::to_string(levels.size() - 1)));
     }
-    return levels[static_cast<size_t>(level)];
+    const detail::Level& l = levels[static_cast<size_t>(level)];
+    PointField out;
+    out.cells = l.cells;
+    out.channels = 1;
+    out.values.resize(l.rigidity.size());
+    for (size_t k = 0; k < l.rigidity.size(); ++k)
+        out.values[k] = value(l, k);
+    return out;
 }
 
 }  // namespace
 
 PointField Solver::levelRigidity(int32_t level) const {
-    const detail::Level& l = levelAt(impl_->levels, level, impl_->source);
-    PointField out;
-    out.cells = l.cells;
-    out.channels = 1;
-    out.values.resize(l.rigidity.size());
-    for (size_t k = 0; k < l.rigidity.size(); ++k)
-        out.values[k] = l.movable(k) ? l.rigidity[k] : kFixed - l.rigidity[k];  // fixed points keep R too
-    return out;
+    // Fixed points keep their R as kFixed - R.
+    return levelField(impl_->levels, level, impl_->source, [](const detail::Level& l, size_t k) {
+        return l.movable(k) ? l.rigidity[k] : kFixed - l.rigidity[k];
+    });
 }
 
 PointField Solver::levelMovable(int32_t level) const {
-    const detail::Level& l = levelAt(impl_->levels, level, impl_->source);
-    PointField out;
-    out.cells = l.cells;
-    out.channels = 1;
-    out.values.resize(l.rigidity.size());
-    for (size_t k = 0; k < l.rigidity.size(); ++k)
-        out.values[k] = l.movable(k) ? 1.0f : 0.0f;
-    return out;
+    return levelField(impl_->levels, level, impl_->source,
+                      [](const detail::Level& l, size_t k) { return l.movable(k) ? 1.0f : 0.0f; });
 }
 
 }  // namespace deformkit::uvwarp

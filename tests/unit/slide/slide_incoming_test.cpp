@@ -13,6 +13,7 @@
 #include "deformkit/geom/limit_surface.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/slide/slider.h"
+#include "slide_real_meshes.h"
 #include "slide_test_support.h"
 
 // The slide over the surface a stack hands it (a deformed copy of the rest mesh), the fold count and
@@ -24,22 +25,11 @@ using slide::SlideDrive;
 using slide::SlideHandle;
 using slide::SlideOptions;
 using slide::SlideResult;
+using test::bob;
+using test::diagonal;
+using test::spot;
 
 namespace {
-
-const geom::Mesh& spot() {
-    static const geom::Mesh mesh = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
-    return mesh;
-}
-
-double diagonal(std::span<const glm::vec3> points) {
-    glm::dvec3 lo(1e300), hi(-1e300);
-    for (const glm::vec3& p : points) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
-    }
-    return glm::length(hi - lo);
-}
 
 // A rotation about a random axis by a random angle (fixed generator).
 glm::dmat3 randomRotation(std::mt19937& rng) {

@@ -12,6 +12,7 @@
 #include "deformkit/geom/bvh.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/slide/slider.h"
+#include "slide_real_meshes.h"
 
 // The slide on a real model: Keenan Crane's "Spot" (tests/data/README.md), a quad mesh with creases,
 // concave dimples and thin parts (ears, horns, legs). Invariants that hold for any handle and drag:
@@ -24,20 +25,11 @@ using slide::SlideDrive;
 using slide::SlideHandle;
 using slide::SlideLanding;
 using slide::SlideResult;
+using test::bob;
+using test::diagonal;
+using test::spot;
 
 namespace {
-
-const geom::Mesh& spot() {
-    static const geom::Mesh mesh = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
-    return mesh;
-}
-
-// Keenan Crane's "Bob" (tests/data/README.md): a triangle mesh with thin parts (the beak, the tail) and
-// slivers, unlike Spot's quads.
-const geom::Mesh& bob() {
-    static const geom::Mesh mesh = io::readObj(DEFORMKIT_TEST_DATA "/bob/bob_tri.obj").mesh;
-    return mesh;
-}
 
 // The rest surface as a BVH, for the distance of a slid vertex to it measured apart from the landings;
 // the last one built is kept while the same points come again.
@@ -49,15 +41,6 @@ const geom::Bvh& bvhOf(const geom::Mesh& mesh) {
         bvh = std::make_unique<geom::Bvh>(mesh);
     }
     return *bvh;
-}
-
-double diagonal(const geom::Mesh& mesh) {
-    glm::dvec3 lo(1e300), hi(-1e300);
-    for (const glm::vec3& p : mesh.points()) {
-        lo = glm::min(lo, glm::dvec3(p));
-        hi = glm::max(hi, glm::dvec3(p));
-    }
-    return glm::length(hi - lo);
 }
 
 struct Worst {
@@ -78,7 +61,7 @@ void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double r
                                                     {&drive, 1}, {}, 1.0f, {}, &result);
     const auto rest = mesh.points();
     const glm::dvec3 p0(rest[handle]);
-    const double scale = diagonal(mesh);
+    const double scale = diagonal(mesh.points());
     for (size_t v = 0; v < out.size(); ++v) {
         worst.finite =
             worst.finite && std::isfinite(out[v].x) && std::isfinite(out[v].y) && std::isfinite(out[v].z);
@@ -129,7 +112,7 @@ TEST_CASE("slide on Spot: random drags keep travel, stay on the surface, stay fi
     // Drags of 3% of the bounding-box diagonal with radius 10%, as a rigger would set them up, at random
     // handles in random directions (fixed seed).
     const geom::Mesh& mesh = spot();
-    const double scale = diagonal(mesh);
+    const double scale = diagonal(mesh.points());
     std::mt19937 rng(2026);
     std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
     std::normal_distribution<double> gauss;
@@ -150,7 +133,7 @@ TEST_CASE("slide on Spot: large drags and geodesic regions keep the travel bound
     // from 5% to 25% of the diagonal, with both region metrics. A geodesic distance is at least the 3D
     // one, so the falloff of the 3D distance bounds the travel in both cases.
     const geom::Mesh& mesh = spot();
-    const double scale = diagonal(mesh);
+    const double scale = diagonal(mesh.points());
     std::mt19937 rng(18);
     std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -189,7 +172,7 @@ TEST_CASE("slide on Bob (triangles): random drags keep travel, stay on the surfa
     // As on Spot: drags of 3% of the diagonal at radius 10%, then drags up to two thirds of radii from 5% to
     // 25%, both region metrics (fixed seeds).
     const geom::Mesh& mesh = bob();
-    const double scale = diagonal(mesh);
+    const double scale = diagonal(mesh.points());
     std::mt19937 rng(1858);
     std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
