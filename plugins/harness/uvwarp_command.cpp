@@ -214,7 +214,14 @@ void addUvWarpCommand(CommandLine& cli) {
     uvwarp.option("--filter", o->filter, "bake filter: bilinear or bicubic")
         .choices({"bilinear", "bicubic"})
         .showDefault();
-    uvwarp.option("--iterations", solver.iterations, "PBD iterations per frame").nonNegative().showDefault();
+    uvwarp.option("--iterations", solver.iterations, "PBD iterations per frame (the most, with --tolerance)")
+        .nonNegative()
+        .showDefault();
+    uvwarp
+        .option("--tolerance", solver.tolerance,
+                "end a frame's iterations once no grid point moves farther, in cells; 0: always --iterations")
+        .range(0.0f, 1.0f)
+        .showDefault();
     uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
     uvwarp
         .option("--sweeps", solver.sweepsPerLevel, "constraint sweeps per iteration and level, finest first")

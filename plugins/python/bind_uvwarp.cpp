@@ -41,7 +41,8 @@ using uvwarp::TileWarp;
 using uvwarp::TileWarpOptions;
 
 constexpr const char* kOptionNames =
-    "iterations, levels, sweeps_per_level, orientation_preservation, smoothing, damping, coarse_stiffness, "
+    "iterations, tolerance, levels, sweeps_per_level, orientation_preservation, smoothing, damping, "
+    "coarse_stiffness, "
     "border_width, dilation_rings, orientation_density";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
@@ -127,6 +128,8 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
             o.solver.smoothing = floatOption(value, source, k, false, "a number in [0, 1]");
         } else if (k == "damping") {
             o.solver.damping = floatOption(value, source, k, false, "a number in [0, 1]");
+        } else if (k == "tolerance") {
+            o.solver.tolerance = floatOption(value, source, k, false, "a number in [0, 1] (grid cells)");
         } else if (k == "coarse_stiffness") {
             o.solver.coarseStiffness = floatOption(value, source, k, true, "a number in (0, 1]");
         } else if (k == "border_width") {
@@ -187,7 +190,10 @@ py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) 
     d["iterations"] = s.iterations;
     d["levels"] = s.levels;
     d["untangled_points"] = s.untangledPoints;
+    d["reverted_points"] = s.revertedPoints;
     d["remaining_folds"] = s.remainingFolds;
+    d["last_move"] = s.lastMove;
+    d["converged"] = s.converged;
     return d;
 }
 
@@ -523,7 +529,9 @@ constexpr const char* kSolverDoc =
     "rigidity in [0, 1] (1 = as rigid as possible); mask (>= 0.5 may warp; None derives one from the UVs:\n"
     "texels outside every UV triangle and on chart borders stay fixed); orientation in [0, 1] scales\n"
     "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n"
-    "options: iterations (12), levels (0: automatic), sweeps_per_level ([1, 2, 4], finest first),\n"
+    "options: iterations (12; the most with a tolerance), tolerance (0: off; in grid cells, end a solve "
+    "once\n"
+    "no point moves farther), levels (0: automatic), sweeps_per_level ([1, 2, 4], finest first),\n"
     "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
     "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
     "off;\n"
@@ -598,7 +606,9 @@ void bindUvWarp(py::module_& m) {
              "Quality figures of the last solve: rigid_stretch_error and identity_stretch_error (mean\n"
              "|l_def / l_org - 1| over rigid grid edges with our warp and with none), rigid_edges,\n"
              "skipped_edges, fold_overs, max_masked_displacement and max_border_displacement (texels),\n"
-             "points_outside, and the solver's iterations, levels, untangled_points, remaining_folds.")
+             "points_outside, and the solver's iterations, levels, untangled_points, reverted_points, "
+             "remaining_folds,\n"
+             "last_move (cells) and converged.")
         .def("reset", &PyUvWarpSolver::reset, "Back to the identity warp (a cut in the shot).")
         .def_property_readonly("warp", &PyUvWarpSolver::warp, "The current warp grid, as solve returns it.")
         .def_property_readonly("tile", [](const PyUvWarpSolver& s) { return s.tileWarp().tile(); })

@@ -136,6 +136,20 @@ def test_one_off_matches_the_solver_and_the_mesh_overload():
     assert np.abs(expected - texel_centres()).max() > 0.5 / T  # the warp did something
 
 
+def test_tolerance_ends_a_settled_solve_and_is_reported():
+    pts, counts, idx, uvs, uv_idx = plane()
+    solver = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks(), iterations=300, tolerance=0.02)
+    solver.solve(stretched(pts))
+    first = solver.metrics()
+    assert first["converged"] and first["last_move"] <= 0.02 and 1 < first["iterations"] < 300
+    assert first["remaining_folds"] == 0 and first["reverted_points"] >= 0
+    solver.solve(stretched(pts))  # the same pose again, warm-started: settled at once
+    assert solver.metrics()["iterations"] <= 2
+    fixed = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks(), iterations=5)
+    fixed.solve(stretched(pts))
+    assert fixed.metrics()["iterations"] == 5 and not fixed.metrics()["converged"]
+
+
 def test_apply_redirect_identity_and_one_texel_shift():
     rng = np.random.default_rng(7)
     tex = rng.uniform(0, 1, (T, T, 3)).astype(np.float32)
@@ -195,6 +209,7 @@ def test_bad_input_names_what_is_wrong():
     for option, value, text in (("smoothing", 1.5, "smoothing: is 1.5"), ("damping", "x", "damping: is a str"),
                                 ("iterations", 2.5, "iterations: is a float"), ("levels", -1, "levels: is -1"),
                                 ("coarse_stiffness", 0.0, "coarse_stiffness: is 0.0"),
+                                ("tolerance", 2.0, "tolerance: is 2.0"),
                                 ("sweeps_per_level", [], "sweeps_per_level: is empty"),
                                 ("sweeps_per_level", [1, -2], r"sweeps_per_level\[1\]: is -2"),
                                 ("border_width", 0, "border_width: is 0"), ("bogus", 1, "bogus: is not an option")):

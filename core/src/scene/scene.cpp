@@ -415,10 +415,10 @@ class Reader {
             const json& params = v.at("params");
             const std::string pp = path + ".params";
             requireObject(params, pp, "an object of UV-warp options by name");
-            onlyKeys(
-                params, pp,
-                {"iterations", "levels", "sweepsPerLevel", "orientationPreservation", "smoothing", "damping",
-                 "coarseStiffness", "dilationRings", "maskBorderWidth", "orientationDensity"});
+            onlyKeys(params, pp,
+                     {"iterations", "tolerance", "levels", "sweepsPerLevel", "orientationPreservation",
+                      "smoothing", "damping", "coarseStiffness", "dilationRings", "maskBorderWidth",
+                      "orientationDensity"});
             uvwarp::SolverOptions& o = u.options.solver;
             auto get = [&](const char* name) -> const json* {
                 return params.contains(name) ? &params.at(name) : nullptr;
@@ -426,6 +426,9 @@ class Reader {
             if (const json* x = get("iterations"))
                 o.iterations =
                     static_cast<int32_t>(ranged(*x, pp + ".iterations", 1, 100000, true, "1 to 100000"));
+            if (const json* x = get("tolerance"))
+                o.tolerance =
+                    static_cast<float>(ranged(*x, pp + ".tolerance", 0, 1, false, "0 to 1 (grid cells)"));
             if (const json* x = get("levels"))
                 o.levels =
                     static_cast<int32_t>(ranged(*x, pp + ".levels", 0, 16, true, "0 (automatic) to 16"));

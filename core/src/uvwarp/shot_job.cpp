@@ -93,6 +93,7 @@ json metricsJson(const WarpMetrics& m, const SolveStats& s) {
             {"iterations", s.iterations},
             {"levels", s.levels},
             {"untangled_points", s.untangledPoints},
+            {"reverted_points", s.revertedPoints},
             {"remaining_folds", s.remainingFolds}};
 }
 
@@ -103,6 +104,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
               {"levels", o.solver.levels},
               {"levelsUsed", levelsUsed},
               {"iterations", o.solver.iterations},
+              {"tolerance", tidy(o.solver.tolerance)},
               {"sweepsPerLevel", o.solver.sweepsPerLevel},
               {"orientationPreservation", tidy(o.solver.orientationPreservation)},
               {"smoothing", tidy(o.solver.smoothing)},

@@ -1,6 +1,9 @@
 #include "deformkit/uvwarp/solver.h"
 
+#include <omp.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -9,6 +12,7 @@
 #include "simd/cpu.h"
 #include "solver_kernels.h"
 #include "solver_state.h"
+#include "team_chooser.h"
 #include "uvwarp/field_checks.h"
 
 namespace deformkit::uvwarp {
@@ -66,6 +70,7 @@ detail::KernelLevel kernelLevel(const Level& level) {
 // The solver's state, and the steps of one iteration over the hierarchy (§4.1, §4.4).
 struct Solver::Impl : detail::SolverState {
     const detail::SolverKernels* kernels = &kernelsFor(simd::activeIsa());
+    detail::TeamChooser team;  // SolverOptions::threads == 0
 
     [[nodiscard]] detail::KernelGrid kernelGrid() {
         return {cells,
@@ -163,7 +168,8 @@ struct Solver::Impl : detail::SolverState {
         return options.sweepsPerLevel[std::min(level, options.sweepsPerLevel.size() - 1)];
     }
 
-    void iterate() {
+    // One iteration; returns the largest distance a point moved, in fine-grid uv units.
+    float iterate() {
         const size_t n = grid.u.size();
         const float keep = 1.0f - options.damping;
         // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force).
@@ -195,12 +201,24 @@ struct Solver::Impl : detail::SolverState {
         }
         // Step 4: regularisation (Eq. 4-5) on the finest grid.
         regulariseAll(levels[0], false);
-        // Step 5: integration.
-#pragma omp parallel for schedule(dynamic, kPointChunk) if (kParallelRows < static_cast <int64_t>(n))
+        // Prediction and propagation move points without the fold check of the projection and the
+        // regularisation, and the neighbours' mean (untangle) does not always repair what they fold: points
+        // of triangles still folded go back to where the iteration found them (velU, velV), so every
+        // iteration ends fold-free and a point the steps fight over stops moving (UV-16).
+        stats.revertedPoints += detail::revertFolds(*this, velU.data(), velV.data());
+        // Step 5: integration. The largest move is a max, the same whatever the order: bit-identical for
+        // any thread count.
+        float largest = 0.0f;
+#pragma omp parallel for schedule(dynamic, kPointChunk) \
+    reduction(max                                       \
+              : largest) if (kParallelRows < static_cast <int64_t>(n))
         for (size_t k = 0; k < n; ++k) {
-            velU[k] = grid.u[k] - velU[k];
-            velV[k] = grid.v[k] - velV[k];
+            const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
+            velU[k] = du;
+            velV[k] = dv;
+            largest = std::max(largest, du * du + dv * dv);
         }
+        return std::sqrt(largest);
     }
 
     void buildMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation);
@@ -339,11 +357,12 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
         options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
         options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
-        options.coarseStiffness > 1.0f || options.levels < 0) {
+        options.coarseStiffness > 1.0f || options.levels < 0 || options.threads < 0 ||
+        !(options.tolerance >= 0.0f) || options.tolerance > 1.0f) {
         throw InvalidInput(
             formatError(source, "solver options", "out of range",
                         "iterations >= 0, levels >= 0, damping, smoothing, orientation preservation "
-                        "in [0, 1], coarse stiffness in (0, 1]"));
+                        "in [0, 1], coarse stiffness in (0, 1], tolerance in [0, 1] (cells), threads >= 0"));
     }
     for (int32_t s : options.sweepsPerLevel) {
         if (s < 0) throw InvalidInput(formatError(source, "sweepsPerLevel", std::to_string(s), ">= 0"));
@@ -392,9 +411,26 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;
-    for (int32_t it = 0; it < m.options.iterations; ++it)
-        m.iterate();
-    m.stats.iterations = m.options.iterations;
+    m.stats.revertedPoints = 0;
+    m.stats.iterations = 0;
+    m.stats.lastMove = 0.0f;
+    m.stats.converged = false;
+    const auto cells = static_cast<float>(m.cells);
+    const int32_t allowed = omp_get_max_threads();
+    while (m.stats.iterations < m.options.iterations && !m.stats.converged) {
+        const int32_t team =
+            m.options.threads > 0 ? std::min(m.options.threads, allowed) : m.team.next(allowed);
+        omp_set_num_threads(team);
+        const auto start = std::chrono::steady_clock::now();
+        m.stats.lastMove = m.iterate() * cells;
+        if (m.options.threads == 0)
+            m.team.record(team,
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        m.stats.threads = team;
+        ++m.stats.iterations;
+        m.stats.converged = m.options.tolerance > 0.0f && m.stats.lastMove <= m.options.tolerance;
+    }
+    omp_set_num_threads(allowed);
     m.stats.remainingFolds = countFolds(m.grid);
     m.deformed = nullptr;
     return m.grid;

@@ -150,6 +150,50 @@ int32_t untangle(SolverState& state, const Level& level) {
     return moved;
 }
 
+// The finest level's triangles are scanned once (vectorised, as untangle's); a folded triangle's corners
+// that moved since (oldU, oldV) go back there, and the cells around each are looked at again. A point goes
+// back at most once and a triangle whose corners are all back is the old one, so this ends, at worst in the
+// old state. Serial, in ascending order: deterministic.
+int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
+    const Level& level = state.levels[0];
+    const int32_t c = level.cells;
+    const auto row = static_cast<size_t>(state.side());
+    float* u = state.grid.u.data();
+    float* v = state.grid.v.data();
+    int32_t* counts = state.rowFolds.data();
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
+    for (int32_t j = 0; j < c; ++j)
+        counts[j] = countNearZero<1>(u + static_cast<size_t>(j) * row, v + static_cast<size_t>(j) * row, row,
+                                     1, c, 0.0f);
+    std::vector<int32_t>& work = state.untangleWork;
+    work.clear();
+    for (int32_t j = 0; j < c; ++j) {
+        if (counts[j] == 0) continue;
+        for (int32_t i = 0; i < c; ++i)
+            collectFolded(state, level, i, j, 0.0f, work);
+    }
+    int32_t reverted = 0;
+    std::vector<int32_t>& next = state.untangleNext;
+    while (!work.empty()) {
+        std::sort(work.begin(), work.end());
+        work.erase(std::unique(work.begin(), work.end()), work.end());
+        next.clear();
+        for (int32_t id : work) {
+            const size_t k = static_cast<size_t>(id);
+            if (u[k] == oldU[k] && v[k] == oldV[k]) continue;
+            u[k] = oldU[k];
+            v[k] = oldV[k];
+            ++reverted;
+            const int32_t i = id % (c + 1), j = id / (c + 1);
+            for (int32_t cj = std::max(j - 1, 0); cj <= std::min(j, c - 1); ++cj)
+                for (int32_t ci = std::max(i - 1, 0); ci <= std::min(i, c - 1); ++ci)
+                    collectFolded(state, level, ci, cj, 0.0f, next);
+        }
+        work.swap(next);
+    }
+    return reverted;
+}
+
 }  // namespace detail
 
 int32_t countFolds(const WarpGrid& warp) {

@@ -78,4 +78,9 @@ struct SolverState {
 // moves.
 int32_t untangle(SolverState& state, const Level& level);
 
+// Makes the finest grid fold-free whatever the steps of an iteration did (solver_folds.cpp): the corners of
+// every triangle with non-positive area that moved since (oldU, oldV), a fold-free state, go back there,
+// spreading to the neighbours until no triangle is folded. Returns the number of points put back.
+int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV);
+
 }  // namespace deformkit::uvwarp::detail

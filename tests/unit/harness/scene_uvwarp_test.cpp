@@ -128,6 +128,14 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     CHECK(object.uvwarp->tiles == std::vector<int>{1001, 1002});  // every tile of the rest UVs
     CHECK(object.uvwarp->rigidity == shot.dir / "rig.<UDIM>.exr");
     CHECK(object.uvwarp->options.solver.iterations == 6);
+    CHECK(object.uvwarp->options.solver.tolerance == 0.0f);
+    std::string withTolerance = kScene;
+    const std::string params = R"("params": {"iterations": 6})";
+    withTolerance.replace(withTolerance.find(params), params.size(),
+                          R"("params": {"iterations": 6, "tolerance": 0.25})");
+    test::writeText(shot.scene, withTolerance);
+    CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.tolerance == 0.25f);
+    test::writeText(shot.scene, kScene);
     CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
     CHECK(scene::uvwarpWarpedTiles(*object.uvwarp, 1) == std::vector<int>{1001, 1002});
     CHECK(scene::uvwarpOutputs(object, 1001, 7) ==
@@ -167,6 +175,8 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
          ": objects[0].stack[0].envelope: is not a known key"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"damping": 2}}])",
          ": objects[0].stack[0].params.damping: is 2 (expected 0 to 1)"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"tolerance": -0.1}}])",
+         ": objects[0].stack[0].params.tolerance: is -0.1 (expected 0 to 1 (grid cells))"},
         {"tubes.obj",
          R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"sweepsPerLevel": [1, 0]}}])",
          ": objects[0].stack[0].params.sweepsPerLevel[1]: is 0"},

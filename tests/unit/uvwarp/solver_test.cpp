@@ -225,7 +225,9 @@ TEST_CASE("uv warp: the same bytes for 1 and 2 threads", "[uvwarp]") {
     uvwarp::Solver one(s.rest, s.rigidity, s.mask);
     const WarpGrid a = one.solve(s.deformed);
     omp_set_num_threads(2);
-    uvwarp::Solver two(s.rest, s.rigidity, s.mask);
+    uvwarp::SolverOptions twoThreads;
+    twoThreads.threads = 2;  // not chosen per iteration: every iteration on two
+    uvwarp::Solver two(s.rest, s.rigidity, s.mask, twoThreads);
     const WarpGrid b = two.solve(s.deformed);
     omp_set_num_threads(saved);
     CHECK(std::memcmp(a.u.data(), b.u.data(), a.u.size() * sizeof(float)) == 0);

@@ -13,9 +13,13 @@ struct SolverOptions {
     // Hierarchy depth (paper §4.4): number of levels including the finest. 0 picks the depth whose coarsest
     // grid has 8 cells per side (or fewer levels for small grids).
     int32_t levels = 0;
-    // PBD iterations per solve (paper §4.1). With warm start, frames after the first start from the last
-    // warp.
+    // PBD iterations per solve (paper §4.1): the number run when `tolerance` is 0, the most run otherwise.
+    // With warm start, frames after the first start from the last warp.
     int32_t iterations = 12;
+    // Convergence stop, in grid cells: > 0 ends a solve after the first iteration in which no point moved
+    // farther than this (SolveStats::converged); 0 runs `iterations` iterations whatever they change. A
+    // warm-started frame of a smooth animation then pays for the iterations its change needs.
+    float tolerance = 0.0f;
     // Constraint-projection sweeps (all 8 parallel sets) per iteration at each level, finest first; levels
     // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion.
     std::vector<int32_t> sweepsPerLevel = {1, 2, 4};
@@ -30,14 +34,27 @@ struct SolverOptions {
     // coarseStiffness^l (§4.4: coarse segments map to curves, not lines, so coarse corrections are applied
     // more conservatively).
     float coarseStiffness = 0.9f;
+    // OpenMP threads of an iteration: 0 chooses per iteration between all the caller allows
+    // (omp_get_max_threads()) and one, from measured times, so that next to other work (a host's threads,
+    // another process on a core) all threads are never slower than one; n > 0 uses min(n, allowed). The
+    // warp is the same, byte for byte, whatever the choice.
+    int32_t threads = 0;
 };
 
 // Figures from the last solve.
 struct SolveStats {
-    int32_t iterations = 0;
+    int32_t iterations = 0;  // iterations run by the last solve
+    // Largest distance a point moved in the last iteration, in grid cells, and whether it was within
+    // SolverOptions::tolerance (false when the tolerance is 0).
+    float lastMove = 0.0f;
+    bool converged = false;
     int32_t levels = 0;
     int32_t untangledPoints = 0;  // points moved by the fold repair (should be 0 in normal use)
-    int32_t remainingFolds = 0;   // grid triangles left with non-positive area (both cell splittings)
+    // Points put back to where their iteration found them because a triangle around them stayed folded
+    // (every iteration ends fold-free).
+    int32_t revertedPoints = 0;
+    int32_t remainingFolds = 0;  // grid triangles left with non-positive area (both cell splittings)
+    int32_t threads = 0;         // OpenMP threads of the last iteration
 };
 
 // The content-aware warp solver of Koniaris et al. on one UV tile's grid: hierarchical position-based

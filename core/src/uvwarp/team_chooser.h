@@ -1,0 +1,68 @@
+#pragma once
+
+// Private to the UV-warp solver: the OpenMP team size of a job repeated many times (an iteration), chosen
+// from the job's measured times, so that a solver next to other work (a host's own threads, another
+// process holding a core) is never slower with all threads than with one. The results do not depend on
+// the team size (every parallel loop of the solver gives the same bytes for any thread count), so the
+// choice changes only the time.
+//
+// The job runs on all threads first, then once on one thread; from then on on whichever team has the lower
+// recent time (a running mean), the other being tried again now and then to notice a change (a core taken
+// or given back): after 8 runs, then after twice as many each time the try confirms the choice (at most
+// 128), and again after 8 once the choice changes. A try costs at most one run at the slower size.
+
+#include <algorithm>
+#include <cstdint>
+
+namespace deformkit::uvwarp::detail {
+
+class TeamChooser {
+  public:
+    // The team for the next run, given the most threads the caller allows (omp_get_max_threads()).
+    [[nodiscard]] int32_t next(int32_t allowed) {
+        allowed = std::max(allowed, 1);
+        if (allowed != all_) {  // the caller changed its thread count: time the new size afresh
+            all_ = allowed;
+            meanAll_ = -1.0;
+            sinceTry_ = 0;
+            tryEvery_ = kFirstTryEvery;
+        }
+        if (all_ == 1) return 1;
+        if (meanAll_ < 0.0) return all_;
+        if (meanOne_ < 0.0) return 1;
+        const int32_t best = meanOne_ < meanAll_ ? 1 : all_;
+        if (sinceTry_ >= tryEvery_) return best == 1 ? all_ : 1;  // try the other one
+        return best;
+    }
+
+    // The time one run took with `team` threads.
+    void record(int32_t team, double seconds) {
+        if (all_ == 1) return;
+        const bool one = team == 1;
+        double& mean = one ? meanOne_ : meanAll_;
+        const int32_t before = chosen();
+        const bool trying = meanAll_ >= 0.0 && meanOne_ >= 0.0 && team != before;
+        mean = mean < 0.0 ? seconds : 0.5 * mean + 0.5 * seconds;
+        if (trying) {
+            sinceTry_ = 0;
+            tryEvery_ = chosen() == before ? std::min(2 * tryEvery_, kMaxTryEvery) : kFirstTryEvery;
+        } else {
+            ++sinceTry_;
+        }
+    }
+
+    // The team size the recent times favour (all threads until both have been timed).
+    [[nodiscard]] int32_t chosen() const {
+        if (meanAll_ < 0.0 || meanOne_ < 0.0) return all_;
+        return meanOne_ < meanAll_ ? 1 : all_;
+    }
+
+  private:
+    static constexpr int32_t kFirstTryEvery = 8;
+    static constexpr int32_t kMaxTryEvery = 128;
+    int32_t all_ = 1;
+    double meanAll_ = -1.0, meanOne_ = -1.0;  // seconds per run; < 0: not timed yet
+    int32_t sinceTry_ = 0, tryEvery_ = kFirstTryEvery;
+};
+
+}  // namespace deformkit::uvwarp::detail

@@ -1,0 +1,260 @@
+// Invariants of the UV-warp solver on any input (issue 19, part 1), over random cases with a fixed seed:
+// every grid triangle keeps its orientation (counted here, not by the solver), no value is NaN, the tile
+// border and masked points stay where they are. And the convergence stop (SolverOptions::tolerance) and the
+// choice of OpenMP team (SolverOptions::threads).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "deformkit/uvwarp/solver.h"
+#include "uvwarp/team_chooser.h"
+
+using namespace deformkit;
+using uvwarp::PointField;
+using uvwarp::WarpGrid;
+
+namespace {
+
+PointField zeros(int32_t cells, int32_t channels) {
+    PointField out;
+    out.cells = cells;
+    out.channels = channels;
+    out.values.assign(static_cast<size_t>(cells + 1) * (cells + 1) * channels, 0.0f);
+    return out;
+}
+
+// Grid triangles with signed area <= 0, both diagonal splittings of every cell, in double precision.
+int foldedTriangles(const WarpGrid& w) {
+    const int n = w.cells, side = n + 1;
+    const auto orient = [&](size_t a, size_t b, size_t c) {
+        return (double(w.u[b]) - w.u[a]) * (double(w.v[c]) - w.v[a]) -
+               (double(w.v[b]) - w.v[a]) * (double(w.u[c]) - w.u[a]);
+    };
+    int folds = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const size_t a = static_cast<size_t>(j) * side + i, b = a + 1, c = a + side + 1, d = a + side;
+            folds += (orient(a, b, c) <= 0) + (orient(a, c, d) <= 0) + (orient(a, b, d) <= 0) +
+                     (orient(b, c, d) <= 0);
+        }
+    return folds;
+}
+
+// A random case: a rest surface (a plane, or a bumpy sheet), a deformed one made of a random affine map, a
+// bend, and noise up to collapsing, folding or tearing f_D; rigidity as random disks, some fractional;
+// a mask with random holes, stripes and single pinned points; random solver options.
+struct Case {
+    PointField rest, deformed, rigidity, mask;
+    uvwarp::SolverOptions options;
+};
+
+Case randomCase(std::mt19937& rng, int32_t cells) {
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const auto range = [&](float lo, float hi) { return lo + (hi - lo) * unit(rng); };
+    Case c;
+    c.rest = zeros(cells, 3);
+    c.deformed = zeros(cells, 3);
+    c.rigidity = zeros(cells, 1);
+    c.mask = zeros(cells, 1);
+    const float bump = unit(rng) < 0.5f ? 0.0f : range(0.0f, 0.3f);
+    const float a = range(0.3f, 2.5f), b = range(-0.8f, 0.8f), d = range(0.3f, 2.5f);
+    const float bend = range(-2.0f, 2.0f), noise = unit(rng) < 0.3f ? range(0.0f, 0.05f) : 0.0f;
+    const bool collapse = unit(rng) < 0.2f;  // a band of f_D squeezed to a line
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    struct Disk {
+        float u, v, r, value;
+    };
+    std::vector<Disk> disks(static_cast<size_t>(range(1.0f, 12.0f)));
+    for (Disk& k : disks)
+        k = {unit(rng), unit(rng), range(0.03f, 0.2f), unit(rng) < 0.7f ? 1.0f : range(0.2f, 1.0f)};
+    std::vector<Disk> holes(static_cast<size_t>(range(0.0f, 4.0f)));
+    for (Disk& k : holes)
+        k = {unit(rng), unit(rng), range(0.0f, 0.1f), 0.0f};
+    const float stripe = unit(rng) < 0.3f ? range(0.2f, 0.8f) : -1.0f;
+    const float pinned = unit(rng) < 0.3f ? 0.02f : 0.0f;
+    for (int32_t j = 0; j <= cells; ++j) {
+        for (int32_t i = 0; i <= cells; ++i) {
+            const size_t k = c.rigidity.index(i, j);
+            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
+            float* r = &c.rest.values[3 * k];
+            r[0] = u;
+            r[1] = v;
+            r[2] = bump * std::sin(7.0f * u) * std::cos(5.0f * v);
+            float* p = &c.deformed.values[3 * k];
+            const float x = a * u + b * v, y = d * v;
+            p[0] = x * std::cos(bend * v);
+            p[1] = y;
+            p[2] = r[2] + x * std::sin(bend * v);
+            if (collapse && std::abs(u - 0.5f) < 0.1f) p[0] = a * 0.5f;
+            for (int q = 0; q < 3; ++q)
+                p[q] += noise * gauss(rng);
+            float rigid = 0.0f;
+            for (const Disk& disk : disks)
+                if (std::hypot(u - disk.u, v - disk.v) < disk.r) rigid = std::max(rigid, disk.value);
+            c.rigidity.values[k] = rigid;
+            bool movable = true;
+            for (const Disk& hole : holes)
+                movable &= std::hypot(u - hole.u, v - hole.v) >= hole.r;
+            movable &= std::abs(u - stripe) > 0.01f;
+            movable &= unit(rng) >= pinned;
+            c.mask.values[k] = movable ? 1.0f : 0.0f;
+        }
+    }
+    c.options.iterations = static_cast<int32_t>(range(1.0f, 8.0f));
+    c.options.damping = range(0.0f, 1.0f);
+    c.options.coarseStiffness = range(0.5f, 1.0f);
+    c.options.orientationPreservation = range(0.0f, 0.3f);
+    c.options.smoothing = range(0.0f, 1.0f);
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, on random inputs",
+          "[uvwarp][invariants]") {
+    std::mt19937 rng(20261202);
+    int casesRepaired = 0;
+    for (int n = 0; n < 48; ++n) {
+        const int32_t cells = n % 3 == 0 ? 64 : 32;
+        const Case c = randomCase(rng, cells);
+        uvwarp::Solver solver(c.rest, c.rigidity, c.mask, c.options);
+        const WarpGrid identity = WarpGrid::identity(cells);
+        for (int frame = 0; frame < 3; ++frame) {
+            const WarpGrid& w = solver.solve(c.deformed);
+            INFO("case " << n << ", frame " << frame << ", " << cells << " cells");
+            bool finite = true;
+            double pinnedMove = 0.0;
+            for (int32_t j = 0; j <= cells; ++j)
+                for (int32_t i = 0; i <= cells; ++i) {
+                    const size_t k = c.mask.index(i, j);
+                    finite &= std::isfinite(w.u[k]) && std::isfinite(w.v[k]);
+                    const bool border = i == 0 || j == 0 || i == cells || j == cells;
+                    if (border || c.mask.values[k] < 0.5f)
+                        pinnedMove = std::max<double>(
+                            pinnedMove, std::hypot(w.u[k] - identity.u[k], w.v[k] - identity.v[k]));
+                }
+            REQUIRE(finite);
+            CHECK(pinnedMove == 0.0);
+            CHECK(foldedTriangles(w) == 0);
+            CHECK(solver.stats().remainingFolds == 0);
+        }
+        casesRepaired += solver.stats().revertedPoints > 0 || solver.stats().untangledPoints > 0;
+    }
+    // The cases are hard enough to need the fold repair (else the test would prove nothing about it).
+    CHECK(casesRepaired > 0);
+}
+
+TEST_CASE("uv warp: the tolerance ends a solve once no point moves farther", "[uvwarp][options]") {
+    const int32_t cells = 64;
+    Case c;
+    c.rest = zeros(cells, 3);
+    c.deformed = zeros(cells, 3);
+    c.rigidity = zeros(cells, 1);
+    c.mask = zeros(cells, 1);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i) {
+            const size_t k = c.mask.index(i, j);
+            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
+            c.rest.values[3 * k] = u;
+            c.rest.values[3 * k + 1] = v;
+            c.deformed.values[3 * k] = 1.5f * u;
+            c.deformed.values[3 * k + 1] = v;
+            c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < 0.2f ? 1.0f : 0.0f;
+            c.mask.values[k] = 1.0f;
+        }
+    uvwarp::SolverOptions options;
+    options.iterations = 400;
+    options.tolerance = 0.01f;
+    uvwarp::Solver stopping(c.rest, c.rigidity, c.mask, options);
+    stopping.solve(c.deformed);
+    const uvwarp::SolveStats stats = stopping.stats();
+    INFO("converged after " << stats.iterations << " iterations, last move " << stats.lastMove << " cells");
+    REQUIRE(stats.converged);
+    CHECK(stats.iterations < 400);
+    CHECK(stats.lastMove <= 0.01f);
+
+    // The same schedule without the stop, one iteration short and exactly as long: the last iteration's
+    // largest move, measured here, is the reported one, and it is the first below the tolerance.
+    options.tolerance = 0.0f;
+    options.iterations = stats.iterations;
+    uvwarp::Solver full(c.rest, c.rigidity, c.mask, options);
+    const WarpGrid last = full.solve(c.deformed);
+    CHECK_FALSE(full.stats().converged);
+    CHECK(full.stats().iterations == stats.iterations);
+    CHECK(std::memcmp(last.u.data(), stopping.warp().u.data(), last.u.size() * sizeof(float)) == 0);
+    options.iterations = stats.iterations - 1;
+    uvwarp::Solver shorter(c.rest, c.rigidity, c.mask, options);
+    const WarpGrid before = shorter.solve(c.deformed);
+    double move = 0.0;
+    for (size_t k = 0; k < last.u.size(); ++k)
+        move = std::max(move, std::hypot(double(last.u[k]) - before.u[k], double(last.v[k]) - before.v[k]));
+    CHECK(move * cells == Approx(stats.lastMove).epsilon(1e-4));
+    CHECK(shorter.stats().lastMove > 0.01f);
+
+    // A warm-started frame of the settled pose stops after its first iteration.
+    options.iterations = 400;
+    options.tolerance = 0.01f;
+    uvwarp::Solver warm(c.rest, c.rigidity, c.mask, options);
+    warm.solve(c.deformed);
+    warm.solve(c.deformed);
+    CHECK(warm.stats().iterations <= 2);
+
+    options.tolerance = 1.5f;
+    CHECK_THROWS_WITH(uvwarp::Solver(c.rest, c.rigidity, c.mask, options), Catch::Contains("tolerance"));
+}
+
+// The team chooser (core/src/uvwarp/team_chooser.h) on made-up times: it must follow whichever team is
+// faster, try the other one now and then, and try less often while the choice holds.
+TEST_CASE("uv warp: the solver's team follows the faster of all threads and one", "[uvwarp][threads]") {
+    uvwarp::detail::TeamChooser chooser;
+    std::vector<int32_t> teams;
+    const auto run = [&](int32_t allowed, double allTime, double oneTime) {
+        const int32_t team = chooser.next(allowed);
+        chooser.record(team, team == 1 ? oneTime : allTime);
+        teams.push_back(team);
+        return team;
+    };
+    // A core taken: all threads 1.3x slower than one. All, then one, then one but for rare tries of all.
+    for (int k = 0; k < 200; ++k)
+        run(2, 1.3, 1.0);
+    CHECK(teams[0] == 2);
+    CHECK(teams[1] == 1);
+    const auto allRuns = std::count(teams.begin() + 2, teams.end(), 2);
+    CHECK(allRuns >= 2);  // it keeps trying
+    CHECK(allRuns <= 6);  // tries after 8, 16, 32, 64, 128 runs
+    CHECK(chooser.chosen() == 1);
+    // The core given back: all threads twice as fast. Within the next try interval (128 runs at most) it
+    // goes back to all threads, and stays there but for tries.
+    teams.clear();
+    for (int k = 0; k < 300; ++k)
+        run(2, 0.5, 1.0);
+    CHECK(chooser.chosen() == 2);
+    const auto switchedAt = std::find(teams.begin(), teams.end(), 2) - teams.begin();
+    CHECK(switchedAt <= 129);
+    CHECK(std::count(teams.begin() + switchedAt, teams.end(), 1) <= 6);
+    // The caller allows one thread: nothing to choose.
+    CHECK(chooser.next(1) == 1);
+    CHECK(chooser.chosen() == 1);
+}
+
+TEST_CASE("uv warp: the same bytes whichever team each iteration runs on", "[uvwarp][threads]") {
+    std::mt19937 rng(7);
+    const Case c = randomCase(rng, 64);
+    uvwarp::SolverOptions options = c.options;
+    options.iterations = 6;
+    std::vector<WarpGrid> warps;
+    for (int32_t threads : {1, 2, 0}) {  // one thread, two, and chosen per iteration
+        options.threads = threads;
+        uvwarp::Solver solver(c.rest, c.rigidity, c.mask, options);
+        solver.solve(c.deformed);
+        warps.push_back(solver.solve(c.deformed));
+    }
+    for (size_t k = 1; k < warps.size(); ++k) {
+        CHECK(std::memcmp(warps[0].u.data(), warps[k].u.data(), warps[0].u.size() * sizeof(float)) == 0);
+        CHECK(std::memcmp(warps[0].v.data(), warps[k].v.data(), warps[0].v.size() * sizeof(float)) == 0);
+    }
+}
