@@ -56,6 +56,33 @@ const detail::SolverKernels& kernelsFor(simd::Isa isa) {
     return detail::kBaselineKernels;
 }
 
+// The largest distance, in cells (chessboard: 8-neighbour steps), from a point that may move (mask >= 0.5,
+// not on the tile border) to the nearest point that may not: the half-width of the widest chart. Two passes
+// of the exact chessboard distance transform.
+int32_t widestChartRadius(const PointField& mask) {
+    const int32_t side = mask.side();
+    const int32_t far = 2 * side;
+    std::vector<int32_t> d(static_cast<size_t>(side) * side);
+    const auto at = [&](int32_t i, int32_t j) -> int32_t& { return d[static_cast<size_t>(j) * side + i]; };
+    for (int32_t j = 0; j < side; ++j)
+        for (int32_t i = 0; i < side; ++i) {
+            const bool border = i == 0 || j == 0 || i == side - 1 || j == side - 1;
+            at(i, j) = border || mask.values[mask.index(i, j)] < 0.5f ? 0 : far;
+        }
+    for (int32_t j = 1; j < side; ++j)
+        for (int32_t i = 1; i < side - 1; ++i)
+            at(i, j) = std::min(
+                {at(i, j), at(i - 1, j) + 1, at(i - 1, j - 1) + 1, at(i, j - 1) + 1, at(i + 1, j - 1) + 1});
+    int32_t widest = 0;
+    for (int32_t j = side - 2; j >= 0; --j)
+        for (int32_t i = side - 2; i >= 1; --i) {
+            at(i, j) = std::min(
+                {at(i, j), at(i + 1, j) + 1, at(i + 1, j + 1) + 1, at(i, j + 1) + 1, at(i - 1, j + 1) + 1});
+            widest = std::max(widest, at(i, j));
+        }
+    return widest;
+}
+
 detail::KernelLevel kernelLevel(const Level& level) {
     return {level.cells,
             level.stride,
@@ -369,8 +396,13 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     }
     int32_t levelCount = options.levels;
     if (levelCount == 0) {
+        // Down to an 8-cell grid, but no level whose cells are wider than a third of the widest chart's
+        // half-width: coarser cells straddle charts and pinned borders, and on real layouts they cost
+        // quality (UV-18).
+        detail::requireField(mask, m.cells, 1, source, "mask");
+        const int32_t widestStride = std::max(widestChartRadius(mask) / 3, 1);
         levelCount = 1;
-        while ((m.cells >> levelCount) >= 8)
+        while ((m.cells >> levelCount) >= 8 && (1 << levelCount) <= widestStride)
             ++levelCount;
     }
     levelCount = std::min(levelCount, static_cast<int32_t>(std::log2(m.cells)));

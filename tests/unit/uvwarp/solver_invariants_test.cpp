@@ -258,3 +258,45 @@ TEST_CASE("uv warp: the same bytes whichever team each iteration runs on", "[uvw
         CHECK(std::memcmp(warps[0].v.data(), warps[k].v.data(), warps[0].v.size() * sizeof(float)) == 0);
     }
 }
+
+// The automatic depth (SolverOptions::levels = 0, UV-18): down to an 8-cell grid, but no level whose point
+// spacing exceeds a third of the widest chart's half-width, the largest chessboard distance from a movable
+// point to a fixed one (mask < 0.5 or the tile border), computed here by brute force.
+TEST_CASE("uv warp: the automatic depth follows the widest chart", "[uvwarp][options]") {
+    const int32_t cells = 64;
+    for (int32_t gap : {0, 40, 24, 12, 6}) {  // fixed vertical lines every `gap` cells (0: none)
+        Case c;
+        c.rest = zeros(cells, 3);
+        c.rigidity = zeros(cells, 1);
+        c.mask = zeros(cells, 1);
+        for (int32_t j = 0; j <= cells; ++j)
+            for (int32_t i = 0; i <= cells; ++i) {
+                const size_t k = c.mask.index(i, j);
+                c.rest.values[3 * k] = static_cast<float>(i) / cells;
+                c.rest.values[3 * k + 1] = static_cast<float>(j) / cells;
+                c.mask.values[k] = gap > 0 && i % gap == 0 ? 0.0f : 1.0f;
+            }
+        const auto fixed = [&](int32_t i, int32_t j) {
+            return i == 0 || j == 0 || i == cells || j == cells || c.mask.values[c.mask.index(i, j)] < 0.5f;
+        };
+        int32_t widest = 0;
+        for (int32_t j = 0; j <= cells; ++j)
+            for (int32_t i = 0; i <= cells; ++i) {
+                if (fixed(i, j)) continue;
+                int32_t nearest = 4 * cells;
+                for (int32_t b = 0; b <= cells; ++b)
+                    for (int32_t a = 0; a <= cells; ++a)
+                        if (fixed(a, b))
+                            nearest = std::min(nearest, std::max(std::abs(a - i), std::abs(b - j)));
+                widest = std::max(widest, nearest);
+            }
+        int32_t expected = 1;
+        while ((cells >> expected) >= 8 && (1 << expected) <= std::max(widest / 3, 1))
+            ++expected;
+        const uvwarp::Solver solver(c.rest, c.rigidity, c.mask);
+        INFO("fixed lines every " << gap << " cells, widest half-width " << widest);
+        CHECK(solver.levels() == expected);
+        if (gap == 0) CHECK(solver.levels() == 4);  // one chart: down to the 8-cell grid, as before
+        if (gap == 6) CHECK(solver.levels() == 1);
+    }
+}
