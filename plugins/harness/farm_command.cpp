@@ -37,11 +37,16 @@ scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
         throw InvalidInput(formatError("--tiles-per-task", "", "is " + std::to_string(command.tilesPerTask),
                                        "a whole number of UDIM tiles per task >= 1"));
     }
+    if (command.warmUp < 0) {
+        throw InvalidInput(formatError("--warm-up", "", "is " + std::to_string(command.warmUp),
+                                       "a whole number of frames >= 0"));
+    }
     if (command.outDir.empty()) throw InvalidInput(formatError("--out", "", "is empty", "an output folder"));
     scene::FarmPlanOptions options;
     options.frames = command.frames;
     options.chunk = command.chunk;
     options.tilesPerTask = command.tilesPerTask;
+    options.warmUp = command.warmUp;
     const scene::FarmPlan plan =
         scene::planFarm(readScene(command.scene), command.scene, command.outDir, options);
     io::createFolder(plan.outDir);
@@ -183,6 +188,9 @@ void addFarmCommands(CommandLine& cli) {
     plan.option("--chunk", p->command.chunk, "frames per task at most").showDefault();
     plan.option("--tiles-per-task", p->command.tilesPerTask,
                 "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
+        .showDefault();
+    plan.option("--warm-up", p->command.warmUp,
+                "frames a UV-warp task solves before its range, so its maps hardly depend on the chunking")
         .showDefault();
     plan.option("--out", p->out, "output folder of the tasks: <object>.<frame 4 digits>.obj").required();
     plan.option("--plan", p->plan, "plan file to write; default: <out>/farm_plan.json");

@@ -299,9 +299,17 @@ contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"
 contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
 expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
-cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" &&
-    { echo "FAIL farm-run-tiles: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
-[ -s "$work/farm-uv/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-tiles: output missing"; failures=$((failures + 1)); }
+contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 3'
+# Warmed up from frame 1, the task of frame 2 writes eval's bytes; started cold (--warm-up 0) it does not.
+cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
+    { echo "FAIL farm-run-tiles: a task warmed up from frame 1 should write eval's frame 2"; failures=$((failures + 1)); }
+expect farm-plan-cold 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --warm-up 0 --out "$work/farm-uv-cold"
+expect farm-run-cold 0 "$dk" farm run "$work/farm-uv-cold/farm_plan.json" --task 3
+cmp -s "$work/farm-uv-cold/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" &&
+    { echo "FAIL farm-run-cold: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
+[ -s "$work/farm-uv-cold/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-cold: output missing"; failures=$((failures + 1)); }
+expect farm-plan-bad-warm-up 2 "$dk" farm plan "$work/uvshot.json" --warm-up -1 --out "$work/farm-uv3"
+contains farm-plan-bad-warm-up "$work/err" "--warm-up: is -1"
 expect farm-plan-bad-tiles 2 "$dk" farm plan "$work/uvshot.json" --tiles-per-task 0 --out "$work/farm-uv2"
 contains farm-plan-bad-tiles "$work/err" "--tiles-per-task: is 0"
 sed 's/"iterations": 4/"iterations": 0/' "$work/uvshot.json" >"$work/uvshot_bad.json"

@@ -79,13 +79,14 @@ cat >"$work/shot.json" <<EOF
     {"type": "uvwarp", "rigidity": "rig.<UDIM>.pgm", "params": {"iterations": 4}}]}]}
 EOF
 
-# The reference: eval over each task's frame range (a UV-warp run starts cold at its first frame).
+# The reference: eval over each task's frame range (with --warm-up 0 a UV-warp task starts cold at its
+# first frame, as eval over the range does).
 for first in $(seq 1 $chunk $frames); do
     "$dk" eval "$work/shot.json" --frames "$first-$((first + chunk - 1))" --out "$work/eval" --no-previews \
         >/dev/null || fail "deformkit eval --frames $first-$((first + chunk - 1)) failed"
 done
 
-"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk $chunk --out "$work/tasks" \
+"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk $chunk --warm-up 0 --out "$work/tasks" \
     --plan "$work/plan.json" >/dev/null || fail "deformkit farm plan failed"
 jobid=$("$dk" farm submit --slurm "$work/plan.json") || fail "deformkit farm submit failed"
 [[ $jobid =~ ^[0-9]+$ ]] || fail "farm submit printed '$jobid', expected a job id"

@@ -47,7 +47,7 @@ class PlanReader {
     explicit PlanReader(const fs::path& source) : source_(source) {}
 
     FarmPlan plan(const json& root) const {
-        requireObject(root, "", {"deformkit_farm_plan", "scene", "out", "chunk", "tasks"});
+        requireObject(root, "", {"deformkit_farm_plan", "scene", "out", "chunk", "warmUp", "tasks"});
         const json& version = member(root, "", "deformkit_farm_plan");
         if (!version.is_number_integer() || version.get<int64_t>() != kFarmPlanVersion) {
             fail("deformkit_farm_plan", "is " + version.dump(),
@@ -58,6 +58,10 @@ class PlanReader {
         plan.outDir = path(member(root, "", "out"), "out");
         plan.chunk = integer(member(root, "", "chunk"), "chunk");
         if (plan.chunk < 1) fail("chunk", "is " + std::to_string(plan.chunk), "a whole number >= 1");
+        if (root.contains("warmUp")) {  // optional: a plan without it warms up nothing
+            plan.warmUp = integer(root.at("warmUp"), "warmUp");
+            if (plan.warmUp < 0) fail("warmUp", "is " + std::to_string(plan.warmUp), "a whole number >= 0");
+        }
         const json& tasks = member(root, "", "tasks");
         if (!tasks.is_array() || tasks.empty()) fail("tasks", "is " + describe(tasks), "a non-empty array");
         for (size_t k = 0; k < tasks.size(); ++k)
@@ -178,6 +182,10 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
                                        "is " + std::to_string(options.tilesPerTask),
                                        "a whole number of UDIM tiles per task >= 1"));
     }
+    if (options.warmUp < 0) {
+        throw InvalidInput(formatError("farm plan", "warmUp", "is " + std::to_string(options.warmUp),
+                                       "a whole number of frames >= 0"));
+    }
     if (outDir.empty()) throw InvalidInput(formatError("farm plan", "output folder", "is empty", "a folder"));
     std::vector<int> frames = options.frames;
     if (frames.empty()) {
@@ -188,6 +196,7 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
     plan.scene = absolutePath(sceneFile);
     plan.outDir = absolutePath(outDir);
     plan.chunk = options.chunk;
+    plan.warmUp = options.warmUp;
     // Runs of consecutive frames, each at most `chunk` long.
     std::vector<std::pair<int, int>> ranges;
     for (size_t i = 0; i < frames.size();) {
@@ -228,7 +237,7 @@ std::string formatFarmPlan(const FarmPlan& plan) {
     out << "{\n  \"deformkit_farm_plan\": " << kFarmPlanVersion
         << ",\n  \"scene\": " << json(plan.scene.string()).dump()
         << ",\n  \"out\": " << json(plan.outDir.string()).dump() << ",\n  \"chunk\": " << plan.chunk
-        << ",\n  \"tasks\": [";
+        << ",\n  \"warmUp\": " << plan.warmUp << ",\n  \"tasks\": [";
     for (size_t k = 0; k < plan.tasks.size(); ++k) {
         const FarmTask& t = plan.tasks[k];
         const json task = {
@@ -303,6 +312,12 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
             (all ? report.skipped : report.written).push_back(frame);
         }
         UvWarpStageRun run;
+        // Up to plan.warmUp frames before the range, within the scene's frames, warm-start the task as the
+        // frames before it warm-start an uninterrupted run.
+        for (int frame = std::max(scene.firstFrame, t.firstFrame - plan.warmUp); frame < t.firstFrame;
+             ++frame)
+            run.frames.push_back(frame);
+        run.warmUpFrames = static_cast<int32_t>(run.frames.size());
         for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame)
             run.frames.push_back(frame);
         run.tiles = t.tiles;

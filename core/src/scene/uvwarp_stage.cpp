@@ -94,6 +94,7 @@ uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpSt
     job.rest = &o.rest;
     job.restName = o.meshFile.string();
     job.frames = run.frames;
+    job.warmUpFrames = run.warmUpFrames;
     for (int tile : run.tiles) {
         if (std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile)) job.tiles.push_back(tile);
     }

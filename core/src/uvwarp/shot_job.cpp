@@ -189,12 +189,15 @@ struct ShotSolver::Impl {
     }
     json baseLine(const TilePlan& plan, size_t k, const char* status) const {
         json line = {{"tile", plan.tile}, {"frame", job.frames[k]}, {"status", status}};
+        if (warmUp(k)) return line;  // no outputs
         if (!plan.outPaths.empty()) line["redirect"] = plan.outPaths[k].string();
         if (plan.texture.found()) line["bake"] = plan.bakePaths[k].string();
         return line;
     }
+    [[nodiscard]] bool warmUp(size_t k) const { return k < static_cast<size_t>(job.warmUpFrames); }
     // The units of frame k that need no solve: unwarped tiles and frames after a tile's last needed one.
     void logUnsolved(TilePlan& plan, size_t k) {
+        if (warmUp(k)) return;  // nothing to warm up: the tile has no output to write
         if (!plan.report.warped) {
             json line = baseLine(plan, k, "unwarped");
             line["reason"] = "no rigidity map '" + plan.rigidity.name + "'";
@@ -220,6 +223,11 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         throw InvalidInput(formatError("uvwarp", "job", "is incomplete",
                                        "a rest mesh, frames, a rigidity map, an output path, and a bake path "
                                        "with a texture"));
+    }
+    if (j.warmUpFrames < 0 || static_cast<size_t>(j.warmUpFrames) >= j.frames.size()) {
+        throw InvalidInput(
+            formatError("uvwarp", "warm-up frames", "are " + std::to_string(j.warmUpFrames),
+                        "0 to one less than the job's " + std::to_string(j.frames.size()) + " frames"));
     }
     if (!std::is_sorted(j.frames.begin(), j.frames.end()) ||
         std::adjacent_find(j.frames.begin(), j.frames.end()) != j.frames.end()) {
@@ -309,8 +317,9 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             const int frame = j.frames[k];
             plan.outPaths.push_back(j.outPath(tile, frame));
             plan.bakePaths.push_back(plan.texture.found() ? j.bakePath(tile, frame) : fs::path());
-            const bool needed = !j.skipExisting || !fileExists(plan.outPaths.back()) ||
-                                (plan.texture.found() && !fileExists(plan.bakePaths.back()));
+            const bool warmUp = k < static_cast<size_t>(j.warmUpFrames);
+            const bool needed = !warmUp && (!j.skipExisting || !fileExists(plan.outPaths.back()) ||
+                                            (plan.texture.found() && !fileExists(plan.bakePaths.back())));
             plan.needed.push_back(needed);
             if (needed) plan.lastNeeded = static_cast<int>(k);
         }
@@ -488,11 +497,13 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
         }
         seconds["write"] = writeSeconds;
         ++r.written;
+    } else if (warmUp(k)) {
+        ++r.warmedUp;
     } else {
         ++r.replayed;
     }
     seconds["total"] = secondsSince(start);
-    json line = baseLine(plan, k, needed ? "written" : "replayed");
+    json line = baseLine(plan, k, needed ? "written" : warmUp(k) ? "warm-up" : "replayed");
     line["metrics"] = metricsJson(metrics, warp.stats());
     line["seconds"] = seconds;
     writeLog(line);
@@ -529,6 +540,7 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
             const char* status = !plan.report.warped ? "unwarped"
                                  : !solves           ? "skipped"
                                  : plan.needed[k]    ? "written"
+                                 : s.warmUp(k)       ? "warm-up"
                                                      : "replayed";
             const std::string unit =
                 "tile " + std::to_string(plan.tile) + " frame " + std::to_string(frame) + " " + status;
@@ -659,6 +671,8 @@ std::vector<std::string> shotSummary(const ShotReport& report) {
             line << tile << t.written << (t.written == 1 ? " frame" : " frames") << " written";
             if (t.baked > 0) line << " (" << t.baked << " baked)";
             line << ", " << t.replayed << " replayed, " << t.skipped << " skipped (outputs exist)";
+            if (t.warmedUp > 0)
+                line << ", " << t.warmedUp << " warm-up " << (t.warmedUp == 1 ? "frame" : "frames");
             if (t.mapChanges > 0)
                 line << ", maps changed at " << t.mapChanges << (t.mapChanges == 1 ? " frame" : " frames");
             if (t.written + t.replayed > 0) {

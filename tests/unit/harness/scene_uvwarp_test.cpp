@@ -250,13 +250,15 @@ TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed
 }
 
 TEST_CASE(
-    "scene uvwarp: farm tasks are frame ranges x tiles; they write eval's bytes over their range and resume",
+    "scene uvwarp: farm tasks are frame ranges x tiles; warmed up from the shot's start they write eval's "
+    "bytes, and resume",
     "[harness][uvwarp][farm]") {
     Shot shot;
     harness::FarmPlanCommand planCommand;
     planCommand.scene = shot.scene;
     planCommand.chunk = 2;  // frames 1-2 and 3
     planCommand.outDir = shot.dir / "farm";
+    REQUIRE(planCommand.warmUp == 3);  // the default: the task of frame 3 first solves frames 1 and 2
     const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
     const fs::path planFile = harness::farmPlanPath(planCommand);
     // 2 mesh tasks, then 2 ranges x 2 tiles.
@@ -281,37 +283,57 @@ TEST_CASE(
         const scene::FarmTaskReport report = harness::farmRunCommand({planFile, k}, &log);
         CHECK(report.skipped.empty());
         if (k >= 2) {
-            // One JSON line per tile and frame, naming task, object and tile.
+            // One JSON line per tile and frame, naming task, object and tile; the warm-up frames before the
+            // range (from the scene's first frame) without outputs.
             std::istringstream in(log.str());
-            int lines = 0;
-            for (std::string line; std::getline(in, line); ++lines) {
+            int written = 0, warmUp = 0;
+            for (std::string line; std::getline(in, line);) {
                 const nlohmann::json j = nlohmann::json::parse(line);
                 CHECK(j["task"] == k);
                 CHECK(j["object"] == "tubes");
                 CHECK(j["tile"] == plan.tasks[k].tiles[0]);
-                CHECK(j["status"] == "written");
+                const bool before = j["frame"].get<int>() < plan.tasks[k].firstFrame;
+                CHECK(j["status"] == (before ? "warm-up" : "written"));
+                CHECK(j.contains("redirect") == !before);
+                (before ? warmUp : written) += 1;
             }
-            CHECK(lines == plan.tasks[k].lastFrame - plan.tasks[k].firstFrame + 1);
+            CHECK(written == plan.tasks[k].lastFrame - plan.tasks[k].firstFrame + 1);
+            CHECK(warmUp == plan.tasks[k].firstFrame - 1);
         }
     }
-    // The reference: eval over each task's frame range (a run starts cold at its first frame).
-    harness::EvalCommand eval12;
-    eval12.scene = shot.scene;
-    eval12.frames = {1, 2};
-    eval12.outDir = shot.dir / "eval12";
-    eval12.previews = false;
-    (void)harness::evalCommand(eval12);
-    harness::EvalCommand eval3 = eval12;
-    eval3.frames = {3};
-    eval3.outDir = shot.dir / "eval3";
-    (void)harness::evalCommand(eval3);
+    // The reference: one eval over the whole shot. The warm-up reaches back to the shot's first frame, so
+    // every task solves exactly the frames the uninterrupted run solved before its outputs.
+    harness::EvalCommand eval123;
+    eval123.scene = shot.scene;
+    eval123.outDir = shot.dir / "eval123";
+    eval123.previews = false;
+    (void)harness::evalCommand(eval123);
     std::vector<fs::path> expected{"farm_plan.json"};
     for (const scene::FarmTask& task : plan.tasks) {
         for (const std::string& name : task.outputs) {
             expected.emplace_back(name);
-            const fs::path reference = (task.firstFrame == 3 ? eval3.outDir : eval12.outDir) / name;
             CAPTURE(name);
-            CHECK(test::readText(shot.dir / "farm" / name) == test::readText(reference));
+            CHECK(test::readText(shot.dir / "farm" / name) == test::readText(eval123.outDir / name));
+        }
+    }
+    // Without warm-up a task starts cold at its first frame: eval over its range alone is the reference.
+    harness::FarmPlanCommand coldCommand = planCommand;
+    coldCommand.warmUp = 0;
+    coldCommand.outDir = shot.dir / "cold";
+    const scene::FarmPlan cold = harness::farmPlanCommand(coldCommand);
+    CHECK(scene::readFarmPlan(harness::farmPlanPath(coldCommand)).warmUp == 0);
+    CHECK(scene::readFarmPlan(planFile).warmUp == 3);
+    harness::EvalCommand eval3 = eval123;
+    eval3.frames = {3};
+    eval3.outDir = shot.dir / "eval3";
+    (void)harness::evalCommand(eval3);
+    for (int k = 2; k < 6; ++k) {
+        (void)harness::farmRunCommand({harness::farmPlanPath(coldCommand), k});
+        if (cold.tasks[k].firstFrame != 3) continue;
+        for (const std::string& name : cold.tasks[k].outputs) {
+            CAPTURE(name);
+            CHECK(test::readText(shot.dir / "cold" / name) == test::readText(eval3.outDir / name));
+            CHECK(test::readText(shot.dir / "cold" / name) != test::readText(eval123.outDir / name));
         }
     }
     std::sort(expected.begin(), expected.end());
@@ -437,4 +459,54 @@ TEST_CASE("scene uvwarp: eval writes the same bytes with 1 and 2 threads", "[har
     REQUIRE(runs[0].size() > 10);  // meshes, previews, maps, bakes, the contact sheet
     for (size_t i = 0; i < runs[0].size(); ++i)
         CHECK(runs[0][i] == runs[1][i]);
+}
+
+// Issue 19, part 3: a frame's redirect map must not depend on where its farm chunk began. A 12-frame shot
+// in chunks of 4: at the chunk starts (frames 5 and 9) the maps of the farm tasks against those of one
+// uninterrupted eval, largest difference over the tile in texels. With the default 3 warm-up frames it must
+// be at most 0.25 texel; without warm-up it is larger (so the bound is not met by accident).
+TEST_CASE(
+    "scene uvwarp: with warm-up frames a chunk's first map is the uninterrupted run's within 0.25 texel",
+    "[harness][uvwarp][farm]") {
+    Shot shot;
+    std::string longer = kScene;
+    const auto replace = [&](const std::string& from, const std::string& to) {
+        longer.replace(longer.find(from), from.size(), to);
+    };
+    replace(R"("frames": [1, 3])", R"("frames": [1, 12])");
+    replace(R"({"frame": 3, "value": 1.8})", R"({"frame": 12, "value": 1.9})");
+    replace(R"("texture": "col.<UDIM>.exr",)", "");
+    test::writeText(shot.scene, longer);
+    harness::EvalCommand eval;
+    eval.scene = shot.scene;
+    eval.outDir = shot.dir / "eval";
+    eval.previews = false;
+    (void)harness::evalCommand(eval);
+    double jumps[2] = {0.0, 0.0};  // without, with warm-up
+    for (int warmUp : {0, 3}) {
+        harness::FarmPlanCommand plan;
+        plan.scene = shot.scene;
+        plan.chunk = 4;
+        plan.warmUp = warmUp;
+        plan.outDir = shot.dir / ("farm" + std::to_string(warmUp));
+        const scene::FarmPlan made = harness::farmPlanCommand(plan);
+        for (size_t k = 0; k < made.tasks.size(); ++k)
+            (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)});
+        for (int frame : {5, 9}) {
+            for (int tile : {1001, 1002}) {
+                char name[64];
+                std::snprintf(name, sizeof(name), "tubes.redirect.%d.%04d.exr", tile, frame);
+                const io::Image chunked = io::readImage(plan.outDir / name);
+                const io::Image whole = io::readImage(eval.outDir / name);
+                REQUIRE(chunked.pixels.size() == whole.pixels.size());
+                for (size_t i = 0; i < whole.pixels.size(); ++i)
+                    jumps[warmUp > 0] = std::max(
+                        jumps[warmUp > 0], std::abs(double(chunked.pixels[i]) - whole.pixels[i]) * kTexels);
+            }
+        }
+    }
+    INFO("largest jump at a chunk start: " << jumps[0] << " texels cold, " << jumps[1]
+                                           << " with 3 warm-up frames");
+    CHECK(jumps[1] <= 0.25);
+    CHECK(jumps[0] > 0.25);
 }

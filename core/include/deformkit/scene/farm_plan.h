@@ -16,10 +16,11 @@
 // A plan lists tasks, each a range of at most `chunk` consecutive frames with the files it writes
 // (scene/uvwarp_stage.h names them): first the mesh tasks (<object>.<frame>.obj for every object), then,
 // when objects have a UV-warp stage, one task per frame range and group of at most `tilesPerTask` UDIM
-// tiles writing those tiles' redirect maps and bakes (warm start within the task's frames, a cold start at
-// its first frame). A task binds the scene's stacks once and evaluates its frames in order; outputs that
-// exist are kept (a UV-warp task replays the warm start up to its last missing output), and every output is
-// written atomically, so a task killed and run again finishes with the bytes an uninterrupted run writes.
+// tiles writing those tiles' redirect maps and bakes (warm start within the task's frames, after up to
+// `warmUp` frames before its range solved without outputs). A task binds the scene's stacks once and
+// evaluates its frames in order; outputs that exist are kept (a UV-warp task replays the warm start up to its
+// last missing output), and every output is written atomically, so a task killed and run again finishes with
+// the bytes an uninterrupted run writes.
 namespace deformkit::scene {
 
 // The plan format version readFarmPlan reads.
@@ -40,7 +41,10 @@ struct FarmPlan {
     std::filesystem::path scene;   // absolute
     std::filesystem::path outDir;  // absolute
     int chunk = 1;                 // frames per task at most
-    std::vector<FarmTask> tasks;   // the task index is the position
+    // UV-warp tasks first solve up to this many frames before their range (within the scene's frames), so
+    // that a frame's redirect map hardly depends on where its chunk began.
+    int warmUp = 0;
+    std::vector<FarmTask> tasks;  // the task index is the position
 };
 
 struct FarmPlanOptions {
@@ -48,6 +52,7 @@ struct FarmPlanOptions {
     std::vector<int> frames;
     int chunk = 10;        // frames per task at most, >= 1
     int tilesPerTask = 1;  // UDIM tiles per UV-warp task at most, >= 1
+    int warmUp = 3;        // FarmPlan::warmUp, >= 0
 };
 
 // The plan of `scene` (read from `sceneFile`) writing into `outDir` (paths made absolute). Throws

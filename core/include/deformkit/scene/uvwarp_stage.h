@@ -47,8 +47,9 @@ namespace deformkit::scene {
 [[nodiscard]] std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame);
 
 struct UvWarpStageRun {
-    std::vector<int> frames;  // ascending
-    std::vector<int> tiles;   // ascending; tiles the stage does not warp are ignored
+    std::vector<int> frames;   // ascending
+    int32_t warmUpFrames = 0;  // the first this many frames only warm-start the rest (ShotJob::warmUpFrames)
+    std::vector<int> tiles;    // ascending; tiles the stage does not warp are ignored
     std::filesystem::path outDir;
     bool skipExisting = false;    // true: keep existing outputs and replay the warm start (farm tasks)
     std::ostream* log = nullptr;  // JSON lines per tile x frame (ShotJob::log)

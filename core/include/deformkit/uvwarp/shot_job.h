@@ -29,9 +29,9 @@ namespace deformkit::uvwarp {
 //
 // - Per tile one TileWarp is bound (rest mesh, rigidity map, mask map or a mask derived from the UVs,
 //   orientation map) and solved frame after frame in ascending order, each frame warm-started from the
-//   previous one; a job starts cold at its first frame. Tiles are solved frame by frame together, so each
-//   frame's deformed positions are asked for once; memory is one solver per tile of the job (a farm task
-//   bounds it with its tile count).
+//   previous one; a job starts cold at its first frame (a warm-up frame, ShotJob::warmUpFrames, if it
+//   has any). Tiles are solved frame by frame together, so each frame's deformed positions are asked for
+//   once; memory is one solver per tile of the job (a farm task bounds it with its tile count).
 // - Outputs per tile and frame: the redirect map as a 2-channel float EXR (the rigidity map's size) whose
 //   header records how it was made (deformkit:version, deformkit:uvwarp:tile, deformkit:uvwarp:frame,
 //   deformkit:uvwarp:solver and deformkit:uvwarp:inputs, the last two JSON); with a texture, the bake
@@ -66,11 +66,14 @@ struct ShotJob {
     const geom::Mesh* rest = nullptr;  // with UVs; must outlive the job
     std::string restName;              // names the rest mesh in messages and EXR headers
     std::vector<int> frames;           // ascending, at least one
-    std::vector<int> tiles;            // tiles of the rest mesh's UVs, ascending; empty: every tile of them
-    TileMapSource rigidity;            // required; channel 0 in [0, 1], 1 = rigid
-    TileMapSource mask;                // optional; channel 0 >= 0.5 may warp
-    TileMapSource orientation;         // optional; channel 0 in [0, 1] scales the orientation preservation
-    TileMapSource texture;             // optional; baked through each redirect map (needs bakePath)
+    // The first this many of `frames` only warm-start the rest (a farm task's frames before its range):
+    // solved, never written nor logged as outputs, whether or not their files exist.
+    int32_t warmUpFrames = 0;
+    std::vector<int> tiles;     // tiles of the rest mesh's UVs, ascending; empty: every tile of them
+    TileMapSource rigidity;     // required; channel 0 in [0, 1], 1 = rigid
+    TileMapSource mask;         // optional; channel 0 >= 0.5 may warp
+    TileMapSource orientation;  // optional; channel 0 in [0, 1] scales the orientation preservation
+    TileMapSource texture;      // optional; baked through each redirect map (needs bakePath)
     // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
     std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
     TileWarpOptions options;  // cells: the grid resolution (0: the rigidity map's size)
@@ -94,6 +97,7 @@ struct ShotTileReport {
     int32_t baked = 0;                         // bakes written
     int32_t replayed = 0;                      // outputs existed; solved to carry the warm start
     int32_t skipped = 0;                       // outputs existed; not solved
+    int32_t warmedUp = 0;                      // warm-up frames solved (ShotJob::warmUpFrames)
     int32_t mapChanges = 0;                    // frames whose animated maps differed from the last (rebuilt)
     int lastFrame = 0;                         // the last frame solved (replayed or written)
     WarpMetrics lastMetrics;                   // of lastFrame
