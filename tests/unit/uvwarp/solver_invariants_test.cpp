@@ -112,6 +112,22 @@ Case randomCase(std::mt19937& rng, int32_t cells) {
     return c;
 }
 
+// The flat unit square (f_O = f_D = (u, v, 0)) with rigidity 0 and nothing movable: tests fill in the rest.
+Case planeCase(int32_t cells) {
+    Case c;
+    c.rest = zeros(cells, 3);
+    c.rigidity = zeros(cells, 1);
+    c.mask = zeros(cells, 1);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i) {
+            const size_t k = c.mask.index(i, j);
+            c.rest.values[3 * k] = static_cast<float>(i) / cells;
+            c.rest.values[3 * k + 1] = static_cast<float>(j) / cells;
+        }
+    c.deformed = c.rest;
+    return c;
+}
+
 }  // namespace
 
 TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, on random inputs",
@@ -150,19 +166,12 @@ TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, 
 
 TEST_CASE("uv warp: the tolerance ends a solve once no point moves farther", "[uvwarp][options]") {
     const int32_t cells = 64;
-    Case c;
-    c.rest = zeros(cells, 3);
-    c.deformed = zeros(cells, 3);
-    c.rigidity = zeros(cells, 1);
-    c.mask = zeros(cells, 1);
+    Case c = planeCase(cells);
     for (int32_t j = 0; j <= cells; ++j)
         for (int32_t i = 0; i <= cells; ++i) {
             const size_t k = c.mask.index(i, j);
             const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
-            c.rest.values[3 * k] = u;
-            c.rest.values[3 * k + 1] = v;
             c.deformed.values[3 * k] = 1.5f * u;
-            c.deformed.values[3 * k + 1] = v;
             c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < 0.2f ? 1.0f : 0.0f;
             c.mask.values[k] = 1.0f;
         }
@@ -265,15 +274,10 @@ TEST_CASE("uv warp: the same bytes whichever team each iteration runs on", "[uvw
 TEST_CASE("uv warp: the automatic depth follows the widest chart", "[uvwarp][options]") {
     const int32_t cells = 64;
     for (int32_t gap : {0, 40, 24, 12, 6}) {  // fixed vertical lines every `gap` cells (0: none)
-        Case c;
-        c.rest = zeros(cells, 3);
-        c.rigidity = zeros(cells, 1);
-        c.mask = zeros(cells, 1);
+        Case c = planeCase(cells);
         for (int32_t j = 0; j <= cells; ++j)
             for (int32_t i = 0; i <= cells; ++i) {
                 const size_t k = c.mask.index(i, j);
-                c.rest.values[3 * k] = static_cast<float>(i) / cells;
-                c.rest.values[3 * k + 1] = static_cast<float>(j) / cells;
                 c.mask.values[k] = gap > 0 && i % gap == 0 ? 0.0f : 1.0f;
             }
         const auto fixed = [&](int32_t i, int32_t j) {
