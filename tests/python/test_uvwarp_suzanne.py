@@ -1,0 +1,56 @@
+"""The UV warp on a shot made and exported by a DCC (tests/data/suzanne: Blender's Suzanne with Blender's UVs,
+bent and twisted by keyframed SimpleDeform modifiers, six frames exported by Blender's OBJ exporter),
+solved frame after frame with warm start, measured by the independent metric of test_uvwarp_spot.py (geometry
+images rasterised from the UV triangles in the test, rigid edges inside one UV island, the deformed 3D length
+between the warped ends against the rest length) and the fold count computed in the test."""
+import os
+
+import numpy as np
+
+import deformkit as dk
+from test_uvwarp_spot import Layout, folded_anywhere, measure
+
+SHOT = os.path.join(os.path.dirname(__file__), "..", "data", "suzanne")
+T = 256  # rigidity texels = grid cells
+
+
+def test_suzanne_shot_from_blender_keeps_rigid_disks_frame_after_frame():
+    frames = [dk.read_mesh(os.path.join(SHOT, "suzanne.%04d.obj" % f)) for f in range(1, 7)]
+    mesh = frames[0]  # frame 1 is the rest pose
+    layout = Layout(mesh)
+    rest = mesh.points.astype(np.float64)
+    yy, xx = np.mgrid[0:T, 0:T]
+    u, v = (xx + 0.5) / T, 1 - (yy + 0.5) / T
+    t, _ = layout.locate(u.ravel(), v.ravel())
+    covered = (t >= 0).reshape(T, T)
+    interior = covered.copy()
+    for dy in range(-4, 5):
+        for dx in range(-4, 5):
+            interior &= np.roll(np.roll(covered, dy, 0), dx, 1)
+    centres = np.arange(0.05, 1, 0.1)
+    disks = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0) < 0.025
+    rigidity = (disks & interior).astype(np.float32)
+    jj, ii = np.mgrid[0:T + 1, 0:T + 1]
+    rigid = rigidity[np.clip(np.round((1 - jj / T) * T - 0.5).astype(int), 0, T - 1),
+                     np.clip(np.round(ii / T * T - 0.5).astype(int), 0, T - 1)] >= 0.5
+    identity = np.stack(np.meshgrid(np.arange(T + 1) / T, np.arange(T + 1) / T), -1)
+    solver = dk.UvWarpSolver(mesh, 1001, rigidity)
+    removed = []
+    for frame, deformed in enumerate(frames, start=1):
+        points = deformed.points.astype(np.float64)
+        solver.solve(points.astype(np.float32))
+        warp = np.asarray(solver.warp, np.float64)
+        assert folded_anywhere(warp) == 0, f"frame {frame}"
+        before, edges, _, _ = measure(layout, rest, points, identity, rigid)
+        after, _, left, inverted = measure(layout, rest, points, warp, rigid)
+        assert edges > 20000 and left == 0 and inverted == 0, f"frame {frame}"
+        if frame > 1:
+            removed.append(1 - after / before)
+        print(f"Suzanne frame {frame}: error {before:.4f} -> {after:.4f}")
+    print("removed per frame:", " ".join(f"{100 * r:.1f}%" for r in removed))
+    # Measured 48.9, 60.0, 64.7, 66.8, 67.5% (frames 2-6): the warm start follows the animation, and the
+    # more the pose deforms the more of its error is removed. Before the fold repair and depth of UV-16 and
+    # UV-18 a similar Blender shot of Suzanne lost 40-49% with 57-1,575 inverted grid cells.
+    assert removed[-1] > 0.62
+    assert all(r > 0.4 for r in removed)
+    assert all(b >= a - 0.01 for a, b in zip(removed, removed[1:]))
