@@ -16,9 +16,9 @@ TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to 
     const uvwarp::WarpMetrics& m = demo.metrics;
     INFO("rigid stretch error: identity " << m.identityStretchError << ", warp " << m.rigidStretchError);
     // The bend stretches the outer side ~1.5x and squashes the inner side ~0.5x; compression cannot be fully
-    // undone in a bounded tile (paper §6). docs/uvwarp.md reports 45% of the error removed (0.104 -> 0.057,
-    // measured 46.5%): the test asks for at least 44%, so the docs cannot drift from what the demo does.
-    CHECK(m.rigidStretchError < 0.56 * m.identityStretchError);
+    // undone in a bounded tile (paper §6). docs/uvwarp.md reports 55% of the error removed (0.104 -> 0.046,
+    // measured 55.5%): the test asks for at least 54%, so the docs cannot drift from what the demo does.
+    CHECK(m.rigidStretchError < 0.46 * m.identityStretchError);
     CHECK(m.foldOvers == 0);
     CHECK(m.maxMaskedDisplacement == 0.0);
     CHECK(m.maxBorderDisplacement == 0.0);

@@ -15,14 +15,14 @@ struct SolverOptions {
     int32_t levels = 0;
     // PBD iterations per solve (paper §4.1): the number run when `tolerance` is 0, the most run otherwise.
     // With warm start, frames after the first start from the last warp.
-    int32_t iterations = 12;
+    int32_t iterations = 4;
     // Convergence stop, in grid cells: > 0 ends a solve after the first iteration in which no point moved
     // farther than this (SolveStats::converged); 0 runs `iterations` iterations whatever they change. A
     // warm-started frame of a smooth animation then pays for the iterations its change needs.
     float tolerance = 0.0f;
     // Constraint-projection sweeps (all 8 parallel sets) per iteration at each level, finest first; levels
     // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion.
-    std::vector<int32_t> sweepsPerLevel = {1, 2, 4};
+    std::vector<int32_t> sweepsPerLevel = {4, 8, 8};
     // Orientation preservation in [0, 1] (§4.2): after projection a segment is turned this fraction of the
     // way back towards its canonical direction (0°, 45°, 90°, 135°). Multiplied by the optional map.
     float orientationPreservation = 0.05f;
