@@ -8,10 +8,9 @@ import os
 import numpy as np
 
 import deformkit as dk
-from test_uvwarp_spot import Layout, folded_anywhere, measure
+from test_uvwarp_spot import T, Layout, folded_anywhere, measure, rigid_disks
 
 SHOT = os.path.join(os.path.dirname(__file__), "..", "data", "suzanne")
-T = 256  # rigidity texels = grid cells
 
 
 def test_suzanne_shot_from_blender_keeps_rigid_disks_frame_after_frame():
@@ -19,20 +18,7 @@ def test_suzanne_shot_from_blender_keeps_rigid_disks_frame_after_frame():
     mesh = frames[0]  # frame 1 is the rest pose
     layout = Layout(mesh)
     rest = mesh.points.astype(np.float64)
-    yy, xx = np.mgrid[0:T, 0:T]
-    u, v = (xx + 0.5) / T, 1 - (yy + 0.5) / T
-    t, _ = layout.locate(u.ravel(), v.ravel())
-    covered = (t >= 0).reshape(T, T)
-    interior = covered.copy()
-    for dy in range(-4, 5):
-        for dx in range(-4, 5):
-            interior &= np.roll(np.roll(covered, dy, 0), dx, 1)
-    centres = np.arange(0.05, 1, 0.1)
-    disks = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0) < 0.025
-    rigidity = (disks & interior).astype(np.float32)
-    jj, ii = np.mgrid[0:T + 1, 0:T + 1]
-    rigid = rigidity[np.clip(np.round((1 - jj / T) * T - 0.5).astype(int), 0, T - 1),
-                     np.clip(np.round(ii / T * T - 0.5).astype(int), 0, T - 1)] >= 0.5
+    rigidity, rigid = rigid_disks(layout)
     identity = np.stack(np.meshgrid(np.arange(T + 1) / T, np.arange(T + 1) / T), -1)
     solver = dk.UvWarpSolver(mesh, 1001, rigidity)
     removed = []
