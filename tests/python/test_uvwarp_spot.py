@@ -1,8 +1,8 @@
-"""The UV warp on real layouts (Keenan Crane's Spot, tests/data/spot, and Bob, tests/data/bob), measured by a metric written here,
-independent of the solver: geometry images of the rest and deformed mesh rasterised from the UV triangles, and
-for every 8-connected grid edge with rigid ends inside one UV island the deformed 3D length between the warped
-ends against the rest 3D length. Rigid disks painted inside the charts, and the same disks unclipped, so that chart
-borders (pinned by the derived mask) cut them."""
+"""The UV warp on real layouts (Keenan Crane's Spot, tests/data/spot, and Bob, tests/data/bob), measured by a
+metric written here, independent of the solver: geometry images of the rest and deformed mesh rasterised from the
+UV triangles, and for every 8-connected grid edge with rigid ends inside one UV island the deformed 3D length
+between the warped ends against the rest 3D length. Rigid disks painted inside the charts, and the same disks
+unclipped, so that chart borders (pinned by the derived mask) cut them."""
 import os
 
 import numpy as np
