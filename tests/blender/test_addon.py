@@ -16,6 +16,7 @@ import traceback
 import zipfile
 
 import bpy
+import mathutils
 import numpy as np
 
 STAGE = sys.argv[sys.argv.index("--") + 1]
@@ -210,6 +211,15 @@ def test_ffd_follows_lattice_points():
     entry = add("ffd")
     lattice = entry.lattice
     assert (lattice.data.points_u, lattice.data.points_v, lattice.data.points_w) == (3, 3, 3)
+    # The new lattice fits the mesh's bounding box padded by 2% on each axis (it measured 2.04x before),
+    # centred; the flat grid's zero height gets 2% of its longest side.
+    bpy.context.view_layer.update()
+    corners = np.array([lattice.matrix_world @ p.co for p in lattice.data.points])
+    world = np.array([obj.matrix_world @ mathutils.Vector(p) for p in rest])
+    size = world.max(axis=0) - world.min(axis=0)
+    expected = np.maximum(1.02 * size, 0.02 * size.max())
+    np.testing.assert_allclose(corners.max(axis=0) - corners.min(axis=0), expected, atol=1e-5)
+    np.testing.assert_allclose(corners.mean(axis=0), 0.5 * (world.max(axis=0) + world.min(axis=0)), atol=1e-5)
     lattice.location, lattice.rotation_euler, lattice.scale = (0, 0, 0), (0, 0, 0), (2.5, 2.5, 1.0)
     # A new 3-point lattice spans [-1, 1] of its object space, so [-2.5, 2.5]^2 x [-1, 1] here. Lift the
     # centre point by 0.5 and push the (2, 2, 2) corner by 0.25 of the object's space along x (Blender lists

@@ -95,8 +95,15 @@ def setup_controls(context, obj, entry):
         data = bpy.data.lattices.new(f"{obj.name}_{entry.name}")
         data.points_u = data.points_v = data.points_w = 3
         lattice = bpy.data.objects.new(f"{obj.name}_{entry.name}_lattice", data)
+        # Blender spaces the points of a lattice resized before it has an object one unit apart, so 3 points
+        # span 2 units, not 1: scale by what the points actually span, so the lattice fits the mesh's bounds
+        # padded by 2% on every axis (a flat side gets 2% of the longest one: the lattice keeps a volume).
+        points = np.array([p.co for p in data.points])
+        span = points.max(axis=0) - points.min(axis=0)
+        extent = np.maximum(1.02 * size, 0.02 * float(size.max()))
+        scale = extent / np.where(span > 0.0, span, 1.0)
         lattice.matrix_world = obj.matrix_world @ (Matrix.Translation(Vector(centre)) @
-                                                   Matrix.Diagonal((*(1.02 * size), 1.0)))
+                                                   Matrix.Diagonal((*scale, 1.0)))
         entry.lattice = _link(context, lattice, obj)
     elif t == "wires":
         # A wire along the object's longest side, and its hidden rest copy.
