@@ -26,7 +26,7 @@ struct FarmPlanCommand {
     std::vector<int> frames;
     int chunk = 10;                // frames per task at most, >= 1
     int tilesPerTask = 1;          // UDIM tiles per UV-warp task at most, >= 1
-    int warmUp = 3;                // frames a UV-warp task solves before its range, >= 0
+    int warmUp = 6;                // frames a UV-warp task solves before its range, >= 0
     std::filesystem::path outDir;  // created when missing
     std::filesystem::path plan;    // empty: outDir / "farm_plan.json"
 };

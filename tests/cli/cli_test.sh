@@ -299,7 +299,7 @@ contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"
 contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
 expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
-contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 3'
+contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 6'
 # Warmed up from frame 1, the task of frame 2 writes eval's bytes; started cold (--warm-up 0) it does not.
 cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
     { echo "FAIL farm-run-tiles: a task warmed up from frame 1 should write eval's frame 2"; failures=$((failures + 1)); }

@@ -52,7 +52,7 @@ struct FarmPlanOptions {
     std::vector<int> frames;
     int chunk = 10;        // frames per task at most, >= 1
     int tilesPerTask = 1;  // UDIM tiles per UV-warp task at most, >= 1
-    int warmUp = 3;        // FarmPlan::warmUp, >= 0
+    int warmUp = 6;        // FarmPlan::warmUp, >= 0
 };
 
 // The plan of `scene` (read from `sceneFile`) writing into `outDir` (paths made absolute). Throws
