@@ -198,21 +198,13 @@ int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
 
 int32_t countFolds(const WarpGrid& warp) {
     using detail::kParallelRows;
-    using detail::orient;
-    const int32_t n = warp.cells, side = n + 1;
+    const int32_t n = warp.cells;
+    const auto row = static_cast<size_t>(n) + 1;
     int32_t folds = 0;
 #pragma omp parallel for schedule(static) reduction(+ : folds) if (kParallelRows < static_cast <int64_t>(n))
-    for (int32_t j = 0; j < n; ++j) {
-        for (int32_t i = 0; i < n; ++i) {
-            const size_t a = static_cast<size_t>(j) * side + i, b = a + 1, c = a + side + 1, d = a + side;
-            const float* u = warp.u.data();
-            const float* v = warp.v.data();
-            folds += orient(u[a], v[a], u[b], v[b], u[c], v[c]) <= 0.0f ? 1 : 0;  // (i,j)-(i+1,j+1) split
-            folds += orient(u[a], v[a], u[c], v[c], u[d], v[d]) <= 0.0f ? 1 : 0;
-            folds += orient(u[a], v[a], u[b], v[b], u[d], v[d]) <= 0.0f ? 1 : 0;  // (i+1,j)-(i,j+1) split
-            folds += orient(u[b], v[b], u[c], v[c], u[d], v[d]) <= 0.0f ? 1 : 0;
-        }
-    }
+    for (int32_t j = 0; j < n; ++j)
+        folds += detail::countNearZero<1>(warp.u.data() + static_cast<size_t>(j) * row,
+                                          warp.v.data() + static_cast<size_t>(j) * row, row, 1, n, 0.0f);
     return folds;
 }
 
