@@ -472,6 +472,141 @@ def test_bake_errors_are_reports():
         assert "no UV map" in str(e), str(e)
 
 
+def key(owner, path, values, index=-1):
+    """Keys owner.path (its component `index`, or the whole property) at the given {frame: value}."""
+    for frame, value in values.items():
+        if index >= 0:
+            getattr(owner, path)[index] = value
+        else:
+            setattr(owner, path, value)
+        owner.keyframe_insert(path, index=index, frame=frame)
+
+
+def fcurve(id_block, path, index=0):
+    """The F-curve of id_block's path[index], made linear between its keys."""
+    curve = id_block.animation_data.action.fcurves.find(path, index=index)
+    assert curve is not None, path
+    for key in curve.keyframe_points:
+        key.interpolation = 'LINEAR'
+    return curve
+
+
+def animated_twist_and_lattice(obj):
+    """A twist whose end angle is keyed (0.3 at frame 1, 1.5 at frame 5) and an FFD whose lattice's centre
+    point is keyed (up 0 at frame 1, 0.5 at frame 5) on `obj`; returns a function giving the module's
+    result for a frame, from the F-curves' own values there."""
+    twist = add("twist")
+    z_up(twist.frame)
+    twist.start_value = 0.0
+    key(twist, "end_value", {1: 0.3, 5: 1.5})
+    twist_curve = fcurve(obj, 'deformkit.entries[0].end_value', 0)
+    lattice = add("ffd").lattice
+    lattice.location, lattice.rotation_euler, lattice.scale = (0, 0, 0), (0, 0, 0), (2.5, 2.5, 1.0)
+    centre = (1 * 3 + 1) * 3 + 1
+    key(lattice.data.points[centre], "co_deform", {1: 0.0, 5: 0.5}, index=2)
+    lift_curve = fcurve(lattice.data, f'points[{centre}].co_deform', 2)
+    rest = addon.evaluate.rest_points(obj)
+    origin, edge = np.array([-2.5, -2.5, -1.0]), np.array([5.0, 5.0, 2.0])
+    grid = np.array([origin + np.array([i, j, k]) / 2.0 * edge
+                     for i in range(3) for j in range(3) for k in range(3)])
+
+    def expected(frame):
+        stack = direct_stack(obj, rest)
+        stack.add("twist", "t")
+        set_all(stack, 0, [("handleOrigin", (0, 0, 0)), ("handleY", (0, 0, 1)), ("startAngle", 0.0),
+                           ("endAngle", np.float32(twist_curve.evaluate(frame))), ("lowBound", -1.0),
+                           ("highBound", 1.0)])
+        points = grid.copy()
+        points[centre, 2] += np.float32(lift_curve.evaluate(frame))
+        stack.add("ffd", "f")
+        set_all(stack, 1, [("basis", 0), ("divisions", (2, 2, 2)), ("origin", origin),
+                           ("axes", (5.0, 0, 0, 0, 5.0, 0, 0, 0, 2.0)), ("points", points.ravel())])
+        return stack.evaluate(rest)
+
+    return expected
+
+
+def test_an_animation_render_deforms_each_frame_as_keyed():
+    # Blender flushes animated values back to the original data only for the active depsgraph; a render
+    # evaluates its own. Each rendered frame must show that frame's keyed twist angle and lattice point.
+    fresh()
+    scene = bpy.context.scene
+    obj = grid_object()
+    expected = animated_twist_and_lattice(obj)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    camera.location = (0.0, 0.0, 5.0)  # looking down -Z
+    camera.data.type = 'ORTHO'
+    camera.data.ortho_scale = 4.0  # [-2, 2]^2: 16 pixels per unit at 64 x 64
+    scene.camera = camera
+    scene.render.engine = 'CYCLES'
+    scene.cycles.samples = 1
+    scene.cycles.use_denoising = False
+    scene.render.film_transparent = True
+    scene.render.resolution_x = scene.render.resolution_y = 64
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = 'PNG'
+    scene.render.image_settings.color_mode = 'RGBA'
+    scene.frame_start, scene.frame_end = 1, 5
+    scene.frame_set(5)  # the viewport shows frame 5: a render that kept it would show frame 5 everywhere
+
+    seen = {}
+
+    def capture(scene_, depsgraph):  # after the add-on's handler: what it wrote for this depsgraph
+        if depsgraph.mode == 'RENDER':
+            seen[scene_.frame_current] = positions(obj).copy()
+
+    folder = tempfile.mkdtemp()
+    widths = {}
+    bpy.app.handlers.frame_change_post.append(capture)
+    try:
+        scene.render.filepath = os.path.join(folder, "frame")
+        bpy.ops.render.render(animation=True)
+        for frame in range(1, 6):
+            want = expected(frame)
+            if frame in seen:  # the same kernels on the same float32 values
+                assert_same(seen[frame], want, f"rendered frame {frame}'s mesh")
+            # The picture: the grid seen from above is a square turned by the twist's angle at z = 0; the
+            # bounding box of its covered pixels is the expected mesh's, to within a pixel and a half
+            # (one sample a pixel), and it grows from 36 to 45 pixels wide between frames 1 and 5.
+            image = bpy.data.images.load(os.path.join(folder, f"frame{frame:04d}.png"))
+            alpha = np.array(image.pixels[:], np.float32).reshape(64, 64, 4)[:, :, 3]
+            bpy.data.images.remove(image)
+            columns = np.nonzero(alpha.max(axis=0) > 0.5)[0]
+            rows = np.nonzero(alpha.max(axis=1) > 0.5)[0]
+            covered = np.array([columns[0], columns[-1] + 1, rows[0], rows[-1] + 1], np.float64)
+            pixels = 16.0 * np.array([want[:, 0].min(), want[:, 0].max(), want[:, 1].min(),
+                                      want[:, 1].max()]) + 32.0
+            assert np.abs(covered - pixels).max() <= 1.5, f"frame {frame}: covered {covered}, mesh {pixels}"
+            widths[frame] = covered[1] - covered[0]
+        assert widths[5] - widths[1] >= 6, widths  # the pictures differ as the keyed angle does
+        assert sorted(seen) == [1, 2, 3, 4, 5], sorted(seen)  # the handler ran in the render's depsgraph
+    finally:
+        bpy.app.handlers.frame_change_post.remove(capture)
+        shutil.rmtree(folder, ignore_errors=True)
+        scene.render.engine = 'BLENDER_EEVEE'
+        scene.camera = None
+
+
+def test_another_scene_changed_with_frame_set_deforms_as_keyed():
+    # A scene that is not the window's: its depsgraph is not the active one.
+    fresh()
+    obj = grid_object()
+    expected = animated_twist_and_lattice(obj)
+    other = bpy.data.scenes.new("other")
+    try:
+        other.collection.objects.link(obj)
+        for control in addon.evaluate.controls(obj):
+            other.collection.objects.link(bpy.data.objects[control])
+        for frame in (4, 2, 5):
+            other.frame_set(frame)
+            assert_same(positions(obj), expected(frame), f"the other scene at frame {frame}")
+        bpy.context.scene.frame_set(3)
+        assert_same(positions(obj), expected(3), "the window's scene at frame 3")
+    finally:
+        bpy.data.scenes.remove(other)
+
+
 def main():
     failures = 0
     tests = [(name, f) for name, f in sorted(globals().items()) if name.startswith("test_") and callable(f)]

@@ -266,19 +266,32 @@ def _same(a, b):
         x[0] == y[0] and x[1] == y[1] and np.array_equal(x[2], y[2]) for x, y in zip(a, b))
 
 
+def evaluated_entries(obj, depsgraph=None):
+    """`obj`'s entries as `depsgraph` evaluated them (the original entries without one).
+
+    Blender writes a frame's animated values (a keyed twist angle, envelope or falloff) back into the
+    original data only for the active depsgraph, the viewport's. A render's depsgraph, or another scene's,
+    holds them only in its evaluated copies, whose entries also point to the evaluated controls (an Empty's
+    matrix, a lattice's keyed points, a cage's evaluated mesh at that frame)."""
+    if depsgraph is None:
+        return obj.deformkit.entries
+    return obj.evaluated_get(depsgraph).deformkit.entries
+
+
 def evaluate_object(obj, depsgraph=None, force=False):
-    """Evaluates `obj`'s stack on its rest shape and writes the result into its vertex positions; does
-    nothing when no input changed since the last evaluation (a frame change that moves no control).
+    """Evaluates `obj`'s stack on its rest shape, with every setting and control as `depsgraph` evaluated
+    them, and writes the result into its vertex positions; does nothing when no input changed since the
+    last evaluation (a frame change that moves no control).
 
     Raises DeformKitError for a problem with the Blender data and the module's errors (ValueError and its
     kind) for bad parameter values, each naming the entry."""
-    settings = obj.deformkit
-    if len(settings.entries) == 0:
+    if len(obj.deformkit.entries) == 0:
         return
+    entries = evaluated_entries(obj, depsgraph)
     cached = _stack_for(obj)
     stack = cached["stack"]
     inputs = []
-    for i, entry in enumerate(settings.entries):
+    for i, entry in enumerate(entries):
         inputs.append((i, "envelope", np.array([entry.envelope if entry.enabled else 0.0])))
         if not entry.enabled or entry.envelope == 0.0:
             continue  # a skipped entry needs no controls
@@ -288,12 +301,12 @@ def evaluate_object(obj, depsgraph=None, force=False):
                        if entry.vertex_group else np.zeros(0)))
     if not force and _same(inputs, cached.get("inputs")):
         return
-    for i, entry in enumerate(settings.entries):
+    for i, entry in enumerate(entries):
         stack.set_envelope(i, entry.envelope if entry.enabled else 0.0)
     for i, name, value in inputs:
         if name == "weights":
             # Set only on a change: new weights rebind the entry.
-            entry = settings.entries[i]
+            entry = entries[i]
             weights = _weights(obj, cached, entry.vertex_group) if entry.vertex_group else None
             previous = cached["weights"].get(i)
             if weights is not previous:
