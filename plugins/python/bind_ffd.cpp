@@ -48,15 +48,34 @@ Lattice latticeOf(const FloatArray& origin, const FloatArray& axes, const IntArr
     return l;
 }
 
-warp::FfdOptions optionsOf(const std::string& basis, const std::string& outside, const char* source) {
+warp::FfdBasis basisNamed(const std::string& name, const std::string& given, const char* source) {
+    if (name == "bernstein") return warp::FfdBasis::Bernstein;
+    if (name == "bspline") return warp::FfdBasis::BSpline;
+    if (name == "linear") return warp::FfdBasis::Linear;
+    if (name == "cardinal") return warp::FfdBasis::Cardinal;
+    if (name == "catmull_rom") return warp::FfdBasis::CatmullRom;
+    throw InvalidInput(formatError(source, "basis", "'" + given + "' is not a basis",
+                                   "bernstein, bspline, linear, cardinal or catmull_rom, or three of them "
+                                   "separated by commas (X, Y, Z)"));
+}
+
+warp::FfdOptions optionsOf(const std::string& basis, const std::string& outside, const std::string& ends,
+                           const char* source) {
     warp::FfdOptions o;
-    if (basis == "bernstein") {
-        o.basis = warp::FfdBasis::Bernstein;
-    } else if (basis == "bspline") {
-        o.basis = warp::FfdBasis::BSpline;
+    std::vector<std::string> names;
+    for (size_t start = 0;;) {
+        const size_t comma = basis.find(',', start);
+        names.push_back(basis.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (names.size() == 1) {
+        o.basis = basisNamed(names[0], basis, source);
+    } else if (names.size() == 3) {
+        o.basis = {basisNamed(names[0], basis, source), basisNamed(names[1], basis, source),
+                   basisNamed(names[2], basis, source)};
     } else {
-        throw InvalidInput(
-            formatError(source, "basis", "'" + basis + "' is not a basis", "bernstein or bspline"));
+        basisNamed("", basis, source);  // throws: neither one basis nor three
     }
     if (outside == "none") {
         o.outside = warp::FfdOutside::None;
@@ -65,6 +84,14 @@ warp::FfdOptions optionsOf(const std::string& basis, const std::string& outside,
     } else {
         throw InvalidInput(
             formatError(source, "outside", "'" + outside + "' is not an option", "none or extrapolate"));
+    }
+    if (ends == "extrapolate") {
+        o.ends = warp::FfdEnds::Extrapolate;
+    } else if (ends == "repeat") {
+        o.ends = warp::FfdEnds::Repeat;
+    } else {
+        throw InvalidInput(
+            formatError(source, "ends", "'" + ends + "' is not an option", "extrapolate or repeat"));
     }
     return o;
 }
@@ -174,21 +201,25 @@ void bindFfd(py::module_& m) {
         "ffd",
         [](const FloatArray& points, const FloatArray& origin, const FloatArray& axes,
            const IntArray& divisions, const FloatArray& target, const std::string& basis,
-           const std::string& outside, const std::optional<FloatArray>& weights, float envelope) {
+           const std::string& outside, const std::string& ends, const std::optional<FloatArray>& weights,
+           float envelope) {
             const char* source = "ffd";
             const Lattice l = latticeOf(origin, axes, divisions, source);
-            Ffd ffd(l, optionsOf(basis, outside, source));
+            Ffd ffd(l, optionsOf(basis, outside, ends, source));
             ffd.setTargets(latticePointsOf(target, l, source, "target"));
             return bindAndRun(ffd, points, weights, envelope, source);
         },
         py::arg("points"), py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("target"),
-        py::arg("basis") = "bernstein", py::arg("outside") = "none", py::arg("weights") = py::none(),
-        py::arg("envelope") = 1.0f,
+        py::arg("basis") = "bernstein", py::arg("outside") = "none", py::arg("ends") = "extrapolate",
+        py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
         "Free-form deformation (Sederberg-Parry; Milliron et al. 4.1). points (N, 3); origin (3,); axes (3, "
         "3) with\n"
         "rows X, Y, Z (edge vectors of the parallelepiped); divisions (3,) = l, m, n; target (l+1, m+1, n+1, "
         "3)\n"
-        "moved control points; basis 'bernstein' or 'bspline'; outside 'none' (unchanged) or 'extrapolate';\n"
+        "moved control points; basis 'bernstein', 'bspline', 'linear', 'cardinal', 'catmull_rom' or three of "
+        "them\n"
+        "separated by commas (X, Y, Z); outside 'none' (unchanged) or 'extrapolate'; ends 'extrapolate' or\n"
+        "'repeat' (Blender's lattice);\n"
         "weights (N,) painted, envelope scalar. Returns (N, 3) float32.");
 
     m.def(
@@ -196,11 +227,11 @@ void bindFfd(py::module_& m) {
         [](const FloatArray& points, const FloatArray& origin, const FloatArray& axes,
            const IntArray& divisions, const FloatArray& targetOrigins, const FloatArray& targetBases,
            const std::optional<FloatArray>& sourceOrigins, const std::optional<FloatArray>& sourceBases,
-           const std::string& basis, const std::string& outside, const std::optional<FloatArray>& weights,
-           float envelope) {
+           const std::string& basis, const std::string& outside, const std::string& ends,
+           const std::optional<FloatArray>& weights, float envelope) {
             const char* source = "ffd_frames";
             const Lattice l = latticeOf(origin, axes, divisions, source);
-            FfdFrames frames(l, optionsOf(basis, outside, source));
+            FfdFrames frames(l, optionsOf(basis, outside, ends, source));
             if (sourceOrigins || sourceBases) {
                 std::vector<Frame> src(frames.sourceFrames().begin(), frames.sourceFrames().end());
                 if (sourceOrigins) {
@@ -222,7 +253,7 @@ void bindFfd(py::module_& m) {
         py::arg("points"), py::arg("origin"), py::arg("axes"), py::arg("divisions"),
         py::arg("target_origins"), py::arg("target_bases"), py::arg("source_origins") = py::none(),
         py::arg("source_bases") = py::none(), py::arg("basis") = "bernstein", py::arg("outside") = "none",
-        py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
+        py::arg("ends") = "extrapolate", py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
         "FFD with coordinate-frame features (Milliron et al. 5.1): each control carries a frame; the source "
         "frame\n"
         "(origin, basis) is mapped to the target frame. target_origins (l+1, m+1, n+1, 3); target_bases\n"
@@ -233,12 +264,12 @@ void bindFfd(py::module_& m) {
     py::class_<PyFfd>(m, "Ffd",
                       "Free-form deformation bound once to rest points, evaluated for many target lattices.")
         .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
-                         const std::string& basis, const std::string& outside) {
+                         const std::string& basis, const std::string& outside, const std::string& ends) {
                  const Lattice l = latticeOf(origin, axes, divisions, "Ffd");
-                 return PyFfd{Ffd(l, optionsOf(basis, outside, "Ffd")), {}};
+                 return PyFfd{Ffd(l, optionsOf(basis, outside, ends, "Ffd")), {}};
              }),
              py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
-             py::arg("outside") = "none")
+             py::arg("outside") = "none", py::arg("ends") = "extrapolate")
         .def(
             "bind",
             [](PyFfd& self, const FloatArray& points) {
@@ -275,12 +306,12 @@ void bindFfd(py::module_& m) {
     py::class_<PyFfdFrames>(m, "FfdFrames",
                             "FFD with coordinate-frame features, bound once, evaluated many times.")
         .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
-                         const std::string& basis, const std::string& outside) {
+                         const std::string& basis, const std::string& outside, const std::string& ends) {
                  const Lattice l = latticeOf(origin, axes, divisions, "FfdFrames");
-                 return PyFfdFrames{FfdFrames(l, optionsOf(basis, outside, "FfdFrames")), {}};
+                 return PyFfdFrames{FfdFrames(l, optionsOf(basis, outside, ends, "FfdFrames")), {}};
              }),
              py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
-             py::arg("outside") = "none")
+             py::arg("outside") = "none", py::arg("ends") = "extrapolate")
         .def(
             "bind",
             [](PyFfdFrames& self, const FloatArray& points) {

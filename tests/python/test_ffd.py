@@ -158,9 +158,43 @@ def test_bad_input_names_the_argument():
         dk.ffd(pts, ORIGIN, AXES, div, control_points(div), basis="nurbs")
     with pytest.raises(dk.InvalidInput, match="outside"):
         dk.ffd(pts, ORIGIN, AXES, div, control_points(div), outside="clamp")
+    with pytest.raises(dk.InvalidInput, match=r"'linear,bspline' is not a basis"):
+        dk.ffd(pts, ORIGIN, AXES, div, control_points(div), basis="linear,bspline")
+    with pytest.raises(dk.InvalidInput, match=r"ends.*'clamp' is not an option \(expected extrapolate or repeat\)"):
+        dk.ffd(pts, ORIGIN, AXES, div, control_points(div), ends="clamp")
     with pytest.raises(dk.InvalidInput, match="weights"):
         dk.ffd(pts, ORIGIN, AXES, div, control_points(div), weights=np.ones(3, dtype=np.float32))
     singular = np.broadcast_to(np.eye(3, dtype=np.float32), (4, 4, 4, 3, 3)).copy()
     singular[1, 0, 0, 2] = 0
     with pytest.raises(dk.InvalidInput, match=r"control 16 \(i=1, j=0, k=0\)"):
         dk.ffd_frames(pts, ORIGIN, AXES, div, control_points(div), singular[..., :, :], source_bases=singular)
+
+
+def test_blender_linear_lattice_is_trilinear_interpolation_with_clamped_cells():
+    # Blender's "Linear" lattice with its end conditions (repeated end controls; every point deformed):
+    # inside, trilinear interpolation of the controls' displacements; outside, the displacement of the
+    # nearest point of the lattice. Written here with numpy's own interpolation, axis by axis.
+    div = (3, 2, 4)
+    target = random_target(div, 7)
+    rng = np.random.default_rng(8)
+    local = rng.uniform(-0.5, 1.5, size=(400, 3))
+    pts = points_at(local)
+    out = dk.ffd(pts, ORIGIN, AXES, div, target, basis="linear", outside="extrapolate", ends="repeat")
+    disp = (target - control_points(div)).astype(np.float64)
+    ref = np.empty_like(disp, shape=(len(pts), 3))
+    solved = np.linalg.solve(AXES.T.astype(np.float64), (pts - ORIGIN).T.astype(np.float64)).T
+    for p, s in enumerate(solved):
+        d = disp
+        for a in range(3):  # np.interp clamps beyond the ends, as repeated end controls do
+            grid = np.arange(div[a] + 1) / div[a]
+            d = np.apply_along_axis(lambda column: np.interp(s[a], grid, column), 0, d)
+        ref[p] = pts[p] + d
+    np.testing.assert_allclose(out, ref, atol=1e-5)
+    # Three names set the axes one by one: linear along all three is the same as "linear".
+    same = dk.ffd(pts, ORIGIN, AXES, div, target, basis="linear,linear,linear", outside="extrapolate",
+                  ends="repeat")
+    np.testing.assert_array_equal(same, out)
+    # Extrapolated ends and outside points left alone: a different result outside.
+    left = dk.ffd(pts, ORIGIN, AXES, div, target, basis="linear")
+    outside = (local < 0).any(axis=1) | (local > 1).any(axis=1)
+    np.testing.assert_array_equal(left[outside], pts[outside])

@@ -26,15 +26,15 @@ constexpr int64_t kMaxControls = int64_t{1} << 24;
 
 void validate(const Lattice& lattice, const FfdOptions& options) {
     const char* source = "FFD lattice";
-    const int32_t maxDiv = options.basis == FfdBasis::Bernstein ? kMaxBernsteinDegree : kMaxFfdDivisions;
     for (int a = 0; a < 3; ++a) {
+        const bool bernstein = options.basis[a] == FfdBasis::Bernstein;
+        const int32_t maxDiv = bernstein ? kMaxBernsteinDegree : kMaxFfdDivisions;
         const int32_t d = lattice.divisions[a];
         if (d < 1 || d > maxDiv) {
-            throw InvalidInput(formatError(
-                source, kDivisionNames[a], "is " + std::to_string(d),
-                "an integer in [1, " + std::to_string(maxDiv) + "]" +
-                    (options.basis == FfdBasis::Bernstein && d > maxDiv ? "; use the B-spline basis for more"
-                                                                        : "")));
+            throw InvalidInput(
+                formatError(source, kDivisionNames[a], "is " + std::to_string(d),
+                            "an integer in [1, " + std::to_string(maxDiv) + "]" +
+                                (bernstein && d > maxDiv ? "; use the B-spline basis for more" : "")));
         }
     }
     int64_t controls = 1;
@@ -69,13 +69,37 @@ void validate(const Lattice& lattice, const FfdOptions& options) {
     }
 }
 
-// Uniform cubic B-spline basis on one span, u in [0, 1] (beyond it when extrapolating).
-void cubicBSpline(float u, float* b) {
-    const float u2 = u * u, u3 = u2 * u, v = 1.0f - u;
-    b[0] = v * v * v / 6.0f;
-    b[1] = (3.0f * u3 - 6.0f * u2 + 4.0f) / 6.0f;
-    b[2] = (-3.0f * u3 + 3.0f * u2 + 3.0f * u + 1.0f) / 6.0f;
-    b[3] = u3 / 6.0f;
+// The four weights of controls span - 1 .. span + 2 of a spline basis at u in [0, 1] along the span (beyond
+// it when extrapolating). Linear touches only the middle two.
+void splineWeights(FfdBasis basis, float u, float* b) {
+    const float u2 = u * u, u3 = u2 * u;
+    switch (basis) {
+        case FfdBasis::Linear:
+            b[0] = 0.0f;
+            b[1] = 1.0f - u;
+            b[2] = u;
+            b[3] = 0.0f;
+            return;
+        case FfdBasis::Cardinal:
+        case FfdBasis::CatmullRom: {
+            // The cardinal spline of tension a: the Hermite curve through controls 1 and 2 with tangents
+            // a (P_2 - P_0) and a (P_3 - P_1); Blender's "Cardinal" takes a = 0.71, Catmull-Rom a = 1/2.
+            const float a = basis == FfdBasis::Cardinal ? 0.71f : 0.5f;
+            b[0] = -a * u3 + 2.0f * a * u2 - a * u;
+            b[1] = (2.0f - a) * u3 + (a - 3.0f) * u2 + 1.0f;
+            b[2] = (a - 2.0f) * u3 + (3.0f - 2.0f * a) * u2 + a * u;
+            b[3] = a * u3 - a * u2;
+            return;
+        }
+        default: {  // uniform cubic B-spline
+            const float v = 1.0f - u;
+            b[0] = v * v * v / 6.0f;
+            b[1] = (3.0f * u3 - 6.0f * u2 + 4.0f) / 6.0f;
+            b[2] = (-3.0f * u3 + 3.0f * u2 + 3.0f * u + 1.0f) / 6.0f;
+            b[3] = u3 / 6.0f;
+            return;
+        }
+    }
 }
 
 // The hot loop for a 4x4x4 window of controls (B-spline, or Bernstein of degree 3): for each (i, j) the
@@ -124,8 +148,8 @@ Bernstein444Kernel bernstein444Kernel(FfdKernel choice) {
 }
 
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
-inline int32_t basisWeights(FfdBasis basis, int32_t d, const float* binomial, float x, int32_t& first,
-                            float* w) {
+inline int32_t basisWeights(FfdBasis basis, FfdEnds ends, int32_t d, const float* binomial, float x,
+                            int32_t& first, float* w) {
     if (basis == FfdBasis::Bernstein && d == 3) {
         // The common cubic in closed form.
         const float s = x / 3.0f, r = 1.0f - s;
@@ -153,12 +177,29 @@ inline int32_t basisWeights(FfdBasis basis, int32_t d, const float* binomial, fl
         first = 0;
         return d + 1;
     }
-    // Uniform cubic B-spline on span [span, span + 1] touching controls span - 1 .. span + 2. The missing
-    // controls -1 and d + 1 beyond the ends are linear extrapolations (T_-1 = 2 T_0 - T_1), folded into
-    // the weights here: partition of unity, linear precision and interpolation of the end faces.
-    const int32_t span = std::clamp(static_cast<int32_t>(std::floor(x)), 0, d - 1);
     float b[4];
-    cubicBSpline(x - static_cast<float>(span), b);
+    if (ends == FfdEnds::Repeat) {
+        // Blender's Lattice: the span holding x, controls span - 1 .. span + 2 with indices clamped to the
+        // lattice, so a missing control is the end control again; beyond the lattice every tap lands on the
+        // end control (the span is kept within two of the ends, which changes no index, not u).
+        const float cell = std::floor(x);
+        const float u = x - cell;
+        const auto span = static_cast<int32_t>(std::clamp(cell, -2.0f, static_cast<float>(d) + 1.0f));
+        splineWeights(basis, u, b);
+        first = std::clamp(span - 1, 0, d);
+        const int32_t last = std::clamp(span + 2, 0, d);
+        for (int32_t i = 0; i <= last - first; ++i)
+            w[i] = 0.0f;
+        for (int32_t c = 0; c < 4; ++c)
+            w[std::clamp(span - 1 + c, 0, d) - first] += b[c];
+        return last - first + 1;
+    }
+    // The span holding x, the end spans beyond the lattice, touching controls span - 1 .. span + 2. The
+    // missing controls -1 and d + 1 beyond the ends are linear extrapolations (T_-1 = 2 T_0 - T_1), folded
+    // into the weights here: partition of unity, linear precision and, for the B-spline, interpolation of
+    // the end faces.
+    const int32_t span = std::clamp(static_cast<int32_t>(std::floor(x)), 0, d - 1);
+    splineWeights(basis, x - static_cast<float>(span), b);
     if (span == 0) {
         b[1] += 2.0f * b[0];
         b[2] -= b[0];
@@ -206,7 +247,7 @@ FfdLattice::FfdLattice(const Lattice& lattice, const FfdOptions& options)
     for (int a = 0; a < 3; ++a) {
         const int32_t d = lattice.divisions[a];
         binomial_[a].assign(static_cast<size_t>(d) + 1, 1.0f);
-        if (options.basis != FfdBasis::Bernstein) continue;
+        if (options.basis[a] != FfdBasis::Bernstein) continue;
         double c = 1.0;
         for (int32_t i = 1; i <= d; ++i) {
             c = c * (d - i + 1) / i;
@@ -248,7 +289,8 @@ void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
 }
 
 int32_t FfdLattice::axisWeights(int32_t axis, float x, int32_t& first, float* w) const {
-    return basisWeights(options_.basis, lattice_.divisions[axis], binomial_[axis].data(), x, first, w);
+    return basisWeights(options_.basis[axis], options_.ends, lattice_.divisions[axis], binomial_[axis].data(),
+                        x, first, w);
 }
 
 void FfdLattice::fields(SparseFields& out) const {
@@ -300,14 +342,15 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
     const glm::ivec3 div = lattice_.divisions;
     const int32_t ny = div.y + 1, nz = div.z + 1;
     const float* data = deltas.data();
-    if (options_.basis == FfdBasis::Bernstein && div == glm::ivec3(3) && stride == 3) {
+    if (options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
         deformBernstein444(points, data, weights, envelope);
         return;
     }
-    // Every point's weights fit a 4x4x4 window of controls: B-spline with >= 3 divisions per axis, or the
-    // Bernstein cubic (the benchmark's 4x4x4 lattice).
-    const bool window = options_.basis == FfdBasis::BSpline ? (div.x >= 3 && div.y >= 3 && div.z >= 3)
-                                                            : (div.x == 3 && div.y == 3 && div.z == 3);
+    // Every point's weights fit a 4x4x4 window of controls: along each axis a spline with >= 3 divisions,
+    // or the Bernstein cubic (the benchmark's 4x4x4 lattice).
+    bool window = true;
+    for (int a = 0; a < 3; ++a)
+        window = window && (options_.basis[a] == FfdBasis::Bernstein ? div[a] == 3 : div[a] >= 3);
 
 #pragma omp parallel for schedule(dynamic, 4096)
     for (int64_t u = 0; u < n; ++u) {
@@ -316,8 +359,7 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
         float w[3][kMaxBernsteinDegree + 1];
         int32_t first[3], count[3];
         for (int a = 0; a < 3; ++a) {
-            count[a] =
-                basisWeights(options_.basis, div[a], binomial_[a].data(), local_[u][a], first[a], w[a]);
+            count[a] = axisWeights(a, local_[u][a], first[a], w[a]);
         }
         float acc[12] = {};
         if (window) {

@@ -65,13 +65,14 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
     const auto d = makeDeformer("ffd", "lattice1");
     // Parameters as listed: bind-time inputs first, then the controls; points follow the divisions.
     const auto params = d->parameters();
-    REQUIRE(params.size() == 6);
+    REQUIRE(params.size() == 7);
     CHECK(params[0].name == "basis");
-    CHECK(params[2].name == "divisions");
-    CHECK(params[2].rebinds);
-    CHECK(params[5].name == "points");
-    CHECK_FALSE(params[5].rebinds);
-    CHECK(params[5].components == 3 * 8);  // one cell: (1+1)^3 controls
+    CHECK(params[2].name == "ends");
+    CHECK(params[3].name == "divisions");
+    CHECK(params[3].rebinds);
+    CHECK(params[6].name == "points");
+    CHECK_FALSE(params[6].rebinds);
+    CHECK(params[6].components == 3 * 8);  // one cell: (1+1)^3 controls
 
     d->set("divisions", std::vector<double>{2, 1, 3});
     CHECK(d->parameter("points").components == 3 * 3 * 2 * 4);
@@ -258,7 +259,12 @@ TEST_CASE("parameters are validated and named", "[host][deformers][errors]") {
                       Contains("parameter 'divisions'") && Contains("B-spline"));
     CHECK_THROWS_WITH(ffd->set("axes", std::vector<double>{1, 0, 0, 0, 1, 0, 2, 3, 0}),
                       Contains("parameter 'axes'") && Contains("coplanar"));
-    CHECK_THROWS_WITH(ffd->set("basis", 2.0), Contains("parameter 'basis': is 2"));
+    CHECK_THROWS_WITH(ffd->set("basis", 5.0), Contains("parameter 'basis': is 5"));
+    CHECK_THROWS_WITH(ffd->set("basis", std::vector<double>{1, 1}),
+                      Contains("parameter 'basis': has 2 values (expected 1 value, or 3 (X, Y, Z))"));
+    CHECK_THROWS_WITH(ffd->set("basis", std::vector<double>{1, 0.5, 1}),
+                      Contains("parameter 'basis': value 1 is 0.5"));
+    CHECK_THROWS_WITH(ffd->set("ends", 2.0), Contains("parameter 'ends': is 2"));
     // Rejected values leave the deformer as it was.
     CHECK(ffd->get("divisions") == std::vector<double>{1, 1, 1});
     CHECK(ffd->get("origin") == std::vector<double>{0, 0, 0});

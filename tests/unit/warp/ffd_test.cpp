@@ -4,6 +4,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -117,6 +118,54 @@ glm::vec3 bsplineRef(const Lattice& l, const std::vector<glm::vec3>& target, con
     return glm::vec3(out);
 }
 
+// The weight of control k (an index on the unbounded line of controls) at x (local coordinate times
+// divisions) for the spline bases, written per basis in its textbook form: hat functions, Cox-de Boor, and
+// the cardinal spline as a Hermite curve through controls span and span + 1 with tangents
+// a (P_span+1 - P_span-1) and a (P_span+2 - P_span).
+double splineRef(FfdBasis basis, int k, double x) {
+    if (basis == FfdBasis::Linear) return std::max(0.0, 1.0 - std::abs(x - k));
+    if (basis == FfdBasis::BSpline) return coxDeBoor(k - 2, 3, x);
+    const double a = basis == FfdBasis::Cardinal ? 0.71 : 0.5;
+    const double span = std::floor(x), u = x - span;
+    const double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u;
+    const double h01 = -2 * u * u * u + 3 * u * u, h11 = u * u * u - u * u;
+    if (k == span - 1) return -a * h10;
+    if (k == span) return h00 - a * h11;
+    if (k == span + 1) return h01 + a * h10;
+    if (k == span + 2) return a * h11;
+    return 0.0;
+}
+
+// Blender's Lattice modifier written out: the controls a span lacks beyond the ends are the end controls
+// again (index k clamped to [0, d]), for points inside and outside alike; per-axis bases.
+glm::vec3 repeatedEndsRef(const Lattice& l, const FfdBases& bases, const std::vector<glm::vec3>& target,
+                          const glm::vec3& p) {
+    const glm::dvec3 x = cramer(l, p) * glm::dvec3(l.divisions);
+    const glm::ivec3 d = l.divisions;
+    // Per axis: the weight of each real control, summed over the virtual indices that clamp to it.
+    std::vector<double> w[3];
+    for (int a = 0; a < 3; ++a) {
+        w[a].assign(static_cast<size_t>(d[a]) + 1, 0.0);
+        const int span = static_cast<int>(std::floor(x[a]));
+        for (int k = span - 3; k <= span + 3; ++k)
+            w[a][static_cast<size_t>(std::clamp(k, 0, d[a]))] += splineRef(bases[a], k, x[a]);
+    }
+    glm::dvec3 out(p);
+    for (int i = 0; i <= d.x; ++i)
+        for (int j = 0; j <= d.y; ++j)
+            for (int k = 0; k <= d.z; ++k) {
+                const double weight = w[0][i] * w[1][j] * w[2][k];
+                out += weight *
+                       (glm::dvec3(target[(i * (d.y + 1) + j) * (d.z + 1) + k]) - controlRef(l, i, j, k));
+            }
+    return glm::vec3(out);
+}
+
+constexpr FfdBasis kSplineBases[4] = {FfdBasis::BSpline, FfdBasis::Linear, FfdBasis::Cardinal,
+                                      FfdBasis::CatmullRom};
+constexpr FfdBasis kAllBases[5] = {FfdBasis::Bernstein, FfdBasis::BSpline, FfdBasis::Linear,
+                                   FfdBasis::Cardinal, FfdBasis::CatmullRom};
+
 std::vector<glm::vec3> randomTargets(const Lattice& l, std::mt19937& rng, float amount) {
     std::uniform_real_distribution<float> uni(-amount, amount);
     std::vector<glm::vec3> t = l.controlPoints();
@@ -164,17 +213,19 @@ TEST_CASE("ffd: Bernstein FFD equals a direct Bernstein sum", "[warp][ffd]") {
 
 TEST_CASE("ffd: identity when targets equal sources", "[warp][ffd]") {
     std::mt19937 rng(12);
-    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+    for (FfdBasis basis : kAllBases) {
         for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
-            const Lattice l = skewLattice({4, 3, 2});
-            Ffd ffd(l, {basis, outside});
-            ffd.setTargets(l.controlPoints());
-            const auto pts = samplePoints(l, rng, 400, -0.3f, 1.3f);
-            CHECK(maxError(viaEngine(ffd, pts), pts) < 1e-6f);
-            std::vector<glm::vec3> fast = pts;
-            ffd.bind(pts);
-            ffd.evaluate(fast);
-            CHECK(maxError(fast, pts) < 1e-6f);
+            for (FfdEnds ends : {FfdEnds::Extrapolate, FfdEnds::Repeat}) {
+                const Lattice l = skewLattice({4, 3, 2});
+                Ffd ffd(l, {basis, outside, FfdKernel::Auto, ends});
+                ffd.setTargets(l.controlPoints());
+                const auto pts = samplePoints(l, rng, 400, -0.3f, 1.3f);
+                CHECK(maxError(viaEngine(ffd, pts), pts) < 1e-6f);
+                std::vector<glm::vec3> fast = pts;
+                ffd.bind(pts);
+                ffd.evaluate(fast);
+                CHECK(maxError(fast, pts) < 1e-6f);
+            }
         }
     }
 }
@@ -184,7 +235,8 @@ TEST_CASE("ffd: linear precision, an affine target lattice gives that affine map
     const glm::mat3 a(glm::vec3(1.2f, 0.3f, -0.1f), glm::vec3(-0.2f, 0.8f, 0.25f),
                       glm::vec3(0.1f, -0.3f, 1.4f));
     const glm::vec3 b(0.5f, -1.0f, 0.25f);
-    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+    // Not the cardinal spline of tension 0.71: its tangents are 1.42x the spacing of evenly spaced controls.
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline, FfdBasis::Linear, FfdBasis::CatmullRom}) {
         for (glm::ivec3 div : {glm::ivec3(3, 3, 3), glm::ivec3(1, 4, 6)}) {
             const Lattice l = skewLattice(div);
             // Extrapolation continues the polynomials, and they reproduce linear functions everywhere.
@@ -208,11 +260,11 @@ TEST_CASE("ffd: linear precision, an affine target lattice gives that affine map
 
 TEST_CASE("ffd: weighting fields are a partition of unity, sparse and non-negative inside", "[warp][ffd]") {
     std::mt19937 rng(14);
-    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+    for (FfdBasis basis : kAllBases) {
         const Lattice l = skewLattice({6, 5, 4});
         FfdLattice lattice(l, {basis, FfdOutside::Extrapolate});
         auto pts = samplePoints(l, rng, 300, -0.25f, 1.25f);
-        pts.push_back(l.origin);  // a corner: only the corner control, weight 1, for both bases
+        pts.push_back(l.origin);  // a corner: only the corner control, weight 1, for every basis
         lattice.bind(pts);
         SparseFields f;
         lattice.fields(f);
@@ -227,8 +279,11 @@ TEST_CASE("ffd: weighting fields are a partition of unity, sparse and non-negati
             }
             CHECK(sum == Approx(1.0).margin(1e-5));
             const int32_t count = f.offsets[u + 1] - f.offsets[u];
-            if (basis == FfdBasis::BSpline) CHECK(count <= 64);  // a point pays only for its 4x4x4 support
-            if (!outsideUnit(cramer(l, pts[u]))) CHECK(nonNegative);
+            if (basis != FfdBasis::Bernstein) CHECK(count <= 64);  // a point pays only for its 4x4x4 support
+            if (basis == FfdBasis::Linear) CHECK(count <= 8);
+            // The interpolating cubics have negative lobes.
+            const bool positive = basis != FfdBasis::Cardinal && basis != FfdBasis::CatmullRom;
+            if (positive && !outsideUnit(cramer(l, pts[u]))) CHECK(nonNegative);
         }
         const int32_t corner = f.numPoints() - 1;
         REQUIRE(f.offsets[corner + 1] - f.offsets[corner] == 1);
@@ -336,10 +391,11 @@ TEST_CASE("ffd: B-spline is local, a control moves only points in its support", 
 TEST_CASE("ffd: fast path equals the generic engine with painted weights and envelope", "[warp][ffd]") {
     std::mt19937 rng(18);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+    for (FfdBasis basis : kAllBases) {
         for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
             const Lattice l = skewLattice({4, 3, 5});
-            Ffd ffd(l, {basis, outside});
+            const FfdEnds ends = basis == FfdBasis::Cardinal ? FfdEnds::Repeat : FfdEnds::Extrapolate;
+            Ffd ffd(l, {basis, outside, FfdKernel::Auto, ends});
             ffd.setTargets(randomTargets(l, rng, 0.5f));
             const auto rest = samplePoints(l, rng, 3000, -0.2f, 1.2f);
             std::vector<float> weights(rest.size());
@@ -363,9 +419,9 @@ TEST_CASE("ffd: fast path equals the generic engine with painted weights and env
 
 TEST_CASE("ffd: bit-identical output for 1 and 2 threads", "[warp][ffd][determinism]") {
     std::mt19937 rng(19);
-    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+    for (FfdBasis basis : kAllBases) {
         const Lattice l = skewLattice({3, 4, 5});
-        Ffd ffd(l, {basis, FfdOutside::Extrapolate});
+        Ffd ffd(l, {basis, FfdOutside::Extrapolate, FfdKernel::Auto, FfdEnds::Repeat});
         ffd.setTargets(randomTargets(l, rng, 0.5f));
         const auto rest = samplePoints(l, rng, 20000, -0.2f, 1.2f);
         std::vector<glm::vec3> one = rest, two = rest, engineOne, engineTwo;
@@ -478,4 +534,71 @@ TEST_CASE("ffd: bad input names the element", "[warp][ffd][errors]") {
     CHECK_THROWS_WITH(ffd.evaluate(three), Catch::Contains("3 points") && Catch::Contains("2 points"));
     std::vector<float> w(5, 1.0f);
     CHECK_THROWS_WITH(ffd.evaluate(pts, w), Catch::Contains("painted weights"));
+}
+
+TEST_CASE("ffd: Blender's lattice interpolations with repeated end controls equal a second implementation",
+          "[warp][ffd][blender]") {
+    // Random lattices (1 to 5 divisions an axis), a random basis per axis, random moved controls, points
+    // inside and up to a lattice width outside: Blender deforms every point, so outside = Extrapolate.
+    std::mt19937 rng(31);
+    std::uniform_int_distribution<int> divisions(1, 5), pick(0, 3);
+    double worst = 0.0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const Lattice l = skewLattice({divisions(rng), divisions(rng), divisions(rng)});
+        const FfdBases bases(kSplineBases[pick(rng)], kSplineBases[pick(rng)], kSplineBases[pick(rng)]);
+        Ffd ffd(l, {bases, FfdOutside::Extrapolate, FfdKernel::Auto, FfdEnds::Repeat});
+        const auto target = randomTargets(l, rng, 0.4f);
+        ffd.setTargets(target);
+        const auto pts = samplePoints(l, rng, 300, -1.0f, 2.0f);
+        std::vector<glm::vec3> ref(pts.size());
+        for (size_t i = 0; i < pts.size(); ++i)
+            ref[i] = repeatedEndsRef(l, bases, target, pts[i]);
+        std::vector<glm::vec3> fast = pts;
+        ffd.bind(pts);
+        ffd.evaluate(fast);
+        worst = std::max<double>(worst, maxError(fast, ref));
+        CHECK(maxError(viaEngine(ffd, pts), ref) < 1e-5f);
+    }
+    CHECK(worst < 1e-5);
+}
+
+TEST_CASE("ffd: repeated end controls, closed forms at the ends and beyond", "[warp][ffd][blender]") {
+    // One cell along each axis would hide the difference; 3 divisions along X, 1 along Y and Z, and only
+    // the X end controls moved.
+    const Lattice l = skewLattice({3, 1, 1});
+    std::vector<glm::vec3> target = l.controlPoints();
+    const glm::vec3 d0(0.3f, 0.0f, 0.0f), d1(0.0f, 0.2f, 0.0f);
+    for (int j = 0; j <= 1; ++j)
+        for (int k = 0; k <= 1; ++k) {
+            target[l.index(0, j, k)] += d0;
+            target[l.index(1, j, k)] += d1;
+        }
+    const glm::vec3 onEndFace = l.origin + l.axes * glm::vec3(0.0f, 0.5f, 0.5f);
+    const glm::vec3 farOutside = l.origin + l.axes * glm::vec3(-2.0f, 0.5f, 0.5f);
+    struct Case {
+        FfdBasis basis;
+        glm::vec3 endFace;  // the displacement at x = 0
+    };
+    // The B-spline at a knot weights its controls 1/6, 4/6, 1/6: controls -1 and 0 are both control 0, so
+    // the end face moves by 5/6 d0 + 1/6 d1 (with extrapolated ends it would move by d0 exactly). The
+    // interpolating bases move it by d0.
+    for (const Case& c :
+         {Case{FfdBasis::BSpline, 5.0f / 6.0f * d0 + 1.0f / 6.0f * d1}, Case{FfdBasis::Linear, d0},
+          Case{FfdBasis::Cardinal, d0}, Case{FfdBasis::CatmullRom, d0}}) {
+        INFO("basis " << static_cast<int>(c.basis));
+        Ffd ffd(l, {c.basis, FfdOutside::Extrapolate, FfdKernel::Auto, FfdEnds::Repeat});
+        ffd.setTargets(target);
+        std::vector<glm::vec3> pts = {onEndFace, farOutside};
+        ffd.bind(pts);
+        ffd.evaluate(pts);
+        CHECK(maxError({pts[0]}, {onEndFace + c.endFace}) < 1e-6f);
+        // Two lattice widths out every tap is control 0: the point moves by d0, rigidly.
+        CHECK(maxError({pts[1]}, {farOutside + d0}) < 1e-6f);
+    }
+    Ffd extrapolated(l, {FfdBasis::BSpline, FfdOutside::Extrapolate});
+    extrapolated.setTargets(target);
+    std::vector<glm::vec3> pts = {onEndFace};
+    extrapolated.bind(pts);
+    extrapolated.evaluate(pts);
+    CHECK(maxError(pts, {onEndFace + d0}) < 1e-6f);
 }

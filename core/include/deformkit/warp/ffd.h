@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -14,16 +15,44 @@ namespace deformkit::warp {
 // Free-form deformation (paper §4.1, Sederberg and Parry 1986): point features on a uniform lattice in a
 // parallelepiped, strength 1, transformations T_ijk = P*_ijk - P_ijk, weighting fields the trivariate
 // Bernstein polynomials of the point's local coordinates. Also the local B-spline variant (§4.1, after
-// Greissmair and Purgathofer 1989). Decisions: docs/decisions.md, "FFD and FFD with frames".
+// Greissmair and Purgathofer 1989), and Blender's Lattice interpolations with its end conditions (linear,
+// cardinal, Catmull-Rom, B-spline; end controls repeated). Decisions: docs/decisions.md, "FFD and FFD with
+// frames".
 
 enum class FfdBasis {
-    Bernstein,  // B^l_i(s) B^m_j(t) B^n_k(u): every control reaches every point inside the lattice
-    BSpline,    // uniform cubic B-spline with linearly extrapolated end controls: a point pays for 4x4x4
+    Bernstein,   // B^l_i(s) B^m_j(t) B^n_k(u): every control reaches every point inside the lattice
+    BSpline,     // uniform cubic B-spline, approximating: a point pays for 4x4x4 (Blender's "B-Spline")
+    Linear,      // piecewise linear: trilinear inside each cell, 2x2x2 (Blender's "Linear")
+    Cardinal,    // cardinal spline of tension 0.71, interpolating, 4x4x4 (Blender's "Cardinal")
+    CatmullRom,  // Catmull-Rom spline (cardinal of tension 0.5), interpolating, 4x4x4 (Blender's
+                 // "Catmull-Rom")
+};
+
+// The basis along each lattice axis (X, Y, Z). One value sets all three; Blender's lattices choose each
+// axis's interpolation on its own.
+struct FfdBases {
+    std::array<FfdBasis, 3> axis{FfdBasis::Bernstein, FfdBasis::Bernstein, FfdBasis::Bernstein};
+
+    FfdBases() = default;
+    FfdBases(FfdBasis all) : axis{all, all, all} {}  // NOLINT(google-explicit-constructor): one for all
+    FfdBases(FfdBasis x, FfdBasis y, FfdBasis z) : axis{x, y, z} {}
+    [[nodiscard]] FfdBasis operator[](int32_t a) const { return axis[static_cast<size_t>(a)]; }
+    [[nodiscard]] bool all(FfdBasis b) const { return axis[0] == b && axis[1] == b && axis[2] == b; }
+    bool operator==(const FfdBases&) const = default;
 };
 
 enum class FfdOutside {
     None,         // points outside the lattice are left where they are (Maya's default)
-    Extrapolate,  // the polynomial (Bernstein) or end-span polynomial (B-spline) is evaluated beyond [0, 1]
+    Extrapolate,  // the basis is evaluated beyond [0, 1]: the polynomial (Bernstein), the end span's
+                  // polynomial (splines with FfdEnds::Extrapolate), or the end controls (FfdEnds::Repeat)
+};
+
+// How the spline bases (all but Bernstein) make up the controls a span needs beyond the end faces.
+enum class FfdEnds {
+    Extrapolate,  // linear extrapolations of the end controls (T_-1 = 2 T_0 - T_1): linear precision, and
+                  // the B-spline reaches the end faces
+    Repeat,       // the end controls repeated, as Blender's Lattice modifier does: with FfdOutside::
+                  // Extrapolate a point beyond the lattice follows the nearest end controls
 };
 
 // The source lattice. Control point P_ijk = origin + i/l X + j/m Y + k/n Z for 0 <= i <= l, 0 <= j <= m,
@@ -57,9 +86,10 @@ inline constexpr int32_t kMaxBernsteinDegree = 64;
 enum class FfdKernel { Auto, Portable };
 
 struct FfdOptions {
-    FfdBasis basis = FfdBasis::Bernstein;
+    FfdBases basis = FfdBasis::Bernstein;
     FfdOutside outside = FfdOutside::None;
     FfdKernel kernel = FfdKernel::Auto;
+    FfdEnds ends = FfdEnds::Extrapolate;
 };
 
 // True when FfdKernel::Auto runs the AVX2 kernel in this process.

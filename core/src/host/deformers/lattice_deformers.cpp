@@ -23,13 +23,24 @@ class LatticeDeformer : public Deformer {
     LatticeDeformer(std::string type, std::string label) : Deformer(std::move(type), std::move(label)) {
         basis_ = addParameter({.name = "basis",
                                .rebinds = true,
-                               .doc = "0 Bernstein (divisions <= 64), 1 uniform cubic B-spline"},
+                               .stride = 1,
+                               .doc = "one value for every axis, or three (X, Y, Z): 0 Bernstein (divisions "
+                                      "<= 64), 1 uniform cubic B-spline, 2 linear, 3 cardinal (tension "
+                                      "0.71), 4 Catmull-Rom: Blender's four lattice interpolations are 1-4"},
                               {0.0});
         outside_ = addParameter({.name = "outside",
                                  .rebinds = true,
-                                 .doc = "0 points outside the lattice stay put (Maya's default), 1 the "
-                                        "polynomials are extrapolated"},
+                                 .doc = "0 points outside the lattice stay put (Maya's default), 1 the basis "
+                                        "is evaluated beyond it (with ends 1: the end controls move them, as "
+                                        "in Blender)"},
                                 {0.0});
+        ends_ =
+            addParameter({.name = "ends",
+                          .rebinds = true,
+                          .doc = "how the spline bases make up controls beyond the end faces: 0 linear "
+                                 "extrapolation of the end controls, 1 the end controls repeated "
+                                 "(Blender's Lattice modifier; with outside 1 it deforms as Blender does)"},
+                         {0.0});
         divisions_ = addParameter({.name = "divisions",
                                    .rebinds = true,
                                    .doc = "l, m, n: cells along X, Y, Z, whole numbers in [1, 1024]"},
@@ -46,7 +57,13 @@ class LatticeDeformer : public Deformer {
     }
 
     void validate(size_t index, std::span<const double> given) const override {
-        if (index == basis_ || index == outside_) requireIntegers(index, given, 0, 1);
+        if (index == basis_) {
+            if (given.size() != 1 && given.size() != 3) {
+                fail(index, "has " + std::to_string(given.size()) + " values", "1 value, or 3 (X, Y, Z)");
+            }
+            requireIntegers(index, given, 0, 4);
+        }
+        if (index == outside_ || index == ends_) requireIntegers(index, given, 0, 1);
         if (index == divisions_) requireIntegers(index, given, 1, warp::kMaxFfdDivisions);
         if (index == basis_ || index == divisions_ || index == origin_ || index == axes_) {
             // The whole lattice with the candidate value in place, through the core's own checks (axes
@@ -56,9 +73,8 @@ class LatticeDeformer : public Deformer {
             const size_t slot = index == basis_ ? 0 : index == divisions_ ? 1 : index == origin_ ? 2 : 3;
             candidate[slot].assign(given.begin(), given.end());
             try {
-                (void)warp::FfdLattice(
-                    latticeFrom(candidate[1], candidate[2], candidate[3]),
-                    {candidate[0][0] == 0.0 ? warp::FfdBasis::Bernstein : warp::FfdBasis::BSpline});
+                (void)warp::FfdLattice(latticeFrom(candidate[1], candidate[2], candidate[3]),
+                                       {basesFrom(candidate[0])});
             } catch (const InvalidInput& e) {
                 fail(index, e.what(), "a valid lattice");
             }
@@ -71,8 +87,9 @@ class LatticeDeformer : public Deformer {
     }
     [[nodiscard]] warp::FfdOptions ffdOptions() const {
         warp::FfdOptions options;
-        options.basis = value(basis_)[0] == 0.0 ? warp::FfdBasis::Bernstein : warp::FfdBasis::BSpline;
+        options.basis = basesFrom(value(basis_));
         options.outside = value(outside_)[0] == 0.0 ? warp::FfdOutside::None : warp::FfdOutside::Extrapolate;
+        options.ends = value(ends_)[0] == 0.0 ? warp::FfdEnds::Extrapolate : warp::FfdEnds::Repeat;
         return options;
     }
     [[nodiscard]] warp::Lattice restLattice() const {
@@ -80,6 +97,17 @@ class LatticeDeformer : public Deformer {
     }
 
   private:
+    // The "basis" parameter's codes (validated: 1 or 3 integers in [0, 4]) as the core's per-axis bases.
+    static warp::FfdBases basesFrom(std::span<const double> codes) {
+        constexpr warp::FfdBasis kBases[5] = {warp::FfdBasis::Bernstein, warp::FfdBasis::BSpline,
+                                              warp::FfdBasis::Linear, warp::FfdBasis::Cardinal,
+                                              warp::FfdBasis::CatmullRom};
+        const auto at = [&](size_t a) {
+            return kBases[static_cast<size_t>(codes[codes.size() == 3 ? a : 0])];
+        };
+        return {at(0), at(1), at(2)};
+    }
+
     static warp::Lattice latticeFrom(std::span<const double> divisions, std::span<const double> origin,
                                      std::span<const double> axes) {
         warp::Lattice lattice;
@@ -91,7 +119,7 @@ class LatticeDeformer : public Deformer {
         return lattice;
     }
 
-    size_t basis_, outside_, divisions_, origin_, axes_;
+    size_t basis_, outside_, ends_, divisions_, origin_, axes_;
 };
 
 class FfdDeformer final : public LatticeDeformer {
