@@ -209,6 +209,7 @@ def test_ffd_follows_lattice_points():
     obj = grid_object()
     rest = positions(obj).copy()
     entry = add("ffd")
+    entry.basis = "0"  # Sederberg and Parry's, as the module's basis 0 below
     lattice = entry.lattice
     assert (lattice.data.points_u, lattice.data.points_v, lattice.data.points_w) == (3, 3, 3)
     # The new lattice fits the mesh's bounding box padded by 2% on each axis (it measured 2.04x before),
@@ -500,7 +501,9 @@ def animated_twist_and_lattice(obj):
     twist.start_value = 0.0
     key(twist, "end_value", {1: 0.3, 5: 1.5})
     twist_curve = fcurve(obj, 'deformkit.entries[0].end_value', 0)
-    lattice = add("ffd").lattice
+    ffd = add("ffd")
+    ffd.basis = "0"  # Sederberg and Parry's, as the module's basis 0 in expected()
+    lattice = ffd.lattice
     lattice.location, lattice.rotation_euler, lattice.scale = (0, 0, 0), (0, 0, 0), (2.5, 2.5, 1.0)
     centre = (1 * 3 + 1) * 3 + 1
     key(lattice.data.points[centre], "co_deform", {1: 0.0, 5: 0.5}, index=2)
@@ -605,6 +608,83 @@ def test_another_scene_changed_with_frame_set_deforms_as_keyed():
         assert_same(positions(obj), expected(3), "the window's scene at frame 3")
     finally:
         bpy.data.scenes.remove(other)
+
+
+def mesh_object_from_obj(path, name):
+    """A mesh object with the OBJ's points and faces, read through the module (not Blender's importer)."""
+    source = dk.read_mesh(path)
+    counts, indices = np.asarray(source.face_counts), np.asarray(source.face_indices)
+    starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
+    faces = [indices[s:s + c].tolist() for s, c in zip(starts, counts)]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(np.asarray(source.points).tolist(), [], faces)
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def test_as_the_lattice_equals_blenders_lattice_modifier_on_real_meshes():
+    # A rig's lattice deforms a DeformKit FFD ("As the Lattice") as Blender's own Lattice modifier deforms a
+    # copy of the mesh: Spot and Suzanne (their own shapes, off-centre, moved and turned), lattices of
+    # several sizes and each interpolation (and a mixed one), covering part of the mesh only, so points lie
+    # inside and outside, every lattice point moved at random.
+    fresh()
+    data = os.environ.get("DEFORMKIT_TEST_DATA",
+                          os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data"))
+    meshes = [os.path.join(data, "spot", "spot_quadrangulated.obj"),
+              os.path.join(data, "suzanne", "suzanne.0001.obj")]
+    rng = np.random.default_rng(20)
+    cases = [((2, 2, 2), ("KEY_LINEAR",) * 3), ((3, 4, 5), ("KEY_BSPLINE",) * 3),
+             ((4, 3, 3), ("KEY_CARDINAL",) * 3), ((5, 2, 4), ("KEY_CATMULL_ROM",) * 3),
+             ((4, 5, 3), ("KEY_BSPLINE", "KEY_CATMULL_ROM", "KEY_LINEAR"))]
+    worst = 0.0
+    for path in meshes:
+        assert os.path.exists(path), path
+        for (size, kinds) in cases:
+            fresh()
+            ours = mesh_object_from_obj(path, "ours")
+            ours.location, ours.rotation_euler = (0.3, -0.2, 0.1), (0.2, 0.0, 0.4)
+            rest = positions(ours).copy()
+            theirs = bpy.data.objects.new("theirs", ours.data.copy())
+            bpy.context.scene.collection.objects.link(theirs)
+            theirs.location, theirs.rotation_euler = ours.location, ours.rotation_euler
+            lattice_data = bpy.data.lattices.new("rig")
+            lattice_data.points_u, lattice_data.points_v, lattice_data.points_w = size
+            (lattice_data.interpolation_type_u, lattice_data.interpolation_type_v,
+             lattice_data.interpolation_type_w) = kinds
+            lattice = bpy.data.objects.new("rig", lattice_data)
+            bpy.context.scene.collection.objects.link(lattice)
+            # About 80% of the mesh's extent, off its centre and turned: points inside and outside.
+            bpy.context.view_layer.update()
+            world = np.array([ours.matrix_world @ mathutils.Vector(p) for p in rest])
+            low, high = world.min(axis=0), world.max(axis=0)
+            lattice.location = 0.5 * (low + high) + 0.1 * (high - low)
+            lattice.rotation_euler = (0.1, -0.15, 0.3)
+            lattice.scale = 0.8 * (high - low) / (np.array(size) - 1)  # a new lattice's points are 1 apart
+            diagonal = float(np.linalg.norm(high - low))
+            for point in lattice_data.points:
+                point.co_deform = mathutils.Vector(point.co) + mathutils.Vector(rng.uniform(-0.2, 0.2, 3))
+            modifier = theirs.modifiers.new("Lattice", 'LATTICE')
+            modifier.object = lattice
+            bpy.context.view_layer.objects.active = ours
+            entry = add("ffd")
+            assert entry.basis == "LATTICE"  # the default
+            entry.lattice = lattice
+            bpy.context.view_layer.update()
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            blender = theirs.evaluated_get(depsgraph).data
+            expected = np.empty(len(blender.vertices) * 3, np.float32)
+            blender.vertices.foreach_get("co", expected)
+            expected = expected.reshape(-1, 3)
+            moved = np.abs(expected - rest).max(axis=1) > 1e-3 * diagonal
+            local = np.array([lattice.matrix_world.inverted() @ p for p in map(mathutils.Vector, world)])
+            corner = np.array(lattice_data.points[-1].co)  # the lattice spans [-corner, corner]
+            outside = (np.abs(local) > corner).any(axis=1)
+            assert moved.mean() > 0.9 and 0.1 < outside.mean() < 0.9, (moved.mean(), outside.mean())
+            error = float(np.abs(positions(ours) - expected).max()) / diagonal
+            worst = max(worst, error)
+            assert error <= 1e-6, f"{os.path.basename(path)} {size} {kinds}: {error:.2e} of the diagonal"
+    print(f"  as the lattice against the Lattice modifier: worst {worst:.2e} of the bounding-box diagonal")
 
 
 def main():

@@ -145,6 +145,10 @@ def lattice_points(lattice, deformed):
     return points.reshape(-1, 3).astype(np.float64)
 
 
+# Blender's lattice interpolation types as the FFD's basis codes.
+_LATTICE_BASES = {"KEY_BSPLINE": 1, "KEY_LINEAR": 2, "KEY_CARDINAL": 3, "KEY_CATMULL_ROM": 4}
+
+
 def entry_parameters(obj, entry, depsgraph=None):
     """The host-layer parameters of one entry, bind-time ones first (the order hosts set them in)."""
     t = entry.type
@@ -187,8 +191,15 @@ def entry_parameters(obj, entry, depsgraph=None):
         axes = np.concatenate([rest[i] - origin for i in last])
         deformed = _apply(m, lattice_points(lattice, True))
         deformed = deformed.reshape(sizes[2], sizes[1], sizes[0], 3).transpose(2, 1, 0, 3)
-        return [("basis", int(entry.basis)), ("divisions", [s - 1 for s in sizes]), ("origin", origin),
-                ("axes", axes), ("points", deformed.ravel())]
+        if entry.basis == "LATTICE":
+            # Blender's interpolation per axis, its repeated end controls, and every point deformed.
+            bases = [_LATTICE_BASES[t] for t in (data.interpolation_type_u, data.interpolation_type_v,
+                                                  data.interpolation_type_w)]
+            options = [("basis", bases), ("outside", 1), ("ends", 1)]
+        else:
+            options = [("basis", int(entry.basis)), ("outside", 0), ("ends", 0)]
+        return options + [("divisions", [s - 1 for s in sizes]), ("origin", origin), ("axes", axes),
+                          ("points", deformed.ravel())]
     if t == "wires":
         curve = _need(entry, "curve", "wire curve")
         rest = _need(entry, "rest_curve", "rest wire curve")

@@ -70,8 +70,11 @@ class DeformKitEntry(bpy.types.PropertyGroup):
 
     # ffd
     lattice: PointerProperty(name="Lattice", type=bpy.types.Object, poll=_poll_lattice, update=_evaluate)
-    basis: EnumProperty(name="Basis", items=[("0", "Bernstein", "Sederberg and Parry's polynomials"),
-                                             ("1", "B-Spline", "Uniform cubic B-spline")], update=_evaluate)
+    basis: EnumProperty(name="Basis", default="LATTICE", update=_evaluate, items=[
+        ("LATTICE", "As the Lattice", "The lattice's own interpolation on each axis (Linear, Cardinal, "
+         "Catmull-Rom, B-Spline) with Blender's end conditions: deforms as Blender's Lattice modifier does"),
+        ("0", "Bernstein", "Sederberg and Parry's polynomials; points outside the lattice stay put"),
+        ("1", "B-Spline", "Uniform cubic B-spline reaching the lattice's faces; points outside stay put")])
 
     # taper, twist, bend
     frame: PointerProperty(name="Handle", type=bpy.types.Object, poll=_poll_empty, update=_evaluate,
