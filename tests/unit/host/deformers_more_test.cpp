@@ -280,12 +280,12 @@ TEST_CASE("ffdframes adapter equals warp::FfdFrames called directly", "[host][de
     const auto d = makeDeformer("ffdframes", "frames1");
     // Parameters: the lattice as ffd's, then points and frames, which follow the divisions.
     const auto params = d->parameters();
-    REQUIRE(params.size() == 8);
-    CHECK(params[5].name == "axes");
-    CHECK(params[6].name == "points");
-    CHECK(params[7].name == "frames");
-    CHECK_FALSE(params[7].rebinds);
-    CHECK(params[7].components == 9 * 8);
+    REQUIRE(params.size() == 9);
+    CHECK(params[6].name == "axes");
+    CHECK(params[7].name == "points");
+    CHECK(params[8].name == "frames");
+    CHECK_FALSE(params[8].rebinds);
+    CHECK(params[8].components == 9 * 8);
     d->set("divisions", std::vector<double>{2, 1, 2});
     CHECK(d->parameter("frames").components == 9 * 3 * 2 * 3);
     CHECK(d->parameter("points").components == 3 * 3 * 2 * 3);

@@ -65,14 +65,16 @@ TEST_CASE("ffd adapter equals warp::Ffd called directly, and its points follow t
     const auto d = makeDeformer("ffd", "lattice1");
     // Parameters as listed: bind-time inputs first, then the controls; points follow the divisions.
     const auto params = d->parameters();
-    REQUIRE(params.size() == 7);
+    REQUIRE(params.size() == 8);
     CHECK(params[0].name == "basis");
     CHECK(params[2].name == "ends");
-    CHECK(params[3].name == "divisions");
-    CHECK(params[3].rebinds);
-    CHECK(params[6].name == "points");
-    CHECK_FALSE(params[6].rebinds);
-    CHECK(params[6].components == 3 * 8);  // one cell: (1+1)^3 controls
+    CHECK(params[3].name == "evaluateAt");
+    CHECK_FALSE(params[3].rebinds);
+    CHECK(params[4].name == "divisions");
+    CHECK(params[4].rebinds);
+    CHECK(params[7].name == "points");
+    CHECK_FALSE(params[7].rebinds);
+    CHECK(params[7].components == 3 * 8);  // one cell: (1+1)^3 controls
 
     d->set("divisions", std::vector<double>{2, 1, 3});
     CHECK(d->parameter("points").components == 3 * 3 * 2 * 4);

@@ -509,3 +509,48 @@ TEST_CASE("evaluate(in, out) gives the in-place result for 0 to 3 active entries
     bad[5].y = std::numeric_limits<float>::infinity();
     CHECK_THROWS_WITH(stack.evaluate(bad), Contains("point 5: is not finite"));
 }
+
+TEST_CASE("ffd after a twist: lattice coordinates at rest, or at the incoming points (evaluateAt)",
+          "[host][stack][ffd]") {
+    // Maya's and Blender's lattices take each point where the deformers above left it; DeformKit's FFD binds
+    // at rest unless evaluateAt is 1. Both against the core: the twist alone, then a warp::Ffd bound to the
+    // rest points or to the twisted ones.
+    const Scene scene;
+    for (const double at : {0.0, 1.0}) {
+        DeformerStack stack;
+        stack.setRest(scene.rest);
+        stack.add(makeDeformer("twist", "twist1"));
+        stack.set(0, "handleOrigin", std::vector<double>{1, 1, 0});
+        stack.set(0, "handleY", std::vector<double>{1, 0, 0});
+        stack.set(0, "startAngle", -0.4);
+        stack.set(0, "endAngle", 0.7);
+        auto ffd = makeDeformer("ffd", "lattice1");
+        ffd->set("divisions", std::vector<double>{2, 2, 1});
+        ffd->set("origin",
+                 std::vector<double>{scene.lattice.origin.x, scene.lattice.origin.y, scene.lattice.origin.z});
+        ffd->set("axes", std::vector<double>{2.2f, 0, 0, 0, 2.2f, 0, 0, 0, 1.2f});
+        ffd->set("points", flatten(scene.targets));
+        ffd->set("evaluateAt", at);
+        stack.add(std::move(ffd));
+        std::vector<glm::vec3> points = restOf(scene.rest);
+        stack.evaluate(points);
+
+        const warp::AxialSetup setup = warp::fromMayaTwist(scene.twist);
+        warp::TwistWarp twistWarp(setup.frame, setup.profile);
+        warp::SparseFields fields;
+        twistWarp.bind(scene.rest.points(), fields);
+        std::vector<glm::vec3> twisted(points.size());
+        twistWarp.evaluate(restOf(scene.rest), twisted);
+        warp::Ffd direct(scene.lattice);
+        direct.setTargets(scene.targets);
+        if (at == 1.0) {
+            direct.bind(twisted);
+        } else {
+            direct.bind(scene.rest.points());
+        }
+        std::vector<glm::vec3> expected = twisted;
+        direct.evaluate(expected);
+        INFO("evaluateAt " << at);
+        CHECK(test::sameBits(points, expected));
+    }
+}

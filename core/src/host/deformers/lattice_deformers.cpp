@@ -41,6 +41,12 @@ class LatticeDeformer : public Deformer {
                                  "extrapolation of the end controls, 1 the end controls repeated "
                                  "(Blender's Lattice modifier; with outside 1 it deforms as Blender does)"},
                          {0.0});
+        evaluateAt_ = addParameter({.name = "evaluateAt",
+                                    .doc = "where each point's lattice coordinates are taken: 0 at its rest "
+                                           "position, once at bind; 1 at its incoming position, every "
+                                           "evaluation (as Maya's and Blender's lattices do after other "
+                                           "deformers)"},
+                                   {0.0});
         divisions_ = addParameter({.name = "divisions",
                                    .rebinds = true,
                                    .doc = "l, m, n: cells along X, Y, Z, whole numbers in [1, 1024]"},
@@ -63,7 +69,7 @@ class LatticeDeformer : public Deformer {
             }
             requireIntegers(index, given, 0, 4);
         }
-        if (index == outside_ || index == ends_) requireIntegers(index, given, 0, 1);
+        if (index == outside_ || index == ends_ || index == evaluateAt_) requireIntegers(index, given, 0, 1);
         if (index == divisions_) requireIntegers(index, given, 1, warp::kMaxFfdDivisions);
         if (index == basis_ || index == divisions_ || index == origin_ || index == axes_) {
             // The whole lattice with the candidate value in place, through the core's own checks (axes
@@ -92,6 +98,8 @@ class LatticeDeformer : public Deformer {
         options.ends = value(ends_)[0] == 0.0 ? warp::FfdEnds::Extrapolate : warp::FfdEnds::Repeat;
         return options;
     }
+    // True when the lattice coordinates are taken at the incoming points on every evaluation.
+    [[nodiscard]] bool atInput() const { return value(evaluateAt_)[0] != 0.0; }
     [[nodiscard]] warp::Lattice restLattice() const {
         return latticeFrom(value(divisions_), value(origin_), value(axes_));
     }
@@ -119,7 +127,7 @@ class LatticeDeformer : public Deformer {
         return lattice;
     }
 
-    size_t basis_, outside_, ends_, divisions_, origin_, axes_;
+    size_t basis_, outside_, ends_, evaluateAt_, divisions_, origin_, axes_;
 };
 
 class FfdDeformer final : public LatticeDeformer {
@@ -148,6 +156,7 @@ class FfdDeformer final : public LatticeDeformer {
         ffd_->setTargets(targets_);
     }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
+        if (atInput()) ffd_->bind(in);
         std::copy(in.begin(), in.end(), out.begin());  // the fast path deforms in place
         ffd_->evaluate(out);
     }
@@ -203,6 +212,7 @@ class FfdFramesDeformer final : public LatticeDeformer {
         ffd_->setTargetFrames(targets_);
     }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
+        if (atInput()) ffd_->bind(in);
         std::copy(in.begin(), in.end(), out.begin());  // the fast path deforms in place
         ffd_->evaluate(out);
     }
