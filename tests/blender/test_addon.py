@@ -31,10 +31,12 @@ CENTRE = (N // 2) * N + N // 2
 
 
 def fresh():
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.lattices, bpy.data.curves):
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.lattices, bpy.data.curves, bpy.data.images,
+                       bpy.data.materials):
         for block in list(collection):
             collection.remove(block)
     addon.evaluate.clear_cache()
+    addon.uvwarp.clear_live()
     bpy.context.scene.frame_set(1)
     bpy.context.scene.cursor.location = (0.0, 0.0, 0.0)
 
@@ -610,14 +612,26 @@ def test_another_scene_changed_with_frame_set_deforms_as_keyed():
         bpy.data.scenes.remove(other)
 
 
-def mesh_object_from_obj(path, name):
-    """A mesh object with the OBJ's points and faces, read through the module (not Blender's importer)."""
+def data_path(*parts):
+    data = os.environ.get("DEFORMKIT_TEST_DATA",
+                          os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data"))
+    path = os.path.join(data, *parts)
+    assert os.path.exists(path), path
+    return path
+
+
+def mesh_object_from_obj(path, name, uvs=False):
+    """A mesh object with the OBJ's points and faces (and its UVs as the UV map), read through the module
+    (not Blender's importer)."""
     source = dk.read_mesh(path)
     counts, indices = np.asarray(source.face_counts), np.asarray(source.face_indices)
     starts = np.concatenate(([0], np.cumsum(counts)[:-1]))
     faces = [indices[s:s + c].tolist() for s, c in zip(starts, counts)]
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(np.asarray(source.points).tolist(), [], faces)
+    if uvs:
+        layer = mesh.uv_layers.new(name="UVMap")  # loops in face order, as the OBJ's corners
+        layer.data.foreach_set("uv", np.asarray(source.uvs)[np.asarray(source.uv_indices)].ravel())
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
@@ -629,17 +643,13 @@ def test_as_the_lattice_equals_blenders_lattice_modifier_on_real_meshes():
     # several sizes and each interpolation (and a mixed one), covering part of the mesh only, so points lie
     # inside and outside, every lattice point moved at random.
     fresh()
-    data = os.environ.get("DEFORMKIT_TEST_DATA",
-                          os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data"))
-    meshes = [os.path.join(data, "spot", "spot_quadrangulated.obj"),
-              os.path.join(data, "suzanne", "suzanne.0001.obj")]
+    meshes = [data_path("spot", "spot_quadrangulated.obj"), data_path("suzanne", "suzanne.0001.obj")]
     rng = np.random.default_rng(20)
     cases = [((2, 2, 2), ("KEY_LINEAR",) * 3), ((3, 4, 5), ("KEY_BSPLINE",) * 3),
              ((4, 3, 3), ("KEY_CARDINAL",) * 3), ((5, 2, 4), ("KEY_CATMULL_ROM",) * 3),
              ((4, 5, 3), ("KEY_BSPLINE", "KEY_CATMULL_ROM", "KEY_LINEAR"))]
     worst = 0.0
     for path in meshes:
-        assert os.path.exists(path), path
         for (size, kinds) in cases:
             fresh()
             ours = mesh_object_from_obj(path, "ours")
@@ -685,6 +695,89 @@ def test_as_the_lattice_equals_blenders_lattice_modifier_on_real_meshes():
             worst = max(worst, error)
             assert error <= 1e-6, f"{os.path.basename(path)} {size} {kinds}: {error:.2e} of the diagonal"
     print(f"  as the lattice against the Lattice modifier: worst {worst:.2e} of the bounding-box diagonal")
+
+
+def test_live_uv_warp_follows_frame_changes_through_the_material():
+    # Spot with its own UVs, twisted by a keyed angle, rigid disks painted in a 128 x 128 image; live mode
+    # on: every frame change solves the warm-started warp and fills the live image the material reads.
+    # The same solver through the module, fed the mesh at each frame, gives the same bytes.
+    fresh()
+    obj = mesh_object_from_obj(data_path("spot", "spot_quadrangulated.obj"), "spot", uvs=True)
+    bpy.context.view_layer.objects.active = obj
+    rest = positions(obj).copy()
+    material = bpy.data.materials.new("skin")
+    material.use_nodes = True
+    texture = material.node_tree.nodes.new('ShaderNodeTexImage')
+    texture.image = bpy.data.images.new("scales", 8, 8)
+    obj.data.materials.append(material)
+    twist = add("twist")
+    twist.start_value = 0.0
+    key(twist, "end_value", {1: 0.0, 5: 1.2})
+    fcurve(obj, 'deformkit.entries[0].end_value', 0)
+    size = 128
+    ys, xs = np.mgrid[0:size, 0:size]
+    disks = np.zeros((size, size), np.float32)
+    for cx, cy in ((0.3, 0.3), (0.6, 0.5), (0.45, 0.75), (0.8, 0.2)):
+        disks[((xs + 0.5) / size - cx) ** 2 + ((ys + 0.5) / size - cy) ** 2 < 0.05 ** 2] = 1.0
+    rgba = np.zeros((size, size, 4), np.float32)
+    rgba[..., 0], rgba[..., 3] = disks, 1.0
+    rigidity = bpy.data.images.new("rigidity", size, size, float_buffer=True)
+    rigidity.pixels.foreach_set(rgba.ravel())
+    obj.deformkit.uv_rigidity = rigidity
+    bpy.context.scene.frame_set(1)
+
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    assert addon.uvwarp.live_active(obj)
+    live = bpy.data.images[addon.uvwarp.LIVE_IMAGE.format(obj.name)]
+    assert tuple(live.size) == (size, size)
+    redirect_nodes = [n for n in material.node_tree.nodes if n.label == addon.uvwarp.GROUP_NAME]
+    assert [n.image for n in redirect_nodes] == [live]
+    group = next(n for n in material.node_tree.nodes if n.type == 'GROUP')
+    assert texture.inputs["Vector"].links[0].from_node == group
+
+    counts = np.full(len(obj.data.polygons), 4, np.int32)
+    indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
+    uvs = np.empty(len(obj.data.loops) * 2, np.float32)
+    obj.data.uv_layers.active.data.foreach_get("uv", uvs)
+    solver = dk.UvWarpSolver(rest, counts, indices, uvs.reshape(-1, 2), np.arange(len(indices), dtype=np.int32),
+                             1001, np.ascontiguousarray(disks[::-1]), **addon.uvwarp.LIVE_OPTIONS)
+    solver.solve(positions(obj))  # the operator's first frame
+    for frame in (2, 3, 4, 5):
+        bpy.context.scene.frame_set(frame)
+        solver.solve(positions(obj))
+        pixels = np.empty(size * size * 4, np.float32)
+        live.pixels.foreach_get(pixels)
+        shown = pixels.reshape(size, size, 4)[::-1, :, :2]
+        assert np.array_equal(shown, solver.redirect_map()), f"frame {frame}"
+    identity = dk.UvWarpSolver(rest, counts, indices, uvs.reshape(-1, 2), np.arange(len(indices), dtype=np.int32),
+                               1001, np.ascontiguousarray(disks[::-1])).redirect_map()
+    assert np.abs(shown - identity).max() > 1e-3  # the twist does warp the texture
+    rate = addon.uvwarp.live_rate(obj)
+    assert rate is not None and rate[0] > 0.0
+    print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")
+
+    # Off: frame changes leave the image alone.
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    assert not addon.uvwarp.live_active(obj)
+    bpy.context.scene.frame_set(3)
+    after = np.empty(size * size * 4, np.float32)
+    live.pixels.foreach_get(after)
+    assert np.array_equal(after, pixels)
+
+
+def test_live_uv_warp_refuses_udim_layouts_with_a_report():
+    fresh()
+    obj = grid_object()
+    layer = obj.data.uv_layers.new(name="UVMap")
+    corners = np.array([obj.data.vertices[l.vertex_index].co[:2] for l in obj.data.loops], np.float32)
+    layer.data.foreach_set("uv", (corners + 1.0).ravel())  # [0, 2]^2: tiles 1001, 1002, 1011, 1012
+    obj.deformkit.uv_rigidity = bpy.data.images.new("rigidity", 16, 16, float_buffer=True)
+    try:
+        bpy.ops.deformkit.uvwarp_live()
+        raise AssertionError("live mode on a UDIM layout did not report")
+    except RuntimeError as e:
+        assert "tile 1001 only" in str(e) and "1012" in str(e), str(e)
+    assert not addon.uvwarp.live_active(obj)
 
 
 def main():

@@ -3,7 +3,7 @@
 import bpy
 from bpy.app.handlers import persistent
 
-from . import evaluate
+from . import evaluate, uvwarp
 
 _busy = False  # writing a mesh triggers another depsgraph update: do not react to our own writes
 
@@ -21,8 +21,22 @@ def on_frame_change(scene, depsgraph=None):
     try:
         for obj in _stacked_objects(scene):
             evaluate.evaluate_safely(obj, depsgraph)
+        # The live UV warp follows the viewport (a render evaluates its own depsgraph and reads baked maps).
+        if depsgraph is not None and depsgraph.mode == 'VIEWPORT':
+            for name in list(uvwarp.live_objects()):
+                obj = scene.objects.get(name)
+                if obj is not None:
+                    _live_frame(obj, depsgraph)
     finally:
         _busy = False
+
+
+def _live_frame(obj, depsgraph):
+    try:
+        uvwarp.live_update(obj, depsgraph)
+    except Exception as e:  # noqa: BLE001 - the panel shows why live mode stopped
+        uvwarp.stop_live(obj)
+        obj.deformkit.status = f"live UV warp stopped: {e}"
 
 
 @persistent
@@ -53,8 +67,10 @@ def on_depsgraph_update(scene, depsgraph):
 
 @persistent
 def on_load(*_):
-    # A loaded file, an undo or a redo brings other data: the cached stacks and inputs no longer apply.
+    # A loaded file, an undo or a redo brings other data: the cached stacks, inputs and live solvers no
+    # longer apply.
     evaluate.clear_cache()
+    uvwarp.clear_live()
 
 
 def register():

@@ -350,7 +350,37 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
+class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
+    """Solve the content-aware UV warp on every frame change and show it through the material's image
+    textures (a warm-started solver, one iteration a frame; tile 1001)"""
+    bl_idname = "deformkit.uvwarp_live"
+    bl_label = "Live DeformKit UV Warp"
+
+    @classmethod
+    def poll(cls, context):
+        return _mesh_object(context) is not None
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        if uvwarp.live_active(obj):
+            uvwarp.stop_live(obj)
+            self.report({'INFO'}, f"{obj.name}: live UV warp off")
+            return {'FINISHED'}
+        settings = obj.deformkit
+        try:
+            image = uvwarp.start_live(obj, settings.uv_rigidity, settings.uv_mask, settings.uv_resolution)
+            uvwarp.live_update(obj, context.evaluated_depsgraph_get())
+        except Exception as e:  # noqa: BLE001 - reported to the user
+            uvwarp.stop_live(obj)
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
+        if obj.active_material is not None:
+            uvwarp.add_live_nodes(obj.active_material, image)
+        self.report({'INFO'}, f"{obj.name}: live UV warp on, {image.size[0]}² redirect map '{image.name}'")
+        return {'FINISHED'}
+
+
+_classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
             DEFORMKIT_OT_reset_rest)
 
 

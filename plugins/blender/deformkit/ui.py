@@ -2,6 +2,7 @@
 
 import bpy
 
+from . import uvwarp
 from .props import DEFORMER_TYPES, TYPE_ICONS
 
 
@@ -105,6 +106,12 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         # Resume keeps the maps that exist (a bake that stopped) and writes the missing ones, with the bytes an
         # uninterrupted bake writes.
         row.operator("deformkit.bake_redirect", icon='FILE_REFRESH', text="Resume").resume = True
+        live = uvwarp.live_active(obj)
+        col.operator("deformkit.uvwarp_live", icon='PAUSE' if live else 'PLAY',
+                     text="Stop Live UV Warp" if live else "Live UV Warp", depress=live)
+        rate = uvwarp.live_rate(obj)
+        if rate is not None:
+            col.label(text=f"live: {rate[0]:.1f} frames/s ({rate[1]:.0f} ms a frame)")
         row.operator("deformkit.redirect_material", icon='NODETREE', text="Redirect Material")
 
 

@@ -9,6 +9,7 @@ bake replays the warm start and so writes the maps an uninterrupted one would.
 """
 
 import os
+import time
 
 import bpy
 import numpy as np
@@ -144,25 +145,18 @@ def redirect_group():
     return group
 
 
-def add_redirect_nodes(material, first_map, frame_start, frame_count):
+def _insert_redirect(material, image):
     """Inserts the redirect between the UVs and every image texture of `material`: a UV Map node, the
-    redirect map sequence (first file `first_map`) read at the original UVs, and the group."""
+    redirect image read at the original UVs, and the group. Returns the redirect image node."""
     material.use_nodes = True
     tree = material.node_tree
     textures = [n for n in tree.nodes if n.type == 'TEX_IMAGE' and n.label != GROUP_NAME]
-    image = bpy.data.images.load(first_map, check_existing=True)
-    image.source = 'SEQUENCE'
-    image.colorspace_settings.name = 'Non-Color'
     uv = tree.nodes.new('ShaderNodeUVMap')
     redirect = tree.nodes.new('ShaderNodeTexImage')
     redirect.label = GROUP_NAME
     redirect.image = image
     redirect.interpolation = 'Linear'
     redirect.extension = 'EXTEND'
-    redirect.image_user.frame_start = frame_start
-    redirect.image_user.frame_duration = frame_count
-    redirect.image_user.frame_offset = frame_start - 1
-    redirect.image_user.use_auto_refresh = True
     group = tree.nodes.new('ShaderNodeGroup')
     group.node_tree = redirect_group()
     tree.links.new(uv.outputs["UV"], redirect.inputs["Vector"])
@@ -172,4 +166,147 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
         tree.links.new(group.outputs["UV"], texture.inputs["Vector"])
     x = min((n.location.x for n in textures), default=0.0) - 700
     uv.location, redirect.location, group.location = (x - 400, 0), (x - 200, -150), (x + 100, 0)
-    return group
+    return redirect
+
+
+def _redirect_nodes(material):
+    tree = material.node_tree if material.use_nodes else None
+    return [n for n in tree.nodes if n.type == 'TEX_IMAGE' and n.label == GROUP_NAME] if tree else []
+
+
+def add_redirect_nodes(material, first_map, frame_start, frame_count):
+    """Reads every image texture of `material` through the baked redirect map sequence (first file
+    `first_map`). Returns the group node."""
+    image = bpy.data.images.load(first_map, check_existing=True)
+    image.source = 'SEQUENCE'
+    image.colorspace_settings.name = 'Non-Color'
+    redirect = _insert_redirect(material, image)
+    redirect.image_user.frame_start = frame_start
+    redirect.image_user.frame_duration = frame_count
+    redirect.image_user.frame_offset = frame_start - 1
+    redirect.image_user.use_auto_refresh = True
+    return next(link.to_node for link in redirect.outputs["Color"].links)
+
+
+# ---- live mode: the warp solved on every frame change, shown through the material -----------------------
+
+# One warm iteration of sweeps {1, 4, 8} a frame: within 2 points of a converged solve on a smooth
+# animation (docs/uvwarp.md, "What a frame costs").
+LIVE_OPTIONS = {"iterations": 1, "sweeps_per_level": [1, 4, 8]}
+LIVE_IMAGE = "DeformKit Live {}"
+
+# Per object name: its tile's solver, the image it fills, the last frames' times.
+_live = {}
+
+
+def live_active(obj):
+    return obj.name in _live
+
+
+def live_objects():
+    return _live.keys()
+
+
+def start_live(obj, rigidity, mask, resolution):
+    """Binds a warm-started solver to the object's tile and makes the image its redirect map fills on
+    every frame change. Layouts in one tile only (Blender 3.4's Python cannot fill the pixels of a UDIM
+    image's other tiles); UDIM layouts bake. Returns the image."""
+    if rigidity is None:
+        raise UvWarpError(f"{obj.name}: no rigidity map set")
+    if rigidity.source == 'TILED':
+        raise UvWarpError(f"{obj.name}: live mode takes a single rigidity image (tile 1001); bake UDIM maps")
+    rest = evaluate.rest_points(obj) if evaluate.has_rest(obj) else None
+    if rest is None:
+        rest = np.empty(len(obj.data.vertices) * 3, np.float32)
+        obj.data.vertices.foreach_get("co", rest)
+        rest = rest.reshape(-1, 3)
+    points, counts, indices, uvs, order = mesh_with_uvs(obj, rest)
+    tiles = dk.Mesh(points, counts, indices, uvs, order).udim_tiles()  # the library's rule (small overhangs)
+    if tiles != [1001]:
+        raise UvWarpError(f"{obj.name}: live mode shows layouts in tile 1001 only; the UVs use tiles {tiles}: "
+                          f"bake the redirect maps instead")
+    _, rigidity_maps = image_map(rigidity, "rigidity")
+    mask_map = image_map(mask, "mask")[1][1001] if mask is not None else None
+    solver = dk.UvWarpSolver(points, counts, indices, uvs, order, 1001, rigidity_maps[1001], mask=mask_map,
+                             resolution=resolution or None, **LIVE_OPTIONS)
+    texels = solver.texels
+    name = LIVE_IMAGE.format(obj.name)
+    image = bpy.data.images.get(name)
+    if image is not None and tuple(image.size) != (texels, texels):
+        bpy.data.images.remove(image)
+        image = None
+    if image is None:
+        image = bpy.data.images.new(name, texels, texels, alpha=True, float_buffer=True, is_data=True)
+    image.colorspace_settings.name = 'Non-Color'
+    _live[obj.name] = {"solver": solver, "image": image.name, "times": [], "pixels": None}
+    _fill(_live[obj.name], image, solver.redirect_map())  # the identity until the first frame change
+    return image
+
+
+def stop_live(obj):
+    _live.pop(obj.name, None)
+
+
+def clear_live():
+    _live.clear()
+
+
+def _fill(state, image, redirect):
+    """The redirect map (T, T, 2), row 0 at v = 1, into the image's RGBA float pixels (rows bottom-up)."""
+    texels = redirect.shape[0]
+    if state["pixels"] is None:
+        state["pixels"] = np.ones((texels, texels, 4), np.float32)
+    state["pixels"][:, :, 0:2] = redirect[::-1]
+    state["pixels"][:, :, 2] = 0.0
+    image.pixels.foreach_set(state["pixels"].ravel())
+    image.update()
+
+
+def live_points(obj, depsgraph, count):
+    """The deformed points the live warp follows: the mesh as DeformKit wrote it, or, with modifiers on
+    the object, the evaluated mesh (the depsgraph is brought up to date first: the handler runs before
+    Blender evaluates the written mesh again)."""
+    if any(m.show_viewport for m in obj.modifiers):
+        depsgraph.update()
+        return evaluated_points(obj, depsgraph, count)
+    points = np.empty(count * 3, np.float32)
+    obj.data.vertices.foreach_get("co", points)
+    return points.reshape(-1, 3)
+
+
+def live_update(obj, depsgraph):
+    """One live frame: the warm-started solve of the deformed mesh, its redirect map into the image.
+    Returns the frame's time in ms, also kept for live_rate()."""
+    state = _live.get(obj.name)
+    if state is None:
+        return None
+    image = bpy.data.images.get(state["image"])
+    if image is None:  # the image was deleted: live mode ends
+        stop_live(obj)
+        return None
+    t0 = time.perf_counter()
+    solver = state["solver"]
+    solver.solve(live_points(obj, depsgraph, solver.num_vertices))
+    _fill(state, image, solver.redirect_map())
+    ms = (time.perf_counter() - t0) * 1e3
+    state["times"] = (state["times"] + [ms])[-24:]
+    return ms
+
+
+def live_rate(obj):
+    """(frames per second, median ms) over the last frames, or None before the first."""
+    state = _live.get(obj.name)
+    if state is None or not state["times"]:
+        return None
+    ms = float(np.median(state["times"]))
+    return 1000.0 / ms, ms
+
+
+def add_live_nodes(material, image):
+    """Reads every image texture of `material` through the live image: the redirect node the material
+    has (a bake's) is pointed at it, or the nodes are inserted."""
+    existing = _redirect_nodes(material)
+    for node in existing:
+        node.image = image
+    if not existing:
+        _insert_redirect(material, image)
