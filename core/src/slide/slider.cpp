@@ -104,6 +104,8 @@ struct Slider::Impl {
     std::vector<Landing> landings;                  // per slot, scratch
     std::vector<int32_t> slotOf;                    // per vertex: its slot in `active`, -1 when inactive
     std::vector<glm::dvec3> slid;                   // per slot: the slid position, scratch
+    std::vector<glm::dvec3> restDisplacement;       // per handle: its displacement in its rest frame, scratch
+    std::vector<double> scales;                     // per handle: its fold-limit scale, scratch
     // Triangles with an active corner (not degenerate at rest), ascending: where folds are counted. Per
     // handle: the triangles with a corner in its region.
     std::vector<int32_t> regionTriangles;
@@ -820,12 +822,15 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
     }
 
     // Each handle's displacement in its rest frame.
-    std::vector<glm::dvec3> restDisplacement(drives.size());
+    // (Scratch kept in the slider: a warm evaluation allocates nothing.)
+    std::vector<glm::dvec3>& restDisplacement = m.restDisplacement;
+    restDisplacement.resize(drives.size());
     for (size_t h = 0; h < drives.size(); ++h)
         restDisplacement[h] = m.toRestFrame(h, in, drives[h].displacement);
 
     const auto numHandles = m.handles.size();
-    std::vector<double> scales(numHandles, 1.0);
+    std::vector<double>& scales = m.scales;
+    scales.assign(numHandles, 1.0);
     Impl::Counts counts = m.slideOnce(restDisplacement, scales, drives, in, weights, envelope);
     // Folds are counted when someone reads the count or the fold limit needs it (a host's evaluation in a
     // stack does neither and skips the pass over the region's triangles).

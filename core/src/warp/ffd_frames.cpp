@@ -94,7 +94,13 @@ void FfdFrames::setTargetFrames(std::span<const Frame> frames) {
 
 void FfdFrames::update() {
     for (size_t c = 0; c < source_.size(); ++c) {
-        const Affine t = frameToFrame(source_[c], target_[c], controlName(lattice_.lattice(), c));
+        // The control's name is made only for the error: an update allocates nothing.
+        Affine t;
+        try {
+            t = frameToFrame(source_[c], target_[c], {});
+        } catch (const InvalidInput&) {
+            t = frameToFrame(source_[c], target_[c], controlName(lattice_.lattice(), c));  // throws, named
+        }
         transform_[c] = t;
         float* d = &delta_[c * 12];
         for (int col = 0; col < 3; ++col) {

@@ -1,7 +1,10 @@
 #include "maya_adapter.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <string_view>
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
@@ -9,6 +12,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/io/udim.h"
 
 namespace deformkit::maya {
 
@@ -32,20 +36,15 @@ MayaMatrix fromGlm(const glm::dmat4& g) {
     return a;
 }
 
-std::vector<double> flat(const glm::dvec3& v) {
-    return {v.x, v.y, v.z};
-}
-
 void append(std::vector<double>& out, const glm::dvec3& v) {
     out.insert(out.end(), {v.x, v.y, v.z});
 }
 
-std::vector<double> flatPoints(std::span<const glm::dvec3> points, const MayaMatrix& toGeometry) {
-    std::vector<double> out;
-    out.reserve(points.size() * 3);
+void appendPoints(std::vector<double>& out, std::span<const glm::dvec3> points,
+                  const MayaMatrix& toGeometry) {
+    out.reserve(out.size() + points.size() * 3);
     for (const glm::dvec3& p : points)
         append(out, transformPoint(toGeometry, p));
-    return out;
 }
 
 double smooth(double t) {
@@ -59,11 +58,11 @@ MayaMatrix multiply(const MayaMatrix& a, const MayaMatrix& b) {
     return fromGlm(toGlm(b) * toGlm(a));
 }
 
-MayaMatrix inverse(const MayaMatrix& a, const std::string& what) {
+MayaMatrix inverse(const MayaMatrix& a, std::string_view what) {
     const glm::dmat4 g = toGlm(a);
     const double det = glm::determinant(g);
     if (!std::isfinite(det) || std::abs(det) < 1e-300) {
-        throw InvalidInput(formatError(what, "world matrix",
+        throw InvalidInput(formatError(std::string(what), "world matrix",
                                        "is singular (determinant " + numberText(det) + ")",
                                        "an invertible transform"));
     }
@@ -78,75 +77,106 @@ glm::dvec3 transformVector(const MayaMatrix& a, const glm::dvec3& v) {
     return glm::dvec3(toGlm(a) * glm::dvec4(v, 0.0));
 }
 
-std::vector<double> sampleRamp(std::span<const RampKey> keys, int samples) {
+std::vector<double>& ParameterWriter::next(std::string_view name) {
+    if (next_ == out_.size()) out_.emplace_back();
+    auto& [entryName, values] = out_[next_++];
+    if (entryName != name) entryName.assign(name);
+    values.clear();
+    return values;
+}
+
+void ParameterWriter::vector(std::string_view name, const glm::dvec3& v) {
+    append(next(name), v);
+}
+
+void sampleRamp(std::span<const RampKey> keys, int samples, std::vector<double>& out) {
     if (keys.empty()) {
         throw InvalidInput(formatError("falloff ramp", "", "has no keys", "at least one key"));
     }
     if (samples < 2) {
         throw InvalidInput(formatError("falloff ramp", "samples", "is " + std::to_string(samples), ">= 2"));
     }
-    std::vector<RampKey> sorted(keys.begin(), keys.end());
-    std::stable_sort(sorted.begin(), sorted.end(),
-                     [](const RampKey& a, const RampKey& b) { return a.position < b.position; });
-    std::vector<double> out(static_cast<size_t>(samples));
+    // Keys in position order without sorting a copy (no allocation): the first key is the lowest position
+    // (the earliest of equal ones), the last the highest (the latest of equal ones), as a stable sort has
+    // them.
+    const RampKey* first = &keys[0];
+    const RampKey* last = &keys[0];
+    for (const RampKey& k : keys) {
+        if (k.position < first->position) first = &k;
+        if (k.position >= last->position) last = &k;
+    }
+    out.resize(static_cast<size_t>(samples));
     for (int i = 0; i < samples; ++i) {
         const double x = static_cast<double>(i) / (samples - 1);
-        size_t k = 0;
-        while (k + 1 < sorted.size() && sorted[k + 1].position <= x)
-            ++k;
-        const RampKey& a = sorted[k];
-        if (x <= sorted.front().position) {
-            out[i] = sorted.front().value;
-        } else if (k + 1 == sorted.size()) {
-            out[i] = sorted.back().value;
-        } else {
-            const RampKey& b = sorted[k + 1];
-            const double t = b.position > a.position ? (x - a.position) / (b.position - a.position) : 1.0;
-            const double s = a.interpolation == 0 ? 0.0 : a.interpolation == 1 ? t : smooth(t);
-            out[i] = a.value + s * (b.value - a.value);
+        if (x <= first->position) {
+            out[i] = first->value;
+            continue;
         }
+        // a: the key at or before x (the latest of equal positions); b: the first key after x.
+        const RampKey* a = nullptr;
+        const RampKey* b = nullptr;
+        for (const RampKey& k : keys) {
+            if (k.position <= x) {
+                if (a == nullptr || k.position >= a->position) a = &k;
+            } else if (b == nullptr || k.position < b->position) {
+                b = &k;
+            }
+        }
+        if (b == nullptr) {
+            out[i] = last->value;
+            continue;
+        }
+        const double t = b->position > a->position ? (x - a->position) / (b->position - a->position) : 1.0;
+        const double sm = a->interpolation == 0 ? 0.0 : a->interpolation == 1 ? t : smooth(t);
+        out[i] = a->value + sm * (b->value - a->value);
     }
+}
+
+std::vector<double> sampleRamp(std::span<const RampKey> keys, int samples) {
+    std::vector<double> out;
+    sampleRamp(keys, samples, out);
     return out;
 }
 
-Parameters slideParameters(const SlideInputs& in) {
+void slideParameters(const SlideInputs& in, Parameters& out) {
     const MayaMatrix toGeometry = inverse(in.geometryWorld, "dkSlide: the deformed shape");
     const glm::dvec3 d = transformVector(toGeometry, in.endWorld - in.startWorld);
-    return {{"vertex", {static_cast<double>(in.vertex)}},
-            {"radius", {in.radius}},
-            {"geodesic", {in.geodesic ? 1.0 : 0.0}},
-            {"limitSurface", {in.limitSurface ? 1.0 : 0.0}},
-            {"paintedWeights", {in.weightsAreFalloff ? 1.0 : 0.0}},
-            {"foldLimit", {in.foldLimit ? 1.0 : 0.0}},
-            {"falloff", {2.0}},
-            {"falloffRamp", sampleRamp(in.falloff, in.rampSamples)},
-            {"displacement", flat(d)}};
+    ParameterWriter w(out);
+    w.scalar("vertex", static_cast<double>(in.vertex));
+    w.scalar("radius", in.radius);
+    w.scalar("geodesic", in.geodesic ? 1.0 : 0.0);
+    w.scalar("limitSurface", in.limitSurface ? 1.0 : 0.0);
+    w.scalar("paintedWeights", in.weightsAreFalloff ? 1.0 : 0.0);
+    w.scalar("foldLimit", in.foldLimit ? 1.0 : 0.0);
+    w.scalar("falloff", 2.0);
+    sampleRamp(in.falloff, in.rampSamples, w.next("falloffRamp"));
+    w.vector("displacement", d);
 }
 
-Parameters barrParameters(const BarrInputs& in) {
+void barrParameters(const BarrInputs& in, Parameters& out) {
     if (in.type != "taper" && in.type != "twist" && in.type != "bend") {
         throw InvalidInput(formatError("dkBarr", "type", "is '" + in.type + "'", "taper, twist or bend"));
     }
     const MayaMatrix local =
         multiply(in.handleWorld, inverse(in.geometryWorld, "dkBarr: the deformed shape"));
-    Parameters p{{"handleOrigin", flat(transformPoint(local, glm::dvec3(0.0)))}};
-    if (in.type == "bend") p.push_back({"handleX", flat(transformVector(local, {1.0, 0.0, 0.0}))});
-    p.push_back({"handleY", flat(transformVector(local, {0.0, 1.0, 0.0}))});
+    ParameterWriter w(out);
+    w.vector("handleOrigin", transformPoint(local, glm::dvec3(0.0)));
+    if (in.type == "bend") w.vector("handleX", transformVector(local, {1.0, 0.0, 0.0}));
+    w.vector("handleY", transformVector(local, {0.0, 1.0, 0.0}));
     if (in.type == "taper") {
-        p.push_back({"startScale", {in.startValue}});
-        p.push_back({"endScale", {in.endValue}});
+        w.scalar("startScale", in.startValue);
+        w.scalar("endScale", in.endValue);
     } else if (in.type == "twist") {
-        p.push_back({"startAngle", {in.startValue}});
-        p.push_back({"endAngle", {in.endValue}});
+        w.scalar("startAngle", in.startValue);
+        w.scalar("endAngle", in.endValue);
     } else {
-        p.push_back({"curvature", {in.curvature}});
+        w.scalar("curvature", in.curvature);
     }
-    p.push_back({"lowBound", {in.lowBound}});
-    p.push_back({"highBound", {in.highBound}});
-    return p;
+    w.scalar("lowBound", in.lowBound);
+    w.scalar("highBound", in.highBound);
 }
 
-Parameters frameLatticeParameters(const FrameLatticeInputs& in) {
+void frameLatticeParameters(const FrameLatticeInputs& in, Parameters& out) {
     const size_t controls = static_cast<size_t>(in.divisions[0] + 1) * (in.divisions[1] + 1) *
                             static_cast<size_t>(in.divisions[2] + 1);
     if (in.divisions[0] < 1 || in.divisions[1] < 1 || in.divisions[2] < 1 ||
@@ -159,35 +189,33 @@ Parameters frameLatticeParameters(const FrameLatticeInputs& in) {
     }
     const MayaMatrix toGeometry = inverse(in.geometryWorld, "dkFrameLattice: the deformed shape");
     const MayaMatrix base = multiply(in.baseLatticeWorld, toGeometry);
-    std::vector<double> axes;
+    ParameterWriter w(out);
+    w.scalar("basis", static_cast<double>(in.basis));
+    std::vector<double>& divisions = w.next("divisions");
+    for (int a = 0; a < 3; ++a)
+        divisions.push_back(static_cast<double>(in.divisions[a]));
+    w.vector("origin", transformPoint(base, {-0.5, -0.5, -0.5}));
+    std::vector<double>& axes = w.next("axes");
     for (int a = 0; a < 3; ++a) {
         glm::dvec3 axis(0.0);
         axis[a] = 1.0;
         append(axes, transformVector(base, axis));
     }
-    std::vector<double> points, frames;
-    points.reserve(controls * 3);
-    frames.reserve(controls * 9);
+    std::vector<double>& points = w.next("points");
+    for (const MayaMatrix& control : in.controlsWorld)
+        append(points, transformPoint(multiply(control, toGeometry), glm::dvec3(0.0)));
+    std::vector<double>& frames = w.next("frames");
     for (const MayaMatrix& control : in.controlsWorld) {
         const MayaMatrix local = multiply(control, toGeometry);
-        append(points, transformPoint(local, glm::dvec3(0.0)));
         for (int a = 0; a < 3; ++a) {
             glm::dvec3 axis(0.0);
             axis[a] = 1.0;
             append(frames, transformVector(local, axis));
         }
     }
-    return {{"basis", {static_cast<double>(in.basis)}},
-            {"divisions",
-             {static_cast<double>(in.divisions[0]), static_cast<double>(in.divisions[1]),
-              static_cast<double>(in.divisions[2])}},
-            {"origin", flat(transformPoint(base, {-0.5, -0.5, -0.5}))},
-            {"axes", axes},
-            {"points", points},
-            {"frames", frames}};
 }
 
-Parameters wireParameters(const WireInputs& in) {
+void wireParameters(const WireInputs& in, Parameters& out) {
     if (in.restWorld.size() != in.curveWorld.size()) {
         throw InvalidInput(formatError("dkWire", "curves",
                                        "have " + std::to_string(in.curveWorld.size()) +
@@ -195,17 +223,18 @@ Parameters wireParameters(const WireInputs& in) {
                                        "as many points as the rest curves"));
     }
     const MayaMatrix toGeometry = inverse(in.geometryWorld, "dkWire: the deformed shape");
-    std::vector<double> sizes(in.curveSizes.begin(), in.curveSizes.end());
-    if (sizes.empty()) sizes = {0.0};
-    return {{"smooth", {in.smooth ? 1.0 : 0.0}},
-            {"restCurve", flatPoints(in.restWorld, toGeometry)},
-            {"curveSizes", sizes},
-            {"dropoff", in.dropoff},
-            {"scale", in.scale},
-            {"curve", flatPoints(in.curveWorld, toGeometry)}};
+    ParameterWriter w(out);
+    w.scalar("smooth", in.smooth ? 1.0 : 0.0);
+    appendPoints(w.next("restCurve"), in.restWorld, toGeometry);
+    std::vector<double>& sizes = w.next("curveSizes");
+    sizes.assign(in.curveSizes.begin(), in.curveSizes.end());
+    if (sizes.empty()) sizes.push_back(0.0);
+    w.next("dropoff").assign(in.dropoff.begin(), in.dropoff.end());
+    w.next("scale").assign(in.scale.begin(), in.scale.end());
+    appendPoints(w.next("curve"), in.curveWorld, toGeometry);
 }
 
-Parameters meshWarpParameters(const MeshWarpInputs& in) {
+void meshWarpParameters(const MeshWarpInputs& in, Parameters& out) {
     if (in.restCageWorld.size() != in.cageWorld.size()) {
         throw InvalidInput(formatError("dkMeshWarp", "cage",
                                        "has " + std::to_string(in.cageWorld.size()) + " points, its rest " +
@@ -213,11 +242,26 @@ Parameters meshWarpParameters(const MeshWarpInputs& in) {
                                        "as many points as the rest cage"));
     }
     const MayaMatrix toGeometry = inverse(in.geometryWorld, "dkMeshWarp: the deformed shape");
-    return {{"restCage", flatPoints(in.restCageWorld, toGeometry)},
-            {"cageFaceCounts", std::vector<double>(in.faceCounts.begin(), in.faceCounts.end())},
-            {"cageFaceIndices", std::vector<double>(in.faceIndices.begin(), in.faceIndices.end())},
-            {"cage", flatPoints(in.cageWorld, toGeometry)}};
+    ParameterWriter w(out);
+    appendPoints(w.next("restCage"), in.restCageWorld, toGeometry);
+    w.next("cageFaceCounts").assign(in.faceCounts.begin(), in.faceCounts.end());
+    w.next("cageFaceIndices").assign(in.faceIndices.begin(), in.faceIndices.end());
+    appendPoints(w.next("cage"), in.cageWorld, toGeometry);
 }
+
+// The value-returning forms, for callers that do not keep their parameters.
+#define DEFORMKIT_RETURNING(function, Inputs) \
+    Parameters function(const Inputs& in) {   \
+        Parameters out;                       \
+        function(in, out);                    \
+        return out;                           \
+    }
+DEFORMKIT_RETURNING(slideParameters, SlideInputs)
+DEFORMKIT_RETURNING(barrParameters, BarrInputs)
+DEFORMKIT_RETURNING(frameLatticeParameters, FrameLatticeInputs)
+DEFORMKIT_RETURNING(wireParameters, WireInputs)
+DEFORMKIT_RETURNING(meshWarpParameters, MeshWarpInputs)
+#undef DEFORMKIT_RETURNING
 
 NodeCore::NodeCore(const std::string& type, const std::string& label) {
     stack_.add(host::makeDeformer(type, label));
@@ -236,9 +280,36 @@ bool NodeCore::setRest(const geom::Mesh& rest) {
     return true;
 }
 
-void NodeCore::set(const Parameters& parameters) {
-    for (const auto& [name, value] : parameters)
-        stack_.set(0, name, value);
+size_t NodeCore::set(const Parameters& parameters) {
+    size_t pushed = 0;
+    for (const auto& [name, value] : parameters) {
+        auto last = std::ranges::find_if(pushed_, [&](const auto& entry) { return entry.first == name; });
+        if (last != pushed_.end() && last->second == value) continue;
+        stack_.set(0, name, value);  // throws for a bad value: nothing is recorded as pushed
+        if (last == pushed_.end()) {
+            pushed_.emplace_back(name, value);
+        } else {
+            last->second.assign(value.begin(), value.end());
+        }
+        ++pushed;
+    }
+    pushCount_ += static_cast<int64_t>(pushed);
+    return pushed;
+}
+
+std::span<glm::vec3> NodeCore::points(size_t n) {
+    pointBuffer_.resize(n);
+    return pointBuffer_;
+}
+
+std::span<float> NodeCore::weights(size_t n) {
+    weightBuffer_.resize(n);
+    return weightBuffer_;
+}
+
+void NodeCore::evaluateBuffers(double envelope, bool painted) {
+    setWeights(painted ? std::span<const float>(weightBuffer_) : std::span<const float>());
+    evaluate(pointBuffer_, envelope);
 }
 
 void NodeCore::setWeights(std::span<const float> weights) {
@@ -253,8 +324,123 @@ void NodeCore::evaluate(std::span<glm::vec3> points, double envelope) {
 }
 
 RedirectCore::RedirectCore(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
-                           const uvwarp::TileWarpOptions& options, const std::string& source)
-    : warp_(rest, tile, rigidity, mask, options, {}, source) {}
+                           const uvwarp::TileWarpOptions& options, const std::string& source,
+                           const io::Image& orientation)
+    : warp_(rest, tile, rigidity, mask, options, orientation, source) {}
+
+void RedirectCore::setMaps(const io::Image& rigidity, const io::Image& mask, const io::Image& orientation) {
+    warp_.setMaps(rigidity, mask, orientation);
+}
+
+namespace {
+
+bool sameOptions(const uvwarp::TileWarpOptions& a, const uvwarp::TileWarpOptions& b) {
+    const uvwarp::SolverOptions &s = a.solver, &t = b.solver;
+    return a.cells == b.cells && a.dilationRings == b.dilationRings &&
+           a.densityOrientationRadius == b.densityOrientationRadius &&
+           a.derivedMask.borderWidth == b.derivedMask.borderWidth && s.levels == t.levels &&
+           s.iterations == t.iterations && s.tolerance == t.tolerance &&
+           s.sweepsPerLevel == t.sweepsPerLevel && s.orientationPreservation == t.orientationPreservation &&
+           s.smoothing == t.smoothing && s.damping == t.damping && s.coarseStiffness == t.coarseStiffness &&
+           s.threads == t.threads;
+}
+
+}  // namespace
+
+std::vector<int32_t> sweepsFromText(std::string_view text) {
+    std::vector<int32_t> out;
+    size_t i = 0;
+    const auto fail = [&](const std::string& problem) {
+        throw InvalidInput(
+            formatError("dkUvRedirect", "sweepsPerLevel", "'" + std::string(text) + "' " + problem,
+                        "whole numbers >= 0 separated by spaces, finest level first (\"4 8 8\")"));
+    };
+    while (i < text.size()) {
+        if (text[i] == ' ' || text[i] == ',' || text[i] == '\t') {
+            ++i;
+            continue;
+        }
+        size_t end = i;
+        while (end < text.size() && text[end] != ' ' && text[end] != ',' && text[end] != '\t')
+            ++end;
+        const std::string_view word = text.substr(i, end - i);
+        int32_t value = 0;
+        const auto [ptr, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+        if (ec != std::errc() || ptr != word.data() + word.size()) fail("has '" + std::string(word) + "'");
+        if (value < 0) fail("has a negative count");
+        out.push_back(value);
+        i = end;
+    }
+    if (out.empty()) fail("lists no sweeps");
+    return out;
+}
+
+std::string fileAt(const std::string& pattern, int tile, int frame) {
+    if (pattern.empty()) return {};
+    std::string path = io::expandUdim(pattern, tile);
+    const size_t at = path.find("####");
+    if (at != std::string::npos) {
+        char digits[16];
+        std::snprintf(digits, sizeof digits, "%04d", frame);
+        path.replace(at, 4, digits);
+    }
+    return path;
+}
+
+RedirectFiles redirectFilesAt(const RedirectInputs& in, int frame) {
+    return {fileAt(in.rigidity, in.tile, frame), fileAt(in.mask, in.tile, frame),
+            fileAt(in.orientation, in.tile, frame)};
+}
+
+bool RedirectNode::needsBuild(const RedirectInputs& in) const {
+    return !core_ || in.tile != built_.tile || in.rigidity != built_.rigidity || in.mask != built_.mask ||
+           in.orientation != built_.orientation || !sameOptions(in.options, built_.options);
+}
+
+RedirectNode::Maps RedirectNode::read(const RedirectFiles& files) {
+    if (files.rigidity.empty()) {
+        throw InvalidInput(
+            formatError("dkUvRedirect", "rigidity", "is empty", "a rigidity map file pattern"));
+    }
+    Maps maps;
+    maps.rigidity = io::readImage(files.rigidity, {0, "rigidity map"});
+    ++mapReads_;
+    if (!files.mask.empty()) {
+        maps.mask = io::readImage(files.mask, {0, "warp mask"});
+        ++mapReads_;
+    }
+    if (!files.orientation.empty()) {
+        maps.orientation = io::readImage(files.orientation, {0, "orientation map"});
+        ++mapReads_;
+    }
+    return maps;
+}
+
+void RedirectNode::build(const geom::Mesh& rest, const RedirectInputs& in, int frame,
+                         const std::string& source) {
+    const RedirectFiles files = redirectFilesAt(in, frame);
+    const Maps maps = read(files);
+    core_ = std::make_unique<RedirectCore>(rest, in.tile, maps.rigidity, maps.mask, in.options, source,
+                                           maps.orientation);
+    built_ = in;
+    loaded_ = files;
+    ++builds_;
+}
+
+io::Image RedirectNode::solve(const RedirectInputs& in, int frame,
+                              std::span<const glm::vec3> deformedPoints) {
+    if (needsBuild(in)) {
+        throw InvalidInput(formatError("dkUvRedirect", "solver", "is not built for these inputs",
+                                       "build() after a change of tile, map pattern or option"));
+    }
+    const RedirectFiles files = redirectFilesAt(in, frame);
+    if (!(files == loaded_)) {  // an animated map: this frame's files
+        const Maps maps = read(files);
+        core_->setMaps(maps.rigidity, maps.mask, maps.orientation);
+        loaded_ = files;
+    }
+    return core_->solve(frame, deformedPoints);
+}
 
 io::Image RedirectCore::solve(int frame, std::span<const glm::vec3> deformedPoints) {
     warm_ = last_ && frame == *last_ + 1;

@@ -2,9 +2,11 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -29,12 +31,32 @@ struct MayaMatrix {
 
 [[nodiscard]] MayaMatrix multiply(const MayaMatrix& a, const MayaMatrix& b);  // a then b: p a b
 // Throws InvalidInput naming `what` for a singular matrix.
-[[nodiscard]] MayaMatrix inverse(const MayaMatrix& a, const std::string& what);
+[[nodiscard]] MayaMatrix inverse(const MayaMatrix& a, std::string_view what);
 [[nodiscard]] glm::dvec3 transformPoint(const MayaMatrix& a, const glm::dvec3& p);
 [[nodiscard]] glm::dvec3 transformVector(const MayaMatrix& a, const glm::dvec3& v);
 
 // Host-layer parameters a node sets on its deformer, bind-time ones first (the order hosts set them in).
 using Parameters = std::vector<std::pair<std::string, std::vector<double>>>;
+
+// Writes a node's parameters into `out` in order, reusing each entry's storage (its name and values): a node
+// that keeps its Parameters between deform() calls builds them again without allocating. The destructor
+// drops entries left from a longer previous list.
+class ParameterWriter {
+  public:
+    explicit ParameterWriter(Parameters& out) : out_(out) {}
+    ParameterWriter(const ParameterWriter&) = delete;
+    ParameterWriter& operator=(const ParameterWriter&) = delete;
+    ~ParameterWriter() { out_.resize(next_); }
+
+    // The next entry, named `name`, its values cleared (capacity kept).
+    std::vector<double>& next(std::string_view name);
+    void scalar(std::string_view name, double value) { next(name).push_back(value); }
+    void vector(std::string_view name, const glm::dvec3& v);
+
+  private:
+    Parameters& out_;
+    size_t next_ = 0;
+};
 
 // A key of a Maya ramp attribute (MRampAttribute): position and value in [0, 1], interpolation as Maya
 // numbers it: 0 none (hold the value to the next key), 1 linear, 2 smooth, 3 spline (sampled as smooth).
@@ -47,6 +69,7 @@ struct RampKey {
 // The ramp sampled at x = i / (samples - 1), as the slide's falloffRamp takes it. Before the first key the
 // first value, after the last the last one. Throws InvalidInput for no keys or samples < 2.
 [[nodiscard]] std::vector<double> sampleRamp(std::span<const RampKey> keys, int samples);
+void sampleRamp(std::span<const RampKey> keys, int samples, std::vector<double>& out);  // into out, reused
 
 // dkSlide: the handle vertex and its support, the falloff ramp, and the start and end locators (world
 // positions) whose difference, in the deformed geometry's space, is the displacement.
@@ -64,6 +87,7 @@ struct SlideInputs {
     MayaMatrix geometryWorld;  // the deformed shape's world matrix
 };
 [[nodiscard]] Parameters slideParameters(const SlideInputs& in);
+void slideParameters(const SlideInputs& in, Parameters& out);  // into out, reusing its storage
 
 // dkBarr: "taper", "twist" or "bend" about a handle transform (its world matrix: the frame's origin and
 // axes, scaled), in the deformed geometry's space.
@@ -78,6 +102,7 @@ struct BarrInputs {
     double highBound = 1.0;
 };
 [[nodiscard]] Parameters barrParameters(const BarrInputs& in);
+void barrParameters(const BarrInputs& in, Parameters& out);  // into out, reusing its storage
 
 // dkFrameLattice: FFD with frames. The rest lattice is the unit cube [-0.5, 0.5]^3 under the base
 // lattice's world matrix (as Maya's ffd baseLattice); each control is a transform (a locator) whose world
@@ -91,6 +116,7 @@ struct FrameLatticeInputs {
     int basis = 0;  // 0 Bernstein, 1 uniform cubic B-spline
 };
 [[nodiscard]] Parameters frameLatticeParameters(const FrameLatticeInputs& in);
+void frameLatticeParameters(const FrameLatticeInputs& in, Parameters& out);  // into out, reusing its storage
 
 // dkWire: the wires' rest and current curve points (world; the node samples each NURBS curve at its CVs or
 // evenly), one after the other as curveSizes says, in the deformed geometry's space.
@@ -104,6 +130,7 @@ struct WireInputs {
     MayaMatrix geometryWorld;
 };
 [[nodiscard]] Parameters wireParameters(const WireInputs& in);
+void wireParameters(const WireInputs& in, Parameters& out);  // into out, reusing its storage
 
 // dkMeshWarp: a cage mesh's rest and current points (world) and its faces, in the deformed geometry's space.
 struct MeshWarpInputs {
@@ -114,6 +141,7 @@ struct MeshWarpInputs {
     MayaMatrix geometryWorld;
 };
 [[nodiscard]] Parameters meshWarpParameters(const MeshWarpInputs& in);
+void meshWarpParameters(const MeshWarpInputs& in, Parameters& out);  // into out, reusing its storage
 
 // What every DeformKit deformer node keeps between evaluations: a host DeformerStack of one entry (so the
 // envelope, painted weights and bind rules are the host layer's) over the node's rest geometry.
@@ -127,19 +155,63 @@ class NodeCore {
     // Returns true when the rest changed (and the entry will rebind).
     bool setRest(const geom::Mesh& rest);
     [[nodiscard]] bool hasRest() const { return stack_.hasRest(); }
-    void set(const Parameters& parameters);
+    // Pushes to the deformer only the parameters whose values differ from the last ones pushed (a locator
+    // that did not move costs a comparison; the host layer validates a value only when it is set). Returns
+    // how many were pushed.
+    size_t set(const Parameters& parameters);
     // Maya's painted weights (one per vertex; empty: all 1). Set on the stack only when they changed.
     void setWeights(std::span<const float> weights);
     // Deforms `points` in place (the node's input geometry) with the node's envelope.
     void evaluate(std::span<glm::vec3> points, double envelope);
 
+    // The node's buffers, kept between deform() calls: the node reads Maya's positions in bulk
+    // (MItGeometry::allPositions) into points(n) and its painted weights into weights(n), calls
+    // evaluateBuffers, and writes points(n) back (setAllPositions). A warm call allocates nothing.
+    std::span<glm::vec3> points(size_t n);
+    std::span<float> weights(size_t n);
+    // Deforms points(n) in place; `painted` false ignores the weights buffer (all 1).
+    void evaluateBuffers(double envelope, bool painted);
+
     [[nodiscard]] const host::DeformerStack& stack() const { return stack_; }
     [[nodiscard]] int64_t bindCount() const { return stack_.bindCount(); }
+    [[nodiscard]] int64_t pushCount() const { return pushCount_; }  // parameters pushed since construction
 
   private:
     host::DeformerStack stack_;
-    std::vector<float> weights_;
+    std::vector<float> weights_;  // the weights set on the stack
+    Parameters pushed_;           // the values last pushed, per name, in the order first seen
+    int64_t pushCount_ = 0;
+    std::vector<glm::vec3> pointBuffer_;
+    std::vector<float> weightBuffer_;
 };
+
+// dkUvRedirect's attributes: the maps as file patterns (<UDIM> for the tile; #### for the frame, 4 digits,
+// in an animated map: one file per frame), the tile, and the solver's options (TileWarpOptions: grid cells,
+// iterations, tolerance, sweeps per level, orientation preservation, smoothing, damping, coarse stiffness,
+// hierarchy levels, the density orientation heuristic's radius).
+struct RedirectInputs {
+    int tile = 1001;
+    std::string rigidity;     // required
+    std::string mask;         // empty: derived from the UVs
+    std::string orientation;  // empty: none (or the density heuristic)
+    uvwarp::TileWarpOptions options;
+};
+
+// The node's sweepsPerLevel string ("4 8 8": sweeps per level, finest first, separated by spaces or commas)
+// as SolverOptions::sweepsPerLevel. Throws InvalidInput quoting the text for an empty list, a word that is
+// not a whole number, or a negative count.
+[[nodiscard]] std::vector<int32_t> sweepsFromText(std::string_view text);
+
+// A file pattern at a tile and frame: <UDIM> replaced by the tile, #### by the frame (4 digits); an empty
+// pattern stays empty.
+[[nodiscard]] std::string fileAt(const std::string& pattern, int tile, int frame);
+
+// The map files of `frame` (empty patterns stay empty).
+struct RedirectFiles {
+    std::string rigidity, mask, orientation;
+    bool operator==(const RedirectFiles&) const = default;
+};
+[[nodiscard]] RedirectFiles redirectFilesAt(const RedirectInputs& in, int frame);
 
 // What the dkUvRedirect node keeps: one UDIM tile's UV-warp solver over the rest mesh. Frames solved in
 // order warm-start from the previous one; any other frame (a jump, scrubbing backwards, the first one)
@@ -148,15 +220,49 @@ class NodeCore {
 class RedirectCore {
   public:
     RedirectCore(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
-                 const uvwarp::TileWarpOptions& options, const std::string& source);
+                 const uvwarp::TileWarpOptions& options, const std::string& source,
+                 const io::Image& orientation = {});
     // The redirect map (T x T x 2) for `frame` with the deformed points.
     [[nodiscard]] io::Image solve(int frame, std::span<const glm::vec3> deformedPoints);
     [[nodiscard]] bool warmStarted() const { return warm_; }
+
+    // New maps for the frames that follow (an animated map's next file); the solver's hierarchy is rebuilt
+    // only where a map changed.
+    void setMaps(const io::Image& rigidity, const io::Image& mask, const io::Image& orientation);
 
   private:
     uvwarp::TileWarp warp_;
     std::optional<int> last_;
     bool warm_ = false;
+};
+
+// The dkUvRedirect node's state over its evaluations: the solver is made again only when the tile, a map
+// pattern or an option changes (needsBuild); per frame, only the map files that changed are read (an
+// animated map reads its frame's file; a still one is read once).
+class RedirectNode {
+  public:
+    [[nodiscard]] bool needsBuild(const RedirectInputs& in) const;
+    // A new solver over `rest` with the maps of `frame`. `source` names the node in errors and headers.
+    void build(const geom::Mesh& rest, const RedirectInputs& in, int frame, const std::string& source);
+    // The redirect map of `frame` (build first when needsBuild): warm-started when `frame` follows the last
+    // one solved, cold otherwise (RedirectCore).
+    [[nodiscard]] io::Image solve(const RedirectInputs& in, int frame,
+                                  std::span<const glm::vec3> deformedPoints);
+    [[nodiscard]] int64_t builds() const { return builds_; }
+    [[nodiscard]] int64_t mapReads() const { return mapReads_; }  // map files read so far
+    [[nodiscard]] bool warmStarted() const { return core_ && core_->warmStarted(); }
+
+  private:
+    struct Maps {
+        io::Image rigidity, mask, orientation;
+    };
+    Maps read(const RedirectFiles& files);
+
+    std::unique_ptr<RedirectCore> core_;
+    RedirectInputs built_;
+    RedirectFiles loaded_;
+    int64_t builds_ = 0;
+    int64_t mapReads_ = 0;
 };
 
 }  // namespace deformkit::maya

@@ -1,5 +1,6 @@
 #include "dk_deformer.h"
 
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,22 +46,17 @@ geom::Mesh meshOf(const MObject& data, const std::string& what) {
     return geom::Mesh(meshDataOf(data, false), what);
 }
 
-std::vector<glm::dvec3> worldPoints(const MObject& data, MSpace::Space space) {
-    std::vector<glm::dvec3> out;
+// A curve's CVs or a mesh's points appended to `out`, read through `scratch` (both kept by the node).
+void appendPoints(const MObject& data, MPointArray& scratch, std::vector<glm::dvec3>& out) {
     if (data.hasFn(MFn::kNurbsCurve)) {
-        MFnNurbsCurve fn(data);
-        MPointArray cvs;
-        fn.getCVs(cvs, space);
-        for (unsigned i = 0; i < cvs.length(); ++i)
-            out.emplace_back(cvs[i].x, cvs[i].y, cvs[i].z);
+        MFnNurbsCurve(data).getCVs(scratch, MSpace::kObject);
     } else if (data.hasFn(MFn::kMesh)) {
-        MFnMesh fn(data);
-        MPointArray points;
-        fn.getPoints(points, space);
-        for (unsigned i = 0; i < points.length(); ++i)
-            out.emplace_back(points[i].x, points[i].y, points[i].z);
+        MFnMesh(data).getPoints(scratch, MSpace::kObject);
+    } else {
+        scratch.clear();
     }
-    return out;
+    for (unsigned i = 0; i < scratch.length(); ++i)
+        out.emplace_back(scratch[i].x, scratch[i].y, scratch[i].z);
 }
 
 }  // namespace
@@ -119,24 +115,29 @@ MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& 
             core_->setRest(meshOf(data, MString(name()).asChar()));
             rebindSeen_ = rebindNow;
         }
-        core_->set(parameters(block, toMaya(geometryWorld)));
-
-        std::vector<glm::vec3> points;
-        points.reserve(iter.count());
-        std::vector<float> weights;
-        weights.reserve(iter.count());
+        // Parameters rebuilt in place; the core pushes only those that changed (and the host layer validates
+        // only what it is given), so a frame that moves nothing costs comparisons.
+        parameters(block, toMaya(geometryWorld), parameters_);
+        core_->set(parameters_);
+        // Positions in bulk, into and out of the core's own buffers (no allocation once warm).
+        iter.allPositions(positions_);
+        const unsigned n = positions_.length();
+        const std::span<glm::vec3> points = core_->points(n);
+        const std::span<float> weights = core_->weights(n);
         bool painted = false;
-        for (iter.reset(); !iter.isDone(); iter.next()) {
-            const MPoint p = iter.position();
-            points.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
-            weights.push_back(weightValue(block, multiIndex, iter.index()));
-            painted = painted || weights.back() != 1.0f;
+        unsigned i = 0;
+        for (iter.reset(); !iter.isDone() && i < n; iter.next(), ++i) {
+            weights[i] = weightValue(block, multiIndex, iter.index());
+            painted = painted || weights[i] != 1.0f;
         }
-        core_->setWeights(painted ? std::span<const float>(weights) : std::span<const float>());
-        core_->evaluate(points, envelope);
-        size_t i = 0;
-        for (iter.reset(); !iter.isDone(); iter.next(), ++i)
-            iter.setPosition(MPoint(points[i].x, points[i].y, points[i].z));
+        for (unsigned k = 0; k < n; ++k) {
+            const MPoint& p = positions_[k];
+            points[k] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+        }
+        core_->evaluateBuffers(envelope, painted);
+        for (unsigned k = 0; k < n; ++k)
+            positions_[k] = MPoint(points[k].x, points[k].y, points[k].z);
+        iter.setAllPositions(positions_);
     } catch (const Error& e) {
         return report(*this, e.what());
     }
@@ -167,8 +168,8 @@ MStatus DkSlide::initialize() {
     return MS::kSuccess;
 }
 
-Parameters DkSlide::parameters(MDataBlock& block, const MayaMatrix& geometryWorld) {
-    SlideInputs in;
+void DkSlide::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
+    SlideInputs& in = in_;
     in.vertex = block.inputValue(vertex).asInt();
     in.radius = block.inputValue(radius).asDouble();
     in.geodesic = block.inputValue(geodesic).asBool();
@@ -176,17 +177,15 @@ Parameters DkSlide::parameters(MDataBlock& block, const MayaMatrix& geometryWorl
     in.weightsAreFalloff = block.inputValue(weightsAreFalloff).asBool();
     in.foldLimit = block.inputValue(foldLimit).asBool();
     MRampAttribute ramp(thisMObject(), falloff);
-    MIntArray indices, interpolations;
-    MFloatArray positions, values;
-    ramp.getEntries(indices, positions, values, interpolations);
+    ramp.getEntries(rampIndices_, rampPositions_, rampValues_, rampInterpolations_);
     in.falloff.clear();
-    for (unsigned i = 0; i < positions.length(); ++i)
-        in.falloff.push_back({positions[i], values[i], interpolations[i]});
-    if (in.falloff.empty()) in.falloff = {{0.0, 1.0, 2}, {1.0, 0.0, 2}};
+    for (unsigned i = 0; i < rampPositions_.length(); ++i)
+        in.falloff.push_back({rampPositions_[i], rampValues_[i], rampInterpolations_[i]});
+    if (in.falloff.empty()) in.falloff.assign({{0.0, 1.0, 2}, {1.0, 0.0, 2}});
     in.startWorld = translation(matrixValue(block, startMatrix));
     in.endWorld = translation(matrixValue(block, endMatrix));
     in.geometryWorld = geometryWorld;
-    return slideParameters(in);
+    slideParameters(in, out);
 }
 
 MStatus DkSlide::accessoryNodeSetup(MDagModifier& modifier) {
@@ -234,9 +233,9 @@ const char* DkBarr::hostType() const {
     return kind_ == 0 ? "taper" : kind_ == 1 ? "twist" : "bend";
 }
 
-Parameters DkBarr::parameters(MDataBlock& block, const MayaMatrix& geometryWorld) {
+void DkBarr::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
     kind_ = block.inputValue(kind).asShort();
-    BarrInputs in;
+    BarrInputs& in = in_;
     in.type = hostType();
     in.handleWorld = matrixValue(block, handleMatrix);
     in.geometryWorld = geometryWorld;
@@ -245,7 +244,7 @@ Parameters DkBarr::parameters(MDataBlock& block, const MayaMatrix& geometryWorld
     in.curvature = block.inputValue(curvature).asDouble();
     in.lowBound = block.inputValue(lowBound).asDouble();
     in.highBound = block.inputValue(highBound).asDouble();
-    return barrParameters(in);
+    barrParameters(in, out);
 }
 
 MStatus DkBarr::accessoryNodeSetup(MDagModifier& modifier) {
@@ -281,17 +280,18 @@ MStatus DkFrameLattice::initialize() {
     return MS::kSuccess;
 }
 
-Parameters DkFrameLattice::parameters(MDataBlock& block, const MayaMatrix& geometryWorld) {
-    FrameLatticeInputs in;
+void DkFrameLattice::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
+    FrameLatticeInputs& in = in_;
     const int3& d = block.inputValue(divisions).asInt3();
     in.divisions = {d[0], d[1], d[2]};
     in.basis = block.inputValue(basis).asShort();
     in.baseLatticeWorld = matrixValue(block, baseMatrix);
     in.geometryWorld = geometryWorld;
+    in.controlsWorld.clear();
     MArrayDataHandle controls = block.inputArrayValue(controlMatrix);
     for (unsigned i = 0; i < controls.elementCount(); ++i, controls.next())
         in.controlsWorld.push_back(toMaya(controls.inputValue().asMatrix()));
-    return frameLatticeParameters(in);
+    frameLatticeParameters(in, out);
 }
 
 // ---- dkWire --------------------------------------------------------------------------------------------
@@ -317,24 +317,25 @@ MStatus DkWire::initialize() {
     return MS::kSuccess;
 }
 
-Parameters DkWire::parameters(MDataBlock& block, const MayaMatrix& geometryWorld) {
-    WireInputs in;
+void DkWire::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
+    WireInputs& in = in_;
     in.geometryWorld = geometryWorld;
-    in.dropoff = {block.inputValue(dropoff).asDouble()};
-    in.scale = {block.inputValue(scale).asDouble()};
+    in.dropoff.assign(1, block.inputValue(dropoff).asDouble());
+    in.scale.assign(1, block.inputValue(scale).asDouble());
     in.smooth = block.inputValue(smooth).asBool();
+    in.restWorld.clear();
+    in.curveWorld.clear();
+    in.curveSizes.clear();
     MArrayDataHandle rest = block.inputArrayValue(restCurve), now = block.inputArrayValue(curve);
     for (unsigned i = 0; i < rest.elementCount(); ++i, rest.next()) {
         // Curves connected from world-space plugs (worldSpace[0]) carry world positions.
-        const std::vector<glm::dvec3> points = worldPoints(rest.inputValue().asNurbsCurve(), MSpace::kObject);
-        in.restWorld.insert(in.restWorld.end(), points.begin(), points.end());
-        in.curveSizes.push_back(static_cast<int>(points.size()));
+        const size_t before = in.restWorld.size();
+        appendPoints(rest.inputValue().asNurbsCurve(), cvs_, in.restWorld);
+        in.curveSizes.push_back(static_cast<int>(in.restWorld.size() - before));
     }
-    for (unsigned i = 0; i < now.elementCount(); ++i, now.next()) {
-        const std::vector<glm::dvec3> points = worldPoints(now.inputValue().asNurbsCurve(), MSpace::kObject);
-        in.curveWorld.insert(in.curveWorld.end(), points.begin(), points.end());
-    }
-    return wireParameters(in);
+    for (unsigned i = 0; i < now.elementCount(); ++i, now.next())
+        appendPoints(now.inputValue().asNurbsCurve(), cvs_, in.curveWorld);
+    wireParameters(in, out);
 }
 
 // ---- dkMeshWarp ----------------------------------------------------------------------------------------
@@ -353,20 +354,22 @@ MStatus DkMeshWarp::initialize() {
     return MS::kSuccess;
 }
 
-Parameters DkMeshWarp::parameters(MDataBlock& block, const MayaMatrix& geometryWorld) {
-    MeshWarpInputs in;
+void DkMeshWarp::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
+    MeshWarpInputs& in = in_;
     in.geometryWorld = geometryWorld;
     const MObject rest = block.inputValue(restCage).asMesh(), now = block.inputValue(cage).asMesh();
-    in.restCageWorld = worldPoints(rest, MSpace::kObject);
-    in.cageWorld = worldPoints(now, MSpace::kObject);
-    MFnMesh fn(rest);
-    MIntArray counts, indices;
-    fn.getVertices(counts, indices);
-    for (unsigned i = 0; i < counts.length(); ++i)
-        in.faceCounts.push_back(counts[i]);
-    for (unsigned i = 0; i < indices.length(); ++i)
-        in.faceIndices.push_back(indices[i]);
-    return meshWarpParameters(in);
+    in.restCageWorld.clear();
+    in.cageWorld.clear();
+    appendPoints(rest, points_, in.restCageWorld);
+    appendPoints(now, points_, in.cageWorld);
+    MFnMesh(rest).getVertices(counts_, indices_);
+    in.faceCounts.resize(counts_.length());
+    for (unsigned i = 0; i < counts_.length(); ++i)
+        in.faceCounts[i] = counts_[i];
+    in.faceIndices.resize(indices_.length());
+    for (unsigned i = 0; i < indices_.length(); ++i)
+        in.faceIndices[i] = indices_[i];
+    meshWarpParameters(in, out);
 }
 
 }  // namespace deformkit::maya

@@ -7,9 +7,12 @@
 #include <memory>
 
 #include <maya/MDataBlock.h>
+#include <maya/MFloatArray.h>
 #include <maya/MFnNumericData.h>
+#include <maya/MIntArray.h>
 #include <maya/MItGeometry.h>
 #include <maya/MMatrix.h>
+#include <maya/MPointArray.h>
 #include <maya/MPxDeformerNode.h>
 #include <maya/MTypeId.h>
 
@@ -38,12 +41,15 @@ class DkDeformer : public MPxDeformerNode {
 
     [[nodiscard]] virtual const char* hostType() const = 0;
     [[nodiscard]] virtual const MObject& rebindAttribute() const = 0;
-    // The host parameters from the node's attributes; throws deformkit::Error for bad values.
-    virtual Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) = 0;
+    // The host parameters from the node's attributes, written into `out` (kept by the node between calls,
+    // so a warm deform() allocates nothing); throws deformkit::Error for bad values.
+    virtual void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) = 0;
 
   private:
     std::unique_ptr<NodeCore> core_;
     bool rebindSeen_ = false;
+    Parameters parameters_;  // the last parameters, rewritten in place each deform()
+    MPointArray positions_;  // the input's positions, read and written in bulk
 };
 
 [[nodiscard]] MayaMatrix toMaya(const MMatrix& m);
@@ -62,7 +68,12 @@ class DkSlide : public DkDeformer {
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
     const char* hostType() const override { return "slide"; }
-    Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) override;
+    void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
+
+  private:
+    SlideInputs in_;  // kept: its falloff keys reuse their storage
+    MIntArray rampIndices_, rampInterpolations_;
+    MFloatArray rampPositions_, rampValues_;
 };
 
 class DkBarr : public DkDeformer {
@@ -79,10 +90,11 @@ class DkBarr : public DkDeformer {
     const MObject& rebindAttribute() const override { return rebind; }
     // The host type follows the `kind` attribute (the node's core is rebuilt when it changes).
     const char* hostType() const override;
-    Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) override;
+    void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:
     short kind_ = 1;
+    BarrInputs in_;
 };
 
 class DkFrameLattice : public DkDeformer {
@@ -96,7 +108,10 @@ class DkFrameLattice : public DkDeformer {
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
     const char* hostType() const override { return "ffdframes"; }
-    Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) override;
+    void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
+
+  private:
+    FrameLatticeInputs in_;
 };
 
 class DkWire : public DkDeformer {
@@ -110,7 +125,11 @@ class DkWire : public DkDeformer {
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
     const char* hostType() const override { return "wires"; }
-    Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) override;
+    void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
+
+  private:
+    WireInputs in_;
+    MPointArray cvs_;
 };
 
 class DkMeshWarp : public DkDeformer {
@@ -124,7 +143,12 @@ class DkMeshWarp : public DkDeformer {
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
     const char* hostType() const override { return "meshwarp"; }
-    Parameters parameters(MDataBlock& block, const MayaMatrix& geometryWorld) override;
+    void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
+
+  private:
+    MeshWarpInputs in_;
+    MPointArray points_;
+    MIntArray counts_, indices_;
 };
 
 }  // namespace deformkit::maya

@@ -28,20 +28,14 @@ geom::Mesh meshWithUVs(const MObject& data, const std::string& what) {
     return geom::Mesh(meshDataOf(data, true), what);
 }
 
-std::string withFrame(std::string pattern, int frame) {
-    const size_t at = pattern.find("####");
-    if (at == std::string::npos) return pattern;
-    char digits[16];
-    std::snprintf(digits, sizeof digits, "%04d", frame);
-    return pattern.replace(at, 4, digits);
-}
-
 }  // namespace
 
 const MTypeId DkUvRedirect::id(0x0013A6C5);
 MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, DkUvRedirect::mask,
-    DkUvRedirect::tile, DkUvRedirect::resolution, DkUvRedirect::output, DkUvRedirect::time,
-    DkUvRedirect::outFile;
+    DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::resolution, DkUvRedirect::iterations,
+    DkUvRedirect::tolerance, DkUvRedirect::sweepsPerLevel, DkUvRedirect::orientationPreservation,
+    DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness, DkUvRedirect::levels,
+    DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time, DkUvRedirect::outFile;
 
 MStatus DkUvRedirect::initialize() {
     MFnTypedAttribute typed;
@@ -50,17 +44,36 @@ MStatus DkUvRedirect::initialize() {
     restMesh = typed.create("restMesh", "rsm", MFnData::kMesh);
     addAttribute(restMesh);
     const std::tuple<MObject*, const char*, const char*> strings[] = {
-        {&rigidity, "rigidity", "rig"}, {&mask, "mask", "msk"}, {&output, "output", "out"}};
+        {&rigidity, "rigidity", "rig"},
+        {&mask, "mask", "msk"},
+        {&orientation, "orientation", "ori"},
+        {&sweepsPerLevel, "sweepsPerLevel", "spl"},
+        {&output, "output", "out"}};
     for (const auto& [attribute, name, shortName] : strings) {
         MFnTypedAttribute fn;
         *attribute = fn.create(name, shortName, MFnData::kString);
         addAttribute(*attribute);
     }
-    MFnNumericAttribute numeric;
-    tile = numeric.create("tile", "til", MFnNumericData::kInt, 1001);
-    addAttribute(tile);
-    resolution = numeric.create("resolution", "res", MFnNumericData::kInt, 0);
-    addAttribute(resolution);
+    // The solver's options, with the library's defaults (uvwarp::SolverOptions, TileWarpOptions).
+    const uvwarp::TileWarpOptions defaults;
+    const std::tuple<MObject*, const char*, const char*, MFnNumericData::Type, double> numbers[] = {
+        {&tile, "tile", "til", MFnNumericData::kInt, 1001},
+        {&resolution, "resolution", "res", MFnNumericData::kInt, 0},
+        {&iterations, "iterations", "itr", MFnNumericData::kInt, defaults.solver.iterations},
+        {&tolerance, "tolerance", "tol", MFnNumericData::kDouble, defaults.solver.tolerance},
+        {&orientationPreservation, "orientationPreservation", "orp", MFnNumericData::kDouble,
+         defaults.solver.orientationPreservation},
+        {&smoothing, "smoothing", "smt", MFnNumericData::kDouble, defaults.solver.smoothing},
+        {&damping, "damping", "dmp", MFnNumericData::kDouble, defaults.solver.damping},
+        {&coarseStiffness, "coarseStiffness", "cst", MFnNumericData::kDouble,
+         defaults.solver.coarseStiffness},
+        {&levels, "levels", "lvl", MFnNumericData::kInt, defaults.solver.levels},
+        {&densityRadius, "densityRadius", "dnr", MFnNumericData::kInt, defaults.densityOrientationRadius}};
+    for (const auto& [attribute, name, shortName, type, value] : numbers) {
+        MFnNumericAttribute fn;
+        *attribute = fn.create(name, shortName, type, value);
+        addAttribute(*attribute);
+    }
     MFnUnitAttribute unit;
     time = unit.create("time", "tim", MFnUnitAttribute::kTime, 0.0);
     addAttribute(time);
@@ -68,7 +81,9 @@ MStatus DkUvRedirect::initialize() {
     typed.setWritable(false);
     typed.setStorable(false);
     addAttribute(outFile);
-    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &tile, &resolution, &output, &time})
+    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &tile, &resolution, &iterations,
+                        &tolerance, &sweepsPerLevel, &orientationPreservation, &smoothing, &damping,
+                        &coarseStiffness, &levels, &densityRadius, &output, &time})
         attributeAffects(*in, outFile);
     return MS::kSuccess;
 }
@@ -76,37 +91,38 @@ MStatus DkUvRedirect::initialize() {
 MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
     if (plug != outFile) return MS::kUnknownParameter;
     try {
-        const int tileNumber = block.inputValue(tile).asInt();
-        const std::string rigidityPattern = block.inputValue(rigidity).asString().asChar();
-        const std::string maskPattern = block.inputValue(mask).asString().asChar();
-        const int cells = block.inputValue(resolution).asInt();
-        const std::string key = rigidityPattern + "|" + maskPattern + "|" + std::to_string(tileNumber) + "|" +
-                                std::to_string(cells);
-        if (!core_ || key != coreKey_) {
-            const geom::Mesh rest =
-                meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar());
-            const io::Image rig =
-                io::readImage(io::expandUdim(rigidityPattern, tileNumber), {0, "rigidity map"});
-            const io::Image msk = maskPattern.empty() ? io::Image()
-                                                      : io::readImage(io::expandUdim(maskPattern, tileNumber),
-                                                                      {0, "warp mask"});
-            uvwarp::TileWarpOptions options;
-            options.cells = cells;
-            core_ = std::make_unique<RedirectCore>(rest, tileNumber, rig, msk, options, rigidityPattern);
-            coreKey_ = key;
+        RedirectInputs in;
+        in.tile = block.inputValue(tile).asInt();
+        in.rigidity = block.inputValue(rigidity).asString().asChar();
+        in.mask = block.inputValue(mask).asString().asChar();
+        in.orientation = block.inputValue(orientation).asString().asChar();
+        in.options.cells = block.inputValue(resolution).asInt();
+        in.options.densityOrientationRadius = block.inputValue(densityRadius).asInt();
+        uvwarp::SolverOptions& solver = in.options.solver;
+        solver.iterations = block.inputValue(iterations).asInt();
+        solver.tolerance = static_cast<float>(block.inputValue(tolerance).asDouble());
+        const std::string sweeps = block.inputValue(sweepsPerLevel).asString().asChar();
+        if (!sweeps.empty()) solver.sweepsPerLevel = sweepsFromText(sweeps);
+        solver.orientationPreservation =
+            static_cast<float>(block.inputValue(orientationPreservation).asDouble());
+        solver.smoothing = static_cast<float>(block.inputValue(smoothing).asDouble());
+        solver.damping = static_cast<float>(block.inputValue(damping).asDouble());
+        solver.coarseStiffness = static_cast<float>(block.inputValue(coarseStiffness).asDouble());
+        solver.levels = block.inputValue(levels).asInt();
+        const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
+        if (node_.needsBuild(in)) {
+            node_.build(meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar()), in, frame,
+                        in.rigidity);
         }
         MFnMesh deformed(block.inputValue(inMesh).asMesh());
         MPointArray points;
         deformed.getPoints(points, MSpace::kObject);
-        std::vector<glm::vec3> p;
-        p.reserve(points.length());
+        points_.resize(points.length());
         for (unsigned i = 0; i < points.length(); ++i)
-            p.emplace_back(static_cast<float>(points[i].x), static_cast<float>(points[i].y),
-                           static_cast<float>(points[i].z));
-        const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
-        const io::Image map = core_->solve(frame, p);
-        const std::string path =
-            withFrame(io::expandUdim(block.inputValue(output).asString().asChar(), tileNumber), frame);
+            points_[i] = {static_cast<float>(points[i].x), static_cast<float>(points[i].y),
+                          static_cast<float>(points[i].z)};
+        const io::Image map = node_.solve(in, frame, points_);
+        const std::string path = fileAt(block.inputValue(output).asString().asChar(), in.tile, frame);
         io::writeImage(path, map, {io::PixelType::Float, {}});
         block.outputValue(outFile).set(MString(path.c_str()));
         block.setClean(plug);

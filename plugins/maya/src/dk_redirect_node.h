@@ -1,6 +1,5 @@
 #pragma once
 
-#include <map>
 #include <memory>
 #include <string>
 
@@ -13,9 +12,11 @@ namespace deformkit::maya {
 
 // dkUvRedirect: the content-aware UV warp of one UDIM tile of a deformed mesh, written as a redirect map per
 // frame. Inputs: the deformed mesh (inMesh, connected from the shape's worldMesh or outMesh), the rest mesh
-// with UVs, the rigidity (and optional mask) map paths (UDIM patterns), the tile, the grid resolution and
-// time; on compute it solves the current frame (warm-started when it follows the last frame solved) and
-// writes `output` (<UDIM> and #### replaced) atomically. outFile holds the path written.
+// with UVs, the rigidity, mask and orientation map paths (UDIM patterns; #### makes a map animated, one file
+// per frame), the tile, the grid resolution, the solver's options and time; on compute it solves the current
+// frame (warm-started when it follows the last frame solved) and writes `output` (<UDIM> and #### replaced)
+// atomically. outFile holds the path written. The solver is made again only when the tile, a pattern or an
+// option changes; an animated map's file is read at each frame, a still one once (RedirectNode).
 class DkUvRedirect : public MPxNode {
   public:
     static void* creator() { return new DkUvRedirect; }
@@ -23,11 +24,13 @@ class DkUvRedirect : public MPxNode {
     MStatus compute(const MPlug& plug, MDataBlock& block) override;
 
     static const MTypeId id;
-    static MObject inMesh, restMesh, rigidity, mask, tile, resolution, output, time, outFile;
+    static MObject inMesh, restMesh, rigidity, mask, orientation, tile, resolution, iterations, tolerance,
+        sweepsPerLevel, orientationPreservation, smoothing, damping, coarseStiffness, levels, densityRadius,
+        output, time, outFile;
 
   private:
-    std::unique_ptr<RedirectCore> core_;
-    std::string coreKey_;  // the inputs the core was built for
+    RedirectNode node_;
+    std::vector<glm::vec3> points_;  // the deformed points, kept between frames
 };
 
 }  // namespace deformkit::maya

@@ -3,7 +3,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 
 #include <glm/geometric.hpp>
 
@@ -15,6 +18,23 @@
 
 using namespace deformkit;
 using maya::MayaMatrix;
+
+// Every allocation of this test program, counted: a deform() cycle of a warm node core must not add one.
+namespace {
+std::atomic<int64_t> allocations{0};
+}  // namespace
+
+void* operator new(size_t size) {
+    allocations.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, size_t) noexcept {
+    std::free(p);
+}
 
 namespace {
 
@@ -234,4 +254,219 @@ TEST_CASE("maya adapter: the redirect core warm-starts frames in order and start
     (void)cold.solve(pose(7));
     CHECK(test::sameBits(jumped.pixels, cold.redirect().pixels));
     CHECK_FALSE(test::sameBits(jumped.pixels, core.solve(1, pose(1)).pixels));  // the maps do change
+}
+
+namespace {
+
+// One deform() as the Maya node makes it: parameters rebuilt in place into the node's kept record, pushed
+// where they changed, the input positions copied into the core's buffer, evaluated.
+template <class Inputs, class Fill>
+void deformCycle(maya::NodeCore& core, maya::Parameters& kept, const Inputs& in, Fill fill,
+                 std::span<const glm::vec3> input) {
+    fill(in, kept);
+    core.set(kept);
+    const std::span<glm::vec3> points = core.points(input.size());
+    std::copy(input.begin(), input.end(), points.begin());
+    const std::span<float> weights = core.weights(input.size());
+    std::fill(weights.begin(), weights.end(), 1.0f);
+    core.evaluateBuffers(1.0, false);
+}
+
+}  // namespace
+
+TEST_CASE("maya adapter: a warm deform cycle allocates nothing, pushes only what changed, binds once",
+          "[maya]") {
+    const geom::Mesh mesh = geom::makeGrid({24, 24, 2.0f, 2.0f});
+    const std::vector<glm::vec3> input(mesh.points().begin(), mesh.points().end());
+
+    SECTION("slide driven by its end locator") {
+        maya::NodeCore core("slide", "slide1");
+        core.setRest(mesh);
+        maya::SlideInputs in;
+        in.vertex = 12 * 25 + 12;
+        in.radius = 0.8;
+        maya::Parameters kept;
+        const auto fill = [](const maya::SlideInputs& i, maya::Parameters& out) {
+            maya::slideParameters(i, out);
+        };
+        int64_t warm = 0;
+        for (int frame = 0; frame < 12; ++frame) {
+            in.endWorld = {0.02 * frame, 0.01 * frame, 0.0};  // the animator drags the end locator
+            const int64_t before = allocations.load();
+            const int64_t pushedBefore = core.pushCount();
+            deformCycle(core, kept, in, fill, input);
+            if (frame >= 2) warm += allocations.load() - before;
+            // The first cycle pushes all 9 parameters; after it only the displacement changes.
+            CHECK(core.pushCount() - pushedBefore == (frame == 0 ? 9 : 1));
+        }
+        CHECK(warm == 0);
+        CHECK(core.bindCount() == 1);  // bound once, driven by the locator
+        const std::span<glm::vec3> out = core.points(input.size());
+        CHECK(glm::length(out[in.vertex] - input[in.vertex]) > 0.1f);  // the handle did slide
+        // Nothing moved: nothing pushed.
+        maya::slideParameters(in, kept);
+        CHECK(core.set(kept) == 0);
+        // A new radius is a bind-time change: pushed (and validated) once, and the slide binds again.
+        in.radius = 0.5;
+        deformCycle(core, kept, in, fill, input);
+        CHECK(core.bindCount() == 2);
+    }
+
+    SECTION("twist and frame lattice") {
+        maya::NodeCore twist("twist", "twist1");
+        twist.setRest(mesh);
+        maya::BarrInputs barr;
+        barr.handleWorld.m[1] = {0, 0, 1, 0};
+        barr.handleWorld.m[2] = {0, -1, 0, 0};
+        maya::NodeCore lattice("ffdframes", "lattice1");
+        lattice.setRest(mesh);
+        maya::FrameLatticeInputs frames;
+        frames.divisions = {1, 1, 1};
+        frames.baseLatticeWorld.m[0] = {2.2, 0, 0, 0};
+        frames.baseLatticeWorld.m[1] = {0, 2.2, 0, 0};
+        frames.baseLatticeWorld.m[2] = {0, 0, 1, 0};
+        for (int c = 0; c < 8; ++c) {
+            MayaMatrix control;
+            control.m[3] = {c & 4 ? 1.1 : -1.1, c & 2 ? 1.1 : -1.1, c & 1 ? 0.5 : -0.5, 1};
+            frames.controlsWorld.push_back(control);
+        }
+        maya::Parameters keptTwist, keptLattice;
+        const auto fillTwist = [](const maya::BarrInputs& i, maya::Parameters& out) {
+            maya::barrParameters(i, out);
+        };
+        const auto fillLattice = [](const maya::FrameLatticeInputs& i, maya::Parameters& out) {
+            maya::frameLatticeParameters(i, out);
+        };
+        int64_t warmTwist = 0, warmLattice = 0;
+        for (int frame = 0; frame < 8; ++frame) {
+            barr.endValue = 0.1 * frame;
+            frames.controlsWorld[7].m[3][2] = 0.5 + 0.05 * frame;
+            const int64_t before = allocations.load();
+            deformCycle(twist, keptTwist, barr, fillTwist, input);
+            const int64_t between = allocations.load();
+            deformCycle(lattice, keptLattice, frames, fillLattice, input);
+            if (frame >= 2) {
+                warmTwist += between - before;
+                warmLattice += allocations.load() - between;
+            }
+        }
+        CHECK(warmLattice == 0);
+        // Not yet zero: a new twist angle builds the twist's profile curve again (five small blocks, sized
+        // by its two samples, not by the mesh), 6 frames here.
+        CHECK(warmTwist <= 5 * 6);
+        CHECK(twist.bindCount() == 1);
+        CHECK(lattice.bindCount() == 1);
+        // Per frame after the first: the twist's end angle, the lattice's points (frames unchanged).
+        CHECK(twist.pushCount() == 6 + 7);
+        CHECK(lattice.pushCount() == 6 + 7);
+    }
+}
+
+TEST_CASE("maya adapter: parameters written in place equal the returned ones, and a shorter list shrinks",
+          "[maya]") {
+    maya::BarrInputs bend;
+    bend.type = "bend";
+    maya::BarrInputs twist;
+    twist.type = "twist";
+    maya::Parameters kept;
+    maya::barrParameters(bend, kept);
+    CHECK(kept == maya::barrParameters(bend));
+    maya::barrParameters(twist, kept);  // one entry fewer (no handleX), names in another order
+    CHECK(kept == maya::barrParameters(twist));
+    maya::SlideInputs slide;
+    slide.falloff = {{0.6, 0.2, 1}, {0.0, 1.0, 2}, {0.6, 0.4, 1}, {1.0, 0.0, 0}};  // unsorted, a tie at 0.6
+    maya::slideParameters(slide, kept);
+    CHECK(kept == maya::slideParameters(slide));
+}
+
+namespace {
+
+io::Image diskMap(int texels, double cx, double cy, double radius) {
+    io::Image image(texels, texels, 1);
+    for (int y = 0; y < texels; ++y)
+        for (int x = 0; x < texels; ++x)
+            image.at(x, y, 0) =
+                std::hypot((x + 0.5) / texels - cx, (y + 0.5) / texels - cy) < radius ? 1.0f : 0.0f;
+    return image;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "maya adapter: the redirect node reads animated maps per frame, still ones once, and rebuilds on "
+    "an option change",
+    "[maya]") {
+    const test::TempDir dir;
+    const geom::Mesh mesh = geom::makeGrid({8, 8, 1.0f, 1.0f});
+    const auto pose = [&](int frame) {
+        std::vector<glm::vec3> p(mesh.points().begin(), mesh.points().end());
+        for (glm::vec3& q : p)
+            q.x *= 1.0f + 0.05f * static_cast<float>(frame);
+        return p;
+    };
+    // An animated rigidity map: the disk moves between frames 1 and 2. A still orientation map.
+    const io::Image rig1 = diskMap(32, 0.4, 0.5, 0.15), rig2 = diskMap(32, 0.6, 0.5, 0.15);
+    io::Image orientation(32, 32, 1);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+            orientation.at(x, y, 0) = x < 16 ? 1.0f : 0.0f;
+    io::writeImage(dir.path() / "rig.1001.0001.exr", rig1, {io::PixelType::Float, {}});
+    io::writeImage(dir.path() / "rig.1001.0002.exr", rig2, {io::PixelType::Float, {}});
+    io::writeImage(dir.path() / "ori.1001.exr", orientation, {io::PixelType::Float, {}});
+    maya::RedirectInputs in;
+    in.rigidity = (dir.path() / "rig.<UDIM>.####.exr").string();
+    in.orientation = (dir.path() / "ori.<UDIM>.exr").string();
+    in.options.solver.iterations = 3;
+    in.options.solver.orientationPreservation = 0.3f;
+    CHECK(maya::redirectFilesAt(in, 2).rigidity == (dir.path() / "rig.1001.0002.exr").string());
+    CHECK(maya::redirectFilesAt(in, 2).mask.empty());
+
+    maya::RedirectNode node;
+    REQUIRE(node.needsBuild(in));
+    node.build(mesh, in, 1, "rig");
+    CHECK(node.mapReads() == 2);  // frame 1's rigidity, the orientation
+    const io::Image first = node.solve(in, 1, pose(1));
+    const io::Image second = node.solve(in, 2, pose(2));
+    CHECK(node.warmStarted());
+    CHECK(node.mapReads() == 4);  // frame 2's rigidity, and the orientation with it (one setMaps)
+    // The reference: TileWarp driven directly, its maps changed between the frames.
+    uvwarp::TileWarp direct(mesh, 1001, rig1, {}, in.options, orientation, "rig");
+    (void)direct.solve(pose(1));
+    CHECK(test::sameBits(first.pixels, direct.redirect().pixels));
+    direct.setMaps(rig2, {}, orientation);
+    (void)direct.solve(pose(2));
+    CHECK(test::sameBits(second.pixels, direct.redirect().pixels));
+    // The orientation map is used: without it the same frames give other bytes.
+    uvwarp::TileWarp plain(mesh, 1001, rig1, {}, in.options, {}, "rig");
+    (void)plain.solve(pose(1));
+    CHECK_FALSE(test::sameBits(first.pixels, plain.redirect().pixels));
+
+    // A still rigidity map is read once over a whole run of frames.
+    maya::RedirectInputs still = in;
+    still.rigidity = (dir.path() / "rig.<UDIM>.0001.exr").string();
+    REQUIRE(node.needsBuild(still));
+    node.build(mesh, still, 1, "rig");
+    const int64_t reads = node.mapReads();
+    for (int frame = 1; frame <= 5; ++frame)
+        (void)node.solve(still, frame, pose(frame));
+    CHECK(node.mapReads() == reads);
+    CHECK(node.builds() == 2);
+    // An option change needs a new solver; the same inputs do not.
+    CHECK_FALSE(node.needsBuild(still));
+    maya::RedirectInputs changed = still;
+    changed.options.solver.sweepsPerLevel = {1, 4, 8};
+    CHECK(node.needsBuild(changed));
+    CHECK_THROWS_WITH(node.solve(changed, 6, pose(6)), Catch::Contains("not built for these inputs"));
+    // A missing frame of an animated map names the file.
+    maya::RedirectNode fresh;
+    fresh.build(mesh, in, 1, "rig");
+    CHECK_THROWS_WITH(fresh.solve(in, 3, pose(3)), Catch::Contains("rig.1001.0003.exr"));
+}
+
+TEST_CASE("maya adapter: sweepsPerLevel text", "[maya]") {
+    CHECK(maya::sweepsFromText("4 8 8") == std::vector<int32_t>{4, 8, 8});
+    CHECK(maya::sweepsFromText(" 1,4, 8 ") == std::vector<int32_t>{1, 4, 8});
+    CHECK_THROWS_WITH(maya::sweepsFromText("4 x 8"), Catch::Contains("'4 x 8' has 'x'"));
+    CHECK_THROWS_WITH(maya::sweepsFromText("4 -1"), Catch::Contains("negative"));
+    CHECK_THROWS_WITH(maya::sweepsFromText("  "), Catch::Contains("lists no sweeps"));
 }

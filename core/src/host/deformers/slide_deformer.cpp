@@ -97,10 +97,16 @@ class SlideDeformer final : public Deformer {
     }
     void pushControls() override {
         drive_[0].displacement = dvec3At(value(displacement_));
+        // The falloff is made again only when its kind or ramp changed: dragging the handle changes the
+        // displacement alone, and such a frame allocates nothing.
         const double kind = value(falloff_)[0];
+        const std::vector<double>& ramp = value(ramp_);
+        if (kind == falloffKind_ && (kind != 2.0 || ramp == falloffRamp_)) return;
         drive_[0].falloff = kind == 0.0   ? slide::Falloff::smooth()
                             : kind == 1.0 ? slide::Falloff::linear()
-                                          : makeRamp(value(ramp_));
+                                          : makeRamp(ramp);
+        falloffKind_ = kind;
+        falloffRamp_.assign(ramp.begin(), ramp.end());
     }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
         deformWeighted(in, out, {}, 1.0);
@@ -120,6 +126,8 @@ class SlideDeformer final : public Deformer {
     size_t vertex_, radius_, geodesic_, limit_, painted_, foldLimit_, displacement_, falloff_, ramp_;
     std::unique_ptr<slide::Slider> slider_;
     std::array<slide::SlideDrive, 1> drive_;
+    double falloffKind_ = -1.0;  // the falloff drive_ holds: its kind and ramp (-1: none yet)
+    std::vector<double> falloffRamp_;
 };
 
 }  // namespace

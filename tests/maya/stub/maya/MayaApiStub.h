@@ -50,6 +50,8 @@ class MPointArray {
   public:
     unsigned length() const;
     MPoint operator[](unsigned) const;
+    MPoint& operator[](unsigned);
+    MStatus clear();
 };
 class MMatrix {
   public:
@@ -113,6 +115,8 @@ class MItGeometry {
     MPoint position() const;
     MStatus setPosition(const MPoint&);
     int index() const;
+    MStatus allPositions(MPointArray&, MSpace::Space = MSpace::kObject) const;
+    MStatus setAllPositions(const MPointArray&, MSpace::Space = MSpace::kObject);
 };
 class MTypeId {
   public:
