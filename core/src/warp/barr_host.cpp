@@ -100,6 +100,12 @@ BendSetup fromMayaBend(const MayaBend& m) {
 }
 
 AxialSetup fromMayaTwist(const MayaTwist& m) {
+    const TwistSamples samples = mayaTwistSamples(m);
+    return {{m.handleOrigin, m.handleY, glm::vec3(0.0f)},
+            ProfileCurve({samples.z[0], samples.z[1]}, {samples.angle[0], samples.angle[1]}, "Maya twist")};
+}
+
+TwistSamples mayaTwistSamples(const MayaTwist& m) {
     const char* source = "Maya twist";
     for (int i = 0; i < 3; ++i) {
         requireFinite(m.handleOrigin[i], source, "handle origin");
@@ -120,8 +126,9 @@ AxialSetup fromMayaTwist(const MayaTwist& m) {
     // Handle units -> world units along the axis: times the handle's Y scale.
     const Range r{m.lowBound * sy, m.highBound * sy};
     const double slope = (m.endAngle - m.startAngle) / (r.hi - r.lo);
-    return {{m.handleOrigin, m.handleY, glm::vec3(0.0f)},
-            linearProfile(r, slope, m.startAngle - slope * r.lo, "Maya twist")};
+    const double offset = m.startAngle - slope * r.lo;  // as linearProfile computes its samples
+    return {{static_cast<float>(r.lo), static_cast<float>(r.hi)},
+            {static_cast<float>(offset + slope * r.lo), static_cast<float>(offset + slope * r.hi)}};
 }
 
 AxialSetup fromBlenderTwist(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {

@@ -12,38 +12,56 @@ ProfileCurve ProfileCurve::constant(float value) {
     return ProfileCurve({0.0f}, {value}, "constant profile");
 }
 
-ProfileCurve::ProfileCurve(std::vector<float> z, std::vector<float> values, std::string_view name)
-    : z_(std::move(z)), values_(std::move(values)) {
-    const std::string source(name);
-    if (z_.empty()) throw InvalidInput(formatError(source, "z_samples", "is empty", "at least one sample"));
-    if (values_.size() != z_.size()) {
-        throw InvalidInput(formatError(source, "value_samples",
-                                       "has " + std::to_string(values_.size()) + " entries",
-                                       std::to_string(z_.size()) + " entries, one per z sample"));
+ProfileCurve::ProfileCurve(std::vector<float> z, std::vector<float> values, std::string_view name) {
+    check(z, values, name);
+    z_ = std::move(z);
+    values_ = std::move(values);
+    computeTangents();
+}
+
+void ProfileCurve::assign(std::span<const float> z, std::span<const float> values, std::string_view name) {
+    check(z, values, name);
+    z_.assign(z.begin(), z.end());
+    values_.assign(values.begin(), values.end());
+    computeTangents();
+}
+
+void ProfileCurve::check(std::span<const float> z, std::span<const float> values, std::string_view name) {
+    const auto source = [&] { return std::string(name); };  // made only for an error
+    if (z.empty()) throw InvalidInput(formatError(source(), "z_samples", "is empty", "at least one sample"));
+    if (values.size() != z.size()) {
+        throw InvalidInput(formatError(source(), "value_samples",
+                                       "has " + std::to_string(values.size()) + " entries",
+                                       std::to_string(z.size()) + " entries, one per z sample"));
     }
-    for (size_t i = 0; i < z_.size(); ++i) {
-        if (!std::isfinite(z_[i])) {
+    for (size_t i = 0; i < z.size(); ++i) {
+        if (!std::isfinite(z[i])) {
             throw InvalidInput(
-                formatError(source, "z_samples[" + std::to_string(i) + "]", "is not finite", "a number"));
+                formatError(source(), "z_samples[" + std::to_string(i) + "]", "is not finite", "a number"));
         }
-        if (!std::isfinite(values_[i])) {
-            throw InvalidInput(
-                formatError(source, "value_samples[" + std::to_string(i) + "]", "is not finite", "a number"));
+        if (!std::isfinite(values[i])) {
+            throw InvalidInput(formatError(source(), "value_samples[" + std::to_string(i) + "]",
+                                           "is not finite", "a number"));
         }
-        if (i > 0 && !(z_[i] > z_[i - 1])) {
-            throw InvalidInput(formatError(source, "z_samples[" + std::to_string(i) + "]",
-                                           "is " + std::to_string(z_[i]) +
-                                               ", not above the previous sample " + std::to_string(z_[i - 1]),
-                                           "strictly ascending z samples"));
+        if (i > 0 && !(z[i] > z[i - 1])) {
+            throw InvalidInput(formatError(
+                source(), "z_samples[" + std::to_string(i) + "]",
+                "is " + std::to_string(z[i]) + ", not above the previous sample " + std::to_string(z[i - 1]),
+                "strictly ascending z samples"));
         }
     }
+}
+
+void ProfileCurve::computeTangents() {
     // Fritsch-Carlson: secant slopes, three-point averages (0 at a local extremum), one-sided at the ends,
     // then each interval's pair of tangents pulled inside the circle alpha^2 + beta^2 <= 9 that keeps the
     // cubic monotone on that interval.
     const size_t n = z_.size();
     tangents_.assign(n, 0.0f);
     if (n < 2) return;
-    std::vector<double> secant(n - 1), m(n, 0.0);
+    work_.assign(2 * n - 1, 0.0);
+    double* secant = work_.data();       // n - 1
+    double* m = work_.data() + (n - 1);  // n
     for (size_t k = 0; k + 1 < n; ++k) {
         secant[k] = (double(values_[k + 1]) - values_[k]) / (double(z_[k + 1]) - z_[k]);
     }

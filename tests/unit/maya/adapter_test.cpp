@@ -351,9 +351,25 @@ TEST_CASE("maya adapter: a warm deform cycle allocates nothing, pushes only what
             }
         }
         CHECK(warmLattice == 0);
-        // Not yet zero: a new twist angle builds the twist's profile curve again (five small blocks, sized
-        // by its two samples, not by the mesh), 6 frames here.
-        CHECK(warmTwist <= 5 * 6);
+        CHECK(warmTwist == 0);  // the new angle updates the twist's profile in place
+        for (const char* type : {"taper", "bend"}) {
+            maya::NodeCore core(type, "barr1");
+            core.setRest(mesh);
+            maya::BarrInputs other = barr;
+            other.type = type;
+            maya::Parameters kept;
+            int64_t warm = 0;
+            for (int frame = 0; frame < 6; ++frame) {
+                other.endValue = 1.0 + 0.1 * frame;    // the taper's end scale
+                other.curvature = 0.1 + 0.05 * frame;  // the bend's curvature
+                const int64_t before = allocations.load();
+                deformCycle(core, kept, other, fillTwist, input);
+                if (frame >= 2) warm += allocations.load() - before;
+            }
+            INFO(type);
+            CHECK(warm == 0);
+            CHECK(core.bindCount() == 1);
+        }
         CHECK(twist.bindCount() == 1);
         CHECK(lattice.bindCount() == 1);
         // Per frame after the first: the twist's end angle, the lattice's points (frames unchanged).

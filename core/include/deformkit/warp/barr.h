@@ -90,6 +90,10 @@ class TaperWarp final : public AxialWarp {
   public:
     explicit TaperWarp(const AxisFrame& frame, ProfileCurve profile = ProfileCurve::constant(1.0f));
     void setProfile(ProfileCurve profile) { profile_ = std::move(profile); }
+    // New samples in place (ProfileCurve::assign): an animated profile updated without allocating.
+    void setProfile(std::span<const float> z, std::span<const float> values, std::string_view name) {
+        profile_.assign(z, values, name);
+    }
     [[nodiscard]] const ProfileCurve& profile() const { return profile_; }
     void evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const override;
     [[nodiscard]] Affine transformationAt(float z) const override;
@@ -103,6 +107,10 @@ class TwistWarp final : public AxialWarp {
   public:
     explicit TwistWarp(const AxisFrame& frame, ProfileCurve angle = ProfileCurve::constant(0.0f));
     void setProfile(ProfileCurve angle) { angle_ = std::move(angle); }
+    // New samples in place (ProfileCurve::assign): an animated angle updated without allocating.
+    void setProfile(std::span<const float> z, std::span<const float> values, std::string_view name) {
+        angle_.assign(z, values, name);
+    }
     [[nodiscard]] const ProfileCurve& profile() const { return angle_; }
     void evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const override;
     [[nodiscard]] Affine transformationAt(float z) const override;

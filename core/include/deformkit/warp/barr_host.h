@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+
 #include <span>
 
 #include <glm/mat3x3.hpp>
@@ -56,6 +58,12 @@ struct MayaTwist {
 // Throws InvalidInput for a zero or non-finite handle axis, a non-finite angle or bound, or
 // lowBound >= highBound.
 [[nodiscard]] AxialSetup fromMayaTwist(const MayaTwist& maya);
+// The same twist's angle profile as its two samples (z in scene units along the axis, angles), for
+// TwistWarp::setProfile in place; the same checks.
+struct TwistSamples {
+    std::array<float, 2> z, angle;
+};
+[[nodiscard]] TwistSamples mayaTwistSamples(const MayaTwist& maya);
 
 // Blender's SimpleDeform modifier (twist, bend, taper modes), evaluated in the space of its origin
 // object (or the modified object when there is none): `basis` columns are that space's unit x, y, z

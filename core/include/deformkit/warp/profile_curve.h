@@ -1,5 +1,6 @@
 #pragma once
 
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,11 @@ class ProfileCurve {
     // `name` labels the curve in error messages ("taper profile"). Throws InvalidInput naming the
     // offending sample for: no samples, a count mismatch, a non-finite z or value, z not strictly ascending.
     ProfileCurve(std::vector<float> z, std::vector<float> values, std::string_view name = "profile curve");
+    // The same samples in place, reusing this curve's storage: a curve of the same length is updated without
+    // allocating (a host pushing an animated angle every frame). Checks as the constructor; on a throw the
+    // curve is unchanged.
+    void assign(std::span<const float> z, std::span<const float> values,
+                std::string_view name = "profile curve");
 
     [[nodiscard]] float operator()(float z) const;
     [[nodiscard]] const std::vector<float>& z() const { return z_; }
@@ -29,7 +35,11 @@ class ProfileCurve {
     [[nodiscard]] const std::vector<float>& tangents() const { return tangents_; }
 
   private:
+    static void check(std::span<const float> z, std::span<const float> values, std::string_view name);
+    void computeTangents();
+
     std::vector<float> z_, values_, tangents_;
+    std::vector<double> work_;  // secants and tangents in double while computing, kept for reuse
 };
 
 }  // namespace deformkit::warp

@@ -90,13 +90,17 @@ class TwistDeformer final : public HandleDeformer {
         twist->bind(rest.points(), fields);
         twist_ = std::move(twist);
     }
-    void pushControls() override { twist_->setProfile(mayaSetup().profile); }
+    void pushControls() override {
+        // In place: an animated angle costs no allocation.
+        const warp::TwistSamples samples = warp::mayaTwistSamples(mayaTwist());
+        twist_->setProfile(samples.z, samples.angle, "Maya twist");
+    }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
         twist_->evaluate(in, out);
     }
 
   private:
-    [[nodiscard]] warp::AxialSetup mayaSetup() const {
+    [[nodiscard]] warp::MayaTwist mayaTwist() const {
         const auto [lo, hi] = bounds();
         warp::MayaTwist m;
         m.handleOrigin = vec3At(value(origin_));
@@ -105,8 +109,9 @@ class TwistDeformer final : public HandleDeformer {
         m.endAngle = value(end_)[0];
         m.lowBound = lo;
         m.highBound = hi;
-        return warp::fromMayaTwist(m);
+        return m;
     }
+    [[nodiscard]] warp::AxialSetup mayaSetup() const { return warp::fromMayaTwist(mayaTwist()); }
 
     size_t start_, end_;
     std::unique_ptr<warp::TwistWarp> twist_;
@@ -177,7 +182,15 @@ class TaperDeformer final : public HandleDeformer {
         taper->bind(rest.points(), fields);
         taper_ = std::move(taper);
     }
-    void pushControls() override { taper_->setProfile(profile()); }
+    void pushControls() override {
+        // In place: animated scales cost no allocation (the samples are checked finite and ascending there).
+        const auto [lo, hi] = bounds();
+        const double sy = glm::length(dvec3At(value(y_)));
+        const std::array<float, 2> z{static_cast<float>(lo * sy), static_cast<float>(hi * sy)};
+        const std::array<float, 2> scale{static_cast<float>(value(start_)[0]),
+                                         static_cast<float>(value(end_)[0])};
+        taper_->setProfile(z, scale, "taper profile");
+    }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
         taper_->evaluate(in, out);
     }
