@@ -451,6 +451,7 @@ std::vector<uint8_t> writePtexBytes(const PtexFile& file, const WriteOptions& op
 }
 
 void writePtex(const std::filesystem::path& path, const PtexFile& file, const WriteOptions& options) {
+    io::requireExtension(path, {".ptx"}, "a Ptex file");
     const std::vector<uint8_t> bytes = Writer(file, options, path.string()).write();
     io::writeFileAtomically(path, {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
 }

@@ -254,6 +254,25 @@ contains uvwarp-info "$work/out" "type        float"
 contains uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect uvwarp-resume 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr"
 contains uvwarp-resume "$work/out" "0 frames written, 0 replayed, 2 skipped"
+expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"
+[ -s "$work/uv/made/here/redirect.1001.0001.exr" ] || { echo "FAIL uvwarp-new-folder: map missing"; failures=$((failures + 1)); }
+# Outputs never destroy what they replace: an extension that is not the format's, a FIFO, a path in a file.
+expect slide-out-png 2 "$dk" slide "$work/grid.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/o.png"
+contains slide-out-png "$work/err" "ending in .obj"
+[ ! -e "$work/o.png" ] || { echo "FAIL slide-out-png: o.png written"; failures=$((failures + 1)); }
+mkfifo "$work/pipe.obj"
+expect slide-out-fifo 2 "$dk" slide "$work/grid.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/pipe.obj"
+contains slide-out-fifo "$work/err" "is a FIFO"
+[ -p "$work/pipe.obj" ] || { echo "FAIL slide-out-fifo: the FIFO was replaced"; failures=$((failures + 1)); }
+printf 'x' >"$work/afile"
+expect slide-out-in-file 2 "$dk" slide "$work/grid.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/afile/o.obj"
+contains slide-out-in-file "$work/err" "afile' is a file, not a folder"
+ln -s "$work/grid.obj" "$work/linked.obj"
+cp "$work/grid.obj" "$work/grid_before.obj"
+expect slide-out-link 0 "$dk" slide "$work/grid_before.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/linked.obj"
+[ -L "$work/linked.obj" ] || { echo "FAIL slide-out-link: the link was replaced"; failures=$((failures + 1)); }
+cmp -s "$work/grid.obj" "$work/grid_before.obj" && { echo "FAIL slide-out-link: the link's target is unchanged"; failures=$((failures + 1)); }
+cp "$work/grid_before.obj" "$work/grid.obj"
 expect uvwarp-no-out 2 uvwarp --frames 1-2
 expect uvwarp-bake-alone 2 uvwarp --frames 1-2 --out "$work/uv/out/r.<UDIM>.####.exr" --bake "$work/uv/out/b.<UDIM>.####.png"
 expect uvwarp-bad-frames 2 uvwarp --frames 2-1 --out "$work/uv/out/r.<UDIM>.####.exr"

@@ -436,12 +436,15 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(deformed=lambda f: mesh[0][:5]), dk.InvalidInput, r"deformed\(1\): returned shape \(5, 3\)"),
             (dict(deformed=lambda f: None), dk.InvalidInput, r"deformed\(1\): returned a NoneType of shape \(\)"),
             (dict(progress=3), dk.InvalidInput, "progress: is a int"),
-            (dict(out=str(tmp_path / "no" / OUT)), dk.IoError, "output folder: does not exist"),
             (dict(smoothing=2.0), dk.InvalidInput, "uvwarp_shot: smoothing: is 2.0"),
             (dict(filter="nearest"), dk.InvalidInput, "filter: is 'nearest'")):
         with pytest.raises(error, match=text):
             run(**changes)
     assert os.listdir(tmp_path) == []  # every check came before the first output
+    # A missing output folder is made; one behind a regular file is named.
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(dk.IoError, match="afile' is a file, not a folder"):
+        run(out=str(tmp_path / "afile" / OUT))
     # An exception raised in a callback reaches the caller unchanged.
     with pytest.raises(ZeroDivisionError):
         run(progress=lambda done, total, unit: 1 / 0)

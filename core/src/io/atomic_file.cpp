@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -34,23 +35,84 @@ void flushToDisk(const fs::path& file) {
     }
 }
 
+// What a path is, for messages: "a folder", "a FIFO", ... (not a regular file).
+const char* kindOf(fs::file_type type) {
+    switch (type) {
+        case fs::file_type::directory:
+            return "a folder";
+        case fs::file_type::fifo:
+            return "a FIFO (named pipe)";
+        case fs::file_type::character:
+            return "a character device";
+        case fs::file_type::block:
+            return "a block device";
+        case fs::file_type::socket:
+            return "a socket";
+        default:
+            return "not a regular file";
+    }
+}
+
+// The file a write to `path` must replace: `path` itself, or, through symbolic links, the file they lead
+// to (the links stay links). Throws IoError naming `path` for a loop of links.
+fs::path writeTarget(const fs::path& path) {
+    fs::path target = path;
+    std::error_code ec;
+    for (int hops = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hops) {
+        if (hops == 40) {
+            throw IoError(formatError(path.string(), "", "cannot write: its symbolic links loop",
+                                      "a link that leads to a file"));
+        }
+        const fs::path next = fs::read_symlink(target, ec);
+        if (ec) break;
+        target = next.is_absolute() ? next : target.parent_path() / next;
+    }
+    return target;
+}
+
+// The nearest existing ancestor of `folder` when it is not a folder (a regular file in the way), else empty.
+fs::path fileInTheWay(const fs::path& folder) {
+    std::error_code ec;
+    for (fs::path p = folder; !p.empty(); p = p.parent_path()) {
+        const fs::file_status status = fs::status(p, ec);
+        if (fs::exists(status)) return fs::is_directory(status) ? fs::path() : p;
+        if (p == p.parent_path()) break;
+    }
+    return {};
+}
+
 }  // namespace
 
-void writeAtomically(const fs::path& path, const std::function<void(const fs::path& tmp)>& write) {
+void writeAtomically(const fs::path& requested, const std::function<void(const fs::path& tmp)>& write) {
+    // Through a symbolic link the link's target is written (atomically, in the target's folder) and the link
+    // stays; a FIFO, a device, a socket or a folder at the path is refused, never replaced.
+    const fs::path path = writeTarget(requested);
     const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
     std::error_code ec;
+    const fs::file_status existing = fs::status(path, ec);
+    if (fs::exists(existing) && !fs::is_regular_file(existing)) {
+        throw IoError(
+            formatError(requested.string(), "",
+                        std::string("cannot write: ") +
+                            (path == requested ? "the path" : "its link's target '" + path.string() + "'") +
+                            " is " + kindOf(existing.type()),
+                        "a regular file or a new path"));
+    }
     if (!fs::is_directory(folder, ec)) {
-        throw IoError(formatError(path.string(), "",
+        const fs::path blocker = fileInTheWay(folder);
+        if (!blocker.empty()) {
+            throw IoError(formatError(requested.string(), "",
+                                      "cannot write: '" + blocker.string() + "' is a file, not a folder",
+                                      "a path whose folders are folders"));
+        }
+        throw IoError(formatError(requested.string(), "",
                                   "cannot write: folder '" + folder.string() + "' does not exist",
                                   "an existing, writable folder"));
     }
     if (::access(folder.c_str(), W_OK) != 0) {
-        throw IoError(formatError(path.string(), "",
+        throw IoError(formatError(requested.string(), "",
                                   "cannot write: folder '" + folder.string() + "' is not writable",
                                   "a writable folder"));
-    }
-    if (fs::is_directory(path, ec)) {
-        throw IoError(formatError(path.string(), "", "cannot write: the path is a folder", "a file path"));
     }
     const fs::path tmp = temporaryPathFor(path);
     try {
@@ -74,10 +136,32 @@ void createFolder(const fs::path& path) {
     std::error_code ec;
     fs::create_directories(path, ec);
     if (!fs::is_directory(path)) {
+        const fs::path blocker = fileInTheWay(path);
+        if (!blocker.empty()) {
+            throw IoError(formatError(path.string(), "",
+                                      "cannot be created: '" + blocker.string() + "' is a file, not a folder",
+                                      "a path whose folders are folders"));
+        }
         throw IoError(formatError(path.string(), "",
                                   "cannot be created" + (ec ? ": " + ec.message() : std::string()),
                                   "a writable folder"));
     }
+}
+
+void requireExtension(const fs::path& path, std::initializer_list<std::string_view> extensions,
+                      std::string_view format) {
+    std::string extension = path.extension().string();
+    for (char& c : extension)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    std::string expected;
+    for (std::string_view e : extensions) {
+        if (extension == e) return;
+        expected += (expected.empty() ? "" : " or ") + std::string(e);
+    }
+    throw InvalidInput(formatError(
+        path.string(), "",
+        extension.empty() ? "has no extension" : "has the extension '" + path.extension().string() + "'",
+        "a file name ending in " + expected + " for " + std::string(format)));
 }
 
 void writeFileAtomically(const fs::path& path, std::string_view bytes) {

@@ -527,6 +527,7 @@ std::string formatObj(const geom::Mesh& mesh, const std::vector<FaceGroup>& grou
 
 void writeObj(const fs::path& path, const geom::Mesh& mesh, const std::vector<FaceGroup>& groups,
               const ObjWriteOptions& options) {
+    requireExtension(path, {".obj"}, "an OBJ mesh");
     writeFileAtomically(path, formatObjText(mesh, groups, options, path.string()));
 }
 

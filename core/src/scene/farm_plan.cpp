@@ -249,6 +249,7 @@ std::string formatFarmPlan(const FarmPlan& plan) {
 }
 
 void writeFarmPlan(const FarmPlan& plan, const fs::path& path) {
+    io::requireExtension(path, {".json"}, "a farm plan (JSON)");
     if (path.has_parent_path()) io::createFolder(path.parent_path());
     io::writeFileAtomically(path, formatFarmPlan(plan));
 }

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/obj_sequence.h"
@@ -251,12 +252,10 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         plan.report.tile = tile;
         std::vector<fs::path> folders = {j.outPath(tile, j.frames.front()).parent_path()};
         if (wantBake) folders.push_back(j.bakePath(tile, j.frames.front()).parent_path());
+        // Made when missing (as eval makes its own), before any work: a path that cannot be a folder fails
+        // here, naming it.
         for (const fs::path& folder : folders) {
-            std::error_code ec;
-            if (!folder.empty() && !fs::is_directory(folder, ec)) {
-                throw IoError(formatError(folder.string(), "output folder", "does not exist",
-                                          "an existing folder for the outputs"));
-            }
+            if (!folder.empty()) io::createFolder(folder);
         }
         plan.rigidity = findTileMap(j.rigidity, tile, j.frames);
         if (!plan.rigidity.found()) {
@@ -474,6 +473,8 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
         if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
             io::ImageWriteOptions write = attributes;
             write.type = io::PixelType::Float;
+            // The output folder is made when missing, as eval makes its own.
+            if (plan.outPaths[k].has_parent_path()) io::createFolder(plan.outPaths[k].parent_path());
             io::writeImage(plan.outPaths[k], plan.redirect, write);
             r.files.push_back(plan.outPaths[k]);
         }
@@ -489,6 +490,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
                            [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
             // Only EXR keeps arbitrary header attributes; other formats get the pixels alone.
             t = Clock::now();
+            if (plan.bakePaths[k].has_parent_path()) io::createFolder(plan.bakePaths[k].parent_path());
             io::writeImage(plan.bakePaths[k], plan.baked,
                            extension == ".exr" ? attributes : io::ImageWriteOptions{});
             r.files.push_back(plan.bakePaths[k]);

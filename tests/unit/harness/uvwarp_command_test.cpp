@@ -328,9 +328,10 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("tile 1005") && Catch::Contains("no UV face"));
         s.command.tiles = {};
-        s.command.out = s.dir / "missing/redirect.<UDIM>.####.exr";
+        test::writeText(s.dir / "afile", "x");
+        s.command.out = s.dir / "afile/redirect.<UDIM>.####.exr";
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
-                   Catch::Contains("does not exist"));
+                   Catch::Contains("afile' is a file, not a folder"));
     }
 }
 

@@ -3,7 +3,9 @@
 #include <sys/stat.h>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/primitives.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/obj.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -85,7 +87,82 @@ TEST_CASE("createFolder makes missing parents and names a path it cannot make", 
     test::writeText(dir / "file", "x");
     const std::string message = test::errorOf<IoError>([&] { io::createFolder(dir / "file" / "sub"); });
     CHECK_THAT(message, Catch::Contains((dir / "file" / "sub").string()) &&
-                            Catch::Contains("cannot be created") && Catch::Contains("a writable folder"));
+                            Catch::Contains("cannot be created") &&
+                            Catch::Contains("file' is a file, not a folder"));
     CHECK_THAT(test::errorOf<IoError>([&] { io::createFolder(dir / "file"); }),
-               Catch::Contains("cannot be created"));
+               Catch::Contains("cannot be created") && Catch::Contains("is a file, not a folder"));
+}
+
+TEST_CASE("a write through a symbolic link replaces the link's target and keeps the link", "[io][atomic]") {
+    test::TempDir dir;
+    fs::create_directories(dir / "real");
+    test::writeText(dir / "real" / "target.txt", "old");
+    fs::create_symlink("real/target.txt", dir / "link.txt");  // relative link
+    fs::create_symlink(dir / "link.txt", dir / "link2.txt");  // a link to the link
+    io::writeFileAtomically(dir / "link2.txt", "new");
+    CHECK(fs::is_symlink(fs::symlink_status(dir / "link.txt")));
+    CHECK(fs::is_symlink(fs::symlink_status(dir / "link2.txt")));
+    CHECK(test::readText(dir / "real" / "target.txt") == "new");
+    CHECK(countEntries(dir / "real") == 1);  // no temporary left, none beside the links
+    CHECK(countEntries(dir.path()) == 3);
+    // A dangling link: its target is created.
+    fs::create_symlink("real/made.txt", dir / "dangling.txt");
+    io::writeFileAtomically(dir / "dangling.txt", "made");
+    CHECK(test::readText(dir / "real" / "made.txt") == "made");
+    CHECK(fs::is_symlink(fs::symlink_status(dir / "dangling.txt")));
+    // A loop of links is an error, not a hang.
+    fs::create_symlink("loop_b", dir / "loop_a");
+    fs::create_symlink("loop_a", dir / "loop_b");
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "loop_a", "x"), Catch::Contains("symbolic links loop"));
+}
+
+TEST_CASE("FIFOs, devices and folders at an output path are refused, never replaced",
+          "[io][atomic][errors]") {
+    test::TempDir dir;
+    const fs::path fifo = dir / "pipe.obj";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    CHECK_THROWS_AS(io::writeFileAtomically(fifo, "x"), IoError);
+    CHECK_THROWS_WITH(io::writeFileAtomically(fifo, "x"),
+                      Catch::Contains("pipe.obj") && Catch::Contains("is a FIFO") &&
+                          Catch::Contains("a regular file or a new path"));
+    CHECK(fs::is_fifo(fs::status(fifo)));
+    CHECK_THROWS_WITH(io::writeFileAtomically("/dev/null", "x"), Catch::Contains("is a character device"));
+    CHECK(fs::is_character_file(fs::status("/dev/null")));
+    fs::create_directories(dir / "folder.obj");
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "folder.obj", "x"), Catch::Contains("is a folder"));
+    // Through a link to a FIFO: named as the link's target.
+    fs::create_symlink(fifo, dir / "to_pipe.obj");
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "to_pipe.obj", "x"),
+                      Catch::Contains("its link's target") && Catch::Contains("is a FIFO"));
+    CHECK(countEntries(dir.path()) == 3);  // nothing written beside them
+}
+
+TEST_CASE("an output path inside a regular file says that it is a file", "[io][atomic][errors]") {
+    test::TempDir dir;
+    test::writeText(dir / "afile", "x");
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "afile" / "out.obj", "x"),
+                      Catch::Contains("afile' is a file, not a folder"));
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "afile" / "sub" / "out.obj", "x"),
+                      Catch::Contains("afile' is a file, not a folder"));
+    CHECK_THROWS_WITH(io::writeFileAtomically(dir / "missing" / "out.obj", "x"),
+                      Catch::Contains("folder '") && Catch::Contains("missing' does not exist"));
+}
+
+TEST_CASE("writers refuse a file name of another format", "[io][atomic][errors]") {
+    CHECK_NOTHROW(io::requireExtension("a/mesh.obj", {".obj"}, "an OBJ mesh"));
+    CHECK_NOTHROW(io::requireExtension("MESH.OBJ", {".obj"}, "an OBJ mesh"));  // case does not matter
+    CHECK_THROWS_AS(io::requireExtension("o.png", {".obj"}, "an OBJ mesh"), InvalidInput);
+    CHECK_THROWS_WITH(
+        io::requireExtension("o.png", {".obj"}, "an OBJ mesh"),
+        Catch::Contains("o.png: has the extension '.png' (expected a file name ending in .obj for an "
+                        "OBJ mesh)"));
+    CHECK_THROWS_WITH(io::requireExtension("plan", {".json"}, "a farm plan"),
+                      Catch::Contains("has no extension"));
+    CHECK_THROWS_WITH(io::requireExtension("x.y", {".tif", ".tiff"}, "a TIFF"),
+                      Catch::Contains(".tif or .tiff"));
+    // The OBJ writer checks it before writing anything.
+    test::TempDir dir;
+    const geom::Mesh mesh = geom::makeGrid({2, 2});
+    CHECK_THROWS_WITH(io::writeObj(dir / "o.png", mesh), Catch::Contains("ending in .obj"));
+    CHECK(countEntries(dir.path()) == 0);
 }

@@ -311,12 +311,19 @@ TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp]
     CHECK_THAT(test::errorOf<IoError>([&] { uvwarp::ShotSolver s(none.job); }),
                Contains("--rigidity") && Contains("no tile has a rigidity map"));
 
+    // A missing output folder is made (before any work); one behind a regular file cannot be, named.
     Shot folder;
     folder.job.outPath = [&](int tile, int f) {
         return folder.dir / "missing" / ("r." + std::to_string(tile) + "." + std::to_string(f) + ".exr");
     };
+    { uvwarp::ShotSolver made(folder.job); }
+    CHECK(fs::is_directory(folder.dir / "missing"));
+    test::writeText(folder.dir / "afile", "x");
+    folder.job.outPath = [&](int tile, int f) {
+        return folder.dir / "afile" / ("r." + std::to_string(tile) + "." + std::to_string(f) + ".exr");
+    };
     CHECK_THAT(test::errorOf<IoError>([&] { uvwarp::ShotSolver s(folder.job); }),
-               Contains("missing") && Contains("does not exist"));
+               Contains("afile' is a file, not a folder"));
 
     Shot tiles;
     tiles.job.tiles = {1003};

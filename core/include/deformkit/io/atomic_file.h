@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <string_view>
 
 namespace deformkit::io {
@@ -17,6 +18,11 @@ void writeAtomically(const std::filesystem::path& path,
 // Creates folder `path` and its parents when missing. Throws IoError naming it (and the system's reason)
 // when it cannot be created or exists as something else.
 void createFolder(const std::filesystem::path& path);
+
+// Throws InvalidInput naming `path` when its extension (compared without case) is none of `extensions`
+// (".obj"): a writer refuses to put one format behind another's name. `format` names it ("an OBJ mesh").
+void requireExtension(const std::filesystem::path& path, std::initializer_list<std::string_view> extensions,
+                      std::string_view format);
 
 // Writes `bytes` to `path` atomically.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
