@@ -175,7 +175,9 @@ ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32
 }
 
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
-    scene::SceneEvaluator evaluator(readScene(command.scene));
+    // The scene by its absolute path, as farm plans hold it: inputs resolve to absolute paths, so the
+    // provenance headers of eval's maps equal those a farm task writes.
+    scene::SceneEvaluator evaluator(readScene(std::filesystem::absolute(command.scene).lexically_normal()));
     const scene::Scene& scene = evaluator.scene();
     EvalReport report;
     if (command.frames.empty()) {

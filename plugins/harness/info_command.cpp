@@ -74,6 +74,9 @@ void describeMesh(const fs::path& file, std::ostream& out) {
 
 void describeImage(const fs::path& file, std::ostream& out) {
     const io::ImageInfo info = io::readImageInfo(file);
+    // The header alone does not say the file is whole: the pixels are read too, so a truncated or corrupt
+    // file is an error (exit 2) before anything is printed.
+    (void)io::readImage(file);
     out << "image       " << file.string() << "\n";
     out << "size        " << info.width << " x " << info.height << "\n";
     out << "channels    " << info.channels;
@@ -99,6 +102,7 @@ void describeUdim(const fs::path& pattern, std::ostream& out) {
     out << "\n";
     for (const auto& f : files) {
         const io::ImageInfo info = io::readImageInfo(f.path);
+        (void)io::readImage(f.path);  // each tile whole (see describeImage)
         out << "  " << f.tile << "  " << f.path.filename().string() << "  " << info.width << " x "
             << info.height << ", " << info.channels << " channels, " << info.pixelType << "\n";
     }

@@ -252,6 +252,11 @@ contains uvwarp-info "$work/out" "64 x 64"
 contains uvwarp-info "$work/out" "channels    2"
 contains uvwarp-info "$work/out" "type        float"
 contains uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
+# info reads far enough to know an image is whole: a truncated EXR is exit 2 naming it, nothing printed.
+head -c "$(($(wc -c <"$work/uv/out/redirect.1001.0002.exr") / 2))" "$work/uv/out/redirect.1001.0002.exr" >"$work/trunc.exr"
+expect info-truncated-exr 2 "$dk" info "$work/trunc.exr"
+contains info-truncated-exr "$work/err" "trunc.exr"
+[ ! -s "$work/out" ] || { echo "FAIL info-truncated-exr: printed a header"; cat "$work/out"; failures=$((failures + 1)); }
 expect uvwarp-resume 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr"
 contains uvwarp-resume "$work/out" "0 frames written, 0 replayed, 2 skipped"
 expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"

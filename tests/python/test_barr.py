@@ -87,6 +87,12 @@ def test_host_parameterisations():
     t = dk.blender_simple_deform_params("TWIST", mesh, angle=math.pi / 2, limits=(0.25, 0.75))
     out = dk.twist(np.array([[1, 0, 2]], dtype=np.float32), **t)
     np.testing.assert_allclose(out[0], [0, 1, 2], atol=1e-6)
+    # A scaled or sheared origin basis would change the mapping silently: refused, naming the axis.
+    with pytest.raises(dk.InvalidInput, match=r"basis x axis: has length 2 \(expected unit, orthogonal axes"):
+        dk.blender_simple_deform_params("TWIST", mesh, angle=1.0, basis=np.diag([2, 1, 1]).astype(np.float32))
+    sheared = np.array([[1, 0, 0], [0.5, 0.8660254, 0], [0, 0, 1]], dtype=np.float32)
+    with pytest.raises(dk.InvalidInput, match=r"basis x and y axes: are not orthogonal"):
+        dk.blender_simple_deform_params("TWIST", mesh, angle=1.0, basis=sheared)
     b = dk.blender_simple_deform_params("BEND", np.array([[-1, 0, 0], [1, 0, 0]], dtype=np.float32), angle=math.pi)
     out = dk.bend(np.array([[2, 0, 0]], dtype=np.float32), **b)
     np.testing.assert_allclose(out[0], [2 / math.pi, 2 / math.pi + 1, 0], atol=1e-6)

@@ -70,6 +70,7 @@ std::vector<warp::SegmentPair> parseFeatureLines(std::string_view text, const st
         detail::parseJson(text, source, "JSON {\"a\", \"b\", \"p\", \"lines\": [{\"src\", \"dst\"}, ...]}");
     if (!root.is_object())
         throw InvalidInput(formatError(source, "(top level)", "is " + detail::jsonKind(root), "an object"));
+    detail::requireKnownKeys(root, source, "", {"a", "b", "p", "lines"});
     float a = 1.0f, b = 2.0f, p = 0.5f;
     parameters(root, source, "", a, b, p);
     if (!root.contains("lines"))
@@ -86,6 +87,7 @@ std::vector<warp::SegmentPair> parseFeatureLines(std::string_view text, const st
             throw InvalidInput(
                 formatError(source, path, "is " + detail::jsonKind(line), "{\"src\": ..., \"dst\": ...}"));
         }
+        detail::requireKnownKeys(line, source, path, {"src", "dst", "a", "b", "p"});
         warp::SegmentPair s;
         s.a = a;
         s.b = b;

@@ -3,6 +3,7 @@
 // The one set of JSON reading helpers of the library (scenes, weights files, feature-line files, farm
 // plans), over nlohmann/json, which stays private to the library.
 
+#include <initializer_list>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,24 @@ inline std::string jsonKind(const json& v) {
     if (v.is_string()) return "a string";
     if (v.is_array()) return "an array of " + std::to_string(v.size());
     return "an object";
+}
+
+// Throws InvalidInput naming `source` and the key (under `path`) when `object` has a key outside `known`: a
+// typo would otherwise be ignored silently.
+inline void requireKnownKeys(const json& object, const std::string& source, const std::string& path,
+                             std::initializer_list<const char*> known) {
+    for (const auto& item : object.items()) {
+        std::string list;
+        bool found = false;
+        for (const char* k : known) {
+            found = found || item.key() == k;
+            list += (list.empty() ? "" : ", ") + std::string(k);
+        }
+        if (!found) {
+            throw InvalidInput(formatError(source, path.empty() ? item.key() : path + "." + item.key(),
+                                           "is not a known key", "one of: " + list));
+        }
+    }
 }
 
 // Parses `text`; ParseError naming `source`, the line and column and what the file should be (`expected`).

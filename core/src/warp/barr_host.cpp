@@ -32,6 +32,28 @@ Range blenderLimits(const BlenderSimpleDeform& b, std::span<const glm::vec3> poi
                         "0 <= lower <= upper <= 1"));
     }
     if (points.empty()) throw InvalidInput(formatError(source, "points", "is empty", "the mesh's points"));
+    // The mapping measures and rotates in the origin space's unit axes: a scaled or sheared basis would
+    // silently change the result, so it is refused (an origin object's scale is Blender's, not ours to
+    // guess).
+    constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+        const glm::dvec3 column(b.basis[a]);
+        const double length = glm::length(column);
+        if (!(std::abs(length - 1.0) <= 1e-4)) {
+            throw InvalidInput(formatError(source, std::string("basis ") + kAxisNames[a] + " axis",
+                                           "has length " + numberText(length),
+                                           "unit, orthogonal axes (the origin's rotation, without scale)"));
+        }
+        for (int c = a + 1; c < 3; ++c) {
+            const double d = glm::dot(column, glm::dvec3(b.basis[c]));
+            if (!(std::abs(d) <= 1e-4)) {
+                throw InvalidInput(formatError(
+                    source, std::string("basis ") + kAxisNames[a] + " and " + kAxisNames[c] + " axes",
+                    "are not orthogonal (dot product " + numberText(d) + ")",
+                    "unit, orthogonal axes (the origin's rotation, without shear)"));
+            }
+        }
+    }
     double lower = std::numeric_limits<double>::infinity(), upper = -lower;
     const glm::dvec3 dir(b.basis[axis]);
     for (size_t i = 0; i < points.size(); ++i) {

@@ -316,6 +316,19 @@ TEST_CASE(
             CHECK(test::readText(shot.dir / "farm" / name) == test::readText(eval123.outDir / name));
         }
     }
+    // Eval given the scene by a relative path writes the same bytes: both name their inputs by absolute
+    // path in the maps' provenance.
+    harness::EvalCommand relative = eval123;
+    relative.scene = fs::relative(shot.scene, fs::current_path());
+    REQUIRE(relative.scene.is_relative());
+    relative.outDir = shot.dir / "eval_relative";
+    (void)harness::evalCommand(relative);
+    for (const scene::FarmTask& task : plan.tasks) {
+        for (const std::string& name : task.outputs) {
+            CAPTURE(name);
+            CHECK(test::readText(shot.dir / "farm" / name) == test::readText(relative.outDir / name));
+        }
+    }
     // Without warm-up a task starts cold at its first frame: eval over its range alone is the reference.
     harness::FarmPlanCommand coldCommand = planCommand;
     coldCommand.warmUp = 0;

@@ -48,6 +48,12 @@ TEST_CASE("feature lines file: bad JSON names the JSON path", "[scene][feature_l
     CHECK_THAT(fails(R"({"lines": [{"dst": [[5, 6], [7, 8]]}]})"),
                Catch::Contains("lines[0].src") && Catch::Contains("missing"));
     CHECK_THAT(fails(R"({"a": 1})"), Catch::Contains("lines: is missing"));
+    // Unknown keys are refused, as scenes refuse theirs (a typo would otherwise be ignored).
+    CHECK_THAT(fails(R"({"lines": [], "P": 0.5})"), Catch::Contains("lines.json: P: is not a known key") &&
+                                                        Catch::Contains("one of: a, b, p, lines"));
+    CHECK_THAT(
+        fails(R"({"lines": [{"src": [[1, 2], [3, 4]], "dst": [[5, 6], [7, 8]], "weight": 2}]})"),
+        Catch::Contains("lines[0].weight: is not a known key") && Catch::Contains("src, dst, a, b, p"));
     CHECK_THAT(fails(R"({"lines": [1e999]})"), Catch::Contains("lines.json"));
     CHECK_THAT(fails(R"({"lines": [}")"),
                Catch::Contains("lines.json") && Catch::Contains("parse error at line 1"));
