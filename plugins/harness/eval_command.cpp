@@ -199,6 +199,9 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
                                     command.contactColumns, command.contactMaxWidth);
         if (command.movie) checkSize("movie frame rate", command.movieFrameRate, 1, 1000);
     }
+    // Every input checked before anything is written: the stacks bound (vertex ranges, bind-time values),
+    // sequence files, and below the UV-warp stages' maps.
+    evaluator.check(report.frames);
     io::createFolder(command.outDir);
 
     std::vector<geom::Box3> restBounds;       // per object

@@ -102,6 +102,31 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
     return ob.deformed;
 }
 
+void SceneEvaluator::check(std::span<const int> frames) {
+    if (frames.empty()) return;
+    for (size_t o = 0; o < objects_.size(); ++o) {
+        const SceneObject& so = scene_.objects[o];
+        Object& ob = objects_[o];
+        setFrame(o, frames.front(), true);
+        try {
+            ob.stack.bind();
+        } catch (const Error& e) {
+            throw InvalidInput(
+                formatError(scene_.source, so.path + ".stack", frameText(frames.front()) + ": " + e.what()));
+        }
+        if (!ob.sequence) continue;
+        for (const int frame : frames) {
+            const std::filesystem::path file = ob.sequence->framePath(frame);
+            std::error_code ec;
+            if (!std::filesystem::is_regular_file(file, ec)) {
+                throw IoError(formatError(scene_.source, so.path + ".mesh",
+                                          frameText(frame) + ": " + file.string() + " does not exist",
+                                          "a file for every frame of the sequence " + so.sequence.string()));
+            }
+        }
+    }
+}
+
 void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3> points) {
     const SceneObject& so = scene_.objects[object];
     Object& ob = objects_[object];

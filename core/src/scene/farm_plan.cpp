@@ -192,6 +192,11 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
         for (int f = scene.firstFrame; f <= scene.lastFrame; ++f)
             frames.push_back(f);
     }
+    // What eval checks before any work, the plan checks too: a task must not be the first to find a slide
+    // vertex out of range or a UV-warp stage without any rigidity map.
+    SceneEvaluator(scene).check(frames);
+    for (size_t o = 0; o < scene.objects.size(); ++o)
+        requireRigidityMaps(scene, o, frames.front());
     FarmPlan plan;
     plan.scene = absolutePath(sceneFile);
     plan.outDir = absolutePath(outDir);

@@ -75,6 +75,17 @@ std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame) {
     return tiles;
 }
 
+void requireRigidityMaps(const Scene& scene, size_t object, int frame) {
+    const SceneObject& so = scene.objects.at(object);
+    if (!so.uvwarp || so.uvwarp->tiles.empty() || !uvwarpWarpedTiles(*so.uvwarp, frame).empty()) return;
+    const SceneUvWarp& stage = *so.uvwarp;
+    std::string list;
+    for (int tile : stage.tiles)
+        list += (list.empty() ? "'" : ", '") + tileFile(stage.rigidity, tile, frame).string() + "'";
+    throw IoError(formatError(scene.source + ": " + stage.path + ".rigidity", stage.rigidity.string(),
+                              "no tile has a rigidity map", "at least one of " + list));
+}
+
 std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame) {
     if (!object.uvwarp) return {};
     const SceneUvWarp& stage = *object.uvwarp;

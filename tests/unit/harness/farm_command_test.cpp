@@ -338,3 +338,37 @@ TEST_CASE("farm submit: --sbatch-args splits like a shell", "[harness][farm]") {
         test::errorOf<InvalidInput>([] { (void)harness::splitArguments("--comment='x", "--sbatch-args"); }),
         Contains("--sbatch-args: has an unterminated ' quote"));
 }
+
+TEST_CASE("eval and farm plan check every input before any work: a vertex out of range, no rigidity map",
+          "[harness][farm][eval][errors]") {
+    // The second object's slide handle is vertex 99999 of a 60-vertex tube: eval used to write the first
+    // object's frame 1 before finding it, and farm plan accepted it (every task then failed).
+    Shot shot;
+    std::string text = kScene;
+    text.replace(text.find(R"({"type": "bend")"), 0,
+                 R"({"type": "slide", "params": {"vertex": 99999, "radius": 0.5}}, )");
+    test::writeText(shot.scene, text);
+    harness::EvalCommand eval;
+    eval.scene = shot.scene;
+    eval.outDir = shot.dir / "eval";
+    const std::string evalError = test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(eval); });
+    CHECK_THAT(evalError, Contains("objects[1].stack") && Contains("99999"));
+    CHECK_FALSE(fs::exists(shot.dir / "eval"));
+    harness::FarmPlanCommand plan;
+    plan.scene = shot.scene;
+    plan.outDir = shot.dir / "farm";
+    CHECK(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }) == evalError);
+    CHECK_FALSE(fs::exists(shot.dir / "farm"));
+
+    // A UV-warp stage whose rigidity pattern finds no map: eval and plan refuse it alike, before any output.
+    text = kScene;
+    const size_t twistEnd = text.find("}}}]}") + 3;  // after the twist entry, inside the first stack
+    text.replace(twistEnd, 0, R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr"})");
+    test::writeText(shot.scene, text);
+    const std::string noMap = test::errorOf<IoError>([&] { (void)harness::evalCommand(eval); });
+    CHECK_THAT(noMap, Contains("objects[0].stack[1].rigidity") && Contains("no tile has a rigidity map"));
+    CHECK_FALSE(fs::exists(shot.dir / "eval" / "tube.0001.obj"));
+    const std::string planNoMap = test::errorOf<IoError>([&] { (void)harness::farmPlanCommand(plan); });
+    CHECK_THAT(planNoMap, Contains("objects[0].stack[1].rigidity") && Contains("no tile has a rigidity map"));
+    CHECK_FALSE(fs::exists(shot.dir / "farm" / "farm_plan.json"));
+}

@@ -42,6 +42,12 @@ class SceneEvaluator {
     // or of another connectivity.
     const geom::Mesh& evaluate(size_t object, double frame);
 
+    // Checks, before any work, what evaluating `frames` would find wrong that does not depend on the frame's
+    // deformation: every object's stack set at the first frame and bound (a slide vertex out of range, a
+    // bind-time value a deformer rejects), and for an object whose mesh is a frame sequence, that each
+    // frame's file exists. Throws InvalidInput / IoError as evaluate() names them. No evaluation is counted.
+    void check(std::span<const int> frames);
+
     // evaluate() calls for the object so far: a host feeding one evaluation to several consumers (a mesh
     // writer and every UV-warp tile) shows with it that a frame is evaluated once.
     [[nodiscard]] int64_t evaluations(size_t object) const { return objects_.at(object).evaluations; }
