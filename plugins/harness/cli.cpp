@@ -36,7 +36,16 @@ Option& Option::nonNegative() {
 }
 
 Option& Option::positive() {
-    option_->check(CLI::PositiveNumber);
+    // CLI11's PositiveNumber reports a range up to the largest double ("[4.9e-324 - 1.8e+308]"): this says
+    // what is expected in words.
+    option_->check(CLI::Validator(
+        [](std::string& text) -> std::string {
+            double value = 0.0;
+            if (!CLI::detail::lexical_cast(text, value)) return "is '" + text + "' (expected a number)";
+            if (!(value > 0.0)) return "is " + text + " (expected a number > 0)";
+            return {};
+        },
+        "> 0"));
     return *this;
 }
 

@@ -91,8 +91,7 @@ std::vector<fs::path> writeDemoPtex(const geom::Mesh& tube, const fs::path& outD
 
     // The weights as read back from the file, as `deformkit preview --weights-ptex` shows them.
     io::PreviewOptions view = demoSlideView();
-    const std::vector<float> weights =
-        ptex::weightsFromPtex(demo.mesh, written.back(), 0, written.back().string());
+    const std::vector<float> weights = ptex::weightsFromPtex(demo.mesh, "demo tube", written.back(), 0, "");
     for (float w : weights)
         view.vertexColors.push_back(io::weightColor(w));
     const io::Image before = io::renderPreview(demo.mesh, view);

@@ -59,8 +59,8 @@ void preview(const PreviewCommand& command) {
         const std::vector<float> weights =
             command.weights
                 ? scene::readWeightsFile(*command.weights, static_cast<size_t>(obj.mesh.numVertices()))
-                : ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel,
-                                        "--weights-ptex");
+                : ptex::weightsFromPtex(obj.mesh, command.mesh.string(), *command.weightsPtex,
+                                        command.weightsChannel, "--weights-ptex");
         options.vertexColors.clear();
         for (float w : weights)
             options.vertexColors.push_back(io::weightColor(w));

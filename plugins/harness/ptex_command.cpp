@@ -102,7 +102,7 @@ void ptexInfo(const fs::path& file, std::ostream& out) {
 size_t ptexToVertexCommand(const PtexToVertexCommand& command) {
     const geom::Mesh mesh = io::readObj(command.mesh).mesh;
     const std::vector<float> weights =
-        ptex::weightsFromPtex(mesh, command.ptex, command.channel, command.ptex.string());
+        ptex::weightsFromPtex(mesh, command.mesh.string(), command.ptex, command.channel, "");
     io::writeFileAtomically(command.out, scene::formatWeightsFile(weights));
     return weights.size();
 }

@@ -69,10 +69,10 @@ slide::SlideResult slideCommand(const SlideCommand& command) {
             formatError("--weights-ptex", "", "is given with --weights", "one source of painted weights"));
     }
     const std::vector<float> weights =
-        command.weights ? scene::readWeightsFile(*command.weights, count)
-        : command.weightsPtex
-            ? ptex::weightsFromPtex(obj.mesh, *command.weightsPtex, command.weightsChannel, "--weights-ptex")
-            : std::vector<float>{};
+        command.weights       ? scene::readWeightsFile(*command.weights, count)
+        : command.weightsPtex ? ptex::weightsFromPtex(obj.mesh, command.mesh.string(), *command.weightsPtex,
+                                                      command.weightsChannel, "--weights-ptex")
+                              : std::vector<float>{};
     slide::Slider slider(obj.mesh, {command.handle}, command.options, command.mesh.string());
     const std::vector<slide::SlideDrive> drives = {{command.to - command.from, command.falloff}};
     std::vector<glm::vec3> points(obj.mesh.points().begin(), obj.mesh.points().end());

@@ -286,7 +286,7 @@ void bindPtex(py::module_& m) {
             std::vector<float> values;
             {
                 py::gil_scoped_release release;
-                values = ptex::vertexValues(ptex::PtexMesh(m, "mesh"), file, source);
+                values = ptex::vertexValues(ptex::PtexMesh(m, "ptex_vertex_values: mesh"), file, source);
             }
             py::array_t<float> out(std::vector<py::ssize_t>{m.numVertices(), file.channels});
             std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(float));

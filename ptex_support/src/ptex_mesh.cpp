@@ -28,13 +28,9 @@ std::array<double, 4> bilinear(double u, double v) {
     return {(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v};
 }
 
-// The UDIM tile of a mesh face (by its UV centroid, as Mesh::udimTiles counts them).
+// The UDIM tile of a mesh face, as Mesh::udimTiles counts them (a face that overhangs a tile belongs to it).
 int faceTile(const geom::Mesh& mesh, int32_t f) {
-    glm::vec2 centroid(0.0f);
-    const auto corners = mesh.faceUVIndices(f);
-    for (int32_t t : corners)
-        centroid += mesh.uvs()[t];
-    return geom::udimTileOf(centroid / static_cast<float>(corners.size()));
+    return mesh.faceUdimTile(f);
 }
 
 // The UV of (u, v) on Ptex face `ptexFace`, interpolated with PtexMesh::cornerWeights.
@@ -482,16 +478,19 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
     return values;
 }
 
-std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::filesystem::path& file, int32_t channel,
+std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::string& meshName,
+                                   const std::filesystem::path& file, int32_t channel,
                                    const std::string& source) {
-    const std::string fileSource = source.empty() ? file.string() : source + ": " + file.string();
+    // The file is named once: a source that is the file itself adds nothing.
+    const bool prefix = !source.empty() && source != file.string();
+    const std::string fileSource = prefix ? source + ": " + file.string() : file.string();
     const PtexFile ptexFile = [&] {
         try {
-            return readPtex(file);
+            return readPtex(file);  // its errors name the file
         } catch (const IoError& e) {
-            throw IoError(source.empty() ? e.what() : source + ": " + e.what());
+            throw IoError(prefix ? source + ": " + e.what() : e.what());
         } catch (const ParseError& e) {
-            throw ParseError(source.empty() ? e.what() : source + ": " + e.what());
+            throw ParseError(prefix ? source + ": " + e.what() : e.what());
         }
     }();
     if (channel < 0 || channel >= ptexFile.channels) {
@@ -500,7 +499,7 @@ std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::filesystem
                         "is not one of the file's " + std::to_string(ptexFile.channels) + " channels",
                         "a channel in [0, " + std::to_string(ptexFile.channels) + ")"));
     }
-    const PtexMesh ptexMesh(mesh, source.empty() ? "mesh" : source);
+    const PtexMesh ptexMesh(mesh, meshName);
     const std::vector<float> values = vertexValues(ptexMesh, ptexFile, fileSource);
     std::vector<float> weights(static_cast<size_t>(mesh.numVertices()));
     for (size_t v = 0; v < weights.size(); ++v)
@@ -574,8 +573,12 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
                                        "a tile resolution in [1, 65536]"));
     }
     std::vector<int> tiles = options.tiles.empty() ? mesh.udimTiles() : options.tiles;
-    for (int tile : tiles)
-        (void)io::udimOrigin(tile);  // throws InvalidInput naming a bad tile number
+    for (int tile : tiles) {  // the mesh's own tiles are valid (Mesh::udimTiles); asked-for ones are checked
+        if (tile < 1001 || tile > 9999) {
+            throw InvalidInput(formatError(fileSource, "tiles", std::to_string(tile) + " is not a UDIM tile",
+                                           "tile numbers 1001 to 9999"));
+        }
+    }
     const PtexSampler sampler(file, fileSource);
     const int32_t channels = sampler.channels(), res = options.resolution;
     const int32_t outChannels = channels + (options.coverageChannel ? 1 : 0);

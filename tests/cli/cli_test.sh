@@ -132,6 +132,29 @@ expect ptex-to-udim 0 "$dk" ptex to-udim "$work/albedo.ptx" "$work/demo/tube.obj
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >"$work/quad.obj"
 expect ptex-wrong-mesh 2 "$dk" ptex to-vertex "$work/demo/ptex/falloff.ptx" "$work/quad.obj" --out "$work/x.json"
 contains ptex-wrong-mesh "$work/err" "has 23040 faces"
+# Errors that name the right thing: the mesh by its file (not the option or the Ptex file), a file once, a
+# plain range, the mesh and face of a UV outside the UDIM tiles.
+contains ptex-wrong-mesh "$work/err" "for mesh $work/quad.obj"
+expect slide-ptex-wrong-mesh 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 \
+    --weights-ptex "$work/demo/ptex/falloff.ptx" --out "$work/x.obj"
+contains slide-ptex-wrong-mesh "$work/err" "for mesh $work/quad.obj"
+grep -q "for mesh --weights-ptex" "$work/err" && { echo "FAIL slide-ptex-wrong-mesh: names the option as the mesh"; failures=$((failures + 1)); }
+head -c 200 "$work/demo/ptex/falloff.ptx" >"$work/trunc.ptx"
+expect ptex-truncated 2 "$dk" ptex to-vertex "$work/trunc.ptx" "$work/demo/ptex/tube.obj" --out "$work/x.json"
+[ "$(grep -o "trunc.ptx" "$work/err" | wc -l)" -eq 1 ] || { echo "FAIL ptex-truncated: the file is not named once:"; cat "$work/err"; failures=$((failures + 1)); }
+expect slide-max-walk-0 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 \
+    --out "$work/x.obj" --max-walk 0
+contains slide-max-walk-0 "$work/err" "--max-walk: is 0 (expected a number > 0)"
+grep -q "e+308" "$work/err" && { echo "FAIL slide-max-walk-0: prints a range to 1.8e308"; failures=$((failures + 1)); }
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt -0.45 0.1\nvt 0.05 0.1\nvt 0.05 0.9\nvt -0.45 0.9\nf 1/1 2/2 3/3 4/4\n' >"$work/left.obj"
+printf '[0, 0.5, 1, 0.5]\n' >"$work/left.json"
+expect ptex-left 0 "$dk" ptex from-vertex "$work/left.json" "$work/left.obj" --out "$work/left.ptx"
+expect ptex-udim-tile 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --tiles 1000
+contains ptex-udim-tile "$work/err" "--tiles: '1000' is not a UDIM tile"
+# A face that overhangs its tile (u from -0.45 to 0.05) belongs to it, as everywhere else: its part inside is
+# rendered (it was skipped, its centroid being left of the tile).
+expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --resolution 16
+[ -s "$work/l.1001.png" ] || { echo "FAIL ptex-udim-overhang: tile missing"; failures=$((failures + 1)); }
 printf 'not a ptex file, just some text that is long enough to hold a header of sixty-four bytes\n' >"$work/bad.ptx"
 expect ptex-bad-file 2 "$dk" ptex info "$work/bad.ptx"
 contains ptex-bad-file "$work/err" "bad.ptx"

@@ -201,7 +201,7 @@ class Reader {
     // Painted weights: a JSON file of one number per vertex, or {"image": pattern, "channel": c} sampled
     // through the rest mesh's UVs (weight_maps.h).
     std::vector<float> weights(const json& v, const std::string& path, const geom::Mesh& rest,
-                               fs::path& file) const {
+                               const fs::path& meshFile, fs::path& file) const {
         const int32_t count = rest.numVertices();
         if (v.is_object()) {
             onlyKeys(v, path, {"image", "ptex", "channel"});
@@ -221,7 +221,8 @@ class Reader {
                          "the deformkit CLI or Python module, which read Ptex weights");
                 std::vector<float> weights;
                 try {
-                    weights = options_.ptexWeights(rest, file, channel, source_ + ": " + path + ".ptex");
+                    weights = options_.ptexWeights(rest, meshFile.string(), file, channel,
+                                                   source_ + ": " + path + ".ptex");
                 } catch (const InvalidInput&) {
                     throw;
                 } catch (const Error& e) {
@@ -251,8 +252,8 @@ class Reader {
         }
     }
 
-    SceneDeformer deformer(const json& v, const std::string& path, size_t entry,
-                           const geom::Mesh& rest) const {
+    SceneDeformer deformer(const json& v, const std::string& path, size_t entry, const geom::Mesh& rest,
+                           const fs::path& meshFile) const {
         requireObject(v, path, "{\"type\": ..., \"params\": {...}}");
         onlyKeys(v, path, {"type", "label", "envelope", "weights", "params"});
         SceneDeformer d;
@@ -273,7 +274,7 @@ class Reader {
             if (n != 1) fail(path + ".envelope", "has " + std::to_string(n) + " components", "one number");
         }
         if (v.contains("weights"))
-            d.weights = weights(v.at("weights"), path + ".weights", rest, d.weightsFile);
+            d.weights = weights(v.at("weights"), path + ".weights", rest, meshFile, d.weightsFile);
 
         // Parameters are checked by a probe deformer's own set(), in its parameters() order (bind-time
         // inputs first, as a host sets them): the constant, or every key's value.
@@ -528,7 +529,7 @@ class Reader {
                 }
                 continue;
             }
-            SceneDeformer d = deformer(stack[i], entryPath, i, o.rest);
+            SceneDeformer d = deformer(stack[i], entryPath, i, o.rest, o.meshFile);
             if (!labels.insert(d.label).second) {
                 fail(entryPath + ".label", "is \"" + d.label + "\", used by an earlier entry",
                      "a label unique in the stack");

@@ -93,10 +93,11 @@ struct Scene {
 // Weight sources that live outside the core library, provided by the application reading the scene (the
 // deformkit CLI and the Python module give every one).
 struct SceneReadOptions {
-    // `"weights": {"ptex": file, "channel": c}`: (rest mesh, file, channel, source for messages) -> #V
-    // weights (deformkit::ptex::weightsFromPtex). Unset: such a scene is refused with a message saying so.
-    std::function<std::vector<float>(const geom::Mesh&, const std::filesystem::path&, int32_t,
-                                     const std::string&)>
+    // `"weights": {"ptex": file, "channel": c}`: (rest mesh, its file name, Ptex file, channel, source for
+    // messages) -> #V weights (deformkit::ptex::weightsFromPtex). Unset: such a scene is refused with a
+    // message saying so.
+    std::function<std::vector<float>(const geom::Mesh&, const std::string&, const std::filesystem::path&,
+                                     int32_t, const std::string&)>
         ptexWeights;
 };
 

@@ -122,12 +122,14 @@ class PtexSampler {
 [[nodiscard]] std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file,
                                               const std::string& fileSource);
 
-// Painted weights of `mesh` from channel `channel` of a Ptex file: vertexValues of that channel, for the
-// falloff weights of the slide and the weights of every warp. Errors name `source` (where the file was
-// named: a command-line option, a scene's JSON path) and the file: IoError / ParseError for the file,
-// InvalidInput for a file of another mesh or a channel it does not have.
-[[nodiscard]] std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::filesystem::path& file,
-                                                 int32_t channel, const std::string& source);
+// Painted weights of `mesh` (named `meshName` in messages: its file) from channel `channel` of a Ptex file:
+// vertexValues of that channel, for the falloff weights of the slide and the weights of every warp. Errors
+// name `source` (where the file was named: a command-line option, a scene's JSON path; empty: the file
+// alone) and the file once: IoError / ParseError for the file, InvalidInput for a file of another mesh
+// (naming the mesh) or a channel it does not have.
+[[nodiscard]] std::vector<float> weightsFromPtex(const geom::Mesh& mesh, const std::string& meshName,
+                                                 const std::filesystem::path& file, int32_t channel,
+                                                 const std::string& source);
 
 struct BakeOptions {
     int8_t ulog2 = 4;  // every face 2^ulog2 × 2^vlog2 texels
