@@ -50,18 +50,7 @@ class Reader {
 
     // Rejects keys outside `known` (a typo would otherwise be ignored silently).
     void onlyKeys(const json& v, const std::string& path, std::initializer_list<const char*> known) const {
-        for (const auto& item : v.items()) {
-            bool found = false;
-            std::string list;
-            for (const char* k : known) {
-                found = found || item.key() == k;
-                list += (list.empty() ? "" : ", ") + std::string(k);
-            }
-            if (!found) {
-                fail(path.empty() ? item.key() : path + "." + item.key(), "is not a known key",
-                     "one of: " + list);
-            }
-        }
+        detail::requireKnownKeys(v, source_, path, known);
     }
 
     double number(const json& v, const std::string& path) const {
