@@ -77,6 +77,23 @@ for f in $(seq 1 "$frames"); do
 done
 n=$(find "$work/tasks" -maxdepth 1 -type f -name 'grid.*.obj' | wc -l)
 [ "$n" -eq "$frames" ] || fail "$n outputs, expected $frames"
+# Two runs of the same task at once (a scheduler's requeue while the first still runs): each frame is
+# written whole by one of them or the other, never a mix, and both exit 0.
+"$dk" farm plan "$work/shot.json" --frames "1-$frames" --chunk "$frames" --out "$work/twice" \
+    --plan "$work/plan2.json" >"$work/plan2.log" 2>&1 || fail "farm plan failed: $(cat "$work/plan2.log")"
+"$dk" farm run "$work/plan2.json" --task 0 >"$work/twice_a.log" 2>&1 &
+pid_a=$!
+"$dk" farm run "$work/plan2.json" --task 0 >"$work/twice_b.log" 2>&1 &
+pid_b=$!
+wait "$pid_a" || fail "the first of two concurrent runs exited $?: $(tail -n 3 "$work/twice_a.log")"
+wait "$pid_b" || fail "the second of two concurrent runs exited $?: $(tail -n 3 "$work/twice_b.log")"
+for f in $(seq 1 "$frames"); do
+    name=$(printf 'grid.%04d.obj' "$f")
+    cmp -s "$work/twice/$name" "$work/eval/$name" || fail "$name after two concurrent runs differs from eval's"
+done
+leftover=$(find "$work/twice" -name '.*' -type f | wc -l)
+[ "$leftover" -eq 0 ] || fail "$leftover temporaries left by two runs that both finished"
 echo "farm_kill: PASS (killed after $done_before of $frames frames, $hidden hidden temporaries left;" \
-    "rerun skipped $skipped, wrote $written; all $frames outputs equal eval's)"
+    "rerun skipped $skipped, wrote $written; all $frames outputs equal eval's; two concurrent runs of the task" \
+    "wrote eval's bytes)"
 rm -rf "$work"
