@@ -37,6 +37,11 @@ void describeMesh(const fs::path& file, std::ostream& out) {
     out << "faces       " << m.numFaces() << " (triangles " << sizes[3] << ", quads " << sizes[4]
         << ", n-gons " << sizes[5] << ")\n";
     out << "edges       " << m.halfEdges().numEdges() << "\n";
+    if (obj.repairedFaces > 0) {
+        out << "repaired    " << obj.repairedFaces << (obj.repairedFaces == 1 ? " polygon" : " polygons")
+            << " that visited a vertex twice (first on line " << obj.firstRepairedLine
+            << "): repeats dropped, split into loops\n";
+    }
     out << std::setprecision(6) << "bounds      (" << box.min.x << ", " << box.min.y << ", " << box.min.z
         << ") - (" << box.max.x << ", " << box.max.y << ", " << box.max.z << ")\n";
     if (m.hasUVs()) {

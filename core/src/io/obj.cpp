@@ -352,17 +352,98 @@ class ObjParser {
             fail<InvalidInput>(statementLine_, "face has " + std::to_string(corners) + " vertices",
                                "at least 3 vertices per face");
         }
-        checkDistinct(corners);
         if (faceHasUVs && firstLineWithoutUVs_ != 0) failMixedUVs(statementLine_, firstLineWithoutUVs_);
         if (!faceHasUVs && firstLineWithUVs_ != 0) failMixedUVs(firstLineWithUVs_, statementLine_);
         int64_t& firstLine = faceHasUVs ? firstLineWithUVs_ : firstLineWithoutUVs_;
         if (firstLine == 0) firstLine = statementLine_;
-        if (data_.faceCounts.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
-            fail<InvalidInput>(statementLine_, "too many faces", "fewer than 2^31 faces");
+        faceCorners_.clear();
+        if (hasRepeat(corners)) {
+            splitRepeats(corners, faceHasUVs);
+        } else {
+            faceCorners_.push_back(corners);
         }
-        const auto face = static_cast<int32_t>(data_.faceCounts.size());
-        data_.faceCounts.push_back(corners);
-        addToCurrentGroups(face);
+        for (const int32_t count : faceCorners_) {
+            if (data_.faceCounts.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+                fail<InvalidInput>(statementLine_, "too many faces", "fewer than 2^31 faces");
+            }
+            const auto face = static_cast<int32_t>(data_.faceCounts.size());
+            data_.faceCounts.push_back(count);
+            addToCurrentGroups(face);
+        }
+    }
+
+    // Exporters write polygons that visit a vertex twice: corners repeated one after the other (a long line
+    // repeating its corners), or a polygon with a hole joined to its outline by an edge walked both ways
+    // (CAD). Repeats one after the other are dropped, then the polygon is split where it comes back to a
+    // vertex: each loop is a face, loops of fewer than 3 corners are dropped. The count is reported
+    // (ObjContent::repairedFaces). Replaces the polygon's last `corners` entries; faceCorners_ gets the
+    // corner counts of the faces it becomes.
+    void splitRepeats(int32_t corners, bool hasUVs) {
+        const size_t n = static_cast<size_t>(corners);
+        std::vector<int32_t> v(data_.faceIndices.end() - static_cast<ptrdiff_t>(n), data_.faceIndices.end());
+        std::vector<int32_t> t = hasUVs
+                                     ? std::vector<int32_t>(data_.uvIndices.end() - static_cast<ptrdiff_t>(n),
+                                                            data_.uvIndices.end())
+                                     : std::vector<int32_t>(n, 0);
+        data_.faceIndices.resize(data_.faceIndices.size() - n);
+        if (hasUVs) data_.uvIndices.resize(data_.uvIndices.size() - n);
+        // Consecutive repeats, around the polygon too.
+        std::vector<int32_t> cv, ct;
+        for (size_t k = 0; k < n; ++k) {
+            if (!cv.empty() && cv.back() == v[k]) continue;
+            cv.push_back(v[k]);
+            ct.push_back(t[k]);
+        }
+        while (cv.size() > 1 && cv.back() == cv.front()) {
+            cv.pop_back();
+            ct.pop_back();
+        }
+        // Split at revisited vertices, loop by loop.
+        std::vector<std::pair<std::vector<int32_t>, std::vector<int32_t>>> pending{{cv, ct}};
+        std::vector<std::vector<int32_t>>
+            emitted;  // the loops made into faces, rotated to start at their least vertex
+        while (!pending.empty()) {
+            auto [pv, pt] = std::move(pending.back());
+            pending.pop_back();
+            size_t first = 0, again = 0;
+            for (size_t j = 1; j < pv.size() && again == 0; ++j) {
+                for (size_t i = 0; i < j; ++i) {
+                    if (pv[i] == pv[j]) {
+                        first = i;
+                        again = j;
+                        break;
+                    }
+                }
+            }
+            if (again == 0) {
+                if (pv.size() < 3) continue;
+                // A loop walked again (a line repeating its corners) is one face, not a stack of copies.
+                std::vector<int32_t> key = pv;
+                std::rotate(key.begin(), std::min_element(key.begin(), key.end()), key.end());
+                if (std::find(emitted.begin(), emitted.end(), key) != emitted.end()) continue;
+                emitted.push_back(std::move(key));
+                data_.faceIndices.insert(data_.faceIndices.end(), pv.begin(), pv.end());
+                if (hasUVs) data_.uvIndices.insert(data_.uvIndices.end(), pt.begin(), pt.end());
+                faceCorners_.push_back(static_cast<int32_t>(pv.size()));
+                continue;
+            }
+            std::vector<int32_t> lv(pv.begin() + static_cast<ptrdiff_t>(first),
+                                    pv.begin() + static_cast<ptrdiff_t>(again));
+            std::vector<int32_t> lt(pt.begin() + static_cast<ptrdiff_t>(first),
+                                    pt.begin() + static_cast<ptrdiff_t>(again));
+            pv.erase(pv.begin() + static_cast<ptrdiff_t>(first) + 1,
+                     pv.begin() + static_cast<ptrdiff_t>(again) + 1);
+            pt.erase(pt.begin() + static_cast<ptrdiff_t>(first) + 1,
+                     pt.begin() + static_cast<ptrdiff_t>(again) + 1);
+            pending.emplace_back(std::move(pv), std::move(pt));
+            pending.emplace_back(std::move(lv), std::move(lt));
+        }
+        if (faceCorners_.empty()) {
+            fail<InvalidInput>(statementLine_, "face has fewer than 3 distinct vertices",
+                               "at least 3 distinct vertices per face");
+        }
+        ++repairedFaces_;
+        if (firstRepairedLine_ == 0) firstRepairedLine_ = statementLine_;
     }
 
     [[noreturn]] void failMixedUVs(int64_t withUVs, int64_t withoutUVs) const {
@@ -373,28 +454,18 @@ class ObjParser {
                            "texture coordinates on every face or on none");
     }
 
-    void checkDistinct(int32_t corners) {
+    bool hasRepeat(int32_t corners) {
         const auto face = std::span<const int32_t>(data_.faceIndices).last(static_cast<size_t>(corners));
-        int32_t repeated = -1;
         if (corners <= 16) {
-            for (int32_t k = 1; k < corners && repeated < 0; ++k) {
-                for (int32_t j = 0; j < k; ++j) {
-                    if (face[j] == face[k]) {
-                        repeated = face[k];
-                        break;
-                    }
-                }
+            for (int32_t k = 1; k < corners; ++k) {
+                for (int32_t j = 0; j < k; ++j)
+                    if (face[j] == face[k]) return true;
             }
-        } else {
-            scratch_.assign(face.begin(), face.end());
-            std::sort(scratch_.begin(), scratch_.end());
-            const auto it = std::adjacent_find(scratch_.begin(), scratch_.end());
-            if (it != scratch_.end()) repeated = *it;
+            return false;
         }
-        if (repeated >= 0) {
-            fail<InvalidInput>(statementLine_, "face uses vertex " + std::to_string(repeated + 1) + " twice",
-                               "distinct vertices per face");
-        }
+        scratch_.assign(face.begin(), face.end());
+        std::sort(scratch_.begin(), scratch_.end());
+        return std::adjacent_find(scratch_.begin(), scratch_.end()) != scratch_.end();
     }
 
     void readGroupNames() {
@@ -448,6 +519,8 @@ class ObjParser {
         ObjContent content;
         content.mesh = geom::Mesh(std::move(data_), source_);
         content.groups = std::move(groups_);
+        content.repairedFaces = repairedFaces_;
+        content.firstRepairedLine = firstRepairedLine_;
         return content;
     }
 
@@ -466,6 +539,10 @@ class ObjParser {
     std::vector<int32_t> currentGroups_;
     bool namesResolved_ = true;
     std::vector<int32_t> scratch_;
+    std::vector<int32_t>
+        faceCorners_;  // the faces one `f` statement becomes (one, unless it repeats a vertex)
+    int64_t repairedFaces_ = 0;
+    int64_t firstRepairedLine_ = 0;
 };
 
 // Text output without iostreams: numbers through to_chars.
@@ -512,6 +589,15 @@ std::string formatObjText(const geom::Mesh& mesh, const std::vector<FaceGroup>& 
 }  // namespace
 
 ObjContent parseObj(std::string_view text, const std::string& source) {
+    // A UTF-16 file (byte order mark, or a NUL in its first bytes) would fail as an unknown statement.
+    const bool bom =
+        text.size() >= 2 &&
+        ((static_cast<unsigned char>(text[0]) == 0xFE && static_cast<unsigned char>(text[1]) == 0xFF) ||
+         (static_cast<unsigned char>(text[0]) == 0xFF && static_cast<unsigned char>(text[1]) == 0xFE));
+    if (bom || text.substr(0, 64).find('\0') != std::string_view::npos) {
+        throw ParseError(formatError(source, "", "is UTF-16 text, which is not supported",
+                                     "UTF-8 or ASCII text: save the file as UTF-8"));
+    }
     return ObjParser(text, source).parse();
 }
 

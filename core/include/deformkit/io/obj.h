@@ -18,14 +18,19 @@ struct FaceGroup {
 struct ObjContent {
     geom::Mesh mesh;
     std::vector<FaceGroup> groups;  // empty when the file names none
+    // Polygons that visited a vertex twice, repaired (repeats dropped, split into loops), and the line of
+    // the first: `deformkit info` reports them.
+    int64_t repairedFaces = 0;
+    int64_t firstRepairedLine = 0;
 };
 
 // Reads a Wavefront OBJ: `v` (extra w or colour values ignored), `vt` (u v [w]), `f` with v, v/vt,
 // v//vn and v/vt/vn corners, 1-based and negative (relative) indices, n-gons, `g`/`o` groups, line
 // continuations (`\`). Normals, materials and smoothing groups are ignored. Throws IoError for a
 // missing or unreadable file, ParseError/InvalidInput naming the file and line for: no faces, a malformed
-// number, an index of 0 or out of range, a face with fewer than 3 vertices, NaN/inf coordinates, some
-// faces with UVs and some without.
+// number, an index of 0 or out of range, a face with fewer than 3 (distinct) vertices, NaN/inf
+// coordinates, some faces with UVs and some without, UTF-16 text. A polygon that visits a vertex twice is
+// repaired (ObjContent::repairedFaces).
 [[nodiscard]] ObjContent readObj(const std::filesystem::path& path);
 
 // Parses OBJ text already in memory; `source` names it in errors.
