@@ -1,6 +1,7 @@
 #include "deformkit/warp/ffd_frames.h"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -29,23 +30,33 @@ std::string controlName(const Lattice& l, size_t c) {
 
 }  // namespace
 
-Affine frameToFrame(const Frame& from, const Frame& to, const std::string& element) {
-    if (!finite(from) || !finite(to)) {
-        throw InvalidInput(
-            formatError("FFD frames", element, "is not finite", "finite origins and basis vectors"));
-    }
+namespace {
+
+// The affine map taking `from` to `to`, or nothing for a non-finite frame or a singular source basis (the
+// cases frameToFrame names): the checks without the message, so an update builds no control names.
+std::optional<Affine> mapBetween(const Frame& from, const Frame& to) {
+    if (!finite(from) || !finite(to)) return std::nullopt;
     const glm::dmat3 b(from.basis);
     double lengths = 1.0;
     for (int a = 0; a < 3; ++a)
         lengths *= glm::length(b[a]);
     const double det = glm::determinant(b);
-    if (!(std::abs(det) > 1e-9 * lengths) || lengths == 0.0) {
-        throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
-                                       "three linearly independent basis vectors"));
-    }
+    if (!(std::abs(det) > 1e-9 * lengths) || lengths == 0.0) return std::nullopt;
     const glm::dmat3 linear = glm::dmat3(to.basis) * glm::inverse(b);
     const glm::dvec3 translation = glm::dvec3(to.origin) - linear * glm::dvec3(from.origin);
-    return {glm::mat3(linear), glm::vec3(translation)};
+    return Affine{glm::mat3(linear), glm::vec3(translation)};
+}
+
+}  // namespace
+
+Affine frameToFrame(const Frame& from, const Frame& to, const std::string& element) {
+    if (const std::optional<Affine> t = mapBetween(from, to)) return *t;
+    if (!finite(from) || !finite(to)) {
+        throw InvalidInput(
+            formatError("FFD frames", element, "is not finite", "finite origins and basis vectors"));
+    }
+    throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
+                                   "three linearly independent basis vectors"));
 }
 
 FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : lattice_(lattice, options) {
@@ -95,12 +106,9 @@ void FfdFrames::setTargetFrames(std::span<const Frame> frames) {
 void FfdFrames::update() {
     for (size_t c = 0; c < source_.size(); ++c) {
         // The control's name is made only for the error: an update allocates nothing.
-        Affine t;
-        try {
-            t = frameToFrame(source_[c], target_[c], {});
-        } catch (const InvalidInput&) {
-            t = frameToFrame(source_[c], target_[c], controlName(lattice_.lattice(), c));  // throws, named
-        }
+        const std::optional<Affine> mapped = mapBetween(source_[c], target_[c]);
+        const Affine t =
+            mapped ? *mapped : frameToFrame(source_[c], target_[c], controlName(lattice_.lattice(), c));
         transform_[c] = t;
         float* d = &delta_[c * 12];
         for (int col = 0; col < 3; ++col) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <string_view>
 
 #include <glm/geometric.hpp>
@@ -12,6 +11,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 
 namespace deformkit::maya {
@@ -377,14 +377,10 @@ std::vector<int32_t> sweepsFromText(std::string_view text) {
 
 std::string fileAt(const std::string& pattern, int tile, int frame) {
     if (pattern.empty()) return {};
-    std::string path = io::expandUdim(pattern, tile);
-    const size_t at = path.find("####");
-    if (at != std::string::npos) {
-        char digits[16];
-        std::snprintf(digits, sizeof digits, "%04d", frame);
-        path.replace(at, 4, digits);
-    }
-    return path;
+    // The library's rule for per-tile maps (and scenes' animated maps): a frame token is one in the file
+    // name, as io::ObjSequence reads them (####, %04d).
+    const std::string path = io::expandUdim(pattern, tile);
+    return io::ObjSequence::isPattern(path) ? io::ObjSequence(path).framePath(frame).string() : path;
 }
 
 RedirectFiles redirectFilesAt(const RedirectInputs& in, int frame) {

@@ -202,8 +202,8 @@ struct RedirectInputs {
 // not a whole number, or a negative count.
 [[nodiscard]] std::vector<int32_t> sweepsFromText(std::string_view text);
 
-// A file pattern at a tile and frame: <UDIM> replaced by the tile, #### by the frame (4 digits); an empty
-// pattern stays empty.
+// A file pattern at a tile and frame: <UDIM> replaced by the tile, a frame token in the file name (####,
+// %04d; io::ObjSequence) by the frame; an empty pattern stays empty.
 [[nodiscard]] std::string fileAt(const std::string& pattern, int tile, int frame);
 
 // The map files of `frame` (empty patterns stay empty).
