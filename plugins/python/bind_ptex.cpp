@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -109,12 +110,32 @@ ptex::MetaValue metaFrom(const std::string& key, py::handle value, const std::st
                                    "int8, int16, int32, float32 or float64"));
 }
 
+const std::array<const char*, 3> kBorderModes{"clamp", "black", "periodic"};
+const std::array<const char*, 2> kEdgeFilterModes{"none", "tangent_vectors"};
+
+// The index of `d[key]` among `names`, `fallback` when the key is absent.
+template <size_t N>
+size_t nameIndex(const py::dict& d, const char* key, const std::array<const char*, N>& names, size_t fallback,
+                 const std::string& source) {
+    if (!d.contains(key)) return fallback;
+    const std::string value = py::str(d[key]).cast<std::string>();
+    std::string expected;
+    for (size_t i = 0; i < N; ++i) {
+        if (value == names[i]) return i;
+        expected += (i == 0 ? "'" : i + 1 == N ? " or '" : ", '") + std::string(names[i]) + "'";
+    }
+    throw InvalidInput(formatError(source, key, "is '" + value + "'", expected));
+}
+
 py::dict toDict(const ptex::PtexFile& file) {
     py::dict out;
     out["mesh_type"] = file.meshType == ptex::MeshType::Quad ? "quad" : "triangle";
     out["data_type"] = typeName(file.dataType);
     out["channels"] = file.channels;
     out["alpha_channel"] = file.alphaChannel;
+    out["u_border_mode"] = kBorderModes[static_cast<size_t>(file.uBorderMode)];
+    out["v_border_mode"] = kBorderModes[static_cast<size_t>(file.vBorderMode)];
+    out["edge_filter_mode"] = kEdgeFilterModes[static_cast<size_t>(file.edgeFilterMode)];
     py::list faces, data;
     for (size_t f = 0; f < file.faces.size(); ++f) {
         const ptex::FaceInfo& info = file.faces[f];
@@ -187,6 +208,12 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
     }
     file.constData.assign(file.faces.size() * file.pixelSize(), 0);
     if (d.contains("alpha_channel")) file.alphaChannel = d["alpha_channel"].cast<int32_t>();
+    const std::array<const char*, 2> meshTypes{"triangle", "quad"};
+    file.meshType = static_cast<ptex::MeshType>(nameIndex(d, "mesh_type", meshTypes, 1, source));
+    file.uBorderMode = static_cast<ptex::BorderMode>(nameIndex(d, "u_border_mode", kBorderModes, 0, source));
+    file.vBorderMode = static_cast<ptex::BorderMode>(nameIndex(d, "v_border_mode", kBorderModes, 0, source));
+    file.edgeFilterMode =
+        static_cast<ptex::EdgeFilterMode>(nameIndex(d, "edge_filter_mode", kEdgeFilterModes, 0, source));
     if (mesh) {
         const ptex::PtexMesh pm(*mesh, source);
         const std::vector<ptex::FaceInfo> infos = pm.faceInfos(0, 0);
@@ -247,7 +274,10 @@ void bindPtex(py::module_& m) {
         py::arg("path"),
         "Read a Ptex file as a dict: mesh_type ('quad'/'triangle'), data_type ('u8', 'u16', 'half', "
         "'float'),\n"
-        "channels, alpha_channel (-1: none), faces (per face a dict: res (ures, vres), adj_faces and\n"
+        "channels, alpha_channel (-1: none), u_border_mode and v_border_mode ('clamp', 'black', "
+        "'periodic'),\n"
+        "edge_filter_mode ('none', 'tangent_vectors'), faces (per face a dict: res (ures, vres), adj_faces "
+        "and\n"
         "adj_edges (4 each, edges bottom, right, top, left; -1: none), constant, subface), data (per face a\n"
         "(vres, ures, channels) array in the file's dtype: uint8, uint16, float16, float32; row 0 at v = 0;\n"
         "constant faces expanded) and metadata (key -> str or 1-D array).");
@@ -269,7 +299,9 @@ void bindPtex(py::module_& m) {
         py::arg("reductions") = true,
         "Write a Ptex file atomically from a dict as read_ptex returns (only 'data' is required: per face a\n"
         "(vres, ures[, C]) uint8 / uint16 / float16 / float32 array, power-of-two sizes; optional 'faces'\n"
-        "with adjacency and sub-face flags, 'metadata', 'alpha_channel'). With mesh (a deformkit.Mesh or an\n"
+        "with adjacency and sub-face flags, 'metadata', 'alpha_channel', 'mesh_type' (default 'quad';\n"
+        "'triangle' takes square faces), the border and edge filter modes). With mesh (a deformkit.Mesh or "
+        "an\n"
         "OBJ path) the faces' adjacency and sub-face flags are the mesh's (OpenSubdiv's Ptex faces) and its\n"
         "face and vertex data are written as the standard mesh metadata.");
     m.def(

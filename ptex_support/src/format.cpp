@@ -1,9 +1,13 @@
 #include "format.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
+#include <utility>
 
 #include "deformkit/ptex/half.h"
 
@@ -76,120 +80,219 @@ void diffDecode(std::span<uint8_t> data, int bpc) {
 
 namespace {
 
-double channelValue(const uint8_t* p, DataType type) {
+// The reference library's float to binary16 conversion: half an ulp added to the magnitude, then truncated
+// (ties away from zero), zero of either sign to +0, subnormals rounded the same way, overflow to infinity,
+// NaN keeping its top payload bits. floatToHalf rounds ties to even; a reduction must round as the files
+// renderers read were written, so it uses this one (docs/decisions.md PTX-2).
+uint16_t referenceHalf(float value) {
+    if (value == 0.0f) return 0;
+    const uint32_t bits = std::bit_cast<uint32_t>(value);
+    const auto sign = static_cast<uint16_t>((bits >> 16) & 0x8000u);
+    const int32_t exponent = static_cast<int32_t>((bits >> 23) & 0xffu) - 127 + 15;
+    if (exponent >= 1 && exponent <= 30) {
+        const uint32_t normal = sign | (static_cast<uint32_t>(exponent) << 10);
+        return static_cast<uint16_t>(normal + (((bits & 0x7fffffu) + 0x1000u) >> 13));
+    }
+    if (exponent <= 0) {
+        const double magnitude = std::fabs(static_cast<double>(value)) * 16777216.0 + 0.5;
+        return static_cast<uint16_t>(sign | static_cast<uint32_t>(magnitude));
+    }
+    if (exponent == 128 + 15) return static_cast<uint16_t>(sign | 0x7c00u | ((bits & 0x7fffffu) >> 13));
+    return static_cast<uint16_t>(sign | 0x7c00u);
+}
+
+// float to an unsigned integer channel by truncation, as a C++ conversion does inside the range (the clamp
+// only keeps values the arithmetic never produces from stored data defined).
+template <typename U>
+U truncateTo(float value) {
+    constexpr float kMax = static_cast<float>(std::numeric_limits<U>::max());
+    if (!(value > 0.0f)) return 0;
+    if (value >= kMax) return std::numeric_limits<U>::max();
+    return static_cast<U>(value);
+}
+
+// One channel type and the arithmetic the format's reductions use on it.
+template <DataType Type>
+struct Channel;
+
+template <>
+struct Channel<DataType::UInt8> {
+    using Stored = uint8_t;
+    static constexpr float kOne = 255.0f;
+    static float value(Stored v) { return v; }
+    static Stored from(float v) { return truncateTo<uint8_t>(v); }
+    static Stored quarter(Stored a, Stored b, Stored c, Stored d) {
+        return static_cast<Stored>((a + b + c + d) >> 2);
+    }
+};
+
+template <>
+struct Channel<DataType::UInt16> {
+    using Stored = uint16_t;
+    static constexpr float kOne = 65535.0f;
+    static float value(Stored v) { return v; }
+    static Stored from(float v) { return truncateTo<uint16_t>(v); }
+    static Stored quarter(Stored a, Stored b, Stored c, Stored d) {
+        return static_cast<Stored>((uint32_t{a} + b + c + d) >> 2);
+    }
+};
+
+template <>
+struct Channel<DataType::Half> {
+    using Stored = uint16_t;  // the binary16 bits
+    static constexpr float kOne = 1.0f;
+    static float value(Stored v) { return halfToFloat(v); }
+    static Stored from(float v) { return referenceHalf(v); }
+    static Stored quarter(Stored a, Stored b, Stored c, Stored d) {
+        return from(0.25f * (value(a) + value(b) + value(c) + value(d)));
+    }
+};
+
+template <>
+struct Channel<DataType::Float> {
+    using Stored = float;
+    static constexpr float kOne = 1.0f;
+    static float value(Stored v) { return v; }
+    static Stored from(float v) { return v; }
+    static Stored quarter(Stored a, Stored b, Stored c, Stored d) { return 0.25f * (a + b + c + d); }
+};
+
+// Calls f(Channel<T>{}) for the file's data type.
+template <typename F>
+decltype(auto) withChannel(DataType type, F&& f) {
     switch (type) {
         case DataType::UInt8:
-            return *p;
+            return f(Channel<DataType::UInt8>{});
         case DataType::UInt16:
-            return load<uint16_t>(p);
+            return f(Channel<DataType::UInt16>{});
         case DataType::Half:
-            return halfToFloat(load<uint16_t>(p));
+            return f(Channel<DataType::Half>{});
         case DataType::Float:
-            return load<float>(p);
-    }
-    return 0;
-}
-
-// Alpha as a weight in [0, 1] for integer types, as stored for floating-point types.
-double alphaWeight(double alpha, DataType type) {
-    switch (type) {
-        case DataType::UInt8:
-            return alpha / 255.0;
-        case DataType::UInt16:
-            return alpha / 65535.0;
-        default:
-            return alpha;
-    }
-}
-
-// double to float without the undefined behaviour of an out-of-range conversion: beyond the float range
-// gives infinity, as the hardware conversion would.
-float toFloat(double value) {
-    constexpr double kMax = std::numeric_limits<float>::max();
-    if (value > kMax) return std::numeric_limits<float>::infinity();
-    if (value < -kMax) return -std::numeric_limits<float>::infinity();
-    return static_cast<float>(value);
-}
-
-void storeChannel(double value, DataType type, uint8_t* p) {
-    switch (type) {
-        case DataType::UInt8: {
-            const double r = std::floor(value + 0.5);
-            *p = static_cast<uint8_t>(std::isnan(r) ? 0.0 : std::clamp(r, 0.0, 255.0));
-            break;
-        }
-        case DataType::UInt16: {
-            const double r = std::floor(value + 0.5);
-            store(p, static_cast<uint16_t>(std::isnan(r) ? 0.0 : std::clamp(r, 0.0, 65535.0)));
-            break;
-        }
-        case DataType::Half:
-            store(p, floatToHalf(toFloat(value)));
-            break;
-        case DataType::Float:
-            store(p, toFloat(value));
             break;
     }
+    return f(Channel<DataType::Float>{});
 }
 
-// Filters `count` texels given by pointers into one pixel: colour = Σ cᵢ aᵢ / Σ aᵢ (plain mean when Σ aᵢ =
-// 0), alpha and every channel without alpha = mean.
-template <typename TexelAt>
-void filterPixel(size_t count, const TexelAt& texelAt, DataType type, int channels, int alphaChannel,
-                 uint8_t* out) {
-    const size_t bpc = bytesPerChannel(type);
-    double alphaSum = 0;
-    if (alphaChannel >= 0) {
-        for (size_t k = 0; k < count; ++k) {
-            alphaSum += alphaWeight(channelValue(texelAt(k) + alphaChannel * bpc, type), type);
-        }
-    }
-    for (int c = 0; c < channels; ++c) {
-        double sum = 0;
-        double weighted = 0;
-        for (size_t k = 0; k < count; ++k) {
-            const double v = channelValue(texelAt(k) + c * bpc, type);
-            sum += v;
-            if (alphaChannel >= 0 && c != alphaChannel) {
-                weighted += v * alphaWeight(channelValue(texelAt(k) + alphaChannel * bpc, type), type);
-            }
-        }
-        const bool premultiplied = alphaChannel >= 0 && c != alphaChannel && alphaSum != 0;
-        const double value = premultiplied ? weighted / alphaSum : sum / static_cast<double>(count);
-        storeChannel(value, type, out + c * bpc);
-    }
+// The channels alpha scales: those before it, or all after it when it is channel 0.
+std::pair<int, int> colourChannels(int channels, int alphaChannel) {
+    return alphaChannel == 0 ? std::pair{1, channels} : std::pair{0, alphaChannel};
 }
 
 }  // namespace
 
-std::vector<uint8_t> reduceFace(std::span<const uint8_t> texels, int w, int h, DataType type, int channels,
-                                int alphaChannel) {
-    const size_t pixel = bytesPerChannel(type) * channels;
-    const int rw = w / 2;
-    const int rh = h / 2;
-    std::vector<uint8_t> out(static_cast<size_t>(rw) * rh * pixel);
-    for (int y = 0; y < rh; ++y) {
-        for (int x = 0; x < rw; ++x) {
-            // Order (2x, 2y), (2x+1, 2y), (2x, 2y+1), (2x+1, 2y+1).
-            const auto texelAt = [&](size_t k) {
-                const size_t sx = 2 * x + (k & 1);
-                const size_t sy = 2 * y + (k >> 1);
-                return texels.data() + (sy * w + sx) * pixel;
-            };
-            filterPixel(4, texelAt, type, channels, alphaChannel,
-                        out.data() + (static_cast<size_t>(y) * rw + x) * pixel);
+void premultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
+    if (alphaChannel < 0) return;
+    withChannel(type, [&]<typename C>(C) {
+        using T = typename C::Stored;
+        const size_t pixel = sizeof(T) * channels;
+        const auto [first, last] = colourChannels(channels, alphaChannel);
+        const float inverseOne = 1.0f / C::kOne;
+        for (size_t p = 0; p + pixel <= texels.size(); p += pixel) {
+            uint8_t* texel = texels.data() + p;
+            const float factor = inverseOne * C::value(load<T>(texel + alphaChannel * sizeof(T)));
+            for (int c = first; c < last; ++c) {
+                uint8_t* v = texel + c * sizeof(T);
+                store(v, C::from(C::value(load<T>(v)) * factor));
+            }
         }
-    }
-    return out;
+    });
 }
 
-std::vector<uint8_t> averagePixel(std::span<const uint8_t> texels, size_t count, DataType type, int channels,
-                                  int alphaChannel) {
-    const size_t pixel = bytesPerChannel(type) * channels;
-    std::vector<uint8_t> out(pixel);
-    filterPixel(
-        count, [&](size_t k) { return texels.data() + k * pixel; }, type, channels, alphaChannel, out.data());
-    return out;
+void unpremultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
+    if (alphaChannel < 0) return;
+    withChannel(type, [&]<typename C>(C) {
+        using T = typename C::Stored;
+        const size_t pixel = sizeof(T) * channels;
+        const auto [first, last] = colourChannels(channels, alphaChannel);
+        for (size_t p = 0; p + pixel <= texels.size(); p += pixel) {
+            uint8_t* texel = texels.data() + p;
+            const float alpha = C::value(load<T>(texel + alphaChannel * sizeof(T)));
+            if (alpha == 0.0f) continue;  // transparent: the colour stays as it is
+            const float factor = C::kOne / alpha;
+            for (int c = first; c < last; ++c) {
+                uint8_t* v = texel + c * sizeof(T);
+                store(v, C::from(C::value(load<T>(v)) * factor));
+            }
+        }
+    });
+}
+
+std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int h, DataType type,
+                                    int channels) {
+    return withChannel(type, [&]<typename C>(C) {
+        using T = typename C::Stored;
+        const size_t pixel = sizeof(T) * channels;
+        const int rw = w / 2;
+        const int rh = h / 2;
+        std::vector<uint8_t> out(static_cast<size_t>(rw) * rh * pixel);
+        const auto at = [&](int x, int y, int c) {
+            return load<T>(texels.data() + (static_cast<size_t>(y) * w + x) * pixel + c * sizeof(T));
+        };
+        for (int y = 0; y < rh; ++y) {
+            for (int x = 0; x < rw; ++x) {
+                uint8_t* o = out.data() + (static_cast<size_t>(y) * rw + x) * pixel;
+                for (int c = 0; c < channels; ++c) {
+                    store(o + c * sizeof(T),
+                          C::quarter(at(2 * x, 2 * y, c), at(2 * x + 1, 2 * y, c), at(2 * x, 2 * y + 1, c),
+                                     at(2 * x + 1, 2 * y + 1, c)));
+                }
+            }
+        }
+        return out;
+    });
+}
+
+std::vector<uint8_t> reduceTriangleFace(std::span<const uint8_t> texels, int w, DataType type, int channels) {
+    return withChannel(type, [&]<typename C>(C) {
+        using T = typename C::Stored;
+        const size_t pixel = sizeof(T) * channels;
+        const int rw = w / 2;
+        std::vector<uint8_t> out(static_cast<size_t>(rw) * rw * pixel);
+        const auto at = [&](int x, int y, int c) {
+            return load<T>(texels.data() + (static_cast<size_t>(y) * w + x) * pixel + c * sizeof(T));
+        };
+        for (int y = 0; y < rw; ++y) {
+            for (int x = 0; x < rw; ++x) {
+                uint8_t* o = out.data() + (static_cast<size_t>(y) * rw + x) * pixel;
+                for (int c = 0; c < channels; ++c) {
+                    // Three texels of the 2 × 2 block and the texel packed opposite them, which holds
+                    // the block's fourth (inverted) texel.
+                    store(o + c * sizeof(T),
+                          C::quarter(at(2 * x, 2 * y, c), at(2 * x + 1, 2 * y, c), at(2 * x, 2 * y + 1, c),
+                                     at(w - 1 - 2 * y, w - 1 - 2 * x, c)));
+                }
+            }
+        }
+        return out;
+    });
+}
+
+void averageTexels(std::span<const uint8_t> texels, size_t count, DataType type, int channels, uint8_t* out) {
+    withChannel(type, [&]<typename C>(C) {
+        using T = typename C::Stored;
+        const size_t pixel = sizeof(T) * channels;
+        std::array<float, kMaxChannels> sums{};
+        for (size_t k = 0; k < count; ++k) {
+            for (int c = 0; c < channels; ++c)
+                sums[c] += C::value(load<T>(texels.data() + k * pixel + c * sizeof(T)));
+        }
+        const float scale = 1.0f / static_cast<float>(count);
+        for (int c = 0; c < channels; ++c)
+            store(out + c * sizeof(T), C::from(sums[c] * scale));
+    });
+}
+
+int reductionRank(const FaceInfo& info) {
+    return info.constant ? 1 : std::min(info.ulog2, info.vlog2);
+}
+
+std::vector<uint32_t> reductionOrder(std::span<const FaceInfo> faces) {
+    std::vector<uint32_t> order(faces.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return reductionRank(faces[a]) > reductionRank(faces[b]);
+    });
+    return order;
 }
 
 FaceInfo loadFaceInfo(const uint8_t* p) {

@@ -91,14 +91,35 @@ void planarToInterleaved(const uint8_t* planar, int w, int h, int channels, int 
 void diffEncode(std::span<uint8_t> data, int bpc);
 void diffDecode(std::span<uint8_t> data, int bpc);
 
-// 2×2 box filter of an interleaved w × h face (both even) into (w/2) × (h/2); colour channels weighted by
-// alpha when alphaChannel >= 0.
-[[nodiscard]] std::vector<uint8_t> reduceFace(std::span<const uint8_t> texels, int w, int h, DataType type,
-                                              int channels, int alphaChannel);
+// The format's reductions as the reference library writes them and renderers read them (docs/decisions.md
+// PTX-2): level i holds a prefix of the faces in reduction order, each at (ulog2 - i, vlog2 - i), with its
+// colour premultiplied by alpha; integer channels are summed in integers and truncated, half and float
+// channels summed in float.
+constexpr int kMinReductionLog2 = 2;  // the writer stores reductions down to 4 texels on the smaller side
 
-// The filter's value over a whole face: one pixel.
-[[nodiscard]] std::vector<uint8_t> averagePixel(std::span<const uint8_t> texels, size_t count, DataType type,
-                                                int channels, int alphaChannel);
+// The size that orders faces in the reduction levels: min(ulog2, vlog2), a constant face counted as 1.
+[[nodiscard]] int reductionRank(const FaceInfo& info);
+
+// Face ids in reduction order: descending reductionRank, equal ranks by face id.
+[[nodiscard]] std::vector<uint32_t> reductionOrder(std::span<const FaceInfo> faces);
+
+// Multiplies (divides) the colour channels of interleaved texels by alpha: the channels before the alpha
+// channel, or all after it when it is channel 0; integer alpha scaled by 1/255 or 1/65535. Dividing skips
+// texels whose alpha is 0. No-ops without alpha (alphaChannel < 0).
+void premultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel);
+void unpremultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel);
+
+// 2×2 box filter of an interleaved w × h quad face (both even) into (w/2) × (h/2).
+[[nodiscard]] std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int h,
+                                                  DataType type, int channels);
+
+// The triangle reduction of a packed w × w triangle face (w even) into (w/2) × (w/2): each texel the mean of
+// three texels of its 2×2 block and the inverted texel packed opposite, at (w − 1 − 2y, w − 1 − 2x).
+[[nodiscard]] std::vector<uint8_t> reduceTriangleFace(std::span<const uint8_t> texels, int w, DataType type,
+                                                      int channels);
+
+// The mean of `count` interleaved texels, summed in float, into one pixel at `out`.
+void averageTexels(std::span<const uint8_t> texels, size_t count, DataType type, int channels, uint8_t* out);
 
 // Decodes a FaceInfo record (20 bytes) and encodes one.
 [[nodiscard]] FaceInfo loadFaceInfo(const uint8_t* p);

@@ -230,13 +230,25 @@ class Reader {
         pos_ = kHeaderSize + extHeaderSize_;
     }
 
-    void validateFaceInfo(const FaceInfo& info, const std::string& section, uint64_t offset,
+    // Checks a face record; a triangle's has no fourth edge and no sub-face flag, so those bits read as none.
+    void validateFaceInfo(FaceInfo& info, const std::string& section, uint64_t offset,
                           const std::string& face, const std::string& where = {}) {
         if (info.ulog2 < 0 || info.ulog2 > kMaxLog2 || info.vlog2 < 0 || info.vlog2 > kMaxLog2) {
             fail(section, offset,
                  face + " has resolution log2 " + std::to_string(info.ulog2) + " x " +
                      std::to_string(info.vlog2) + where,
                  "each log2 in 0..15");
+        }
+        if (file_.meshType == MeshType::Triangle) {
+            if (info.ulog2 != info.vlog2) {
+                fail(section, offset,
+                     face + " has resolution log2 " + std::to_string(info.ulog2) + " x " +
+                         std::to_string(info.vlog2) + " in a triangle file" + where,
+                     "equal log2 resolutions (a triangle face is stored as a square)");
+            }
+            info.adjFaces[3] = -1;
+            info.adjEdges[3] = 0;
+            info.subface = false;
         }
         for (int e = 0; e < 4; ++e) {
             if (info.adjFaces[e] < -1 || info.adjFaces[e] >= static_cast<int64_t>(faceCount_)) {
@@ -531,30 +543,29 @@ class Reader {
         }
     }
 
+    // Level `index` lists a prefix of the faces in reduction order (constant faces ranked 1), each at
+    // (ulog2 − index, vlog2 − index); the reference writer stops at 4 texels on the smaller side, so a level
+    // may list fewer faces than could be reduced to it.
     void readReduction(const Level& level, int index) {
-        std::vector<uint32_t> order;
-        for (uint32_t f = 0; f < faceCount_; ++f) {
-            if (std::min(file_.faces[f].ulog2, file_.faces[f].vlog2) >= index) order.push_back(f);
-        }
-        std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-            return std::min(file_.faces[a].ulog2, file_.faces[a].vlog2) >
-                   std::min(file_.faces[b].ulog2, file_.faces[b].vlog2);
-        });
+        const std::vector<uint32_t> order = reductionOrder(file_.faces);
+        size_t reducible = 0;
+        while (reducible < order.size() && reductionRank(file_.faces[order[reducible]]) >= index)
+            ++reducible;
         const std::string section = "level " + std::to_string(index) + " data";
-        if (order.size() != level.faces) {
+        if (level.faces > reducible) {
             fail(section, level.offset, "lists " + std::to_string(level.faces) + " faces",
-                 std::to_string(order.size()) +
-                     " (the faces with min(ulog2, vlog2) >= " + std::to_string(index) + ")");
+                 "at most " + std::to_string(reducible) + " (the faces with min(ulog2, vlog2) >= " +
+                     std::to_string(index) + ", a constant face counted as 1)");
         }
-        std::vector<ReducedFace> faces(order.size());
-        for (size_t k = 0; k < order.size(); ++k) {
+        std::vector<ReducedFace> faces(level.faces);
+        for (size_t k = 0; k < level.faces; ++k) {
             const uint32_t f = order[k];
             ReducedFace& r = faces[k];
             r.faceId = static_cast<int32_t>(f);
-            r.ulog2 = static_cast<int8_t>(file_.faces[f].ulog2 - index);
-            r.vlog2 = static_cast<int8_t>(file_.faces[f].vlog2 - index);
+            r.ulog2 = static_cast<int8_t>(std::max(0, file_.faces[f].ulog2 - index));
+            r.vlog2 = static_cast<int8_t>(std::max(0, file_.faces[f].vlog2 - index));
             const uint32_t header = level.headers[k];
-            if (header == 0) continue;  // constant: the face's ConstData
+            if (header == 0 || file_.faces[f].constant) continue;  // the face's ConstData
             r.texels = decodeFace(section + ", face " + std::to_string(f), level.blockOffsets[k], header,
                                   r.ulog2, r.vlog2);
         }

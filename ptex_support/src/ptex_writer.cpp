@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <numeric>
 #include <string>
@@ -171,6 +172,12 @@ class Writer {
                      "has resolution log2 " + std::to_string(info.ulog2) + " x " + std::to_string(info.vlog2),
                      "each log2 in 0..15");
             }
+            if (file_.meshType == MeshType::Triangle && info.ulog2 != info.vlog2) {
+                fail(face,
+                     "has resolution log2 " + std::to_string(info.ulog2) + " x " +
+                         std::to_string(info.vlog2) + " in a triangle file",
+                     "equal log2 resolutions (a triangle face is stored as a square)");
+            }
             for (int e = 0; e < 4; ++e) {
                 if (info.adjFaces[e] < -1 || info.adjFaces[e] >= static_cast<int64_t>(n)) {
                     fail(face,
@@ -206,7 +213,9 @@ class Writer {
             fail(element, "has key '" + m.key + "'", "1..254 bytes without NUL");
         }
         if (static_cast<uint8_t>(m.type) > 5) fail(element, "has an unknown type", "0..5");
-        if (m.bytes().size() > 0xffffffffu) fail(element, "is larger than 4 GiB", "a smaller value");
+        const size_t size = m.bytes().size();
+        if (size > 0xffffffffu) fail(element, "is larger than 4 GiB", "a smaller value");
+        if (size == 0) fail(element, "key '" + m.key + "' has no values", "at least one value");
         if (options_.mesh &&
             (m.key == kFaceVertCounts || m.key == kFaceVertIndices || m.key == kVertPositions)) {
             fail(element, "key '" + m.key + "' is also given as WriteOptions::mesh", "one or the other");
@@ -257,7 +266,9 @@ class Writer {
         out.put(static_cast<uint32_t>(valueSize));
     }
 
-    // Decides which faces are constant, their ConstData pixel, and the neighbourhood-constant flag.
+    // Decides which faces are constant (their ConstData pixel is the texel value), the neighbourhood-constant
+    // flag, and each face's place in the reduction levels. A triangle file's faces keep no flags but
+    // `constant` and no fourth edge, as the format defines them.
     void classifyFaces() {
         const size_t n = file_.faces.size();
         const size_t pixel = file_.pixelSize();
@@ -265,12 +276,17 @@ class Writer {
         constData_.assign(n * pixel, 0);
         for (size_t f = 0; f < n; ++f) {
             FaceInfo& info = faces_[f];
-            uint8_t* value = constData_.data() + f * pixel;
-            const std::vector<uint8_t>& texels = file_.texels[f];
             info.hasEdits = false;
+            info.neighbourhoodConstant = false;
+            if (file_.meshType == MeshType::Triangle) {
+                info.subface = false;
+                info.adjFaces[3] = -1;
+                info.adjEdges[3] = 0;
+            }
+            const std::vector<uint8_t>& texels = file_.texels[f];
             if (texels.empty()) {
                 info.constant = true;
-                std::memcpy(value, file_.constData.data() + f * pixel, pixel);
+                std::memcpy(constData_.data() + f * pixel, file_.constData.data() + f * pixel, pixel);
                 continue;
             }
             bool allEqual = true;
@@ -278,35 +294,84 @@ class Writer {
                 allEqual = std::memcmp(texels.data(), texels.data() + t, pixel) == 0;
             }
             info.constant = allEqual;
-            const std::vector<uint8_t> average =
-                allEqual ? std::vector<uint8_t>(texels.begin(), texels.begin() + pixel)
-                         : averagePixel(texels, info.texelCount(), file_.dataType, file_.channels,
-                                        file_.alphaChannel);
-            std::memcpy(value, average.data(), pixel);
+            if (allEqual) std::memcpy(constData_.data() + f * pixel, texels.data(), pixel);
         }
+        for (size_t f = 0; f < n; ++f)
+            faces_[f].neighbourhoodConstant = faces_[f].constant && constantAroundCorners(f);
+        order_ = reductionOrder(faces_);
+        lastLevel_.assign(n, 0);
         for (size_t f = 0; f < n; ++f) {
-            FaceInfo& info = faces_[f];
-            bool same = info.constant;
-            for (int e = 0; e < 4 && same; ++e) {
-                const int32_t g = info.adjFaces[e];
-                if (g < 0) continue;
-                same = faces_[g].constant &&
-                       std::memcmp(constData_.data() + f * pixel, constData_.data() + g * pixel, pixel) == 0;
-            }
-            info.neighbourhoodConstant = same;
+            if (!faces_[f].constant && options_.reductions)
+                lastLevel_[f] = std::max(0, reductionRank(faces_[f]) - kMinReductionLog2);
         }
     }
 
+    // True when every face met walking around each corner of constant face f is constant with f's value,
+    // walking as the reference writer does: clockwise from each edge's neighbour, at most 9 faces, stopping
+    // at a T-vertex between a sub-face and a main face; at a boundary (which only clamp border modes allow)
+    // also counter-clockwise, starting from the edge before the one the clockwise walk ended on.
+    bool constantAroundCorners(size_t f) const {
+        const size_t pixel = file_.pixelSize();
+        const uint8_t* value = constData_.data() + f * pixel;
+        const int edges = file_.meshType == MeshType::Triangle ? 3 : 4;
+        const auto sameConstant = [&](int32_t g) {
+            return faces_[g].constant && std::memcmp(value, constData_.data() + g * pixel, pixel) == 0;
+        };
+        constexpr int kMaxValence = 10;
+        const auto self = static_cast<int32_t>(f);
+        for (int e = 0; e < edges; ++e) {
+            bool previousWasSubface = faces_[f].subface;
+            int32_t previous = self;
+            int32_t g = faces_[f].adjFaces[e];
+            int edge = faces_[f].adjEdges[e];
+            for (int count = 1; g != self && g >= 0 && count < kMaxValence; ++count) {
+                if (!sameConstant(g)) return false;
+                const FaceInfo& other = faces_[g];
+                const bool tVertex =
+                    edges == 4 && previousWasSubface && !other.subface && other.adjFaces[edge] == previous;
+                if (tVertex) break;
+                previousWasSubface = other.subface;
+                previous = g;
+                const int next = (edge + 1) % edges;
+                g = other.adjFaces[next];
+                edge = other.adjEdges[next];
+            }
+            if (g >= 0) continue;
+            if (file_.uBorderMode != BorderMode::Clamp || file_.vBorderMode != BorderMode::Clamp)
+                return false;
+            int start = (edge - 1 + edges) % edges;
+            g = faces_[f].adjFaces[start];
+            edge = faces_[f].adjEdges[start];
+            for (int count = 1; g != self && g >= 0 && count < kMaxValence; ++count) {
+                if (!sameConstant(g)) return false;
+                const FaceInfo& other = faces_[g];
+                const int next = (edge - 1 + edges) % edges;
+                g = other.adjFaces[next];
+                edge = other.adjEdges[next];
+                if (other.subface && !previousWasSubface) {
+                    // Entering a sub-face from a main face: continue from the second sub-face of the edge.
+                    const int turned = (edge + 3) % 4;
+                    edge = (other.adjEdges[turned] + 3) % 4;
+                    g = other.adjFaces[turned];
+                }
+                previousWasSubface = other.subface;
+            }
+        }
+        return true;
+    }
+
+    // Level 0 plus one level per reduction down to kMinReductionLog2 on the smaller side.
     int levelCount() const {
-        if (!options_.reductions) return 1;
-        int maxMin = 0;
-        for (const FaceInfo& info : faces_)
-            maxMin = std::max(maxMin, static_cast<int>(std::min(info.ulog2, info.vlog2)));
-        return maxMin + 1;
+        int levels = 1;
+        for (size_t f = 0; f < faces_.size(); ++f)
+            levels = std::max(levels, lastLevel_[f] + 1);
+        return levels;
     }
 
     // Appends one level (zipped face-data headers, then the blocks) and returns the zipped header size and
-    // the number of faces.
+    // the number of faces. Level 0 lists every face in face order; level i the faces whose reductions reach
+    // it, in reduction order. Each face's premultiplied texels at the level are kept for the next one, and
+    // at its last level give its ConstData value.
     std::pair<size_t, size_t> writeLevel(int level, std::vector<uint8_t>& out) {
         std::vector<uint32_t> order;
         if (level == 0) {
@@ -314,17 +379,15 @@ class Writer {
             std::iota(order.begin(), order.end(), 0u);
             reduced_.assign(faces_.size(), {});
         } else {
-            for (uint32_t f = 0; f < faces_.size(); ++f) {
-                if (std::min(faces_[f].ulog2, faces_[f].vlog2) >= level) order.push_back(f);
+            for (const uint32_t f : order_) {
+                if (lastLevel_[f] < level) break;  // reduction order is by descending last level
+                order.push_back(f);
             }
-            std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-                return std::min(faces_[a].ulog2, faces_[a].vlog2) >
-                       std::min(faces_[b].ulog2, faces_[b].vlog2);
-            });
         }
         std::vector<uint8_t> headers;
         std::vector<uint8_t> blocks;
         ByteWriter h(headers);
+        const bool alpha = file_.alphaChannel >= 0;
         for (const uint32_t f : order) {
             const FaceInfo& info = faces_[f];
             if (info.constant) {
@@ -333,14 +396,28 @@ class Writer {
             }
             const int w = info.ures() >> level;
             const int hgt = info.vres() >> level;
-            if (level > 0) {
-                const std::vector<uint8_t>& source = level == 1 ? file_.texels[f] : reduced_[f];
-                reduced_[f] =
-                    reduceFace(source, w * 2, hgt * 2, file_.dataType, file_.channels, file_.alphaChannel);
-            }
-            const std::vector<uint8_t>& texels = level == 0 ? file_.texels[f] : reduced_[f];
             const std::string element = "face " + std::to_string(f) + " at level " + std::to_string(level);
-            h.put(encodeFace(texels, w, hgt, blocks, element));
+            if (level == 0) {
+                h.put(encodeFace(file_.texels[f], w, hgt, blocks, element));
+                if (alpha) {
+                    reduced_[f] = file_.texels[f];
+                    premultiplyAlpha(reduced_[f], file_.dataType, file_.channels, file_.alphaChannel);
+                }
+            } else {
+                const std::vector<uint8_t>& source = reduced_[f].empty() ? file_.texels[f] : reduced_[f];
+                reduced_[f] = file_.meshType == MeshType::Triangle
+                                  ? reduceTriangleFace(source, w * 2, file_.dataType, file_.channels)
+                                  : reduceQuadFace(source, w * 2, hgt * 2, file_.dataType, file_.channels);
+                h.put(encodeFace(reduced_[f], w, hgt, blocks, element));
+            }
+            if (level == lastLevel_[f]) {
+                const std::vector<uint8_t>& last = reduced_[f].empty() ? file_.texels[f] : reduced_[f];
+                uint8_t* value = constData_.data() + f * file_.pixelSize();
+                averageTexels(last, static_cast<size_t>(w) * hgt, file_.dataType, file_.channels, value);
+                unpremultiplyAlpha({value, file_.pixelSize()}, file_.dataType, file_.channels,
+                                   file_.alphaChannel);
+                reduced_[f] = {};
+            }
         }
         const std::vector<uint8_t> headerZip = zip(headers, "level " + std::to_string(level) + " headers");
         out.insert(out.end(), headerZip.begin(), headerZip.end());
@@ -358,16 +435,14 @@ class Writer {
             const uint32_t encoding = zipRect(texels.data(), w, 0, 0, w, h, out, element);
             return blockHeader(encoding, checkedBlockSize(out.size() - before, element));
         }
-        int tileULog2 = std::countr_zero(static_cast<unsigned>(w));
-        int tileVLog2 = std::countr_zero(static_cast<unsigned>(h));
-        while ((size_t{1} << (tileULog2 + tileVLog2)) * pixel > options_.tileBytes &&
-               tileULog2 + tileVLog2 > 0) {
-            if (tileULog2 >= tileVLog2) {
-                --tileULog2;
-            } else {
-                --tileVLog2;
-            }
-        }
+        // Tiles of about tileBytes: 2^k tiles, k = floor(log2(bytes / tileBytes)), as square as the face
+        // allows (the reference writer's rule, so both write the same blocks).
+        const int faceLog2 =
+            std::countr_zero(static_cast<unsigned>(w)) + std::countr_zero(static_cast<unsigned>(h));
+        const int tilesLog2 = std::max(1, static_cast<int>(std::bit_width(bytes / options_.tileBytes)) - 1);
+        const int tileLog2 = std::max(0, faceLog2 - tilesLog2);
+        const int tileULog2 = std::min((tileLog2 + 1) / 2, std::countr_zero(static_cast<unsigned>(w)));
+        const int tileVLog2 = std::min(tileLog2 - tileULog2, std::countr_zero(static_cast<unsigned>(h)));
         const int tw = 1 << tileULog2;
         const int th = 1 << tileVLog2;
         std::vector<uint8_t> tileHeaders;
@@ -440,7 +515,9 @@ class Writer {
     std::string source_;
     std::vector<FaceInfo> faces_;
     std::vector<uint8_t> constData_;
-    std::vector<std::vector<uint8_t>> reduced_;
+    std::vector<uint32_t> order_;                // reduction order
+    std::vector<int> lastLevel_;                 // per face: its smallest stored reduction (0: none)
+    std::vector<std::vector<uint8_t>> reduced_;  // per face: premultiplied texels at the level being written
     std::vector<uint8_t> planar_;
 };
 

@@ -1,5 +1,7 @@
 """deformkit.read_ptex / write_ptex / ptex_vertex_values and slide(weights_ptex=...): round trips bit for
 bit per dtype, per-vertex values against a numpy reference, adjacency from a mesh, errors."""
+import os
+
 import numpy as np
 import pytest
 
@@ -108,3 +110,30 @@ def test_bad_input_names_the_problem(tmp_path):
     (tmp_path / "bad.ptx").write_bytes(b"x" * 100)
     with pytest.raises(dk.ParseError, match="bad.ptx"):
         dk.read_ptex(tmp_path / "bad.ptx")
+
+
+REFERENCE_FILES = os.path.join(os.path.dirname(__file__), "..", "data", "ptex")
+
+
+@pytest.mark.parametrize("name", ["ref_tri_float.ptx", "ref_quad_u8_rgba.ptx", "ref_quad_half_a0.ptx"])
+def test_a_reference_file_read_and_written_again_is_the_same_file(tmp_path, name):
+    """Files written by the reference Ptex library (tests/data/ptex/README.txt): the dict keeps the mesh
+    type, modes, adjacency and metadata, and the writer gives back the reference writer's bytes."""
+    path = os.path.join(REFERENCE_FILES, name)
+    d = dk.read_ptex(path)
+    assert d["mesh_type"] == ("triangle" if "tri" in name else "quad")
+    dk.write_ptex(tmp_path / name, d)
+    assert (tmp_path / name).read_bytes() == open(path, "rb").read()
+
+
+def test_mesh_type_and_modes_are_written_and_checked(tmp_path):
+    data = [np.arange(16, dtype=np.float32).reshape(4, 4, 1)]
+    dk.write_ptex(tmp_path / "t.ptx", {"data": data, "mesh_type": "triangle", "v_border_mode": "periodic",
+                                       "edge_filter_mode": "tangent_vectors"})
+    back = dk.read_ptex(tmp_path / "t.ptx")
+    assert (back["mesh_type"], back["u_border_mode"], back["v_border_mode"], back["edge_filter_mode"]) == (
+        "triangle", "clamp", "periodic", "tangent_vectors")
+    with pytest.raises(dk.InvalidInput, match="mesh_type: is 'quads' .*'triangle' or 'quad'"):
+        dk.write_ptex(tmp_path / "x.ptx", {"data": data, "mesh_type": "quads"})
+    with pytest.raises(dk.InvalidInput, match="face 0.*triangle file"):
+        dk.write_ptex(tmp_path / "x.ptx", {"data": [np.zeros((4, 8, 1), np.float32)], "mesh_type": "triangle"})

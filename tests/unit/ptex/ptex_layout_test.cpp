@@ -119,10 +119,10 @@ TEST_CASE("the writer's header fields and section sizes follow the notes", "[pte
     file.alphaChannel = 1;
     file.vBorderMode = BorderMode::Periodic;
     file.faces.resize(3);
-    file.faces[0].ulog2 = 3;
-    file.faces[0].vlog2 = 2;  // 8 × 4: levels 0..2
+    file.faces[0].ulog2 = 5;
+    file.faces[0].vlog2 = 4;  // 32 × 16: levels 0..2 (reductions down to 4 texels on the smaller side)
     file.faces[1].ulog2 = 1;
-    file.faces[1].vlog2 = 1;  // 2 × 2: levels 0..1
+    file.faces[1].vlog2 = 1;  // 2 × 2: level 0 only
     file.faces[2].ulog2 = 0;
     file.faces[2].vlog2 = 5;  // 1 × 32: level 0 only
     file.faces[0].adjFaces = {2, -1, 1, -1};
@@ -161,8 +161,8 @@ TEST_CASE("the writer's header fields and section sizes follow the notes", "[pte
     size_t at = 104;
     const std::vector<uint8_t> faceInfo = tp::zlibUncompress(std::span(b).subspan(at, h.faceInfoSize), 60);
     REQUIRE(faceInfo.size() == 60);
-    CHECK(static_cast<int8_t>(faceInfo[0]) == 3);
-    CHECK(static_cast<int8_t>(faceInfo[1]) == 2);
+    CHECK(static_cast<int8_t>(faceInfo[0]) == 5);
+    CHECK(static_cast<int8_t>(faceInfo[1]) == 4);
     CHECK(faceInfo[2] == (1 | (0 << 2) | (3 << 4)));  // adjedges, 2 bits per edge
     CHECK(faceInfo[3] == 0);                          // flags: not constant
     CHECK(static_cast<int32_t>(tp::rd32(faceInfo, 4)) == 2);
@@ -173,8 +173,8 @@ TEST_CASE("the writer's header fields and section sizes follow the notes", "[pte
     const std::vector<uint8_t> constData = tp::zlibUncompress(std::span(b).subspan(at, h.constDataSize), 24);
     CHECK(constData.size() == 3 * 8);
     at += h.constDataSize;
-    // Level info: faces per level are the faces with min(ulog2, vlog2) >= level: 3, 2, 1.
-    const uint32_t expectedFaces[3] = {3, 2, 1};
+    // Level info: level 0 lists every face, level i the faces with min(ulog2, vlog2) >= i + 2: 3, 1, 1.
+    const uint32_t expectedFaces[3] = {3, 1, 1};
     uint64_t levelSum = 0;
     const size_t levelInfoAt = at;
     for (int i = 0; i < 3; ++i) {
@@ -193,14 +193,14 @@ TEST_CASE("the writer's header fields and section sizes follow the notes", "[pte
         blocks += tp::rd32(headers, 4 * f) & 0x3fffffffu;
     }
     CHECK(headerZip + blocks == tp::rd64(b, levelInfoAt));
-    // Face 0's block, decoded here: channel planes of 8 × 4 floats, v-major.
+    // Face 0's block, decoded here: channel planes of 32 × 16 floats, v-major.
     const std::vector<uint8_t> planes =
-        tp::zlibUncompress(std::span(b).subspan(at + headerZip, tp::rd32(headers, 0) & 0x3fffffffu), 256);
-    REQUIRE(planes.size() == 256);
+        tp::zlibUncompress(std::span(b).subspan(at + headerZip, tp::rd32(headers, 0) & 0x3fffffffu), 4096);
+    REQUIRE(planes.size() == 4096);
     int wrong = 0;
     for (int c = 0; c < 2; ++c) {
-        for (int t = 0; t < 32; ++t) {
-            if (std::memcmp(planes.data() + 4 * (c * 32 + t), file.texels[0].data() + 4 * (t * 2 + c), 4) !=
+        for (int t = 0; t < 512; ++t) {
+            if (std::memcmp(planes.data() + 4 * (c * 512 + t), file.texels[0].data() + 4 * (t * 2 + c), 4) !=
                 0)
                 ++wrong;
         }

@@ -165,9 +165,11 @@ TEST_CASE("write then read gives every texel and field back bit for bit", "[ptex
             const std::vector<uint8_t> bytes = writePtexBytes(file);
             const PtexFile back = readPtex(bytes, "roundtrip.ptx");
             CHECK(compareFiles(file, back) == 0);
-            CHECK(back.faces[4].neighbourhoodConstant);
-            CHECK(back.faces[5].neighbourhoodConstant);
-            CHECK_FALSE(back.faces[1].neighbourhoodConstant);
+            // Faces 4 and 5 are equal constants side by side, but walking around their corners reaches the
+            // border, and the format flags a neighbourhood constant there only with clamp borders (these are
+            // periodic and black): no face is flagged (the flag's rule: ptex_reduction_test.cpp).
+            for (const FaceInfo& info : back.faces)
+                CHECK_FALSE(info.neighbourhoodConstant);
             // The large face really was tiled: its level-0 face-data header has encoding 3.
             const tp::Header h = tp::parseHeader(bytes);
             const size_t levelInfo = 104 + h.faceInfoSize + h.constDataSize;

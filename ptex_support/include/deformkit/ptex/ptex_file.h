@@ -97,8 +97,10 @@ struct PtexFile {
     std::vector<std::vector<uint8_t>> texels;  // per face, level 0
     std::vector<uint8_t> constData;  // faces.size() × pixelSize(): constant value or average per face
     std::vector<MetaValue> metadata;
-    // reductions[i - 1] is level i, faces in file order (descending min(ulog2, vlog2), then face id). Filled
-    // by readPtex with ReadOptions::readReductions; writePtex ignores it and computes its own.
+    // reductions[i - 1] is level i, faces in the format's reduction order (descending min(ulog2, vlog2), a
+    // constant face counted as 1, then face id); a level may list only the first faces of that order.
+    // Texels are as stored: colour premultiplied by alpha when the file has an alpha channel. Filled by
+    // readPtex with ReadOptions::readReductions; writePtex ignores it and computes its own.
     std::vector<std::vector<ReducedFace>> reductions;
 
     [[nodiscard]] size_t pixelSize() const {
@@ -124,11 +126,13 @@ struct MeshData {
 };
 
 struct WriteOptions {
-    bool reductions = true;    // write the reduction levels (2×2 box filter, alpha-premultiplied)
-    int compressionLevel = 6;  // zlib, 0..9
+    // Write the reduction levels as the reference library does: each face halved down to 4 texels on its
+    // smaller side (2×2 box filter, or the triangle reduction in a triangle file), alpha-premultiplied.
+    bool reductions = true;
+    int compressionLevel = 6;                // zlib, 0..9
     size_t tileThresholdBytes = 128 * 1024;  // faces (and reduced faces) of this many bytes or more are tiled
-    size_t tileBytes = 64 * 1024;            // largest tile, in bytes (tiles are powers of two per axis)
-    std::optional<MeshData> mesh;            // written as the standard mesh metadata when given
+    size_t tileBytes = 64 * 1024;  // a tiled face has 2^floor(log2(bytes / tileBytes)) tiles, near square
+    std::optional<MeshData> mesh;  // written as the standard mesh metadata when given
 };
 
 // Reads a Ptex file: header, extended header, face info, constant data, level 0 (every block encoding:
@@ -143,9 +147,13 @@ struct WriteOptions {
 
 // Writes a Ptex file atomically (temporary file + rename). The writer decides the flags `constant` (all
 // texels equal, or texels empty: the value is taken from constData) and `neighbourhoodConstant`, and
-// writes `hasEdits` false; constData of non-constant faces is recomputed (alpha-weighted average). Throws
-// InvalidInput naming the face or entry for a file that cannot be written (bad resolution, channel count,
-// alpha channel, adjacency, texel buffer size, metadata key, mesh data).
+// writes `hasEdits` false; constData of non-constant faces is recomputed (the mean of the smallest stored
+// reduction, alpha-premultiplied, then divided by its alpha). A triangle file (meshType Triangle) takes
+// square faces and writes no sub-face flag or fourth edge. Files read back through the reference Ptex
+// library with the texels, reductions, constant values and flags its own writer gives the same faces.
+// Throws InvalidInput naming the face or entry for a file that cannot be written (bad resolution, a
+// non-square triangle face, channel count, alpha channel, adjacency, texel buffer size, metadata key, an
+// entry without values, mesh data).
 void writePtex(const std::filesystem::path& path, const PtexFile& file, const WriteOptions& options = {});
 [[nodiscard]] std::vector<uint8_t> writePtexBytes(const PtexFile& file, const WriteOptions& options = {});
 
