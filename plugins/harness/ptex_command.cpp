@@ -118,6 +118,7 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
     ptex::ToUdimOptions options;
     options.resolution = command.resolution;
     options.tiles = command.tiles;
+    options.padding = command.padding;
     std::vector<fs::path> written;
     for (const ptex::UdimTile& tile :
          ptex::ptexToUdim(ptexMesh, mesh, file, command.ptex.string(), options)) {
@@ -230,6 +231,8 @@ void addPtexCommands(CommandLine& cli) {
     toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
     toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
     toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
+    toUdim.option("--padding", tu->command.padding, "texels of edge padding around the UV charts")
+        .showDefault();
 
     struct FromUdim {
         PtexFromUdimCommand command;

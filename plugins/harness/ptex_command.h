@@ -34,6 +34,7 @@ struct PtexToUdimCommand {
     std::string out;  // a UDIM pattern
     int32_t resolution = 1024;
     std::vector<int> tiles;  // empty: every tile of the mesh
+    int32_t padding = 8;     // texels of edge padding around the charts
 };
 std::vector<std::filesystem::path> ptexToUdimCommand(const PtexToUdimCommand& command);
 

@@ -1,9 +1,12 @@
 #include "deformkit/ptex/ptex_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <utility>
 
 #include <opensubdiv/far/ptexIndices.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -564,6 +567,123 @@ PtexFile bakeVertexValues(const PtexMesh& mesh, std::span<const float> values, i
 // ---------------------------------------------------------------------------------------------------------
 // UDIM conversions
 
+namespace {
+
+// Barycentric weights of the point of triangle (a, b, c) nearest to p, and its squared distance.
+std::pair<glm::dvec3, double> nearestOnTriangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b,
+                                                const glm::dvec2& c) {
+    const glm::dvec2 ab = b - a, ac = c - a, ap = p - a;
+    const double det = ab.x * ac.y - ab.y * ac.x;
+    if (det != 0.0) {
+        const double l1 = (ap.x * ac.y - ap.y * ac.x) / det;
+        const double l2 = (ab.x * ap.y - ab.y * ap.x) / det;
+        if (l1 >= 0.0 && l2 >= 0.0 && l1 + l2 <= 1.0) return {{1.0 - l1 - l2, l1, l2}, 0.0};
+    }
+    // Outside (or degenerate): the nearest point of the three edges.
+    std::pair<glm::dvec3, double> best{{1.0, 0.0, 0.0}, glm::dot(ap, ap)};
+    const std::array<glm::dvec2, 3> corner{a, b, c};
+    for (int e = 0; e < 3; ++e) {
+        const glm::dvec2 from = corner[e], to = corner[(e + 1) % 3];
+        const glm::dvec2 edge = to - from;
+        const double length2 = glm::dot(edge, edge);
+        const double t = length2 > 0.0 ? std::clamp(glm::dot(p - from, edge) / length2, 0.0, 1.0) : 0.0;
+        const glm::dvec2 q = from + t * edge;
+        const double d2 = glm::dot(p - q, p - q);
+        if (d2 < best.second) {
+            glm::dvec3 l(0.0);
+            l[e] = 1.0 - t;
+            l[(e + 1) % 3] = t;
+            best = {l, d2};
+        }
+    }
+    return best;
+}
+
+// Texels whose centre lies in a UV face of `tile` (each face fanned into triangles from its first corner),
+// rasterised by the same rule as the faces' cells.
+std::vector<uint8_t> chartMask(const geom::Mesh& mesh, int tile, const io::TileOrigin& origin, int32_t res) {
+    std::vector<glm::vec2> positions;
+    std::vector<std::array<int32_t, 3>> triangles;
+    for (int32_t f = 0; f < mesh.numFaces(); ++f) {
+        if (faceTile(mesh, f) != tile) continue;
+        const auto corners = mesh.faceUVIndices(f);
+        const auto base = static_cast<int32_t>(positions.size());
+        for (const int32_t c : corners) {
+            const glm::vec2 uv = mesh.uvs()[c];
+            positions.emplace_back(static_cast<float>((uv.x - origin.u) * res),
+                                   static_cast<float>((1.0 - (uv.y - origin.v)) * res));
+        }
+        for (int32_t k = 1; k + 1 < static_cast<int32_t>(corners.size()); ++k)
+            triangles.push_back({base, base + k, base + k + 1});
+    }
+    const std::vector<float> attributes(positions.size(), 0.0f);
+    geom::AttributeRaster raster;
+    geom::rasterizeAttributes({res, res}, positions, triangles, attributes, 1, raster);
+    std::vector<uint8_t> mask(raster.triangle.size());
+    for (size_t i = 0; i < mask.size(); ++i)
+        mask[i] = raster.triangle[i] >= 0 ? 1 : 0;
+    return mask;
+}
+
+// Gives uncovered texels the (u, v) of the nearest point of a covered 8-neighbour's cell, one ring at a
+// time: every texel of `chart` (hairline cracks where the cell grids of two faces meet) and `padding` rings
+// around the charts, as texture bakers pad chart edges. Neighbours are taken in a fixed order and ties
+// keep the first, so the result is the same on every run.
+void fillFromNeighbours(geom::AttributeRaster& raster, std::span<const glm::vec2> positions,
+                        std::span<const std::array<int32_t, 3>> triangles, std::span<const float> attributes,
+                        const std::vector<uint8_t>& chart, int32_t padding) {
+    const int32_t w = raster.width, h = raster.height;
+    struct Update {
+        size_t texel;
+        int32_t triangle;
+        glm::vec2 uv;
+    };
+    std::vector<Update> updates;
+    for (int32_t ring = 1;; ++ring) {
+        updates.clear();
+        size_t chartLeft = 0;
+        for (int32_t y = 0; y < h; ++y) {
+            for (int32_t x = 0; x < w; ++x) {
+                const size_t i = static_cast<size_t>(y) * w + x;
+                if (raster.triangle[i] >= 0 || (!chart[i] && ring > padding)) continue;
+                const glm::dvec2 centre(x + 0.5, y + 0.5);
+                double bestD2 = std::numeric_limits<double>::infinity();
+                Update best{i, -1, {}};
+                for (int32_t dy = -1; dy <= 1; ++dy) {
+                    for (int32_t dx = -1; dx <= 1; ++dx) {
+                        const int32_t nx = x + dx, ny = y + dy;
+                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                        const int32_t t = raster.triangle[static_cast<size_t>(ny) * w + nx];
+                        if (t < 0) continue;
+                        const auto& tri = triangles[t];
+                        const auto [l, d2] = nearestOnTriangle(centre, positions[tri[0]], positions[tri[1]],
+                                                               positions[tri[2]]);
+                        if (d2 >= bestD2) continue;
+                        bestD2 = d2;
+                        glm::dvec2 uv(0.0);
+                        for (int k = 0; k < 3; ++k)
+                            uv += l[k] * glm::dvec2(attributes[2 * tri[k]], attributes[2 * tri[k] + 1]);
+                        best = {i, t, glm::vec2(uv)};
+                    }
+                }
+                if (best.triangle >= 0) {
+                    updates.push_back(best);
+                } else if (chart[i]) {
+                    ++chartLeft;
+                }
+            }
+        }
+        for (const Update& u : updates) {
+            raster.triangle[u.texel] = u.triangle;
+            raster.values[2 * u.texel] = u.uv.x;
+            raster.values[2 * u.texel + 1] = u.uv.y;
+        }
+        if (updates.empty() || (ring >= padding && chartLeft == 0)) break;
+    }
+}
+
+}  // namespace
+
 std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mesh, const PtexFile& file,
                                  const std::string& fileSource, const ToUdimOptions& options) {
     requireUVs(mesh, ptexMesh);
@@ -571,6 +691,10 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
     if (options.resolution < 1 || options.resolution > 65536) {
         throw InvalidInput(formatError(fileSource, "resolution", "is " + std::to_string(options.resolution),
                                        "a tile resolution in [1, 65536]"));
+    }
+    if (options.padding < 0 || options.padding > 65536) {
+        throw InvalidInput(formatError(fileSource, "padding", "is " + std::to_string(options.padding),
+                                       "texels of edge padding in [0, 65536]"));
     }
     std::vector<int> tiles = options.tiles.empty() ? mesh.udimTiles() : options.tiles;
     for (int tile : tiles) {  // the mesh's own tiles are valid (Mesh::udimTiles); asked-for ones are checked
@@ -628,6 +752,8 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
         }
         geom::AttributeRaster raster;
         geom::rasterizeAttributes({res, res}, positions, triangles, attributes, 2, raster);
+        const std::vector<uint8_t> chart = chartMask(mesh, tile, origin, res);
+        fillFromNeighbours(raster, positions, triangles, attributes, chart, options.padding);
         UdimTile result{tile, io::Image(res, res, outChannels, 0.0f)};
         for (int32_t y = 0; y < res; ++y) {
             for (int32_t x = 0; x < res; ++x) {
@@ -638,7 +764,7 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
                                value);
                 for (int32_t c = 0; c < channels; ++c)
                     result.image.at(x, y, c) = value[c];
-                if (options.coverageChannel) result.image.at(x, y, channels) = 1.0f;
+                if (options.coverageChannel && chart[pixel]) result.image.at(x, y, channels) = 1.0f;
             }
         }
         out.push_back(std::move(result));

@@ -155,6 +155,8 @@ contains ptex-udim-tile "$work/err" "--tiles: '1000' is not a UDIM tile"
 # rendered (it was skipped, its centroid being left of the tile).
 expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --resolution 16
 [ -s "$work/l.1001.png" ] || { echo "FAIL ptex-udim-overhang: tile missing"; failures=$((failures + 1)); }
+expect ptex-udim-padding 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --padding -1
+contains ptex-udim-padding "$work/err" "padding: is -1 (expected texels of edge padding in [0, 65536])"
 printf 'not a ptex file, just some text that is long enough to hold a header of sixty-four bytes\n' >"$work/bad.ptx"
 expect ptex-bad-file 2 "$dk" ptex info "$work/bad.ptx"
 contains ptex-bad-file "$work/err" "bad.ptx"

@@ -146,9 +146,13 @@ struct BakeOptions {
 
 // Ptex -> UDIM: renders the file into one image per UDIM tile through the mesh's UVs. Each Ptex face is
 // drawn as a grid of small triangles carrying its (u, v), mapped into UV space with the same bilinear
-// interpolation of the corner UVs as cornerWeights(); texels whose centre no face covers get 0 and alpha
-// (a last channel added when `coverageChannel`) 0. Throws InvalidInput naming the mesh when it has no
-// UVs, and the tile when a tile number is not valid.
+// interpolation of the corner UVs as cornerWeights(). Every texel whose centre lies in a UV face of the
+// tile is covered (where the cell grids of two faces meet, a texel takes the nearest point of a
+// neighbouring cell), and `padding` rings of texels around the charts take the value at the nearest chart
+// border (edge padding), so bilinear look-ups at a chart's edge read the chart's own values; texels
+// farther out are 0. The coverage channel (a last channel added when `coverageChannel`) is 1 exactly on
+// the charts. Throws InvalidInput naming the mesh when it has no UVs, and the tile when a tile number is
+// not valid.
 struct UdimTile {
     int tile = 1001;
     io::Image image;
@@ -157,6 +161,7 @@ struct ToUdimOptions {
     int32_t resolution = 1024;  // each tile resolution × resolution
     std::vector<int> tiles;     // empty: every tile the mesh's UV faces touch
     bool coverageChannel = false;
+    int32_t padding = 8;  // texels of edge padding around the charts (0: none)
 };
 [[nodiscard]] std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mesh,
                                                const PtexFile& file, const std::string& fileSource,
