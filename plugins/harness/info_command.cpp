@@ -49,6 +49,11 @@ void describeMesh(const fs::path& file, std::ostream& out) {
         for (int t : m.udimTiles())
             out << " " << t;
         out << "\n";
+        if (obj.facesWithoutUVs > 0) {
+            out << "warning     " << obj.facesWithoutUVs
+                << (obj.facesWithoutUVs == 1 ? " face has" : " faces have") << " no UVs (first on line "
+                << obj.firstLineWithoutUVs << "): in no UDIM tile, left alone by texture-space work\n";
+        }
         const geom::UdimOverhang overhang = geom::udimOverhang(m);
         if (overhang.faces > 0) {
             out << "warning     " << overhang.faces

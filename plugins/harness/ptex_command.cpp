@@ -128,7 +128,7 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
     return written;
 }
 
-void ptexFromUdimCommand(const PtexFromUdimCommand& command) {
+int32_t ptexFromUdimCommand(const PtexFromUdimCommand& command) {
     const geom::Mesh mesh = io::readObj(command.mesh).mesh;
     std::vector<ptex::UdimTile> tiles;
     for (const io::UdimFile& f : io::findUdimFiles(command.pattern))
@@ -141,6 +141,7 @@ void ptexFromUdimCommand(const PtexFromUdimCommand& command) {
     ptex::WriteOptions write;
     write.mesh = ptex::meshData(mesh);
     ptex::writePtex(command.out, file, write);
+    return mesh.numFacesWithoutUVs();
 }
 
 void ptexFromVertexCommand(const PtexFromVertexCommand& command) {
@@ -245,7 +246,11 @@ void addPtexCommands(CommandLine& cli) {
             fu->command.out = fu->out;
             fu->command.faceLog2 = parseFaceResolution(fu->faceRes);
             fu->command.type = parsePtexType(fu->type);
-            ptexFromUdimCommand(fu->command);
+            const int32_t withoutUVs = ptexFromUdimCommand(fu->command);
+            if (withoutUVs > 0) {
+                std::cout << withoutUVs << (withoutUVs == 1 ? " face has" : " faces have")
+                          << " no UVs: written as 0\n";
+            }
             std::cout << "wrote " << fu->out << "\n";
             return 0;
         });

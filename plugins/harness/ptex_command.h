@@ -47,7 +47,8 @@ struct PtexFromUdimCommand {
     int8_t faceLog2 = -1;  // -1: per face from its size in tile texels
     ptex::DataType type = ptex::DataType::Float;
 };
-void ptexFromUdimCommand(const PtexFromUdimCommand& command);
+// Returns the number of mesh faces without UVs (written as 0).
+int32_t ptexFromUdimCommand(const PtexFromUdimCommand& command);
 
 // `deformkit ptex from-vertex weights.json MESH --out FILE.ptx [--face-res N] [--type ...]`: per-vertex
 // weights (the JSON weights file) baked into a Ptex file of the mesh (ptex::bakeVertexValues): each texel

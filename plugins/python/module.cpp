@@ -105,13 +105,15 @@ PYBIND11_MODULE(deformkit, m) {
                             true);
             },
             "(K, 2) float32 view of the UVs, or None")
-        .def_property_readonly("uv_indices",
-                               [](py::object self) -> py::object {
-                                   const auto& mesh = self.cast<const geom::Mesh&>();
-                                   if (!mesh.hasUVs()) return py::none();
-                                   return view(mesh.uvIndices().data(), mesh.uvIndices().size(), 1, self,
-                                               false);
-                               })
+        .def_property_readonly(
+            "uv_indices",
+            [](py::object self) -> py::object {
+                const auto& mesh = self.cast<const geom::Mesh&>();
+                if (!mesh.hasUVs()) return py::none();
+                return view(mesh.uvIndices().data(), mesh.uvIndices().size(), 1, self, false);
+            },
+            "(corners,) int32 view of each face corner's UV index (-1 on every corner of "
+            "a face without UVs), or None")
         .def_property_readonly("num_vertices", &geom::Mesh::numVertices)
         .def_property_readonly("num_faces", &geom::Mesh::numFaces)
         .def("udim_tiles", &geom::Mesh::udimTiles, "UDIM tiles the UV faces touch")

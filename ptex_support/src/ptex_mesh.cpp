@@ -820,6 +820,13 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
     };
     for (int32_t p = 0; p < ptexMesh.numPtexFaces(); ++p) {
         const int32_t f = ptexMesh.meshFace(p);
+        if (!mesh.faceHasUVs(f)) {  // in no tile: 0, at the fixed resolution or 1 × 1
+            FaceInfo& info = file.faces[p];
+            info.ulog2 = std::max<int8_t>(ulog2, 0);
+            info.vlog2 = std::max<int8_t>(vlog2, 0);
+            file.texels[p].assign(info.texelCount() * file.pixelSize(), 0);
+            continue;
+        }
         const int tile = faceTile(mesh, f);
         const auto found = byTile.find(tile);
         if (found == byTile.end()) {

@@ -155,6 +155,12 @@ contains ptex-udim-tile "$work/err" "--tiles: '1000' is not a UDIM tile"
 # rendered (it was skipped, its centroid being left of the tile).
 expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --resolution 16
 [ -s "$work/l.1001.png" ] || { echo "FAIL ptex-udim-overhang: tile missing"; failures=$((failures + 1)); }
+# Faces without UVs beside faces with them (as exporters write them): read, in no tile, reported.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nf 1/1 2/2 3/3 4/4\nf 2 5 3\n' >"$work/mixed.obj"
+expect info-mixed-uvs 0 "$dk" info "$work/mixed.obj"
+contains info-mixed-uvs "$work/out" "warning     1 face has no UVs (first on line 11): in no UDIM tile"
+expect ptex-from-udim-mixed 0 "$dk" ptex from-udim "$work/demo/albedo.<UDIM>.png" "$work/mixed.obj" --out "$work/mixed.ptx"
+contains ptex-from-udim-mixed "$work/out" "1 face has no UVs: written as 0"
 expect ptex-udim-padding 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --padding -1
 contains ptex-udim-padding "$work/err" "padding: is -1 (expected texels of edge padding in [0, 65536])"
 printf 'not a ptex file, just some text that is long enough to hold a header of sixty-four bytes\n' >"$work/bad.ptx"

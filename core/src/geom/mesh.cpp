@@ -92,13 +92,28 @@ Mesh::Mesh(Data data, const std::string& source)
                                            "one UV index per face corner, or none"));
         }
         const int32_t nt = numUVs();
-        for (size_t c = 0; c < uvIndices_.size(); ++c) {
-            if (uvIndices_[c] < 0 || uvIndices_[c] >= nt) {
-                throw InvalidInput(
-                    formatError(source, "face corner " + std::to_string(c),
-                                "uv index " + std::to_string(uvIndices_[c]) + " is out of range",
-                                "an index in [0, " + std::to_string(nt) + ")"));
+        for (int32_t f = 0; f < numFaces(); ++f) {
+            const bool without = uvIndices_[faceOffsets_[f]] == -1;
+            facesWithoutUVs_ += without ? 1 : 0;
+            for (int32_t c = faceOffsets_[f]; c < faceOffsets_[f + 1]; ++c) {
+                const int32_t t = uvIndices_[c];
+                if (without && t != -1) {
+                    throw InvalidInput(formatError(
+                        source, "face " + std::to_string(f),
+                        "has UVs on some corners only (corner " + std::to_string(c - faceOffsets_[f]) +
+                            " has uv index " + std::to_string(t) + ", corner 0 has none)",
+                        "a UV index on every corner of a face, or -1 on every corner"));
+                }
+                if (!without && (t < 0 || t >= nt)) {
+                    throw InvalidInput(formatError(source, "face corner " + std::to_string(c),
+                                                   "uv index " + std::to_string(t) + " is out of range",
+                                                   "an index in [0, " + std::to_string(nt) + ")"));
+                }
             }
+        }
+        if (facesWithoutUVs_ == numFaces()) {
+            uvIndices_.clear();  // no face has UVs: the mesh has none
+            facesWithoutUVs_ = 0;
         }
     }
 }
@@ -132,7 +147,7 @@ int udimTileOf(const glm::vec2& uv) {
 std::vector<int> Mesh::udimTiles() const {
     std::set<int> tiles;
     for (int32_t f = 0; f < numFaces() && hasUVs(); ++f)
-        tiles.insert(faceUdimTile(f));
+        if (faceHasUVs(f)) tiles.insert(faceUdimTile(f));
     return {tiles.begin(), tiles.end()};
 }
 
@@ -151,13 +166,13 @@ glm::ivec2 faceTileCell(std::span<const glm::vec2> uvs, std::span<const int32_t>
 }  // namespace
 
 int Mesh::faceUdimTile(int32_t f) const {
-    if (!hasUVs()) return 0;
+    if (!faceHasUVs(f)) return 0;
     const glm::ivec2 cell = faceTileCell(uvs_, faceUVIndices(f));
     return 1001 + cell.x + 10 * cell.y;
 }
 
 float Mesh::faceUdimOverhang(int32_t f) const {
-    if (!hasUVs()) return 0.0f;
+    if (!faceHasUVs(f)) return 0.0f;
     const auto corners = faceUVIndices(f);
     const glm::vec2 lo(faceTileCell(uvs_, corners));
     const glm::vec2 hi = lo + 1.0f;

@@ -331,7 +331,7 @@ class ObjParser {
             if (!ok || !atSeparator(p))
                 fail<ParseError>(line_, "malformed face corner " + printable(tokenAt(p_)), kCornerForm);
             const int32_t vertex = resolveIndex(v, data_.points.size(), kVertex);
-            const int32_t uv = hasT ? resolveIndex(t, data_.uvs.size(), kTexCoord) : 0;
+            const int32_t uv = hasT ? resolveIndex(t, data_.uvs.size(), kTexCoord) : -1;
             if (hasN) resolveIndex(n, normalCount_, kNormal);
             if (corners == 0) {
                 faceHasUVs = hasT;
@@ -344,7 +344,7 @@ class ObjParser {
             }
             p_ = p;
             data_.faceIndices.push_back(vertex);
-            if (hasT) data_.uvIndices.push_back(uv);
+            data_.uvIndices.push_back(uv);  // -1: no UVs (cleared at the end when no face has any)
             ++corners;
         }
         endStatement();
@@ -352,13 +352,11 @@ class ObjParser {
             fail<InvalidInput>(statementLine_, "face has " + std::to_string(corners) + " vertices",
                                "at least 3 vertices per face");
         }
-        if (faceHasUVs && firstLineWithoutUVs_ != 0) failMixedUVs(statementLine_, firstLineWithoutUVs_);
-        if (!faceHasUVs && firstLineWithUVs_ != 0) failMixedUVs(firstLineWithUVs_, statementLine_);
         int64_t& firstLine = faceHasUVs ? firstLineWithUVs_ : firstLineWithoutUVs_;
         if (firstLine == 0) firstLine = statementLine_;
         faceCorners_.clear();
         if (hasRepeat(corners)) {
-            splitRepeats(corners, faceHasUVs);
+            splitRepeats(corners);
         } else {
             faceCorners_.push_back(corners);
         }
@@ -378,15 +376,12 @@ class ObjParser {
     // vertex: each loop is a face, loops of fewer than 3 corners are dropped. The count is reported
     // (ObjContent::repairedFaces). Replaces the polygon's last `corners` entries; faceCorners_ gets the
     // corner counts of the faces it becomes.
-    void splitRepeats(int32_t corners, bool hasUVs) {
+    void splitRepeats(int32_t corners) {
         const size_t n = static_cast<size_t>(corners);
         std::vector<int32_t> v(data_.faceIndices.end() - static_cast<ptrdiff_t>(n), data_.faceIndices.end());
-        std::vector<int32_t> t = hasUVs
-                                     ? std::vector<int32_t>(data_.uvIndices.end() - static_cast<ptrdiff_t>(n),
-                                                            data_.uvIndices.end())
-                                     : std::vector<int32_t>(n, 0);
+        std::vector<int32_t> t(data_.uvIndices.end() - static_cast<ptrdiff_t>(n), data_.uvIndices.end());
         data_.faceIndices.resize(data_.faceIndices.size() - n);
-        if (hasUVs) data_.uvIndices.resize(data_.uvIndices.size() - n);
+        data_.uvIndices.resize(data_.uvIndices.size() - n);
         // Consecutive repeats, around the polygon too.
         std::vector<int32_t> cv, ct;
         for (size_t k = 0; k < n; ++k) {
@@ -423,7 +418,7 @@ class ObjParser {
                 if (std::find(emitted.begin(), emitted.end(), key) != emitted.end()) continue;
                 emitted.push_back(std::move(key));
                 data_.faceIndices.insert(data_.faceIndices.end(), pv.begin(), pv.end());
-                if (hasUVs) data_.uvIndices.insert(data_.uvIndices.end(), pt.begin(), pt.end());
+                data_.uvIndices.insert(data_.uvIndices.end(), pt.begin(), pt.end());
                 faceCorners_.push_back(static_cast<int32_t>(pv.size()));
                 continue;
             }
@@ -444,14 +439,6 @@ class ObjParser {
         }
         ++repairedFaces_;
         if (firstRepairedLine_ == 0) firstRepairedLine_ = statementLine_;
-    }
-
-    [[noreturn]] void failMixedUVs(int64_t withUVs, int64_t withoutUVs) const {
-        fail<InvalidInput>(std::max(withUVs, withoutUVs),
-                           "the face on line " + std::to_string(withUVs) +
-                               " has texture coordinates but the face on line " + std::to_string(withoutUVs) +
-                               " has none",
-                           "texture coordinates on every face or on none");
     }
 
     bool hasRepeat(int32_t corners) {
@@ -514,12 +501,17 @@ class ObjParser {
             data_.uvs.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
             throw InvalidInput(formatError(source_, "", "has too many vertices", "fewer than 2^31"));
         }
-        // Texture coordinates no face uses are dropped with the faces' lack of UVs.
-        if (data_.uvIndices.empty()) data_.uvs.clear();
+        // Without a face with UVs the mesh has none: texture coordinates no face uses are dropped.
+        if (firstLineWithUVs_ == 0) {
+            data_.uvIndices.clear();
+            data_.uvs.clear();
+        }
         ObjContent content;
         content.mesh = geom::Mesh(std::move(data_), source_);
         content.groups = std::move(groups_);
         content.repairedFaces = repairedFaces_;
+        content.facesWithoutUVs = content.mesh.numFacesWithoutUVs();
+        content.firstLineWithoutUVs = content.facesWithoutUVs > 0 ? firstLineWithoutUVs_ : 0;
         content.firstRepairedLine = firstRepairedLine_;
         return content;
     }
@@ -710,11 +702,11 @@ std::string formatObjText(const geom::Mesh& mesh, const std::vector<FaceGroup>& 
         }
         out.append('f');
         const auto vertices = mesh.face(f);
-        const auto uvs = mesh.faceUVIndices(f);
+        const auto uvs = mesh.faceUVIndices(f);  // empty for a face without UVs
         for (size_t k = 0; k < vertices.size(); ++k) {
             out.append(' ');
             out.number(int64_t{vertices[k]} + 1);
-            if (withUVs) {
+            if (!uvs.empty()) {
                 out.append('/');
                 out.number(int64_t{uvs[k]} + 1);
             }

@@ -163,7 +163,7 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
             glm::vec3 albedo = o.vertexColors.empty() ? o.baseColor
                                                       : w.x * o.vertexColors[v0] + w.y * o.vertexColors[v1] +
                                                             w.z * o.vertexColors[v2];
-            if (texture) {
+            if (texture && uvIndices[c[0]] >= 0) {  // a face without UVs keeps the base colour
                 const glm::vec2 uv = w.x * mesh.uvs()[uvIndices[c[0]]] + w.y * mesh.uvs()[uvIndices[c[1]]] +
                                      w.z * mesh.uvs()[uvIndices[c[2]]];
                 if (auto s = sampleTexture(*texture, uv)) albedo = *s;

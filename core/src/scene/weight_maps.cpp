@@ -47,6 +47,7 @@ std::vector<float> weightsFromMaps(const geom::Mesh& mesh, const std::filesystem
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
         const auto corners = mesh.face(f);
         const auto cornerUVs = mesh.faceUVIndices(f);
+        if (cornerUVs.empty()) continue;  // a face without UVs reads no map
         const int tile = mesh.faceUdimTile(f);
         const io::Image& image = imageOf(tile, f);
         sample.resize(static_cast<size_t>(image.channels));

@@ -246,6 +246,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
     }
     const int32_t resolution = j.options.cells;
     const bool wantBake = j.texture.given();
+    bool saidNoUVs = false;
     for (int tile : tiles) {
         TilePlan plan;
         plan.tile = tile;
@@ -263,6 +264,12 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             plan.report.notes.push_back("left unwarped: no rigidity map '" + plan.rigidity.name + "'");
             s.plans.push_back(std::move(plan));
             continue;
+        }
+        if (!saidNoUVs && j.rest->numFacesWithoutUVs() > 0) {  // said once, with the first warped tile
+            saidNoUVs = true;
+            const int32_t n = j.rest->numFacesWithoutUVs();
+            plan.report.notes.push_back(std::to_string(n) + (n == 1 ? " face has" : " faces have") +
+                                        " no UVs: in no tile, left unwarped");
         }
         const geom::UdimOverhang overhang = geom::udimOverhang(*j.rest, tile);
         if (overhang.faces > 0) {

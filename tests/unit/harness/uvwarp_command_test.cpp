@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -413,4 +414,29 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     outOfRange.command.orientation = outOfRange.dir / "orient.<UDIM>.exr";
     CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(outOfRange.command, nullptr); }),
                Catch::Contains("orient.1001.exr") && Catch::Contains("1.5"));
+}
+
+TEST_CASE("uvwarp command: faces without UVs are in no tile, left alone and reported once",
+          "[harness][uvwarp]") {
+    Scene plain({0, 1});
+    Scene mixed({0, 1});  // the same files, each with one more face, without texture coordinates
+    for (const char* name : {"rest.obj", "anim.0001.obj", "anim.0002.obj", "anim.0003.obj"}) {
+        std::ofstream(mixed.dir / name, std::ios::app) << "f 1 3 2\n";
+    }
+    for (Scene* s : {&plain, &mixed})
+        io::writeImage(s->dir / "rig.1002.exr", disks(), {io::PixelType::Float, {}});
+    const uvwarp::ShotReport plainReport = harness::uvwarpCommand(plain.command);
+    const uvwarp::ShotReport report = harness::uvwarpCommand(mixed.command);
+    REQUIRE(report.tiles.size() == 2);
+    int said = 0;
+    for (const auto& tile : report.tiles)
+        for (const std::string& note : tile.notes)
+            said += note.find("no UVs") != std::string::npos ? 1 : 0;
+    CHECK(said == 1);
+    REQUIRE_FALSE(report.tiles[0].notes.empty());
+    CHECK(report.tiles[0].notes[0] == "1 face has no UVs: in no tile, left unwarped");
+    for (int tile : {1001, 1002}) {
+        CHECK(io::readImage(mixed.redirect(3, tile)).pixels == io::readImage(plain.redirect(3, tile)).pixels);
+    }
+    CHECK(plainReport.tiles[0].notes.empty());
 }

@@ -346,6 +346,30 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         }
         CHECK_NOTHROW(GeometryImager(leftOfZero, 1001, 8, options));
     }
+    SECTION("a face without UVs belongs to no tile and is left alone") {
+        // The chart plus a triangle without UVs (as OBJ exporters write them beside UV'd faces), on two of
+        // the chart's vertices and one far away: the tile's geometry image is the chart's alone.
+        geom::Mesh::Data d;
+        d.points.assign(chart.points().begin(), chart.points().end());
+        d.points.push_back({0.5f, 0.5f, 5.0f});
+        d.faceCounts.assign(chart.faceCounts().begin(), chart.faceCounts().end());
+        d.faceCounts.push_back(3);
+        d.faceIndices.assign(chart.faceIndices().begin(), chart.faceIndices().end());
+        d.faceIndices.insert(d.faceIndices.end(), {0, 1, chart.numVertices()});
+        d.uvs.assign(chart.uvs().begin(), chart.uvs().end());
+        d.uvIndices.assign(chart.uvIndices().begin(), chart.uvIndices().end());
+        d.uvIndices.insert(d.uvIndices.end(), {-1, -1, -1});
+        const geom::Mesh mixed(std::move(d), "mixed.obj");
+        CHECK(mixed.numFacesWithoutUVs() == 1);
+        CHECK(mixed.udimTiles() == std::vector<int>{1001});
+        const GeometryImager alone(chart, 1001, 8, options);
+        const GeometryImager withExtra(mixed, 1001, 8, options);
+        CHECK(std::vector<uint8_t>(withExtra.coverage().begin(), withExtra.coverage().end()) ==
+              std::vector<uint8_t>(alone.coverage().begin(), alone.coverage().end()));
+        std::vector<glm::vec3> moved(mixed.points().begin(), mixed.points().end());
+        moved.back() = {7.0f, -3.0f, 2.0f};  // the face without UVs moves: nothing in the tile changes
+        CHECK(withExtra.sample(moved).values == alone.sample(chart.points()).values);
+    }
     SECTION("a face on the tile border does not overhang") {
         const geom::Mesh onBorder = test::planarChart({0.5f, 0.0f}, {1.0f, 1.0f}, 1, 1, flat);
         CHECK_NOTHROW(GeometryImager(onBorder, 1001, 8, options));

@@ -27,21 +27,30 @@ class Mesh {
         std::vector<glm::vec3> points;     // #V positions, scene units
         std::vector<int32_t> faceCounts;   // #F vertex counts, each >= 3
         std::vector<int32_t> faceIndices;  // sum(faceCounts) vertex indices in [0, #V), face by face
-        std::vector<glm::vec2> uvs;      // #UV texture coordinates (UDIM: tile 1001 + floor(u) + 10 floor(v))
-        std::vector<int32_t> uvIndices;  // empty, or one index into uvs per face corner
+        std::vector<glm::vec2> uvs;  // #UV texture coordinates (UDIM: tile 1001 + floor(u) + 10 floor(v))
+        // Empty, or one index into uvs per face corner; -1 on every corner of a face without UVs (OBJ files
+        // mix such faces with UV'd ones: they belong to no UDIM tile).
+        std::vector<int32_t> uvIndices;
     };
 
     Mesh();
     // Validates `data` and throws InvalidInput naming `source` (a file path or a label) and the first
     // bad element: a face with fewer than 3 vertices or a repeated vertex, an index out of range, a
-    // NaN or infinite coordinate, UV indices that do not match the corners.
+    // NaN or infinite coordinate, UV indices that do not match the corners, a face with UVs on some corners
+    // only.
     explicit Mesh(Data data, const std::string& source = "mesh");
 
     [[nodiscard]] int32_t numVertices() const { return static_cast<int32_t>(points_.size()); }
     [[nodiscard]] int32_t numFaces() const { return static_cast<int32_t>(faceCounts_.size()); }
     [[nodiscard]] int32_t numCorners() const { return static_cast<int32_t>(faceIndices_.size()); }
     [[nodiscard]] int32_t numUVs() const { return static_cast<int32_t>(uvs_.size()); }
+    // True when some face has UVs.
     [[nodiscard]] bool hasUVs() const { return !uvIndices_.empty(); }
+    // Faces without UVs in a mesh that has UVs (0 without UVs at all).
+    [[nodiscard]] int32_t numFacesWithoutUVs() const { return facesWithoutUVs_; }
+    [[nodiscard]] bool faceHasUVs(int32_t f) const {
+        return !uvIndices_.empty() && uvIndices_[faceOffsets_[f]] >= 0;
+    }
 
     [[nodiscard]] std::span<const glm::vec3> points() const { return points_; }
     // Mutable positions for deformers; the vertex count cannot change.
@@ -59,18 +68,18 @@ class Mesh {
     [[nodiscard]] std::span<const glm::vec2> uvs() const { return uvs_; }
     [[nodiscard]] std::span<glm::vec2> uvs() { return uvs_; }
     [[nodiscard]] std::span<const int32_t> uvIndices() const { return uvIndices_; }
-    // The UV indices of face f's corners; empty when the mesh has no UVs.
+    // The UV indices of face f's corners; empty when the face has no UVs.
     [[nodiscard]] std::span<const int32_t> faceUVIndices(int32_t f) const {
-        if (uvIndices_.empty()) return {};
+        if (!faceHasUVs(f)) return {};
         return std::span<const int32_t>(uvIndices_).subspan(faceOffsets_[f], faceCounts_[f]);
     }
 
     [[nodiscard]] Box3 bounds() const;
-    // The sorted UDIM tile numbers of the faces (faceUdimTile). Empty without UVs.
+    // The sorted UDIM tile numbers of the faces with UVs (faceUdimTile). Empty without UVs.
     [[nodiscard]] std::vector<int> udimTiles() const;
     // The UDIM tile face f belongs to: the tile of its UV centroid, the centroid's column clamped to 0..9
     // and its row to >= 0, so a face overhanging the left or bottom edge of the UV space stays in the tile
-    // it overhangs. 0 without UVs.
+    // it overhangs. 0 for a face without UVs.
     [[nodiscard]] int faceUdimTile(int32_t f) const;
     // How far face f's UV corners reach outside its tile (faceUdimTile), in tile widths (UV units): 0 for
     // a face inside its tile, and without UVs.
@@ -88,6 +97,7 @@ class Mesh {
     std::vector<int32_t> faceIndices_;
     std::vector<glm::vec2> uvs_;
     std::vector<int32_t> uvIndices_;
+    int32_t facesWithoutUVs_ = 0;
     std::shared_ptr<TopologyCache> topology_;
 };
 

@@ -22,6 +22,10 @@ struct ObjContent {
     // the first: `deformkit info` reports them.
     int64_t repairedFaces = 0;
     int64_t firstRepairedLine = 0;
+    // Faces without texture coordinates in a file whose other faces have them (they belong to no UDIM tile:
+    // texture-space work leaves them alone), and the line of the first.
+    int64_t facesWithoutUVs = 0;
+    int64_t firstLineWithoutUVs = 0;
 };
 
 // Reads a Wavefront OBJ: `v` (extra w or colour values ignored), `vt` (u v [w]), `f` with v, v/vt,
@@ -29,8 +33,9 @@ struct ObjContent {
 // continuations (`\`). Normals, materials and smoothing groups are ignored. Throws IoError for a
 // missing or unreadable file, ParseError/InvalidInput naming the file and line for: no faces, a malformed
 // number, an index of 0 or out of range, a face with fewer than 3 (distinct) vertices, NaN/inf
-// coordinates, some faces with UVs and some without, UTF-16 text. A polygon that visits a vertex twice is
-// repaired (ObjContent::repairedFaces).
+// coordinates, a face with texture coordinates on some corners only, UTF-16 text. A polygon that visits a
+// vertex twice is repaired (ObjContent::repairedFaces); faces without texture coordinates beside faces
+// with them are read as faces without UVs (ObjContent::facesWithoutUVs).
 [[nodiscard]] ObjContent readObj(const std::filesystem::path& path);
 
 // Parses OBJ text already in memory; `source` names it in errors.

@@ -17,7 +17,7 @@ namespace deformkit::scene {
 // the face's UV centroid, as geom::Mesh::udimTiles) at its tile-local uv: pixel position x = u W,
 // y = (1 - v) H (row 0 at the top, pixel centres at half-integers), bilinear, clamped to the edge pixels
 // (io::sampleImage). A vertex's weight is the mean of its corners' samples (UV seams give a vertex
-// several corners), in double, rounded to float once; a vertex on no face gets 0.
+// several corners), in double, rounded to float once; a vertex on no face with UVs gets 0.
 //
 // Throws InvalidInput naming `source` (how the caller names the weights, e.g. a scene's JSON path) for a
 // mesh without UVs, a channel the image does not have, a face in a tile other than 1001 with a pattern

@@ -171,7 +171,8 @@ struct ToUdimOptions {
 // and takes the bilinear sample of the tile image there (clamped at the tile's border). `tiles` holds one
 // image per tile, all with the same channel count. Face resolution: fixed (ulog2/vlog2 >= 0) or, with -1,
 // per face the power of two nearest the face's extent in texels of its tile (each axis, in [0, 12]).
-// Throws InvalidInput naming the mesh (no UVs) or the face whose UVs fall in a tile that is not given.
+// A face without UVs (Mesh::faceHasUVs) is in no tile: its Ptex faces are written 0. Throws InvalidInput
+// naming the mesh (no UVs) or the face whose UVs fall in a tile that is not given.
 struct FromUdimOptions {
     int8_t ulog2 = -1;
     int8_t vlog2 = -1;
