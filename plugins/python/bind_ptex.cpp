@@ -253,6 +253,12 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
     return file;
 }
 
+// How a mesh argument is named in messages: its OBJ path, or its size when it is a Mesh or arrays.
+std::string meshName(py::handle mesh, const geom::Mesh& m) {
+    if (!py::isinstance<geom::Mesh>(mesh)) return mesh.cast<std::filesystem::path>().string();
+    return "(" + std::to_string(m.numVertices()) + " vertices, " + std::to_string(m.numFaces()) + " faces)";
+}
+
 geom::Mesh meshFrom(py::handle mesh) {
     if (py::isinstance<geom::Mesh>(mesh)) return mesh.cast<geom::Mesh>();
     return io::readObj(mesh.cast<std::filesystem::path>()).mesh;
@@ -315,10 +321,11 @@ void bindPtex(py::module_& m) {
             const std::string source = py::isinstance<py::dict>(ptex)
                                            ? std::string("ptex")
                                            : ptex.cast<std::filesystem::path>().string();
+            const std::string name = meshName(mesh, m);
             std::vector<float> values;
             {
                 py::gil_scoped_release release;
-                values = ptex::vertexValues(ptex::PtexMesh(m, "ptex_vertex_values: mesh"), file, source);
+                values = ptex::vertexValues(ptex::PtexMesh(m, name), file, source);
             }
             py::array_t<float> out(std::vector<py::ssize_t>{m.numVertices(), file.channels});
             std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(float));

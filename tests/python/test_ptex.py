@@ -137,3 +137,18 @@ def test_mesh_type_and_modes_are_written_and_checked(tmp_path):
         dk.write_ptex(tmp_path / "x.ptx", {"data": data, "mesh_type": "quads"})
     with pytest.raises(dk.InvalidInput, match="face 0.*triangle file"):
         dk.write_ptex(tmp_path / "x.ptx", {"data": [np.zeros((4, 8, 1), np.float32)], "mesh_type": "triangle"})
+
+
+def test_a_file_of_another_mesh_names_the_file_once_and_the_mesh_by_its_size_or_path(tmp_path):
+    dk.write_ptex(tmp_path / "w.ptx", {"data": [np.zeros((2, 2, 1), np.float32)] * 16}, mesh=grid(4))
+    small = grid(3)
+    expected = r"w\.ptx: has 16 faces \(expected 9 Ptex faces .* for mesh \(16 vertices, 9 faces\)\)$"
+    with pytest.raises(dk.InvalidInput, match=expected) as error:
+        dk.ptex_vertex_values(small, tmp_path / "w.ptx")
+    assert str(error.value).count("w.ptx") == 1
+    with pytest.raises(dk.InvalidInput, match=r"^slide: weights_ptex: .*w\.ptx: .*for mesh \(16 vertices, 9 faces\)"):
+        dk.slide(small.points, small.face_counts, small.face_indices, 0, [0.1, 0, 0], 0.5,
+                 weights_ptex=tmp_path / "w.ptx")
+    dk.write_mesh(tmp_path / "small.obj", small)
+    with pytest.raises(dk.InvalidInput, match=r"for mesh .*small\.obj\)$"):
+        dk.ptex_vertex_values(tmp_path / "small.obj", tmp_path / "w.ptx")
