@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include "deformkit/ptex/half.h"
@@ -180,25 +181,12 @@ std::pair<int, int> colourChannels(int channels, int alphaChannel) {
 
 }  // namespace
 
-void premultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
-    if (alphaChannel < 0) return;
-    withChannel(type, [&]<typename C>(C) {
-        using T = typename C::Stored;
-        const size_t pixel = sizeof(T) * channels;
-        const auto [first, last] = colourChannels(channels, alphaChannel);
-        const float inverseOne = 1.0f / C::kOne;
-        for (size_t p = 0; p + pixel <= texels.size(); p += pixel) {
-            uint8_t* texel = texels.data() + p;
-            const float factor = inverseOne * C::value(load<T>(texel + alphaChannel * sizeof(T)));
-            for (int c = first; c < last; ++c) {
-                uint8_t* v = texel + c * sizeof(T);
-                store(v, C::from(C::value(load<T>(v)) * factor));
-            }
-        }
-    });
-}
+namespace {
 
-void unpremultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
+// Multiplies the colour channels of every texel by factor(C, alpha), a float; a texel whose factor is
+// not set keeps its colour.
+template <typename Factor>
+void scaleColour(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel, Factor factor) {
     if (alphaChannel < 0) return;
     withChannel(type, [&]<typename C>(C) {
         using T = typename C::Stored;
@@ -206,19 +194,20 @@ void unpremultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, 
         const auto [first, last] = colourChannels(channels, alphaChannel);
         for (size_t p = 0; p + pixel <= texels.size(); p += pixel) {
             uint8_t* texel = texels.data() + p;
-            const float alpha = C::value(load<T>(texel + alphaChannel * sizeof(T)));
-            if (alpha == 0.0f) continue;  // transparent: the colour stays as it is
-            const float factor = C::kOne / alpha;
+            const std::optional<float> f = factor(C{}, C::value(load<T>(texel + alphaChannel * sizeof(T))));
+            if (!f) continue;
             for (int c = first; c < last; ++c) {
                 uint8_t* v = texel + c * sizeof(T);
-                store(v, C::from(C::value(load<T>(v)) * factor));
+                store(v, C::from(C::value(load<T>(v)) * *f));
             }
         }
     });
 }
 
-std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int h, DataType type,
-                                    int channels) {
+// The 2 × 2 reduction of a quad face, or with `triangle` of a packed triangle face (w = h), whose fourth
+// texel is the inverted one packed opposite the block.
+std::vector<uint8_t> reduce(std::span<const uint8_t> texels, int w, int h, DataType type, int channels,
+                            bool triangle) {
     return withChannel(type, [&]<typename C>(C) {
         using T = typename C::Stored;
         const size_t pixel = sizeof(T) * channels;
@@ -231,10 +220,11 @@ std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int 
         for (int y = 0; y < rh; ++y) {
             for (int x = 0; x < rw; ++x) {
                 uint8_t* o = out.data() + (static_cast<size_t>(y) * rw + x) * pixel;
+                const int fourthX = triangle ? w - 1 - 2 * y : 2 * x + 1;
+                const int fourthY = triangle ? w - 1 - 2 * x : 2 * y + 1;
                 for (int c = 0; c < channels; ++c) {
-                    store(o + c * sizeof(T),
-                          C::quarter(at(2 * x, 2 * y, c), at(2 * x + 1, 2 * y, c), at(2 * x, 2 * y + 1, c),
-                                     at(2 * x + 1, 2 * y + 1, c)));
+                    store(o + c * sizeof(T), C::quarter(at(2 * x, 2 * y, c), at(2 * x + 1, 2 * y, c),
+                                                        at(2 * x, 2 * y + 1, c), at(fourthX, fourthY, c)));
                 }
             }
         }
@@ -242,29 +232,27 @@ std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int 
     });
 }
 
-std::vector<uint8_t> reduceTriangleFace(std::span<const uint8_t> texels, int w, DataType type, int channels) {
-    return withChannel(type, [&]<typename C>(C) {
-        using T = typename C::Stored;
-        const size_t pixel = sizeof(T) * channels;
-        const int rw = w / 2;
-        std::vector<uint8_t> out(static_cast<size_t>(rw) * rw * pixel);
-        const auto at = [&](int x, int y, int c) {
-            return load<T>(texels.data() + (static_cast<size_t>(y) * w + x) * pixel + c * sizeof(T));
-        };
-        for (int y = 0; y < rw; ++y) {
-            for (int x = 0; x < rw; ++x) {
-                uint8_t* o = out.data() + (static_cast<size_t>(y) * rw + x) * pixel;
-                for (int c = 0; c < channels; ++c) {
-                    // Three texels of the 2 × 2 block and the texel packed opposite them, which holds
-                    // the block's fourth (inverted) texel.
-                    store(o + c * sizeof(T),
-                          C::quarter(at(2 * x, 2 * y, c), at(2 * x + 1, 2 * y, c), at(2 * x, 2 * y + 1, c),
-                                     at(w - 1 - 2 * y, w - 1 - 2 * x, c)));
-                }
-            }
-        }
-        return out;
+}  // namespace
+
+void premultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
+    scaleColour(texels, type, channels, alphaChannel,
+                []<typename C>(C, float alpha) -> std::optional<float> { return (1.0f / C::kOne) * alpha; });
+}
+
+void unpremultiplyAlpha(std::span<uint8_t> texels, DataType type, int channels, int alphaChannel) {
+    scaleColour(texels, type, channels, alphaChannel, []<typename C>(C, float alpha) -> std::optional<float> {
+        if (alpha == 0.0f) return std::nullopt;  // transparent: the colour stays as it is
+        return C::kOne / alpha;
     });
+}
+
+std::vector<uint8_t> reduceQuadFace(std::span<const uint8_t> texels, int w, int h, DataType type,
+                                    int channels) {
+    return reduce(texels, w, h, type, channels, false);
+}
+
+std::vector<uint8_t> reduceTriangleFace(std::span<const uint8_t> texels, int w, DataType type, int channels) {
+    return reduce(texels, w, w, type, channels, true);
 }
 
 void averageTexels(std::span<const uint8_t> texels, size_t count, DataType type, int channels, uint8_t* out) {
