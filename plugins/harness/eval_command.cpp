@@ -126,7 +126,8 @@ void encodeMovie(const fs::path& ffmpeg, const std::vector<fs::path>& pngs, cons
             " -i " + shellQuote((scratch.dir / "%06d.png").string()) +
             " -pix_fmt yuv420p -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' " + shellQuote(tmp.string());
         const int status = std::system(command.c_str());
-        if (status != 0 || !fs::is_regular_file(tmp)) {
+        std::error_code ec;
+        if (status != 0 || !fs::is_regular_file(tmp, ec)) {
             std::string what = "wrote no file";
             if (status == -1) {
                 what = "could not be started";

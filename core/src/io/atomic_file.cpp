@@ -135,7 +135,7 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
 void createFolder(const fs::path& path) {
     std::error_code ec;
     fs::create_directories(path, ec);
-    if (!fs::is_directory(path)) {
+    if (!fs::is_directory(fs::status(path, ec))) {
         const fs::path blocker = fileInTheWay(path);
         if (!blocker.empty()) {
             throw IoError(formatError(path.string(), "",

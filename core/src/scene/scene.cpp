@@ -44,6 +44,18 @@ class Reader {
         throw InvalidInput(formatError(source_, path, problem, expected));
     }
 
+    // Whether `file` is a regular file; a path the system cannot even look up (a name too long, a folder
+    // without permission) is an error naming the JSON path.
+    bool isRegularFile(const fs::path& file, const std::string& path) const {
+        std::error_code ec;
+        const fs::file_status status = fs::status(file, ec);
+        if (ec && status.type() != fs::file_type::not_found) {
+            fail(path, "names " + file.string() + ", which cannot be looked up: " + ec.message(),
+                 "a readable OBJ file");
+        }
+        return fs::is_regular_file(status);
+    }
+
     void requireObject(const json& v, const std::string& path, const std::string& expected) const {
         if (!v.is_object()) fail(path, "is " + detail::jsonKind(v), expected);
     }
@@ -478,7 +490,7 @@ class Reader {
             o.restFrame =
                 v.contains("restFrame") ? integer(v.at("restFrame"), path + ".restFrame") : firstFrame;
             o.meshFile = io::ObjSequence(o.sequence).framePath(o.restFrame);
-            if (!fs::is_regular_file(o.meshFile)) {
+            if (!isRegularFile(o.meshFile, path + ".mesh")) {
                 fail(path + ".mesh",
                      "names the sequence " + o.sequence.string() + ", whose rest frame " +
                          std::to_string(o.restFrame) + " (" + o.meshFile.string() + ") does not exist",
@@ -488,7 +500,7 @@ class Reader {
             fail(path + ".restFrame", "is given for the single mesh " + o.meshFile.string(),
                  "restFrame only with a frame sequence (\"mesh\": \"anim.####.obj\")");
         }
-        if (!fs::is_regular_file(o.meshFile))
+        if (!isRegularFile(o.meshFile, path + ".mesh"))
             fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "an OBJ file");
         try {
             io::ObjContent content = io::readObj(o.meshFile);
