@@ -29,7 +29,8 @@ REFERENCES = {
     # eval of the whole shot (the cost of cutting it into tasks: scene loading, cold starts per task).
     "BM_FarmRunPlan": ("BM_FarmEval", "farm tasks / one eval, frames per second"),
     # Ptex (issue 7): a 50k-face float RGB file read whole against a plain read of its bytes, and zlib
-    # alone inflating the same texels as one stream against the whole read (zlib's share of it).
+    # alone inflating the same texels as one stream against the whole read (zlib's share of it); writing it
+    # against zlib alone deflating the same texels.
     # Issue 19: an animated UV-warp frame on Spot (warm solve + redirect map) against the last frame solved
     # cold to convergence, frames per second (the quality gap is the gap_pts counter).
     # Issue 19, part 5: one 2048^2 iteration while another process holds a core; < 1 is faster than 1 thread.
@@ -38,6 +39,7 @@ REFERENCES = {
     "BM_UvWarpFrame": ("BM_UvWarpFrameConverged", "animated frame / converged cold solve, frames per second"),
     "BM_PtexRead": ("BM_PtexPlainRead", "Ptex read / plain read of the file's bytes, same texel bytes"),
     "BM_PtexZlibInflate": ("BM_PtexRead", "zlib inflate alone / whole Ptex read, same texel bytes"),
+    "BM_PtexWrite": ("BM_PtexZlibDeflate", "Ptex write (with reductions) / zlib deflate alone, same texel bytes"),
     "BM_PtexVertexValues": ("BM_PtexCornerLoop", "vertex values / minimal corner loop, 1M vertices"),
 }
 

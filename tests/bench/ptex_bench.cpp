@@ -1,6 +1,7 @@
 // Ptex speed, each against an in-run reference (scripts/bench_table.py prints the ratios):
 // - reading a 50,176-face float RGB file (8 x 8 texels a face, smooth content: every face zipped) against a
 //   plain read of the file's bytes and a plain zlib inflate of the same texels compressed as one stream;
+//   writing it against zlib alone deflating the same texels as one stream;
 // - per-vertex values of a 1,002,001-vertex quad grid (1-channel float, 4 x 4 a face) against a minimal
 //   loop over the same corner texels; and filtered look-ups at random points.
 
@@ -102,6 +103,32 @@ void BM_PtexZlibInflate(benchmark::State& state) {
     state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * f.texelBytes));
 }
 BENCHMARK(BM_PtexZlibInflate)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Writing the same file (level 0 and its reductions, zipped face by face) against zlib alone deflating the
+// same texels as one stream: what the writer adds to compression (reductions, planes, headers, zlib
+// blocks per face).
+void BM_PtexWrite(benchmark::State& state) {
+    ReadFixture& f = readFixture();
+    const ptex::PtexFile file = ptex::readPtex(f.path);
+    for (auto _ : state) {
+        std::vector<uint8_t> bytes = ptex::writePtexBytes(file);
+        benchmark::DoNotOptimize(bytes.data());
+    }
+    state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * f.texelBytes));
+}
+BENCHMARK(BM_PtexWrite)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PtexZlibDeflate(benchmark::State& state) {
+    ReadFixture& f = readFixture();
+    std::vector<uint8_t> out(compressBound(f.raw.size()));
+    for (auto _ : state) {
+        uLongf size = out.size();
+        compress2(out.data(), &size, f.raw.data(), f.raw.size(), ptex::WriteOptions{}.compressionLevel);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * f.texelBytes));
+}
+BENCHMARK(BM_PtexZlibDeflate)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 struct MeshFixture {
     geom::Mesh mesh = geom::makeGrid({1000, 1000, 1.0f, 1.0f});
