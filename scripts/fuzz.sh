@@ -32,6 +32,9 @@ fi
 build=${FUZZ_BUILD:-build-fuzz}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}  # JOBS=1 on a shared machine
 mkdir -p "$build"
+# Several fuzz.sh may run at once on one build folder (one per core): configure and build one at a time.
+exec 9>"$build/.configure.lock"
+flock 9
 build_log=$build/build.log
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DDEFORMKIT_BUILD_FUZZ=ON -DDEFORMKIT_BUILD_PYTHON=OFF -DDEFORMKIT_BUILD_BENCH=OFF \
@@ -39,6 +42,8 @@ CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     { cat "$build_log" >&2; echo "fuzz.sh: configure failed" >&2; exit 2; }
 cmake --build "$build" -j "$jobs" --target "fuzz_$name" >>"$build_log" 2>&1 ||
     { tail -n 40 "$build_log" >&2; echo "fuzz.sh: build failed (log: $build_log)" >&2; exit 2; }
+
+flock -u 9
 
 corpus=$build/corpus/$name
 artifacts=$build/artifacts/$name
