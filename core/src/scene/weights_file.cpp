@@ -52,8 +52,12 @@ std::string formatWeightsFile(std::span<const float> weights) {
     std::string text = "[";
     char number[32];
     for (size_t v = 0; v < weights.size(); ++v) {
-        const auto [end, ec] = std::to_chars(number, number + sizeof(number), weights[v]);
         if (v > 0) text += ", ";
+        if (weights[v] == 0.0f && std::signbit(weights[v])) {
+            text += "-0.0";  // "-0" would read back as the integer 0, losing the sign
+            continue;
+        }
+        const auto [end, ec] = std::to_chars(number, number + sizeof(number), weights[v]);
         text.append(number, ec == std::errc() ? end : number);
     }
     return text + "]\n";
