@@ -4,23 +4,32 @@
         [--rounds N] [--grid-only | --mesh-only] [--profile]
 
 Two meshes: Keenan Crane's Spot (tests/data/spot) subdivided twice by Blender's Subdivision Surface
-(46,850 vertices), and a 1,001,000-vertex grid. On each, four scenes hold a copy of the mesh:
+(46,850 vertices), and a 1,001,000-vertex grid. On each, six scenes hold a copy of the mesh:
   plain       no deformer: what a frame change costs anyway
   write       a handler writes precomputed positions into the mesh: the floor of any add-on that deforms
               by writing the mesh from Python (Blender then copies and evaluates the mesh again)
+  cache       the same positions written by a handler into a PC2 file that Blender's Mesh Cache modifier
+              reads (the mesh left alone; the object tagged for evaluation)
+  nodes       the same positions written into a vertex-only helper mesh that a Geometry Nodes modifier
+              copies onto the mesh (Object Info, Sample Index by index, Set Position)
   blender     SimpleDeform TWIST (angle keyed) then a Lattice modifier (4 x 4 x 4 points, B-spline, moved)
   deformkit   the add-on's stack: twist (angles keyed to the same twist) then FFD "As the Lattice" on the
               same lattice object
-Each round sets every scene to the next frame with `scene.frame_set` (rounds alternate the scenes, so
-load from other processes falls on all four alike) and times it. Printed: medians over the rounds, the
+write, cache and nodes are the three ways a Python add-on can hand Blender positions from a frame handler;
+each is checked to show, after frame_set, the shape its handler wrote in that frame. Each round sets every
+scene to the next frame with `scene.frame_set` (rounds alternate the scenes, so load from other processes
+falls on all of them alike) and times it. Printed: medians over the rounds, the
 net cost (minus the plain frame change), the ratio deformkit / blender of the net costs, and the largest
 distance between the two deformed meshes (the same deformation, to float rounding). --profile prints where
 the add-on's frame changes go instead (cProfile; Spot, or the grid with --grid-only).
 """
 
 import os
+import shutil
 import statistics
+import struct
 import sys
+import tempfile
 import time
 
 import bpy
@@ -90,6 +99,100 @@ def linear(id_block):
             key.interpolation = 'LINEAR'
 
 
+SHAPES = []  # the two position sets the floor handlers write, alternately
+WRITTEN = {}  # per floor scene, the index of the shape its handler wrote last
+SCRATCH = tempfile.mkdtemp(prefix="deformkit-bench-")
+
+
+def pc2_header(vertices):
+    """A PC2 point cache of one sample: 'POINTCACHE2\\0', version 1, points, start frame, sample rate, samples."""
+    return b"POINTCACHE2\0" + struct.pack("<iiffi", 1, vertices, 0.0, 1.0, 1)
+
+
+def handler_floors(scenes, points):
+    """The three ways a Python add-on can give Blender positions from frame_change_post, each writing
+    precomputed positions (two sets, alternately): into the mesh, into a PC2 file read by a Mesh Cache
+    modifier, into a helper mesh read by a Geometry Nodes modifier."""
+    SHAPES[:] = [points.ravel().copy(), (points * 1.001).ravel()]
+
+    def alternate(kind, own, write):
+        state = {"next": 0}
+
+        def handler(scene_, _depsgraph):
+            if scene_ == own:
+                write(SHAPES[state["next"]])
+                WRITTEN[kind] = state["next"]
+                state["next"] ^= 1
+
+        bpy.app.handlers.frame_change_post.append(handler)
+
+    scene, obj = scenes["write"]
+
+    def write_mesh(shape, mesh=obj.data):
+        mesh.vertices.foreach_set("co", shape)
+        mesh.update()
+
+    alternate("write", scene, write_mesh)
+
+    scene, obj = scenes["cache"]
+    path = os.path.join(SCRATCH, obj.name + ".pc2")
+    with open(path, "wb") as f:
+        f.write(pc2_header(len(points)) + SHAPES[0].tobytes())
+    cache = obj.modifiers.new("Positions", 'MESH_CACHE')
+    cache.cache_format, cache.filepath = 'PC2', path
+    cache.play_mode, cache.time_mode, cache.interpolation, cache.eval_frame = 'CUSTOM', 'FRAME', 'NONE', 0.0
+
+    def write_cache(shape, obj=obj):
+        with open(path, "r+b") as f:
+            f.seek(len(pc2_header(0)))
+            f.write(shape.tobytes())
+        obj.update_tag()
+
+    alternate("cache", scene, write_cache)
+
+    scene, obj = scenes["nodes"]
+    helper_mesh = bpy.data.meshes.new(obj.name + "_positions")
+    helper_mesh.vertices.add(len(points))
+    helper_mesh.vertices.foreach_set("co", SHAPES[0])
+    helper = bpy.data.objects.new(obj.name + "_positions", helper_mesh)
+    scene.collection.objects.link(helper)
+    group = bpy.data.node_groups.new("positions_by_index", 'GeometryNodeTree')
+    group.inputs.new('NodeSocketGeometry', "Geometry")
+    group.outputs.new('NodeSocketGeometry', "Geometry")
+    nodes, links = group.nodes, group.links
+    group_in, group_out = nodes.new('NodeGroupInput'), nodes.new('NodeGroupOutput')
+    info = nodes.new('GeometryNodeObjectInfo')
+    info.inputs['Object'].default_value = helper
+    sample = nodes.new('GeometryNodeSampleIndex')
+    sample.data_type, sample.domain = 'FLOAT_VECTOR', 'POINT'
+    position, index = nodes.new('GeometryNodeInputPosition'), nodes.new('GeometryNodeInputIndex')
+    set_position = nodes.new('GeometryNodeSetPosition')
+    links.new(info.outputs['Geometry'], sample.inputs['Geometry'])
+    links.new(position.outputs['Position'], sample.inputs[3])  # the vector value input
+    links.new(index.outputs['Index'], sample.inputs['Index'])
+    links.new(group_in.outputs[0], set_position.inputs['Geometry'])
+    links.new(sample.outputs[2], set_position.inputs['Position'])  # the vector value output
+    links.new(set_position.outputs['Geometry'], group_out.inputs[0])
+    obj.modifiers.new("Positions", 'NODES').node_group = group
+
+    def write_helper(shape, mesh=helper_mesh):
+        mesh.vertices.foreach_set("co", shape)
+        mesh.update()
+
+    alternate("nodes", scene, write_helper)
+
+
+def check_floors(scenes):
+    """Each floor scene shows, after frame_set, the shape its handler wrote in that frame (no frame of lag)."""
+    for kind in ("write", "cache", "nodes"):
+        scene, obj = scenes[kind]
+        scene.frame_set(7)
+        evaluated = obj.evaluated_get(scene.view_layers[0].depsgraph).data
+        co = np.empty(len(evaluated.vertices) * 3, np.float32)
+        evaluated.vertices.foreach_get("co", co)
+        assert np.array_equal(co, SHAPES[WRITTEN[kind]]), f"{kind}: the evaluated mesh is not this frame's shape"
+
+
 def build(mesh):
     points = np.empty(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", points)
@@ -104,26 +207,14 @@ def build(mesh):
     for point in lattice_data.points:
         point.co_deform = mathutils.Vector(point.co) + mathutils.Vector(rng.uniform(-0.25, 0.25, 3))
     scenes = {}
-    for kind in ("plain", "write", "blender", "deformkit"):
+    for kind in ("plain", "write", "cache", "nodes", "blender", "deformkit"):
         # The add-on's operators work on the context's scene: the deformkit copy goes there.
         scene = bpy.context.scene if kind == "deformkit" else bpy.data.scenes.new(kind)
         obj = bpy.data.objects.new(f"{mesh.name}_{kind}", mesh.copy())
         scene.collection.objects.link(obj)
         scene.collection.objects.link(lattice)
         scenes[kind] = (scene, obj)
-    # The floor of any add-on that writes a mesh from Python: a handler writes precomputed positions (two
-    # sets, alternately) and tags the mesh, which Blender then evaluates again (a copy of the whole mesh).
-    scene, obj = scenes["write"]
-    shapes = [points.ravel().copy(), (points * 1.001).ravel()]
-    state = {"next": 0}
-
-    def write(scene_, _depsgraph, own=scene, mesh=obj.data):  # bound now: the names are reused below
-        if scene_ == own:
-            mesh.vertices.foreach_set("co", shapes[state["next"]])
-            mesh.update()
-            state["next"] ^= 1
-
-    bpy.app.handlers.frame_change_post.append(write)
+    handler_floors(scenes, points)
     # Blender's modifiers: SimpleDeform TWIST about Z (origin: world), angle keyed; then the lattice.
     scene, obj = scenes["blender"]
     twist = obj.modifiers.new("Twist", 'SIMPLE_DEFORM')
@@ -193,9 +284,10 @@ def report(name, scenes):
     for scene, _obj in scenes.values():
         scene.frame_set(1)  # bind, caches, first evaluation: outside the timing
     difference = same_deformation(scenes)
+    check_floors(scenes)
     t = time_scenes(scenes)
     blender_net, ours_net = t["blender"] - t["plain"], t["deformkit"] - t["plain"]
-    write_net = t["write"] - t["plain"]
+    write_net, cache_net, nodes_net = (t[k] - t["plain"] for k in ("write", "cache", "nodes"))
     vertices = len(scenes["plain"][1].data.vertices)
     print(f"{name} ({vertices:,} vertices), median of {rounds} frame changes each:")
     print(f"  plain frame change              {t['plain']:8.2f} ms")
@@ -203,6 +295,10 @@ def report(name, scenes):
     print(f"  DeformKit twist + FFD           {t['deformkit']:8.2f} ms   net {ours_net:8.2f} ms")
     print(f"  a Python write of the mesh      {t['write']:8.2f} ms   net {write_net:8.2f} ms   "
           f"({write_net / blender_net:.2f}x Blender's: the floor of writing the mesh)")
+    print(f"  a PC2 file + Mesh Cache         {t['cache']:8.2f} ms   net {cache_net:8.2f} ms   "
+          f"({cache_net / blender_net:.2f}x)")
+    print(f"  a helper mesh + Geometry Nodes  {t['nodes']:8.2f} ms   net {nodes_net:8.2f} ms   "
+          f"({nodes_net / blender_net:.2f}x)")
     print(f"  DeformKit / Blender (net)       {ours_net / blender_net:8.2f}x   (goal <= 0.5x)")
     print(f"  same deformation: meshes differ by {difference:.1e} of the bounding-box diagonal")
 
@@ -226,3 +322,4 @@ if "--grid-only" not in args:
     report("Spot subdivided twice", build(spot_subdivided()))
 if "--mesh-only" not in args:
     report("grid", build(grid()))
+shutil.rmtree(SCRATCH, ignore_errors=True)
