@@ -116,27 +116,23 @@ U truncateTo(float value) {
 template <DataType Type>
 struct Channel;
 
-template <>
-struct Channel<DataType::UInt8> {
-    using Stored = uint8_t;
-    static constexpr float kOne = 255.0f;
+// u8 and u16: four values summed in integers and shifted by 2; from float by truncation.
+template <typename U>
+struct IntegerChannel {
+    using Stored = U;
+    static constexpr float kOne = static_cast<float>(std::numeric_limits<U>::max());  // 255, 65535
     static float value(Stored v) { return v; }
-    static Stored from(float v) { return truncateTo<uint8_t>(v); }
-    static Stored quarter(Stored a, Stored b, Stored c, Stored d) {
-        return static_cast<Stored>((a + b + c + d) >> 2);
-    }
-};
-
-template <>
-struct Channel<DataType::UInt16> {
-    using Stored = uint16_t;
-    static constexpr float kOne = 65535.0f;
-    static float value(Stored v) { return v; }
-    static Stored from(float v) { return truncateTo<uint16_t>(v); }
+    static Stored from(float v) { return truncateTo<U>(v); }
     static Stored quarter(Stored a, Stored b, Stored c, Stored d) {
         return static_cast<Stored>((uint32_t{a} + b + c + d) >> 2);
     }
 };
+
+template <>
+struct Channel<DataType::UInt8> : IntegerChannel<uint8_t> {};
+
+template <>
+struct Channel<DataType::UInt16> : IntegerChannel<uint16_t> {};
 
 template <>
 struct Channel<DataType::Half> {
