@@ -29,12 +29,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
     deformkit::scene::FarmPlan plan;
     try {
-        plan = deformkit::scene::parseFarmPlan(text, "/farm/plan.json");
+        plan = deformkit::scene::parseFarmPlan(text, "plan.json");
     } catch (const deformkit::Error&) {
         return 0;
     }
     const deformkit::scene::FarmPlan again =
-        deformkit::scene::parseFarmPlan(deformkit::scene::formatFarmPlan(plan), "/farm/plan.json");
+        deformkit::scene::parseFarmPlan(deformkit::scene::formatFarmPlan(plan), "plan.json");
     if (!identical(plan, again)) std::abort();
     return 0;
 }
