@@ -256,7 +256,7 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
 // How a mesh argument is named in messages: its OBJ path, or its size when it is a Mesh or arrays.
 std::string meshName(py::handle mesh, const geom::Mesh& m) {
     if (!py::isinstance<geom::Mesh>(mesh)) return mesh.cast<std::filesystem::path>().string();
-    return "(" + std::to_string(m.numVertices()) + " vertices, " + std::to_string(m.numFaces()) + " faces)";
+    return meshLabel(m);
 }
 
 geom::Mesh meshFrom(py::handle mesh) {

@@ -340,10 +340,8 @@ void bindSlide(py::module_& m) {
             const std::vector<SlideDrive> drives = {
                 {displacementsOf(displacement, 1, source)[0], falloffOf(falloff, source, "falloff")}};
             const std::vector<float> w =
-                weightsPtex ? ptex::weightsFromPtex(mesh,
-                                                    "(" + std::to_string(mesh.numVertices()) + " vertices, " +
-                                                        std::to_string(mesh.numFaces()) + " faces)",
-                                                    *weightsPtex, weightsChannel, "slide: weights_ptex")
+                weightsPtex ? ptex::weightsFromPtex(mesh, meshLabel(mesh), *weightsPtex, weightsChannel,
+                                                    "slide: weights_ptex")
                             : weightsOf(weights, static_cast<size_t>(mesh.numVertices()), source);
             std::vector<glm::vec3> out(mesh.points().begin(), mesh.points().end());
             {

@@ -32,6 +32,12 @@ inline std::string shapeOf(const pybind11::array& a) {
     return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
+// How an in-memory mesh is named in messages: "(16 vertices, 9 faces)".
+inline std::string meshLabel(const geom::Mesh& mesh) {
+    return "(" + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numFaces()) +
+           " faces)";
+}
+
 // An (n, 3) array as positions (a copy the C++ side owns).
 inline std::vector<glm::vec3> pointsOf(const FloatArray& a, const std::string& source,
                                        const std::string& name) {

@@ -339,8 +339,10 @@ class Reader {
         for (size_t i = 0; i < levels_; ++i)
             readLevelHeaders(levels[i], i);
         readLevelZero(levels.empty() ? Level{} : levels[0]);
-        for (size_t i = 1; i < levels_; ++i) {
-            if (options_.readReductions) readReduction(levels[i], static_cast<int>(i));
+        if (options_.readReductions) {
+            const std::vector<uint32_t> order = reductionOrder(file_.faces);
+            for (size_t i = 1; i < levels_; ++i)
+                readReduction(levels[i], static_cast<int>(i), order);
         }
         pos_ = dataStart + levelDataSize_;
     }
@@ -543,11 +545,10 @@ class Reader {
         }
     }
 
-    // Level `index` lists a prefix of the faces in reduction order (constant faces ranked 1), each at
-    // (ulog2 − index, vlog2 − index); the reference writer stops at 4 texels on the smaller side, so a level
-    // may list fewer faces than could be reduced to it.
-    void readReduction(const Level& level, int index) {
-        const std::vector<uint32_t> order = reductionOrder(file_.faces);
+    // Level `index` lists a prefix of `order`, the faces in reduction order (constant faces ranked 1), each
+    // at (ulog2 − index, vlog2 − index); the reference writer stops at 4 texels on the smaller side, so a
+    // level may list fewer faces than could be reduced to it.
+    void readReduction(const Level& level, int index, const std::vector<uint32_t>& order) {
         size_t reducible = 0;
         while (reducible < order.size() && reductionRank(file_.faces[order[reducible]]) >= index)
             ++reducible;

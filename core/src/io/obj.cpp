@@ -503,8 +503,8 @@ class ObjParser {
         }
         // Without a face with UVs the mesh has none: texture coordinates no face uses are dropped.
         if (firstLineWithUVs_ == 0) {
-            data_.uvIndices.clear();
-            data_.uvs.clear();
+            data_.uvIndices = {};  // released, not kept as capacity in the mesh
+            data_.uvs = {};
         }
         ObjContent content;
         content.mesh = geom::Mesh(std::move(data_), source_);
