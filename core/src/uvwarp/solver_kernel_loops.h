@@ -209,11 +209,6 @@ template <class Ops, int32_t Type, bool Mapped>
     const int32_t right = minOf(pad, (limit - 1 - start) / step + 1 - lanes);
     const int32_t left = minOf(pad - right, (start - 1) / step);
     const int32_t low = -left, high = lanes + right;
-    // GCC would read the per-level maps (rigidity, orientation) at their constant stride as one interleaved
-    // load with gaps, which forces a scalar epilogue of up to 8 lanes on every call; a stride it cannot see
-    // (1, hidden by an empty asm) makes them plain strided loads, with no epilogue.
-    int32_t unit = 1;
-    asm("" : "+r"(unit));
     // Each lane reads a window of the warp: point rows j - 1 .. j - 1 + kRows - 1 and columns i - 1 ..
     // i - 1 + kCols - 1 around its segment's cell (i, j), which holds both ends and their 8 neighbours.
     // Windows of different lanes do not overlap, and a lane moves only its two ends.
@@ -268,12 +263,25 @@ template <class Ops, int32_t Type, bool Mapped>
         alignas(32) float xb0[kLaneBlock], xb1[kLaneBlock], xb2[kLaneBlock];
         Ops::blendCells(deformedImage, fineCells, cellA, fxA, fyA, xa0, xa1, xa2);
         Ops::blendCells(deformedImage, fineCells, cellB, fxB, fyB, xb0, xb1, xb2);
+        // The per-level maps at both ends, copied into lane arrays, so that the main loop reads lane arrays
+        // only.
+        alignas(32) float rigA[kLaneBlock] = {}, rigB[kLaneBlock] = {}, oriA[kLaneBlock] = {},
+                          oriB[kLaneBlock] = {};
+        for (int32_t l = 0; l < n; ++l) {
+            const int32_t i = firstCell + l * step;
+            rigA[l] = rigidityA[i + e.ai];
+            rigB[l] = rigidityB[i + e.bi];
+            if constexpr (Mapped) {
+                oriA[l] = orientationA[i + e.ai];
+                oriB[l] = orientationB[i + e.bi];
+            }
+        }
 #pragma omp simd
         for (int32_t l = 0; l < n; ++l) {
             const int32_t lane = block + l;
             const int32_t i = start + lane * step;
             const int32_t ia = i + e.ai, ib = i + e.bi;  // level columns of the ends
-            const float ra = rigidityA[ia * unit], rb = rigidityB[ib * unit];
+            const float ra = rigA[l], rb = rigB[l];
             const bool live = (lane >= 0) & (lane < lanes);
             // Both ends movable: projected when either is rigid (§4.2). Both fixed (kFixed - R: masked or on
             // the border): nothing to do. One end fixed: the paper does not project it; here a segment rigid
@@ -281,7 +289,9 @@ template <class Ops, int32_t Type, bool Mapped>
             // mass is infinite), so rigid detail that a pinned chart border cuts keeps its lengths to the
             // border instead of tearing from it (docs/decisions.md, UV-15).
             const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
-            const float paintedA = fixedA ? kFixed - ra : ra, paintedB = fixedB ? kFixed - rb : rb;
+            // The painted R of an end, fixed (kFixed - R) or not (R), as a max: GCC does not vectorise the
+            // loop with a select here.
+            const float paintedA = maxOf(ra, kFixed - ra), paintedB = maxOf(rb, kFixed - rb);
             const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
             const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
             const bool active = live & ((!fixedA & !fixedB & (rig > 0.0f)) | pinned);
@@ -317,9 +327,7 @@ template <class Ops, int32_t Type, bool Mapped>
             const float shareB = fixedB ? 0.0f : (fixedA ? 1.0f : 0.5f);
             float nax = pax + shareA * correction * ux, nay = pay + shareA * correction * uy;
             float nbx = pbx - shareB * correction * ux, nby = pby - shareB * correction * uy;
-            const float preserve =
-                Mapped ? preservation * 0.5f * (orientationA[ia * unit] + orientationB[ib * unit])
-                       : preservation;
+            const float preserve = Mapped ? preservation * 0.5f * (oriA[l] + oriB[l]) : preservation;
             // Turn the segment about its centre towards its canonical direction (normalised lerp of
             // directions).
             const float mx = 0.5f * (nax + nbx), my = 0.5f * (nay + nby);
@@ -373,7 +381,10 @@ template <class Ops, bool Fine>
     float* vC = v + centre;
     const float* rigidity = level.rigidity + levelIndex(level, 0, j);
     const int32_t lanes = first < c ? (c - first + 1) / 2 : 0;
-    int32_t unit = 1;  // hides the rigidity map's stride, as in projectRun: no scalar epilogue
+    // GCC would read the rigidity map at its constant stride as one interleaved load with gaps, which forces
+    // a scalar epilogue of up to 8 lanes on every call; a stride it cannot see (1, hidden by an empty asm)
+    // makes it a plain strided load, with no epilogue.
+    int32_t unit = 1;
     asm("" : "+r"(unit));
     int32_t lane = 0;
     if constexpr (Fine) {
