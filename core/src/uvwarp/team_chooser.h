@@ -6,13 +6,14 @@
 // the team size (every parallel loop of the solver gives the same bytes for any thread count), so the
 // choice changes only the time.
 //
-// The job runs on all threads for its first 8 runs, then once on one thread; from then on on whichever team
-// has the lower recent time (a running mean), the other being tried again now and then to notice a change
-// (a core taken or given back): after 8 runs, then after twice as many each time the try confirms the
-// choice (at most 128), and again after 8 once the choice changes. A try costs at most one run at the
-// slower size; a short job (a cold frame's few iterations) pays none on a quiet machine, where one thread
-// is about twice as slow, and at most 8 runs of all threads next to other work, where they are about
-// 1.25 times as slow as one.
+// The job runs on all threads for its first 8 runs, then once on one thread; from then on on one thread
+// unless all threads' recent time (a running mean) is clearly lower (by a fifth: next to other work all
+// threads are about as fast as one in most runs and much slower in a few, and a choice that followed the
+// near-ties would pay for those few), the other team being tried again now and then to notice a change (a
+// core taken or given back): after 8 runs, then after twice as many each time the try confirms the choice (at
+// most 128), and again after 8 once the choice changes. A try costs at most one run at the slower size; a
+// short job (a cold frame's few iterations) pays none on a quiet machine, where one thread is about twice as
+// slow, and at most 8 runs of all threads next to other work, where they are about 1.25 times as slow as one.
 
 #include <algorithm>
 #include <cstdint>
@@ -33,7 +34,7 @@ class TeamChooser {
         if (all_ == 1) return 1;
         if (meanAll_ < 0.0) return all_;
         if (meanOne_ < 0.0) return sinceTry_ >= tryEvery_ ? 1 : all_;  // one thread first timed after 8 runs
-        const int32_t best = meanOne_ < meanAll_ ? 1 : all_;
+        const int32_t best = chosen();
         if (sinceTry_ >= tryEvery_) return best == 1 ? all_ : 1;  // try the other one
         return best;
     }
@@ -60,12 +61,15 @@ class TeamChooser {
     // The team size the recent times favour (all threads until both have been timed).
     [[nodiscard]] int32_t chosen() const {
         if (meanAll_ < 0.0 || meanOne_ < 0.0) return all_;
-        return meanOne_ < meanAll_ ? 1 : all_;
+        return meanAll_ < kAllFaster * meanOne_ ? all_ : 1;
     }
 
   private:
     static constexpr int32_t kFirstTryEvery = 8;
     static constexpr int32_t kMaxTryEvery = 128;
+    // All threads are chosen when their mean time is below this fraction of one thread's (on a quiet
+    // machine it is about 0.55 with 2 threads).
+    static constexpr double kAllFaster = 0.8;
     int32_t all_ = 1;
     double meanAll_ = -1.0, meanOne_ = -1.0;  // seconds per run; < 0: not timed yet
     int32_t sinceTry_ = 0, tryEvery_ = kFirstTryEvery;
