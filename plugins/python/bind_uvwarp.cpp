@@ -43,7 +43,7 @@ using uvwarp::TileWarpOptions;
 constexpr const char* kOptionNames =
     "iterations, tolerance, levels, sweeps_per_level, orientation_preservation, smoothing, damping, "
     "coarse_stiffness, "
-    "border_width, dilation_rings, orientation_density";
+    "border_width, dilation_rings, orientation_density, warm_start";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
 // names the texel.
@@ -141,6 +141,13 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
                     formatError(source, k, "is " + std::to_string(o.dilationRings), "an integer in [0, 64]"));
         } else if (k == "orientation_density") {
             o.densityOrientationRadius = intOption(value, source, k, 0, "0 (off) or a radius in texels");
+        } else if (k == "warm_start") {
+            if (!py::isinstance<py::bool_>(value)) {
+                throw InvalidInput(formatError(
+                    source, k, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))),
+                    "True or False"));
+            }
+            o.solver.warmStart = value.cast<bool>();
         } else {
             throw InvalidInput(formatError(source, k, "is not an option", kOptionNames));
         }
@@ -536,7 +543,8 @@ constexpr const char* kSolverDoc =
     "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
     "off;\n"
     "a radius in texels: without an orientation map, orientation preservation follows the rigidity's local\n"
-    "density, the paper's heuristic for severe compression).";
+    "density, the paper's heuristic for severe compression), warm_start (True: each solve starts from the\n"
+    "last warp; False: from the identity, so a frame's warp depends on that frame alone).";
 
 constexpr const char* kSolveDoc =
     "Solve one frame: deformed_points (N, 3) float32, the rest mesh's vertices moved (scene units).\n"

@@ -269,7 +269,7 @@ contains slide-bad-painted "$work/err" "--painted-weights"
 
 # UV warp over a 2-frame shot of the grid (UVs in tile 1001) with the demo's 64 x 64 rigidity map: frame 1 is the
 # rest pose, frame 2 stretches 1.5x along x.
-mkdir -p "$work/uv/out"
+mkdir -p "$work/uv/out" "$work/uv/cold" "$work/uv/coldalone"
 cp "$work/grid.obj" "$work/uv/anim.0001.obj"
 awk '/^v / { printf "v %.9g %s %s\n", $2 * 1.5, $3, $4; next } { print }' "$work/grid.obj" >"$work/uv/anim.0002.obj"
 uvwarp() { "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/uv/anim.####.obj" --rigidity "$work/demo/rigidity.<UDIM>.exr" "$@"; }
@@ -290,6 +290,14 @@ contains info-truncated-exr "$work/err" "trunc.exr"
 [ ! -s "$work/out" ] || { echo "FAIL info-truncated-exr: printed a header"; cat "$work/out"; failures=$((failures + 1)); }
 expect uvwarp-resume 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr"
 contains uvwarp-resume "$work/out" "0 frames written, 0 replayed, 2 skipped"
+# --cold-frames: each frame from the identity, so frame 2 alone gives frame 2 of the whole shot, byte for byte,
+# and the header says so.
+expect uvwarp-cold 0 uvwarp --frames 1-2 --cold-frames --out "$work/uv/cold/redirect.<UDIM>.####.exr"
+expect uvwarp-cold-alone 0 uvwarp --frames 2-2 --cold-frames --out "$work/uv/coldalone/redirect.<UDIM>.####.exr"
+cmp -s "$work/uv/cold/redirect.1001.0002.exr" "$work/uv/coldalone/redirect.1001.0002.exr" ||
+    { echo "FAIL uvwarp-cold-alone: frame 2 alone differs from frame 2 of the shot"; failures=$((failures + 1)); }
+expect uvwarp-cold-info 0 "$dk" info "$work/uv/cold/redirect.1001.0002.exr"
+contains uvwarp-cold-info "$work/out" '"warmStart":false'
 expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"
 [ -s "$work/uv/made/here/redirect.1001.0001.exr" ] || { echo "FAIL uvwarp-new-folder: map missing"; failures=$((failures + 1)); }
 # Outputs never destroy what they replace: an extension that is not the format's, a FIFO, a path in a file.

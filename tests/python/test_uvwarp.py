@@ -150,6 +150,20 @@ def test_tolerance_ends_a_settled_solve_and_is_reported():
     assert fixed.metrics()["iterations"] == 5 and not fixed.metrics()["converged"]
 
 
+def test_without_warm_start_a_solve_depends_on_its_frame_alone():
+    pts, counts, idx, uvs, uv_idx = plane()
+    frames = [stretched(pts), pts.copy(), stretched(pts)]
+    history = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks(), warm_start=False)
+    for frame in frames:
+        after_history = history.solve(frame).copy()
+    alone = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks(), warm_start=False).solve(frames[-1])
+    np.testing.assert_array_equal(after_history, alone)
+    warm = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks())
+    for frame in frames:
+        warmed = warm.solve(frame).copy()
+    assert np.abs(warmed - alone).max() > 1e-3 / T  # warm-started, the frames before it count
+
+
 def test_apply_redirect_identity_and_one_texel_shift():
     rng = np.random.default_rng(7)
     tex = rng.uniform(0, 1, (T, T, 3)).astype(np.float32)
@@ -210,6 +224,7 @@ def test_bad_input_names_what_is_wrong():
                                 ("iterations", 2.5, "iterations: is a float"), ("levels", -1, "levels: is -1"),
                                 ("coarse_stiffness", 0.0, "coarse_stiffness: is 0.0"),
                                 ("tolerance", 2.0, "tolerance: is 2.0"),
+                                ("warm_start", 1, "warm_start: is a int"),
                                 ("sweeps_per_level", [], "sweeps_per_level: is empty"),
                                 ("sweeps_per_level", [1, -2], r"sweeps_per_level\[1\]: is -2"),
                                 ("border_width", 0, "border_width: is 0"), ("bogus", 1, "bogus: is not an option")):

@@ -420,7 +420,7 @@ class Reader {
             onlyKeys(params, pp,
                      {"iterations", "tolerance", "levels", "sweepsPerLevel", "orientationPreservation",
                       "smoothing", "damping", "coarseStiffness", "dilationRings", "maskBorderWidth",
-                      "orientationDensity"});
+                      "orientationDensity", "warmStart"});
             uvwarp::SolverOptions& o = u.options.solver;
             auto get = [&](const char* name) -> const json* {
                 return params.contains(name) ? &params.at(name) : nullptr;
@@ -461,6 +461,10 @@ class Reader {
             if (const json* x = get("maskBorderWidth"))
                 u.options.derivedMask.borderWidth =
                     static_cast<int32_t>(ranged(*x, pp + ".maskBorderWidth", 1, 64, true, "1 to 64"));
+            if (const json* x = get("warmStart")) {
+                if (!x->is_boolean()) fail(pp + ".warmStart", "is " + x->dump(), "true or false");
+                o.warmStart = x->get<bool>();
+            }
             if (const json* x = get("orientationDensity"))
                 u.options.densityOrientationRadius = static_cast<int32_t>(
                     ranged(*x, pp + ".orientationDensity", 0, 4096, true, "0 (off) to 4096 texels"));

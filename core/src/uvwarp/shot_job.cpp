@@ -112,7 +112,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
               {"damping", tidy(o.solver.damping)},
               {"coarseStiffness", tidy(o.solver.coarseStiffness)},
               {"dilationRings", o.dilationRings},
-              {"warmStart", true}};
+              {"warmStart", o.solver.warmStart}};
     if (derivedMask) j["derivedMaskBorderWidth"] = o.derivedMask.borderWidth;
     return j;
 }
@@ -538,7 +538,11 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
     }
     const size_t k = s.nextFrame++;
     for (TilePlan& plan : s.plans) {
-        const bool solves = plan.report.warped && static_cast<int>(k) <= plan.lastNeeded;
+        // Warm-started frames carry the warm start up to the last output; frames solved from the identity
+        // (SolverOptions::warmStart false) depend on nothing before them: only the outputs are solved.
+        const bool solves =
+            plan.report.warped &&
+            (s.job.options.solver.warmStart ? static_cast<int>(k) <= plan.lastNeeded : plan.needed[k] != 0);
         if (solves) {
             s.solveTile(plan, k, deformed, inputName);
         } else {

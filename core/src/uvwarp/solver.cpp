@@ -441,6 +441,7 @@ void Solver::setMaps(const PointField& rigidity, const PointField& mask, const P
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
     detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
+    if (!m.options.warmStart) reset();
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;
     m.stats.revertedPoints = 0;

@@ -180,6 +180,8 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
         {"tubes.obj",
          R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"sweepsPerLevel": [1, 0]}}])",
          ": objects[0].stack[0].params.sweepsPerLevel[1]: is 0"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"warmStart": 0}}])",
+         ": objects[0].stack[0].params.warmStart: is 0 (expected true or false)"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "filter": "lanczos"}])",
          ": objects[0].stack[0].filter: is \"lanczos\""},
         {"tubes.obj", R"([{"type": "uvwarps"}])", "uvwarp (last entry)"},
@@ -525,4 +527,60 @@ TEST_CASE(
                                            << defaultWarmUp << " warm-up frames");
     CHECK(jumps[1] <= 0.25);
     CHECK(jumps[0] > 0.25);
+}
+
+// Issue 19, part 3, by construction: with every frame solved from the identity ("warmStart": false) a frame's
+// map depends on that frame alone, so farm tasks in chunks of 8, without warm-up, write every frame's map
+// byte for byte as one uninterrupted eval does, and solve no frame outside their ranges. Warm-started, the
+// same chunks differ (the test could fail).
+TEST_CASE("scene uvwarp: frames solved from the identity make chunked maps the uninterrupted run's bytes",
+          "[harness][uvwarp][farm]") {
+    Shot shot;
+    std::string longer = kScene;
+    const auto replace = [&](const std::string& from, const std::string& to) {
+        longer.replace(longer.find(from), from.size(), to);
+    };
+    replace(R"("frames": [1, 3])", R"("frames": [1, 24])");
+    replace(R"({"frame": 3, "value": 1.8})", R"({"frame": 24, "value": 1.9})");
+    replace(R"("texture": "col.<UDIM>.exr",)", "");
+    const std::string warm = longer;
+    replace(R"("params": {"iterations": 6})", R"("params": {"iterations": 6, "warmStart": false})");
+    const std::string cold = longer;
+    int differing[2] = {0, 0};  // maps of frames 9 to 24 unlike the uninterrupted run's: warm, cold
+    for (const bool coldFrames : {false, true}) {
+        test::writeText(shot.scene, coldFrames ? cold : warm);
+        harness::EvalCommand eval;
+        eval.scene = shot.scene;
+        eval.outDir = shot.dir / (coldFrames ? "eval-cold" : "eval-warm");
+        eval.previews = false;
+        (void)harness::evalCommand(eval);
+        harness::FarmPlanCommand plan;
+        plan.scene = shot.scene;
+        plan.chunk = 8;
+        plan.warmUp = 0;
+        plan.outDir = shot.dir / (coldFrames ? "farm-cold" : "farm-warm");
+        const scene::FarmPlan made = harness::farmPlanCommand(plan);
+        for (size_t k = 0; k < made.tasks.size(); ++k)
+            (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)});
+        for (int frame = 9; frame <= 24; ++frame) {
+            for (int tile : {1001, 1002}) {
+                char name[64];
+                std::snprintf(name, sizeof(name), "tubes.redirect.%d.%04d.exr", tile, frame);
+                const io::Image chunked = io::readImage(plan.outDir / name);
+                const io::Image whole = io::readImage(eval.outDir / name);
+                REQUIRE(chunked.pixels.size() == whole.pixels.size());
+                differing[coldFrames] += chunked.pixels != whole.pixels ? 1 : 0;
+            }
+        }
+        if (coldFrames) {
+            // The headers say how the maps were made.
+            const io::ImageInfo info = io::readImageInfo(plan.outDir / "tubes.redirect.1001.0009.exr");
+            std::string solver;
+            for (const auto& [key, value] : info.attributes)
+                if (key == "deformkit:uvwarp:solver") solver = value;
+            CHECK(solver.find(R"("warmStart":false)") != std::string::npos);
+        }
+    }
+    CHECK(differing[0] > 0);
+    CHECK(differing[1] == 0);
 }

@@ -190,6 +190,26 @@ TEST_CASE("uv warp: a static pose converges to a static warp with warm start", "
     CHECK(lastChange < 0.25 * firstChange);
 }
 
+TEST_CASE("uv warp: without warm start a solve depends on its own frame alone", "[uvwarp]") {
+    const Scene a = stretchedPlane(64, 1.5f), b = stretchedPlane(64, 1.3f);
+    uvwarp::SolverOptions options;
+    options.warmStart = false;
+    uvwarp::Solver history(a.rest, a.rigidity, a.mask, options);
+    for (int frame = 0; frame < 3; ++frame)
+        history.solve(a.deformed);
+    const WarpGrid& afterHistory = history.solve(b.deformed);
+    uvwarp::Solver fresh(b.rest, b.rigidity, b.mask, options);
+    const WarpGrid& alone = fresh.solve(b.deformed);
+    CHECK(std::memcmp(afterHistory.u.data(), alone.u.data(), alone.u.size() * sizeof(float)) == 0);
+    CHECK(std::memcmp(afterHistory.v.data(), alone.v.data(), alone.v.size() * sizeof(float)) == 0);
+    // Warm-started, the same frames give another warp (the frames before it count).
+    options.warmStart = true;
+    uvwarp::Solver warm(a.rest, a.rigidity, a.mask, options);
+    for (int frame = 0; frame < 3; ++frame)
+        warm.solve(a.deformed);
+    CHECK(maxMove(warm.solve(b.deformed), alone) > 0.01 / 64.0);
+}
+
 TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]") {
     // Stretch ramps 1.30, 1.31, ... : the per-frame warp change stays bounded by a small multiple of the
     // change a 1-frame step causes at a settled state, and never jumps.

@@ -39,7 +39,9 @@ namespace deformkit::uvwarp {
 // - Resuming (skipExisting): an output that exists is not written again. So that a resumed job writes the
 //   bytes an uninterrupted one would have, the warm start is replayed: each tile solves every frame up to
 //   its last missing output, frames whose outputs exist only to carry the warm start ("replayed"), and no
-//   frame after it ("skipped"). A tile whose outputs all exist is not bound.
+//   frame after it ("skipped"). A tile whose outputs all exist is not bound. Frames solved from the
+//   identity (SolverOptions::warmStart false) need no replay and no warm-up: only the missing outputs are
+//   solved.
 // - Checks before anything is written: map patterns have a UDIM token; output folders exist; per tile the
 //   maps' sizes (square, equal, a power of two when the grid takes the map's size). A tile without a rigidity
 //   map is left unwarped (no outputs) and reported, unless no tile has one (an error). A missing mask tile is

@@ -39,6 +39,11 @@ struct SolverOptions {
     // another process on a core) all threads are never slower than one; n > 0 uses min(n, allowed). The
     // warp is the same, byte for byte, whatever the choice.
     int32_t threads = 0;
+    // Warm start (paper §4.1, temporal coherence): each solve starts from the last warp. false: each solve
+    // starts from the identity, so a frame's warp depends on that frame's inputs alone, not on the frames
+    // solved before it (a farm chunk's maps are then an uninterrupted run's, byte for byte, with no warm-up
+    // frames; docs/decisions.md UV-20). The default schedule reaches the same quality either way.
+    bool warmStart = true;
 };
 
 // Figures from the last solve.
