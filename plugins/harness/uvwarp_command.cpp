@@ -160,7 +160,7 @@ void addUvWarpCommand(CommandLine& cli) {
         UvWarpCommand command;
         std::string frames, tiles, mask, orientation, texture, bake, log, filter = "bilinear", rest, deformed,
                                                                           rigidity, out;
-        bool coldFrames = false;
+        bool warmStart = false;
     };
     auto o = std::make_shared<Options>();
     Command uvwarp = cli.add(
@@ -180,7 +180,7 @@ void addUvWarpCommand(CommandLine& cli) {
             if (!o->tiles.empty()) c.tiles = parseTiles(o->tiles);
             if (!o->log.empty()) c.log = o->log;
             c.filter = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
-            c.options.solver.warmStart = !o->coldFrames;
+            c.options.solver.warmStart = o->warmStart;
             // The progress bar redraws one line in place: only for a person watching a terminal.
             ProgressBar bar(std::cerr);
             const uvwarp::ShotReport report = uvwarpCommand(c, ::isatty(STDERR_FILENO) ? &bar : nullptr);
@@ -225,9 +225,10 @@ void addUvWarpCommand(CommandLine& cli) {
         .range(0.0f, 1.0f)
         .showDefault();
     uvwarp.flag(
-        "--cold-frames", o->coldFrames,
-        "solve every frame from the identity, not from the last frame's warp: each frame's maps depend "
-        "on that frame alone (any chunk of frames gives the same bytes)");
+        "--warm-start", o->warmStart,
+        "start each frame from the last frame's warp, as a live preview does; by default each frame starts "
+        "from the identity, so its maps depend on that frame alone (any range of frames gives the same "
+        "bytes)");
     uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
     uvwarp
         .option("--sweeps", solver.sweepsPerLevel, "constraint sweeps per iteration and level, finest first")

@@ -39,7 +39,8 @@ struct UvWarpCommand {
     std::optional<std::filesystem::path> bake;         // UDIM + frame pattern, any writable format
     std::vector<int> tiles;                            // empty: every tile the rest mesh's UVs touch
     int32_t resolution = 0;                            // grid cells per side, a power of two; 0: map size
-    uvwarp::TileWarpOptions options;                   // solver, derived mask, dilation (cells: resolution)
+    uvwarp::TileWarpOptions options =
+        uvwarp::shotOptions();  // solver, derived mask, dilation (cells: resolution)
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;              // JSON lines, appended: one per tile x frame
 };

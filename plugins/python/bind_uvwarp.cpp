@@ -91,10 +91,11 @@ float floatOption(py::handle value, const std::string& source, const std::string
 }
 
 // resolution (grid cells per side, None = the rigidity map's size) and the keyword options, each checked
-// and named: the core checks them too but names only "solver options".
+// and named: the core checks them too but names only "solver options". `o` starts as `base`: a solver's
+// defaults (warm start) or a shot's (every frame from the identity, uvwarp::shotOptions).
 TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs& kwargs,
-                          const std::string& source) {
-    TileWarpOptions o;
+                          const std::string& source, const TileWarpOptions& base = {}) {
+    TileWarpOptions o = base;
     if (resolution) {
         const int64_t n = *resolution;
         if (n < 2 || n > (int64_t{1} << 15) || (n & (n - 1)) != 0) {
@@ -409,7 +410,7 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                     const std::string& filter, bool skipExisting, const py::object& log,
                     const py::object& progress, const std::string& restName, const py::kwargs& kwargs) {
     uvwarp::ShotJob job;
-    job.options = optionsOf(resolution, kwargs, kShot);
+    job.options = optionsOf(resolution, kwargs, kShot, uvwarp::shotOptions());
     job.filter = bakeOptionsOf(filter, kShot).filter;
     if (frames.empty()) throw InvalidInput(formatError(kShot, "frames", "is empty", "at least one frame"));
     job.rest = &rest;
@@ -562,17 +563,20 @@ constexpr const char* kShotDoc =
     "            ...)\n\n"
     "mesh: a deformkit.Mesh with UVs, or its arrays as UvWarpSolver takes them. frames: ascending ints.\n"
     "deformed: a callable frame -> (N, 3) float32 positions of the rest mesh's vertices, or -> (positions,\n"
-    "name) to name the frame's input in the headers; called once per frame, in order, up to the last frame\n"
-    "an output is missing for. Or an OBJ sequence pattern ('anim.####.obj', '%04d').\n"
+    "name) to name the frame's input in the headers; called once per frame the job solves, in order: the\n"
+    "frames whose outputs are missing (warm-started, every frame up to the last of them). Or an OBJ\n"
+    "sequence pattern ('anim.####.obj', '%04d').\n"
     "rigidity, mask, orientation, texture: a UDIM pattern ('rig.<UDIM>.exr'), or images in memory as\n"
     "{tile: (T, T) or (T, T, C) float32} (row 0 at v = 1, channel 0 used except for the texture), named\n"
     "by the argument in messages and headers, or (label, {tile: array}) to name them. A tile without a\n"
     "rigidity map is left unwarped (a note); without a mask the mask is derived from the UVs.\n"
     "out, bake: patterns with a UDIM token and a frame token ('out/redirect.<UDIM>.####.exr'); out is a\n"
     "2-channel float EXR, bake (with texture) any format; their folders must exist. tiles: None for every\n"
-    "tile of the UVs. resolution and options as UvWarpSolver; filter of the bake: 'bilinear', 'bicubic'.\n"
-    "skip_existing: keep outputs that exist and replay the warm start, so a rerun after a cancellation or\n"
-    "a crash writes the bytes an uninterrupted run writes; False writes every output again.\n"
+    "tile of the UVs. resolution and options as UvWarpSolver, but warm_start defaults to False: each frame\n"
+    "is solved from the identity, so its maps depend on that frame alone, whatever range the job covers\n"
+    "(warm_start=True: from the last frame's warp). filter of the bake: 'bilinear', 'bicubic'.\n"
+    "skip_existing: keep outputs that exist (warm-started, the warm start is replayed), so a rerun after a\n"
+    "cancellation or a crash writes the bytes an uninterrupted run writes; False writes every output again.\n"
     "log: a file to append JSON lines to (one per tile and frame). progress: a callable (done, total,\n"
     "unit) called after each tile and frame (unit: 'tile 1001 frame 12 written'); a true result cancels:\n"
     "deformkit.Cancelled is raised and every file written is complete. The solve runs without the GIL;\n"

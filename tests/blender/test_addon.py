@@ -388,13 +388,14 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     assert files == [f"redirect.1001.{f:04d}.exr" for f in (1, 2, 3)], files
 
     # The same solve through the module: the mesh's own positions at each frame, the painted disk (row 0 at
-    # v = 1, so Blender's bottom-up rows flipped), warm-started frame after frame: the same bytes.
+    # v = 1, so Blender's bottom-up rows flipped), each frame from the identity (a shot's default): the same
+    # bytes.
     counts = np.full(len(obj.data.polygons), 4, np.int32)
     indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
     uv_indices = np.arange(len(indices), dtype=np.int32)
     uvs = (rest[indices][:, :2] + 1.0) / 2.0
     solver = dk.UvWarpSolver(rest, counts, indices, uvs.astype(np.float32), uv_indices, 1001,
-                             np.ascontiguousarray(disk[::-1]))
+                             np.ascontiguousarray(disk[::-1]), warm_start=False)
     for frame in (1, 2, 3):
         bpy.context.scene.frame_set(frame)
         solver.solve(positions(obj))
@@ -413,8 +414,9 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
             "orientation": "none", "deformed": f"Blender object 'grid' evaluated at frame {frame}"}, header
         assert json.loads(header["deformkit:uvwarp:solver"])["texels"] == size
 
-    # Resume: a bake that lost frame 2's map sets frames 1 and 2 only (the warm start replayed) and writes that
-    # map alone, the same bytes; the others are not written (they keep an old modification time set here).
+    # Resume: a bake that lost frame 2's map sets frame 2 only (each frame is solved from the identity, so
+    # frame 1 is not needed) and writes that map alone, the same bytes; the others are not written (they keep
+    # an old modification time set here).
     old = 10**18  # ns: 2001
 
     def files_now():
@@ -436,7 +438,7 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
         assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3, resume=True) == {'FINISHED'}
     finally:
         bpy.app.handlers.frame_change_post.remove(record)
-    assert frames_set == [1, 2, 3], frames_set  # the last one puts the scene back on its frame
+    assert frames_set == [2, 3], frames_set  # the last one puts the scene back on its frame
     resumed = files_now()
     assert {name: data for name, (_, data) in resumed.items()} == {name: data for name, (_, data) in first.items()}
     assert [resumed[name][0] for name in sorted(first)] == [True, False, True], resumed.keys()

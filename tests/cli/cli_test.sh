@@ -269,7 +269,7 @@ contains slide-bad-painted "$work/err" "--painted-weights"
 
 # UV warp over a 2-frame shot of the grid (UVs in tile 1001) with the demo's 64 x 64 rigidity map: frame 1 is the
 # rest pose, frame 2 stretches 1.5x along x.
-mkdir -p "$work/uv/out" "$work/uv/cold" "$work/uv/coldalone"
+mkdir -p "$work/uv/out" "$work/uv/cold" "$work/uv/coldalone" "$work/uv/warm"
 cp "$work/grid.obj" "$work/uv/anim.0001.obj"
 awk '/^v / { printf "v %.9g %s %s\n", $2 * 1.5, $3, $4; next } { print }' "$work/grid.obj" >"$work/uv/anim.0002.obj"
 uvwarp() { "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/uv/anim.####.obj" --rigidity "$work/demo/rigidity.<UDIM>.exr" "$@"; }
@@ -290,14 +290,19 @@ contains info-truncated-exr "$work/err" "trunc.exr"
 [ ! -s "$work/out" ] || { echo "FAIL info-truncated-exr: printed a header"; cat "$work/out"; failures=$((failures + 1)); }
 expect uvwarp-resume 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr"
 contains uvwarp-resume "$work/out" "0 frames written, 0 replayed, 2 skipped"
-# --cold-frames: each frame from the identity, so frame 2 alone gives frame 2 of the whole shot, byte for byte,
-# and the header says so.
-expect uvwarp-cold 0 uvwarp --frames 1-2 --cold-frames --out "$work/uv/cold/redirect.<UDIM>.####.exr"
-expect uvwarp-cold-alone 0 uvwarp --frames 2-2 --cold-frames --out "$work/uv/coldalone/redirect.<UDIM>.####.exr"
+# Each frame from the identity (the default of a shot): frame 2 alone gives frame 2 of the whole shot, byte
+# for byte, and the header says so; warm-started (--warm-start) it does not.
+expect uvwarp-cold 0 uvwarp --frames 1-2 --out "$work/uv/cold/redirect.<UDIM>.####.exr"
+expect uvwarp-cold-alone 0 uvwarp --frames 2-2 --out "$work/uv/coldalone/redirect.<UDIM>.####.exr"
 cmp -s "$work/uv/cold/redirect.1001.0002.exr" "$work/uv/coldalone/redirect.1001.0002.exr" ||
     { echo "FAIL uvwarp-cold-alone: frame 2 alone differs from frame 2 of the shot"; failures=$((failures + 1)); }
 expect uvwarp-cold-info 0 "$dk" info "$work/uv/cold/redirect.1001.0002.exr"
 contains uvwarp-cold-info "$work/out" '"warmStart":false'
+expect uvwarp-warm 0 uvwarp --frames 1-2 --warm-start --out "$work/uv/warm/redirect.<UDIM>.####.exr"
+cmp -s "$work/uv/warm/redirect.1001.0002.exr" "$work/uv/coldalone/redirect.1001.0002.exr" &&
+    { echo "FAIL uvwarp-warm: a warm-started frame 2 equals frame 2 alone"; failures=$((failures + 1)); }
+expect uvwarp-warm-info 0 "$dk" info "$work/uv/warm/redirect.1001.0002.exr"
+contains uvwarp-warm-info "$work/out" '"warmStart":true'
 expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"
 [ -s "$work/uv/made/here/redirect.1001.0001.exr" ] || { echo "FAIL uvwarp-new-folder: map missing"; failures=$((failures + 1)); }
 # Outputs never destroy what they replace: an extension that is not the format's, a FIFO, a path in a file.
@@ -363,14 +368,21 @@ expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-p
 contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
 expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
 contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 6'
-# Warmed up from frame 1, the task of frame 2 writes eval's bytes; started cold (--warm-up 0) it does not.
+# Each frame from the identity (a scene's default): the task of frame 2 writes eval's bytes, warmed up or not.
 cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
-    { echo "FAIL farm-run-tiles: a task warmed up from frame 1 should write eval's frame 2"; failures=$((failures + 1)); }
+    { echo "FAIL farm-run-tiles: the task of frame 2 should write eval's frame 2"; failures=$((failures + 1)); }
 expect farm-plan-cold 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --warm-up 0 --out "$work/farm-uv-cold"
 expect farm-run-cold 0 "$dk" farm run "$work/farm-uv-cold/farm_plan.json" --task 3
-cmp -s "$work/farm-uv-cold/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" &&
-    { echo "FAIL farm-run-cold: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
-[ -s "$work/farm-uv-cold/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-cold: output missing"; failures=$((failures + 1)); }
+cmp -s "$work/farm-uv-cold/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
+    { echo "FAIL farm-run-cold: without warm-up the task of frame 2 should write eval's frame 2"; failures=$((failures + 1)); }
+# Warm-started ("warmStart": true): without warm-up the task of frame 2 starts cold and differs from eval's.
+sed 's/"iterations": 4}/"iterations": 4, "warmStart": true}/' "$work/uvshot.json" >"$work/uvshot_warm.json"
+expect eval-uvwarp-warm 0 "$dk" eval "$work/uvshot_warm.json" --out "$work/eval-uv-warm" --no-previews
+expect farm-plan-warm 0 "$dk" farm plan "$work/uvshot_warm.json" --chunk 1 --warm-up 0 --out "$work/farm-uv-warm"
+expect farm-run-warm 0 "$dk" farm run "$work/farm-uv-warm/farm_plan.json" --task 3
+cmp -s "$work/farm-uv-warm/grid.redirect.1001.0002.exr" "$work/eval-uv-warm/grid.redirect.1001.0002.exr" &&
+    { echo "FAIL farm-run-warm: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
+[ -s "$work/farm-uv-warm/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-warm: output missing"; failures=$((failures + 1)); }
 expect farm-plan-bad-warm-up 2 "$dk" farm plan "$work/uvshot.json" --warm-up -1 --out "$work/farm-uv3"
 contains farm-plan-bad-warm-up "$work/err" "--warm-up: is -1"
 expect farm-plan-bad-tiles 2 "$dk" farm plan "$work/uvshot.json" --tiles-per-task 0 --out "$work/farm-uv2"

@@ -245,7 +245,9 @@ def test_bad_input_names_what_is_wrong():
 
 S = 32  # texels per side of the shot tests' maps
 FRAMES = [1, 2, 3, 4]
-OPTIONS = dict(iterations=4)  # few iterations: the tests compare against the same solve, not a quality
+# Few iterations: the tests compare against the same solve, not a quality. Warm-started (a shot's default is
+# every frame from the identity): the replay of a resumed shot is what most of them check.
+OPTIONS = dict(iterations=4, warm_start=True)
 OUT = "redirect.<UDIM>.####.exr"
 
 
@@ -356,6 +358,37 @@ def test_shot_maps_in_memory_equal_maps_from_files(tmp_path):
     inputs = json.loads(dk.read_image_info(b / "redirect.1001.0002.exr")["attributes"]["deformkit:uvwarp:inputs"])
     assert (inputs["rigidity"], inputs["mask"], inputs["deformed"]) == (
         "rigidity tile 1001", "painted mask tile 1001", "frame 2")
+
+
+def test_shot_by_default_solves_each_frame_from_the_identity(tmp_path):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    (tmp_path / "whole").mkdir()
+    (tmp_path / "last").mkdir()
+    dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(tmp_path / "whole" / OUT), iterations=4)
+    asked = []
+
+    def deformed(frame):
+        asked.append(frame)
+        return pose(mesh[0], frame)
+
+    dk.uvwarp_shot(*mesh, [3, 4], deformed, rig, str(tmp_path / "last" / OUT), iterations=4)
+    for tile in (1001, 1002):
+        for frame in (3, 4):
+            name = f"redirect.{tile}.{frame:04d}.exr"
+            whole = dk.read_image(str(tmp_path / "whole" / name))
+            np.testing.assert_array_equal(dk.read_image(str(tmp_path / "last" / name)), whole)
+            alone = dk.UvWarpSolver(*mesh, tile, rig[tile], iterations=4, warm_start=False)
+            alone.solve(pose(mesh[0], frame))
+            np.testing.assert_array_equal(whole, alone.redirect_map())
+    solver = json.loads(dk.read_image_info(str(tmp_path / "whole" / "redirect.1001.0004.exr"))["attributes"][
+        "deformkit:uvwarp:solver"])
+    assert solver["warmStart"] is False
+    # A rerun that misses one output solves that frame only.
+    (tmp_path / "whole" / "redirect.1001.0002.exr").unlink()
+    report = dk.uvwarp_shot(*mesh, FRAMES, lambda f: pose(mesh[0], f), rig, str(tmp_path / "whole" / OUT),
+                            iterations=4)
+    assert (report[1001]["written"], report[1001]["replayed"], report[1001]["skipped"]) == (1, 0, 3)
 
 
 def test_shot_resume_replays_the_warm_start_and_writes_the_same_bytes(tmp_path):

@@ -160,8 +160,12 @@ uvwarp::ShotReport runUvWarpStage(SceneEvaluator& evaluator, size_t object, cons
     const InterrupterScope scope(interrupter, "uvwarp", solver->units());
     for (int frame : run.frames) {
         if (!last || frame > *last) break;
-        solveStageFrame(*solver, scene, object, frame, evaluator.evaluate(object, frame).points(),
-                        interrupter);
+        if (solver->needsPositions()) {
+            solveStageFrame(*solver, scene, object, frame, evaluator.evaluate(object, frame).points(),
+                            interrupter);
+        } else {
+            solveStageFrame(*solver, scene, object, frame, {}, interrupter);
+        }
     }
     return solver->finish();
 }

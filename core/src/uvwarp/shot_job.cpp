@@ -208,6 +208,13 @@ struct ShotSolver::Impl {
             writeLog(baseLine(plan, k, "skipped"));
         }
     }
+    // Does `plan` solve frame k? Warm-started frames carry the warm start up to the tile's last output;
+    // frames solved from the identity (SolverOptions::warmStart false) depend on nothing before them: only
+    // the outputs are solved.
+    [[nodiscard]] bool solves(const TilePlan& plan, size_t k) const {
+        return plan.report.warped &&
+               (job.options.solver.warmStart ? static_cast<int>(k) <= plan.lastNeeded : plan.needed[k]);
+    }
     void bind(TilePlan& plan, int frame);
     // Animated maps: gives the warp the frame's maps when they differ from the last ones.
     void animateMaps(TilePlan& plan, int frame);
@@ -353,6 +360,13 @@ ShotSolver& ShotSolver::operator=(ShotSolver&&) noexcept = default;
 
 int64_t ShotSolver::units() const {
     return static_cast<int64_t>(impl_->plans.size() * impl_->job.frames.size());
+}
+
+bool ShotSolver::needsPositions() const {
+    const Impl& s = *impl_;
+    if (s.nextFrame >= s.job.frames.size()) return false;
+    return std::any_of(s.plans.begin(), s.plans.end(),
+                       [&](const TilePlan& plan) { return s.solves(plan, s.nextFrame); });
 }
 
 std::optional<int> ShotSolver::lastNeededFrame() const {
@@ -518,6 +532,12 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     writeLog(line);
 }
 
+TileWarpOptions shotOptions() {
+    TileWarpOptions options;
+    options.solver.warmStart = false;
+    return options;
+}
+
 void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, const std::string& inputName,
                             Interrupter* interrupter) {
     Impl& s = *impl_;
@@ -531,18 +551,14 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
             formatError("uvwarp", "frame " + std::to_string(frame), "is out of order", expected));
     }
     const auto vertices = static_cast<size_t>(s.job.rest->numVertices());
-    if (deformed.size() != vertices) {
+    if (deformed.size() != vertices && (needsPositions() || !deformed.empty())) {
         throw InvalidInput(formatError(
             inputName, "", "has " + std::to_string(deformed.size()) + " vertices",
             std::to_string(vertices) + ", the vertex count of the rest mesh '" + s.job.restName + "'"));
     }
     const size_t k = s.nextFrame++;
     for (TilePlan& plan : s.plans) {
-        // Warm-started frames carry the warm start up to the last output; frames solved from the identity
-        // (SolverOptions::warmStart false) depend on nothing before them: only the outputs are solved.
-        const bool solves =
-            plan.report.warped &&
-            (s.job.options.solver.warmStart ? static_cast<int>(k) <= plan.lastNeeded : plan.needed[k] != 0);
+        const bool solves = s.solves(plan, k);
         if (solves) {
             s.solveTile(plan, k, deformed, inputName);
         } else {
@@ -588,7 +604,8 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
     for (int frame : job.frames) {
         if (!last || frame > *last) break;
         std::string name;
-        const std::span<const glm::vec3> points = deformed(frame, name);
+        const std::span<const glm::vec3> points =
+            solver.needsPositions() ? deformed(frame, name) : std::span<const glm::vec3>();
         solver.solveFrame(frame, points, name, interrupter);
     }
     return solver.finish();

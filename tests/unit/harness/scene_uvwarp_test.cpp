@@ -81,7 +81,7 @@ const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
     {"type": "taper", "params": {"handleY": [0, 1, 0], "lowBound": -1, "highBound": 1,
        "endScale": {"keys": [{"frame": 1, "value": 1.2, "interpolation": "linear"}, {"frame": 3, "value": 1.8}]}}},
     {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr",
-     "params": {"iterations": 6}}]}]})";
+     "params": {"iterations": 6, "warmStart": true}}]}]})";
 
 struct Shot {
     test::TempDir dir;
@@ -130,9 +130,9 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     CHECK(object.uvwarp->options.solver.iterations == 6);
     CHECK(object.uvwarp->options.solver.tolerance == 0.0f);
     std::string withTolerance = kScene;
-    const std::string params = R"("params": {"iterations": 6})";
+    const std::string params = R"("params": {"iterations": 6, "warmStart": true})";
     withTolerance.replace(withTolerance.find(params), params.size(),
-                          R"("params": {"iterations": 6, "tolerance": 0.25})");
+                          R"("params": {"iterations": 6, "warmStart": true, "tolerance": 0.25})");
     test::writeText(shot.scene, withTolerance);
     CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.tolerance == 0.25f);
     test::writeText(shot.scene, kScene);
@@ -544,7 +544,7 @@ TEST_CASE("scene uvwarp: frames solved from the identity make chunked maps the u
     replace(R"({"frame": 3, "value": 1.8})", R"({"frame": 24, "value": 1.9})");
     replace(R"("texture": "col.<UDIM>.exr",)", "");
     const std::string warm = longer;
-    replace(R"("params": {"iterations": 6})", R"("params": {"iterations": 6, "warmStart": false})");
+    replace(R"("warmStart": true)", R"("warmStart": false)");
     const std::string cold = longer;
     int differing[2] = {0, 0};  // maps of frames 9 to 24 unlike the uninterrupted run's: warm, cold
     for (const bool coldFrames : {false, true}) {

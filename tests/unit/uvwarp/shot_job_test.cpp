@@ -76,7 +76,9 @@ struct Shot {
     int asked = 0;  // deformed-frame requests
     std::vector<glm::vec3> frame;
 
-    Shot() {
+    // warm: frames warm-started (the replay of a resumed job); false: the shot's default, from the identity.
+    explicit Shot(bool warm = true) {
+        job.options.solver.warmStart = warm;
         job.rest = &rest;
         job.restName = "two tiles";
         job.frames = {1, 2, 3, 4};
@@ -348,4 +350,31 @@ TEST_CASE("shot job: shotTiles gives the asked tiles or every tile of the UVs, a
     const geom::Mesh noUvs(std::move(bare), "bare");
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)uvwarp::shotTiles(noUvs, "bare.obj", {}, "tiles"); }),
                Contains("bare.obj") && Contains("has no UVs"));
+}
+
+// A shot's default (uvwarp::shotOptions): every frame from the identity, so each map is a TileWarp's solve of
+// that frame alone, a job over the last two frames writes the whole job's bytes for them, and a rerun that
+// misses one output solves that frame only.
+TEST_CASE("shot job: by default each frame's map depends on that frame alone", "[uvwarp][shot_job]") {
+    CHECK_FALSE(uvwarp::ShotJob{}.options.solver.warmStart);
+    Shot whole(false), last(false);
+    last.job.frames = {3, 4};
+    (void)uvwarp::runShotJob(whole.job, whole.frames());
+    (void)uvwarp::runShotJob(last.job, last.frames());
+    for (const int tile : {1001, 1002}) {
+        for (int f = 3; f <= kFrames; ++f) {
+            uvwarp::TileWarp alone(whole.rest, tile, disks(), {}, uvwarp::shotOptions());
+            alone.solve(deformedAt(whole.rest, f));
+            const io::Image written = io::readImage(whole.out(tile, f));
+            CHECK(test::sameBits(written.pixels, alone.redirect().pixels));
+            CHECK(test::readText(last.out(tile, f)) == test::readText(whole.out(tile, f)));
+        }
+    }
+    fs::remove(whole.out(1001, 3));
+    whole.asked = 0;
+    const uvwarp::ShotReport again = uvwarp::runShotJob(whole.job, whole.frames());
+    CHECK(again.tiles[0].written == 1);
+    CHECK(again.tiles[0].replayed == 0);
+    CHECK(again.tiles[0].skipped == kFrames - 1);
+    CHECK(again.tiles[1].written == 0);
 }

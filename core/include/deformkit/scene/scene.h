@@ -11,6 +11,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/io/sampling.h"
 #include "deformkit/scene/anim_curve.h"
+#include "deformkit/uvwarp/shot_job.h"
 #include "deformkit/uvwarp/tile_warp.h"
 
 namespace deformkit::scene {
@@ -61,7 +62,9 @@ struct SceneUvWarp {
     std::filesystem::path rigidity;                                   // UDIM pattern, resolved like meshes
     std::optional<std::filesystem::path> mask, orientation, texture;  // UDIM patterns
     std::vector<int> tiles;  // ascending; every tile of the rest mesh's UVs when the scene gives none
-    uvwarp::TileWarpOptions options;  // options.cells: the grid resolution (0: the rigidity map's size)
+    // options.cells: the grid resolution (0: the rigidity map's size); every frame from the identity unless
+    // the scene's params say "warmStart": true (uvwarp::shotOptions).
+    uvwarp::TileWarpOptions options = uvwarp::shotOptions();
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
     std::string path;                                      // "objects[0].stack[2]"
 };

@@ -64,6 +64,13 @@ struct TileMapSource {
     [[nodiscard]] bool given() const { return !pattern.empty() || !images.empty(); }
 };
 
+// The options a job over a shot starts from: TileWarpOptions{} but every frame solved from the identity
+// (SolverOptions::warmStart false). With the default schedule that costs what a warm-started frame does and
+// removes as much of the rigid stretch, and a frame's maps then depend on that frame alone: not on the
+// frames before it, nor on where a farm chunk or a resumed job begins (docs/decisions.md, UV-20). Hosts
+// that show a live preview, one iteration a frame, warm-start instead (TileWarpOptions{}).
+[[nodiscard]] TileWarpOptions shotOptions();
+
 struct ShotJob {
     const geom::Mesh* rest = nullptr;  // with UVs; must outlive the job
     std::string restName;              // names the rest mesh in messages and EXR headers
@@ -78,7 +85,7 @@ struct ShotJob {
     TileMapSource texture;      // optional; baked through each redirect map (needs bakePath)
     // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
     std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
-    TileWarpOptions options;  // cells: the grid resolution (0: the rigidity map's size)
+    TileWarpOptions options = shotOptions();  // cells: the grid resolution (0: the rigidity map's size)
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
     // Keep existing outputs and replay the warm start (a resumed job writes an uninterrupted job's bytes);
     // false writes every output again.
@@ -127,8 +134,13 @@ class ShotSolver {
     // The last frame whose deformed positions some tile needs; frames after it need no evaluation. None
     // when every output exists.
     [[nodiscard]] std::optional<int> lastNeededFrame() const;
+    // Whether the job's next frame is solved by some tile, so solveFrame needs its deformed positions (a
+    // frame solved from the identity whose outputs exist, or a warm-up frame, is not): callers skip
+    // evaluating the others and pass no positions.
+    [[nodiscard]] bool needsPositions() const;
     // Frame `frame`, the job's next frame in order: solves every tile that needs it from `deformed` (#V
-    // positions of the rest mesh's vertices) and writes its outputs. `inputName` is what the headers record
+    // positions of the rest mesh's vertices; may be empty when needsPositions() is false) and writes its
+    // outputs. `inputName` is what the headers record
     // as the frame's input ("anim.0007.obj"). After each tile the interrupter, when given, is told and may
     // cancel (Cancelled). Throws InvalidInput for a frame out of order or a vertex count that differs.
     void solveFrame(int frame, std::span<const glm::vec3> deformed, const std::string& inputName,
