@@ -1,7 +1,8 @@
 // Farm throughput (issue 6): a 100-frame shot of two UDIM tiles, one object (two 64 x 64 quad grids, one
 // per tile, 8,450 vertices) under a keyframed twist and the UV warp (64 x 64 rigidity maps, 6 iterations per
-// frame). BM_FarmRunPlan runs every task of its farm plan (--chunk 10, 6 warm-up frames, one tile per UV-warp
-// task: 10 mesh tasks and 20 UV-warp tasks) one after the other in this process, as a farm of one slot would;
+// frame, each from the identity: the scene's default). BM_FarmRunPlan runs every task of its farm plan
+// (--chunk 10, 6 warm-up frames, which frames solved from the identity skip; one tile per UV-warp task: 10
+// mesh tasks and 20 UV-warp tasks) one after the other in this process, as a farm of one slot would;
 // BM_FarmEval evaluates the whole shot with one `deformkit eval` (previews off) as the reference. Both
 // write every output again each iteration. items/s = frames per second.
 #include <benchmark/benchmark.h>
