@@ -358,7 +358,6 @@ class Reader {
                  {"type", "label", "rigidity", "mask", "orientation", "texture", "tiles", "resolution",
                   "filter", "params"});
         SceneUvWarp u;
-        u.options = uvwarp::shotOptions();
         u.path = path;
         u.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
                                       : "uvwarp" + std::to_string(entry + 1);

@@ -85,8 +85,8 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
     """Solves every UDIM tile of the object's UVs over `frames` (ascending) with the module's shot job and
     writes REDIRECT_PATTERN's files into out_dir. Each frame is set once and the evaluated mesh read once for
     all tiles. Each frame is solved from the identity (the shot job's default), so resume keeps the maps that
-    exist and sets only the frames of the missing ones; otherwise every map is written again. progress(done, total, unit) is uvwarp_shot's. Returns the job's
-    report, {tile: dict}."""
+    exist and sets only the frames of the missing ones; otherwise every map is written again.
+    progress(done, total, unit) is uvwarp_shot's. Returns the job's report, {tile: dict}."""
     scene = context.scene
     if evaluate.has_rest(obj):
         rest = evaluate.rest_points(obj)

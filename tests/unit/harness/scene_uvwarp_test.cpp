@@ -476,15 +476,10 @@ TEST_CASE("scene uvwarp: eval writes the same bytes with 1 and 2 threads", "[har
         CHECK(runs[0][i] == runs[1][i]);
 }
 
-// Issue 19, part 3: a frame's redirect map must not depend on where its farm chunk began. A 24-frame shot
-// in chunks of 8: at the chunk starts (frames 9 and 17, whose warm-up does not reach back to frame 1) the
-// maps of the farm tasks against those of one uninterrupted eval, largest difference over the tile in
-// texels. With the default warm-up (6 frames) it must be at most 0.25 texel; without warm-up it is larger
-// (so the bound is not met by accident).
-TEST_CASE(
-    "scene uvwarp: with warm-up frames a chunk's first map is the uninterrupted run's within 0.25 texel",
-    "[harness][uvwarp][farm]") {
-    Shot shot;
+namespace {
+
+// The chunk tests' shot: kScene over 24 frames, without a texture, warm-started or not.
+std::string chunkShot(bool warmStart) {
     std::string longer = kScene;
     const auto replace = [&](const std::string& from, const std::string& to) {
         longer.replace(longer.find(from), from.size(), to);
@@ -492,34 +487,68 @@ TEST_CASE(
     replace(R"("frames": [1, 3])", R"("frames": [1, 24])");
     replace(R"({"frame": 3, "value": 1.8})", R"({"frame": 24, "value": 1.9})");
     replace(R"("texture": "col.<UDIM>.exr",)", "");
-    test::writeText(shot.scene, longer);
+    if (!warmStart) replace(R"("warmStart": true)", R"("warmStart": false)");
+    return longer;
+}
+
+// One uninterrupted eval of shot.scene into shot.dir / folder.
+fs::path evalShot(const Shot& shot, const std::string& folder) {
     harness::EvalCommand eval;
     eval.scene = shot.scene;
-    eval.outDir = shot.dir / "eval";
+    eval.outDir = shot.dir / folder;
     eval.previews = false;
     (void)harness::evalCommand(eval);
+    return eval.outDir;
+}
+
+// shot.scene as farm tasks in chunks of 8 frames with `warmUp` warm-up frames, run one after the other into
+// shot.dir / folder.
+fs::path farmShot(const Shot& shot, int warmUp, const std::string& folder) {
+    harness::FarmPlanCommand plan;
+    plan.scene = shot.scene;
+    plan.chunk = 8;
+    plan.warmUp = warmUp;
+    plan.outDir = shot.dir / folder;
+    const scene::FarmPlan made = harness::farmPlanCommand(plan);
+    for (size_t k = 0; k < made.tasks.size(); ++k)
+        (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)});
+    return plan.outDir;
+}
+
+// The redirect maps of `tile` and `frame` in an eval's or a farm's output folder.
+io::Image redirectIn(const fs::path& folder, int tile, int frame) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "tubes.redirect.%d.%04d.exr", tile, frame);
+    return io::readImage(folder / name);
+}
+
+}  // namespace
+
+// Issue 19, part 3: a frame's redirect map must not depend on where its farm chunk began. A 24-frame shot,
+// warm-started, in chunks of 8: at the chunk starts (frames 9 and 17, whose warm-up does not reach back to
+// frame 1) the maps of the farm tasks against those of one uninterrupted eval, largest difference over the
+// tile in texels. With the default warm-up (6 frames) it must be at most 0.25 texel; without warm-up it is
+// larger (so the bound is not met by accident).
+TEST_CASE(
+    "scene uvwarp: with warm-up frames a chunk's first map is the uninterrupted run's within 0.25 texel",
+    "[harness][uvwarp][farm]") {
+    Shot shot;
+    test::writeText(shot.scene, chunkShot(true));
+    const fs::path whole = evalShot(shot, "eval");
     double jumps[2] = {0.0, 0.0};  // without, with warm-up
     const int defaultWarmUp = harness::FarmPlanCommand{}.warmUp;
     REQUIRE(defaultWarmUp < 8);
     for (int warmUp : {0, defaultWarmUp}) {
-        harness::FarmPlanCommand plan;
-        plan.scene = shot.scene;
-        plan.chunk = 8;
-        plan.warmUp = warmUp;
-        plan.outDir = shot.dir / ("farm" + std::to_string(warmUp));
-        const scene::FarmPlan made = harness::farmPlanCommand(plan);
-        for (size_t k = 0; k < made.tasks.size(); ++k)
-            (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)});
+        const fs::path farm = farmShot(shot, warmUp, "farm" + std::to_string(warmUp));
         for (int frame : {9, 17}) {
             for (int tile : {1001, 1002}) {
-                char name[64];
-                std::snprintf(name, sizeof(name), "tubes.redirect.%d.%04d.exr", tile, frame);
-                const io::Image chunked = io::readImage(plan.outDir / name);
-                const io::Image whole = io::readImage(eval.outDir / name);
-                REQUIRE(chunked.pixels.size() == whole.pixels.size());
-                for (size_t i = 0; i < whole.pixels.size(); ++i)
-                    jumps[warmUp > 0] = std::max(
-                        jumps[warmUp > 0], std::abs(double(chunked.pixels[i]) - whole.pixels[i]) * kTexels);
+                const io::Image chunked = redirectIn(farm, tile, frame),
+                                uninterrupted = redirectIn(whole, tile, frame);
+                REQUIRE(chunked.pixels.size() == uninterrupted.pixels.size());
+                for (size_t i = 0; i < uninterrupted.pixels.size(); ++i)
+                    jumps[warmUp > 0] =
+                        std::max(jumps[warmUp > 0],
+                                 std::abs(double(chunked.pixels[i]) - uninterrupted.pixels[i]) * kTexels);
             }
         }
     }
@@ -529,52 +558,28 @@ TEST_CASE(
     CHECK(jumps[0] > 0.25);
 }
 
-// Issue 19, part 3, by construction: with every frame solved from the identity ("warmStart": false) a frame's
+// Issue 19, part 3, by construction: with every frame solved from the identity (a scene's default) a frame's
 // map depends on that frame alone, so farm tasks in chunks of 8, without warm-up, write every frame's map
-// byte for byte as one uninterrupted eval does, and solve no frame outside their ranges. Warm-started, the
-// same chunks differ (the test could fail).
+// byte for byte as one uninterrupted eval does. Warm-started, the same chunks differ (the test could fail).
 TEST_CASE("scene uvwarp: frames solved from the identity make chunked maps the uninterrupted run's bytes",
           "[harness][uvwarp][farm]") {
     Shot shot;
-    std::string longer = kScene;
-    const auto replace = [&](const std::string& from, const std::string& to) {
-        longer.replace(longer.find(from), from.size(), to);
-    };
-    replace(R"("frames": [1, 3])", R"("frames": [1, 24])");
-    replace(R"({"frame": 3, "value": 1.8})", R"({"frame": 24, "value": 1.9})");
-    replace(R"("texture": "col.<UDIM>.exr",)", "");
-    const std::string warm = longer;
-    replace(R"("warmStart": true)", R"("warmStart": false)");
-    const std::string cold = longer;
     int differing[2] = {0, 0};  // maps of frames 9 to 24 unlike the uninterrupted run's: warm, cold
     for (const bool coldFrames : {false, true}) {
-        test::writeText(shot.scene, coldFrames ? cold : warm);
-        harness::EvalCommand eval;
-        eval.scene = shot.scene;
-        eval.outDir = shot.dir / (coldFrames ? "eval-cold" : "eval-warm");
-        eval.previews = false;
-        (void)harness::evalCommand(eval);
-        harness::FarmPlanCommand plan;
-        plan.scene = shot.scene;
-        plan.chunk = 8;
-        plan.warmUp = 0;
-        plan.outDir = shot.dir / (coldFrames ? "farm-cold" : "farm-warm");
-        const scene::FarmPlan made = harness::farmPlanCommand(plan);
-        for (size_t k = 0; k < made.tasks.size(); ++k)
-            (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)});
+        test::writeText(shot.scene, chunkShot(!coldFrames));
+        const fs::path whole = evalShot(shot, coldFrames ? "eval-cold" : "eval-warm");
+        const fs::path farm = farmShot(shot, 0, coldFrames ? "farm-cold" : "farm-warm");
         for (int frame = 9; frame <= 24; ++frame) {
             for (int tile : {1001, 1002}) {
-                char name[64];
-                std::snprintf(name, sizeof(name), "tubes.redirect.%d.%04d.exr", tile, frame);
-                const io::Image chunked = io::readImage(plan.outDir / name);
-                const io::Image whole = io::readImage(eval.outDir / name);
-                REQUIRE(chunked.pixels.size() == whole.pixels.size());
-                differing[coldFrames] += chunked.pixels != whole.pixels ? 1 : 0;
+                const io::Image chunked = redirectIn(farm, tile, frame),
+                                uninterrupted = redirectIn(whole, tile, frame);
+                REQUIRE(chunked.pixels.size() == uninterrupted.pixels.size());
+                differing[coldFrames] += chunked.pixels != uninterrupted.pixels ? 1 : 0;
             }
         }
         if (coldFrames) {
             // The headers say how the maps were made.
-            const io::ImageInfo info = io::readImageInfo(plan.outDir / "tubes.redirect.1001.0009.exr");
+            const io::ImageInfo info = io::readImageInfo(farm / "tubes.redirect.1001.0009.exr");
             std::string solver;
             for (const auto& [key, value] : info.attributes)
                 if (key == "deformkit:uvwarp:solver") solver = value;

@@ -140,9 +140,9 @@ class ShotSolver {
     [[nodiscard]] bool needsPositions() const;
     // Frame `frame`, the job's next frame in order: solves every tile that needs it from `deformed` (#V
     // positions of the rest mesh's vertices; may be empty when needsPositions() is false) and writes its
-    // outputs. `inputName` is what the headers record
-    // as the frame's input ("anim.0007.obj"). After each tile the interrupter, when given, is told and may
-    // cancel (Cancelled). Throws InvalidInput for a frame out of order or a vertex count that differs.
+    // outputs. `inputName` is what the headers record as the frame's input ("anim.0007.obj"). After each
+    // tile the interrupter, when given, is told and may cancel (Cancelled). Throws InvalidInput for a frame
+    // out of order or a vertex count that differs.
     void solveFrame(int frame, std::span<const glm::vec3> deformed, const std::string& inputName,
                     Interrupter* interrupter = nullptr);
     // Logs the frames not given (after lastNeededFrame) and returns the report.
