@@ -160,12 +160,11 @@ uvwarp::ShotReport runUvWarpStage(SceneEvaluator& evaluator, size_t object, cons
     const InterrupterScope scope(interrupter, "uvwarp", solver->units());
     for (int frame : run.frames) {
         if (!last || frame > *last) break;
-        if (solver->needsPositions()) {
-            solveStageFrame(*solver, scene, object, frame, evaluator.evaluate(object, frame).points(),
-                            interrupter);
-        } else {
-            solveStageFrame(*solver, scene, object, frame, {}, interrupter);
-        }
+        // Frames no tile solves (warm-up, or outputs that exist) are not evaluated.
+        const std::span<const glm::vec3> deformed = solver->needsPositions()
+                                                        ? evaluator.evaluate(object, frame).points()
+                                                        : std::span<const glm::vec3>();
+        solveStageFrame(*solver, scene, object, frame, deformed, interrupter);
     }
     return solver->finish();
 }
