@@ -10,6 +10,7 @@
 #include "deformkit/geom/rasterizer.h"
 #include "geom/rasterize_triangle.h"
 #include "lookup.h"
+#include "memory/large_buffers.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -37,7 +38,8 @@ double distanceToSegment(double px, double py, double ax, double ay, double bx, 
 // Ties go to the lower column, then (within a column) to the lower row.
 std::vector<int32_t> nearestCovered(const std::vector<int32_t>& triangle, int32_t side) {
     const size_t count = static_cast<size_t>(side) * side;
-    std::vector<int32_t> nearRow(count, -1);
+    std::vector<int32_t> nearRow;
+    deformkit::detail::assignLarge(nearRow, count, -1);
 #pragma omp parallel for schedule(static)
     for (int32_t i = 0; i < side; ++i) {
         int32_t last = -1;
@@ -53,7 +55,8 @@ std::vector<int32_t> nearestCovered(const std::vector<int32_t>& triangle, int32_
             if (next >= 0 && (nearRow[k] < 0 || next - j < j - nearRow[k])) nearRow[k] = next;
         }
     }
-    std::vector<int32_t> nearest(count, -1);
+    std::vector<int32_t> nearest;
+    deformkit::detail::assignLarge(nearest, count, -1);
 #pragma omp parallel
     {
         std::vector<int32_t> sites(static_cast<size_t>(side));
@@ -132,9 +135,9 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     const int32_t side = cells + 1;
     const size_t count = static_cast<size_t>(side) * side;
     const auto n = static_cast<float>(cells);
-    pointTriangle_.assign(count, -1);
-    pointB_.assign(count, 0.0f);
-    pointC_.assign(count, 0.0f);
+    deformkit::detail::assignLarge(pointTriangle_, count, -1);
+    deformkit::detail::assignLarge(pointB_, count, 0.0f);
+    deformkit::detail::assignLarge(pointC_, count, 0.0f);
 
     // Point (i, j) is the centre of raster pixel (i, j): raster coordinates uv * n + 0.5.
     const geom::RasterGrid grid{side, side};
@@ -198,17 +201,22 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
         }
     }
 
-    coverage_.resize(count);
-    std::vector<uint8_t> ring(count, kUnassigned);
-    std::vector<int32_t> frontier;
+    deformkit::detail::assignLarge(coverage_, count, uint8_t{0});
+    std::vector<uint8_t> ring;
+    deformkit::detail::assignLarge(ring, count, kUnassigned);
+    numCovered_ = 0;
     for (size_t k = 0; k < count; ++k) {
         coverage_[k] = pointTriangle_[k] >= 0 ? 1 : 0;
+        numCovered_ += coverage_[k];
+    }
+    std::vector<int32_t> frontier;
+    deformkit::detail::reserveLarge(frontier, static_cast<size_t>(numCovered_));
+    for (size_t k = 0; k < count; ++k) {
         if (coverage_[k]) {
             ring[k] = 0;
             frontier.push_back(static_cast<int32_t>(k));
         }
     }
-    numCovered_ = static_cast<int64_t>(frontier.size());
 
     // Dilation rings (breadth-first over 8-neighbours from the covered points).
     auto inside = [&](int32_t i, int32_t j) { return i >= 0 && j >= 0 && i < side && j < side; };
@@ -273,6 +281,9 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
 
     if (numCovered_ + numDilated() < static_cast<int64_t>(count)) {
         const std::vector<int32_t> nearest = nearestCovered(pointTriangle_, side);
+        const auto far = static_cast<size_t>(static_cast<int64_t>(count) - numCovered_ - numDilated());
+        deformkit::detail::reserveLarge(farPoint_, far);
+        deformkit::detail::reserveLarge(farSource_, far);
         for (size_t k = 0; k < count; ++k) {
             if (ring[k] != kUnassigned) continue;
             farPoint_.push_back(static_cast<int32_t>(k));
@@ -297,7 +308,8 @@ void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& ou
     const int32_t side = cells_ + 1;
     out.cells = cells_;
     out.channels = 3;
-    out.values.resize(static_cast<size_t>(side) * side * 3);
+    if (out.values.size() != static_cast<size_t>(side) * side * 3)
+        deformkit::detail::assignLarge(out.values, static_cast<size_t>(side) * side * 3, 0.0f);
     float* values = out.values.data();
     const glm::vec3* p = positions.data();
 

@@ -1,21 +1,27 @@
 #include "deformkit/uvwarp/grid.h"
 
+#include "memory/large_buffers.h"
+
 namespace deformkit::uvwarp {
 
 WarpGrid WarpGrid::identity(int32_t cells) {
     WarpGrid grid;
-    grid.cells = cells;
-    const int32_t side = cells + 1;
-    grid.u.resize(static_cast<size_t>(side) * side);
-    grid.v.resize(grid.u.size());
+    grid.setIdentity(cells);
+    return grid;
+}
+
+void WarpGrid::setIdentity(int32_t n) {
+    cells = n;
+    const int32_t side = n + 1;
+    deformkit::detail::assignLarge(u, static_cast<size_t>(side) * side, 0.0f);
+    deformkit::detail::assignLarge(v, u.size(), 0.0f);
     for (int32_t j = 0; j < side; ++j) {
         for (int32_t i = 0; i < side; ++i) {
             const size_t k = static_cast<size_t>(j) * side + i;
-            grid.u[k] = static_cast<float>(i) / static_cast<float>(cells);
-            grid.v[k] = static_cast<float>(j) / static_cast<float>(cells);
+            u[k] = static_cast<float>(i) / static_cast<float>(n);
+            v[k] = static_cast<float>(j) / static_cast<float>(n);
         }
     }
-    return grid;
 }
 
 bool isPowerOfTwo(int32_t n) {

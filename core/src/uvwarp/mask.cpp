@@ -8,6 +8,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
 #include "geom/rasterize_triangle.h"
+#include "memory/large_buffers.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -70,7 +71,10 @@ io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
     const auto t = static_cast<float>(texels);
 
     // Raster row r holds v from r / T to (r + 1) / T, i.e. image row T - 1 - r.
-    io::Image mask(size, size, 1, 0.0f);
+    io::Image mask;
+    mask.width = mask.height = size;
+    mask.channels = 1;
+    deformkit::detail::assignLarge(mask.pixels, static_cast<size_t>(size) * size, 0.0f);
     const geom::RasterGrid grid{size, size};
     for (const auto& c : uvs.uvs) {
         rasterizeTriangle(grid, c[0] * t, c[1] * t, c[2] * t, [&](int32_t x, int32_t r, const glm::vec3&) {
@@ -162,7 +166,7 @@ PointField rigidityAtPoints(const io::Image& rigidity, int32_t cells, const MapL
     out.cells = cells;
     out.channels = 1;
     const int32_t side = cells + 1;
-    out.values.resize(static_cast<size_t>(side) * side);
+    deformkit::detail::assignLarge(out.values, static_cast<size_t>(side) * side, 0.0f);
     // Continuous texel coordinates (texel centres at integers) of u = i / n and of v = j / n (image rows
     // run down), clamped to the edge texels: taps and weights per column and per row.
     const double scale = static_cast<double>(size) / cells;
@@ -206,7 +210,8 @@ PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& la
         texelsWithinOne((cells - k) * scale - 0.5, size, rowLo[k], rowHi[k]);
     }
     // Separable minimum: over each point column's texel columns per image row, then over texel rows.
-    std::vector<uint8_t> rowMin(static_cast<size_t>(size) * side);
+    std::vector<uint8_t> rowMin;
+    deformkit::detail::assignLarge(rowMin, static_cast<size_t>(size) * side, uint8_t{0});
 #pragma omp parallel for schedule(static)
     for (int32_t y = 0; y < size; ++y) {
         for (int32_t i = 0; i < side; ++i) {
@@ -219,7 +224,7 @@ PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& la
     PointField out;
     out.cells = cells;
     out.channels = 1;
-    out.values.resize(static_cast<size_t>(side) * side);
+    deformkit::detail::assignLarge(out.values, static_cast<size_t>(side) * side, 0.0f);
 #pragma omp parallel for schedule(static)
     for (int32_t j = 0; j < side; ++j) {
         for (int32_t i = 0; i < side; ++i) {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "deformkit/error.h"
+#include "memory/large_buffers.h"
 #include "simd/cpu.h"
 #include "solver_kernels.h"
 #include "solver_state.h"
@@ -62,7 +63,8 @@ const detail::SolverKernels& kernelsFor(simd::Isa isa) {
 int32_t widestChartRadius(const PointField& mask) {
     const int32_t side = mask.side();
     const int32_t far = 2 * side;
-    std::vector<int32_t> d(static_cast<size_t>(side) * side);
+    std::vector<int32_t> d;
+    deformkit::detail::assignLarge(d, static_cast<size_t>(side) * side, 0);
     const auto at = [&](int32_t i, int32_t j) -> int32_t& { return d[static_cast<size_t>(j) * side + i]; };
     for (int32_t j = 0; j < side; ++j)
         for (int32_t i = 0; i < side; ++i) {
@@ -266,17 +268,18 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
     }
     for (Level& level : levels) {
         const size_t count = static_cast<size_t>(level.side()) * level.side();
-        level.rigidity.assign(count, 0.0f);
+        deformkit::detail::assignLarge(level.rigidity, count, 0.0f);
         if (orientation.values.empty()) {
             level.orientation.clear();
             level.orientation.shrink_to_fit();
         } else {
-            level.orientation.assign(count, 1.0f);
+            deformkit::detail::assignLarge(level.orientation, count, 1.0f);
         }
     }
     // Per point of the level being built from: may it move (mask, Eq. 8, and not on the tile border)?
     // Written into Level::rigidity as kFixed - R once the next level's blur (Eq. 7) has read the level's R.
-    std::vector<uint8_t> movable(static_cast<size_t>(side()) * side()), coarser;
+    std::vector<uint8_t> movable, coarser;
+    deformkit::detail::assignLarge(movable, static_cast<size_t>(side()) * side(), uint8_t{0});
     const auto markFixed = [](Level& level, const std::vector<uint8_t>& canMove) {
         for (size_t k = 0; k < canMove.size(); ++k)
             if (canMove[k] == 0) level.rigidity[k] = detail::fixedRigidity(level.rigidity[k]);
@@ -414,8 +417,8 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
         level.stride = 1 << l;
         const size_t count = static_cast<size_t>(level.side()) * level.side();
         if (l > 0) {
-            level.snapshotU.resize(count);
-            level.snapshotV.resize(count);
+            deformkit::detail::assignLarge(level.snapshotU, count, 0.0f);
+            deformkit::detail::assignLarge(level.snapshotV, count, 0.0f);
         }
     }
     m.rest = std::move(restGeometry);
@@ -425,8 +428,8 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     m.buildMaps(rigidity, mask, orientation);
     m.grid = WarpGrid::identity(m.cells);
     const size_t n = m.grid.numPoints();
-    m.velU.assign(n, 0.0f);
-    m.velV.assign(n, 0.0f);
+    deformkit::detail::assignLarge(m.velU, n, 0.0f);
+    deformkit::detail::assignLarge(m.velV, n, 0.0f);
     m.stats.levels = levelCount;
 }
 
@@ -471,7 +474,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
 
 void Solver::reset() {
     Impl& m = *impl_;
-    m.grid = WarpGrid::identity(m.cells);
+    m.grid.setIdentity(m.cells);
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);
 }

@@ -7,6 +7,7 @@
 #include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/inversion.h"
 #include "deformkit/uvwarp/mask.h"
+#include "memory/large_buffers.h"
 
 namespace deformkit::uvwarp {
 
@@ -92,7 +93,9 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
         orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
                                                {source + " density orientation", tile});
     }
-    m.boundMask = m.mask;
+    m.boundMask.cells = m.mask.cells;
+    m.boundMask.channels = m.mask.channels;
+    deformkit::detail::copyLarge(m.boundMask.values, m.mask.values);
     m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
                                         orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
 }

@@ -38,6 +38,9 @@ struct WarpGrid {
     [[nodiscard]] int32_t side() const { return cells + 1; }
     [[nodiscard]] size_t numPoints() const { return u.size(); }
     [[nodiscard]] static WarpGrid identity(int32_t cells);
+    // Makes this grid the identity warp of `cells` cells, in the storage it already has where it is large
+    // enough (a solve from the identity every frame then allocates nothing).
+    void setIdentity(int32_t cells);
 };
 
 [[nodiscard]] bool isPowerOfTwo(int32_t n);

@@ -1,0 +1,71 @@
+#pragma once
+
+// Private to the library: per-point buffers of a UV-warp tile (geometry images, maps, the warp grid, its
+// velocities, the redirect map) run to tens or hundreds of megabytes at 2048^2 and more. Each 4 KiB page of a
+// fresh allocation costs a page fault when it is first written, and in a virtual machine a fault can cost
+// several microseconds: on the 2-core test machine the faults of a cold 2048^2 frame (about 100,000 pages)
+// took 0.8 s of its 1.6 s. Buffers sized here are, from kLargeBuffer bytes, fresh memory that the kernel is
+// asked to back with transparent huge pages (2 MiB) before it is first written, so a cold frame faults about
+// 500 times fewer (docs/decisions.md, "Huge pages for large buffers"). Nothing else changes: the same values,
+// an ordinary std::vector; on kernels without transparent huge pages (or set to "never") the advice is
+// ignored.
+
+#include <cstddef>
+#include <vector>
+
+namespace deformkit::detail {
+
+// Buffers from this size on are advised (a few huge pages each: smaller ones would gain little).
+constexpr size_t kLargeBuffer = size_t{4} << 20;
+
+// Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes) with transparent huge pages.
+// Harmless where they are unavailable.
+void adviseHugePages(void* data, size_t bytes);
+
+// A capacity of at least n elements whose allocation, with the allocator's own header, fills whole huge
+// pages: Linux places an anonymous mapping of a whole number of huge pages on a huge-page boundary, so all of
+// the buffer but its last part can be backed by huge pages, not only the aligned pages inside it.
+template <class T>
+size_t hugeCapacity(size_t n) {
+    constexpr size_t kHugePage = size_t{2} << 20, kHeader = 64;
+    const size_t bytes = (n * sizeof(T) + kHeader + kHugePage - 1) / kHugePage * kHugePage - kHeader;
+    return bytes / sizeof(T);
+}
+
+// values.reserve(n) for a buffer that is then filled by push_back: when it is large and has to grow, its
+// storage is allocated afresh (what it held is kept) and advised before anything is written to the new part.
+template <class T>
+void reserveLarge(std::vector<T>& values, size_t n) {
+    if (n * sizeof(T) < kLargeBuffer || values.capacity() >= n) {
+        values.reserve(n);
+        return;
+    }
+    std::vector<T> fresh;
+    fresh.reserve(hugeCapacity<T>(n));
+    adviseHugePages(fresh.data(), fresh.capacity() * sizeof(T));
+    fresh.insert(fresh.end(), values.begin(), values.end());
+    values.swap(fresh);
+}
+
+// values = n copies of fill. When the buffer is large and has to grow, it is allocated afresh and advised
+// before the fill writes it (an allocation that already holds n is reused as it is).
+template <class T>
+void assignLarge(std::vector<T>& values, size_t n, const T& fill) {
+    if (n * sizeof(T) >= kLargeBuffer && values.capacity() < n) {
+        values.clear();
+        reserveLarge(values, n);
+    }
+    values.assign(n, fill);
+}
+
+// to = from, with to's storage allocated as assignLarge's.
+template <class T>
+void copyLarge(std::vector<T>& to, const std::vector<T>& from) {
+    if (from.size() * sizeof(T) >= kLargeBuffer && to.capacity() < from.size()) {
+        to.clear();
+        reserveLarge(to, from.size());
+    }
+    to.assign(from.begin(), from.end());
+}
+
+}  // namespace deformkit::detail
