@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "deformkit/error.h"
+#include "memory/large_buffers.h"
 
 namespace deformkit::uvwarp {
 namespace {
@@ -191,7 +192,10 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     const int32_t cells = warp.cells, side = cells + 1, size = texels;
     if (redirect.width != size || redirect.height != size || redirect.channels != 2 ||
         redirect.pixels.size() != static_cast<size_t>(size) * size * 2) {
-        redirect = io::Image(size, size, 2);
+        redirect = io::Image();
+        redirect.width = redirect.height = size;
+        redirect.channels = 2;
+        deformkit::detail::assignLarge(redirect.pixels, static_cast<size_t>(size) * size * 2, 0.0f);
     }
     const auto t = static_cast<float>(size);
     const float* wu = warp.u.data();
@@ -247,18 +251,37 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     }
 
     const double inverseCells = 1.0 / cells;  // exact: cells is a power of two
+    // Cells the warp leaves where they are (every point fixed by the warp mask, most of a real tile) are
+    // drawn as a rectangle of texels, without edge tests, when each cell is a whole number of texels, a power
+    // of two (texels = r cells): no texel centre then lies on a cell's edge, so the cell's texels are exactly
+    // those of its square, and the rasteriser's barycentric blend, exact for such corners, gives each the
+    // value the identity fill below writes. The same bytes as rasterising the cell, folds elsewhere included
+    // (it is drawn in its turn, over what earlier cells drew).
+    const int32_t ratio = size / cells;
+    const bool identityRects = size >= cells && size % cells == 0 && isPowerOfTwo(ratio);
+    std::vector<float> identityAt(static_cast<size_t>(side));
+    for (int32_t i = 0; i <= cells; ++i)
+        identityAt[i] = static_cast<float>(i) / static_cast<float>(cells);  // WarpGrid::identity's values
+    // The identity redirect: texel (x, y) -> its own centre.
+    std::vector<float> centreU(static_cast<size_t>(size)), centreV(static_cast<size_t>(size));
+    for (int32_t x = 0; x < size; ++x) {
+        centreU[x] = (static_cast<float>(x) + 0.5f) / t;
+        centreV[x] = 1.0f - (static_cast<float>(x) + 0.5f) / t;
+    }
 #pragma omp parallel
     {
-        // Raster points of a chunk's two point rows.
+        // Raster points of a chunk's two point rows (those of its cells that are not the identity), and which
+        // of its cells are.
         std::vector<RasterPoint> lowerRow(kChunkCells + 1), upperRow(kChunkCells + 1);
+        std::vector<uint8_t> identity(kChunkCells), pointStill(kChunkCells + 1);
 #pragma omp for schedule(dynamic, 1)
         for (int32_t band = 0; band < numBands; ++band) {
             const int32_t y0 = band * kBandRows, y1 = std::min(size, y0 + kBandRows);
             for (int32_t y = y0; y < y1; ++y) {
-                const float v = 1.0f - (static_cast<float>(y) + 0.5f) / t;
+                const float v = centreV[y];
                 float* row = out + static_cast<size_t>(y) * size * 2;
                 for (int32_t x = 0; x < size; ++x) {
-                    row[2 * x] = (static_cast<float>(x) + 0.5f) / t;
+                    row[2 * x] = centreU[x];
                     row[2 * x + 1] = v;
                 }
             }
@@ -267,12 +290,47 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                 const auto j = static_cast<int32_t>(chunk / chunksPerRow);
                 const auto i0 = static_cast<int32_t>(chunk % chunksPerRow) * kChunkCells;
                 const int32_t i1 = std::min(cells, i0 + kChunkCells);
+                if (identityRects) {
+                    // Per point of the chunk's two rows whether it is where the identity has it, then per
+                    // cell.
+                    const size_t k0 = static_cast<size_t>(j) * side + i0;
+                    const float* __restrict lu = wu + k0;
+                    const float* __restrict lv = wv + k0;
+                    const float* __restrict at = identityAt.data() + i0;
+                    const float lowerV = identityAt[j], upperV = identityAt[j + 1];
+                    uint8_t* __restrict still = pointStill.data();
+                    for (int32_t m = 0; m <= i1 - i0; ++m)
+                        still[m] = ((lu[m] == at[m]) & (lv[m] == lowerV) & (lu[m + side] == at[m]) &
+                                    (lv[m + side] == upperV))
+                                       ? 1
+                                       : 0;
+                    for (int32_t m = 0; m < i1 - i0; ++m)
+                        identity[m] = still[m] & still[m + 1];
+                } else {
+                    std::fill(identity.begin(), identity.end(), uint8_t{0});
+                }
                 for (int32_t i = i0; i <= i1; ++i) {
+                    if ((i == i0 || identity[i - 1 - i0]) && (i == i1 || identity[i - i0])) continue;
                     const size_t k = static_cast<size_t>(j) * side + i;
                     lowerRow[i - i0] = rasterPoint(wu[k], wv[k], t);
                     upperRow[i - i0] = rasterPoint(wu[k + side], wv[k + side], t);
                 }
                 for (int32_t i = i0; i < i1; ++i) {
+                    if (identity[i - i0]) {
+                        // Texel rows size - (j + 1) r .. size - j r - 1 (raster y runs down), within the
+                        // band.
+                        const int32_t yFirst = std::max(y0, size - (j + 1) * ratio);
+                        const int32_t yLast = std::min(y1, size - j * ratio);
+                        for (int32_t y = yFirst; y < yLast; ++y) {
+                            float* texel =
+                                out + (static_cast<size_t>(y) * size + static_cast<size_t>(i) * ratio) * 2;
+                            for (int32_t x = i * ratio; x < (i + 1) * ratio; ++x, texel += 2) {
+                                texel[0] = centreU[x];
+                                texel[1] = centreV[y];
+                            }
+                        }
+                        continue;
+                    }
                     const RasterPoint &p00 = lowerRow[i - i0], &p10 = lowerRow[i - i0 + 1];
                     const RasterPoint &p01 = upperRow[i - i0], &p11 = upperRow[i - i0 + 1];
                     // Candidate texel centres: those in the cell's bounding box within the band.
