@@ -161,7 +161,10 @@ InversionError measure(const WarpGrid& warp, const io::Image& redirect, const io
 
 }  // namespace
 
-void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
+namespace {
+
+// validateWarpGrid's checks of the grid's size and of its arrays' lengths.
+void validateWarpShape(const WarpGrid& warp, std::string_view source) {
     if (!isPowerOfTwo(warp.cells) || warp.cells > kMaxGridCells) {
         throw InvalidInput(formatError(source, "cells", "is " + std::to_string(warp.cells),
                                        "a power of two from 1 to " + std::to_string(kMaxGridCells)));
@@ -173,6 +176,13 @@ void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
             "has " + std::to_string(warp.u.size()) + " u and " + std::to_string(warp.v.size()) + " v values",
             std::to_string(count) + " of each ((cells + 1)^2)"));
     }
+}
+
+}  // namespace
+
+void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
+    validateWarpShape(warp, source);
+    const size_t count = warp.u.size();
     for (size_t k = 0; k < count; ++k) {
         if (!std::isfinite(warp.u[k]) || !std::isfinite(warp.v[k])) {
             const size_t side = static_cast<size_t>(warp.cells) + 1;
@@ -184,23 +194,16 @@ void validateWarpGrid(const WarpGrid& warp, std::string_view source) {
 }
 
 void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
-    validateWarpGrid(warp, "invert warp: warp grid");
+    // The points' finiteness is checked by the first pass below, which reads every point anyway.
+    validateWarpShape(warp, "invert warp: warp grid");
     if (texels < 1) {
         throw InvalidInput(
             formatError("invert warp", "texels", "is " + std::to_string(texels), "at least 1"));
     }
     const int32_t cells = warp.cells, side = cells + 1, size = texels;
-    if (redirect.width != size || redirect.height != size || redirect.channels != 2 ||
-        redirect.pixels.size() != static_cast<size_t>(size) * size * 2) {
-        redirect = io::Image();
-        redirect.width = redirect.height = size;
-        redirect.channels = 2;
-        deformkit::detail::assignLarge(redirect.pixels, static_cast<size_t>(size) * size * 2, 0.0f);
-    }
     const auto t = static_cast<float>(size);
     const float* wu = warp.u.data();
     const float* wv = warp.v.data();
-    float* out = redirect.pixels.data();
 
     // Work is split into bands of output rows; each band draws the chunks of cells (runs of kChunkCells
     // in one cell row) whose raster y range reaches it, in (j, i) order.
@@ -208,19 +211,29 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     const int32_t chunksPerRow = (cells + kChunkCells - 1) / kChunkCells;
     const int64_t numChunks = static_cast<int64_t>(cells) * chunksPerRow;
     std::vector<int32_t> chunkFirstBand(numChunks), chunkLastBand(numChunks);
-#pragma omp parallel for schedule(static)
+    bool finite = true;
+#pragma omp parallel for schedule(static) reduction(&& : finite)
     for (int32_t j = 0; j < cells; ++j) {
         for (int32_t c = 0; c < chunksPerRow; ++c) {
             const int32_t i0 = c * kChunkCells, i1 = std::min(cells, i0 + kChunkCells);
             float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+            bool chunkFinite = true;
             for (int32_t row = j; row <= j + 1; ++row) {
                 for (int32_t i = i0; i <= i1; ++i) {
-                    const float y = rasterPoint(wu[0], wv[static_cast<size_t>(row) * side + i], t).y;
+                    const size_t k = static_cast<size_t>(row) * side + i;
+                    chunkFinite = chunkFinite && std::isfinite(wu[k]) && std::isfinite(wv[k]);
+                    const float y = rasterPoint(wu[0], wv[k], t).y;
                     lo = std::min(lo, y);
                     hi = std::max(hi, y);
                 }
             }
             const int64_t chunk = static_cast<int64_t>(j) * chunksPerRow + c;
+            if (!chunkFinite) {  // reported below, before anything is drawn
+                finite = false;
+                chunkFirstBand[chunk] = 1;
+                chunkLastBand[chunk] = 0;
+                continue;
+            }
             // Texel rows whose centre lies within the snapped y range (snapping can move a vertex onto a
             // centre).
             const int64_t first = firstCentreAtOrAbove(snap(lo));
@@ -234,6 +247,15 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
             chunkLastBand[chunk] = static_cast<int32_t>(std::min<int64_t>(last, size - 1) / kBandRows);
         }
     }
+    if (!finite) validateWarpGrid(warp, "invert warp: warp grid");  // throws, naming the first bad point
+    if (redirect.width != size || redirect.height != size || redirect.channels != 2 ||
+        redirect.pixels.size() != static_cast<size_t>(size) * size * 2) {
+        redirect = io::Image();
+        redirect.width = redirect.height = size;
+        redirect.channels = 2;
+        deformkit::detail::assignLarge(redirect.pixels, static_cast<size_t>(size) * size * 2, 0.0f);
+    }
+    float* out = redirect.pixels.data();
     std::vector<int64_t> bandBegin(static_cast<size_t>(numBands) + 1, 0);
     for (int64_t chunk = 0; chunk < numChunks; ++chunk) {
         for (int32_t band = chunkFirstBand[chunk]; band <= chunkLastBand[chunk]; ++band)

@@ -467,7 +467,8 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
         m.stats.converged = m.options.tolerance > 0.0f && m.stats.lastMove <= m.options.tolerance;
     }
     omp_set_num_threads(allowed);
-    m.stats.remainingFolds = countFolds(m.grid);
+    // After an iteration the fold revert has counted them; otherwise the grid is scanned.
+    m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);
     m.deformed = nullptr;
     return m.grid;
 }

@@ -174,6 +174,8 @@ int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
     }
     int32_t reverted = 0;
     std::vector<int32_t>& next = state.untangleNext;
+    // counts[j] != 0 from here on: cell row j may hold a folded triangle (the scan found one there, or a
+    // point of the row's cells went back).
     while (!work.empty()) {
         std::sort(work.begin(), work.end());
         work.erase(std::unique(work.begin(), work.end()), work.end());
@@ -185,12 +187,23 @@ int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
             v[k] = oldV[k];
             ++reverted;
             const int32_t i = id % (c + 1), j = id / (c + 1);
-            for (int32_t cj = std::max(j - 1, 0); cj <= std::min(j, c - 1); ++cj)
+            for (int32_t cj = std::max(j - 1, 0); cj <= std::min(j, c - 1); ++cj) {
+                counts[cj] = 1;
                 for (int32_t ci = std::max(i - 1, 0); ci <= std::min(i, c - 1); ++ci)
                     collectFolded(state, level, ci, cj, 0.0f, next);
+            }
         }
         work.swap(next);
     }
+    // The folds left (countFolds of the grid): a triangle changes only when a corner goes back, so only the
+    // rows marked can hold one.
+    int32_t left = 0;
+    for (int32_t j = 0; j < c; ++j) {
+        if (counts[j] != 0)
+            left += countNearZero<1>(u + static_cast<size_t>(j) * row, v + static_cast<size_t>(j) * row, row,
+                                     1, c, 0.0f);
+    }
+    state.foldsLeft = left;
     return reverted;
 }
 

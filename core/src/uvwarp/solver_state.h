@@ -65,6 +65,7 @@ struct SolverState {
     std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
     std::vector<int32_t> untangleNext;
     std::vector<int32_t> rowFolds;  // per cell row of the scan: triangles at or near zero area
+    int32_t foldsLeft = 0;          // folded triangles of the finest grid after the last revertFolds
     SolveStats stats;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
@@ -80,7 +81,8 @@ int32_t untangle(SolverState& state, const Level& level);
 
 // Makes the finest grid fold-free whatever the steps of an iteration did (solver_folds.cpp): the corners of
 // every triangle with non-positive area that moved since (oldU, oldV), a fold-free state, go back there,
-// spreading to the neighbours until no triangle is folded. Returns the number of points put back.
+// spreading to the neighbours until no triangle is folded. Returns the number of points put back, and sets
+// foldsLeft to the grid's folded triangles (countFolds) without another scan of the whole grid.
 int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV);
 
 }  // namespace deformkit::uvwarp::detail

@@ -281,6 +281,18 @@ TEST_CASE("inversion bad input", "[uvwarp][inversion]") {
     CHECK_THROWS_WITH(invertWarp(warp, 0), Catch::Contains("texels"));
     warp.v[3 * 9 + 4] = std::numeric_limits<float>::quiet_NaN();
     CHECK_THROWS_WITH(invertWarp(warp, 16), Catch::Contains("point (4, 3)") && Catch::Contains("not finite"));
+    // Any point, u or v, the last one included; the caller's image is left as it was.
+    for (const size_t k : {size_t{0}, size_t{40}, size_t{80}}) {
+        for (const bool inU : {true, false}) {
+            WarpGrid bad = WarpGrid::identity(8);
+            (inU ? bad.u : bad.v)[k] = inU ? std::numeric_limits<float>::infinity() : std::nanf("");
+            io::Image kept(4, 4, 2, 0.5f);
+            CHECK_THROWS_WITH(invertWarp(bad, 16, kept), Catch::Contains("point (" + std::to_string(k % 9) +
+                                                                         ", " + std::to_string(k / 9) + ")"));
+            CHECK(kept.width == 4);
+            CHECK(kept.pixels == std::vector<float>(32, 0.5f));
+        }
+    }
     WarpGrid odd = WarpGrid::identity(6);
     CHECK_THROWS_WITH(invertWarp(odd, 16), Catch::Contains("power of two"));
     WarpGrid shortGrid = WarpGrid::identity(8);
