@@ -85,13 +85,48 @@ int32_t widestChartRadius(const PointField& mask) {
     return widest;
 }
 
+// Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) where in(i, j) holds, r in
+// [begin[j], begin[j + 1]); runs closer than kSpanGap are merged.
+template <class In>
+void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>& begin,
+              std::vector<int32_t>& runs) {
+    begin.assign(static_cast<size_t>(rows) + 1, 0);
+    runs.clear();
+    int32_t count = 0;
+    for (int32_t j = 0; j < rows; ++j) {
+        begin[j] = count;
+        int32_t open = -1, last = -1;  // current run [open, last + 1)
+        for (int32_t i = 0; i < columns; ++i) {
+            if (!in(i, j)) continue;
+            if (open >= 0 && i - (last + 1) < kSpanGap) {
+                last = i;
+                continue;
+            }
+            if (open >= 0) {
+                runs.push_back(open);
+                runs.push_back(last + 1);
+                ++count;
+            }
+            open = last = i;
+        }
+        if (open >= 0) {
+            runs.push_back(open);
+            runs.push_back(last + 1);
+            ++count;
+        }
+    }
+    begin[rows] = count;
+}
+
 detail::KernelLevel kernelLevel(const Level& level) {
     return {level.cells,
             level.stride,
             level.rigidity.data(),
             level.orientation.empty() ? nullptr : level.orientation.data(),
             level.spanBegin.data(),
-            level.spans.data()};
+            level.spans.data(),
+            level.movableBegin.data(),
+            level.movableRuns.data()};
 }
 
 }  // namespace
@@ -334,38 +369,23 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
 
 void Solver::Impl::findSpans(Level& level) {
     const int32_t c = level.cells;
-    auto pointActive = [&](int32_t i, int32_t j) {
-        const size_t k = level.index(i, j);
-        return level.rigidity[k] > 0.0f;  // movable (kFixed < 0) and rigid
+    const auto active = [&](int32_t i, int32_t j) {
+        return level.rigidity[level.index(i, j)] > 0.0f;  // movable (kFixed < 0) and rigid
     };
-    level.spanBegin.assign(static_cast<size_t>(c) + 1, 0);
-    level.spans.clear();
-    int32_t count = 0;
-    for (int32_t j = 0; j < c; ++j) {
-        level.spanBegin[j] = count;
-        int32_t open = -1, last = -1;  // current run [open, last + 1)
-        for (int32_t i = 0; i < c; ++i) {
-            const bool active = pointActive(i, j) || pointActive(i + 1, j) || pointActive(i, j + 1) ||
-                                pointActive(i + 1, j + 1);
-            if (!active) continue;
-            if (open >= 0 && i - (last + 1) < kSpanGap) {
-                last = i;
-                continue;
-            }
-            if (open >= 0) {
-                level.spans.push_back(open);
-                level.spans.push_back(last + 1);
-                ++count;
-            }
-            open = last = i;
-        }
-        if (open >= 0) {
-            level.spans.push_back(open);
-            level.spans.push_back(last + 1);
-            ++count;
-        }
-    }
-    level.spanBegin[c] = count;
+    findRuns(
+        c, c,
+        [&](int32_t i, int32_t j) {
+            return active(i, j) || active(i + 1, j) || active(i, j + 1) || active(i + 1, j + 1);
+        },
+        level.spanBegin, level.spans);
+    const auto movable = [&](int32_t i, int32_t j) { return level.movable(level.index(i, j)); };
+    findRuns(c + 1, c + 1, movable, level.movableBegin, level.movableRuns);
+    findRuns(
+        c, c,
+        [&](int32_t i, int32_t j) {
+            return movable(i, j) || movable(i + 1, j) || movable(i, j + 1) || movable(i + 1, j + 1);
+        },
+        level.cellRunBegin, level.cellRuns);
 }
 
 Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointField& mask,
@@ -438,7 +458,17 @@ Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
 void Solver::setMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation) {
-    impl_->buildMaps(rigidity, mask, orientation);
+    Impl& m = *impl_;
+    m.buildMaps(rigidity, mask, orientation);
+    // A point the new maps fix stays where it is: without its velocity, prediction would carry it on.
+    const detail::Level& finest = m.levels[0];
+    for (size_t k = 0; k < m.velU.size(); ++k) {
+        if (!finest.movable(k)) {
+            m.velU[k] = 0.0f;
+            m.velV[k] = 0.0f;
+        }
+    }
+    m.fixedFolds = -1;  // other cells may change now: their folds are counted again
 }
 
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
@@ -476,6 +506,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
 void Solver::reset() {
     Impl& m = *impl_;
     m.grid.setIdentity(m.cells);
+    m.fixedFolds = 0;  // the identity has none
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);
 }

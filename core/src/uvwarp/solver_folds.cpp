@@ -80,6 +80,26 @@ int32_t countNearZero(const float* u, const float* v, size_t rowStep, size_t spa
     return count;
 }
 
+// Triangles at or below nearZero area in the cells of row j of a level that have a corner that may move (the
+// level's cellRuns; the other cells never change).
+int32_t countInRuns(const SolverState& state, const Level& level, int32_t j, float nearZero) {
+    const size_t s = static_cast<size_t>(level.stride);
+    const size_t rowStep = s * static_cast<size_t>(state.side());
+    const float* u = state.grid.u.data() + static_cast<size_t>(j) * rowStep;
+    const float* v = state.grid.v.data() + static_cast<size_t>(j) * rowStep;
+    const int32_t* run = level.cellRuns.data() + 2 * static_cast<size_t>(level.cellRunBegin[j]);
+    const int32_t runs = level.cellRunBegin[j + 1] - level.cellRunBegin[j];
+    int32_t count = 0;
+    for (int32_t r = 0; r < runs; ++r) {
+        const size_t first = static_cast<size_t>(run[2 * r]) * s;
+        const int32_t cells = run[2 * r + 1] - run[2 * r];
+        // The finest level's points are contiguous: a constant spacing gives vector loads.
+        count += s == 1 ? countNearZero<1>(u + first, v + first, rowStep, 1, cells, nearZero)
+                        : countNearZero<0>(u + first, v + first, rowStep, s, cells, nearZero);
+    }
+    return count;
+}
+
 }  // namespace
 
 // One scan over the level's cells (4 orientation tests per cell, vectorisable) finds the triangles at or
@@ -95,16 +115,11 @@ int32_t untangle(SolverState& state, const Level& level) {
     const float cellSize = static_cast<float>(level.stride) / static_cast<float>(state.cells);
     const float nearZero = 1e-3f * cellSize * cellSize;
     WarpGrid& grid = state.grid;
-    const float* u = grid.u.data();
-    const float* v = grid.v.data();
     int32_t* counts = state.rowFolds.data();
+    // Cells whose corners may not move are skipped: none of their corners would be moved.
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
-    for (int32_t j = 0; j < c; ++j) {
-        const size_t base = static_cast<size_t>(j) * rowStep;
-        // The finest level's points are contiguous: a constant spacing gives vector loads.
-        counts[j] = s == 1 ? countNearZero<1>(u + base, v + base, rowStep, 1, c, nearZero)
-                           : countNearZero<0>(u + base, v + base, rowStep, s, c, nearZero);
-    }
+    for (int32_t j = 0; j < c; ++j)
+        counts[j] = countInRuns(state, level, j, nearZero);
     std::vector<int32_t>& work = state.untangleWork;
     work.clear();
     for (int32_t j = 0; j < c; ++j) {
@@ -157,14 +172,13 @@ int32_t untangle(SolverState& state, const Level& level) {
 int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
     const Level& level = state.levels[0];
     const int32_t c = level.cells;
-    const auto row = static_cast<size_t>(state.side());
     float* u = state.grid.u.data();
     float* v = state.grid.v.data();
     int32_t* counts = state.rowFolds.data();
+    // Cells whose corners may not move are skipped: none of their corners would go back.
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
     for (int32_t j = 0; j < c; ++j)
-        counts[j] = countNearZero<1>(u + static_cast<size_t>(j) * row, v + static_cast<size_t>(j) * row, row,
-                                     1, c, 0.0f);
+        counts[j] = countInRuns(state, level, j, 0.0f);
     std::vector<int32_t>& work = state.untangleWork;
     work.clear();
     for (int32_t j = 0; j < c; ++j) {
@@ -195,13 +209,17 @@ int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
         }
         work.swap(next);
     }
-    // The folds left (countFolds of the grid): a triangle changes only when a corner goes back, so only the
-    // rows marked can hold one.
-    int32_t left = 0;
+    // The folds left (countFolds of the grid): those of the cells that never change, and of the marked rows'
+    // other cells (a triangle changes only when a corner goes back).
+    if (state.fixedFolds < 0) {
+        int32_t inRuns = 0;
+        for (int32_t j = 0; j < c; ++j)
+            inRuns += countInRuns(state, level, j, 0.0f);
+        state.fixedFolds = countFolds(state.grid) - inRuns;
+    }
+    int32_t left = state.fixedFolds;
     for (int32_t j = 0; j < c; ++j) {
-        if (counts[j] != 0)
-            left += countNearZero<1>(u + static_cast<size_t>(j) * row, v + static_cast<size_t>(j) * row, row,
-                                     1, c, 0.0f);
+        if (counts[j] != 0) left += countInRuns(state, level, j, 0.0f);
     }
     state.foldsLeft = left;
     return reverted;

@@ -360,7 +360,7 @@ template <class Ops, int32_t Type, bool Mapped>
     }
 }
 
-// Eq. 4-5 on the points i = first, first + 2, ... of row j of a level: blend with K_G by
+// Eq. 4-5 on the points i = first, first + 2, ... in [begin, end) of row j of a level: blend with K_G by
 // b = M((1 - R) + R s), then the clamp to the 8-neighbourhood's box and the fold check.
 // Points two apart are not neighbours, so the lanes of one call are independent: the loop is written
 // branch-free for SIMD, and gives the same bytes as one point after another. Fine: the finest level, whose
@@ -368,7 +368,7 @@ template <class Ops, int32_t Type, bool Mapped>
 // loads and shuffles instead of one scalar load per lane.
 template <class Ops, bool Fine>
 [[gnu::noinline]] void regulariseRun(const KernelGrid& grid, const KernelLevel& level, int32_t j,
-                                     int32_t first) {
+                                     int32_t first, int32_t begin, int32_t end) {
     const int32_t c = level.cells;
     const int32_t s = Fine ? 1 : level.stride;
     const ptrdiff_t row = static_cast<ptrdiff_t>(s) * (grid.cells + 1);
@@ -380,7 +380,11 @@ template <class Ops, bool Fine>
     float* uC = u + centre;
     float* vC = v + centre;
     const float* rigidity = level.rigidity + levelIndex(level, 0, j);
-    const int32_t lanes = first < c ? (c - first + 1) / 2 : 0;
+    // The points of the run with first's parity, inside the grid's border: i = first + 2m, m in [0, lanes).
+    begin = maxOf(begin, 1);
+    end = minOf(end, c);
+    first = begin + ((first - begin) % 2 + 2) % 2;
+    const int32_t lanes = first < end ? (end - first + 1) / 2 : 0;
     // GCC would read the rigidity map at its constant stride as one interleaved load with gaps, which forces
     // a scalar epilogue of up to 8 lanes on every call; a stride it cannot see (1, hidden by an empty asm)
     // makes it a plain strided load, with no epilogue.
@@ -460,11 +464,17 @@ void sweepRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, float
 }
 
 // Odd points of the row, then even ones (after a propagation only the level's new points: every point of an
-// odd row, the odd points of an even row).
+// odd row, the odd points of an even row), in the row's runs of points that may move: a fixed point keeps its
+// place (regularisePoint), so the points outside them are not visited.
 template <class Ops, bool Fine>
 void regulariseRowAt(const KernelGrid& grid, const KernelLevel& level, int32_t j, bool onlyNew) {
-    regulariseRun<Ops, Fine>(grid, level, j, 1);
-    if (!onlyNew || (j % 2) == 1) regulariseRun<Ops, Fine>(grid, level, j, 2);
+    const int32_t* run = level.movableRuns + 2 * static_cast<size_t>(level.movableBegin[j]);
+    const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
+    for (int32_t r = 0; r < runs; ++r)
+        regulariseRun<Ops, Fine>(grid, level, j, 1, run[2 * r], run[2 * r + 1]);
+    if (onlyNew && (j % 2) == 0) return;
+    for (int32_t r = 0; r < runs; ++r)
+        regulariseRun<Ops, Fine>(grid, level, j, 2, run[2 * r], run[2 * r + 1]);
 }
 
 template <class Ops>

@@ -27,18 +27,20 @@ struct KernelGrid {
 struct KernelLevel {
     int32_t cells;
     int32_t stride;
-    const float* rigidity;     // R, or kFixed: (cells + 1)^2 points
-    const float* orientation;  // null without an orientation map
-    const int32_t* spanBegin;  // per row of cells, its first run of cells to project
-    const int32_t* spans;      // runs [spans[2r], spans[2r + 1])
+    const float* rigidity;        // R, or kFixed: (cells + 1)^2 points
+    const float* orientation;     // null without an orientation map
+    const int32_t* spanBegin;     // per row of cells, its first run of cells to project
+    const int32_t* spans;         // runs [spans[2r], spans[2r + 1])
+    const int32_t* movableBegin;  // per row of points, its first run of points that may move
+    const int32_t* movableRuns;   // runs [movableRuns[2r], movableRuns[2r + 1])
 };
 
 // One instruction set's kernels. Both builds give the same bytes.
 struct SolverKernels {
     // The 8 parallel sets of constraints (Eq. 1-3 and orientation preservation) on row of cells j.
     void (*sweepRow)(const KernelGrid& grid, const KernelLevel& level, int32_t j, float stiffness);
-    // Eq. 4-5 on the points of row j: odd points, then even ones (onlyNew: after a propagation, only the
-    // level's points that the coarser level does not have).
+    // Eq. 4-5 on the points of row j that may move: odd points, then even ones (onlyNew: after a propagation,
+    // only the level's points that the coarser level does not have).
     void (*regulariseRow)(const KernelGrid& grid, const KernelLevel& level, int32_t j, bool onlyNew);
 };
 

@@ -46,6 +46,14 @@ struct Level {
     // outside which no cell has a movable corner of rigidity > 0: no segment there is projected (§4.2), so
     // sweeps skip them. Runs closer than kSpanGap cells are merged.
     std::vector<int32_t> spanBegin, spans;
+    // Per row of points j, runs [movableRuns[2r], movableRuns[2r + 1]) of points, r in [movableBegin[j],
+    // movableBegin[j + 1]), outside which no point may move: the regularisation, which moves nothing else,
+    // visits only these (on a real tile about half of the points are fixed by the warp mask). Runs closer
+    // than kSpanGap points are merged.
+    std::vector<int32_t> movableBegin, movableRuns;
+    // The same per row of cells j ([cellRunBegin[j], cellRunBegin[j + 1])): runs of cells with a corner
+    // that may move. A cell outside them never changes, so the fold scans visit only these.
+    std::vector<int32_t> cellRunBegin, cellRuns;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }
     [[nodiscard]] size_t index(int32_t i, int32_t j) const { return static_cast<size_t>(j) * side() + i; }
@@ -66,6 +74,9 @@ struct SolverState {
     std::vector<int32_t> untangleNext;
     std::vector<int32_t> rowFolds;  // per cell row of the scan: triangles at or near zero area
     int32_t foldsLeft = 0;          // folded triangles of the finest grid after the last revertFolds
+    // Folded triangles of the finest grid's cells outside its cellRuns (constant: their corners may not
+    // move); < 0: to be counted (after setMaps changes which points may move).
+    int32_t fixedFolds = 0;
     SolveStats stats;
 
     [[nodiscard]] int32_t side() const { return cells + 1; }

@@ -330,3 +330,46 @@ TEST_CASE("uv warp: the automatic depth follows the widest chart", "[uvwarp][opt
         if (gap == 6) CHECK(solver.levels() == 1);
     }
 }
+
+TEST_CASE("uv warp: points a new mask fixes stay put, and the fold count stays the grid's",
+          "[uvwarp][maps]") {
+    // A warm-started solve moves points; a new mask then fixes the left half where they moved (away from
+    // the identity). The solver skips cells whose corners may not move in its fold scans and counts their
+    // folds once after a map change: its count must still be the whole grid's, and the fixed points must
+    // not move again.
+    const int32_t cells = 64;
+    Case c = planeCase(cells);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i) {
+            const size_t k = c.mask.index(i, j);
+            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
+            c.deformed.values[3 * k] = 1.4f * u + 0.2f * v * v;
+            c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < 0.25f ? 1.0f : 0.0f;
+            c.mask.values[k] = 1.0f;
+        }
+    uvwarp::SolverOptions options;
+    options.iterations = 3;
+    uvwarp::Solver solver(c.rest, c.rigidity, c.mask, options);
+    solver.solve(c.deformed);
+    const WarpGrid before = solver.warp();
+    PointField half = c.mask;
+    size_t movedThenFixed = 0;
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells / 2; ++i) {
+            const size_t k = half.index(i, j);
+            half.values[k] = 0.0f;
+            movedThenFixed += before.u[k] != static_cast<float>(i) / cells;
+        }
+    REQUIRE(movedThenFixed > 100);
+    solver.setMaps(c.rigidity, half, {});
+    for (int frame = 0; frame < 2; ++frame) {
+        const WarpGrid& w = solver.solve(c.deformed);
+        CHECK(solver.stats().remainingFolds == foldedTriangles(w));
+        CHECK(solver.stats().remainingFolds == uvwarp::countFolds(w));
+        for (int32_t j = 0; j <= cells; ++j)
+            for (int32_t i = 0; i <= cells / 2; ++i) {
+                const size_t k = half.index(i, j);
+                CHECK((w.u[k] == before.u[k] && w.v[k] == before.v[k]));
+            }
+    }
+}

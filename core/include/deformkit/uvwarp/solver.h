@@ -85,7 +85,7 @@ class Solver {
     Solver& operator=(Solver&&) noexcept;
 
     // New rigidity / mask / orientation maps (a painter's edit): rebuilds the per-level hierarchies (Eq.
-    // 7-8).
+    // 7-8). The warp is kept; a point the new mask fixes stays where it is (its velocity is dropped).
     void setMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation = {});
     // One frame: deformedGeometry f_D (3 channels, same grid). Returns the warp W.
     const WarpGrid& solve(const PointField& deformedGeometry);
