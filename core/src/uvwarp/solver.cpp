@@ -203,15 +203,23 @@ struct Solver::Impl : detail::SolverState {
                 v[k] += m * dv;
             };
             // Coarse points (both indices even) are moved by their own level: on an even row only the odd
-            // points are new.
-            if (jj & 1) {
+            // points are new. Only the row's runs of points that may move are visited (the others would move
+            // by 0).
+            const int32_t* run = finer.movableRuns.data() + 2 * static_cast<size_t>(finer.movableBegin[jj]);
+            const int32_t runs = finer.movableBegin[jj + 1] - finer.movableBegin[jj];
+            for (int32_t r = 0; r < runs; ++r) {
+                const int32_t a = run[2 * r], b = run[2 * r + 1];  // points ii in [a, b)
+                if (jj & 1) {
+                    const int32_t last = std::min((b + 1) >> 1, c + 1);
 #pragma omp simd
-                for (int32_t m = 0; m <= c; ++m)
-                    move(2 * m, m, m);
+                    for (int32_t m = (a + 1) >> 1; m < last; ++m)
+                        move(2 * m, m, m);
+                }
+                const int32_t last = std::min(b >> 1, c);
+#pragma omp simd
+                for (int32_t m = a >> 1; m < last; ++m)
+                    move(2 * m + 1, m, m + 1);
             }
-#pragma omp simd
-            for (int32_t m = 0; m < c; ++m)
-                move(2 * m + 1, m, m + 1);
         }
     }
 
