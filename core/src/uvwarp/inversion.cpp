@@ -96,8 +96,13 @@ inline void barycentric(const RasterPoint& a, const RasterPoint& b, const Raster
     const double ax = a.x, ay = a.y, bx = b.x, by = b.y, cx = c.x, cy = c.y;
     const double px = static_cast<double>(x) + 0.5, py = static_cast<double>(y) + 0.5;
     const double area = exactArea(a, b, c);
-    bb = ((px - ax) * (cy - ay) - (py - ay) * (cx - ax)) / area;
-    bc = ((bx - ax) * (py - ay) - (by - ay) * (px - ax)) / area;
+    // Both divisions in one vector instruction (each lane is the IEEE quotient, as two scalar divisions).
+    using Pair = double __attribute__((vector_size(16)));
+    const Pair numerators = {(px - ax) * (cy - ay) - (py - ay) * (cx - ax),
+                             (bx - ax) * (py - ay) - (by - ay) * (px - ax)};
+    const Pair quotients = numerators / area;
+    bb = quotients[0];
+    bc = quotients[1];
 }
 
 InversionError measure(const WarpGrid& warp, const io::Image& redirect, const io::Image* region) {
