@@ -24,12 +24,14 @@ void adviseHugePages(void* data, size_t bytes);
 
 // A capacity of at least n elements whose allocation, with the allocator's own header, fills whole huge
 // pages: Linux places an anonymous mapping of a whole number of huge pages on a huge-page boundary, so all of
-// the buffer but its last part can be backed by huge pages, not only the aligned pages inside it.
+// the buffer can be backed by huge pages, not only the aligned pages inside it. Only where that adds at most
+// an eighth to the buffer (from 16 MiB on); smaller buffers keep n and get huge pages inside them only.
 template <class T>
 size_t hugeCapacity(size_t n) {
     constexpr size_t kHugePage = size_t{2} << 20, kHeader = 64;
-    const size_t bytes = (n * sizeof(T) + kHeader + kHugePage - 1) / kHugePage * kHugePage - kHeader;
-    return bytes / sizeof(T);
+    const size_t bytes = n * sizeof(T);
+    const size_t whole = (bytes + kHeader + kHugePage - 1) / kHugePage * kHugePage - kHeader;
+    return whole - bytes <= bytes / 8 ? whole / sizeof(T) : n;
 }
 
 // values.reserve(n) for a buffer that is then filled by push_back: when it is large and has to grow, its
