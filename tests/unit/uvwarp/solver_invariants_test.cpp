@@ -128,6 +128,21 @@ Case planeCase(int32_t cells) {
     return c;
 }
 
+// The plane stretched along u (x = stretch u + bend v^2), a rigid disk of `radius` at the centre, every point
+// movable.
+Case stretchedDiskCase(int32_t cells, float stretch, float bend, float radius) {
+    Case c = planeCase(cells);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i) {
+            const size_t k = c.mask.index(i, j);
+            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
+            c.deformed.values[3 * k] = stretch * u + bend * v * v;
+            c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < radius ? 1.0f : 0.0f;
+            c.mask.values[k] = 1.0f;
+        }
+    return c;
+}
+
 }  // namespace
 
 TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, on random inputs",
@@ -166,15 +181,7 @@ TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, 
 
 TEST_CASE("uv warp: the tolerance ends a solve once no point moves farther", "[uvwarp][options]") {
     const int32_t cells = 64;
-    Case c = planeCase(cells);
-    for (int32_t j = 0; j <= cells; ++j)
-        for (int32_t i = 0; i <= cells; ++i) {
-            const size_t k = c.mask.index(i, j);
-            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
-            c.deformed.values[3 * k] = 1.5f * u;
-            c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < 0.2f ? 1.0f : 0.0f;
-            c.mask.values[k] = 1.0f;
-        }
+    const Case c = stretchedDiskCase(cells, 1.5f, 0.0f, 0.2f);
     uvwarp::SolverOptions options;
     options.iterations = 400;
     options.tolerance = 0.01f;
@@ -338,15 +345,7 @@ TEST_CASE("uv warp: points a new mask fixes stay put, and the fold count stays t
     // folds once after a map change: its count must still be the whole grid's, and the fixed points must
     // not move again.
     const int32_t cells = 64;
-    Case c = planeCase(cells);
-    for (int32_t j = 0; j <= cells; ++j)
-        for (int32_t i = 0; i <= cells; ++i) {
-            const size_t k = c.mask.index(i, j);
-            const float u = static_cast<float>(i) / cells, v = static_cast<float>(j) / cells;
-            c.deformed.values[3 * k] = 1.4f * u + 0.2f * v * v;
-            c.rigidity.values[k] = std::hypot(u - 0.5f, v - 0.5f) < 0.25f ? 1.0f : 0.0f;
-            c.mask.values[k] = 1.0f;
-        }
+    const Case c = stretchedDiskCase(cells, 1.4f, 0.2f, 0.25f);
     uvwarp::SolverOptions options;
     options.iterations = 3;
     uvwarp::Solver solver(c.rest, c.rigidity, c.mask, options);
