@@ -3,12 +3,11 @@
 // Private to the library: per-point buffers of a UV-warp tile (geometry images, maps, the warp grid, its
 // velocities, the redirect map) run to tens or hundreds of megabytes at 2048^2 and more. Each 4 KiB page of a
 // fresh allocation costs a page fault when it is first written, and in a virtual machine a fault can cost
-// several microseconds: on the 2-core test machine the faults of a cold 2048^2 frame (about 100,000 pages)
-// took 0.8 s of its 1.6 s. Buffers sized here are, from kLargeBuffer bytes, fresh memory that the kernel is
-// asked to back with transparent huge pages (2 MiB) before it is first written, so a cold frame faults about
-// 500 times fewer (docs/decisions.md, "Huge pages for large buffers"). Nothing else changes: the same values,
-// an ordinary std::vector; on kernels without transparent huge pages (or set to "never") the advice is
-// ignored.
+// several microseconds: on the 2-core test machine a cold 2048^2 frame faulted about 65,000 times, 0.5-0.8 s
+// of its 1.6-1.8 s. Buffers sized here are, from kLargeBuffer bytes, fresh memory that the kernel is asked to
+// back with transparent huge pages (2 MiB) before it is first written, so they fault once per 2 MiB instead
+// of once per 4 KiB (docs/decisions.md, UV-22). Nothing else changes: the same values, an ordinary
+// std::vector; on kernels without transparent huge pages (or set to "never") the advice is ignored.
 
 #include <cstddef>
 #include <vector>
