@@ -274,6 +274,16 @@ TEST_CASE("inversion is bit-identical for 1 and 2 threads, folds included", "[uv
     const std::vector<float> one = test::withThreads(1, run);
     const std::vector<float> two = test::withThreads(2, run);
     CHECK(one == two);
+    // Still cells (drawn as rectangles) beside the fold.
+    WarpGrid still = WarpGrid::identity(64);
+    for (size_t p = 18 * 65 + 25; p < 18 * 65 + 35; ++p) {
+        still.u[p] = folded.u[p];
+        still.v[p] = folded.v[p];
+    }
+    still.u[k] = folded.u[k];
+    still.v[k] = folded.v[k];
+    const auto runStill = [&] { return invertWarp(still, 128).pixels; };
+    CHECK(test::withThreads(1, runStill) == test::withThreads(2, runStill));
 }
 
 TEST_CASE("inversion bad input", "[uvwarp][inversion]") {

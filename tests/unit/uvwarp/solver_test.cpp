@@ -239,19 +239,37 @@ TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]"
 }
 
 TEST_CASE("uv warp: the same bytes for 1 and 2 threads", "[uvwarp]") {
-    const Scene s = stretchedPlane(64, 0.6f);
-    const int saved = omp_get_max_threads();
-    omp_set_num_threads(1);
-    uvwarp::Solver one(s.rest, s.rigidity, s.mask);
-    const WarpGrid a = one.solve(s.deformed);
-    omp_set_num_threads(2);
-    uvwarp::SolverOptions twoThreads;
-    twoThreads.threads = 2;  // not chosen per iteration: every iteration on two
-    uvwarp::Solver two(s.rest, s.rigidity, s.mask, twoThreads);
-    const WarpGrid b = two.solve(s.deformed);
-    omp_set_num_threads(saved);
-    CHECK(std::memcmp(a.u.data(), b.u.data(), a.u.size() * sizeof(float)) == 0);
-    CHECK(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(float)) == 0);
+    // 64 cells: every loop of the solver runs on one thread (kParallelRows); 256 cells, with the mask fixing
+    // stripes and a corner (the solver then visits runs of movable points and cells only), runs the finer
+    // levels' loops on both threads.
+    for (const int32_t cells : {64, 256}) {
+        Scene s = stretchedPlane(cells, 0.6f);
+        if (cells == 256)
+            s.mask = field(cells, 1, [](float u, float v, float* p) {
+                p[0] = (u < 0.3f && v < 0.3f) || std::fmod(u * 7.0f, 1.0f) < 0.15f ? 0.0f : 1.0f;
+            });
+        const int saved = omp_get_max_threads();
+        omp_set_num_threads(1);
+        uvwarp::Solver one(s.rest, s.rigidity, s.mask);
+        const WarpGrid a = one.solve(s.deformed);
+        omp_set_num_threads(2);
+        uvwarp::SolverOptions twoThreads;
+        twoThreads.threads = 2;  // not chosen per iteration: every iteration on two
+        uvwarp::Solver two(s.rest, s.rigidity, s.mask, twoThreads);
+        const WarpGrid b = two.solve(s.deformed);
+        omp_set_num_threads(saved);
+        INFO(cells << " cells");
+        CHECK(std::memcmp(a.u.data(), b.u.data(), a.u.size() * sizeof(float)) == 0);
+        CHECK(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(float)) == 0);
+        CHECK(one.stats().remainingFolds == 0);
+        CHECK(uvwarp::countFolds(a) == 0);
+        // The mask fixes what it fixes: those points stay at the identity.
+        const WarpGrid identity = WarpGrid::identity(cells);
+        size_t fixedMoved = 0;
+        for (size_t k = 0; k < a.u.size(); ++k)
+            fixedMoved += s.mask.values[k] < 0.5f && (a.u[k] != identity.u[k] || a.v[k] != identity.v[k]);
+        CHECK(fixedMoved == 0);
+    }
 }
 
 TEST_CASE("uv warp: bad solver input names what is wrong", "[uvwarp]") {
