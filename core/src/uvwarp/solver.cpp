@@ -118,9 +118,14 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
     begin[rows] = count;
 }
 
-detail::KernelLevel kernelLevel(const Level& level) {
+// The kernels' view of a level whose points are at u[j * row + i * step].
+detail::KernelLevel kernelLevel(const Level& level, float* u, float* v, int32_t step, ptrdiff_t row) {
     return {level.cells,
             level.stride,
+            u,
+            v,
+            step,
+            row,
             level.rigidity.data(),
             level.orientation.empty() ? nullptr : level.orientation.data(),
             level.spanBegin.data(),
@@ -137,27 +142,54 @@ struct Solver::Impl : detail::SolverState {
     detail::TeamChooser team;  // SolverOptions::threads == 0
 
     [[nodiscard]] detail::KernelGrid kernelGrid() {
-        return {cells,
-                grid.u.data(),
-                grid.v.data(),
-                rest.values.data(),
-                deformed,
-                options.orientationPreservation,
-                options.smoothing};
+        return {cells, rest.values.data(), deformed, options.orientationPreservation, options.smoothing};
     }
 
     // Rows of cells j moves points on rows j and j + 1 and reads rows j - 1 .. j + 2 (the clamp and the
     // fold check read 8-neighbours): forRowBlocks' blocks keep parallel rows apart.
-    void sweep(const Level& level, float stiffness) {
+    void sweep(const detail::KernelLevel& l, float stiffness) {
         const detail::KernelGrid g = kernelGrid();
-        const detail::KernelLevel l = kernelLevel(level);
-        forRowBlocks(0, level.cells, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
+        forRowBlocks(0, l.cells, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
+    }
+
+    // The level's points where they are, in the warp.
+    detail::KernelLevel inPlace(const Level& level) {
+        return kernelLevel(level, grid.u.data(), grid.v.data(), level.stride,
+                           static_cast<ptrdiff_t>(level.stride) * side());
+    }
+
+    // A coarse level's sweeps run on a compact copy of its points (workU, workV): the kernels then read
+    // their neighbourhoods as contiguous stretches, as on the finest level, not one scattered point per lane.
+    // The same arithmetic on the same values: the same bytes as in place.
+    detail::KernelLevel gather(const Level& level) {
+        const int32_t n = level.side();
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
+        for (int32_t j = 0; j < n; ++j) {
+            for (int32_t i = 0; i < n; ++i) {
+                const size_t k = fine(level, i, j);
+                workU[level.index(i, j)] = grid.u[k];
+                workV[level.index(i, j)] = grid.v[k];
+            }
+        }
+        return kernelLevel(level, workU.data(), workV.data(), 1, n);
+    }
+
+    void scatter(const Level& level) {
+        const int32_t n = level.side();
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
+        for (int32_t j = 0; j < n; ++j) {
+            for (int32_t i = 0; i < n; ++i) {
+                const size_t k = fine(level, i, j);
+                grid.u[k] = workU[level.index(i, j)];
+                grid.v[k] = workV[level.index(i, j)];
+            }
+        }
     }
 
     // A row of points moves only itself and reads one row either side.
     void regulariseAll(const Level& level, bool onlyNew) {
         const detail::KernelGrid g = kernelGrid();
-        const detail::KernelLevel l = kernelLevel(level);
+        const detail::KernelLevel l = inPlace(level);
         forRowBlocks(1, level.cells, [&](int32_t j) { kernels->regulariseRow(g, l, j, onlyNew); });
     }
 
@@ -262,8 +294,16 @@ struct Solver::Impl : detail::SolverState {
         for (size_t l = levels.size(); l-- > 0;) {
             Level& level = levels[l];
             const float stiffness = std::pow(options.coarseStiffness, static_cast<float>(l));
-            for (int32_t s = 0; s < sweepsAt(l); ++s)
-                sweep(level, stiffness);
+            const int32_t sweeps = sweepsAt(l);
+            if (l == 0) {
+                for (int32_t s = 0; s < sweeps; ++s)
+                    sweep(inPlace(level), stiffness);
+            } else if (sweeps > 0) {
+                const detail::KernelLevel compact = gather(level);
+                for (int32_t s = 0; s < sweeps; ++s)
+                    sweep(compact, stiffness);
+                scatter(level);
+            }
             if (l > 0) {
                 Level& finer = levels[l - 1];
                 propagate(level, finer);
@@ -447,6 +487,10 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
         if (l > 0) {
             deformkit::detail::assignLarge(level.snapshotU, count, 0.0f);
             deformkit::detail::assignLarge(level.snapshotV, count, 0.0f);
+        }
+        if (l == 1) {  // the largest coarse level: its points fit every coarser level's
+            deformkit::detail::assignLarge(m.workU, count, 0.0f);
+            deformkit::detail::assignLarge(m.workV, count, 0.0f);
         }
     }
     m.rest = std::move(restGeometry);

@@ -163,8 +163,8 @@ constexpr int32_t ringSlot(int32_t di, int32_t dj) {
 // of a level (step 4, or 2 for vertical segments, whose ends share a column), then orientation
 // preservation, then the clamped, fold-safe moves of both ends. Written branch-free over independent
 // segments so the loop vectorises; the same bytes as one segment after another. The point spacing stays a
-// run-time value: with a constant 1 on the finest level the compiler trades gathers for shuffles, which
-// measured slower. Out of line, one function per set type, as in the builds UV-14 measured.
+// run-time value: with a constant 1 the compiler trades gathers for shuffles, which measured slower. Out of
+// line, one function per set type, as in the builds UV-14 measured.
 template <class Ops, int32_t Type, bool Mapped>
 [[gnu::noinline]] void projectRun(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
                                   int32_t begin, int32_t end, float stiffness) {
@@ -180,17 +180,20 @@ template <class Ops, int32_t Type, bool Mapped>
     end = minOf(end, limit);
     // The first lane: the first i >= begin with i = first (mod step).
     const int32_t start = begin + ((first - begin) % step + step) % step;
-    const int32_t s = level.stride;
-    const ptrdiff_t row = static_cast<ptrdiff_t>(s) * (grid.cells + 1);
-    float* __restrict u = grid.u;
-    float* __restrict v = grid.v;
+    const int32_t s = level.step;
+    const ptrdiff_t row = level.row;
+    float* __restrict u = level.u;
+    float* __restrict v = level.v;
     const ptrdiff_t centreA = ja * row, centreB = jb * row;
     float* uA = u + centreA;
     float* vA = v + centreA;
     float* uB = u + centreB;
     float* vB = v + centreB;
-    const float* restA = grid.rest + 3 * centreA;
-    const float* restB = grid.rest + 3 * centreB;
+    // f_O at the level's points: every stride-th fine point of every stride-th fine row.
+    const int32_t restStep = 3 * level.stride;
+    const ptrdiff_t restRow = static_cast<ptrdiff_t>(restStep) * (grid.cells + 1);
+    const float* restA = grid.rest + ja * restRow;
+    const float* restB = grid.rest + jb * restRow;
     const float* deformedImage = grid.deformed;
     const float* rigidityA = level.rigidity + levelIndex(level, 0, ja);
     const float* rigidityB = level.rigidity + levelIndex(level, 0, jb);
@@ -231,7 +234,8 @@ template <class Ops, int32_t Type, bool Mapped>
         const int32_t firstCell = start + block * step;
         alignas(32) float wu[kRows][kCols][kLaneBlock], wv[kRows][kCols][kLaneBlock];
         if (s == 1 && n == kLaneBlock) {
-            // The finest level: each window row of the block is one contiguous stretch of the warp's row.
+            // Points one apart (the finest level, or a coarse level's compact copy): each window row of the
+            // block is one contiguous stretch of a row.
             for (int32_t r = 0; r < kRows; ++r) {
                 Ops::template loadWindows<step>(rowU[r] + firstCell - 1, &wu[r][0][0]);
                 Ops::template loadWindows<step>(rowV[r] + firstCell - 1, &wv[r][0][0]);
@@ -295,7 +299,7 @@ template <class Ops, int32_t Type, bool Mapped>
             const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
             const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
             const bool active = live & ((!fixedA & !fixedB & (rig > 0.0f)) | pinned);
-            const int32_t ka = ia * s, kb = ib * s;  // offsets in the fine rows
+            const int32_t ka = ia * s, kb = ib * s;  // offsets in the rows of u and v
             Ring ringA, ringB;                       // B's slot for A is filled once A has moved
 #pragma GCC unroll 8
             for (int32_t q = 0; q < 8; ++q) {
@@ -313,8 +317,9 @@ template <class Ops, int32_t Type, bool Mapped>
             const float dx = pbx - pax, dy = pby - pay;
             const float length = sqrtOf(dx * dx + dy * dy);
             // l_org (Eq. 1) through f_O at the rest grid points (Eq. 6).
-            const float r0 = restB[3 * kb] - restA[3 * ka], r1 = restB[3 * kb + 1] - restA[3 * ka + 1],
-                        r2 = restB[3 * kb + 2] - restA[3 * ka + 2];
+            const int32_t qa = ia * restStep, qb = ib * restStep;
+            const float r0 = restB[qb] - restA[qa], r1 = restB[qb + 1] - restA[qa + 1],
+                        r2 = restB[qb + 2] - restA[qa + 2];
             const float lOrg = sqrtOf(r0 * r0 + r1 * r1 + r2 * r2);
             const bool valid = active & (lDef > 1e-12f) & (length > 1e-12f) & (lOrg > 0.0f);
             // Along the segment f_D is taken as linear, so the UV length that gives l_def = l_org is
@@ -363,18 +368,18 @@ template <class Ops, int32_t Type, bool Mapped>
 // Eq. 4-5 on the points i = first, first + 2, ... in [begin, end) of row j of a level: blend with K_G by
 // b = M((1 - R) + R s), then the clamp to the 8-neighbourhood's box and the fold check.
 // Points two apart are not neighbours, so the lanes of one call are independent: the loop is written
-// branch-free for SIMD, and gives the same bytes as one point after another. Fine: the finest level, whose
-// point spacing 1 is then a compile-time constant, so the neighbour loads of lanes two apart are vector
+// branch-free for SIMD, and gives the same bytes as one point after another. Fine: points one apart (step 1),
+// a compile-time constant then, so the neighbour loads of lanes two apart are vector
 // loads and shuffles instead of one scalar load per lane.
 template <class Ops, bool Fine>
 [[gnu::noinline]] void regulariseRun(const KernelGrid& grid, const KernelLevel& level, int32_t j,
                                      int32_t first, int32_t begin, int32_t end) {
     const int32_t c = level.cells;
-    const int32_t s = Fine ? 1 : level.stride;
-    const ptrdiff_t row = static_cast<ptrdiff_t>(s) * (grid.cells + 1);
+    const int32_t s = Fine ? 1 : level.step;
+    const ptrdiff_t row = level.row;
     const float smoothing = grid.smoothing;
-    float* __restrict u = grid.u;
-    float* __restrict v = grid.v;
+    float* __restrict u = level.u;
+    float* __restrict v = level.v;
     const ptrdiff_t centre = static_cast<ptrdiff_t>(j) * row;
     const Rows3 rows = rowsAround(u, v, centre, row);
     float* uC = u + centre;
@@ -479,7 +484,7 @@ void regulariseRowAt(const KernelGrid& grid, const KernelLevel& level, int32_t j
 
 template <class Ops>
 void regulariseRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, bool onlyNew) {
-    if (level.stride == 1) {
+    if (level.step == 1) {
         regulariseRowAt<Ops, true>(grid, level, j, onlyNew);
     } else {
         regulariseRowAt<Ops, false>(grid, level, j, onlyNew);

@@ -16,7 +16,6 @@ namespace deformkit::uvwarp::detail {
 // between an AVX2 and a baseline object (docs/decisions.md, "SIMD kernels").
 struct KernelGrid {
     int32_t cells;                  // n, cells per side of the fine grid
-    float *u, *v;                   // the warp (WarpGrid): (n + 1)^2 points
     const float* rest;              // f_O, 3 floats per fine point
     const float* deformed;          // f_D of the current solve, 3 floats per fine point
     float orientationPreservation;  // SolverOptions
@@ -24,9 +23,14 @@ struct KernelGrid {
 };
 
 // One level of the hierarchy (Level): its points are every stride-th fine point of every stride-th row.
+// The kernels move them where u and v say: point (i, j) at u[j * row + i * step], either in place in the
+// warp (step = stride) or in a compact copy of the level's points (step 1).
 struct KernelLevel {
     int32_t cells;
-    int32_t stride;
+    int32_t stride;  // fine points between the level's points: where f_O is read
+    float *u, *v;
+    int32_t step;
+    ptrdiff_t row;
     const float* rigidity;        // R, or kFixed: (cells + 1)^2 points
     const float* orientation;     // null without an orientation map
     const int32_t* spanBegin;     // per row of cells, its first run of cells to project

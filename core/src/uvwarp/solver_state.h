@@ -68,6 +68,8 @@ struct SolverState {
     WarpGrid grid;
     // Velocities; between prediction and integration they hold the positions before the prediction.
     std::vector<float> velU, velV;
+    // A compact copy of the points of the coarse level being swept (level 1's size: the largest).
+    std::vector<float> workU, workV;
     PointField rest;                    // f_O: rest lengths (Eq. 1) are measured through it when needed
     const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
     std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
