@@ -3,10 +3,11 @@
 // Private to solver_kernels_<isa>.cpp: the UV-warp solver's kernels, one source for every instruction set.
 // Each kernel file includes this header once and instantiates sweepRow and regulariseRow with its own Ops, a
 // class of the few steps written per instruction set:
-//   template <int32_t Step> static void loadWindows(const float* p, float* out);
+//   template <int32_t Step> static void loadWindows(const float* lo, const float* hi, float* out);
 //   static void blendCells(const float* image, int32_t cells, const uint32_t* p00, const float* fx,
 //                          const float* fy, float* x0, float* x1, float* x2);
 //   static void storeInterleaved(float* p, const float* even, const float* odd);
+//   static void loadPoints(const float* image, const uint32_t* at, float* x0, float* x1, float* x2);
 //
 // Everything here has internal linkage (an anonymous namespace), and it calls no inline function of the
 // standard library (min, max and sqrt are written below): an AVX2 file then emits no function with vague
@@ -159,27 +160,41 @@ constexpr int32_t ringSlot(int32_t di, int32_t dj) {
     x2 = w00 * image[p00 + 2] + w10 * image[p10 + 2] + w01 * image[p01 + 2] + w11 * image[p11 + 2];
 }
 
-// Eq. 1-3 for the segments of type Type anchored at cells i = first (mod step) of [begin, end) on row j
-// of a level (step 4, or 2 for vertical segments, whose ends share a column), then orientation
-// preservation, then the clamped, fold-safe moves of both ends. Written branch-free over independent
-// segments so the loop vectorises; the same bytes as one segment after another. The point spacing stays a
-// run-time value: with a constant 1 the compiler trades gathers for shuffles, which measured slower. Out of
-// line, one function per set type, as in the builds UV-14 measured.
+// Lanes per quad, half a block: the unit in which a row's segments are gathered into blocks.
+constexpr int32_t kQuad = kLaneBlock / 2;
+
+// Eq. 1-3 for the segments of type Type anchored at cells i = first (mod step) on row j of a level (step
+// 4, or 2 for vertical segments, whose ends share a column), in the row's runs of cells [runs[2r],
+// runs[2r + 1]) (each widened by `widen` cells), then orientation preservation, then the clamped,
+// fold-safe moves of both ends. Written branch-free over independent segments so the loop vectorises; the
+// same bytes as one segment after another. The point spacing stays a run-time value: with a constant 1
+// the compiler trades gathers for shuffles, which measured slower. Out of line, one function per set
+// type, as in the builds UV-14 measured.
+//
+// Lanes. The segments of the set on the row are numbered g (cell first + g step); those inside the grid
+// are g in [gMin, gMax). The runs' segments are taken kQuad consecutive ones at a time (a quad) and two
+// quads make a block of kLaneBlock lanes, so the vector loop runs no scalar remainder and a run's last,
+// partial quad shares its block with the next run's first: on a real tile the runs of a row are a few
+// quads long, and whole blocks per run left a third of the lanes idle. The lanes of a quad outside every
+// run are not live: they never move, and store back the values they read. A block holds no segment twice
+// (a last quad alone takes a quad beside it as its partner), so every segment is moved once. Segments of
+// one set never share a point nor read a point another one moves, so the lanes are independent whatever
+// block holds them: the same bytes as one run after another. The few segments left at the grid's right
+// edge, fewer than a quad, go in a last block of fewer lanes.
 template <class Ops, int32_t Type, bool Mapped>
-[[gnu::noinline]] void projectRun(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
-                                  int32_t begin, int32_t end, float stiffness) {
+[[gnu::noinline]] void projectRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
+                                  const int32_t* runs, int32_t runCount, int32_t widen, float stiffness) {
     constexpr int32_t step = Type == 1 ? 2 : 4;
-    constexpr EdgeType e = kEdgeTypes[Type];
+    static constexpr EdgeType e = kEdgeTypes[Type];
     const int32_t c = level.cells;
     const int32_t ja = j + e.aj, jb = j + e.bj;  // rows of the two ends
     // A segment with an end on the tile border is never projected (border points do not move), so
     // lanes are kept to segments whose ends and their 8 neighbours lie inside the grid.
     if (ja < 1 || jb > c - 1) return;
     const int32_t limit = Type == 1 ? c : c - 1;  // segments at cells i in [1, limit) are inside
-    begin = maxOf(begin, 1);
-    end = minOf(end, limit);
-    // The first lane: the first i >= begin with i = first (mod step).
-    const int32_t start = begin + ((first - begin) % step + step) % step;
+    const int32_t gMin = (step - first) / step,
+                  gMax = limit - 1 >= first ? (limit - 1 - first) / step + 1 : 0;
+    if (gMin >= gMax) return;
     const int32_t s = level.step;
     const ptrdiff_t row = level.row;
     float* __restrict u = level.u;
@@ -201,20 +216,9 @@ template <class Ops, int32_t Type, bool Mapped>
     const float* orientationB = Mapped ? level.orientation + levelIndex(level, 0, jb) : nullptr;
     const float preservation = grid.orientationPreservation;
     const int32_t fineCells = grid.cells;
-    // Lanes [0, lanes) are the run's segments. The loop covers [low, high): the run widened, where the
-    // grid has room, to a whole number of kLaneBlock lanes by segments of the same set beside it. Those
-    // extra lanes never move (live is false): each stores back the values it read, which no other lane of
-    // the call touches. So the vector loop needs no scalar remainder, which on short runs (a rigid
-    // region's width on a row, every coarse level) cost as much as the vector part.
-    const int32_t lanes = start < end ? (end - start + step - 1) / step : 0;
-    if (lanes == 0) return;
-    const int32_t pad = (kLaneBlock - lanes % kLaneBlock) % kLaneBlock;
-    const int32_t right = minOf(pad, (limit - 1 - start) / step + 1 - lanes);
-    const int32_t left = minOf(pad - right, (start - 1) / step);
-    const int32_t low = -left, high = lanes + right;
     // Each lane reads a window of the warp: point rows j - 1 .. j - 1 + kRows - 1 and columns i - 1 ..
     // i - 1 + kCols - 1 around its segment's cell (i, j), which holds both ends and their 8 neighbours.
-    // Windows of different lanes do not overlap, and a lane moves only its two ends.
+    // Windows of different segments of the set do not overlap, and a lane moves only its two ends.
     constexpr int32_t kRows = e.aj == e.bj ? 3 : 4, kCols = e.ai == e.bi ? 3 : 4;
     const float* rowU[kRows];
     const float* rowV[kRows];
@@ -228,22 +232,26 @@ template <class Ops, int32_t Type, bool Mapped>
     constexpr auto ringRow = [](int32_t r, int32_t q) { return r + kRingDj[q]; };
     constexpr int32_t slotA = ringSlot(e.ai - e.bi, e.aj - e.bj);  // A among B's neighbours
     static_assert(slotA >= 0, "the ends of a segment are neighbours");
-    for (int32_t block = low; block < high; block += kLaneBlock) {
-        // The lanes of this block: a whole block except, on levels too small to pad, the last one.
-        const int32_t n = minOf(kLaneBlock, high - block);
-        const int32_t firstCell = start + block * step;
+
+    // One block of `lanes` lanes: lane l is the segment at cell cell[l], moved if bit l of liveMask is set.
+    // quads: the block is two quads (lanes 0-3 and 4-7) of consecutive segments, read as contiguous
+    // stretches when points are one apart.
+    const auto project = [&](const int32_t* cell, int32_t lanes, bool quads, uint32_t liveMask) {
+        // A lane count GCC cannot see: with the constant, it unrolls the loops that fill the lane arrays and
+        // keeps those in registers, and then does not vectorise the loop that reads them.
+        asm("" : "+r"(lanes));
         alignas(32) float wu[kRows][kCols][kLaneBlock], wv[kRows][kCols][kLaneBlock];
-        if (s == 1 && n == kLaneBlock) {
-            // Points one apart (the finest level, or a coarse level's compact copy): each window row of the
-            // block is one contiguous stretch of a row.
+        if (s == 1 && quads) {
             for (int32_t r = 0; r < kRows; ++r) {
-                Ops::template loadWindows<step>(rowU[r] + firstCell - 1, &wu[r][0][0]);
-                Ops::template loadWindows<step>(rowV[r] + firstCell - 1, &wv[r][0][0]);
+                Ops::template loadWindows<step>(rowU[r] + cell[0] - 1, rowU[r] + cell[kQuad] - 1,
+                                                &wu[r][0][0]);
+                Ops::template loadWindows<step>(rowV[r] + cell[0] - 1, rowV[r] + cell[kQuad] - 1,
+                                                &wv[r][0][0]);
             }
         } else {
 #pragma omp simd
-            for (int32_t l = 0; l < n; ++l) {
-                const int32_t i = firstCell + l * step;
+            for (int32_t l = 0; l < lanes; ++l) {
+                const int32_t i = cell[l];
 #pragma GCC unroll 4
                 for (int32_t r = 0; r < kRows; ++r) {
 #pragma GCC unroll 4
@@ -255,11 +263,11 @@ template <class Ops, int32_t Type, bool Mapped>
             }
         }
         // The f_D look-ups at both ends of the block's segments: cells first, then the blends.
-        alignas(32) uint32_t cellA[kLaneBlock] = {}, cellB[kLaneBlock] = {};
+        alignas(32) uint32_t cellA[kLaneBlock] = {}, cellB[kLaneBlock] = {};  // 0: lanes past `lanes`
         alignas(32) float fxA[kLaneBlock] = {}, fyA[kLaneBlock] = {}, fxB[kLaneBlock] = {},
                           fyB[kLaneBlock] = {};
 #pragma omp simd
-        for (int32_t l = 0; l < n; ++l) {
+        for (int32_t l = 0; l < lanes; ++l) {
             imageCell(fineCells, wu[rowA][colA][l], wv[rowA][colA][l], cellA[l], fxA[l], fyA[l]);
             imageCell(fineCells, wu[rowB][colB][l], wv[rowB][colB][l], cellB[l], fxB[l], fyB[l]);
         }
@@ -267,26 +275,33 @@ template <class Ops, int32_t Type, bool Mapped>
         alignas(32) float xb0[kLaneBlock], xb1[kLaneBlock], xb2[kLaneBlock];
         Ops::blendCells(deformedImage, fineCells, cellA, fxA, fyA, xa0, xa1, xa2);
         Ops::blendCells(deformedImage, fineCells, cellB, fxB, fyB, xb0, xb1, xb2);
+        // f_O at both ends (l_org, Eq. 1, through f_O at the rest grid points, Eq. 6).
+        alignas(32) uint32_t restAt[2][kLaneBlock] = {};  // 0: lanes past `lanes`
+        for (int32_t l = 0; l < lanes; ++l) {
+            restAt[0][l] = static_cast<uint32_t>((cell[l] + e.ai) * restStep);
+            restAt[1][l] = static_cast<uint32_t>((cell[l] + e.bi) * restStep);
+        }
+        alignas(32) float ra0[kLaneBlock], ra1[kLaneBlock], ra2[kLaneBlock];
+        alignas(32) float rb0[kLaneBlock], rb1[kLaneBlock], rb2[kLaneBlock];
+        Ops::loadPoints(restA, restAt[0], ra0, ra1, ra2);
+        Ops::loadPoints(restB, restAt[1], rb0, rb1, rb2);
         // The per-level maps at both ends, copied into lane arrays, so that the main loop reads lane arrays
         // only.
-        alignas(32) float rigA[kLaneBlock] = {}, rigB[kLaneBlock] = {}, oriA[kLaneBlock] = {},
-                          oriB[kLaneBlock] = {};
-        for (int32_t l = 0; l < n; ++l) {
-            const int32_t i = firstCell + l * step;
-            rigA[l] = rigidityA[i + e.ai];
-            rigB[l] = rigidityB[i + e.bi];
+        alignas(32) float rigA[kLaneBlock], rigB[kLaneBlock], oriA[kLaneBlock] = {}, oriB[kLaneBlock] = {};
+        alignas(32) int32_t liveLane[kLaneBlock];  // a lane array: GCC does not vectorise the mask's bits
+        for (int32_t l = 0; l < lanes; ++l) {
+            liveLane[l] = static_cast<int32_t>((liveMask >> l) & 1u);
+            rigA[l] = rigidityA[cell[l] + e.ai];
+            rigB[l] = rigidityB[cell[l] + e.bi];
             if constexpr (Mapped) {
-                oriA[l] = orientationA[i + e.ai];
-                oriB[l] = orientationB[i + e.bi];
+                oriA[l] = orientationA[cell[l] + e.ai];
+                oriB[l] = orientationB[cell[l] + e.bi];
             }
         }
+        alignas(32) float endAx[kLaneBlock], endAy[kLaneBlock], endBx[kLaneBlock], endBy[kLaneBlock];
 #pragma omp simd
-        for (int32_t l = 0; l < n; ++l) {
-            const int32_t lane = block + l;
-            const int32_t i = start + lane * step;
-            const int32_t ia = i + e.ai, ib = i + e.bi;  // level columns of the ends
+        for (int32_t l = 0; l < lanes; ++l) {
             const float ra = rigA[l], rb = rigB[l];
-            const bool live = (lane >= 0) & (lane < lanes);
             // Both ends movable: projected when either is rigid (§4.2). Both fixed (kFixed - R: masked or on
             // the border): nothing to do. One end fixed: the paper does not project it; here a segment rigid
             // at both ends (R >= 0.5) is projected with the whole correction on its free end (the fixed end's
@@ -298,9 +313,9 @@ template <class Ops, int32_t Type, bool Mapped>
             const float paintedA = maxOf(ra, kFixed - ra), paintedB = maxOf(rb, kFixed - rb);
             const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
             const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
+            const bool live = liveLane[l] != 0;
             const bool active = live & ((!fixedA & !fixedB & (rig > 0.0f)) | pinned);
-            const int32_t ka = ia * s, kb = ib * s;  // offsets in the rows of u and v
-            Ring ringA, ringB;                       // B's slot for A is filled once A has moved
+            Ring ringA, ringB;  // B's slot for A is filled once A has moved
 #pragma GCC unroll 8
             for (int32_t q = 0; q < 8; ++q) {
                 ringA.u[q] = wu[ringRow(rowA, q)][ringCol(colA, q)][l];
@@ -317,9 +332,7 @@ template <class Ops, int32_t Type, bool Mapped>
             const float dx = pbx - pax, dy = pby - pay;
             const float length = sqrtOf(dx * dx + dy * dy);
             // l_org (Eq. 1) through f_O at the rest grid points (Eq. 6).
-            const int32_t qa = ia * restStep, qb = ib * restStep;
-            const float r0 = restB[qb] - restA[qa], r1 = restB[qb + 1] - restA[qa + 1],
-                        r2 = restB[qb + 2] - restA[qa + 2];
+            const float r0 = rb0[l] - ra0[l], r1 = rb1[l] - ra1[l], r2 = rb2[l] - ra2[l];
             const float lOrg = sqrtOf(r0 * r0 + r1 * r1 + r2 * r2);
             const bool valid = active & (lDef > 1e-12f) & (length > 1e-12f) & (lOrg > 0.0f);
             // Along the segment f_D is taken as linear, so the UV length that gives l_def = l_org is
@@ -353,14 +366,95 @@ template <class Ops, int32_t Type, bool Mapped>
             // Both ends' rings are read before either end is stored; B's check sees where A ended up, as
             // when the segment's ends move one after the other.
             const bool moveA = valid & !fixedA & clampKeepsOrientation(ringA, nax, nay);
-            const float endAx = moveA ? nax : pax, endAy = moveA ? nay : pay;
-            uA[ka] = endAx;
-            vA[ka] = endAy;
-            ringB.u[slotA] = endAx;
-            ringB.v[slotA] = endAy;
+            endAx[l] = moveA ? nax : pax;
+            endAy[l] = moveA ? nay : pay;
+            ringB.u[slotA] = endAx[l];
+            ringB.v[slotA] = endAy[l];
             const bool moveB = valid & !fixedB & clampKeepsOrientation(ringB, nbx, nby);
-            uB[kb] = moveB ? nbx : pbx;
-            vB[kb] = moveB ? nby : pby;
+            endBx[l] = moveB ? nbx : pbx;
+            endBy[l] = moveB ? nby : pby;
+        }
+        // Stored one lane after another: the lanes' points are not evenly spaced (two quads), and AVX2 has
+        // no scatter, so a store in the loop above would keep GCC from vectorising it.
+        for (int32_t l = 0; l < lanes; ++l) {
+            const int32_t ka = (cell[l] + e.ai) * s, kb = (cell[l] + e.bi) * s;  // offsets in rows of u, v
+            uA[ka] = endAx[l];
+            vA[ka] = endAy[l];
+            uB[kb] = endBx[l];
+            vB[kb] = endBy[l];
+        }
+    };
+
+    // The quads, in order: a pending one waits for a second to make a block.
+    alignas(32) int32_t cell[kLaneBlock];
+    bool pending = false;
+    int32_t pendingQuad = 0;
+    uint32_t pendingMask = 0;
+    const auto fillQuad = [&](int32_t* slot, int32_t g) {
+        for (int32_t l = 0; l < kQuad; ++l)
+            slot[l] = first + (g + l) * step;
+    };
+    const auto addQuad = [&](int32_t g, uint32_t mask) {  // segments g .. g + kQuad - 1, mask of the live
+        fillQuad(cell + (pending ? kQuad : 0), g);
+        if (!pending) {
+            pending = true;
+            pendingQuad = g;
+            pendingMask = mask;
+            return;
+        }
+        pending = false;
+        project(cell, kLaneBlock, true, pendingMask | (mask << kQuad));
+    };
+    // The lanes [a, b) of run r (widened, clipped to the grid), empty when a >= b.
+    const auto runLanes = [&](int32_t r, int32_t& a, int32_t& b) {
+        const int32_t begin = maxOf(runs[2 * r], 1), end = minOf(runs[2 * r + 1] + widen, limit);
+        a = maxOf((begin - first + step - 1) / step, gMin);  // the first g with first + g step >= begin
+        b = end > first ? minOf((end - first + step - 1) / step, gMax) : 0;
+    };
+    // The live lanes among segments [g, g + count), from run r on.
+    const auto liveLanes = [&](int32_t r, int32_t g, int32_t count) {
+        uint32_t mask = 0;
+        for (; r < runCount; ++r) {
+            int32_t a = 0, b = 0;
+            runLanes(r, a, b);
+            if (a >= g + count) break;
+            for (int32_t l = 0; l < count; ++l)
+                if (g + l >= a && g + l < b) mask |= 1u << l;
+        }
+        return mask;
+    };
+    int32_t next = gMin;  // the first segment not yet in a quad
+    for (int32_t r = 0; r < runCount; ++r) {
+        int32_t a = 0, b = 0;
+        runLanes(r, a, b);
+        for (a = maxOf(a, next); a < b && a + kQuad <= gMax; a = next) {
+            addQuad(a, liveLanes(r, a, kQuad));
+            next = a + kQuad;
+        }
+        if (a < b) {
+            // Fewer than a quad left before the grid's edge: with a pending quad, in one last block.
+            int32_t lanes = 0;
+            uint32_t mask = 0;
+            if (pending) {
+                lanes = kQuad;
+                mask = pendingMask;
+                pending = false;
+            }
+            const int32_t tail = gMax - a;
+            fillQuad(cell + lanes, a);  // the segments from gMax on are not read
+            mask |= liveLanes(r, a, tail) << lanes;
+            project(cell, lanes + tail, false, mask);
+            return;
+        }
+    }
+    if (pending) {
+        // A last quad alone: with a quad beside it that does not overlap it, its lanes not live.
+        const int32_t partner = pendingQuad + 2 * kQuad <= gMax ? pendingQuad + kQuad : pendingQuad - kQuad;
+        if (partner >= gMin) {
+            fillQuad(cell + kQuad, partner);
+            project(cell, kLaneBlock, true, pendingMask);
+        } else {
+            project(cell, kQuad, false, pendingMask);
         }
     }
 }
@@ -406,8 +500,8 @@ template <class Ops, bool Fine>
             const int32_t i0 = first + 2 * lane;
             alignas(32) float wu[3][3][kLaneBlock], wv[3][3][kLaneBlock];
             for (int32_t r = 0; r < 3; ++r) {
-                Ops::template loadWindows<2>(rowU[r] + i0 - 1, &wu[r][0][0]);
-                Ops::template loadWindows<2>(rowV[r] + i0 - 1, &wv[r][0][0]);
+                Ops::template loadWindows<2>(rowU[r] + i0 - 1, rowU[r] + i0 - 1 + 2 * kQuad, &wu[r][0][0]);
+                Ops::template loadWindows<2>(rowV[r] + i0 - 1, rowV[r] + i0 - 1 + 2 * kQuad, &wv[r][0][0]);
             }
             alignas(32) float movedU[kLaneBlock], movedV[kLaneBlock];
 #pragma omp simd
@@ -445,18 +539,15 @@ template <class Ops, bool Mapped>
 void sweepRowSets(const KernelGrid& grid, const KernelLevel& level, int32_t j, float stiffness) {
     const int32_t* span = level.spans + 2 * static_cast<size_t>(level.spanBegin[j]);
     const int32_t runs = level.spanBegin[j + 1] - level.spanBegin[j];
+    if (runs == 0) return;
     for (int32_t first = 0; first < 4; ++first)
-        for (int32_t r = 0; r < runs; ++r)
-            projectRun<Ops, 0, Mapped>(grid, level, j, first, span[2 * r], span[2 * r + 1], stiffness);
-    for (int32_t first = 0; first < 2; ++first)
-        for (int32_t r = 0; r < runs; ++r)  // vertical segments on both sides of the run's cells
-            projectRun<Ops, 1, Mapped>(grid, level, j, first, span[2 * r], span[2 * r + 1] + 1, stiffness);
+        projectRow<Ops, 0, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
+    for (int32_t first = 0; first < 2; ++first)  // vertical segments on both sides of the runs' cells
+        projectRow<Ops, 1, Mapped>(grid, level, j, first, span, runs, 1, stiffness);
     for (int32_t first = 0; first < 4; ++first)
-        for (int32_t r = 0; r < runs; ++r)
-            projectRun<Ops, 2, Mapped>(grid, level, j, first, span[2 * r], span[2 * r + 1], stiffness);
+        projectRow<Ops, 2, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
     for (int32_t first = 0; first < 4; ++first)
-        for (int32_t r = 0; r < runs; ++r)
-            projectRun<Ops, 3, Mapped>(grid, level, j, first, span[2 * r], span[2 * r + 1], stiffness);
+        projectRow<Ops, 3, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
 }
 
 template <class Ops>

@@ -6,16 +6,20 @@ namespace deformkit::uvwarp::detail {
 namespace {
 
 struct BaselineOps {
-    // The windows of a block of kLaneBlock segments on the finest level (points one apart), one window row:
-    // p points at column i - 1 of lane 0's segment, lanes are Step points apart, and out[col * kLaneBlock +
-    // l] = p[l * Step + col] for the columns i - 1 .. i + 2 (Step 4) or i - 1 .. i + 1 (Step 2, vertical
-    // segments; lane l's column i + 1 is lane l + 1's i - 1). Reads p[0, kLaneBlock * Step + 1) at most.
+    // The windows of a block of kLaneBlock segments at points one apart, one window row: two quads of
+    // kQuad lanes Step points apart, lo and hi at column i - 1 of their first lane's segment, and
+    // out[col * kLaneBlock + l] = lo[l * Step + col] (hi[(l - kQuad) * Step + col] for the second quad) for
+    // the columns i - 1 .. i + 2 (Step 4) or i - 1 .. i + 1 (Step 2, vertical segments). Reads lo and hi
+    // [0, kQuad * Step + 1) at most.
     template <int32_t Step>
-    static void loadWindows(const float* p, float* out) {
+    static void loadWindows(const float* lo, const float* hi, float* out) {
         constexpr int32_t cols = Step == 4 ? 4 : 3;
-        for (int32_t col = 0; col < cols; ++col)
-            for (int32_t l = 0; l < kLaneBlock; ++l)
-                out[col * kLaneBlock + l] = p[l * Step + col];
+        for (int32_t col = 0; col < cols; ++col) {
+            for (int32_t l = 0; l < kQuad; ++l) {
+                out[col * kLaneBlock + l] = lo[l * Step + col];
+                out[col * kLaneBlock + kQuad + l] = hi[l * Step + col];
+            }
+        }
     }
 
     // blendCell for kLaneBlock look-ups, lane l of every array one look-up. Out of line: inlined into the
@@ -26,6 +30,15 @@ struct BaselineOps {
 #pragma omp simd
         for (int32_t l = 0; l < kLaneBlock; ++l)
             blendCell(image, cells, p00[l], fx[l], fy[l], x0[l], x1[l], x2[l]);
+    }
+
+    // The kLaneBlock points of a 3-float image at offsets at[l]: x0[l], x1[l], x2[l].
+    static void loadPoints(const float* image, const uint32_t* at, float* x0, float* x1, float* x2) {
+        for (int32_t l = 0; l < kLaneBlock; ++l) {
+            x0[l] = image[at[l]];
+            x1[l] = image[at[l] + 1];
+            x2[l] = image[at[l] + 2];
+        }
     }
 
     // p[2l] = even[l], p[2l + 1] = odd[l] for the kLaneBlock lanes.

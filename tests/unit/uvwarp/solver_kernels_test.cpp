@@ -1,0 +1,272 @@
+// The UV-warp solver's projection kernel (solver_kernel_loops.h, sweepRow) against a reference written
+// here: one segment after another, in the order of the paper's 8 parallel sets on a row, over the row's runs
+// of cells. The kernel packs a row's segments into blocks of two quads of lanes across runs, takes a quad
+// beside a lone last quad as padding, and puts the segments left at the grid's right edge in a short block;
+// none of that may change a byte. Random rows of runs (short, long, touching the edge, one cell wide),
+// levels of 8 to 64 cells, compact and in-place layouts of the level's points, with and without an
+// orientation map; both instruction sets.
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "simd/cpu.h"
+#include "uvwarp/solver_kernel_loops.h"
+
+namespace {
+
+using namespace deformkit::uvwarp::detail;
+
+// One segment of the set of edge type `type`, anchored at level cell (i, j): Eq. 1-3, the turn towards the
+// canonical direction, the clamped, fold-checked moves of both ends, written for one segment with scalar
+// code. The per-point helpers (f_D look-up, clamp and fold check) are the kernel's own: this reference
+// checks which segments are projected, from which state, and where the results go.
+void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int32_t i, int32_t j,
+                    float stiffness) {
+    const EdgeType e = kEdgeTypes[type];
+    const int32_t ia = i + e.ai, ja = j + e.aj, ib = i + e.bi, jb = j + e.bj;
+    const auto at = [&](int32_t pi, int32_t pj) { return static_cast<ptrdiff_t>(pj) * l.row + pi * l.step; };
+    const auto ringOf = [&](int32_t pi, int32_t pj) {
+        Ring ring;
+        for (int32_t q = 0; q < 8; ++q) {
+            ring.u[q] = l.u[at(pi + kRingDi[q], pj + kRingDj[q])];
+            ring.v[q] = l.v[at(pi + kRingDi[q], pj + kRingDj[q])];
+        }
+        return ring;
+    };
+    const auto fD = [&](float u, float v, float& x0, float& x1, float& x2) {
+        uint32_t p00 = 0;
+        float fx = 0.0f, fy = 0.0f;
+        imageCell(g.cells, u, v, p00, fx, fy);
+        blendCell(g.deformed, g.cells, p00, fx, fy, x0, x1, x2);
+    };
+    const size_t side = static_cast<size_t>(l.cells) + 1;
+    const float ra = l.rigidity[static_cast<size_t>(ja) * side + ia];
+    const float rb = l.rigidity[static_cast<size_t>(jb) * side + ib];
+    const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
+    const float paintedA = std::max(ra, kFixed - ra), paintedB = std::max(rb, kFixed - rb);
+    const bool pinned = fixedA != fixedB && paintedA >= 0.5f && paintedB >= 0.5f;
+    const float rig = fixedA ? rb : (fixedB ? ra : std::max(ra, rb));
+    const bool active = (!fixedA && !fixedB && rig > 0.0f) || pinned;
+    if (!active) return;
+    Ring ringA = ringOf(ia, ja), ringB = ringOf(ib, jb);
+    const float pax = l.u[at(ia, ja)], pay = l.v[at(ia, ja)];
+    const float pbx = l.u[at(ib, jb)], pby = l.v[at(ib, jb)];
+    float xa0 = 0, xa1 = 0, xa2 = 0, xb0 = 0, xb1 = 0, xb2 = 0;
+    fD(pax, pay, xa0, xa1, xa2);
+    fD(pbx, pby, xb0, xb1, xb2);
+    const float d0 = xb0 - xa0, d1 = xb1 - xa1, d2 = xb2 - xa2;
+    const float lDef = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    const float dx = pbx - pax, dy = pby - pay;
+    const float length = std::sqrt(dx * dx + dy * dy);
+    const size_t restRow = 3 * static_cast<size_t>(l.stride) * (static_cast<size_t>(g.cells) + 1);
+    const float* restA = g.rest + ja * restRow + 3 * static_cast<size_t>(ia) * l.stride;
+    const float* restB = g.rest + jb * restRow + 3 * static_cast<size_t>(ib) * l.stride;
+    const float r0 = restB[0] - restA[0], r1 = restB[1] - restA[1], r2 = restB[2] - restA[2];
+    const float lOrg = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
+    if (!(lDef > 1e-12f && length > 1e-12f && lOrg > 0.0f)) return;
+    const float correction = stiffness * rig * length * (1.0f - lOrg / lDef);
+    const float ux = dx / length, uy = dy / length;
+    const float shareA = fixedA ? 0.0f : (fixedB ? 1.0f : 0.5f);
+    const float shareB = fixedB ? 0.0f : (fixedA ? 1.0f : 0.5f);
+    float nax = pax + shareA * correction * ux, nay = pay + shareA * correction * uy;
+    float nbx = pbx - shareB * correction * ux, nby = pby - shareB * correction * uy;
+    float preserve = g.orientationPreservation;
+    if (l.orientation != nullptr) {
+        preserve = g.orientationPreservation * 0.5f *
+                   (l.orientation[static_cast<size_t>(ja) * side + ia] +
+                    l.orientation[static_cast<size_t>(jb) * side + ib]);
+    }
+    const float hx = 0.5f * (nbx - nax), hy = 0.5f * (nby - nay);
+    const float half = std::sqrt(hx * hx + hy * hy);
+    if (preserve > 0.0f && half > 0.0f && !fixedA && !fixedB) {
+        const float mx = 0.5f * (nax + nbx), my = 0.5f * (nay + nby);
+        float tx = hx / half + preserve * (e.canonicalU - hx / half);
+        float ty = hy / half + preserve * (e.canonicalV - hy / half);
+        const float tl = std::sqrt(tx * tx + ty * ty);
+        if (tl > 1e-6f) {
+            const float scale = half / tl;
+            tx *= scale;
+            ty *= scale;
+            nax = mx - tx;
+            nay = my - ty;
+            nbx = mx + tx;
+            nby = my + ty;
+        }
+    }
+    if (!fixedA && clampKeepsOrientation(ringA, nax, nay)) {
+        l.u[at(ia, ja)] = nax;
+        l.v[at(ia, ja)] = nay;
+    }
+    const int32_t slotA = ringSlot(e.ai - e.bi, e.aj - e.bj);
+    ringB.u[slotA] = l.u[at(ia, ja)];
+    ringB.v[slotA] = l.v[at(ia, ja)];
+    if (!fixedB && clampKeepsOrientation(ringB, nbx, nby)) {
+        l.u[at(ib, jb)] = nbx;
+        l.v[at(ib, jb)] = nby;
+    }
+}
+
+// The reference sweep of row of cells j: the 8 sets in the kernel's order (each edge type by the parity of
+// its cell column), a set's segments one after another, those of cells in the row's runs (vertical
+// segments also at a run's right end) with both ends and their rings inside the grid.
+void referenceSweepRow(const KernelGrid& g, const KernelLevel& l, int32_t j, float stiffness) {
+    const int32_t c = l.cells;
+    const int32_t* run = l.spans + 2 * static_cast<size_t>(l.spanBegin[j]);
+    const int32_t runs = l.spanBegin[j + 1] - l.spanBegin[j];
+    for (int32_t type : {0, 1, 2, 3}) {
+        const EdgeType e = kEdgeTypes[type];
+        const int32_t step = type == 1 ? 2 : 4, widen = type == 1 ? 1 : 0;
+        const int32_t limit = type == 1 ? c : c - 1;
+        if (j + e.aj < 1 || j + e.bj > c - 1) continue;
+        for (int32_t first = 0; first < step; ++first) {
+            for (int32_t i = 1; i < limit; ++i) {
+                if (i % step != first) continue;
+                bool inRun = false;
+                for (int32_t r = 0; r < runs; ++r)
+                    inRun = inRun || (i >= run[2 * r] && i < run[2 * r + 1] + widen);
+                if (inRun) projectSegment(g, l, type, i, j, stiffness);
+            }
+        }
+    }
+}
+
+struct Scene {
+    int32_t fineCells = 0;
+    std::vector<float> rest, deformed;  // 3 floats per fine point
+    std::vector<float> u, v;            // the level's points, in its layout
+    std::vector<float> rigidity, orientation;
+    std::vector<int32_t> spanBegin, spans;
+    KernelGrid grid{};
+    KernelLevel level{};
+};
+
+// A level of `cells` cells (level stride `stride` in a fine grid of cells * stride cells), its points
+// jittered about the identity (compact: a copy of its own; otherwise in place in a fine warp), random
+// rigidity with fixed points and a fixed border, and per row of cells random runs.
+Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, bool mapped) {
+    Scene s;
+    s.fineCells = cells * stride;
+    const int32_t n = s.fineCells, side = cells + 1;
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f), jitter(-0.3f, 0.3f);
+    s.rest.resize(3 * static_cast<size_t>(n + 1) * (n + 1));
+    s.deformed.resize(s.rest.size());
+    for (int32_t y = 0; y <= n; ++y) {
+        for (int32_t x = 0; x <= n; ++x) {
+            const size_t k = 3 * (static_cast<size_t>(y) * (n + 1) + x);
+            const float fu = static_cast<float>(x) / n, fv = static_cast<float>(y) / n;
+            s.rest[k] = fu + 0.01f * unit(rng);
+            s.rest[k + 1] = fv + 0.01f * unit(rng);
+            s.rest[k + 2] = 0.1f * fu * fv;
+            s.deformed[k] = 1.4f * s.rest[k] + 0.02f * unit(rng);
+            s.deformed[k + 1] = s.rest[k + 1] + 0.2f * s.rest[k] * s.rest[k];
+            s.deformed[k + 2] = s.rest[k + 2];
+        }
+    }
+    const int32_t step = compact ? 1 : stride;
+    const ptrdiff_t row = compact ? side : static_cast<ptrdiff_t>(stride) * (n + 1);
+    const size_t points = compact ? static_cast<size_t>(side) * side : static_cast<size_t>(n + 1) * (n + 1);
+    s.u.assign(points, -7.0f);  // fine points between the level's are never read
+    s.v.assign(points, -7.0f);
+    for (int32_t j = 0; j <= cells; ++j) {
+        for (int32_t i = 0; i <= cells; ++i) {
+            const bool border = i == 0 || j == 0 || i == cells || j == cells;
+            const ptrdiff_t k = j * row + i * step;
+            s.u[k] = (static_cast<float>(i) + (border ? 0.0f : jitter(rng))) / cells;
+            s.v[k] = (static_cast<float>(j) + (border ? 0.0f : jitter(rng))) / cells;
+        }
+    }
+    s.rigidity.resize(static_cast<size_t>(side) * side);
+    s.orientation.resize(s.rigidity.size());
+    for (int32_t j = 0; j <= cells; ++j) {
+        for (int32_t i = 0; i <= cells; ++i) {
+            const bool border = i == 0 || j == 0 || i == cells || j == cells;
+            const float r = unit(rng) < 0.3f ? 0.0f : unit(rng);
+            const size_t k = static_cast<size_t>(j) * side + i;
+            s.rigidity[k] = border || unit(rng) < 0.15f ? kFixed - r : r;  // fixed: kFixed - R
+            s.orientation[k] = unit(rng);
+        }
+    }
+    // Runs of cells: sorted, disjoint, at least one cell apart; some one cell wide, some reaching the edge.
+    s.spanBegin.assign(static_cast<size_t>(cells) + 1, 0);
+    std::uniform_int_distribution<int32_t> width(1, std::max(2, cells / 3)), gap(1, 12);
+    for (int32_t j = 0; j < cells; ++j) {
+        s.spanBegin[j] = static_cast<int32_t>(s.spans.size() / 2);
+        if (unit(rng) < 0.1f) continue;  // a row without runs
+        for (int32_t a = gap(rng) - 1; a < cells;) {
+            const int32_t b = unit(rng) < 0.15f ? cells : std::min(cells, a + width(rng));
+            s.spans.push_back(a);
+            s.spans.push_back(b);
+            a = b + gap(rng);
+        }
+    }
+    s.spanBegin[cells] = static_cast<int32_t>(s.spans.size() / 2);
+    s.grid = {n, s.rest.data(), s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
+    s.level = {cells,
+               stride,
+               s.u.data(),
+               s.v.data(),
+               step,
+               row,
+               s.rigidity.data(),
+               mapped ? s.orientation.data() : nullptr,
+               s.spanBegin.data(),
+               s.spans.data(),
+               nullptr,
+               nullptr};
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another moves", "[uvwarp][kernels]") {
+    std::vector<const SolverKernels*> kernels = {&kBaselineKernels};
+#ifdef DEFORMKIT_SIMD_X86
+    if (deformkit::simd::activeIsa() == deformkit::simd::Isa::Avx2) kernels.push_back(&kAvx2Kernels);
+#endif
+    std::mt19937 rng(2026);
+    int cases = 0, moved = 0;
+    for (const int32_t cells : {8, 16, 32, 64}) {
+        for (const int32_t stride : {1, 2}) {
+            for (const bool compact : {true, false}) {
+                for (const bool mapped : {false, true}) {
+                    for (int trial = 0; trial < 3; ++trial) {
+                        const Scene scene = makeScene(rng, cells, stride, compact, mapped);
+                        for (const SolverKernels* k : kernels) {
+                            Scene kernel = scene, reference = scene;
+                            kernel.grid.rest = reference.grid.rest = scene.rest.data();
+                            kernel.grid.deformed = reference.grid.deformed = scene.deformed.data();
+                            kernel.level.u = kernel.u.data();
+                            kernel.level.v = kernel.v.data();
+                            reference.level.u = reference.u.data();
+                            reference.level.v = reference.v.data();
+                            for (Scene* s : {&kernel, &reference}) {
+                                s->level.rigidity = scene.rigidity.data();
+                                s->level.orientation = mapped ? scene.orientation.data() : nullptr;
+                                s->level.spanBegin = scene.spanBegin.data();
+                                s->level.spans = scene.spans.data();
+                            }
+                            const float stiffness = 0.8f;
+                            for (int32_t j = 0; j < cells; ++j) {
+                                k->sweepRow(kernel.grid, kernel.level, j, stiffness);
+                                referenceSweepRow(reference.grid, reference.level, j, stiffness);
+                            }
+                            INFO("cells " << cells << ", stride " << stride << ", compact " << compact
+                                          << ", orientation map " << mapped << ", trial " << trial
+                                          << (k == &kBaselineKernels ? ", baseline" : ", AVX2"));
+                            CHECK(std::memcmp(kernel.u.data(), reference.u.data(), 4 * kernel.u.size()) == 0);
+                            CHECK(std::memcmp(kernel.v.data(), reference.v.data(), 4 * kernel.v.size()) == 0);
+                            for (size_t q = 0; q < scene.u.size(); ++q)
+                                moved += kernel.u[q] != scene.u[q] || kernel.v[q] != scene.v[q];
+                            ++cases;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    CHECK(cases >= 96);
+    CHECK(moved > 1000);  // the sweeps did move points: the comparison is not of untouched grids
+}
