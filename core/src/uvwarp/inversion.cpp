@@ -44,9 +44,12 @@ inline int64_t snap(float x) {
 }
 
 // Far-off points (a broken warp) are clamped to 2^20 texels, which keeps every edge function within int64.
+constexpr float kRasterLimit = 1048576.0f;
+inline float rasterY(float v, float t) {
+    return std::clamp((1.0f - v) * t, -kRasterLimit, kRasterLimit);
+}
 inline RasterPoint rasterPoint(float u, float v, float t) {
-    constexpr float kLimit = 1048576.0f;
-    const float x = std::clamp(u * t, -kLimit, kLimit), y = std::clamp((1.0f - v) * t, -kLimit, kLimit);
+    const float x = std::clamp(u * t, -kRasterLimit, kRasterLimit), y = rasterY(v, t);
     return {x, y, snap(x), snap(y)};
 }
 
@@ -216,38 +219,52 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     const int32_t chunksPerRow = (cells + kChunkCells - 1) / kChunkCells;
     const int64_t numChunks = static_cast<int64_t>(cells) * chunksPerRow;
     std::vector<int32_t> chunkFirstBand(numChunks), chunkLastBand(numChunks);
-    bool finite = true;
-#pragma omp parallel for schedule(static) reduction(&& : finite)
-    for (int32_t j = 0; j < cells; ++j) {
+    // Per point row and chunk, the range of v and whether every u and v is finite. Raster y falls as v
+    // rises (rasterY is monotonic: a subtraction, a product and a clamp, each rounded monotonically), so a
+    // chunk's raster y range is rasterY of its largest v down to rasterY of its smallest, exactly what
+    // rasterY of every point would give.
+    const size_t rowChunks = static_cast<size_t>(side) * chunksPerRow;
+    std::vector<float> rowLowV(rowChunks), rowHighV(rowChunks);
+    std::vector<uint8_t> rowFinite(rowChunks);
+#pragma omp parallel for schedule(static)
+    for (int32_t j = 0; j < side; ++j) {
         for (int32_t c = 0; c < chunksPerRow; ++c) {
             const int32_t i0 = c * kChunkCells, i1 = std::min(cells, i0 + kChunkCells);
-            float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-            bool chunkFinite = true;
-            for (int32_t row = j; row <= j + 1; ++row) {
-                for (int32_t i = i0; i <= i1; ++i) {
-                    const size_t k = static_cast<size_t>(row) * side + i;
-                    chunkFinite = chunkFinite && std::isfinite(wu[k]) && std::isfinite(wv[k]);
-                    const float y = rasterPoint(wu[0], wv[k], t).y;
-                    lo = std::min(lo, y);
-                    hi = std::max(hi, y);
-                }
+            const float* ru = wu + static_cast<size_t>(j) * side;
+            const float* rv = wv + static_cast<size_t>(j) * side;
+            float low = std::numeric_limits<float>::infinity(), high = -low;
+            int32_t bad = 0;
+#pragma omp simd reduction(min : low) reduction(max : high) reduction(| : bad)
+            for (int32_t i = i0; i <= i1; ++i) {
+                constexpr float kLargest = std::numeric_limits<float>::max();
+                bad |= !(std::abs(ru[i]) <= kLargest) | !(std::abs(rv[i]) <= kLargest);  // NaN or infinite
+                low = std::min(low, rv[i]);
+                high = std::max(high, rv[i]);
             }
+            const size_t q = static_cast<size_t>(j) * chunksPerRow + c;
+            rowLowV[q] = low;
+            rowHighV[q] = high;
+            rowFinite[q] = bad == 0 ? 1 : 0;
+        }
+    }
+    bool finite = true;
+    for (int32_t j = 0; j < cells; ++j) {
+        for (int32_t c = 0; c < chunksPerRow; ++c) {
+            const size_t lower = static_cast<size_t>(j) * chunksPerRow + c, upper = lower + chunksPerRow;
             const int64_t chunk = static_cast<int64_t>(j) * chunksPerRow + c;
-            if (!chunkFinite) {  // reported below, before anything is drawn
+            chunkFirstBand[chunk] = 1;  // no band, unless set below
+            chunkLastBand[chunk] = 0;
+            if (!rowFinite[lower] || !rowFinite[upper]) {  // reported below, before anything is drawn
                 finite = false;
-                chunkFirstBand[chunk] = 1;
-                chunkLastBand[chunk] = 0;
                 continue;
             }
+            const float lo = rasterY(std::max(rowHighV[lower], rowHighV[upper]), t);
+            const float hi = rasterY(std::min(rowLowV[lower], rowLowV[upper]), t);
             // Texel rows whose centre lies within the snapped y range (snapping can move a vertex onto a
             // centre).
             const int64_t first = firstCentreAtOrAbove(snap(lo));
             const int64_t last = lastCentreAtOrBelow(snap(hi));
-            if (last < 0 || first >= size || first > last) {
-                chunkFirstBand[chunk] = 1;
-                chunkLastBand[chunk] = 0;
-                continue;
-            }
+            if (last < 0 || first >= size || first > last) continue;
             chunkFirstBand[chunk] = static_cast<int32_t>(std::max<int64_t>(first, 0) / kBandRows);
             chunkLastBand[chunk] = static_cast<int32_t>(std::min<int64_t>(last, size - 1) / kBandRows);
         }
