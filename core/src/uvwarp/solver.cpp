@@ -42,9 +42,6 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     }
 }
 
-// Points per chunk of the loops over every point (prediction, integration).
-constexpr size_t kPointChunk = 32768;
-
 // Level::spans: runs of cells closer than this are merged.
 constexpr int32_t kSpanGap = 8;
 
@@ -174,14 +171,19 @@ struct Solver::Impl : detail::SolverState {
         return kernelLevel(level, workU.data(), workV.data(), 1, n);
     }
 
+    // The copy's points back into the warp: those that may move (the sweeps move no other).
     void scatter(const Level& level) {
         const int32_t n = level.side();
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
         for (int32_t j = 0; j < n; ++j) {
-            for (int32_t i = 0; i < n; ++i) {
-                const size_t k = fine(level, i, j);
-                grid.u[k] = workU[level.index(i, j)];
-                grid.v[k] = workV[level.index(i, j)];
+            const int32_t* run = level.movableRuns.data() + 2 * static_cast<size_t>(level.movableBegin[j]);
+            const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
+            for (int32_t r = 0; r < runs; ++r) {
+                for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
+                    const size_t k = fine(level, i, j);
+                    grid.u[k] = workU[level.index(i, j)];
+                    grid.v[k] = workV[level.index(i, j)];
+                }
             }
         }
     }
@@ -195,22 +197,22 @@ struct Solver::Impl : detail::SolverState {
 
     // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level:
     // the mean of the displacements of the 2 or 4 coarse points around each (bilinear at the midpoints).
-    void propagate(const Level& coarse, const Level& finer) {
+    // The coarse points are read from `from`: the warp, or the compact copy the level was swept in.
+    void propagate(const Level& coarse, const Level& finer, const detail::KernelLevel& from) {
         const int32_t c = coarse.cells;
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(finer.cells))
         for (int32_t jj = 0; jj <= finer.cells; ++jj) {
             const int32_t j0 = jj >> 1, j1 = std::min(j0 + (jj & 1), c);
             // Coarse rows j0 and j1: positions in the fine arrays, and their snapshots.
-            const ptrdiff_t coarseRow = static_cast<ptrdiff_t>(coarse.stride) * side();
-            const float* u0 = grid.u.data() + j0 * coarseRow;
-            const float* v0 = grid.v.data() + j0 * coarseRow;
-            const float* u1 = grid.u.data() + j1 * coarseRow;
-            const float* v1 = grid.v.data() + j1 * coarseRow;
+            const float* u0 = from.u + j0 * from.row;
+            const float* v0 = from.v + j0 * from.row;
+            const float* u1 = from.u + j1 * from.row;
+            const float* v1 = from.v + j1 * from.row;
             const float* su0 = coarse.snapshotU.data() + coarse.index(0, j0);
             const float* sv0 = coarse.snapshotV.data() + coarse.index(0, j0);
             const float* su1 = coarse.snapshotU.data() + coarse.index(0, j1);
             const float* sv1 = coarse.snapshotV.data() + coarse.index(0, j1);
-            const int32_t cs = coarse.stride;
+            const int32_t cs = from.step;
             const ptrdiff_t finerRow = static_cast<ptrdiff_t>(finer.stride) * side();
             float* u = grid.u.data() + jj * finerRow;
             float* v = grid.v.data() + jj * finerRow;
@@ -267,6 +269,23 @@ struct Solver::Impl : detail::SolverState {
         }
     }
 
+    // Runs fn(k) for the points k of the finest level that may move, rows in parallel: only those ever move
+    // (a point a coarser level moves may move on the finest, Eq. 8), so the others' velocity stays 0.
+    template <class Fn>
+    void forMovablePoints(const Fn& fn) {
+        const Level& finest = levels[0];
+        const int32_t n = finest.side();
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
+        for (int32_t j = 0; j < n; ++j) {
+            const int32_t* run = finest.movableRuns.data() + 2 * static_cast<size_t>(finest.movableBegin[j]);
+            const int32_t runs = finest.movableBegin[j + 1] - finest.movableBegin[j];
+            const size_t row = static_cast<size_t>(j) * n;
+            for (int32_t r = 0; r < runs; ++r)
+                for (size_t k = row + run[2 * r]; k < row + run[2 * r + 1]; ++k)
+                    fn(k);
+        }
+    }
+
     int32_t sweepsAt(size_t level) const {
         if (options.sweepsPerLevel.empty()) return 1;
         return options.sweepsPerLevel[std::min(level, options.sweepsPerLevel.size() - 1)];
@@ -274,17 +293,17 @@ struct Solver::Impl : detail::SolverState {
 
     // One iteration; returns the largest distance a point moved, in fine-grid uv units.
     float iterate() {
-        const size_t n = grid.u.size();
         const float keep = 1.0f - options.damping;
-        // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force).
-#pragma omp parallel for schedule(dynamic, kPointChunk) if (kParallelRows < static_cast <int64_t>(n))
-        for (size_t k = 0; k < n; ++k) {
+        // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force). Points
+        // that may not move are left out here and in the integration: their velocity stays 0, and velU, velV
+        // hold no position of theirs (revertFolds never moves them).
+        forMovablePoints([&](size_t k) {
             const float du = keep * velU[k], dv = keep * velV[k];
             velU[k] = grid.u[k];  // the position before prediction, until integration
             velV[k] = grid.v[k];
             grid.u[k] += du;
             grid.v[k] += dv;
-        }
+        });
         stats.untangledPoints += detail::untangle(*this, levels[0]);
         // Step 3, hierarchical (§4.4): coarsest level first; then propagate, smooth, and go finer.
         // Every level's points are recorded before any level moves, so the displacement a level hands down
@@ -295,18 +314,14 @@ struct Solver::Impl : detail::SolverState {
             Level& level = levels[l];
             const float stiffness = std::pow(options.coarseStiffness, static_cast<float>(l));
             const int32_t sweeps = sweepsAt(l);
-            if (l == 0) {
-                for (int32_t s = 0; s < sweeps; ++s)
-                    sweep(inPlace(level), stiffness);
-            } else if (sweeps > 0) {
-                const detail::KernelLevel compact = gather(level);
-                for (int32_t s = 0; s < sweeps; ++s)
-                    sweep(compact, stiffness);
-                scatter(level);
-            }
+            detail::KernelLevel points = inPlace(level);
+            if (l > 0 && sweeps > 0) points = gather(level);
+            for (int32_t s = 0; s < sweeps; ++s)
+                sweep(points, stiffness);
+            if (points.u != grid.u.data()) scatter(level);
             if (l > 0) {
                 Level& finer = levels[l - 1];
-                propagate(level, finer);
+                propagate(level, finer, points);
                 regulariseAll(finer, true);
                 stats.untangledPoints += detail::untangle(*this, finer);
             }
@@ -320,15 +335,24 @@ struct Solver::Impl : detail::SolverState {
         stats.revertedPoints += detail::revertFolds(*this, velU.data(), velV.data());
         // Step 5: integration. The largest move is a max, the same whatever the order: bit-identical for
         // any thread count.
+        const Level& finest = levels[0];
+        const int32_t side = finest.side();
         float largest = 0.0f;
-#pragma omp parallel for schedule(dynamic, kPointChunk) \
-    reduction(max                                       \
-              : largest) if (kParallelRows < static_cast <int64_t>(n))
-        for (size_t k = 0; k < n; ++k) {
-            const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
-            velU[k] = du;
-            velV[k] = dv;
-            largest = std::max(largest, du * du + dv * dv);
+#pragma omp parallel for schedule(dynamic, kBlockRows) \
+    reduction(max                                      \
+              : largest) if (kParallelRows < static_cast <int64_t>(side))
+        for (int32_t j = 0; j < side; ++j) {
+            const int32_t* run = finest.movableRuns.data() + 2 * static_cast<size_t>(finest.movableBegin[j]);
+            const int32_t runs = finest.movableBegin[j + 1] - finest.movableBegin[j];
+            const size_t row = static_cast<size_t>(j) * side;
+            for (int32_t r = 0; r < runs; ++r) {
+                for (size_t k = row + run[2 * r]; k < row + run[2 * r + 1]; ++k) {
+                    const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
+                    velU[k] = du;
+                    velV[k] = dv;
+                    largest = std::max(largest, du * du + dv * dv);
+                }
+            }
         }
         return std::sqrt(largest);
     }

@@ -196,7 +196,8 @@ int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV) {
         next.clear();
         for (int32_t id : work) {
             const size_t k = static_cast<size_t>(id);
-            if (u[k] == oldU[k] && v[k] == oldV[k]) continue;
+            // A point that may not move has not (and the iteration keeps no old position of it).
+            if (!level.movable(k) || (u[k] == oldU[k] && v[k] == oldV[k])) continue;
             u[k] = oldU[k];
             v[k] = oldV[k];
             ++reverted;

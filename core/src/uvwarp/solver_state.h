@@ -66,7 +66,8 @@ struct SolverState {
     int32_t cells = 0;
     std::vector<Level> levels;
     WarpGrid grid;
-    // Velocities; between prediction and integration they hold the positions before the prediction.
+    // Velocities; between prediction and integration they hold the positions before the prediction (of the
+    // points that may move: the others never do, and keep velocity 0).
     std::vector<float> velU, velV;
     // A compact copy of the points of the coarse level being swept (level 1's size: the largest).
     std::vector<float> workU, workV;
