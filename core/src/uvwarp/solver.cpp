@@ -42,8 +42,11 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     }
 }
 
-// Level::spans: runs of cells closer than this are merged.
-constexpr int32_t kSpanGap = 8;
+// Level::movableRuns and cellRuns: runs closer than this are merged.
+constexpr int32_t kRunGap = 8;
+
+// Level::setRuns: runs of segments fewer than this apart are merged.
+constexpr int32_t kRunGapLanes = 4;
 
 // The kernels of an instruction set: the same bytes from each.
 const detail::SolverKernels& kernelsFor(simd::Isa isa) {
@@ -83,7 +86,7 @@ int32_t widestChartRadius(const PointField& mask) {
 }
 
 // Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) where in(i, j) holds, r in
-// [begin[j], begin[j + 1]); runs closer than kSpanGap are merged.
+// [begin[j], begin[j + 1]); runs closer than kRunGap are merged.
 template <class In>
 void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>& begin,
               std::vector<int32_t>& runs) {
@@ -95,7 +98,7 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
         int32_t open = -1, last = -1;  // current run [open, last + 1)
         for (int32_t i = 0; i < columns; ++i) {
             if (!in(i, j)) continue;
-            if (open >= 0 && i - (last + 1) < kSpanGap) {
+            if (open >= 0 && i - (last + 1) < kRunGap) {
                 last = i;
                 continue;
             }
@@ -125,8 +128,8 @@ detail::KernelLevel kernelLevel(const Level& level, float* u, float* v, int32_t 
             row,
             level.rigidity.data(),
             level.orientation.empty() ? nullptr : level.orientation.data(),
-            level.spanBegin.data(),
-            level.spans.data(),
+            level.setRunBegin.data(),
+            level.setRuns.data(),
             level.movableBegin.data(),
             level.movableRuns.data()};
 }
@@ -358,7 +361,7 @@ struct Solver::Impl : detail::SolverState {
     }
 
     void buildMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation);
-    static void findSpans(Level& level);
+    static void findLevelRuns(Level& level);
 };
 
 void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
@@ -436,20 +439,54 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
     }
     markFixed(levels.back(), movable);
     for (Level& level : levels)
-        findSpans(level);
+        findLevelRuns(level);
 }
 
-void Solver::Impl::findSpans(Level& level) {
+void detail::findSetRuns(Level& level) {
     const int32_t c = level.cells;
-    const auto active = [&](int32_t i, int32_t j) {
-        return level.rigidity[level.index(i, j)] > 0.0f;  // movable (kFixed < 0) and rigid
-    };
-    findRuns(
-        c, c,
-        [&](int32_t i, int32_t j) {
-            return active(i, j) || active(i + 1, j) || active(i, j + 1) || active(i + 1, j + 1);
-        },
-        level.spanBegin, level.spans);
+    // Per row and set, the runs of segments it projects. A gap shorter than a quad of lanes costs a sweep
+    // nothing (the quad is computed whole), so runs are merged across it.
+    level.setRunBegin.assign(static_cast<size_t>(c) * detail::kSets + 1, 0);
+    level.setRuns.clear();
+    int32_t count = 0;
+    for (int32_t j = 0; j < c; ++j) {
+        for (int32_t set = 0; set < detail::kSets; ++set) {
+            level.setRunBegin[static_cast<size_t>(j) * detail::kSets + set] = count;
+            const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
+            const detail::EdgeType e = detail::kEdgeTypes[type];
+            const int32_t step = detail::setStep(type);
+            int32_t gMin = 0, gMax = 0;
+            detail::setLanes(type, first, j, c, gMin, gMax);
+            int32_t open = -1, last = -1;  // the current run [open, last + 1)
+            for (int32_t g = gMin; g < gMax; ++g) {
+                const int32_t i = first + g * step;
+                if (!detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
+                                              level.rigidity[level.index(i + e.bi, j + e.bj)]))
+                    continue;
+                if (open >= 0 && g - (last + 1) < kRunGapLanes) {
+                    last = g;
+                    continue;
+                }
+                if (open >= 0) {
+                    level.setRuns.push_back(open);
+                    level.setRuns.push_back(last + 1);
+                    ++count;
+                }
+                open = last = g;
+            }
+            if (open >= 0) {
+                level.setRuns.push_back(open);
+                level.setRuns.push_back(last + 1);
+                ++count;
+            }
+        }
+    }
+    level.setRunBegin[static_cast<size_t>(c) * detail::kSets] = count;
+}
+
+void Solver::Impl::findLevelRuns(Level& level) {
+    detail::findSetRuns(level);
+    const int32_t c = level.cells;
     const auto movable = [&](int32_t i, int32_t j) { return level.movable(level.index(i, j)); };
     findRuns(c + 1, c + 1, movable, level.movableBegin, level.movableRuns);
     findRuns(

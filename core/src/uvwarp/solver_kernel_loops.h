@@ -38,21 +38,6 @@ template <class T>
 // build). The projection pads its runs to a multiple of it.
 constexpr int32_t kLaneBlock = 8;
 
-// The four constraint directions of the 8-connected grid (paper §4.2, V_horz, V_vert, V_shear0, V_shear1),
-// as the level-grid offsets of the segment's two ends from the cell corner (I, J), and the segment's
-// canonical (rest) direction.
-struct EdgeType {
-    int32_t ai, aj, bi, bj;
-    float canonicalU, canonicalV;
-};
-constexpr float kHalfSqrt2 = 0.70710678f;
-constexpr EdgeType kEdgeTypes[4] = {
-    {0, 0, 1, 0, 1.0f, 0.0f},               // horizontal, 0°
-    {0, 0, 0, 1, 0.0f, 1.0f},               // vertical, 90°
-    {0, 0, 1, 1, kHalfSqrt2, kHalfSqrt2},   // shear0, 45°
-    {1, 0, 0, 1, -kHalfSqrt2, kHalfSqrt2},  // shear1, 135°
-};
-
 // Offset of level point (i, j) in the level's maps.
 [[gnu::always_inline]] inline size_t levelIndex(const KernelLevel& level, int32_t i, int32_t j) {
     return static_cast<size_t>(j) * (level.cells + 1) + i;
@@ -164,36 +149,31 @@ constexpr int32_t ringSlot(int32_t di, int32_t dj) {
 constexpr int32_t kQuad = kLaneBlock / 2;
 
 // Eq. 1-3 for the segments of type Type anchored at cells i = first (mod step) on row j of a level (step
-// 4, or 2 for vertical segments, whose ends share a column), in the row's runs of cells [runs[2r],
-// runs[2r + 1]) (each widened by `widen` cells), then orientation preservation, then the clamped,
-// fold-safe moves of both ends. Written branch-free over independent segments so the loop vectorises; the
-// same bytes as one segment after another. The point spacing stays a run-time value: with a constant 1
-// the compiler trades gathers for shuffles, which measured slower. Out of line, one function per set
-// type, as in the builds UV-14 measured.
+// 4, or 2 for vertical segments, whose ends share a column), in the runs [runs[2r], runs[2r + 1]) of their
+// numbers g (cell first + g step) that hold every segment of the set the row projects (Level::setRuns),
+// then orientation preservation, then the clamped, fold-safe moves of both ends. Written branch-free over
+// independent segments so the loop vectorises; the same bytes as one segment after another. The point spacing
+// stays a run-time value: with a constant 1 the compiler trades gathers for shuffles, which measured slower.
+// Out of line, one function per set type, as in the builds UV-14 measured.
 //
-// Lanes. The segments of the set on the row are numbered g (cell first + g step); those inside the grid
-// are g in [gMin, gMax). The runs' segments are taken kQuad consecutive ones at a time (a quad) and two
-// quads make a block of kLaneBlock lanes, so the vector loop runs no scalar remainder and a run's last,
-// partial quad shares its block with the next run's first: on a real tile the runs of a row are a few
-// quads long, and whole blocks per run left a third of the lanes idle. The lanes of a quad outside every
-// run are not live: they never move, and store back the values they read. A block holds no segment twice
-// (a last quad alone takes a quad beside it as its partner), so every segment is moved once. Segments of
-// one set never share a point nor read a point another one moves, so the lanes are independent whatever
-// block holds them: the same bytes as one run after another. The few segments left at the grid's right
-// edge, fewer than a quad, go in a last block of fewer lanes.
+// Lanes. The segments of the set on the row inside the grid are g in [gMin, gMax). The runs' segments are
+// taken kQuad consecutive ones at a time (a quad) and two quads make a block of kLaneBlock lanes, so the
+// vector loop runs no scalar remainder and a run's last, partial quad shares its block with the next run's
+// first: on a real tile the runs of a row are a few quads long, and whole blocks per run left a third of the
+// lanes idle. The lanes of a quad outside every run are not live: they never move, and store back the values
+// they read. A block holds no segment twice (a last quad alone takes a quad beside it as its partner), so
+// every segment is moved once. Segments of one set never share a point nor read a point another one moves, so
+// the lanes are independent whatever block holds them: the same bytes as one run after another. The few
+// segments left at the grid's right edge, fewer than a quad, go in a last block of fewer lanes.
 template <class Ops, int32_t Type, bool Mapped>
 [[gnu::noinline]] void projectRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
-                                  const int32_t* runs, int32_t runCount, int32_t widen, float stiffness) {
-    constexpr int32_t step = Type == 1 ? 2 : 4;
+                                  const int32_t* runs, int32_t runCount, float stiffness) {
+    constexpr int32_t step = setStep(Type);
     static constexpr EdgeType e = kEdgeTypes[Type];
     const int32_t c = level.cells;
     const int32_t ja = j + e.aj, jb = j + e.bj;  // rows of the two ends
-    // A segment with an end on the tile border is never projected (border points do not move), so
-    // lanes are kept to segments whose ends and their 8 neighbours lie inside the grid.
-    if (ja < 1 || jb > c - 1) return;
-    const int32_t limit = Type == 1 ? c : c - 1;  // segments at cells i in [1, limit) are inside
-    const int32_t gMin = (step - first) / step,
-                  gMax = limit - 1 >= first ? (limit - 1 - first) / step + 1 : 0;
+    int32_t gMin = 0, gMax = 0;
+    setLanes(Type, first, j, c, gMin, gMax);
     if (gMin >= gMax) return;
     const int32_t s = level.step;
     const ptrdiff_t row = level.row;
@@ -405,11 +385,10 @@ template <class Ops, int32_t Type, bool Mapped>
         pending = false;
         project(cell, kLaneBlock, true, pendingMask | (mask << kQuad));
     };
-    // The lanes [a, b) of run r (widened, clipped to the grid), empty when a >= b.
+    // The lanes [a, b) of run r (inside [gMin, gMax): Level::setRuns).
     const auto runLanes = [&](int32_t r, int32_t& a, int32_t& b) {
-        const int32_t begin = maxOf(runs[2 * r], 1), end = minOf(runs[2 * r + 1] + widen, limit);
-        a = maxOf((begin - first + step - 1) / step, gMin);  // the first g with first + g step >= begin
-        b = end > first ? minOf((end - first + step - 1) / step, gMax) : 0;
+        a = runs[2 * r];
+        b = runs[2 * r + 1];
     };
     // The live lanes among segments [g, g + count), from run r on.
     const auto liveLanes = [&](int32_t r, int32_t g, int32_t count) {
@@ -528,26 +507,38 @@ template <class Ops, bool Fine>
 }
 
 // One sweep over the 8 parallel sets (paper Fig. 8) on row of cells j: each edge type split by the parity
-// of its cell column, so no two segments of a set share a point. The sets are interleaved row by row: for
-// each row of cells, the horizontal segments of its lower point row, then its vertical, then its two
-// diagonal segments, each set by parity. A set's segments on one row are independent (one SIMD or GPU pass
-// each); running all 8 on a row while it is in cache streams the grid once per sweep, not 8 times. Within a
-// set, segments `step` cells apart: ends of different segments are then never neighbours, so the fold
-// checks of one projectRun are independent (SIMD lanes). Only the runs of cells that can hold a projected
-// segment are visited; what is skipped would not move.
+// of its cell column, so no two segments of a set share a point (kSets, in kSetType and kSetFirst's order).
+// The sets are interleaved row by row: for each row of cells, the horizontal segments of its lower point row,
+// then its vertical, then its two diagonal segments, each set by parity. A set's segments on one row are
+// independent (one SIMD or GPU pass each); running all of them on a row while it is in cache streams the
+// grid once per sweep, not once per set. Within a set, segments `step` cells apart: ends of different
+// segments are then never neighbours, so the fold checks of one projectRow are independent (SIMD lanes).
+// Only the runs of segments the row projects (Level::setRuns, from the maps) are visited; what is skipped
+// would not move.
 template <class Ops, bool Mapped>
 void sweepRowSets(const KernelGrid& grid, const KernelLevel& level, int32_t j, float stiffness) {
-    const int32_t* span = level.spans + 2 * static_cast<size_t>(level.spanBegin[j]);
-    const int32_t runs = level.spanBegin[j + 1] - level.spanBegin[j];
-    if (runs == 0) return;
-    for (int32_t first = 0; first < 4; ++first)
-        projectRow<Ops, 0, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
-    for (int32_t first = 0; first < 2; ++first)  // vertical segments on both sides of the runs' cells
-        projectRow<Ops, 1, Mapped>(grid, level, j, first, span, runs, 1, stiffness);
-    for (int32_t first = 0; first < 4; ++first)
-        projectRow<Ops, 2, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
-    for (int32_t first = 0; first < 4; ++first)
-        projectRow<Ops, 3, Mapped>(grid, level, j, first, span, runs, 0, stiffness);
+    const int32_t* begin = level.setRunBegin + static_cast<size_t>(j) * kSets;
+    const auto runsOf = [&](int32_t set) { return level.setRuns + 2 * static_cast<size_t>(begin[set]); };
+    const auto countOf = [&](int32_t set) { return begin[set + 1] - begin[set]; };
+    for (int32_t set = 0; set < kSets; ++set) {
+        const int32_t count = countOf(set);
+        if (count == 0) continue;
+        const int32_t first = kSetFirst[set];
+        switch (kSetType[set]) {
+            case 0:
+                projectRow<Ops, 0, Mapped>(grid, level, j, first, runsOf(set), count, stiffness);
+                break;
+            case 1:
+                projectRow<Ops, 1, Mapped>(grid, level, j, first, runsOf(set), count, stiffness);
+                break;
+            case 2:
+                projectRow<Ops, 2, Mapped>(grid, level, j, first, runsOf(set), count, stiffness);
+                break;
+            default:
+                projectRow<Ops, 3, Mapped>(grid, level, j, first, runsOf(set), count, stiffness);
+                break;
+        }
+    }
 }
 
 template <class Ops>

@@ -33,8 +33,8 @@ struct KernelLevel {
     ptrdiff_t row;
     const float* rigidity;        // R, or kFixed: (cells + 1)^2 points
     const float* orientation;     // null without an orientation map
-    const int32_t* spanBegin;     // per row of cells, its first run of cells to project
-    const int32_t* spans;         // runs [spans[2r], spans[2r + 1])
+    const int32_t* setRunBegin;   // per row of cells and set (kSets of them), its first run of segments
+    const int32_t* setRuns;       // runs [setRuns[2r], setRuns[2r + 1]) of segment numbers g
     const int32_t* movableBegin;  // per row of points, its first run of points that may move
     const int32_t* movableRuns;   // runs [movableRuns[2r], movableRuns[2r + 1])
 };
@@ -61,6 +61,58 @@ constexpr float kFixed = -1.0f;
 constexpr float kGauss[3] = {0.25f, 0.5f, 0.25f};
 
 namespace {
+
+// The four constraint directions of the 8-connected grid (paper §4.2, V_horz, V_vert, V_shear0, V_shear1),
+// as the level-grid offsets of the segment's two ends from the cell corner (I, J), and the segment's
+// canonical (rest) direction.
+struct EdgeType {
+    int32_t ai, aj, bi, bj;
+    float canonicalU, canonicalV;
+};
+constexpr float kHalfSqrt2 = 0.70710678f;
+constexpr EdgeType kEdgeTypes[4] = {
+    {0, 0, 1, 0, 1.0f, 0.0f},               // horizontal, 0°
+    {0, 0, 0, 1, 0.0f, 1.0f},               // vertical, 90°
+    {0, 0, 1, 1, kHalfSqrt2, kHalfSqrt2},   // shear0, 45°
+    {1, 0, 0, 1, -kHalfSqrt2, kHalfSqrt2},  // shear1, 135°
+};
+
+// The parallel sets of a row of cells, in the order a sweep runs them (paper Fig. 8: each edge type split by
+// the parity of its cell column; 4 columns apart for the types whose ends lie in different columns, so that
+// no two segments of a set are neighbours): set s is the segments of type kSetType[s] at cells i =
+// kSetFirst[s] (mod the type's step), numbered g by i = first + g step.
+constexpr int32_t kSets = 14;
+constexpr int32_t kSetType[kSets] = {0, 0, 0, 0, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3};
+constexpr int32_t kSetFirst[kSets] = {0, 1, 2, 3, 0, 1, 0, 1, 2, 3, 0, 1, 2, 3};
+constexpr int32_t setStep(int32_t type) {
+    return type == 1 ? 2 : 4;
+}
+
+// The segments g in [gMin, gMax) of a set (type, first) on row of cells j of a level of `cells` cells that
+// lie inside the grid: a segment with an end on the tile border is never projected (border points do not
+// move), so both ends and their 8 neighbours must be inside. Empty (gMin >= gMax) on rows without any.
+inline void setLanes(int32_t type, int32_t first, int32_t j, int32_t cells, int32_t& gMin, int32_t& gMax) {
+    const EdgeType e = kEdgeTypes[type];
+    const int32_t step = setStep(type);
+    const int32_t limit = type == 1 ? cells : cells - 1;  // segments at cells i in [1, limit) are inside
+    gMin = (step - first) / step;                         // the first g with first + g step >= 1
+    gMax = limit - 1 >= first ? (limit - 1 - first) / step + 1 : 0;
+    if (j + e.aj < 1 || j + e.bj > cells - 1) gMax = 0;
+}
+
+// Whether a segment with ends of level rigidity ra and rb is projected (§4.2): both ends movable and either
+// rigid, or one end fixed (kFixed - R) and both painted rigid (R >= 0.5: UV-15, the whole correction on the
+// free end). Written without branches or library calls (the SIMD kernels inline it).
+inline bool segmentProjected(float ra, float rb) {
+    const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
+    // The painted R of an end, fixed (kFixed - R) or not (R), as a max: GCC does not vectorise the kernel's
+    // loop with a select here.
+    const float paintedA = ra < kFixed - ra ? kFixed - ra : ra,
+                paintedB = rb < kFixed - rb ? kFixed - rb : rb;
+    const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
+    const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
+    return (!fixedA & !fixedB & (rig > 0.0f)) | pinned;
+}
 
 // Twice the signed area of triangle (a, b, c): > 0 counter-clockwise.
 inline float orient(float ax, float ay, float bx, float by, float cx, float cy) {

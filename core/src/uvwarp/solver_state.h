@@ -42,14 +42,15 @@ struct Level {
     std::vector<float> rigidity;
     std::vector<float> orientation;           // empty without an orientation map (1 everywhere)
     std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)
-    // Per row of cells j, runs [spans[2r], spans[2r + 1]) of cells, r in [spanBegin[j], spanBegin[j + 1]),
-    // outside which no cell has a movable corner of rigidity > 0: no segment there is projected (§4.2), so
-    // sweeps skip them. Runs closer than kSpanGap cells are merged.
-    std::vector<int32_t> spanBegin, spans;
+    // Per row of cells j and parallel set s (kSets, solver_kernels.h), runs [setRuns[2r], setRuns[2r + 1])
+    // of the set's segment numbers g, r in [setRunBegin[j kSets + s], setRunBegin[j kSets + s + 1]), holding
+    // every segment the row projects (segmentProjected): the sweeps visit only these. Found from the maps
+    // (buildMaps), since whether a segment is projected depends on its ends' rigidity alone.
+    std::vector<int32_t> setRunBegin, setRuns;
     // Per row of points j, runs [movableRuns[2r], movableRuns[2r + 1]) of points, r in [movableBegin[j],
     // movableBegin[j + 1]), outside which no point may move: the regularisation, which moves nothing else,
     // visits only these (on a real tile about half of the points are fixed by the warp mask). Runs closer
-    // than kSpanGap points are merged.
+    // than kRunGap points are merged.
     std::vector<int32_t> movableBegin, movableRuns;
     // The same per row of cells j ([cellRunBegin[j], cellRunBegin[j + 1])): runs of cells with a corner
     // that may move. A cell outside them never changes, so the fold scans visit only these.
@@ -87,6 +88,9 @@ struct SolverState {
         return static_cast<size_t>(j) * level.stride * side() + static_cast<size_t>(i) * level.stride;
     }
 };
+
+// Level::setRunBegin and setRuns from the level's rigidity map (solver.cpp).
+void findSetRuns(Level& level);
 
 // Repairs folds a propagation or prediction step may have made on `level` (solver_folds.cpp): a movable
 // point with a non-positive triangle around it moves to the mean of its 8 neighbours. Returns the number of

@@ -1,10 +1,11 @@
 // The UV-warp solver's projection kernel (solver_kernel_loops.h, sweepRow) against a reference written
-// here: one segment after another, in the order of the paper's 8 parallel sets on a row, over the row's runs
-// of cells. The kernel packs a row's segments into blocks of two quads of lanes across runs, takes a quad
-// beside a lone last quad as padding, and puts the segments left at the grid's right edge in a short block;
-// none of that may change a byte. Random rows of runs (short, long, touching the edge, one cell wide),
-// levels of 8 to 64 cells, compact and in-place layouts of the level's points, with and without an
-// orientation map; both instruction sets.
+// here: every segment of a row, one after another, in the order of the paper's 8 parallel sets. The kernel
+// visits only the runs of segments the row projects (Level::setRuns, found by the solver from the rigidity
+// map), packs them into blocks of two quads of lanes across runs, takes a quad beside a lone last quad as
+// padding, and puts the segments left at the grid's right edge in a short block; none of that may change a
+// byte. Random blocks of rigid points on a free background (rows without any, one point wide, touching the
+// edge) with fixed points scattered, levels of 8 to 64 cells, compact and in-place layouts of the level's
+// points, with and without an orientation map; both instruction sets.
 #include <algorithm>
 #include <cstring>
 #include <random>
@@ -14,6 +15,7 @@
 
 #include "simd/cpu.h"
 #include "uvwarp/solver_kernel_loops.h"
+#include "uvwarp/solver_state.h"
 
 namespace {
 
@@ -110,24 +112,18 @@ void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int
 }
 
 // The reference sweep of row of cells j: the 8 sets in the kernel's order (each edge type by the parity of
-// its cell column), a set's segments one after another, those of cells in the row's runs (vertical
-// segments also at a run's right end) with both ends and their rings inside the grid.
+// its cell column), a set's segments one after another, every one with both ends and their rings inside the
+// grid (projectSegment leaves those it does not project).
 void referenceSweepRow(const KernelGrid& g, const KernelLevel& l, int32_t j, float stiffness) {
     const int32_t c = l.cells;
-    const int32_t* run = l.spans + 2 * static_cast<size_t>(l.spanBegin[j]);
-    const int32_t runs = l.spanBegin[j + 1] - l.spanBegin[j];
     for (int32_t type : {0, 1, 2, 3}) {
         const EdgeType e = kEdgeTypes[type];
-        const int32_t step = type == 1 ? 2 : 4, widen = type == 1 ? 1 : 0;
+        const int32_t step = type == 1 ? 2 : 4;
         const int32_t limit = type == 1 ? c : c - 1;
         if (j + e.aj < 1 || j + e.bj > c - 1) continue;
         for (int32_t first = 0; first < step; ++first) {
             for (int32_t i = 1; i < limit; ++i) {
-                if (i % step != first) continue;
-                bool inRun = false;
-                for (int32_t r = 0; r < runs; ++r)
-                    inRun = inRun || (i >= run[2 * r] && i < run[2 * r + 1] + widen);
-                if (inRun) projectSegment(g, l, type, i, j, stiffness);
+                if (i % step == first) projectSegment(g, l, type, i, j, stiffness);
             }
         }
     }
@@ -137,15 +133,15 @@ struct Scene {
     int32_t fineCells = 0;
     std::vector<float> rest, deformed;  // 3 floats per fine point
     std::vector<float> u, v;            // the level's points, in its layout
-    std::vector<float> rigidity, orientation;
-    std::vector<int32_t> spanBegin, spans;
+    std::vector<float> orientation;
+    Level runs;  // cells, rigidity and the runs of projected segments (findSetRuns)
     KernelGrid grid{};
     KernelLevel level{};
 };
 
 // A level of `cells` cells (level stride `stride` in a fine grid of cells * stride cells), its points
-// jittered about the identity (compact: a copy of its own; otherwise in place in a fine warp), random
-// rigidity with fixed points and a fixed border, and per row of cells random runs.
+// jittered about the identity (compact: a copy of its own; otherwise in place in a fine warp), rigidity
+// in random blocks on a free background, with fixed points and a fixed border.
 Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, bool mapped) {
     Scene s;
     s.fineCells = cells * stride;
@@ -178,31 +174,27 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
             s.v[k] = (static_cast<float>(j) + (border ? 0.0f : jitter(rng))) / cells;
         }
     }
-    s.rigidity.resize(static_cast<size_t>(side) * side);
-    s.orientation.resize(s.rigidity.size());
+    s.runs.cells = cells;
+    s.runs.rigidity.assign(static_cast<size_t>(side) * side, 0.0f);
+    s.orientation.resize(s.runs.rigidity.size());
+    std::uniform_int_distribution<int32_t> at(0, cells), width(1, std::max(2, cells / 3));
+    for (int32_t block = 0; block < cells / 4; ++block) {
+        const int32_t i0 = at(rng), j0 = at(rng), i1 = std::min(cells, i0 + width(rng)),
+                      j1 = std::min(cells, j0 + width(rng) / 2);
+        const float r = 0.2f + 0.8f * unit(rng);
+        for (int32_t j = j0; j <= j1; ++j)
+            for (int32_t i = i0; i <= i1; ++i)
+                s.runs.rigidity[static_cast<size_t>(j) * side + i] = r;
+    }
     for (int32_t j = 0; j <= cells; ++j) {
         for (int32_t i = 0; i <= cells; ++i) {
             const bool border = i == 0 || j == 0 || i == cells || j == cells;
-            const float r = unit(rng) < 0.3f ? 0.0f : unit(rng);
-            const size_t k = static_cast<size_t>(j) * side + i;
-            s.rigidity[k] = border || unit(rng) < 0.15f ? kFixed - r : r;  // fixed: kFixed - R
-            s.orientation[k] = unit(rng);
+            float& r = s.runs.rigidity[static_cast<size_t>(j) * side + i];
+            if (border || unit(rng) < 0.1f) r = kFixed - r;  // fixed: kFixed - R
+            s.orientation[static_cast<size_t>(j) * side + i] = unit(rng);
         }
     }
-    // Runs of cells: sorted, disjoint, at least one cell apart; some one cell wide, some reaching the edge.
-    s.spanBegin.assign(static_cast<size_t>(cells) + 1, 0);
-    std::uniform_int_distribution<int32_t> width(1, std::max(2, cells / 3)), gap(1, 12);
-    for (int32_t j = 0; j < cells; ++j) {
-        s.spanBegin[j] = static_cast<int32_t>(s.spans.size() / 2);
-        if (unit(rng) < 0.1f) continue;  // a row without runs
-        for (int32_t a = gap(rng) - 1; a < cells;) {
-            const int32_t b = unit(rng) < 0.15f ? cells : std::min(cells, a + width(rng));
-            s.spans.push_back(a);
-            s.spans.push_back(b);
-            a = b + gap(rng);
-        }
-    }
-    s.spanBegin[cells] = static_cast<int32_t>(s.spans.size() / 2);
+    findSetRuns(s.runs);
     s.grid = {n, s.rest.data(), s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
     s.level = {cells,
                stride,
@@ -210,10 +202,10 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
                s.v.data(),
                step,
                row,
-               s.rigidity.data(),
+               s.runs.rigidity.data(),
                mapped ? s.orientation.data() : nullptr,
-               s.spanBegin.data(),
-               s.spans.data(),
+               s.runs.setRunBegin.data(),
+               s.runs.setRuns.data(),
                nullptr,
                nullptr};
     return s;
@@ -243,10 +235,10 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
                             reference.level.u = reference.u.data();
                             reference.level.v = reference.v.data();
                             for (Scene* s : {&kernel, &reference}) {
-                                s->level.rigidity = scene.rigidity.data();
+                                s->level.rigidity = scene.runs.rigidity.data();
                                 s->level.orientation = mapped ? scene.orientation.data() : nullptr;
-                                s->level.spanBegin = scene.spanBegin.data();
-                                s->level.spans = scene.spans.data();
+                                s->level.setRunBegin = scene.runs.setRunBegin.data();
+                                s->level.setRuns = scene.runs.setRuns.data();
                             }
                             const float stiffness = 0.8f;
                             for (int32_t j = 0; j < cells; ++j) {
