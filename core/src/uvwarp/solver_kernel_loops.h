@@ -169,6 +169,8 @@ template <class Ops, int32_t Type, bool Mapped>
 [[gnu::noinline]] void projectRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
                                   const int32_t* runs, int32_t runCount, float stiffness) {
     constexpr int32_t step = setStep(Type);
+    // Static, so the block lambda below reads it without a capture (a captured copy became a masked load of
+    // e.canonicalV, which kept GCC from vectorising the lambda's loop).
     static constexpr EdgeType e = kEdgeTypes[Type];
     const int32_t c = level.cells;
     const int32_t ja = j + e.aj, jb = j + e.bj;  // rows of the two ends
@@ -217,9 +219,6 @@ template <class Ops, int32_t Type, bool Mapped>
     // quads: the block is two quads (lanes 0-3 and 4-7) of consecutive segments, read as contiguous
     // stretches when points are one apart.
     const auto project = [&](const int32_t* cell, int32_t lanes, bool quads, uint32_t liveMask) {
-        // A lane count GCC cannot see: with the constant, it unrolls the loops that fill the lane arrays and
-        // keeps those in registers, and then does not vectorise the loop that reads them.
-        asm("" : "+r"(lanes));
         alignas(32) float wu[kRows][kCols][kLaneBlock], wv[kRows][kCols][kLaneBlock];
         if (s == 1 && quads) {
             for (int32_t r = 0; r < kRows; ++r) {
