@@ -206,7 +206,7 @@ struct Solver::Impl : detail::SolverState {
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(finer.cells))
         for (int32_t jj = 0; jj <= finer.cells; ++jj) {
             const int32_t j0 = jj >> 1, j1 = std::min(j0 + (jj & 1), c);
-            // Coarse rows j0 and j1: positions in the fine arrays, and their snapshots.
+            // Coarse rows j0 and j1: positions (in `from`), and their snapshots.
             const float* u0 = from.u + j0 * from.row;
             const float* v0 = from.v + j0 * from.row;
             const float* u1 = from.u + j1 * from.row;
