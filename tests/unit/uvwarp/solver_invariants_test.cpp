@@ -372,3 +372,37 @@ TEST_CASE("uv warp: points a new mask fixes stay put, and the fold count stays t
             }
     }
 }
+
+TEST_CASE("uv warp: maps set after construction solve as maps given at construction", "[uvwarp][maps]") {
+    // Everything the solver derives from its maps (the levels' rigidity, the runs of points that may move
+    // and of the segments each row projects) is rebuilt by setMaps: a solver built with other maps, or none
+    // rigid, and given these before its first solve gives the bytes of one built with them. A run of
+    // projected segments left from the old maps would leave the new rigid disk's segments unprojected.
+    const int32_t cells = 64;
+    const Case c = stretchedDiskCase(cells, 1.4f, 0.2f, 0.25f);
+    uvwarp::SolverOptions options;
+    options.iterations = 3;
+    PointField free = c.rigidity, shifted = c.rigidity;
+    std::fill(free.values.begin(), free.values.end(), 0.0f);
+    for (int32_t j = 0; j <= cells; ++j)  // the disks moved a quarter of the tile
+        for (int32_t i = 0; i <= cells; ++i)
+            shifted.values[shifted.index(i, j)] =
+                c.rigidity.values[c.rigidity.index((i + cells / 4) % (cells + 1), j)];
+    uvwarp::Solver reference(c.rest, c.rigidity, c.mask, options);
+    for (const PointField* before : {&free, &shifted}) {
+        uvwarp::Solver changed(c.rest, *before, c.mask, options);
+        changed.setMaps(c.rigidity, c.mask, {});
+        for (int frame = 0; frame < 2; ++frame) {
+            const WarpGrid& expected = reference.solve(c.deformed);
+            const WarpGrid& got = changed.solve(c.deformed);
+            CHECK(std::memcmp(got.u.data(), expected.u.data(), 4 * got.u.size()) == 0);
+            CHECK(std::memcmp(got.v.data(), expected.v.data(), 4 * got.v.size()) == 0);
+        }
+        reference.reset();
+    }
+    // The test can fail: the maps do make a difference.
+    uvwarp::Solver other(c.rest, shifted, c.mask, options);
+    reference.reset();
+    CHECK(std::memcmp(other.solve(c.deformed).u.data(), reference.solve(c.deformed).u.data(),
+                      4 * static_cast<size_t>(cells + 1) * (cells + 1)) != 0);
+}
