@@ -85,6 +85,33 @@ int32_t widestChartRadius(const PointField& mask) {
     return widest;
 }
 
+// Appends to `runs` the runs [runs[2r], runs[2r + 1]) of i in [from, to) where in(i) holds, runs fewer than
+// `gap` apart merged; returns how many.
+template <class In>
+int32_t appendRuns(int32_t from, int32_t to, int32_t gap, const In& in, std::vector<int32_t>& runs) {
+    int32_t count = 0;
+    int32_t open = -1, last = -1;  // current run [open, last + 1)
+    for (int32_t i = from; i < to; ++i) {
+        if (!in(i)) continue;
+        if (open >= 0 && i - (last + 1) < gap) {
+            last = i;
+            continue;
+        }
+        if (open >= 0) {
+            runs.push_back(open);
+            runs.push_back(last + 1);
+            ++count;
+        }
+        open = last = i;
+    }
+    if (open >= 0) {
+        runs.push_back(open);
+        runs.push_back(last + 1);
+        ++count;
+    }
+    return count;
+}
+
 // Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) where in(i, j) holds, r in
 // [begin[j], begin[j + 1]); runs closer than kRunGap are merged.
 template <class In>
@@ -95,25 +122,8 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
     int32_t count = 0;
     for (int32_t j = 0; j < rows; ++j) {
         begin[j] = count;
-        int32_t open = -1, last = -1;  // current run [open, last + 1)
-        for (int32_t i = 0; i < columns; ++i) {
-            if (!in(i, j)) continue;
-            if (open >= 0 && i - (last + 1) < kRunGap) {
-                last = i;
-                continue;
-            }
-            if (open >= 0) {
-                runs.push_back(open);
-                runs.push_back(last + 1);
-                ++count;
-            }
-            open = last = i;
-        }
-        if (open >= 0) {
-            runs.push_back(open);
-            runs.push_back(last + 1);
-            ++count;
-        }
+        count += appendRuns(
+            0, columns, kRunGap, [&](int32_t i) { return in(i, j); }, runs);
     }
     begin[rows] = count;
 }
@@ -176,19 +186,12 @@ struct Solver::Impl : detail::SolverState {
 
     // The copy's points back into the warp: those that may move (the sweeps move no other).
     void scatter(const Level& level) {
-        const int32_t n = level.side();
-#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
-        for (int32_t j = 0; j < n; ++j) {
-            const int32_t* run = level.movableRuns.data() + 2 * static_cast<size_t>(level.movableBegin[j]);
-            const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
-            for (int32_t r = 0; r < runs; ++r) {
-                for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
-                    const size_t k = fine(level, i, j);
-                    grid.u[k] = workU[level.index(i, j)];
-                    grid.v[k] = workV[level.index(i, j)];
-                }
-            }
-        }
+        maxOverMovable(level, [&](int32_t i, int32_t j) {
+            const size_t k = fine(level, i, j);
+            grid.u[k] = workU[level.index(i, j)];
+            grid.v[k] = workV[level.index(i, j)];
+            return 0.0f;
+        });
     }
 
     // A row of points moves only itself and reads one row either side.
@@ -272,21 +275,25 @@ struct Solver::Impl : detail::SolverState {
         }
     }
 
-    // Runs fn(k) for the points k of the finest level that may move, rows in parallel: only those ever move
-    // (a point a coarser level moves may move on the finest, Eq. 8), so the others' velocity stays 0.
+    // Runs fn(i, j) for the points (i, j) of `level` in its runs of points that may move, rows in parallel,
+    // and returns the largest value fn returns (0 without points): a max, the same whatever the order, so
+    // the same bytes for any thread count. On the finest level these are the only points that ever move
+    // (a point a coarser level moves may move on the finest, Eq. 8).
     template <class Fn>
-    void forMovablePoints(const Fn& fn) {
-        const Level& finest = levels[0];
-        const int32_t n = finest.side();
-#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(n))
+    float maxOverMovable(const Level& level, const Fn& fn) {
+        const int32_t n = level.side();
+        float largest = 0.0f;
+#pragma omp parallel for schedule(dynamic, kBlockRows) \
+    reduction(max                                      \
+              : largest) if (kParallelRows < static_cast <int64_t>(n))
         for (int32_t j = 0; j < n; ++j) {
-            const int32_t* run = finest.movableRuns.data() + 2 * static_cast<size_t>(finest.movableBegin[j]);
-            const int32_t runs = finest.movableBegin[j + 1] - finest.movableBegin[j];
-            const size_t row = static_cast<size_t>(j) * n;
+            const int32_t* run = level.movableRuns.data() + 2 * static_cast<size_t>(level.movableBegin[j]);
+            const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
             for (int32_t r = 0; r < runs; ++r)
-                for (size_t k = row + run[2 * r]; k < row + run[2 * r + 1]; ++k)
-                    fn(k);
+                for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i)
+                    largest = std::max(largest, fn(i, j));
         }
+        return largest;
     }
 
     int32_t sweepsAt(size_t level) const {
@@ -300,12 +307,15 @@ struct Solver::Impl : detail::SolverState {
         // §4.1 steps 1-2: damping and prediction (explicit Euler, unit time step, no external force). Points
         // that may not move are left out here and in the integration: their velocity stays 0, and velU, velV
         // hold no position of theirs (revertFolds never moves them).
-        forMovablePoints([&](size_t k) {
+        const Level& finest = levels[0];
+        maxOverMovable(finest, [&](int32_t i, int32_t j) {
+            const size_t k = finest.index(i, j);
             const float du = keep * velU[k], dv = keep * velV[k];
             velU[k] = grid.u[k];  // the position before prediction, until integration
             velV[k] = grid.v[k];
             grid.u[k] += du;
             grid.v[k] += dv;
+            return 0.0f;
         });
         stats.untangledPoints += detail::untangle(*this, levels[0]);
         // Step 3, hierarchical (§4.4): coarsest level first; then propagate, smooth, and go finer.
@@ -338,25 +348,13 @@ struct Solver::Impl : detail::SolverState {
         stats.revertedPoints += detail::revertFolds(*this, velU.data(), velV.data());
         // Step 5: integration. The largest move is a max, the same whatever the order: bit-identical for
         // any thread count.
-        const Level& finest = levels[0];
-        const int32_t side = finest.side();
-        float largest = 0.0f;
-#pragma omp parallel for schedule(dynamic, kBlockRows) \
-    reduction(max                                      \
-              : largest) if (kParallelRows < static_cast <int64_t>(side))
-        for (int32_t j = 0; j < side; ++j) {
-            const int32_t* run = finest.movableRuns.data() + 2 * static_cast<size_t>(finest.movableBegin[j]);
-            const int32_t runs = finest.movableBegin[j + 1] - finest.movableBegin[j];
-            const size_t row = static_cast<size_t>(j) * side;
-            for (int32_t r = 0; r < runs; ++r) {
-                for (size_t k = row + run[2 * r]; k < row + run[2 * r + 1]; ++k) {
-                    const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
-                    velU[k] = du;
-                    velV[k] = dv;
-                    largest = std::max(largest, du * du + dv * dv);
-                }
-            }
-        }
+        const float largest = maxOverMovable(finest, [&](int32_t i, int32_t j) {
+            const size_t k = finest.index(i, j);
+            const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
+            velU[k] = du;
+            velV[k] = dv;
+            return du * du + dv * dv;
+        });
         return std::sqrt(largest);
     }
 
@@ -457,28 +455,14 @@ void detail::findSetRuns(Level& level) {
             const int32_t step = detail::setStep(type);
             int32_t gMin = 0, gMax = 0;
             detail::setLanes(type, first, j, c, gMin, gMax);
-            int32_t open = -1, last = -1;  // the current run [open, last + 1)
-            for (int32_t g = gMin; g < gMax; ++g) {
-                const int32_t i = first + g * step;
-                if (!detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
-                                              level.rigidity[level.index(i + e.bi, j + e.bj)]))
-                    continue;
-                if (open >= 0 && g - (last + 1) < kRunGapLanes) {
-                    last = g;
-                    continue;
-                }
-                if (open >= 0) {
-                    level.setRuns.push_back(open);
-                    level.setRuns.push_back(last + 1);
-                    ++count;
-                }
-                open = last = g;
-            }
-            if (open >= 0) {
-                level.setRuns.push_back(open);
-                level.setRuns.push_back(last + 1);
-                ++count;
-            }
+            count += appendRuns(
+                gMin, gMax, kRunGapLanes,
+                [&](int32_t g) {
+                    const int32_t i = first + g * step;
+                    return detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
+                                                    level.rigidity[level.index(i + e.bi, j + e.bj)]);
+                },
+                level.setRuns);
         }
     }
     level.setRunBegin[static_cast<size_t>(c) * detail::kSets] = count;

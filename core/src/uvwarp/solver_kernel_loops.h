@@ -35,7 +35,7 @@ template <class T>
 }
 
 // Lanes per vector iteration of the kernels: 8 floats per AVX2 register (two SSE ones in the baseline
-// build). The projection pads its runs to a multiple of it.
+// build). The projection fills its blocks with two quads of kQuad lanes.
 constexpr int32_t kLaneBlock = 8;
 
 // Offset of level point (i, j) in the level's maps.

@@ -28,16 +28,20 @@ namespace {
     out[3] = _mm256_shuffle_ps(hi01, hi23, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
+// The 4 floats at image + at[l] of 8 lanes, one 128-bit load each, transposed: c[f] = float f of lanes 0..7.
+[[gnu::always_inline]] inline void loadTransposed(const float* image, const uint32_t* at, __m256* c) {
+    __m256 m[4];
+    for (int32_t k = 0; k < 4; ++k)
+        m[k] = loadHalves(image + at[k], image + at[k + 4]);
+    transposeHalves(m, c);
+}
+
 // One cell row of 8 look-ups: `image` points at the row's left corners (minus the lanes' offsets p00),
 // c[0..5] = x, y, z of the left corner, then of the right one.
 [[gnu::always_inline]] inline void cellRowValues(const float* image, const uint32_t* p00, __m256* c) {
-    __m256 m[4], shifted[4];
-    for (int32_t k = 0; k < 4; ++k)
-        m[k] = loadHalves(image + p00[k], image + p00[k + 4]);
-    transposeHalves(m, c);  // x00 y00 z00 x10
-    for (int32_t k = 0; k < 4; ++k)
-        m[k] = loadHalves(image + p00[k] + 2, image + p00[k + 4] + 2);
-    transposeHalves(m, shifted);  // z00 x10 y10 z10: the right corner's y and z
+    __m256 shifted[4];
+    loadTransposed(image, p00, c);            // x00 y00 z00 x10
+    loadTransposed(image + 2, p00, shifted);  // z00 x10 y10 z10: the right corner's y and z
     c[4] = shifted[2];
     c[5] = shifted[3];
 }
@@ -104,10 +108,8 @@ struct Avx2Ops {
     // image: the points are inside the grid, never its last one.
     [[gnu::always_inline]] static void loadPoints(const float* image, const uint32_t* at, float* x0,
                                                   float* x1, float* x2) {
-        __m256 m[4], c[4];
-        for (int32_t k = 0; k < 4; ++k)
-            m[k] = loadHalves(image + at[k], image + at[k + 4]);
-        transposeHalves(m, c);
+        __m256 c[4];
+        loadTransposed(image, at, c);
         _mm256_store_ps(x0, c[0]);
         _mm256_store_ps(x1, c[1]);
         _mm256_store_ps(x2, c[2]);
