@@ -26,17 +26,20 @@ using detail::Level;
 
 namespace {
 
-// Runs rowFn(j) for j in [first, last): blocks of kBlockRows rows, even blocks (in parallel), then odd ones.
+// Runs rowFn(j) for j in [first, last): blocks of wavefrontBlockRows rows, even blocks (in parallel), then
+// odd ones.
 template <class RowFn>
 void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     const int32_t rows = last - first;
     if (rows <= 0) return;
-    const int32_t blocks = (rows + kBlockRows - 1) / kBlockRows;
+    const int32_t blockRows = detail::wavefrontBlockRows(rows);
+    const int32_t blocks = (rows + blockRows - 1) / blockRows;
     for (int32_t parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(dynamic, 1) if (kParallelRows < static_cast <int64_t>(rows))
+#pragma omp parallel for schedule(dynamic, \
+                                  1) if (detail::kParallelWavefrontRows < static_cast <int64_t>(rows))
         for (int32_t b = parity; b < blocks; b += 2) {
-            const int32_t end = std::min(last, first + (b + 1) * kBlockRows);
-            for (int32_t j = first + b * kBlockRows; j < end; ++j)
+            const int32_t end = std::min(last, first + (b + 1) * blockRows);
+            for (int32_t j = first + b * blockRows; j < end; ++j)
                 rowFn(j);
         }
     }

@@ -19,13 +19,26 @@ namespace deformkit::uvwarp::detail {
 // tiny loop costs more than the loop (badly so when the machine is oversubscribed).
 constexpr int64_t kParallelRows = 64;
 
-// Rows per block of the row-wavefront schedule (sweep, regularise). A block's rows are processed in order;
-// blocks of one parity never touch a point another block of that parity reads or moves (a row reads at most
-// one row beyond its block on each side), so they run in parallel. Blocks depend on the grid size alone, so
-// the result does not depend on the thread count, nor on which thread runs a block: blocks (and the rows
-// of the other parallel loops) are handed out dynamically, so a thread the machine delays or a row block
-// with more rigid detail does not hold the other threads at the next barrier.
+// Rows per chunk of the parallel loops over a level's rows that do not depend on each other.
 constexpr int32_t kBlockRows = 16;
+
+// Rows per block of the row-wavefront schedule (sweep, regularise) of a level of `rows` rows: a 64th of
+// them, from 2 to 16. A block's rows are processed in order; blocks of one parity never touch a point another
+// block of that parity reads or moves (a row reads at most one row beyond its block on each side, so blocks
+// of 2 rows suffice), so they run in parallel. Blocks depend on the grid size alone, so the result does not
+// depend on the thread count, nor on which thread runs a block: blocks (and the rows of the other parallel
+// loops) are handed out dynamically, so a thread the machine delays or a row block with more rigid detail
+// does not hold the other threads at the next barrier. About 32 blocks per level keep both threads busy on
+// the coarse levels (16-row blocks left level 3 of a 1024^2 grid 4 blocks per parity); the shorter blocks'
+// order also converges a little faster there (UV-26).
+[[nodiscard]] constexpr int32_t wavefrontBlockRows(int32_t rows) {
+    const int32_t share = rows / 64;
+    return share < 2 ? 2 : (share > 16 ? 16 : share);
+}
+
+// Wavefronts over more rows than this run in parallel: with 2-row blocks, a 32-row level still gives each of
+// two threads 4 blocks per parity.
+constexpr int64_t kParallelWavefrontRows = 16;
 
 // Level::rigidity of a point that may not move is kFixed - R (kFixed: solver_kernels.h).
 [[nodiscard]] inline float fixedRigidity(float r) {
