@@ -34,9 +34,9 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
     if (rows <= 0) return;
     const int32_t blockRows = detail::wavefrontBlockRows(rows);
     const int32_t blocks = (rows + blockRows - 1) / blockRows;
+    const bool parallel = detail::kParallelWavefrontRows < static_cast<int64_t>(rows);
     for (int32_t parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(dynamic, \
-                                  1) if (detail::kParallelWavefrontRows < static_cast <int64_t>(rows))
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
         for (int32_t b = parity; b < blocks; b += 2) {
             const int32_t end = std::min(last, first + (b + 1) * blockRows);
             for (int32_t j = first + b * blockRows; j < end; ++j)

@@ -28,7 +28,7 @@ constexpr int32_t kBlockRows = 16;
 // of 2 rows suffice), so they run in parallel. Blocks depend on the grid size alone, so the result does not
 // depend on the thread count, nor on which thread runs a block: blocks (and the rows of the other parallel
 // loops) are handed out dynamically, so a thread the machine delays or a row block with more rigid detail
-// does not hold the other threads at the next barrier. About 32 blocks per level keep both threads busy on
+// does not hold the other threads at the next barrier. About 64 blocks per level keep both threads busy on
 // the coarse levels (16-row blocks left level 3 of a 1024^2 grid 4 blocks per parity); the shorter blocks'
 // order also converges a little faster there (UV-26).
 [[nodiscard]] constexpr int32_t wavefrontBlockRows(int32_t rows) {
