@@ -36,9 +36,10 @@ constexpr int32_t kBlockRows = 16;
     return share < 2 ? 2 : (share > 16 ? 16 : share);
 }
 
-// Wavefronts over more rows than this run in parallel: with 2-row blocks, a 32-row level still gives each of
-// two threads 4 blocks per parity.
-constexpr int64_t kParallelWavefrontRows = 16;
+// Wavefronts over more rows than this run in parallel: with 2-row blocks a 64-row level gives each of two
+// threads 8 blocks per parity, while a 32-row level is swept faster on one thread than the two threads' forks
+// and barriers cost (timed on a 1024^2 grid's level 5).
+constexpr int64_t kParallelWavefrontRows = 32;
 
 // Level::rigidity of a point that may not move is kFixed - R (kFixed: solver_kernels.h).
 [[nodiscard]] inline float fixedRigidity(float r) {

@@ -239,7 +239,7 @@ TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]"
 }
 
 TEST_CASE("uv warp: the same bytes for 1 and 2 threads", "[uvwarp]") {
-    // 64 cells: the sweeps and regularisations of levels over 16 rows run on both threads in 2-row blocks
+    // 64 cells: the sweeps and regularisations of levels over 32 rows run on both threads in 2-row blocks
     // (wavefrontBlockRows, the narrowest blocks), every other loop on one thread (kParallelRows); 256 cells,
     // with the mask fixing stripes and a corner (the solver then visits runs of movable points and cells
     // only), runs the finer levels' other loops on both threads too.
