@@ -48,8 +48,9 @@ void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
 // Level::movableRuns and cellRuns: runs closer than this are merged.
 constexpr int32_t kRunGap = 8;
 
-// Level::setRuns: runs of segments fewer than this apart are merged.
-constexpr int32_t kRunGapLanes = 4;
+// Level::setRuns: runs of segments fewer than this apart are merged: the lanes of a pair (kPair), the unit of
+// the projection's blocks (UV-27).
+constexpr int32_t kRunGapLanes = 2;
 
 // The kernels of an instruction set: the same bytes from each.
 const detail::SolverKernels& kernelsFor(simd::Isa isa) {
@@ -445,8 +446,8 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
 
 void detail::findSetRuns(Level& level) {
     const int32_t c = level.cells;
-    // Per row and set, the runs of segments it projects. A gap shorter than a quad of lanes costs a sweep
-    // nothing (the quad is computed whole), so runs are merged across it.
+    // Per row and set, the runs of segments it projects. A gap shorter than a pair of lanes costs a sweep
+    // nothing (the pair is computed whole), so runs are merged across it.
     level.setRunBegin.assign(static_cast<size_t>(c) * detail::kSets + 1, 0);
     level.setRuns.clear();
     int32_t count = 0;

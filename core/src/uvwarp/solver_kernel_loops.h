@@ -4,6 +4,7 @@
 // Each kernel file includes this header once and instantiates sweepRow and regulariseRow with its own Ops, a
 // class of the few steps written per instruction set:
 //   template <int32_t Step> static void loadWindows(const float* lo, const float* hi, float* out);
+//   template <int32_t Step> static void loadPairWindows(const float* row, const int32_t* cell, float* out);
 //   static void blendCells(const float* image, int32_t cells, const uint32_t* p00, const float* fx,
 //                          const float* fy, float* x0, float* x1, float* x2);
 //   static void storeInterleaved(float* p, const float* even, const float* odd);
@@ -35,7 +36,7 @@ template <class T>
 }
 
 // Lanes per vector iteration of the kernels: 8 floats per AVX2 register (two SSE ones in the baseline
-// build). The projection fills its blocks with two quads of kQuad lanes.
+// build). The projection fills its blocks with kPairs pairs of kPair lanes.
 constexpr int32_t kLaneBlock = 8;
 
 // Offset of level point (i, j) in the level's maps.
@@ -145,8 +146,11 @@ constexpr int32_t ringSlot(int32_t di, int32_t dj) {
     x2 = w00 * image[p00 + 2] + w10 * image[p10 + 2] + w01 * image[p01 + 2] + w11 * image[p11 + 2];
 }
 
-// Lanes per quad, half a block: the unit in which a row's segments are gathered into blocks.
+// Lanes per quad, half a block: the regularisation reads its blocks as two quads of points.
 constexpr int32_t kQuad = kLaneBlock / 2;
+// Lanes per pair: the projection gathers a row's segments into blocks of kPairs pairs.
+constexpr int32_t kPair = 2;
+constexpr int32_t kPairs = kLaneBlock / kPair;
 
 // Eq. 1-3 for the segments of type Type anchored at cells i = first (mod step) on row j of a level (step
 // 4, or 2 for vertical segments, whose ends share a column), in the runs [runs[2r], runs[2r + 1]) of their
@@ -157,14 +161,15 @@ constexpr int32_t kQuad = kLaneBlock / 2;
 // Out of line, one function per set type, as in the builds UV-14 measured.
 //
 // Lanes. The segments of the set on the row inside the grid are g in [gMin, gMax). The runs' segments are
-// taken kQuad consecutive ones at a time (a quad) and two quads make a block of kLaneBlock lanes, so the
-// vector loop runs no scalar remainder and a run's last, partial quad shares its block with the next run's
-// first: on a real tile the runs of a row are a few quads long, and whole blocks per run left a third of the
-// lanes idle. The lanes of a quad outside every run are not live: they never move, and store back the values
-// they read. A block holds no segment twice (a last quad alone takes a quad beside it as its partner), so
-// every segment is moved once. Segments of one set never share a point nor read a point another one moves, so
-// the lanes are independent whatever block holds them: the same bytes as one run after another. The few
-// segments left at the grid's right edge, fewer than a quad, go in a last block of fewer lanes.
+// taken kPair consecutive ones at a time (a pair) and kPairs pairs make a block of kLaneBlock lanes, so the
+// vector loop runs no scalar remainder and a run's last, partial pair shares its block with the next runs'
+// pairs: on a real tile the runs of a row are a few segments long (on the coarse levels often 2 to 5), and
+// whole blocks per run left a third of the lanes idle, quads of 4 a quarter (UV-27). The lanes of a pair
+// outside every run are not live: they never move, and store back the values they read. A block holds no
+// segment twice (the last block of a row is filled with pairs that overlap none in it), so every segment is
+// moved once. Segments of one set never share a point nor read a point another one moves, so the lanes are
+// independent whatever block holds them: the same bytes as one run after another. A last segment alone at the
+// grid's right edge goes in a last block of fewer lanes.
 template <class Ops, int32_t Type, bool Mapped>
 [[gnu::noinline]] void projectRow(const KernelGrid& grid, const KernelLevel& level, int32_t j, int32_t first,
                                   const int32_t* runs, int32_t runCount, float stiffness) {
@@ -216,16 +221,14 @@ template <class Ops, int32_t Type, bool Mapped>
     static_assert(slotA >= 0, "the ends of a segment are neighbours");
 
     // One block of `lanes` lanes: lane l is the segment at cell cell[l], moved if bit l of liveMask is set.
-    // quads: the block is two quads (lanes 0-3 and 4-7) of consecutive segments, read as contiguous
-    // stretches when points are one apart.
-    const auto project = [&](const int32_t* cell, int32_t lanes, bool quads, uint32_t liveMask) {
+    // pairs: the block is kPairs pairs of consecutive segments (lanes 2q, 2q + 1), whose windows are read as
+    // contiguous stretches when points are one apart.
+    const auto project = [&](const int32_t* cell, int32_t lanes, bool pairs, uint32_t liveMask) {
         alignas(32) float wu[kRows][kCols][kLaneBlock], wv[kRows][kCols][kLaneBlock];
-        if (s == 1 && quads) {
+        if (s == 1 && pairs) {
             for (int32_t r = 0; r < kRows; ++r) {
-                Ops::template loadWindows<step>(rowU[r] + cell[0] - 1, rowU[r] + cell[kQuad] - 1,
-                                                &wu[r][0][0]);
-                Ops::template loadWindows<step>(rowV[r] + cell[0] - 1, rowV[r] + cell[kQuad] - 1,
-                                                &wv[r][0][0]);
+                Ops::template loadPairWindows<step>(rowU[r], cell, &wu[r][0][0]);
+                Ops::template loadPairWindows<step>(rowV[r], cell, &wv[r][0][0]);
             }
         } else {
 #pragma omp simd
@@ -353,7 +356,7 @@ template <class Ops, int32_t Type, bool Mapped>
             endBx[l] = moveB ? nbx : pbx;
             endBy[l] = moveB ? nby : pby;
         }
-        // Stored one lane after another: the lanes' points are not evenly spaced (two quads), and AVX2 has
+        // Stored one lane after another: the lanes' points are not evenly spaced (four pairs), and AVX2 has
         // no scatter, so a store in the loop above would keep GCC from vectorising it.
         for (int32_t l = 0; l < lanes; ++l) {
             const int32_t ka = (cell[l] + e.ai) * s, kb = (cell[l] + e.bi) * s;  // offsets in rows of u, v
@@ -364,25 +367,23 @@ template <class Ops, int32_t Type, bool Mapped>
         }
     };
 
-    // The quads, in order: a pending one waits for a second to make a block.
+    // The pairs, in order, kPairs to a block.
     alignas(32) int32_t cell[kLaneBlock];
-    bool pending = false;
-    int32_t pendingQuad = 0;
-    uint32_t pendingMask = 0;
-    const auto fillQuad = [&](int32_t* slot, int32_t g) {
-        for (int32_t l = 0; l < kQuad; ++l)
+    int32_t pairStart[kPairs];
+    int32_t pairs = 0;
+    uint32_t blockMask = 0;
+    const auto fillPair = [&](int32_t* slot, int32_t g) {
+        for (int32_t l = 0; l < kPair; ++l)
             slot[l] = first + (g + l) * step;
     };
-    const auto addQuad = [&](int32_t g, uint32_t mask) {  // segments g .. g + kQuad - 1, mask of the live
-        fillQuad(cell + (pending ? kQuad : 0), g);
-        if (!pending) {
-            pending = true;
-            pendingQuad = g;
-            pendingMask = mask;
-            return;
-        }
-        pending = false;
-        project(cell, kLaneBlock, true, pendingMask | (mask << kQuad));
+    const auto addPair = [&](int32_t g, uint32_t mask) {  // segments g, g + 1, mask of the live ones
+        fillPair(cell + pairs * kPair, g);
+        pairStart[pairs] = g;
+        blockMask |= mask << (pairs * kPair);
+        if (++pairs < kPairs) return;
+        project(cell, kLaneBlock, true, blockMask);
+        pairs = 0;
+        blockMask = 0;
     };
     // The lanes [a, b) of run r (inside [gMin, gMax): Level::setRuns).
     const auto runLanes = [&](int32_t r, int32_t& a, int32_t& b) {
@@ -401,39 +402,37 @@ template <class Ops, int32_t Type, bool Mapped>
         }
         return mask;
     };
-    int32_t next = gMin;  // the first segment not yet in a quad
+    int32_t next = gMin;  // the first segment not yet in a pair
     for (int32_t r = 0; r < runCount; ++r) {
         int32_t a = 0, b = 0;
         runLanes(r, a, b);
-        for (a = maxOf(a, next); a < b && a + kQuad <= gMax; a = next) {
-            addQuad(a, liveLanes(r, a, kQuad));
-            next = a + kQuad;
+        for (a = maxOf(a, next); a < b && a + kPair <= gMax; a = next) {
+            addPair(a, liveLanes(r, a, kPair));
+            next = a + kPair;
         }
         if (a < b) {
-            // Fewer than a quad left before the grid's edge: with a pending quad, in one last block.
-            int32_t lanes = 0;
-            uint32_t mask = 0;
-            if (pending) {
-                lanes = kQuad;
-                mask = pendingMask;
-                pending = false;
-            }
-            const int32_t tail = gMax - a;
-            fillQuad(cell + lanes, a);  // the segments from gMax on are not read
-            mask |= liveLanes(r, a, tail) << lanes;
-            project(cell, lanes + tail, false, mask);
+            // The last segment before the grid's edge, alone: with the pending pairs, in one last block.
+            const int32_t lanes = pairs * kPair;
+            fillPair(cell + lanes, a);  // the segment at gMax is not read
+            project(cell, lanes + 1, false, blockMask | (liveLanes(r, a, 1) << lanes));
             return;
         }
     }
-    if (pending) {
-        // A last quad alone: with a quad beside it that does not overlap it, its lanes not live.
-        const int32_t partner = pendingQuad + 2 * kQuad <= gMax ? pendingQuad + kQuad : pendingQuad - kQuad;
-        if (partner >= gMin) {
-            fillQuad(cell + kQuad, partner);
-            project(cell, kLaneBlock, true, pendingMask);
-        } else {
-            project(cell, kQuad, false, pendingMask);
-        }
+    if (pairs == 0) return;
+    // A last block of fewer pairs: filled with pairs that overlap none in it, their lanes not live.
+    const int32_t used = pairs;
+    for (int32_t g = gMin; pairs < kPairs && g + kPair <= gMax; ++g) {
+        bool free = true;
+        for (int32_t q = 0; q < pairs; ++q)
+            free = free && (g + kPair <= pairStart[q] || g >= pairStart[q] + kPair);
+        if (!free) continue;
+        fillPair(cell + pairs * kPair, g);
+        pairStart[pairs++] = g;
+    }
+    if (pairs == kPairs) {
+        project(cell, kLaneBlock, true, blockMask);
+    } else {
+        project(cell, used * kPair, false, blockMask);
     }
 }
 

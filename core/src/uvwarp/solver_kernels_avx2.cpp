@@ -47,32 +47,52 @@ namespace {
 }
 
 struct Avx2Ops {
-    // BaselineOps::loadWindows with 128-bit loads and in-register transposes (8 shuffles for 4 columns)
-    // instead of one scalar load and insert per value: a quad is one 128-bit half of each register.
+    // BaselineOps::loadWindows with 128-bit loads and in-register shuffles instead of one scalar load and
+    // insert per value: a quad is one 128-bit half of each register.
     template <int32_t Step>
     [[gnu::always_inline]] static void loadWindows(const float* lo, const float* hi, float* out) {
         static_assert(kQuad == 4, "a quad is a 128-bit half");
-        if constexpr (Step == 4) {
-            // Lane l's 4 columns are lo[4l, 4l + 4) (hi for lanes 4-7).
-            __m256 m[4], column[4];
-            for (int32_t k = 0; k < 4; ++k)
-                m[k] = loadHalves(lo + 4 * k, hi + 4 * k);
-            transposeHalves(m, column);
-            for (int32_t col = 0; col < 4; ++col)
-                _mm256_store_ps(out + col * kLaneBlock, column[col]);
-        } else {
-            static_assert(Step == 2);
-            // Lane l's columns i - 1, i are lo[2l], lo[2l + 1]; its column i + 1 is lo[2l + 2] (hi for lanes
-            // 4-7).
-            const __m256 m0 = loadHalves(lo, hi), m1 = loadHalves(lo + 4, hi + 4);
-            const __m256 west = _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(2, 0, 2, 0));
-            _mm256_store_ps(out, west);
-            _mm256_store_ps(out + 8, _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(3, 1, 3, 1)));
-            const __m256 next = _mm256_permutevar8x32_ps(west, _mm256_setr_epi32(1, 2, 3, 3, 5, 6, 7, 7));
-            const __m256 ends = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(lo + 8)),
-                                                     _mm_broadcast_ss(hi + 8), 1);
-            _mm256_store_ps(out + 16, _mm256_blend_ps(next, ends, 0x88));
+        static_assert(Step == 2, "the regularisation's points, two apart");
+        // Lane l's columns i - 1, i are lo[2l], lo[2l + 1]; its column i + 1 is lo[2l + 2] (hi for lanes
+        // 4-7).
+        const __m256 m0 = loadHalves(lo, hi), m1 = loadHalves(lo + 4, hi + 4);
+        const __m256 west = _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(2, 0, 2, 0));
+        _mm256_store_ps(out, west);
+        _mm256_store_ps(out + 8, _mm256_shuffle_ps(m0, m1, _MM_SHUFFLE(3, 1, 3, 1)));
+        const __m256 next = _mm256_permutevar8x32_ps(west, _mm256_setr_epi32(1, 2, 3, 3, 5, 6, 7, 7));
+        const __m256 ends = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_broadcast_ss(lo + 8)),
+                                                 _mm_broadcast_ss(hi + 8), 1);
+        _mm256_store_ps(out + 16, _mm256_blend_ps(next, ends, 0x88));
+    }
+
+    // BaselineOps::loadPairWindows as 128-bit loads, each half one lane's window (so a block is read as in
+    // loadWindows, and the same in-register transpose follows): the first lane of pair q at p[q], the second
+    // Step points on (for Step 2 read from one point on and shifted down a float, so that no load reaches
+    // past the last column of the second window, p[q] + 4).
+    template <int32_t Step>
+    [[gnu::always_inline]] static void loadPairWindows(const float* row, const int32_t* cell, float* out) {
+        static_assert(kPair == 2 && kPairs == 4, "four pairs of two lanes");
+        const float* p[kPairs];
+        for (int32_t q = 0; q < kPairs; ++q)
+            p[q] = row + cell[kPair * q] - 1;
+        // m[k]: lane k (pair k / 2) in the low half, lane k + 4 (pair k / 2 + 2) in the high half.
+        __m256 m[4];
+        for (int32_t k = 0; k < 4; k += 2) {
+            const float* lo = p[k / 2];
+            const float* hi = p[k / 2 + 2];
+            m[k] = loadHalves(lo, hi);
+            if constexpr (Step == 4) {
+                m[k + 1] = loadHalves(lo + 4, hi + 4);
+            } else {
+                static_assert(Step == 2);
+                m[k + 1] = _mm256_permute_ps(loadHalves(lo + 1, hi + 1), _MM_SHUFFLE(3, 3, 2, 1));
+            }
         }
+        __m256 column[4];
+        transposeHalves(m, column);
+        constexpr int32_t cols = Step == 4 ? 4 : 3;
+        for (int32_t col = 0; col < cols; ++col)
+            _mm256_store_ps(out + col * kLaneBlock, column[col]);
     }
 
     // BaselineOps::blendCells with the same arithmetic (so the same bits). A vectorised blendCell reads its

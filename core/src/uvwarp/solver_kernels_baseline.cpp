@@ -6,20 +6,31 @@ namespace deformkit::uvwarp::detail {
 namespace {
 
 struct BaselineOps {
-    // The windows of a block of kLaneBlock segments at points one apart, one window row: two quads of
-    // kQuad lanes Step points apart, lo and hi at column i - 1 of their first lane's segment, and
-    // out[col * kLaneBlock + l] = lo[l * Step + col] (hi[(l - kQuad) * Step + col] for the second quad) for
-    // the columns i - 1 .. i + 2 (Step 4) or i - 1 .. i + 1 (Step 2, vertical segments). Reads lo and hi
-    // [0, kQuad * Step + 1) at most.
+    // The regularisation's windows of a block of kLaneBlock points (Step 2: points two apart), one window
+    // row: two quads of kQuad lanes Step points apart, lo and hi at column i - 1 of their first lane's point,
+    // and out[col * kLaneBlock + l] = lo[l * Step + col] (hi[(l - kQuad) * Step + col] for the second quad)
+    // for the columns i - 1 .. i + 1. Reads lo and hi [0, kQuad * Step + 1) at most.
     template <int32_t Step>
     static void loadWindows(const float* lo, const float* hi, float* out) {
-        constexpr int32_t cols = Step == 4 ? 4 : 3;
-        for (int32_t col = 0; col < cols; ++col) {
+        static_assert(Step == 2, "the regularisation's points, two apart");
+        for (int32_t col = 0; col < 3; ++col) {
             for (int32_t l = 0; l < kQuad; ++l) {
                 out[col * kLaneBlock + l] = lo[l * Step + col];
                 out[col * kLaneBlock + kQuad + l] = hi[l * Step + col];
             }
         }
+    }
+
+    // The windows of a block of kPairs pairs of segments at points one apart, one window row: lane l is
+    // segment l % kPair of the pair at cell[kPair (l / kPair)] (Step points apart), and
+    // out[col * kLaneBlock + l] = row[cell[l] - 1 + col] for the columns i - 1 .. i + 2 (Step 4) or
+    // i - 1 .. i + 1 (Step 2).
+    template <int32_t Step>
+    static void loadPairWindows(const float* row, const int32_t* cell, float* out) {
+        constexpr int32_t cols = Step == 4 ? 4 : 3;
+        for (int32_t col = 0; col < cols; ++col)
+            for (int32_t l = 0; l < kLaneBlock; ++l)
+                out[col * kLaneBlock + l] = row[cell[l] - 1 + col];
     }
 
     // blendCell for kLaneBlock look-ups, lane l of every array one look-up. Out of line: inlined into the
