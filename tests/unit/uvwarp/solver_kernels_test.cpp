@@ -1,9 +1,9 @@
 // The UV-warp solver's projection kernel (solver_kernel_loops.h, sweepRow) against a reference written
 // here: every segment of a row, one after another, in the order of the paper's 8 parallel sets. The kernel
 // visits only the runs of segments the row projects (Level::setRuns, found by the solver from the rigidity
-// map), packs them into blocks of two quads of lanes across runs, takes a quad beside a lone last quad as
-// padding, and puts the segments left at the grid's right edge in a short block; none of that may change a
-// byte. Random blocks of rigid points on a free background (rows without any, one point wide, touching the
+// map), packs them into blocks of four pairs of lanes across runs, fills a row's last block with pairs that
+// overlap none in it, and puts a segment left alone at the grid's right edge in a short block; none of that
+// may change a byte. Random blocks of rigid points on a free background (rows without any, one point wide, touching the
 // edge) with fixed points scattered, levels of 8 to 64 cells, compact and in-place layouts of the level's
 // points, with and without an orientation map; both instruction sets.
 #include <algorithm>
