@@ -3,9 +3,9 @@
 // visits only the runs of segments the row projects (Level::setRuns, found by the solver from the rigidity
 // map), packs them into blocks of four pairs of lanes across runs, fills a row's last block with pairs that
 // overlap none in it, and puts a segment left alone at the grid's right edge in a short block; none of that
-// may change a byte. Random blocks of rigid points on a free background (rows without any, one point wide, touching the
-// edge) with fixed points scattered, levels of 8 to 64 cells, compact and in-place layouts of the level's
-// points, with and without an orientation map; both instruction sets.
+// may change a byte. Random blocks of rigid points on a free background (rows without any, one point wide,
+// touching the edge) with fixed points scattered, levels of 8 to 64 cells, compact and in-place layouts of
+// the level's points, with and without an orientation map; both instruction sets.
 #include <algorithm>
 #include <cstring>
 #include <random>
