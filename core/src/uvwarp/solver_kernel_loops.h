@@ -3,7 +3,7 @@
 // Private to solver_kernels_<isa>.cpp: the UV-warp solver's kernels, one source for every instruction set.
 // Each kernel file includes this header once and instantiates sweepRow and regulariseRow with its own Ops, a
 // class of the few steps written per instruction set:
-//   template <int32_t Step> static void loadWindows(const float* lo, const float* hi, float* out);
+//   static void loadWindows(const float* lo, const float* hi, float* out);
 //   template <int32_t Step> static void loadPairWindows(const float* row, const int32_t* cell, float* out);
 //   static void blendCells(const float* image, int32_t cells, const uint32_t* p00, const float* fx,
 //                          const float* fy, float* x0, float* x1, float* x2);
@@ -477,8 +477,8 @@ template <class Ops, bool Fine>
             const int32_t i0 = first + 2 * lane;
             alignas(32) float wu[3][3][kLaneBlock], wv[3][3][kLaneBlock];
             for (int32_t r = 0; r < 3; ++r) {
-                Ops::template loadWindows<2>(rowU[r] + i0 - 1, rowU[r] + i0 - 1 + 2 * kQuad, &wu[r][0][0]);
-                Ops::template loadWindows<2>(rowV[r] + i0 - 1, rowV[r] + i0 - 1 + 2 * kQuad, &wv[r][0][0]);
+                Ops::loadWindows(rowU[r] + i0 - 1, rowU[r] + i0 - 1 + 2 * kQuad, &wu[r][0][0]);
+                Ops::loadWindows(rowV[r] + i0 - 1, rowV[r] + i0 - 1 + 2 * kQuad, &wv[r][0][0]);
             }
             alignas(32) float movedU[kLaneBlock], movedV[kLaneBlock];
 #pragma omp simd

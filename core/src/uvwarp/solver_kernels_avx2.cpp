@@ -49,10 +49,8 @@ namespace {
 struct Avx2Ops {
     // BaselineOps::loadWindows with 128-bit loads and in-register shuffles instead of one scalar load and
     // insert per value: a quad is one 128-bit half of each register.
-    template <int32_t Step>
     [[gnu::always_inline]] static void loadWindows(const float* lo, const float* hi, float* out) {
         static_assert(kQuad == 4, "a quad is a 128-bit half");
-        static_assert(Step == 2, "the regularisation's points, two apart");
         // Lane l's columns i - 1, i are lo[2l], lo[2l + 1]; its column i + 1 is lo[2l + 2] (hi for lanes
         // 4-7).
         const __m256 m0 = loadHalves(lo, hi), m1 = loadHalves(lo + 4, hi + 4);

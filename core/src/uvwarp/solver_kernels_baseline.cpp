@@ -6,17 +6,15 @@ namespace deformkit::uvwarp::detail {
 namespace {
 
 struct BaselineOps {
-    // The regularisation's windows of a block of kLaneBlock points (Step 2: points two apart), one window
-    // row: two quads of kQuad lanes Step points apart, lo and hi at column i - 1 of their first lane's point,
-    // and out[col * kLaneBlock + l] = lo[l * Step + col] (hi[(l - kQuad) * Step + col] for the second quad)
-    // for the columns i - 1 .. i + 1. Reads lo and hi [0, kQuad * Step + 1) at most.
-    template <int32_t Step>
+    // The regularisation's windows of a block of kLaneBlock points two apart, one window row: two quads of
+    // kQuad lanes, lo and hi at column i - 1 of their first lane's point, and out[col * kLaneBlock + l] =
+    // lo[2 l + col] (hi[2 (l - kQuad) + col] for the second quad) for the columns i - 1 .. i + 1. Reads lo
+    // and hi [0, 2 kQuad + 1) at most.
     static void loadWindows(const float* lo, const float* hi, float* out) {
-        static_assert(Step == 2, "the regularisation's points, two apart");
         for (int32_t col = 0; col < 3; ++col) {
             for (int32_t l = 0; l < kQuad; ++l) {
-                out[col * kLaneBlock + l] = lo[l * Step + col];
-                out[col * kLaneBlock + kQuad + l] = hi[l * Step + col];
+                out[col * kLaneBlock + l] = lo[2 * l + col];
+                out[col * kLaneBlock + kQuad + l] = hi[2 * l + col];
             }
         }
     }

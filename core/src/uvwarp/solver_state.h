@@ -3,6 +3,7 @@
 // Private to the UV-warp solver: its state, shared by the API and hierarchy (solver.cpp) and the fold
 // repair (solver_folds.cpp). The kernels see it through solver_kernels.h's plain views.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -32,8 +33,7 @@ constexpr int32_t kBlockRows = 16;
 // the coarse levels (16-row blocks left level 3 of a 1024^2 grid 4 blocks per parity); the shorter blocks'
 // order also converges a little faster there (UV-26).
 [[nodiscard]] constexpr int32_t wavefrontBlockRows(int32_t rows) {
-    const int32_t share = rows / 64;
-    return share < 2 ? 2 : (share > 16 ? 16 : share);
+    return std::clamp(rows / 64, 2, kBlockRows);
 }
 
 // Wavefronts over more rows than this run in parallel: with 2-row blocks a 64-row level gives each of two
