@@ -5,9 +5,9 @@
 
 Keenan Crane's Spot (tests/data/spot) with its own UVs, twisted by a keyed angle over N frames (24), rigid
 disks painted in a T x T rigidity image (1024): live mode on, every frame change solves the warm-started
-warp (one iteration of sweeps {1, 4, 8}) and fills the T x T redirect image the material reads. Prints
-the medians over the frames of: the whole frame change with live mode, the same frame change without it,
-and the live step alone (solve, redirect map, image fill), with its frame rate.
+warp (the add-on's live preset for a T x T grid: one iteration a frame) and fills the T x T redirect image
+the material reads. Prints the medians over the frames of: the whole frame change with live mode, the same
+frame change without it, and the live step alone (solve, redirect map, image fill), with its frame rate.
 """
 
 import os

@@ -742,7 +742,7 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     uvs = np.empty(len(obj.data.loops) * 2, np.float32)
     obj.data.uv_layers.active.data.foreach_get("uv", uvs)
     solver = dk.UvWarpSolver(rest, counts, indices, uvs.reshape(-1, 2), np.arange(len(indices), dtype=np.int32),
-                             1001, np.ascontiguousarray(disks[::-1]), **addon.uvwarp.LIVE_OPTIONS)
+                             1001, np.ascontiguousarray(disks[::-1]), **addon.uvwarp.live_options(size))
     solver.solve(positions(obj))  # the operator's first frame
     for frame in (2, 3, 4, 5):
         bpy.context.scene.frame_set(frame)
@@ -756,6 +756,10 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     assert np.abs(shown - identity).max() > 1e-3  # the twist does warp the texture
     rate = addon.uvwarp.live_rate(obj)
     assert rate is not None and rate[0] > 0.0
+    # The preset by grid size (docs/decisions.md UV-28): the measured schedules of 512, 1024 and 2048 cells.
+    presets = {cells: addon.uvwarp.live_options(cells)["sweeps_per_level"] for cells in (128, 512, 1024, 2048, 4096)}
+    assert presets == {128: [2, 4, 12], 512: [2, 4, 12], 1024: [1, 4, 10], 2048: [1, 2, 5, 12],
+                       4096: [1, 2, 5, 12]}
     print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")
 
     # Off: frame changes leave the image alone.

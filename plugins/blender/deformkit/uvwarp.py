@@ -190,9 +190,19 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
 
 # ---- live mode: the warp solved on every frame change, shown through the material -----------------------
 
-# One warm iteration of sweeps {1, 4, 8} a frame: within 2 points of a converged solve on a smooth
-# animation (docs/uvwarp.md, "What a frame costs").
-LIVE_OPTIONS = {"iterations": 1, "sweeps_per_level": [1, 4, 8]}
+# One warm iteration a frame, its sweeps per level by the grid's size: the lightest schedules measured
+# within 2 points of a converged solve on every frame of a smooth animation (docs/uvwarp.md, "What a frame
+# costs"; docs/decisions.md UV-28). Finer grids have one level more, whose first sweeps carry less.
+LIVE_SWEEPS = ((512, [2, 4, 12]), (1024, [1, 4, 10]))  # (largest grid, sweeps); finer grids: LIVE_SWEEPS_FINE
+LIVE_SWEEPS_FINE = [1, 2, 5, 12]
+
+
+def live_options(cells):
+    """The live preset's solver options for a grid of `cells` cells per side."""
+    sweeps = next((s for largest, s in LIVE_SWEEPS if cells <= largest), LIVE_SWEEPS_FINE)
+    return {"iterations": 1, "sweeps_per_level": list(sweeps)}
+
+
 LIVE_IMAGE = "DeformKit Live {}"
 
 # Per object name: its tile's solver, the image it fills, the last frames' times.
@@ -227,8 +237,9 @@ def start_live(obj, rigidity, mask, resolution):
                           f"bake the redirect maps instead")
     _, rigidity_maps = image_map(rigidity, "rigidity")
     mask_map = image_map(mask, "mask")[1][1001] if mask is not None else None
+    cells = resolution or rigidity_maps[1001].shape[0]
     solver = dk.UvWarpSolver(points, counts, indices, uvs, order, 1001, rigidity_maps[1001], mask=mask_map,
-                             resolution=resolution or None, **LIVE_OPTIONS)
+                             resolution=resolution or None, **live_options(cells))
     texels = solver.texels
     name = LIVE_IMAGE.format(obj.name)
     image = bpy.data.images.get(name)
