@@ -190,10 +190,11 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
 
 # ---- live mode: the warp solved on every frame change, shown through the material -----------------------
 
-# One warm iteration a frame, its sweeps per level by the grid's size: the lightest schedules measured
-# within 2 points of a converged solve on every frame of a smooth animation (docs/uvwarp.md, "What a frame
-# costs"; docs/decisions.md UV-28). Finer grids have one level more, whose first sweeps carry less.
-LIVE_SWEEPS = ((512, [2, 4, 12]), (1024, [1, 4, 10]))  # (largest grid, sweeps); finer grids: LIVE_SWEEPS_FINE
+# One warm iteration a frame, its sweeps per level by the grid's size: the cheapest schedules measured
+# within 2 points of a converged solve on every probed frame of a smooth animation, on two models
+# (docs/uvwarp.md, "What a frame costs"; docs/decisions.md UV-28). (largest grid, sweeps), then the sweeps of
+# finer grids.
+LIVE_SWEEPS = ((512, [2, 4, 12]), (1024, [1, 4, 10]))
 LIVE_SWEEPS_FINE = [1, 2, 5, 12]
 
 
