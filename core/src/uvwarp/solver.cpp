@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstdint>
 #include <utility>
+#include <vector>
 
 #include "deformkit/error.h"
 #include "memory/large_buffers.h"
+#include "row_wavefront.h"
 #include "simd/cpu.h"
 #include "solver_kernels.h"
 #include "solver_state.h"
@@ -18,6 +20,7 @@
 
 namespace deformkit::uvwarp {
 
+using detail::forRowBlocks;
 using detail::kBlockRows;
 using detail::kFixed;
 using detail::kGauss;
@@ -25,25 +28,6 @@ using detail::kParallelRows;
 using detail::Level;
 
 namespace {
-
-// Runs rowFn(j) for j in [first, last): blocks of wavefrontBlockRows rows, even blocks (in parallel), then
-// odd ones.
-template <class RowFn>
-void forRowBlocks(int32_t first, int32_t last, const RowFn& rowFn) {
-    const int32_t rows = last - first;
-    if (rows <= 0) return;
-    const int32_t blockRows = detail::wavefrontBlockRows(rows);
-    const int32_t blocks = (rows + blockRows - 1) / blockRows;
-    const bool parallel = detail::kParallelWavefrontRows < static_cast<int64_t>(rows);
-    for (int32_t parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
-        for (int32_t b = parity; b < blocks; b += 2) {
-            const int32_t end = std::min(last, first + (b + 1) * blockRows);
-            for (int32_t j = first + b * blockRows; j < end; ++j)
-                rowFn(j);
-        }
-    }
-}
 
 // Level::movableRuns and cellRuns: runs closer than this are merged.
 constexpr int32_t kRunGap = 8;
@@ -161,9 +145,9 @@ struct Solver::Impl : detail::SolverState {
 
     // Rows of cells j moves points on rows j and j + 1 and reads rows j - 1 .. j + 2 (the clamp and the
     // fold check read 8-neighbours): forRowBlocks' blocks keep parallel rows apart.
-    void sweep(const detail::KernelLevel& l, float stiffness) {
+    void sweepLevel(const detail::KernelLevel& l, float stiffness, int32_t count) {
         const detail::KernelGrid g = kernelGrid();
-        forRowBlocks(0, l.cells, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
+        forRowBlocks(0, l.cells, count, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
     }
 
     // The level's points where they are, in the warp.
@@ -202,7 +186,7 @@ struct Solver::Impl : detail::SolverState {
     void regulariseAll(const Level& level, bool onlyNew) {
         const detail::KernelGrid g = kernelGrid();
         const detail::KernelLevel l = inPlace(level);
-        forRowBlocks(1, level.cells, [&](int32_t j) { kernels->regulariseRow(g, l, j, onlyNew); });
+        forRowBlocks(1, level.cells, 1, [&](int32_t j) { kernels->regulariseRow(g, l, j, onlyNew); });
     }
 
     // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level:
@@ -333,8 +317,7 @@ struct Solver::Impl : detail::SolverState {
             const int32_t sweeps = sweepsAt(l);
             detail::KernelLevel points = inPlace(level);
             if (l > 0 && sweeps > 0) points = gather(level);
-            for (int32_t s = 0; s < sweeps; ++s)
-                sweep(points, stiffness);
+            sweepLevel(points, stiffness, sweeps);
             if (points.u != grid.u.data()) scatter(level);
             if (l > 0) {
                 Level& finer = levels[l - 1];
