@@ -246,6 +246,11 @@ void addUvWarpCommand(CommandLine& cli) {
         .range(1e-6f, 1.0f)
         .showDefault();
     uvwarp
+        .option("--coarse-relaxation", solver.coarseRelaxation,
+                "over-relaxation of the levels above the finest, in [1, 2] (live previews: 1.4)")
+        .range(1.0f, 2.0f)
+        .showDefault();
+    uvwarp
         .option("--border-width", o->command.options.derivedMask.borderWidth,
                 "texels of chart border kept fixed by a derived mask")
         .positive()

@@ -42,7 +42,7 @@ using uvwarp::TileWarpOptions;
 
 constexpr const char* kOptionNames =
     "iterations, tolerance, levels, sweeps_per_level, orientation_preservation, smoothing, damping, "
-    "coarse_stiffness, "
+    "coarse_stiffness, coarse_relaxation, "
     "border_width, dilation_rings, orientation_density, warm_start";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
@@ -76,8 +76,9 @@ int32_t intOption(py::handle value, const std::string& source, const std::string
     return static_cast<int32_t>(v);
 }
 
+// A number in [0, 1] ((0, 1] when openLow), or in [low, high].
 float floatOption(py::handle value, const std::string& source, const std::string& name, bool openLow,
-                  const char* expected) {
+                  const char* expected, double low = 0.0, double high = 1.0) {
     double v = 0.0;
     try {
         v = value.cast<double>();
@@ -85,7 +86,7 @@ float floatOption(py::handle value, const std::string& source, const std::string
         throw InvalidInput(formatError(
             source, name, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))), expected));
     }
-    if (!std::isfinite(v) || v > 1.0 || (openLow ? !(v > 0.0) : v < 0.0))
+    if (!std::isfinite(v) || v > high || (openLow ? !(v > low) : v < low))
         throw InvalidInput(formatError(source, name, "is " + std::string(py::str(value)), expected));
     return static_cast<float>(v);
 }
@@ -133,6 +134,8 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
             o.solver.tolerance = floatOption(value, source, k, false, "a number in [0, 1] (grid cells)");
         } else if (k == "coarse_stiffness") {
             o.solver.coarseStiffness = floatOption(value, source, k, true, "a number in (0, 1]");
+        } else if (k == "coarse_relaxation") {
+            o.solver.coarseRelaxation = floatOption(value, source, k, false, "a number in [1, 2]", 1.0, 2.0);
         } else if (k == "border_width") {
             o.derivedMask.borderWidth = intOption(value, source, k, 1, "an integer >= 1 (texels)");
         } else if (k == "dilation_rings") {
@@ -541,6 +544,7 @@ constexpr const char* kSolverDoc =
     "once\n"
     "no point moves farther), levels (0: automatic), sweeps_per_level ([4, 8, 8], finest first),\n"
     "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
+    "coarse_relaxation (1: over-relaxation of the coarse levels, in [1, 2]; the live presets use 1.4),\n"
     "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
     "off;\n"
     "a radius in texels: without an orientation map, orientation preservation follows the rigidity's local\n"

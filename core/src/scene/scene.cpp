@@ -419,8 +419,8 @@ class Reader {
             requireObject(params, pp, "an object of UV-warp options by name");
             onlyKeys(params, pp,
                      {"iterations", "tolerance", "levels", "sweepsPerLevel", "orientationPreservation",
-                      "smoothing", "damping", "coarseStiffness", "dilationRings", "maskBorderWidth",
-                      "orientationDensity", "warmStart"});
+                      "smoothing", "damping", "coarseStiffness", "coarseRelaxation", "dilationRings",
+                      "maskBorderWidth", "orientationDensity", "warmStart"});
             uvwarp::SolverOptions& o = u.options.solver;
             auto get = [&](const char* name) -> const json* {
                 return params.contains(name) ? &params.at(name) : nullptr;
@@ -455,6 +455,9 @@ class Reader {
                     static_cast<float>(ranged(*x, pp + ".coarseStiffness", 0, 1, false, "(0, 1]"));
                 if (!(o.coarseStiffness > 0.0f)) fail(pp + ".coarseStiffness", "is " + x->dump(), "(0, 1]");
             }
+            if (const json* x = get("coarseRelaxation"))
+                o.coarseRelaxation =
+                    static_cast<float>(ranged(*x, pp + ".coarseRelaxation", 1, 2, false, "1 to 2"));
             if (const json* x = get("dilationRings"))
                 u.options.dilationRings =
                     static_cast<int32_t>(ranged(*x, pp + ".dilationRings", 0, 64, true, "0 to 64"));

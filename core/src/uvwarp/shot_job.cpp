@@ -111,6 +111,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
               {"smoothing", tidy(o.solver.smoothing)},
               {"damping", tidy(o.solver.damping)},
               {"coarseStiffness", tidy(o.solver.coarseStiffness)},
+              {"coarseRelaxation", tidy(o.solver.coarseRelaxation)},
               {"dilationRings", o.dilationRings},
               {"warmStart", o.solver.warmStart}};
     if (derivedMask) j["derivedMaskBorderWidth"] = o.derivedMask.borderWidth;

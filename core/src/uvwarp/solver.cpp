@@ -313,7 +313,9 @@ struct Solver::Impl : detail::SolverState {
             snapshot(levels[l]);
         for (size_t l = levels.size(); l-- > 0;) {
             Level& level = levels[l];
-            const float stiffness = std::pow(options.coarseStiffness, static_cast<float>(l));
+            const float stiffness =
+                l == 0 ? 1.0f
+                       : std::pow(options.coarseStiffness, static_cast<float>(l)) * options.coarseRelaxation;
             const int32_t sweeps = sweepsAt(l);
             detail::KernelLevel points = inPlace(level);
             if (l > 0 && sweeps > 0) points = gather(level);
@@ -487,12 +489,14 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
         options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
         options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
-        options.coarseStiffness > 1.0f || options.levels < 0 || options.threads < 0 ||
+        options.coarseStiffness > 1.0f || !(options.coarseRelaxation >= 1.0f) ||
+        options.coarseRelaxation > 2.0f || options.levels < 0 || options.threads < 0 ||
         !(options.tolerance >= 0.0f) || options.tolerance > 1.0f) {
-        throw InvalidInput(
-            formatError(source, "solver options", "out of range",
-                        "iterations >= 0, levels >= 0, damping, smoothing, orientation preservation "
-                        "in [0, 1], coarse stiffness in (0, 1], tolerance in [0, 1] (cells), threads >= 0"));
+        throw InvalidInput(formatError(
+            source, "solver options", "out of range",
+            "iterations >= 0, levels >= 0, damping, smoothing, orientation preservation "
+            "in [0, 1], coarse stiffness in (0, 1], coarse relaxation in [1, 2], tolerance in [0, 1] "
+            "(cells), threads >= 0"));
     }
     for (int32_t s : options.sweepsPerLevel) {
         if (s < 0) throw InvalidInput(formatError(source, "sweepsPerLevel", std::to_string(s), ">= 0"));

@@ -188,7 +188,7 @@ class NodeCore {
 // dkUvRedirect's attributes: the maps as file patterns (<UDIM> for the tile; #### for the frame, 4 digits,
 // in an animated map: one file per frame), the tile, and the solver's options (TileWarpOptions: grid cells,
 // iterations, tolerance, sweeps per level, orientation preservation, smoothing, damping, coarse stiffness,
-// hierarchy levels, the density orientation heuristic's radius).
+// coarse relaxation, hierarchy levels, the density orientation heuristic's radius).
 struct RedirectInputs {
     int tile = 1001;
     std::string rigidity;     // required

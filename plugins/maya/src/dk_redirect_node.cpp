@@ -34,8 +34,9 @@ const MTypeId DkUvRedirect::id(0x0013A6C5);
 MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, DkUvRedirect::mask,
     DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::resolution, DkUvRedirect::iterations,
     DkUvRedirect::tolerance, DkUvRedirect::sweepsPerLevel, DkUvRedirect::orientationPreservation,
-    DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness, DkUvRedirect::levels,
-    DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time, DkUvRedirect::outFile;
+    DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness,
+    DkUvRedirect::coarseRelaxation, DkUvRedirect::levels, DkUvRedirect::densityRadius, DkUvRedirect::output,
+    DkUvRedirect::time, DkUvRedirect::outFile;
 
 MStatus DkUvRedirect::initialize() {
     MFnTypedAttribute typed;
@@ -67,6 +68,8 @@ MStatus DkUvRedirect::initialize() {
         {&damping, "damping", "dmp", MFnNumericData::kDouble, defaults.solver.damping},
         {&coarseStiffness, "coarseStiffness", "cst", MFnNumericData::kDouble,
          defaults.solver.coarseStiffness},
+        {&coarseRelaxation, "coarseRelaxation", "crx", MFnNumericData::kDouble,
+         defaults.solver.coarseRelaxation},
         {&levels, "levels", "lvl", MFnNumericData::kInt, defaults.solver.levels},
         {&densityRadius, "densityRadius", "dnr", MFnNumericData::kInt, defaults.densityOrientationRadius}};
     for (const auto& [attribute, name, shortName, type, value] : numbers) {
@@ -83,7 +86,7 @@ MStatus DkUvRedirect::initialize() {
     addAttribute(outFile);
     for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &tile, &resolution, &iterations,
                         &tolerance, &sweepsPerLevel, &orientationPreservation, &smoothing, &damping,
-                        &coarseStiffness, &levels, &densityRadius, &output, &time})
+                        &coarseStiffness, &coarseRelaxation, &levels, &densityRadius, &output, &time})
         attributeAffects(*in, outFile);
     return MS::kSuccess;
 }
@@ -108,6 +111,7 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
         solver.smoothing = static_cast<float>(block.inputValue(smoothing).asDouble());
         solver.damping = static_cast<float>(block.inputValue(damping).asDouble());
         solver.coarseStiffness = static_cast<float>(block.inputValue(coarseStiffness).asDouble());
+        solver.coarseRelaxation = static_cast<float>(block.inputValue(coarseRelaxation).asDouble());
         solver.levels = block.inputValue(levels).asInt();
         const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
         if (node_.needsBuild(in)) {

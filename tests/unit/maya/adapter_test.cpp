@@ -473,6 +473,9 @@ TEST_CASE(
     changed.options.solver.sweepsPerLevel = {1, 4, 8};
     CHECK(node.needsBuild(changed));
     CHECK_THROWS_WITH(node.solve(changed, 6, pose(6)), Catch::Contains("not built for these inputs"));
+    maya::RedirectInputs relaxed = still;
+    relaxed.options.solver.coarseRelaxation = 1.4f;
+    CHECK(node.needsBuild(relaxed));
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");

@@ -109,6 +109,7 @@ Case randomCase(std::mt19937& rng, int32_t cells) {
     c.options.coarseStiffness = range(0.5f, 1.0f);
     c.options.orientationPreservation = range(0.0f, 0.3f);
     c.options.smoothing = range(0.0f, 1.0f);
+    c.options.coarseRelaxation = range(1.0f, 2.0f);
     return c;
 }
 

@@ -34,6 +34,11 @@ struct SolverOptions {
     // coarseStiffness^l (§4.4: coarse segments map to curves, not lines, so coarse corrections are applied
     // more conservatively).
     float coarseStiffness = 0.9f;
+    // Over-relaxation of the levels above the finest, in [1, 2]: their corrections are further multiplied by
+    // it (successive over-relaxation of their Gauss-Seidel sweeps; the finest level is never scaled). 1, the
+    // default, is the paper's. The live presets use 1.4: a warm-started frame of one iteration then follows
+    // the motion with fewer coarse sweeps (docs/decisions.md UV-30).
+    float coarseRelaxation = 1.0f;
     // OpenMP threads of an iteration: 0 chooses per iteration between all the caller allows
     // (omp_get_max_threads()) and one, from measured times, so that next to other work (a host's threads,
     // another process on a core) all threads are never slower than one; n > 0 uses min(n, allowed). The
