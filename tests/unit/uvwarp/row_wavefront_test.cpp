@@ -99,6 +99,18 @@ TEST_CASE("row wavefront: serial sizes and one thread keep the serial order", "[
     // 32 rows run serially whatever the threads; and 128 rows on one thread.
     CHECK(runWavefront(0, 32, 3, 2, 7).outOfOrder == 0);
     CHECK(runWavefront(0, 128, 3, 1, 8).outOfOrder == 0);
+    // Called from inside another parallel region (nested parallelism off: the inner team has one thread,
+    // though omp_get_max_threads() may say more): the tasks run in order on that thread, nothing waits.
+    int64_t nestedOutOfOrder = 0, nestedRows = 0, outerThreads = 0;
+#pragma omp parallel num_threads(2) reduction(+ : nestedOutOfOrder, nestedRows, outerThreads)
+    {
+        ++outerThreads;
+        const Run run = runWavefront(0, 96, 2, 2, 11u + static_cast<uint32_t>(omp_get_thread_num()));
+        nestedOutOfOrder += run.outOfOrder;
+        nestedRows += run.rowsRun;
+    }
+    CHECK(nestedOutOfOrder == 0);
+    CHECK(nestedRows == 2 * 96 * outerThreads);
     // No passes, or no rows: nothing runs.
     CHECK(runWavefront(0, 64, 0, 2, 9).rowsRun == 0);
     CHECK(runWavefront(5, 5, 2, 2, 10).rowsRun == 0);
