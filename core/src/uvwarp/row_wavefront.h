@@ -8,12 +8,17 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <thread>
-#include <vector>
 
 #include "solver_state.h"
 
 namespace deformkit::uvwarp::detail {
+
+// The most row blocks a wavefront over at most `rows` rows has (blocks have at least 2 rows).
+[[nodiscard]] constexpr int32_t mostWavefrontBlocks(int32_t rows) {
+    return rows <= 0 ? 0 : (rows + 1) / 2;
+}
 
 // A task waiting for a neighbouring block spins a little (a block takes microseconds), then yields the core:
 // next to other work the thread it waits for may need it.
@@ -33,9 +38,12 @@ inline void waitAWhile(int32_t spins) {
 // and its two neighbours). In parallel the blocks are tasks handed out in that order, and a task waits only
 // for its two neighbours to have finished the phase before it (a phase: one parity of one pass), not for the
 // whole phase: one parallel region for all the passes, no barrier between them, and a pass may start while
-// the last blocks of the one before are still being swept (docs/decisions.md UV-29).
+// the last blocks of the one before are still being swept (docs/decisions.md UV-29). `done` holds a flag per
+// block, mostWavefrontBlocks(last - first) of them will do (the caller's, so that a solve allocates nothing;
+// with fewer the blocks run serially, the same bytes).
 template <class RowFn>
-void forRowBlocks(int32_t first, int32_t last, int32_t passes, const RowFn& rowFn) {
+void forRowBlocks(int32_t first, int32_t last, int32_t passes, std::span<std::atomic<int32_t>> done,
+                  const RowFn& rowFn) {
     const int32_t rows = last - first;
     if (rows <= 0 || passes <= 0) return;
     const int32_t blockRows = wavefrontBlockRows(rows);
@@ -45,7 +53,8 @@ void forRowBlocks(int32_t first, int32_t last, int32_t passes, const RowFn& rowF
         for (int32_t j = first + b * blockRows; j < end; ++j)
             rowFn(j);
     };
-    if (rows <= kParallelWavefrontRows || omp_get_max_threads() == 1 || blocks < 2) {
+    if (rows <= kParallelWavefrontRows || omp_get_max_threads() == 1 || blocks < 2 ||
+        done.size() < static_cast<size_t>(blocks)) {
         for (int32_t pass = 0; pass < passes; ++pass)
             for (int32_t parity = 0; parity < 2; ++parity)
                 for (int32_t b = parity; b < blocks; b += 2)
@@ -53,9 +62,8 @@ void forRowBlocks(int32_t first, int32_t last, int32_t passes, const RowFn& rowF
         return;
     }
     // done[b]: the last phase block b finished (-1: none). Block b's phases have its parity.
-    std::vector<std::atomic<int32_t>> done(static_cast<size_t>(blocks));
-    for (auto& d : done)
-        d.store(-1, std::memory_order_relaxed);
+    for (int32_t b = 0; b < blocks; ++b)
+        done[static_cast<size_t>(b)].store(-1, std::memory_order_relaxed);
     std::atomic<int64_t> nextTask{0};
     const int32_t evenBlocks = (blocks + 1) / 2;
     const int64_t tasks = static_cast<int64_t>(passes) * blocks;

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -138,6 +139,8 @@ detail::KernelLevel kernelLevel(const Level& level, float* u, float* v, int32_t 
 struct Solver::Impl : detail::SolverState {
     const detail::SolverKernels* kernels = &kernelsFor(simd::activeIsa());
     detail::TeamChooser team;  // SolverOptions::threads == 0
+    // The wavefront's per-block flags (forRowBlocks), enough for any level's rows.
+    std::vector<std::atomic<int32_t>> blockDone;
 
     [[nodiscard]] detail::KernelGrid kernelGrid() {
         return {cells, rest.values.data(), deformed, options.orientationPreservation, options.smoothing};
@@ -147,7 +150,7 @@ struct Solver::Impl : detail::SolverState {
     // fold check read 8-neighbours): forRowBlocks' blocks keep parallel rows apart.
     void sweepLevel(const detail::KernelLevel& l, float stiffness, int32_t count) {
         const detail::KernelGrid g = kernelGrid();
-        forRowBlocks(0, l.cells, count, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
+        forRowBlocks(0, l.cells, count, blockDone, [&](int32_t j) { kernels->sweepRow(g, l, j, stiffness); });
     }
 
     // The level's points where they are, in the warp.
@@ -186,7 +189,8 @@ struct Solver::Impl : detail::SolverState {
     void regulariseAll(const Level& level, bool onlyNew) {
         const detail::KernelGrid g = kernelGrid();
         const detail::KernelLevel l = inPlace(level);
-        forRowBlocks(1, level.cells, 1, [&](int32_t j) { kernels->regulariseRow(g, l, j, onlyNew); });
+        forRowBlocks(1, level.cells, 1, blockDone,
+                     [&](int32_t j) { kernels->regulariseRow(g, l, j, onlyNew); });
     }
 
     // §4.4: coarse-level displacements interpolated to the in-between points of the next finer level:
@@ -477,6 +481,8 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     m.source = source;
     m.options = options;
     m.cells = restGeometry.cells;
+    m.blockDone =
+        std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "a power of two, at least 2"));

@@ -489,3 +489,50 @@ TEST_CASE("maya adapter: sweepsPerLevel text", "[maya]") {
     CHECK_THROWS_WITH(maya::sweepsFromText("4 -1"), Catch::Contains("negative"));
     CHECK_THROWS_WITH(maya::sweepsFromText("  "), Catch::Contains("lists no sweeps"));
 }
+
+TEST_CASE("uv warp: a warm solve allocates nothing, on one thread or two", "[maya][uvwarp]") {
+    // What dkUvRedirect runs per frame, with this program's allocation counter: the UV-warp solver on a
+    // 128-cell plane stretched 1.4x along u, rigid disks on a lattice, the border fixed; the live preset's
+    // schedule, so that every level's sweeps and regularisations run (levels over 32 rows on the parallel
+    // wavefront with two threads).
+    const int32_t n = 128, side = n + 1;
+    const auto plane = [&](int32_t channels, const auto& value) {
+        uvwarp::PointField f;
+        f.cells = n;
+        f.channels = channels;
+        f.values.resize(static_cast<size_t>(side) * side * channels);
+        for (int32_t j = 0; j < side; ++j)
+            for (int32_t i = 0; i < side; ++i)
+                value(static_cast<float>(i) / n, static_cast<float>(j) / n, f.values.data() + f.index(i, j));
+        return f;
+    };
+    const uvwarp::PointField rest =
+        plane(3, [](float u, float v, float* p) { p[0] = u, p[1] = v, p[2] = 0; });
+    const uvwarp::PointField deformed =
+        plane(3, [](float u, float v, float* p) { p[0] = 1.4f * u, p[1] = v, p[2] = 0; });
+    const uvwarp::PointField rigidity = plane(1, [](float u, float v, float* p) {
+        const float du = u - (std::floor(u * 8.0f) + 0.5f) / 8.0f,
+                    dv = v - (std::floor(v * 8.0f) + 0.5f) / 8.0f;
+        p[0] = du * du + dv * dv < 0.04f * 0.04f ? 1.0f : 0.0f;
+    });
+    const uvwarp::PointField mask = plane(1, [](float u, float v, float* p) {
+        p[0] = u > 0.0f && v > 0.0f && u < 1.0f && v < 1.0f ? 1.0f : 0.0f;
+    });
+    for (const int32_t threads : {1, 2}) {
+        uvwarp::SolverOptions options;
+        options.iterations = 1;
+        options.sweepsPerLevel = {1, 2, 10};
+        options.coarseRelaxation = 1.4f;
+        options.threads = threads;
+        options.levels = 3;
+        uvwarp::Solver solver(rest, rigidity, mask, options);
+        solver.solve(deformed);  // the first frame may size its buffers
+        const int64_t before = allocations.load();
+        for (int frame = 0; frame < 3; ++frame)
+            solver.solve(deformed);
+        const int64_t allocated = allocations.load() - before;  // read before INFO, which allocates
+        INFO(threads << " threads");
+        CHECK(allocated == 0);
+        CHECK(solver.stats().remainingFolds == 0);
+    }
+}

@@ -22,6 +22,7 @@ namespace {
 
 using deformkit::uvwarp::detail::forRowBlocks;
 using deformkit::uvwarp::detail::kParallelWavefrontRows;
+using deformkit::uvwarp::detail::mostWavefrontBlocks;
 using deformkit::uvwarp::detail::wavefrontBlockRows;
 
 struct Run {
@@ -30,7 +31,9 @@ struct Run {
     std::vector<int32_t> passesOfRow;
 };
 
-Run runWavefront(int32_t first, int32_t last, int32_t passes, int32_t threads, uint32_t seed) {
+// flags: the wavefront's per-block flags, by default as many as it may need.
+Run runWavefront(int32_t first, int32_t last, int32_t passes, int32_t threads, uint32_t seed,
+                 int32_t flags = -1) {
     const int32_t rows = last - first;
     const int32_t blockRows = wavefrontBlockRows(rows);
     const int32_t blocks = (rows + blockRows - 1) / blockRows;
@@ -57,9 +60,11 @@ Run runWavefront(int32_t first, int32_t last, int32_t passes, int32_t threads, u
         visits[static_cast<size_t>(r)].store(pass + 1);
         ++rowsRun;
     };
+    std::vector<std::atomic<int32_t>> done(
+        static_cast<size_t>(flags < 0 ? mostWavefrontBlocks(rows) : flags));
     const int32_t before = omp_get_max_threads();
     omp_set_num_threads(threads);
-    forRowBlocks(first, last, passes, rowFn);
+    forRowBlocks(first, last, passes, done, rowFn);
     omp_set_num_threads(before);
     Run run;
     run.rowsRun = rowsRun.load();
@@ -111,6 +116,10 @@ TEST_CASE("row wavefront: serial sizes and one thread keep the serial order", "[
     }
     CHECK(nestedOutOfOrder == 0);
     CHECK(nestedRows == 2 * 96 * outerThreads);
+    // Too few flags for the blocks: the blocks run serially, in order.
+    const Run fewFlags = runWavefront(0, 128, 2, 2, 12, 10);
+    CHECK(fewFlags.outOfOrder == 0);
+    CHECK(fewFlags.rowsRun == 256);
     // No passes, or no rows: nothing runs.
     CHECK(runWavefront(0, 64, 0, 2, 9).rowsRun == 0);
     CHECK(runWavefront(5, 5, 2, 2, 10).rowsRun == 0);
