@@ -481,8 +481,6 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     m.source = source;
     m.options = options;
     m.cells = restGeometry.cells;
-    m.blockDone =
-        std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "a power of two, at least 2"));
@@ -492,6 +490,8 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
                                        "at most " + std::to_string(kMaxGridCells)));
     }
     detail::requireField(restGeometry, m.cells, 3, source, "rest geometry image");
+    m.blockDone =
+        std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
     if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
         options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
         options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
