@@ -5,10 +5,11 @@
 // starts the shot) is left out of the medians.
 //
 // BM_UvWarpFrame/T/schedule: schedule 0 = the default SolverOptions (4 iterations of sweeps {4, 8, 8}),
-// 1 = one iteration of sweeps {1, 2, 10} per frame, the live-preview schedule at 1024^2 (the paper's
-// per-frame figure is one iteration, UV-13), 2 = one iteration of {1, 1, 4, 10}, the live schedule at
-// 2048^2, both with the coarse levels over-relaxed by 1.4 (docs/decisions.md UV-28, UV-30: schedules
-// measured within 2 points of the converged default solve on every probed frame, on Spot and on Bob).
+// 1 = uvwarp::liveOptions(1024), the live preset at 1024^2: one iteration of sweeps {1, 2, 10} per frame
+// (the paper's per-frame figure is one iteration, UV-13), 2 = liveOptions(2048): one iteration of
+// {1, 1, 4, 10}; both with the coarse levels over-relaxed by 1.4 (docs/decisions.md UV-28, UV-30:
+// schedules measured within 2 points of the converged default solve on every probed frame, on Spot and on
+// Bob).
 // Counters:
 // frame_ms (median), target_ratio = frame_ms / the target on 2 cores (1024^2: 33 ms, 2048^2:
 // 141 ms), solve_ms and redirect_ms (medians; solve includes the geometry image), iterations per frame,
@@ -168,12 +169,7 @@ void BM_UvWarpFrame(benchmark::State& state) {
     const double targetMs = texels >= 2048 ? 141.0 : 33.0;
     const Inputs& in = inputs(texels);
     TileWarpOptions options;
-    if (schedule > 0) {
-        options.solver.iterations = 1;
-        options.solver.sweepsPerLevel =
-            schedule == 1 ? std::vector<int32_t>{1, 2, 10} : std::vector<int32_t>{1, 1, 4, 10};
-        options.solver.coarseRelaxation = 1.4f;
-    }
+    if (schedule > 0) options.solver = liveOptions(schedule == 1 ? 1024 : 2048);
     std::vector<double> frameMs, solveMs, redirectMs;
     double animated = 0.0;
     std::map<int, double> atProbes;  // the animation's reduction at the probe frames

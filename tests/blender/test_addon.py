@@ -756,13 +756,14 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     assert np.abs(shown - identity).max() > 1e-3  # the twist does warp the texture
     rate = addon.uvwarp.live_rate(obj)
     assert rate is not None and rate[0] > 0.0
-    # The preset by grid size (docs/decisions.md UV-28, UV-30): the measured schedules of 512, 1024 and 2048
-    # cells, the coarse levels over-relaxed by 1.4.
+    # The preset by grid size, the library's (docs/decisions.md UV-28, UV-30): the measured schedules of 64 to
+    # 2048 cells, the coarse levels over-relaxed by 1.4.
     presets = {cells: addon.uvwarp.live_options(cells)["sweeps_per_level"]
-               for cells in (128, 512, 1024, 2048, 4096)}
-    assert presets == {128: [2, 2, 10], 512: [2, 2, 10], 1024: [1, 2, 10], 2048: [1, 1, 4, 10],
-                       4096: [1, 1, 4, 10]}
-    assert all(addon.uvwarp.live_options(cells)["coarse_relaxation"] == 1.4 for cells in (128, 1024, 4096))
+               for cells in (64, 128, 256, 512, 1024, 2048, 4096)}
+    assert presets == {64: [8, 16, 32], 128: [8, 16, 32], 256: [3, 8, 12], 512: [2, 2, 10], 1024: [1, 2, 10],
+                       2048: [1, 1, 4, 10], 4096: [1, 1, 4, 10]}
+    assert all(abs(addon.uvwarp.live_options(cells)["coarse_relaxation"] - 1.4) < 1e-6  # a float32
+               for cells in (128, 1024, 4096))
     print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")
 
     # Off: frame changes leave the image alone.

@@ -233,6 +233,8 @@ def test_bad_input_names_what_is_wrong():
                                 ("border_width", 0, "border_width: is 0"), ("bogus", 1, "bogus: is not an option")):
         with pytest.raises(dk.InvalidInput, match=text):
             dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, **{option: value})
+    with pytest.raises(dk.InvalidInput, match="uv_warp_live_options: cells: is 0"):
+        dk.uv_warp_live_options(0)
     identity = texel_centres().astype(np.float32)
     with pytest.raises(dk.InvalidInput, match="filter: is 'nearest'"):
         dk.apply_redirect(rig, identity, filter="nearest")

@@ -565,6 +565,25 @@ void Solver::setMaps(const PointField& rigidity, const PointField& mask, const P
     m.fixedFolds = -1;  // other cells may change now: their folds are counted again
 }
 
+SolverOptions liveOptions(int32_t cells) {
+    SolverOptions options;
+    options.iterations = 1;
+    options.warmStart = true;
+    options.coarseRelaxation = 1.4f;
+    if (cells <= 128) {
+        options.sweepsPerLevel = {8, 16, 32};
+    } else if (cells <= 256) {
+        options.sweepsPerLevel = {3, 8, 12};
+    } else if (cells <= 512) {
+        options.sweepsPerLevel = {2, 2, 10};
+    } else if (cells <= 1024) {
+        options.sweepsPerLevel = {1, 2, 10};
+    } else {
+        options.sweepsPerLevel = {1, 1, 4, 10};
+    }
+    return options;
+}
+
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
     detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");

@@ -190,19 +190,12 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
 
 # ---- live mode: the warp solved on every frame change, shown through the material -----------------------
 
-# One warm iteration a frame, the coarse levels over-relaxed by LIVE_RELAXATION, its sweeps per level by the
-# grid's size: the cheapest schedules measured within 2 points of a converged solve on every probed frame of
-# a smooth animation, on two models (docs/uvwarp.md, "What a frame costs"; docs/decisions.md UV-28, UV-30).
-# (largest grid, sweeps), then the sweeps of finer grids.
-LIVE_RELAXATION = 1.4
-LIVE_SWEEPS = ((512, [2, 2, 10]), (1024, [1, 2, 10]))
-LIVE_SWEEPS_FINE = [1, 1, 4, 10]
-
-
 def live_options(cells):
-    """The live preset's solver options for a grid of `cells` cells per side."""
-    sweeps = next((s for largest, s in LIVE_SWEEPS if cells <= largest), LIVE_SWEEPS_FINE)
-    return {"iterations": 1, "sweeps_per_level": list(sweeps), "coarse_relaxation": LIVE_RELAXATION}
+    """The live preset's solver options for a grid of `cells` cells per side: the library's
+    (uvwarp::liveOptions): one warm iteration a frame, the coarse levels over-relaxed, sweeps per level by
+    the grid's size, measured within 2 points of a converged solve on every probed frame of a smooth
+    animation on two models (docs/uvwarp.md, "What a frame costs"; docs/decisions.md UV-28, UV-30)."""
+    return dict(dk.uv_warp_live_options(cells))
 
 
 LIVE_IMAGE = "DeformKit Live {}"

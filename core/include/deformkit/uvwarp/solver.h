@@ -51,6 +51,13 @@ struct SolverOptions {
     bool warmStart = true;
 };
 
+// The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the
+// coarse levels over-relaxed by 1.4, and sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
+// {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 2, 10} at 1024, {1, 1, 4, 10} from 2048): the cheapest schedules
+// measured within 2 points of a converged default solve on every probed frame of a smooth animation, on two
+// real models (docs/decisions.md UV-28, UV-30). The other options are the defaults.
+[[nodiscard]] SolverOptions liveOptions(int32_t cells);
+
 // Figures from the last solve.
 struct SolveStats {
     int32_t iterations = 0;  // iterations run by the last solve
