@@ -230,6 +230,9 @@ void addUvWarpCommand(CommandLine& cli) {
         "from the identity, so its maps depend on that frame alone (any range of frames gives the same "
         "bytes)");
     uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
+    uvwarp.option("--max-levels", solver.maxLevels, "at most this many automatic levels; 0: no cap")
+        .nonNegative()
+        .showDefault();
     uvwarp
         .option("--sweeps", solver.sweepsPerLevel, "constraint sweeps per iteration and level, finest first")
         .delimiter(',')

@@ -760,8 +760,9 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     # 2048 cells, the coarse levels over-relaxed by 1.4.
     presets = {cells: addon.uvwarp.live_options(cells)["sweeps_per_level"]
                for cells in (64, 128, 256, 512, 1024, 2048, 4096)}
-    assert presets == {64: [8, 16, 32], 128: [8, 16, 32], 256: [3, 8, 12], 512: [2, 2, 10], 1024: [1, 2, 10],
-                       2048: [1, 1, 4, 10], 4096: [1, 1, 4, 10]}
+    assert presets == {64: [8, 16, 32], 128: [8, 16, 32], 256: [3, 8, 12], 512: [2, 2, 10], 1024: [1, 1, 10],
+                       2048: [1, 1, 2, 8], 4096: [1, 1, 2, 8]}
+    assert [addon.uvwarp.live_options(cells)["max_levels"] for cells in (512, 1024, 2048)] == [0, 4, 5]
     assert all(abs(addon.uvwarp.live_options(cells)["coarse_relaxation"] - 1.4) < 1e-6  # a float32
                for cells in (128, 1024, 4096))
     print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")

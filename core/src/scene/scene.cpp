@@ -417,10 +417,11 @@ class Reader {
             const json& params = v.at("params");
             const std::string pp = path + ".params";
             requireObject(params, pp, "an object of UV-warp options by name");
-            onlyKeys(params, pp,
-                     {"iterations", "tolerance", "levels", "sweepsPerLevel", "orientationPreservation",
-                      "smoothing", "damping", "coarseStiffness", "coarseRelaxation", "dilationRings",
-                      "maskBorderWidth", "orientationDensity", "warmStart"});
+            onlyKeys(
+                params, pp,
+                {"iterations", "tolerance", "levels", "maxLevels", "sweepsPerLevel",
+                 "orientationPreservation", "smoothing", "damping", "coarseStiffness", "coarseRelaxation",
+                 "dilationRings", "maskBorderWidth", "orientationDensity", "warmStart"});
             uvwarp::SolverOptions& o = u.options.solver;
             auto get = [&](const char* name) -> const json* {
                 return params.contains(name) ? &params.at(name) : nullptr;
@@ -434,6 +435,9 @@ class Reader {
             if (const json* x = get("levels"))
                 o.levels =
                     static_cast<int32_t>(ranged(*x, pp + ".levels", 0, 16, true, "0 (automatic) to 16"));
+            if (const json* x = get("maxLevels"))
+                o.maxLevels =
+                    static_cast<int32_t>(ranged(*x, pp + ".maxLevels", 0, 16, true, "0 (no cap) to 16"));
             if (const json* x = get("sweepsPerLevel")) {
                 const std::string sp = pp + ".sweepsPerLevel";
                 if (!x->is_array() || x->empty())

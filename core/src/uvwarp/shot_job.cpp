@@ -103,6 +103,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
     json j = {{"cells", cells},
               {"texels", texels},
               {"levels", o.solver.levels},
+              {"maxLevels", o.solver.maxLevels},
               {"levelsUsed", levelsUsed},
               {"iterations", o.solver.iterations},
               {"tolerance", tidy(o.solver.tolerance)},

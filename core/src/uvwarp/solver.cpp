@@ -496,11 +496,11 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
         options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
         options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
         options.coarseStiffness > 1.0f || !(options.coarseRelaxation >= 1.0f) ||
-        options.coarseRelaxation > 2.0f || options.levels < 0 || options.threads < 0 ||
-        !(options.tolerance >= 0.0f) || options.tolerance > 1.0f) {
+        options.coarseRelaxation > 2.0f || options.levels < 0 || options.maxLevels < 0 ||
+        options.threads < 0 || !(options.tolerance >= 0.0f) || options.tolerance > 1.0f) {
         throw InvalidInput(formatError(
             source, "solver options", "out of range",
-            "iterations >= 0, levels >= 0, damping, smoothing, orientation preservation "
+            "iterations >= 0, levels >= 0, max levels >= 0, damping, smoothing, orientation preservation "
             "in [0, 1], coarse stiffness in (0, 1], coarse relaxation in [1, 2], tolerance in [0, 1] "
             "(cells), threads >= 0"));
     }
@@ -515,7 +515,8 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
         detail::requireField(mask, m.cells, 1, source, "mask");
         const int32_t widestStride = std::max(widestChartRadius(mask) / 3, 1);
         levelCount = 1;
-        while ((m.cells >> levelCount) >= 8 && (1 << levelCount) <= widestStride)
+        while ((m.cells >> levelCount) >= 8 && (1 << levelCount) <= widestStride &&
+               (options.maxLevels == 0 || levelCount < options.maxLevels))
             ++levelCount;
     }
     levelCount = std::min(levelCount, static_cast<int32_t>(std::log2(m.cells)));
@@ -577,10 +578,13 @@ SolverOptions liveOptions(int32_t cells) {
     } else if (cells <= 512) {
         options.sweepsPerLevel = {2, 2, 10};
     } else if (cells <= 1024) {
-        options.sweepsPerLevel = {1, 2, 10};
+        options.sweepsPerLevel = {1, 1, 10};
     } else {
-        options.sweepsPerLevel = {1, 1, 4, 10};
+        options.sweepsPerLevel = {1, 1, 2, 8};
     }
+    // From 1024 cells on, the coarsest level has 128 cells (or more, where the charts allow fewer levels).
+    for (int32_t coarsest = cells; cells >= 1024 && coarsest >= 128; coarsest /= 2)
+        ++options.maxLevels;
     return options;
 }
 

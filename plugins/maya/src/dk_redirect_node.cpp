@@ -35,8 +35,8 @@ MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, Dk
     DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::resolution, DkUvRedirect::iterations,
     DkUvRedirect::tolerance, DkUvRedirect::sweepsPerLevel, DkUvRedirect::orientationPreservation,
     DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness,
-    DkUvRedirect::coarseRelaxation, DkUvRedirect::levels, DkUvRedirect::densityRadius, DkUvRedirect::output,
-    DkUvRedirect::time, DkUvRedirect::outFile;
+    DkUvRedirect::coarseRelaxation, DkUvRedirect::levels, DkUvRedirect::maxLevels,
+    DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time, DkUvRedirect::outFile;
 
 MStatus DkUvRedirect::initialize() {
     MFnTypedAttribute typed;
@@ -71,6 +71,7 @@ MStatus DkUvRedirect::initialize() {
         {&coarseRelaxation, "coarseRelaxation", "crx", MFnNumericData::kDouble,
          defaults.solver.coarseRelaxation},
         {&levels, "levels", "lvl", MFnNumericData::kInt, defaults.solver.levels},
+        {&maxLevels, "maxLevels", "mxl", MFnNumericData::kInt, defaults.solver.maxLevels},
         {&densityRadius, "densityRadius", "dnr", MFnNumericData::kInt, defaults.densityOrientationRadius}};
     for (const auto& [attribute, name, shortName, type, value] : numbers) {
         MFnNumericAttribute fn;
@@ -84,9 +85,26 @@ MStatus DkUvRedirect::initialize() {
     typed.setWritable(false);
     typed.setStorable(false);
     addAttribute(outFile);
-    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &tile, &resolution, &iterations,
-                        &tolerance, &sweepsPerLevel, &orientationPreservation, &smoothing, &damping,
-                        &coarseStiffness, &coarseRelaxation, &levels, &densityRadius, &output, &time})
+    for (MObject* in : {&inMesh,
+                        &restMesh,
+                        &rigidity,
+                        &mask,
+                        &orientation,
+                        &tile,
+                        &resolution,
+                        &iterations,
+                        &tolerance,
+                        &sweepsPerLevel,
+                        &orientationPreservation,
+                        &smoothing,
+                        &damping,
+                        &coarseStiffness,
+                        &coarseRelaxation,
+                        &levels,
+                        &maxLevels,
+                        &densityRadius,
+                        &output,
+                        &time})
         attributeAffects(*in, outFile);
     return MS::kSuccess;
 }
@@ -113,6 +131,7 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
         solver.coarseStiffness = static_cast<float>(block.inputValue(coarseStiffness).asDouble());
         solver.coarseRelaxation = static_cast<float>(block.inputValue(coarseRelaxation).asDouble());
         solver.levels = block.inputValue(levels).asInt();
+        solver.maxLevels = block.inputValue(maxLevels).asInt();
         const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
         if (node_.needsBuild(in)) {
             node_.build(meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar()), in, frame,

@@ -476,6 +476,9 @@ TEST_CASE(
     maya::RedirectInputs relaxed = still;
     relaxed.options.solver.coarseRelaxation = 1.4f;
     CHECK(node.needsBuild(relaxed));
+    maya::RedirectInputs capped = still;
+    capped.options.solver.maxLevels = 3;
+    CHECK(node.needsBuild(capped));
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");

@@ -460,6 +460,31 @@ TEST_CASE("uv warp: coarse relaxation scales the coarse levels' corrections, not
     }
 }
 
+TEST_CASE("uv warp: maxLevels caps the automatic depth, not an explicit one", "[uvwarp][options]") {
+    // The plane's one chart fills the tile: the automatic depth goes down to an 8-cell grid, 4 levels at 64
+    // cells.
+    const Scene base = stretchedPlane(64, 1.5f);
+    const auto depth = [&](int32_t levels, int32_t maxLevels) {
+        uvwarp::SolverOptions options;
+        options.levels = levels;
+        options.maxLevels = maxLevels;
+        return uvwarp::Solver(base.rest, base.rigidity, base.mask, options).levels();
+    };
+    CHECK(depth(0, 0) == 4);
+    CHECK(depth(0, 2) == 2);
+    CHECK(depth(0, 9) == 4);
+    CHECK(depth(5, 2) == 5);
+    uvwarp::SolverOptions bad;
+    bad.maxLevels = -1;
+    CHECK_THROWS_WITH(uvwarp::Solver(base.rest, base.rigidity, base.mask, bad),
+                      Catch::Contains("max levels >= 0"));
+    // The live presets cap it from 1024 cells on, at a 128-cell coarsest grid.
+    CHECK(uvwarp::liveOptions(512).maxLevels == 0);
+    CHECK(uvwarp::liveOptions(1024).maxLevels == 4);
+    CHECK(uvwarp::liveOptions(2048).maxLevels == 5);
+    CHECK(uvwarp::liveOptions(4096).maxLevels == 6);
+}
+
 TEST_CASE("uv warp: orientation preservation turns rigid segments back to their directions",
           "[uvwarp][options]") {
     // Under a shear (u + 0.5 v, v) a rigid disk keeps its lengths under any turn; §4.2's orientation

@@ -10,9 +10,13 @@
 namespace deformkit::uvwarp {
 
 struct SolverOptions {
-    // Hierarchy depth (paper §4.4): number of levels including the finest. 0 picks the depth whose coarsest
-    // grid has 8 cells per side (or fewer levels for small grids).
+    // Hierarchy depth (paper §4.4): number of levels including the finest. 0 picks it from the warp mask:
+    // down to an 8-cell grid, but no level whose points are farther apart than a third of the widest chart's
+    // half-width (docs/decisions.md UV-18).
     int32_t levels = 0;
+    // With levels = 0, at most this many levels (0: no cap). The live presets of large grids cap the depth:
+    // a warm-started frame follows the motion better without the coarsest levels (UV-30).
+    int32_t maxLevels = 0;
     // PBD iterations per solve (paper §4.1): the number run when `tolerance` is 0, the most run otherwise.
     // With warm start, frames after the first start from the last warp.
     int32_t iterations = 4;
@@ -52,10 +56,11 @@ struct SolverOptions {
 };
 
 // The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the
-// coarse levels over-relaxed by 1.4, and sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
-// {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 2, 10} at 1024, {1, 1, 4, 10} from 2048): the cheapest schedules
-// measured within 2 points of a converged default solve on every probed frame of a smooth animation, on two
-// real models (docs/decisions.md UV-28, UV-30). The other options are the defaults.
+// coarse levels over-relaxed by 1.4, sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
+// {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 1, 10} at 1024, {1, 1, 2, 8} from 2048) and, from 1024 cells, no
+// level coarser than 128 cells (maxLevels): the cheapest settings measured within 2 points of a converged
+// default solve on every probed frame of a smooth animation, on two real models (docs/decisions.md UV-28,
+// UV-30). The other options are the defaults.
 [[nodiscard]] SolverOptions liveOptions(int32_t cells);
 
 // Figures from the last solve.
