@@ -230,6 +230,11 @@ void addUvWarpCommand(CommandLine& cli) {
         "from the identity, so its maps depend on that frame alone (any range of frames gives the same "
         "bytes)");
     uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
+    uvwarp
+        .option("--cold-iterations", solver.coldIterations,
+                "iterations of a solve from the identity; 0: --iterations")
+        .nonNegative()
+        .showDefault();
     uvwarp.option("--max-levels", solver.maxLevels, "at most this many automatic levels; 0: no cap")
         .nonNegative()
         .showDefault();

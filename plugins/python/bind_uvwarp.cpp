@@ -42,7 +42,7 @@ using uvwarp::TileWarpOptions;
 
 constexpr const char* kOptionNames =
     "iterations, tolerance, levels, sweeps_per_level, orientation_preservation, smoothing, damping, "
-    "coarse_stiffness, coarse_relaxation, max_levels, "
+    "coarse_stiffness, coarse_relaxation, max_levels, cold_iterations, "
     "border_width, dilation_rings, orientation_density, warm_start";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
@@ -111,6 +111,8 @@ TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kw
             o.solver.iterations = intOption(value, source, k, 0, "an integer >= 0");
         } else if (k == "levels") {
             o.solver.levels = intOption(value, source, k, 0, "an integer >= 0 (0: automatic)");
+        } else if (k == "cold_iterations") {
+            o.solver.coldIterations = intOption(value, source, k, 0, "an integer >= 0 (0: iterations)");
         } else if (k == "max_levels") {
             o.solver.maxLevels = intOption(value, source, k, 0, "an integer >= 0 (0: no cap)");
         } else if (k == "sweeps_per_level") {
@@ -547,7 +549,8 @@ constexpr const char* kSolverDoc =
     "no point moves farther), levels (0: automatic), sweeps_per_level ([4, 8, 8], finest first),\n"
     "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
     "coarse_relaxation (1: over-relaxation of the coarse levels, in [1, 2]; the live presets use 1.4),\n"
-    "max_levels (0: no cap on the automatic depth),\n"
+    "max_levels (0: no cap on the automatic depth), cold_iterations (0: iterations; of a solve from the\n"
+    "identity),\n"
     "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
     "off;\n"
     "a radius in texels: without an orientation map, orientation preservation follows the rigidity's local\n"
@@ -679,6 +682,7 @@ void bindUvWarp(py::module_& m) {
             options["coarse_relaxation"] = o.coarseRelaxation;
             options["warm_start"] = o.warmStart;
             options["max_levels"] = o.maxLevels;
+            options["cold_iterations"] = o.coldIterations;
             return options;
         },
         py::arg("cells"),

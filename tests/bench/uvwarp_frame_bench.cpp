@@ -18,9 +18,10 @@
 // over frames 4, 7, 13 and 24 (each against that frame's converged solve: a warm start lags most early in
 // the shot, while the motion builds up, and catches up by the last frame), folds on the last frame.
 // BM_UvWarpColdFrame/T/k/r: the first frame of a shot, cold (binding, k default iterations, redirect map) on
-// the last frame, with its gap to the converged solve; r = 1: the coarse levels over-relaxed by 1.4 (UV-30).
-// BM_UvWarpFrameConverged/T, the in-run reference: the last frame solved cold, from the identity, for
-// kColdRounds default solves (a settled warp), plus its redirect map; items/s of the two give the ratio
+// the last frame, with its gap to the converged solve; r = 1: the coarse levels over-relaxed by 1.4 (UV-30);
+// r = 2: the live preset's first frame (uvwarp::liveOptions: its cold iterations of its own sweeps; k
+// unused). BM_UvWarpFrameConverged/T, the in-run reference: the last frame solved cold, from the identity,
+// for kColdRounds default solves (a settled warp), plus its redirect map; items/s of the two give the ratio
 // bench_table.py prints (frames per second animated / converged cold).
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -225,7 +226,8 @@ void BM_UvWarpColdFrame(benchmark::State& state) {
     const Inputs& in = inputs(texels);
     TileWarpOptions options;
     options.solver.iterations = static_cast<int32_t>(state.range(1));
-    if (state.range(2) != 0) options.solver.coarseRelaxation = 1.4f;
+    if (state.range(2) == 1) options.solver.coarseRelaxation = 1.4f;
+    if (state.range(2) == 2) options.solver = liveOptions(texels);  // its coldIterations, not k
     io::Image redirect;
     double figure = 0.0;
     std::vector<double> frameMs;
@@ -268,6 +270,7 @@ BENCHMARK(BM_UvWarpColdFrame)
     ->Args({2048, 2, 0})
     ->Args({2048, 4, 0})
     ->Args({2048, 2, 1})
+    ->Args({2048, 0, 2})
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

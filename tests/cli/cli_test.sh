@@ -304,10 +304,11 @@ cmp -s "$work/uv/warm/redirect.1001.0002.exr" "$work/uv/coldalone/redirect.1001.
 expect uvwarp-warm-info 0 "$dk" info "$work/uv/warm/redirect.1001.0002.exr"
 contains uvwarp-warm-info "$work/out" '"warmStart":true'
 # The live presets' over-relaxation of the coarse levels: recorded in the header, and in range [1, 2].
-expect uvwarp-relaxed 0 uvwarp --frames 1-1 --warm-start --iterations 1 --sweeps 1,2,10 --coarse-relaxation 1.4 --max-levels 3 --out "$work/uv/relaxed/redirect.<UDIM>.####.exr"
+expect uvwarp-relaxed 0 uvwarp --frames 1-1 --warm-start --iterations 1 --sweeps 1,2,10 --coarse-relaxation 1.4 --max-levels 3 --cold-iterations 2 --out "$work/uv/relaxed/redirect.<UDIM>.####.exr"
 expect uvwarp-relaxed-info 0 "$dk" info "$work/uv/relaxed/redirect.1001.0001.exr"
 contains uvwarp-relaxed-info "$work/out" '"coarseRelaxation":1.4'
 contains uvwarp-relaxed-info "$work/out" '"maxLevels":3'
+contains uvwarp-relaxed-info "$work/out" '"coldIterations":2'
 expect uvwarp-relaxation-range 2 uvwarp --frames 1-1 --coarse-relaxation 2.5 --out "$work/uv/out/x.<UDIM>.####.exr"
 contains uvwarp-relaxation-range "$work/err" "coarse-relaxation"
 expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"

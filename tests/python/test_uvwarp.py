@@ -225,6 +225,7 @@ def test_bad_input_names_what_is_wrong():
                                 ("coarse_stiffness", 0.0, "coarse_stiffness: is 0.0"),
                                 ("coarse_relaxation", 2.5, "coarse_relaxation: is 2.5"),
                                 ("max_levels", -1, "max_levels: is -1"),
+                                ("cold_iterations", -2, "cold_iterations: is -2"),
                                 ("coarse_relaxation", 0.9,
                                  r"coarse_relaxation: is 0.9 \(expected a number in \[1, 2\]"),
                                 ("tolerance", 2.0, "tolerance: is 2.0"),

@@ -419,7 +419,7 @@ class Reader {
             requireObject(params, pp, "an object of UV-warp options by name");
             onlyKeys(
                 params, pp,
-                {"iterations", "tolerance", "levels", "maxLevels", "sweepsPerLevel",
+                {"iterations", "coldIterations", "tolerance", "levels", "maxLevels", "sweepsPerLevel",
                  "orientationPreservation", "smoothing", "damping", "coarseStiffness", "coarseRelaxation",
                  "dilationRings", "maskBorderWidth", "orientationDensity", "warmStart"});
             uvwarp::SolverOptions& o = u.options.solver;
@@ -435,6 +435,9 @@ class Reader {
             if (const json* x = get("levels"))
                 o.levels =
                     static_cast<int32_t>(ranged(*x, pp + ".levels", 0, 16, true, "0 (automatic) to 16"));
+            if (const json* x = get("coldIterations"))
+                o.coldIterations = static_cast<int32_t>(
+                    ranged(*x, pp + ".coldIterations", 0, 100000, true, "0 (iterations) to 100000"));
             if (const json* x = get("maxLevels"))
                 o.maxLevels =
                     static_cast<int32_t>(ranged(*x, pp + ".maxLevels", 0, 16, true, "0 (no cap) to 16"));

@@ -104,6 +104,7 @@ json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t
               {"texels", texels},
               {"levels", o.solver.levels},
               {"maxLevels", o.solver.maxLevels},
+              {"coldIterations", o.solver.coldIterations},
               {"levelsUsed", levelsUsed},
               {"iterations", o.solver.iterations},
               {"tolerance", tidy(o.solver.tolerance)},

@@ -139,6 +139,7 @@ detail::KernelLevel kernelLevel(const Level& level, float* u, float* v, int32_t 
 struct Solver::Impl : detail::SolverState {
     const detail::SolverKernels* kernels = &kernelsFor(simd::activeIsa());
     detail::TeamChooser team;  // SolverOptions::threads == 0
+    bool fromIdentity = true;  // the next solve starts from the identity (SolverOptions::coldIterations)
     // The wavefront's per-block flags (forRowBlocks), enough for any level's rows.
     std::vector<std::atomic<int32_t>> blockDone;
 
@@ -492,15 +493,17 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     detail::requireField(restGeometry, m.cells, 3, source, "rest geometry image");
     m.blockDone =
         std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
-    if (options.iterations < 0 || options.damping < 0.0f || options.damping > 1.0f ||
-        options.smoothing < 0.0f || options.smoothing > 1.0f || options.orientationPreservation < 0.0f ||
-        options.orientationPreservation > 1.0f || !(options.coarseStiffness > 0.0f) ||
-        options.coarseStiffness > 1.0f || !(options.coarseRelaxation >= 1.0f) ||
-        options.coarseRelaxation > 2.0f || options.levels < 0 || options.maxLevels < 0 ||
-        options.threads < 0 || !(options.tolerance >= 0.0f) || options.tolerance > 1.0f) {
+    if (options.iterations < 0 || options.coldIterations < 0 || options.damping < 0.0f ||
+        options.damping > 1.0f || options.smoothing < 0.0f || options.smoothing > 1.0f ||
+        options.orientationPreservation < 0.0f || options.orientationPreservation > 1.0f ||
+        !(options.coarseStiffness > 0.0f) || options.coarseStiffness > 1.0f ||
+        !(options.coarseRelaxation >= 1.0f) || options.coarseRelaxation > 2.0f || options.levels < 0 ||
+        options.maxLevels < 0 || options.threads < 0 || !(options.tolerance >= 0.0f) ||
+        options.tolerance > 1.0f) {
         throw InvalidInput(formatError(
             source, "solver options", "out of range",
-            "iterations >= 0, levels >= 0, max levels >= 0, damping, smoothing, orientation preservation "
+            "iterations >= 0, cold iterations >= 0, levels >= 0, max levels >= 0, damping, smoothing, "
+            "orientation preservation "
             "in [0, 1], coarse stiffness in (0, 1], coarse relaxation in [1, 2], tolerance in [0, 1] "
             "(cells), threads >= 0"));
     }
@@ -569,6 +572,7 @@ void Solver::setMaps(const PointField& rigidity, const PointField& mask, const P
 SolverOptions liveOptions(int32_t cells) {
     SolverOptions options;
     options.iterations = 1;
+    options.coldIterations = cells > 256 && cells <= 512 ? 3 : 2;
     options.warmStart = true;
     options.coarseRelaxation = 1.4f;
     if (cells <= 128) {
@@ -600,7 +604,9 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     m.stats.converged = false;
     const auto cells = static_cast<float>(m.cells);
     const int32_t allowed = omp_get_max_threads();
-    while (m.stats.iterations < m.options.iterations && !m.stats.converged) {
+    const int32_t planned =
+        m.fromIdentity && m.options.coldIterations > 0 ? m.options.coldIterations : m.options.iterations;
+    while (m.stats.iterations < planned && !m.stats.converged) {
         const int32_t team =
             m.options.threads > 0 ? std::min(m.options.threads, allowed) : m.team.next(allowed);
         omp_set_num_threads(team);
@@ -614,6 +620,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
         m.stats.converged = m.options.tolerance > 0.0f && m.stats.lastMove <= m.options.tolerance;
     }
     omp_set_num_threads(allowed);
+    if (m.stats.iterations > 0) m.fromIdentity = false;
     // After an iteration the fold revert has counted them; otherwise the grid is scanned.
     m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);
     m.deformed = nullptr;
@@ -623,6 +630,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
 void Solver::reset() {
     Impl& m = *impl_;
     m.grid.setIdentity(m.cells);
+    m.fromIdentity = true;
     m.fixedFolds = 0;  // the identity has none
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);

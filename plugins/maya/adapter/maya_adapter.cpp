@@ -342,7 +342,8 @@ bool sameOptions(const uvwarp::TileWarpOptions& a, const uvwarp::TileWarpOptions
            s.iterations == t.iterations && s.tolerance == t.tolerance &&
            s.sweepsPerLevel == t.sweepsPerLevel && s.orientationPreservation == t.orientationPreservation &&
            s.smoothing == t.smoothing && s.damping == t.damping && s.coarseStiffness == t.coarseStiffness &&
-           s.coarseRelaxation == t.coarseRelaxation && s.maxLevels == t.maxLevels && s.threads == t.threads;
+           s.coarseRelaxation == t.coarseRelaxation && s.maxLevels == t.maxLevels &&
+           s.coldIterations == t.coldIterations && s.threads == t.threads;
 }
 
 }  // namespace

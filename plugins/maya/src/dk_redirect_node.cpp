@@ -36,7 +36,8 @@ MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, Dk
     DkUvRedirect::tolerance, DkUvRedirect::sweepsPerLevel, DkUvRedirect::orientationPreservation,
     DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness,
     DkUvRedirect::coarseRelaxation, DkUvRedirect::levels, DkUvRedirect::maxLevels,
-    DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time, DkUvRedirect::outFile;
+    DkUvRedirect::coldIterations, DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time,
+    DkUvRedirect::outFile;
 
 MStatus DkUvRedirect::initialize() {
     MFnTypedAttribute typed;
@@ -72,6 +73,7 @@ MStatus DkUvRedirect::initialize() {
          defaults.solver.coarseRelaxation},
         {&levels, "levels", "lvl", MFnNumericData::kInt, defaults.solver.levels},
         {&maxLevels, "maxLevels", "mxl", MFnNumericData::kInt, defaults.solver.maxLevels},
+        {&coldIterations, "coldIterations", "cit", MFnNumericData::kInt, defaults.solver.coldIterations},
         {&densityRadius, "densityRadius", "dnr", MFnNumericData::kInt, defaults.densityOrientationRadius}};
     for (const auto& [attribute, name, shortName, type, value] : numbers) {
         MFnNumericAttribute fn;
@@ -102,6 +104,7 @@ MStatus DkUvRedirect::initialize() {
                         &coarseRelaxation,
                         &levels,
                         &maxLevels,
+                        &coldIterations,
                         &densityRadius,
                         &output,
                         &time})
@@ -132,6 +135,7 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
         solver.coarseRelaxation = static_cast<float>(block.inputValue(coarseRelaxation).asDouble());
         solver.levels = block.inputValue(levels).asInt();
         solver.maxLevels = block.inputValue(maxLevels).asInt();
+        solver.coldIterations = block.inputValue(coldIterations).asInt();
         const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
         if (node_.needsBuild(in)) {
             node_.build(meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar()), in, frame,

@@ -26,7 +26,7 @@ class DkUvRedirect : public MPxNode {
     static const MTypeId id;
     static MObject inMesh, restMesh, rigidity, mask, orientation, tile, resolution, iterations, tolerance,
         sweepsPerLevel, orientationPreservation, smoothing, damping, coarseStiffness, coarseRelaxation,
-        levels, maxLevels, densityRadius, output, time, outFile;
+        levels, maxLevels, coldIterations, densityRadius, output, time, outFile;
 
   private:
     RedirectNode node_;

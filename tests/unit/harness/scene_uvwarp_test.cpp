@@ -136,12 +136,13 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     test::writeText(shot.scene, withTolerance);
     CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.tolerance == 0.25f);
     std::string relaxed = kScene;
-    relaxed.replace(
-        relaxed.find(params), params.size(),
-        R"("params": {"iterations": 6, "warmStart": true, "coarseRelaxation": 1.4, "maxLevels": 4})");
+    relaxed.replace(relaxed.find(params), params.size(),
+                    R"("params": {"iterations": 6, "warmStart": true, "coarseRelaxation": 1.4, "maxLevels": 4,
+                       "coldIterations": 2})");
     test::writeText(shot.scene, relaxed);
     CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.coarseRelaxation == 1.4f);
     CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.maxLevels == 4);
+    CHECK(scene::readScene(shot.scene).objects[0].uvwarp->options.solver.coldIterations == 2);
     CHECK(object.uvwarp->options.solver.coarseRelaxation == 1.0f);  // the paper's, by default
     test::writeText(shot.scene, kScene);
     CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
@@ -190,6 +191,9 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
          ": objects[0].stack[0].params.coarseRelaxation: is 0.5 (expected 1 to 2)"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"maxLevels": -2}}])",
          ": objects[0].stack[0].params.maxLevels: is -2 (expected 0 (no cap) to 16)"},
+        {"tubes.obj",
+         R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"coldIterations": -1}}])",
+         ": objects[0].stack[0].params.coldIterations: is -1 (expected 0 (iterations) to 100000)"},
         {"tubes.obj",
          R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"sweepsPerLevel": [1, 0]}}])",
          ": objects[0].stack[0].params.sweepsPerLevel[1]: is 0"},

@@ -479,6 +479,9 @@ TEST_CASE(
     maya::RedirectInputs capped = still;
     capped.options.solver.maxLevels = 3;
     CHECK(node.needsBuild(capped));
+    maya::RedirectInputs longerFirst = still;
+    longerFirst.options.solver.coldIterations = 2;
+    CHECK(node.needsBuild(longerFirst));
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");

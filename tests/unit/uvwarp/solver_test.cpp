@@ -460,6 +460,44 @@ TEST_CASE("uv warp: coarse relaxation scales the coarse levels' corrections, not
     }
 }
 
+TEST_CASE("uv warp: coldIterations runs a solve from the identity longer", "[uvwarp][options]") {
+    const Scene base = stretchedPlane(64, 1.5f);
+    uvwarp::SolverOptions options;
+    options.iterations = 1;
+    options.coldIterations = 3;
+    uvwarp::Solver warm(base.rest, base.rigidity, base.mask, options);
+    const auto iterationsRun = [&] {
+        warm.solve(base.deformed);
+        return warm.stats().iterations;
+    };
+    std::vector<int32_t> ran;
+    for (int f = 0; f < 3; ++f)
+        ran.push_back(iterationsRun());
+    warm.reset();  // a cut: the next solve starts from the identity again
+    ran.push_back(iterationsRun());
+    CHECK(ran == std::vector<int32_t>{3, 1, 1, 3});
+    // Without warm start every solve starts from the identity.
+    options.warmStart = false;
+    uvwarp::Solver cold(base.rest, base.rigidity, base.mask, options);
+    for (int f = 0; f < 2; ++f) {
+        cold.solve(base.deformed);
+        CHECK(cold.stats().iterations == 3);
+    }
+    // 0 (the default): `iterations` throughout; the same bytes as 3 iterations asked for directly.
+    uvwarp::SolverOptions three;
+    three.iterations = 3;
+    uvwarp::Solver direct(base.rest, base.rigidity, base.mask, three);
+    direct.solve(base.deformed);
+    CHECK(direct.warp().u == cold.warp().u);
+    CHECK(direct.warp().v == cold.warp().v);
+    uvwarp::SolverOptions bad;
+    bad.coldIterations = -1;
+    CHECK_THROWS_WITH(uvwarp::Solver(base.rest, base.rigidity, base.mask, bad),
+                      Catch::Contains("cold iterations >= 0"));
+    CHECK(uvwarp::liveOptions(512).coldIterations == 3);
+    CHECK(uvwarp::liveOptions(1024).coldIterations == 2);
+}
+
 TEST_CASE("uv warp: maxLevels caps the automatic depth, not an explicit one", "[uvwarp][options]") {
     // The plane's one chart fills the tile: the automatic depth goes down to an 8-cell grid, 4 levels at 64
     // cells.

@@ -20,6 +20,11 @@ struct SolverOptions {
     // PBD iterations per solve (paper §4.1): the number run when `tolerance` is 0, the most run otherwise.
     // With warm start, frames after the first start from the last warp.
     int32_t iterations = 4;
+    // Iterations of a solve that starts from the identity (a solver's first, the first after reset(), every
+    // solve without warm start) when > 0; 0: `iterations`. The live presets use 2 or 3, so that a preview's
+    // first frame, and the first after a cut, is within 2 points of converged as well (docs/decisions.md
+    // UV-30).
+    int32_t coldIterations = 0;
     // Convergence stop, in grid cells: > 0 ends a solve after the first iteration in which no point moved
     // farther than this (SolveStats::converged); 0 runs `iterations` iterations whatever they change. A
     // warm-started frame of a smooth animation then pays for the iterations its change needs.
@@ -59,8 +64,9 @@ struct SolverOptions {
 // coarse levels over-relaxed by 1.4, sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
 // {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 1, 10} at 1024, {1, 1, 2, 8} from 2048) and, from 1024 cells, no
 // level coarser than 128 cells (maxLevels): the cheapest settings measured within 2 points of a converged
-// default solve on every probed frame of a smooth animation, on two real models (docs/decisions.md UV-28,
-// UV-30). The other options are the defaults.
+// default solve on every probed frame of a smooth animation, on two real models; a solve from the identity
+// (the first frame, or after a cut) runs 2 iterations (3 at 512 cells) to be within 2 points as well
+// (docs/decisions.md UV-28, UV-30). The other options are the defaults.
 [[nodiscard]] SolverOptions liveOptions(int32_t cells);
 
 // Figures from the last solve.
