@@ -5,11 +5,11 @@
 // starts the shot) is left out of the medians.
 //
 // BM_UvWarpFrame/T/schedule: schedule 0 = the default SolverOptions (4 iterations of sweeps {4, 8, 8}),
-// 1 = uvwarp::liveOptions(1024), the live preset at 1024^2: one iteration of sweeps {1, 2, 10} per frame
-// (the paper's per-frame figure is one iteration, UV-13), 2 = liveOptions(2048): one iteration of
-// {1, 1, 4, 10}; both with the coarse levels over-relaxed by 1.4 (docs/decisions.md UV-28, UV-30:
-// schedules measured within 2 points of the converged default solve on every probed frame, on Spot and on
-// Bob).
+// 1 = uvwarp::liveOptions(1024), the live preset at 1024^2: one iteration of sweeps {1, 1, 10} per frame on
+// at most 4 levels (the paper's per-frame figure is one iteration, UV-13), 2 = liveOptions(2048): one
+// iteration of {1, 1, 2, 8} on at most 5 levels; both with the coarse levels over-relaxed by 1.4 and the
+// first frame solved with 2 iterations (docs/decisions.md UV-28, UV-30: presets measured within 2 points of
+// the converged default solve on every probed frame, on Spot and on Bob).
 // Counters:
 // frame_ms (median), target_ratio = frame_ms / the target on 2 cores (1024^2: 33 ms, 2048^2:
 // 141 ms), solve_ms and redirect_ms (medians; solve includes the geometry image), iterations per frame,
