@@ -334,16 +334,11 @@ void RedirectCore::setMaps(const io::Image& rigidity, const io::Image& mask, con
 
 namespace {
 
+// The derived mask's label only names the mesh in errors.
 bool sameOptions(const uvwarp::TileWarpOptions& a, const uvwarp::TileWarpOptions& b) {
-    const uvwarp::SolverOptions &s = a.solver, &t = b.solver;
     return a.cells == b.cells && a.dilationRings == b.dilationRings &&
            a.densityOrientationRadius == b.densityOrientationRadius &&
-           a.derivedMask.borderWidth == b.derivedMask.borderWidth && s.levels == t.levels &&
-           s.iterations == t.iterations && s.tolerance == t.tolerance &&
-           s.sweepsPerLevel == t.sweepsPerLevel && s.orientationPreservation == t.orientationPreservation &&
-           s.smoothing == t.smoothing && s.damping == t.damping && s.coarseStiffness == t.coarseStiffness &&
-           s.coarseRelaxation == t.coarseRelaxation && s.maxLevels == t.maxLevels &&
-           s.coldIterations == t.coldIterations && s.threads == t.threads;
+           a.derivedMask.borderWidth == b.derivedMask.borderWidth && a.solver == b.solver;
 }
 
 }  // namespace

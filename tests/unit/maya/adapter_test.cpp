@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <new>
 
 #include <glm/geometric.hpp>
@@ -473,15 +474,14 @@ TEST_CASE(
     changed.options.solver.sweepsPerLevel = {1, 4, 8};
     CHECK(node.needsBuild(changed));
     CHECK_THROWS_WITH(node.solve(changed, 6, pose(6)), Catch::Contains("not built for these inputs"));
-    maya::RedirectInputs relaxed = still;
-    relaxed.options.solver.coarseRelaxation = 1.4f;
-    CHECK(node.needsBuild(relaxed));
-    maya::RedirectInputs capped = still;
-    capped.options.solver.maxLevels = 3;
-    CHECK(node.needsBuild(capped));
-    maya::RedirectInputs longerFirst = still;
-    longerFirst.options.solver.coldIterations = 2;
-    CHECK(node.needsBuild(longerFirst));
+    const std::function<void(uvwarp::SolverOptions&)> changes[] = {[](auto& o) { o.coarseRelaxation = 1.4f; },
+                                                                   [](auto& o) { o.maxLevels = 3; },
+                                                                   [](auto& o) { o.coldIterations = 2; }};
+    for (const auto& change : changes) {
+        maya::RedirectInputs other = still;
+        change(other.options.solver);
+        CHECK(node.needsBuild(other));
+    }
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");

@@ -58,6 +58,9 @@ struct SolverOptions {
     // solved before it (a farm chunk's maps are then an uninterrupted run's, byte for byte, with no warm-up
     // frames; docs/decisions.md UV-20). The default schedule reaches the same quality either way.
     bool warmStart = true;
+
+    // Every option equal: a solver built with one set behaves as one built with the other.
+    bool operator==(const SolverOptions&) const = default;
 };
 
 // The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the
