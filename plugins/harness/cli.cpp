@@ -59,6 +59,11 @@ Option& Option::needs(const Option& other) {
     return *this;
 }
 
+Option& Option::typeName(const std::string& name) {
+    option_->type_name(name);
+    return *this;
+}
+
 Option Command::option(const std::string& name, std::string& target, const std::string& help) {
     return Option(app_->add_option(name, target, help));
 }
@@ -81,6 +86,24 @@ Option Command::option(const std::string& name, float& target, const std::string
 
 Option Command::option(const std::string& name, std::vector<int32_t>& target, const std::string& help) {
     return Option(app_->add_option(name, target, help));
+}
+
+Option Command::option(const std::string& name, std::vector<double>& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
+void Command::listing(const std::string& name, const std::string& fallback, const std::string& help,
+                      std::function<void(const std::string& value)> print) {
+    app_->add_option_function<std::string>(
+            name,
+            [print = std::move(print)](const std::string& value) {
+                print(value);
+                throw CLI::Success();
+            },
+            help)
+        ->expected(0, 1)
+        ->trigger_on_parse()
+        ->default_str(fallback);
 }
 
 Option Command::flag(const std::string& name, bool& target, const std::string& help) {
@@ -121,6 +144,9 @@ int CommandLine::run(int argc, char** argv) {
         // Help and version print and exit 0; a usage error is one line on stderr and exit code 2.
         if (e.get_exit_code() == 0) return app_->exit(e);
         std::cerr << "deformkit: usage error: " << e.what() << " (see deformkit --help)\n";
+        return 2;
+    } catch (const Error& e) {  // from an option that acts as it is parsed (listing)
+        std::cerr << "deformkit: error: " << e.what() << "\n";
         return 2;
     }
     try {

@@ -30,6 +30,7 @@ class Option {
     Option& positive();
     Option& delimiter(char separator);  // a list option takes "a,b,c" too
     Option& needs(const Option& other);
+    Option& typeName(const std::string& name);  // what --help shows for the value: INT, FLOAT, FILE...
 
   private:
     CLI::Option* option_;
@@ -46,7 +47,13 @@ class Command {
     Option option(const std::string& name, double& target, const std::string& help);
     Option option(const std::string& name, float& target, const std::string& help);
     Option option(const std::string& name, std::vector<int32_t>& target, const std::string& help);
+    Option option(const std::string& name, std::vector<double>& target, const std::string& help);
     Option flag(const std::string& name, bool& target, const std::string& help);
+    // An option that, as soon as it is parsed, calls `print` with its value (`fallback` when none is given)
+    // and ends the program with exit code 0, as --help does: the command's other options, required ones
+    // included, are not needed then.
+    void listing(const std::string& name, const std::string& fallback, const std::string& help,
+                 std::function<void(const std::string& value)> print);
 
   private:
     friend class CommandLine;

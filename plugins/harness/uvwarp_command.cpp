@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <deque>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -20,6 +21,7 @@
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/options.h"
 #include "deformkit/version.h"
 
 namespace deformkit::harness {
@@ -108,10 +110,6 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     // Everything that can be checked without solving is checked before the first output is written.
     if (command.frames.empty())
         throw InvalidInput(formatError("--frames", "", "no frames", "at least one frame"));
-    if (command.resolution != 0 && (!uvwarp::isPowerOfTwo(command.resolution) || command.resolution < 2)) {
-        throw InvalidInput(formatError("--resolution", "", std::to_string(command.resolution),
-                                       "a power of two, at least 2 (grid cells per side)"));
-    }
     if (command.texture.has_value() != command.bake.has_value()) {
         throw InvalidInput(formatError(command.bake ? "--bake" : "--texture", "",
                                        command.bake ? "given without --texture" : "given without --bake",
@@ -137,7 +135,6 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     if (command.orientation) job.orientation = {*command.orientation, {}, "--orientation"};
     if (command.texture) job.texture = {*command.texture, {}, "--texture"};
     job.options = command.options;
-    job.options.cells = command.resolution;
     job.filter = command.filter;
     std::ofstream logFile;
     if (command.log) {
@@ -155,18 +152,30 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     return report;
 }
 
+// Older names of options that the command still takes.
+constexpr std::pair<std::string_view, const char*> kOptionAliases[] = {{"sweepsPerLevel", "--sweeps"},
+                                                                       {"maskBorderWidth", "--border-width"}};
+
 void addUvWarpCommand(CommandLine& cli) {
     struct Options {
         UvWarpCommand command;
         std::string frames, tiles, mask, orientation, texture, bake, log, filter = "bilinear", rest, deformed,
                                                                           rigidity, out;
-        bool warmStart = false;
+        // The UV-warp options as parsed, one per declaration (uvwarp/options.h), from the shot's defaults;
+        // checked by the library when the command runs.
+        std::vector<std::vector<double>> values;
+        std::deque<bool> flags;  // the flags' values (a deque keeps each element's address)
     };
     auto o = std::make_shared<Options>();
+    const std::span<const uvwarp::OptionSpec> specs = uvwarp::optionSpecs();
+    for (const uvwarp::OptionSpec& spec : specs) {
+        o->values.push_back(spec.get(o->command.options));
+        o->flags.push_back(spec.type == uvwarp::OptionType::Flag && o->values.back().front() != 0);
+    }
     Command uvwarp = cli.add(
         "uvwarp",
         "Content-aware UV warp over a shot: per UDIM tile and frame a redirect map (and a baked texture)",
-        [o] {
+        [o, specs] {
             UvWarpCommand& c = o->command;
             c.rest = o->rest;
             c.deformed = o->deformed;
@@ -180,7 +189,17 @@ void addUvWarpCommand(CommandLine& cli) {
             if (!o->tiles.empty()) c.tiles = parseTiles(o->tiles);
             if (!o->log.empty()) c.log = o->log;
             c.filter = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
-            c.options.solver.warmStart = o->warmStart;
+            for (size_t i = 0; i < specs.size(); ++i) {
+                uvwarp::OptionValue value;
+                value.numbers = o->values[i];
+                if (specs[i].type == uvwarp::OptionType::Flag) {
+                    value.kind = uvwarp::OptionValue::Kind::Boolean;
+                    value.numbers = {o->flags[i] ? 1.0 : 0.0};
+                } else if (specs[i].type == uvwarp::OptionType::IntegerList) {
+                    value.kind = uvwarp::OptionValue::Kind::List;
+                }
+                uvwarp::setOption(c.options, specs[i], value, "", uvwarp::cliName(specs[i]));
+            }
             // The progress bar redraws one line in place: only for a person watching a terminal.
             ProgressBar bar(std::cerr);
             const uvwarp::ShotReport report = uvwarpCommand(c, ::isatty(STDERR_FILENO) ? &bar : nullptr);
@@ -188,7 +207,6 @@ void addUvWarpCommand(CommandLine& cli) {
                 std::cout << "uvwarp: " << line << "\n";
             return 0;
         });
-    uvwarp::SolverOptions& solver = o->command.options.solver;
     uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj)").required();
     uvwarp.option("--deformed", o->deformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
         .required();
@@ -208,67 +226,43 @@ void addUvWarpCommand(CommandLine& cli) {
     texture.needs(bake);
     bake.needs(texture);
     uvwarp.option("--tiles", o->tiles, "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
-    uvwarp
-        .option("--resolution", o->command.resolution,
-                "grid cells per side, a power of two; 0: the rigidity map's size")
-        .showDefault();
     uvwarp.option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
     uvwarp.option("--filter", o->filter, "bake filter: bilinear or bicubic")
         .choices({"bilinear", "bicubic"})
         .showDefault();
-    uvwarp.option("--iterations", solver.iterations, "PBD iterations per frame (the most, with --tolerance)")
-        .nonNegative()
-        .showDefault();
-    uvwarp
-        .option("--tolerance", solver.tolerance,
-                "end a frame's iterations once no grid point moves farther, in cells; 0: always --iterations")
-        .range(0.0f, 1.0f)
-        .showDefault();
-    uvwarp.flag(
-        "--warm-start", o->warmStart,
-        "start each frame from the last frame's warp, as a live preview does; by default each frame starts "
-        "from the identity, so its maps depend on that frame alone (any range of frames gives the same "
-        "bytes)");
-    uvwarp.option("--levels", solver.levels, "hierarchy levels; 0: automatic").nonNegative().showDefault();
-    uvwarp
-        .option("--cold-iterations", solver.coldIterations,
-                "iterations of a solve from the identity; 0: --iterations")
-        .nonNegative()
-        .showDefault();
-    uvwarp.option("--max-levels", solver.maxLevels, "at most this many automatic levels; 0: no cap")
-        .nonNegative()
-        .showDefault();
-    uvwarp
-        .option("--sweeps", solver.sweepsPerLevel, "constraint sweeps per iteration and level, finest first")
-        .delimiter(',')
-        .nonNegative()
-        .showDefault();
-    uvwarp.option("--orientation-preservation", solver.orientationPreservation, "in [0, 1]")
-        .range(0.0f, 1.0f)
-        .showDefault();
-    uvwarp.option("--smoothing", solver.smoothing, "smoothing of rigid points, in [0, 1]")
-        .range(0.0f, 1.0f)
-        .showDefault();
-    uvwarp.option("--damping", solver.damping, "velocity damping, in [0, 1]").range(0.0f, 1.0f).showDefault();
-    uvwarp.option("--coarse-stiffness", solver.coarseStiffness, "per coarser level, in (0, 1]")
-        .range(1e-6f, 1.0f)
-        .showDefault();
-    uvwarp
-        .option("--coarse-relaxation", solver.coarseRelaxation,
-                "over-relaxation of the levels above the finest, in [1, 2] (live previews: 1.4)")
-        .range(1.0f, 2.0f)
-        .showDefault();
-    uvwarp
-        .option("--border-width", o->command.options.derivedMask.borderWidth,
-                "texels of chart border kept fixed by a derived mask")
-        .positive()
-        .showDefault();
-    uvwarp
-        .option("--orientation-density", o->command.options.densityOrientationRadius,
-                "without --orientation: orientation preservation from the rigidity's local density over a "
-                "window of this radius, texels (the paper's heuristic for severe compression); 0: off")
-        .nonNegative()
-        .showDefault();
+    for (size_t i = 0; i < specs.size(); ++i) {
+        const uvwarp::OptionSpec& spec = specs[i];
+        std::string names = uvwarp::cliName(spec);
+        for (const auto& [option, alias] : kOptionAliases) {
+            if (option == spec.name) names.append(",").append(alias);
+        }
+        const std::string help = std::string(spec.meaning) + " (" + uvwarp::expectedValue(spec) + ")";
+        switch (spec.type) {
+            case uvwarp::OptionType::Flag:
+                uvwarp.flag(names, o->flags[i], std::string(spec.meaning));
+                break;
+            case uvwarp::OptionType::IntegerList:
+                uvwarp.option(names, o->values[i], help).delimiter(',').typeName("INT").showDefault();
+                break;
+            case uvwarp::OptionType::Integer:
+                uvwarp.option(names, o->values[i].front(), help).typeName("INT").showDefault();
+                break;
+            case uvwarp::OptionType::Number:
+                uvwarp.option(names, o->values[i].front(), help).typeName("FLOAT").showDefault();
+                break;
+        }
+    }
+    uvwarp.listing(
+        "--list-options", "text",
+        "print every UV-warp option (its name here, in scenes and Python, range, default, meaning) "
+        "and exit; --list-options markdown prints the table of docs/uvwarp.md",
+        [](const std::string& format) {
+            if (format != "text" && format != "markdown") {
+                throw InvalidInput(
+                    formatError("--list-options", "", "is '" + format + "'", "text or markdown"));
+            }
+            std::cout << uvwarp::optionReference(format == "markdown");
+        });
 }
 
 }  // namespace deformkit::harness

@@ -18,6 +18,7 @@
 //   deformkit uvwarp --rest rest.obj --deformed 'anim.####.obj' --frames 1-24 --rigidity 'rig.<UDIM>.exr'
 //       [--mask 'mask.<UDIM>.exr'] [--texture 'col.<UDIM>.exr' --bake 'out/col.<UDIM>.####.exr']
 //       --out 'out/redirect.<UDIM>.####.exr' [--tiles 1001,1002] [--resolution N] [--log log.jsonl]
+//       [every UV-warp option of uvwarp/options.h as --kebab-case: --iterations 4 --sweeps-per-level 4,8,8]
 //
 // Frame tokens: #### (one # per digit, zero padded) or %04d (io::ObjSequence); UDIM tokens: <UDIM>,
 // <UVTILE>, %(UDIM)d, _MAPID_ (io/udim.h). Output folders must exist. Besides the shot job's own checks,
@@ -38,9 +39,8 @@ struct UvWarpCommand {
     std::filesystem::path out;                         // UDIM + frame pattern, .exr
     std::optional<std::filesystem::path> bake;         // UDIM + frame pattern, any writable format
     std::vector<int> tiles;                            // empty: every tile the rest mesh's UVs touch
-    int32_t resolution = 0;                            // grid cells per side, a power of two; 0: map size
-    uvwarp::TileWarpOptions options =
-        uvwarp::shotOptions();  // solver, derived mask, dilation (cells: resolution)
+    // The grid (cells: --resolution), solver, derived mask and dilation: every option of uvwarp/options.h.
+    uvwarp::TileWarpOptions options = uvwarp::shotOptions();
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;              // JSON lines, appended: one per tile x frame
 };

@@ -164,6 +164,14 @@ py::list entryList(const scene::SceneObject& object) {
         e["path"] = d.path;
         out.append(std::move(e));
     }
+    if (object.uvwarp) {
+        py::dict e;
+        e["type"] = "uvwarp";
+        e["label"] = object.uvwarp->label;
+        e["path"] = object.uvwarp->path;
+        e["options"] = uvwarpOptionsDict(object.uvwarp->options, false);
+        out.append(std::move(e));
+    }
     return out;
 }
 
@@ -413,7 +421,9 @@ void bindHost(py::module_& m) {
             "A copy of the object's rest mesh (connectivity and UVs for the evaluated points).")
         .def(
             "entries", [](const Scene& s, size_t object) { return entryList(sceneObject(s, object)); },
-            "object_index"_a, "The object's stack entries as dicts {type, label, path}.");
+            "object_index"_a,
+            "The object's stack entries as dicts {type, label, path}; a UV-warp stage, last, also has\n"
+            "options: every UV-warp option it runs with, {camelCase name: value}.");
 
     m.def(
         "read_scene",

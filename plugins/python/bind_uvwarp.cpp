@@ -28,6 +28,7 @@
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/shot_job.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "numpy_support.h"
@@ -39,11 +40,6 @@ namespace {
 
 using uvwarp::TileWarp;
 using uvwarp::TileWarpOptions;
-
-constexpr const char* kOptionNames =
-    "iterations, tolerance, levels, sweeps_per_level, orientation_preservation, smoothing, damping, "
-    "coarse_stiffness, coarse_relaxation, max_levels, cold_iterations, "
-    "border_width, dilation_rings, orientation_density, warm_start";
 
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
 // names the texel.
@@ -76,91 +72,113 @@ int32_t intOption(py::handle value, const std::string& source, const std::string
     return static_cast<int32_t>(v);
 }
 
-// A number in [0, 1] ((0, 1] when openLow), or in [low, high].
-float floatOption(py::handle value, const std::string& source, const std::string& name, bool openLow,
-                  const char* expected, double low = 0.0, double high = 1.0) {
-    double v = 0.0;
-    try {
-        v = value.cast<double>();
-    } catch (const py::cast_error&) {
-        throw InvalidInput(formatError(
-            source, name, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))), expected));
+// A Python value as the library's options take it (uvwarp/options.h checks it): a bool, a number, a
+// sequence of numbers, or anything else, described.
+uvwarp::OptionValue optionValueOf(py::handle value) {
+    using Kind = uvwarp::OptionValue::Kind;
+    const auto number = [](py::handle x, double& out) {
+        if (py::isinstance<py::bool_>(x) || py::isinstance<py::str>(x) || py::isinstance<py::bytes>(x) ||
+            py::isinstance<py::sequence>(x))
+            return false;
+        try {
+            out = x.cast<double>();
+            return true;
+        } catch (const py::cast_error&) {
+            return false;
+        }
+    };
+    uvwarp::OptionValue v;
+    double x = 0.0;
+    if (py::isinstance<py::bool_>(value)) {
+        v.kind = Kind::Boolean;
+        v.numbers = {value.cast<bool>() ? 1.0 : 0.0};
+    } else if (number(value, x)) {
+        v.numbers = {x};
+    } else if (py::isinstance<py::sequence>(value) && !py::isinstance<py::str>(value)) {
+        v.kind = Kind::List;
+        for (py::handle item : py::reinterpret_borrow<py::sequence>(value)) {
+            if (!number(item, x)) {
+                v.kind = Kind::Other;
+                v.shown = "a " + typeName(value) + " holding a " + typeName(item);
+                break;
+            }
+            v.numbers.push_back(x);
+        }
+    } else {
+        v.kind = Kind::Other;
+        v.shown = "a " + typeName(value);
     }
-    if (!std::isfinite(v) || v > high || (openLow ? !(v > low) : v < low))
-        throw InvalidInput(formatError(source, name, "is " + std::string(py::str(value)), expected));
-    return static_cast<float>(v);
+    if (v.kind != Kind::Other) v.shown = py::repr(value);  // as the caller wrote it: 2.0, [0, 0], True
+    return v;
 }
 
-// resolution (grid cells per side, None = the rigidity map's size) and the keyword options, each checked
-// and named: the core checks them too but names only "solver options". `o` starts as `base`: a solver's
-// defaults (warm start) or a shot's (every frame from the identity, uvwarp::shotOptions).
+// The option whose snake_case name is `name`, or nullptr.
+const uvwarp::OptionSpec* pythonOption(std::string_view name) {
+    for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+        if (uvwarp::pythonName(spec) == name) return &spec;
+    }
+    return nullptr;
+}
+
+// resolution (grid cells per side, None = the rigidity map's size) and the keyword options by their
+// snake_case names (uvwarp/options.h), each checked by the library and named as the caller wrote it. `o`
+// starts as `base`: a solver's defaults (warm start) or a shot's (every frame from the identity,
+// uvwarp::shotOptions).
 TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs& kwargs,
                           const std::string& source, const TileWarpOptions& base = {}) {
     TileWarpOptions o = base;
     if (resolution) {
-        const int64_t n = *resolution;
-        if (n < 2 || n > (int64_t{1} << 15) || (n & (n - 1)) != 0) {
-            throw InvalidInput(formatError(source, "resolution", "is " + std::to_string(n),
-                                           "None (the rigidity map's size) or a power of two in [2, 32768]"));
-        }
-        o.cells = static_cast<int32_t>(n);
+        uvwarp::OptionValue value;
+        value.numbers = {static_cast<double>(*resolution)};
+        uvwarp::setOption(o, *uvwarp::findOption("resolution"), value, source, "resolution");
     }
     for (const auto& [key, value] : kwargs) {
         const std::string k = py::str(key);
-        if (k == "iterations") {
-            o.solver.iterations = intOption(value, source, k, 0, "an integer >= 0");
-        } else if (k == "levels") {
-            o.solver.levels = intOption(value, source, k, 0, "an integer >= 0 (0: automatic)");
-        } else if (k == "cold_iterations") {
-            o.solver.coldIterations = intOption(value, source, k, 0, "an integer >= 0 (0: iterations)");
-        } else if (k == "max_levels") {
-            o.solver.maxLevels = intOption(value, source, k, 0, "an integer >= 0 (0: no cap)");
-        } else if (k == "sweeps_per_level") {
-            const char* expected = "a non-empty sequence of integers >= 0, finest level first";
-            if (!py::isinstance<py::sequence>(value) || py::isinstance<py::str>(value)) {
-                throw InvalidInput(formatError(
-                    source, k, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))),
-                    expected));
+        const uvwarp::OptionSpec* spec = pythonOption(k);
+        if (spec == nullptr || k == "resolution") {
+            std::string known;
+            for (const uvwarp::OptionSpec& s : uvwarp::optionSpecs()) {
+                if (s.name != "resolution") known += (known.empty() ? "" : ", ") + uvwarp::pythonName(s);
             }
-            const auto items = py::reinterpret_borrow<py::sequence>(value);
-            if (items.size() == 0) throw InvalidInput(formatError(source, k, "is empty", expected));
-            o.solver.sweepsPerLevel.clear();
-            for (size_t i = 0; i < items.size(); ++i)
-                o.solver.sweepsPerLevel.push_back(
-                    intOption(items[i], source, k + "[" + std::to_string(i) + "]", 0, "an integer >= 0"));
-        } else if (k == "orientation_preservation") {
-            o.solver.orientationPreservation = floatOption(value, source, k, false, "a number in [0, 1]");
-        } else if (k == "smoothing") {
-            o.solver.smoothing = floatOption(value, source, k, false, "a number in [0, 1]");
-        } else if (k == "damping") {
-            o.solver.damping = floatOption(value, source, k, false, "a number in [0, 1]");
-        } else if (k == "tolerance") {
-            o.solver.tolerance = floatOption(value, source, k, false, "a number in [0, 1] (grid cells)");
-        } else if (k == "coarse_stiffness") {
-            o.solver.coarseStiffness = floatOption(value, source, k, true, "a number in (0, 1]");
-        } else if (k == "coarse_relaxation") {
-            o.solver.coarseRelaxation = floatOption(value, source, k, false, "a number in [1, 2]", 1.0, 2.0);
-        } else if (k == "border_width") {
-            o.derivedMask.borderWidth = intOption(value, source, k, 1, "an integer >= 1 (texels)");
-        } else if (k == "dilation_rings") {
-            o.dilationRings = intOption(value, source, k, 0, "an integer in [0, 64]");
-            if (o.dilationRings > 64)
-                throw InvalidInput(
-                    formatError(source, k, "is " + std::to_string(o.dilationRings), "an integer in [0, 64]"));
-        } else if (k == "orientation_density") {
-            o.densityOrientationRadius = intOption(value, source, k, 0, "0 (off) or a radius in texels");
-        } else if (k == "warm_start") {
-            if (!py::isinstance<py::bool_>(value)) {
-                throw InvalidInput(formatError(
-                    source, k, "is a " + std::string(py::str(py::type::of(value).attr("__name__"))),
-                    "True or False"));
-            }
-            o.solver.warmStart = value.cast<bool>();
-        } else {
-            throw InvalidInput(formatError(source, k, "is not an option", kOptionNames));
+            throw InvalidInput(formatError(source, k, "is not an option", known));
         }
+        uvwarp::setOption(o, *spec, optionValueOf(value), source, k);
     }
     return o;
+}
+
+// An option's value as Python sees it: bool, int, float or a list of ints.
+py::object optionObject(const uvwarp::OptionSpec& spec, const TileWarpOptions& options) {
+    const std::vector<double> v = spec.get(options);
+    switch (spec.type) {
+        case uvwarp::OptionType::Flag:
+            return py::bool_(v.front() != 0);
+        case uvwarp::OptionType::IntegerList: {
+            py::list list;
+            for (double x : v)
+                list.append(py::int_(static_cast<int64_t>(x)));
+            return std::move(list);
+        }
+        case uvwarp::OptionType::Integer:
+            return py::int_(static_cast<int64_t>(v.front()));
+        case uvwarp::OptionType::Number:
+            break;
+    }
+    return py::float_(static_cast<double>(static_cast<float>(v.front())));
+}
+
+// The keyword options' part of the docstrings, made from the declaration.
+std::string optionsDoc() {
+    std::string doc =
+        "options (keywords; the same option is camelCase in scenes and `deformkit uvwarp "
+        "--list-options`):\n";
+    const TileWarpOptions defaults;
+    for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+        if (spec.name == "resolution") continue;
+        doc += "  " + uvwarp::pythonName(spec) + " (" + uvwarp::valueText(spec, spec.get(defaults)) + "; " +
+               uvwarp::expectedValue(spec) + "): " + std::string(spec.meaning) + "\n";
+    }
+    return doc;
 }
 
 uvwarp::BakeOptions bakeOptionsOf(const std::string& filter, const std::string& source) {
@@ -235,9 +253,9 @@ class PyUvWarpSolver {
                    const std::optional<FloatArray>& mask, const std::optional<int64_t>& resolution,
                    const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
         const std::string source = "UvWarpSolver";
-        const TileWarpOptions options = optionsOf(resolution, kwargs, source);
+        options_ = optionsOf(resolution, kwargs, source);
         warp_ = bindTile(mesh, tile, mapOf(rigidity, source, "rigidity"), optionalMapOf(mask, source, "mask"),
-                         options, optionalMapOf(orientation, source, "orientation"), source);
+                         options_, optionalMapOf(orientation, source, "orientation"), source);
         vertices_ = mesh.numVertices();
     }
 
@@ -292,8 +310,10 @@ class PyUvWarpSolver {
 
     [[nodiscard]] const TileWarp& tileWarp() const { return *warp_; }
     [[nodiscard]] int32_t vertices() const { return vertices_; }
+    [[nodiscard]] const TileWarpOptions& options() const { return options_; }
 
   private:
+    TileWarpOptions options_;
     std::unique_ptr<TileWarp> warp_;
     int32_t vertices_ = 0;
     mutable std::mutex mutex_;
@@ -543,19 +563,7 @@ constexpr const char* kSolverDoc =
     "tile: the UDIM tile (1001, ...). Maps are (T, T) or (T, T, 1) float32 images, row 0 at v = 1:\n"
     "rigidity in [0, 1] (1 = as rigid as possible); mask (>= 0.5 may warp; None derives one from the UVs:\n"
     "texels outside every UV triangle and on chart borders stay fixed); orientation in [0, 1] scales\n"
-    "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n"
-    "options: iterations (4; the most with a tolerance), tolerance (0: off; in grid cells, end a solve "
-    "once\n"
-    "no point moves farther), levels (0: automatic), sweeps_per_level ([4, 8, 8], finest first),\n"
-    "orientation_preservation (0.05), smoothing (0.1), damping (0.5), coarse_stiffness (0.9),\n"
-    "coarse_relaxation (1: over-relaxation of the coarse levels, in [1, 2]; the live presets use 1.4),\n"
-    "max_levels (0: no cap on the automatic depth), cold_iterations (0: iterations; of a solve from the\n"
-    "identity),\n"
-    "border_width (1 texel, derived mask), dilation_rings (4, geometry images), orientation_density (0: "
-    "off;\n"
-    "a radius in texels: without an orientation map, orientation preservation follows the rigidity's local\n"
-    "density, the paper's heuristic for severe compression), warm_start (True: each solve starts from the\n"
-    "last warp; False: from the identity, so a frame's warp depends on that frame alone).";
+    "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n";
 
 constexpr const char* kSolveDoc =
     "Solve one frame: deformed_points (N, 3) float32, the rest mesh's vertices moved (scene units).\n"
@@ -600,8 +608,18 @@ constexpr const char* kShotDoc =
 
 }  // namespace
 
+py::dict uvwarpOptionsDict(const TileWarpOptions& options, bool snakeCase) {
+    py::dict d;
+    for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+        const std::string name = snakeCase ? uvwarp::pythonName(spec) : std::string(spec.name);
+        d[py::str(name)] = optionObject(spec, options);
+    }
+    return d;
+}
+
 void bindUvWarp(py::module_& m) {
-    py::class_<PyUvWarpSolver>(m, "UvWarpSolver", kSolverDoc)
+    static const std::string solverDoc = std::string(kSolverDoc) + optionsDoc();
+    py::class_<PyUvWarpSolver>(m, "UvWarpSolver", solverDoc.c_str())
         .def(py::init<const geom::Mesh&, int, const FloatArray&, const std::optional<FloatArray>&,
                       const std::optional<int64_t>&, const std::optional<FloatArray>&, const py::kwargs&>(),
              py::arg("mesh"), py::arg("tile"), py::arg("rigidity"), py::arg("mask") = py::none(),
@@ -641,6 +659,10 @@ void bindUvWarp(py::module_& m) {
             "cells", [](const PyUvWarpSolver& s) { return s.tileWarp().cells(); },
             "n, the warp grid's cells per side")
         .def_property_readonly("num_vertices", &PyUvWarpSolver::vertices)
+        .def_property_readonly(
+            "options", [](const PyUvWarpSolver& s) { return uvwarpOptionsDict(s.options(), true); },
+            "Every option the solver was made with, {snake_case name: value}, resolution included (0: the\n"
+            "rigidity map's size).")
         .def("__repr__", [](const PyUvWarpSolver& s) {
             return "<deformkit.UvWarpSolver tile " + std::to_string(s.tileWarp().tile()) + ", " +
                    std::to_string(s.tileWarp().texels()) + " texels, " +
@@ -675,22 +697,55 @@ void bindUvWarp(py::module_& m) {
             if (cells < 1 || cells > (int64_t{1} << 15))
                 throw InvalidInput(formatError("uv_warp_live_options", "cells", "is " + std::to_string(cells),
                                                "a grid size from 1 to 32768"));
-            const uvwarp::SolverOptions o = uvwarp::liveOptions(static_cast<int32_t>(cells));
+            TileWarpOptions o;
+            o.solver = uvwarp::liveOptions(static_cast<int32_t>(cells));
             py::dict options;
-            options["iterations"] = o.iterations;
-            options["sweeps_per_level"] = o.sweepsPerLevel;
-            options["coarse_relaxation"] = o.coarseRelaxation;
-            options["warm_start"] = o.warmStart;
-            options["max_levels"] = o.maxLevels;
-            options["cold_iterations"] = o.coldIterations;
+            for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+                if (spec.solver) options[py::str(uvwarp::pythonName(spec))] = optionObject(spec, o);
+            }
             return options;
         },
         py::arg("cells"),
-        "The live-preview preset for a grid of `cells` cells per side, as UvWarpSolver keyword options: one\n"
+        "The live-preview preset for a grid of `cells` cells per side, as UvWarpSolver keyword options "
+        "(every\n"
+        "solver option): one\n"
         "warm-started iteration a frame, the coarse levels over-relaxed by 1.4, sweeps per level by grid "
         "size\n"
         "(uvwarp::liveOptions; within 2 points of a converged solve on every probed frame of a smooth\n"
         "animation).");
+
+    m.def(
+        "uv_warp_options",
+        [] {
+            py::list out;
+            const TileWarpOptions defaults;
+            const TileWarpOptions shot = uvwarp::shotOptions();
+            for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+                py::dict d;
+                d["name"] = std::string(spec.name);
+                d["python"] = uvwarp::pythonName(spec);
+                d["cli"] = uvwarp::cliName(spec);
+                d["type"] = spec.type == uvwarp::OptionType::Flag          ? "flag"
+                            : spec.type == uvwarp::OptionType::IntegerList ? "integer list"
+                            : spec.type == uvwarp::OptionType::Integer     ? "integer"
+                                                                           : "number";
+                d["low"] = spec.low;
+                d["high"] = spec.high;
+                d["low_open"] = spec.lowOpen;
+                d["power_of_two"] = spec.powerOfTwo;
+                d["default"] = optionObject(spec, defaults);
+                d["shot_default"] = optionObject(spec, shot);
+                d["expected"] = uvwarp::expectedValue(spec);
+                d["meaning"] = std::string(spec.meaning);
+                out.append(d);
+            }
+            return out;
+        },
+        "The UV warp's options as declared once in the library (deformkit/uvwarp/options.h), in reference\n"
+        "order: a list of dicts with name (camelCase: scenes, Maya, shot headers), python (the keyword\n"
+        "name), cli (the `deformkit uvwarp` option), type ('integer', 'number', 'flag', 'integer list'),\n"
+        "low, high, low_open, power_of_two (the range of a value, of each element of a list), default,\n"
+        "shot_default (uvwarp_shot's, every frame from the identity), expected and meaning (text).");
 
     m.def(
         "apply_redirect",

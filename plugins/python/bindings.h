@@ -2,6 +2,8 @@
 
 #include <pybind11/pybind11.h>
 
+#include "deformkit/uvwarp/tile_warp.h"
+
 // Each area of the module registers its functions from its own file (bind_<area>.cpp).
 namespace deformkit::python {
 
@@ -15,5 +17,9 @@ void bindSlide(pybind11::module_& m);
 void bindUvWarp(pybind11::module_& m);
 void bindHost(pybind11::module_& m);
 void bindPtex(pybind11::module_& m);
+
+// Every UV-warp option of `options` (uvwarp/options.h) as {name: value}, the names in snake_case (Python's
+// keywords) or camelCase (scenes'): bool, int, float or a list of ints.
+[[nodiscard]] pybind11::dict uvwarpOptionsDict(const uvwarp::TileWarpOptions& options, bool snakeCase);
 
 }  // namespace deformkit::python

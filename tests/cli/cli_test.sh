@@ -304,13 +304,23 @@ cmp -s "$work/uv/warm/redirect.1001.0002.exr" "$work/uv/coldalone/redirect.1001.
 expect uvwarp-warm-info 0 "$dk" info "$work/uv/warm/redirect.1001.0002.exr"
 contains uvwarp-warm-info "$work/out" '"warmStart":true'
 # The live presets' over-relaxation of the coarse levels: recorded in the header, and in range [1, 2].
-expect uvwarp-relaxed 0 uvwarp --frames 1-1 --warm-start --iterations 1 --sweeps 1,2,10 --coarse-relaxation 1.4 --max-levels 3 --cold-iterations 2 --out "$work/uv/relaxed/redirect.<UDIM>.####.exr"
+expect uvwarp-relaxed 0 uvwarp --frames 1-1 --warm-start --iterations 1 --sweeps-per-level 1,2,10 --coarse-relaxation 1.4 --max-levels 3 --cold-iterations 2 --out "$work/uv/relaxed/redirect.<UDIM>.####.exr"
 expect uvwarp-relaxed-info 0 "$dk" info "$work/uv/relaxed/redirect.1001.0001.exr"
 contains uvwarp-relaxed-info "$work/out" '"coarseRelaxation":1.4'
 contains uvwarp-relaxed-info "$work/out" '"maxLevels":3'
 contains uvwarp-relaxed-info "$work/out" '"coldIterations":2'
 expect uvwarp-relaxation-range 2 uvwarp --frames 1-1 --coarse-relaxation 2.5 --out "$work/uv/out/x.<UDIM>.####.exr"
 contains uvwarp-relaxation-range "$work/err" "coarse-relaxation"
+# The older option names still work and record the declared names; zero iterations or no sweeps at all are
+# refused, naming the option as the command spells it.
+expect uvwarp-aliases 0 uvwarp --frames 1-1 --sweeps 2,3 --border-width 2 --out "$work/uv/aliases/redirect.<UDIM>.####.exr"
+expect uvwarp-aliases-info 0 "$dk" info "$work/uv/aliases/redirect.1001.0001.exr"
+contains uvwarp-aliases-info "$work/out" '"sweepsPerLevel":[2,3]'
+contains uvwarp-aliases-info "$work/out" '"maskBorderWidth":2'
+expect uvwarp-zero-iterations 2 uvwarp --frames 1-1 --iterations 0 --out "$work/uv/out/x.<UDIM>.####.exr"
+contains uvwarp-zero-iterations "$work/err" "--iterations: is 0 (expected a whole number from 1 to 100000)"
+expect uvwarp-zero-sweeps 2 uvwarp --frames 1-1 --sweeps-per-level 0,0 --out "$work/uv/out/x.<UDIM>.####.exr"
+contains uvwarp-zero-sweeps "$work/err" "--sweeps-per-level: is [0, 0]"
 expect uvwarp-new-folder 0 uvwarp --frames 1-1 --out "$work/uv/made/here/redirect.<UDIM>.####.exr"
 [ -s "$work/uv/made/here/redirect.1001.0001.exr" ] || { echo "FAIL uvwarp-new-folder: map missing"; failures=$((failures + 1)); }
 # Outputs never destroy what they replace: an extension that is not the format's, a FIFO, a path in a file.
@@ -335,7 +345,7 @@ expect uvwarp-bake-alone 2 uvwarp --frames 1-2 --out "$work/uv/out/r.<UDIM>.####
 expect uvwarp-bad-frames 2 uvwarp --frames 2-1 --out "$work/uv/out/r.<UDIM>.####.exr"
 contains uvwarp-bad-frames "$work/err" "--frames"
 expect uvwarp-resolution 2 uvwarp --frames 1-2 --resolution 48 --out "$work/uv/out/r.<UDIM>.####.exr"
-contains uvwarp-resolution "$work/err" "--resolution: 48"
+contains uvwarp-resolution "$work/err" "--resolution: is 48"
 expect uvwarp-missing-frame 2 uvwarp --frames 1-3 --out "$work/uv/out/r.<UDIM>.####.exr"
 contains uvwarp-missing-frame "$work/err" "anim.0003.obj: frame 3: is missing"
 [ ! -e "$work/uv/out/r.1001.0001.exr" ] || { echo "FAIL uvwarp errors: output written"; failures=$((failures + 1)); }

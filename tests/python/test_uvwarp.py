@@ -122,7 +122,7 @@ def test_one_off_matches_the_solver_and_the_mesh_overload():
     rig = disks()
     mask = np.ones((T, T, 1), dtype=np.float32)
     deformed = stretched(pts)
-    options = dict(iterations=8, smoothing=0.2, sweeps_per_level=[1, 2], border_width=2)
+    options = dict(iterations=8, smoothing=0.2, sweeps_per_level=[1, 2], mask_border_width=2)
     solver = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1002, rig, mask=mask, resolution=32, **options)
     assert solver.cells == 32 and solver.texels == T
     assert solver.solve(deformed).shape == (33, 33, 2)
@@ -221,18 +221,24 @@ def test_bad_input_names_what_is_wrong():
     with pytest.raises(dk.InvalidInput, match="UDIM tile 1002: holds no UV face"):
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1002, rig)
     for option, value, text in (("smoothing", 1.5, "smoothing: is 1.5"), ("damping", "x", "damping: is a str"),
-                                ("iterations", 2.5, "iterations: is a float"), ("levels", -1, "levels: is -1"),
-                                ("coarse_stiffness", 0.0, "coarse_stiffness: is 0.0"),
+                                ("iterations", 2.5, "iterations: is 2.5"), ("levels", -1, "levels: is -1"),
+                                ("iterations", 0, r"iterations: is 0 \(expected a whole number from 1"),
+                                ("coarse_stiffness", 0.0, r"coarse_stiffness: is 0.0 \(expected a number in \(0, 1\]"),
                                 ("coarse_relaxation", 2.5, "coarse_relaxation: is 2.5"),
                                 ("max_levels", -1, "max_levels: is -1"),
                                 ("cold_iterations", -2, "cold_iterations: is -2"),
                                 ("coarse_relaxation", 0.9,
-                                 r"coarse_relaxation: is 0.9 \(expected a number in \[1, 2\]"),
+                                 r"coarse_relaxation: is 0.9 \(expected a number from 1 to 2\)"),
                                 ("tolerance", 2.0, "tolerance: is 2.0"),
-                                ("warm_start", 1, "warm_start: is a int"),
-                                ("sweeps_per_level", [], "sweeps_per_level: is empty"),
-                                ("sweeps_per_level", [1, -2], r"sweeps_per_level\[1\]: is -2"),
-                                ("border_width", 0, "border_width: is 0"), ("bogus", 1, "bogus: is not an option")):
+                                ("warm_start", 1, r"warm_start: is 1 \(expected true or false\)"),
+                                ("warm_start", None, r"warm_start: is a NoneType \(expected true or false\)"),
+                                ("sweeps_per_level", [], r"sweeps_per_level: is \[\]"),
+                                ("sweeps_per_level", [0, 0], r"sweeps_per_level: is \[0, 0\].*not all 0"),
+                                ("sweeps_per_level", [1, -2], r"sweeps_per_level: is \[1, -2\]"),
+                                ("sweeps_per_level", [1, "a"], "sweeps_per_level: is a list holding a str"),
+                                ("mask_border_width", 0, "mask_border_width: is 0"),
+                                ("border_width", 1, "border_width: is not an option"),
+                                ("bogus", 1, "bogus: is not an option")):
         with pytest.raises(dk.InvalidInput, match=text):
             dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, **{option: value})
     with pytest.raises(dk.InvalidInput, match="uv_warp_live_options: cells: is 0"):

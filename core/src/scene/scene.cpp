@@ -16,6 +16,7 @@
 #include "deformkit/scene/weight_maps.h"
 #include "deformkit/scene/weights_file.h"
 #include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/options.h"
 #include "scene/json_reading.h"
 
 namespace deformkit::scene {
@@ -342,6 +343,29 @@ class Reader {
         return d;
     }
 
+    // A UV-warp option from its JSON value, checked by the library (uvwarp/options.h).
+    void uvwarpOption(uvwarp::TileWarpOptions& options, const uvwarp::OptionSpec& spec, const json& v,
+                      const std::string& path) const {
+        uvwarp::OptionValue value;
+        using Kind = uvwarp::OptionValue::Kind;
+        if (v.is_boolean()) {
+            value.kind = Kind::Boolean;
+            value.numbers = {v.get<bool>() ? 1.0 : 0.0};
+        } else if (v.is_number()) {
+            value.numbers = {v.get<double>()};
+        } else if (v.is_array() &&
+                   std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
+            value.kind = Kind::List;
+            for (const json& x : v)
+                value.numbers.push_back(x.get<double>());
+        } else {
+            value.kind = Kind::Other;
+            value.shown = detail::jsonKind(v);
+        }
+        if (value.kind != Kind::Other) value.shown = v.dump();  // as the scene writes it: 2.0, [0,0]
+        uvwarp::setOption(options, spec, value, source_, path);
+    }
+
     // A UDIM pattern ("rig.<UDIM>.exr"), resolved against the scene's folder.
     fs::path udimPattern(const json& v, const std::string& path) const {
         const fs::path p = file(v, path, "an image file name with a UDIM token");
@@ -394,15 +418,9 @@ class Reader {
         } else {
             u.tiles = meshTiles;
         }
-        if (v.contains("resolution")) {
-            const json& r = v.at("resolution");
-            const double cells = ranged(r, path + ".resolution", 0, 32768, true,
-                                        "0 (the map's size) or a power of two from 2 to 32768");
-            if (cells != 0 && (cells < 2 || !uvwarp::isPowerOfTwo(static_cast<int32_t>(cells))))
-                fail(path + ".resolution", "is " + r.dump(),
-                     "0 (the map's size) or a power of two from 2 to 32768");
-            u.options.cells = static_cast<int32_t>(cells);
-        }
+        if (v.contains("resolution"))
+            uvwarpOption(u.options, *uvwarp::findOption("resolution"), v.at("resolution"),
+                         path + ".resolution");
         if (v.contains("filter")) {
             const std::string f = string(v.at("filter"), path + ".filter", "\"bilinear\" or \"bicubic\"");
             if (f == "bilinear") {
@@ -417,67 +435,16 @@ class Reader {
             const json& params = v.at("params");
             const std::string pp = path + ".params";
             requireObject(params, pp, "an object of UV-warp options by name");
-            onlyKeys(
-                params, pp,
-                {"iterations", "coldIterations", "tolerance", "levels", "maxLevels", "sweepsPerLevel",
-                 "orientationPreservation", "smoothing", "damping", "coarseStiffness", "coarseRelaxation",
-                 "dilationRings", "maskBorderWidth", "orientationDensity", "warmStart"});
-            uvwarp::SolverOptions& o = u.options.solver;
-            auto get = [&](const char* name) -> const json* {
-                return params.contains(name) ? &params.at(name) : nullptr;
-            };
-            if (const json* x = get("iterations"))
-                o.iterations =
-                    static_cast<int32_t>(ranged(*x, pp + ".iterations", 1, 100000, true, "1 to 100000"));
-            if (const json* x = get("tolerance"))
-                o.tolerance =
-                    static_cast<float>(ranged(*x, pp + ".tolerance", 0, 1, false, "0 to 1 (grid cells)"));
-            if (const json* x = get("levels"))
-                o.levels =
-                    static_cast<int32_t>(ranged(*x, pp + ".levels", 0, 16, true, "0 (automatic) to 16"));
-            if (const json* x = get("coldIterations"))
-                o.coldIterations = static_cast<int32_t>(
-                    ranged(*x, pp + ".coldIterations", 0, 100000, true, "0 (iterations) to 100000"));
-            if (const json* x = get("maxLevels"))
-                o.maxLevels =
-                    static_cast<int32_t>(ranged(*x, pp + ".maxLevels", 0, 16, true, "0 (no cap) to 16"));
-            if (const json* x = get("sweepsPerLevel")) {
-                const std::string sp = pp + ".sweepsPerLevel";
-                if (!x->is_array() || x->empty())
-                    fail(sp, "is " + detail::jsonKind(*x), "a non-empty array of sweep counts");
-                o.sweepsPerLevel.clear();
-                for (size_t i = 0; i < x->size(); ++i)
-                    o.sweepsPerLevel.push_back(static_cast<int32_t>(
-                        ranged((*x)[i], detail::jsonIndex(sp, i), 1, 1000, true, "1 to 1000")));
+            for (const auto& item : params.items()) {
+                const uvwarp::OptionSpec* spec = uvwarp::findOption(item.key());
+                if (spec == nullptr) {
+                    std::string known;
+                    for (const uvwarp::OptionSpec& s : uvwarp::optionSpecs())
+                        known += (known.empty() ? "" : ", ") + std::string(s.name);
+                    fail(pp + "." + item.key(), "is not a UV-warp option", "one of: " + known);
+                }
+                uvwarpOption(u.options, *spec, item.value(), pp + "." + item.key());
             }
-            if (const json* x = get("orientationPreservation"))
-                o.orientationPreservation =
-                    static_cast<float>(ranged(*x, pp + ".orientationPreservation", 0, 1, false, "0 to 1"));
-            if (const json* x = get("smoothing"))
-                o.smoothing = static_cast<float>(ranged(*x, pp + ".smoothing", 0, 1, false, "0 to 1"));
-            if (const json* x = get("damping"))
-                o.damping = static_cast<float>(ranged(*x, pp + ".damping", 0, 1, false, "0 to 1"));
-            if (const json* x = get("coarseStiffness")) {
-                o.coarseStiffness =
-                    static_cast<float>(ranged(*x, pp + ".coarseStiffness", 0, 1, false, "(0, 1]"));
-                if (!(o.coarseStiffness > 0.0f)) fail(pp + ".coarseStiffness", "is " + x->dump(), "(0, 1]");
-            }
-            if (const json* x = get("coarseRelaxation"))
-                o.coarseRelaxation =
-                    static_cast<float>(ranged(*x, pp + ".coarseRelaxation", 1, 2, false, "1 to 2"));
-            if (const json* x = get("dilationRings"))
-                u.options.dilationRings =
-                    static_cast<int32_t>(ranged(*x, pp + ".dilationRings", 0, 64, true, "0 to 64"));
-            if (const json* x = get("maskBorderWidth"))
-                u.options.derivedMask.borderWidth =
-                    static_cast<int32_t>(ranged(*x, pp + ".maskBorderWidth", 1, 64, true, "1 to 64"));
-            if (const json* x = get("warmStart")) {
-                if (!x->is_boolean()) fail(pp + ".warmStart", "is " + x->dump(), "true or false");
-                o.warmStart = x->get<bool>();
-            }
-            if (const json* x = get("orientationDensity"))
-                u.options.densityOrientationRadius = static_cast<int32_t>(
-                    ranged(*x, pp + ".orientationDensity", 0, 4096, true, "0 (off) to 4096 texels"));
         }
         return u;
     }

@@ -21,6 +21,7 @@
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/options.h"
 #include "deformkit/version.h"
 
 namespace deformkit::uvwarp {
@@ -98,25 +99,28 @@ json metricsJson(const WarpMetrics& m, const SolveStats& s) {
             {"remaining_folds", s.remainingFolds}};
 }
 
-json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t levelsUsed,
-                bool derivedMask) {
-    json j = {{"cells", cells},
-              {"texels", texels},
-              {"levels", o.solver.levels},
-              {"maxLevels", o.solver.maxLevels},
-              {"coldIterations", o.solver.coldIterations},
-              {"levelsUsed", levelsUsed},
-              {"iterations", o.solver.iterations},
-              {"tolerance", tidy(o.solver.tolerance)},
-              {"sweepsPerLevel", o.solver.sweepsPerLevel},
-              {"orientationPreservation", tidy(o.solver.orientationPreservation)},
-              {"smoothing", tidy(o.solver.smoothing)},
-              {"damping", tidy(o.solver.damping)},
-              {"coarseStiffness", tidy(o.solver.coarseStiffness)},
-              {"coarseRelaxation", tidy(o.solver.coarseRelaxation)},
-              {"dilationRings", o.dilationRings},
-              {"warmStart", o.solver.warmStart}};
-    if (derivedMask) j["derivedMaskBorderWidth"] = o.derivedMask.borderWidth;
+// The options a map was made with, by their declared names (uvwarp/options.h), and the grid in use.
+json solverJson(const TileWarpOptions& o, int32_t cells, int32_t texels, int32_t levelsUsed) {
+    json j = {{"cells", cells}, {"texels", texels}, {"levelsUsed", levelsUsed}};
+    for (const OptionSpec& spec : optionSpecs()) {
+        if (!spec.recorded) continue;
+        const std::vector<double> v = spec.get(o);
+        json& slot = j[std::string(spec.name)];
+        switch (spec.type) {
+            case OptionType::Flag:
+                slot = v.front() != 0;
+                break;
+            case OptionType::IntegerList:
+                slot = std::vector<int64_t>(v.begin(), v.end());
+                break;
+            case OptionType::Integer:
+                slot = static_cast<int64_t>(v.front());
+                break;
+            case OptionType::Number:
+                slot = tidy(static_cast<float>(v.front()));
+                break;
+        }
+    }
     return j;
 }
 
@@ -244,6 +248,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         std::adjacent_find(j.frames.begin(), j.frames.end()) != j.frames.end()) {
         throw InvalidInput(formatError("uvwarp", "frames", "are not ascending", "frames in ascending order"));
     }
+    checkOptions(j.options, "uvwarp");
     const std::vector<int> tiles = shotTiles(*j.rest, j.restName, j.tiles, "tiles");
     for (const auto& [source, role] :
          {std::pair{&j.rigidity, "rigidity"}, std::pair{&j.mask, "mask"},
@@ -490,8 +495,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             {"deformkit:uvwarp:tile", std::to_string(plan.tile)},
             {"deformkit:uvwarp:frame", std::to_string(frame)},
             {"deformkit:uvwarp:solver",
-             solverJson(job.options, warp.cells(), warp.texels(), warp.stats().levels, !plan.mask.found())
-                 .dump()},
+             solverJson(job.options, warp.cells(), warp.texels(), warp.stats().levels).dump()},
             {"deformkit:uvwarp:inputs", frameInputs.dump()}};
         t = Clock::now();
         if (!job.skipExisting || !fileExists(plan.outPaths[k])) {

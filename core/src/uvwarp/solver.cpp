@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "deformkit/error.h"
+#include "deformkit/uvwarp/options.h"
 #include "memory/large_buffers.h"
 #include "row_wavefront.h"
 #include "simd/cpu.h"
@@ -493,23 +494,7 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     detail::requireField(restGeometry, m.cells, 3, source, "rest geometry image");
     m.blockDone =
         std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
-    if (options.iterations < 0 || options.coldIterations < 0 || options.damping < 0.0f ||
-        options.damping > 1.0f || options.smoothing < 0.0f || options.smoothing > 1.0f ||
-        options.orientationPreservation < 0.0f || options.orientationPreservation > 1.0f ||
-        !(options.coarseStiffness > 0.0f) || options.coarseStiffness > 1.0f ||
-        !(options.coarseRelaxation >= 1.0f) || options.coarseRelaxation > 2.0f || options.levels < 0 ||
-        options.maxLevels < 0 || options.threads < 0 || !(options.tolerance >= 0.0f) ||
-        options.tolerance > 1.0f) {
-        throw InvalidInput(formatError(
-            source, "solver options", "out of range",
-            "iterations >= 0, cold iterations >= 0, levels >= 0, max levels >= 0, damping, smoothing, "
-            "orientation preservation "
-            "in [0, 1], coarse stiffness in (0, 1], coarse relaxation in [1, 2], tolerance in [0, 1] "
-            "(cells), threads >= 0"));
-    }
-    for (int32_t s : options.sweepsPerLevel) {
-        if (s < 0) throw InvalidInput(formatError(source, "sweepsPerLevel", std::to_string(s), ">= 0"));
-    }
+    checkOptions(options, source);
     int32_t levelCount = options.levels;
     if (levelCount == 0) {
         // Down to an 8-cell grid, but no level whose cells are wider than a third of the widest chart's

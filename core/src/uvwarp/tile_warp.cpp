@@ -7,6 +7,7 @@
 #include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/inversion.h"
 #include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/options.h"
 #include "memory/large_buffers.h"
 
 namespace deformkit::uvwarp {
@@ -32,7 +33,7 @@ struct TileWarp::Impl {
     std::unique_ptr<GeometryImager> imager;
     PointField deformed, rigidity, mask;  // f_O lives in the solver
     PointField boundMask;                 // the constructor's mask (given or derived): setMaps' default
-    int32_t densityRadius = 0;            // TileWarpOptions::densityOrientationRadius
+    int32_t densityRadius = 0;            // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     bool solved = false;
 };
@@ -43,6 +44,7 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     Impl& m = *impl_;
     m.source = source;
     m.tile = tile;
+    checkOptions(options, source);
     requireSquare(rigidity, source, tile, "rigidity map");
     m.texels = rigidity.width;
     const bool derive = mask.pixels.empty();
@@ -80,12 +82,7 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     } else {
         m.mask = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
     }
-    if (options.densityOrientationRadius < 0) {
-        throw InvalidInput(formatError(source, "density orientation radius",
-                                       "is " + std::to_string(options.densityOrientationRadius),
-                                       "0 (off) or a radius in texels"));
-    }
-    m.densityRadius = options.densityOrientationRadius;
+    m.densityRadius = options.orientationDensity;
     PointField orientationAtPoints;
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});

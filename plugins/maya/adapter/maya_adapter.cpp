@@ -13,6 +13,7 @@
 #include "deformkit/host/deformers.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
+#include "deformkit/uvwarp/options.h"
 
 namespace deformkit::maya {
 
@@ -334,41 +335,90 @@ void RedirectCore::setMaps(const io::Image& rigidity, const io::Image& mask, con
 
 namespace {
 
-// The derived mask's label only names the mesh in errors.
+// Every option equal (the derived mask's label only names the mesh in errors).
 bool sameOptions(const uvwarp::TileWarpOptions& a, const uvwarp::TileWarpOptions& b) {
-    return a.cells == b.cells && a.dilationRings == b.dilationRings &&
-           a.densityOrientationRadius == b.densityOrientationRadius &&
-           a.derivedMask.borderWidth == b.derivedMask.borderWidth && a.solver == b.solver;
+    const auto specs = uvwarp::optionSpecs();
+    return std::all_of(specs.begin(), specs.end(),
+                       [&](const uvwarp::OptionSpec& spec) { return spec.get(a) == spec.get(b); });
 }
 
 }  // namespace
 
-std::vector<int32_t> sweepsFromText(std::string_view text) {
-    std::vector<int32_t> out;
-    size_t i = 0;
-    const auto fail = [&](const std::string& problem) {
-        throw InvalidInput(
-            formatError("dkUvRedirect", "sweepsPerLevel", "'" + std::string(text) + "' " + problem,
-                        "whole numbers >= 0 separated by spaces, finest level first (\"4 8 8\")"));
-    };
-    while (i < text.size()) {
-        if (text[i] == ' ' || text[i] == ',' || text[i] == '\t') {
-            ++i;
-            continue;
-        }
-        size_t end = i;
-        while (end < text.size() && text[end] != ' ' && text[end] != ',' && text[end] != '\t')
-            ++end;
-        const std::string_view word = text.substr(i, end - i);
-        int32_t value = 0;
-        const auto [ptr, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
-        if (ec != std::errc() || ptr != word.data() + word.size()) fail("has '" + std::string(word) + "'");
-        if (value < 0) fail("has a negative count");
-        out.push_back(value);
-        i = end;
-    }
-    if (out.empty()) fail("lists no sweeps");
+namespace {
+
+// 'text', for messages.
+std::string quoted(std::string_view text) {
+    std::string out(text.size() + 2, '\'');
+    std::copy(text.begin(), text.end(), out.begin() + 1);
     return out;
+}
+
+}  // namespace
+
+std::vector<RedirectOptionAttribute> redirectOptionAttributes() {
+    std::vector<RedirectOptionAttribute> out;
+    const uvwarp::TileWarpOptions defaults;
+    for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
+        RedirectOptionAttribute a;
+        a.spec = &spec;
+        const std::vector<double> value = spec.get(defaults);
+        switch (spec.type) {
+            case uvwarp::OptionType::Integer:
+                a.kind = RedirectOptionAttribute::Kind::Int;
+                break;
+            case uvwarp::OptionType::Number:
+                a.kind = RedirectOptionAttribute::Kind::Double;
+                break;
+            case uvwarp::OptionType::Flag:
+                a.kind = RedirectOptionAttribute::Kind::Boolean;
+                break;
+            case uvwarp::OptionType::IntegerList:
+                a.kind = RedirectOptionAttribute::Kind::Text;
+                a.text = uvwarp::valueText(spec, value);
+                break;
+        }
+        if (a.kind != RedirectOptionAttribute::Kind::Text) a.number = value.front();
+        out.push_back(std::move(a));
+    }
+    return out;
+}
+
+void setRedirectOption(RedirectInputs& in, const RedirectOptionAttribute& attribute, double number,
+                       std::string_view text) {
+    using Kind = uvwarp::OptionValue::Kind;
+    uvwarp::OptionValue value;
+    value.numbers = {number};
+    if (attribute.kind == RedirectOptionAttribute::Kind::Boolean) {
+        value.kind = Kind::Boolean;
+        value.numbers = {number != 0 ? 1.0 : 0.0};
+    } else if (attribute.kind == RedirectOptionAttribute::Kind::Text) {
+        // Whole numbers separated by spaces, commas or tabs; the library checks their range.
+        value.kind = Kind::List;
+        value.numbers.clear();
+        size_t i = 0;
+        while (i < text.size() && value.kind == Kind::List) {
+            if (text[i] == ' ' || text[i] == ',' || text[i] == '\t') {
+                ++i;
+                continue;
+            }
+            size_t end = i;
+            while (end < text.size() && text[end] != ' ' && text[end] != ',' && text[end] != '\t')
+                ++end;
+            double x = 0.0;
+            const auto [ptr, ec] = std::from_chars(text.data() + i, text.data() + end, x);
+            if (ec != std::errc() || ptr != text.data() + end) {
+                value.kind = Kind::Other;
+                value.shown = quoted(text);
+            }
+            value.numbers.push_back(x);
+            i = end;
+        }
+        if (value.kind == Kind::List && value.numbers.empty()) {
+            value.kind = Kind::Other;
+            value.shown = quoted(text) + ", which lists no number";
+        }
+    }
+    uvwarp::setOption(in.options, *attribute.spec, value, "dkUvRedirect", attribute.spec->name);
 }
 
 std::string fileAt(const std::string& pattern, int tile, int frame) {

@@ -15,7 +15,7 @@
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/stack.h"
 #include "deformkit/io/image.h"
-#include "deformkit/uvwarp/tile_warp.h"
+#include "deformkit/uvwarp/options.h"
 
 // The Maya plugin's translation layer, free of Maya headers so it is built and tested everywhere: Maya's
 // conventions (row-vector matrices, ramp attributes, world-space controls) turned into host-layer
@@ -186,9 +186,8 @@ class NodeCore {
 };
 
 // dkUvRedirect's attributes: the maps as file patterns (<UDIM> for the tile; #### for the frame, 4 digits,
-// in an animated map: one file per frame), the tile, and the solver's options (TileWarpOptions: grid cells,
-// iterations, tolerance, sweeps per level, orientation preservation, smoothing, damping, coarse stiffness,
-// coarse relaxation, hierarchy levels, the density orientation heuristic's radius).
+// in an animated map: one file per frame), the tile, and one attribute per UV-warp option
+// (redirectOptionAttributes).
 struct RedirectInputs {
     int tile = 1001;
     std::string rigidity;     // required
@@ -197,10 +196,22 @@ struct RedirectInputs {
     uvwarp::TileWarpOptions options;
 };
 
-// The node's sweepsPerLevel string ("4 8 8": sweeps per level, finest first, separated by spaces or commas)
-// as SolverOptions::sweepsPerLevel. Throws InvalidInput quoting the text for an empty list, a word that is
-// not a whole number, or a negative count.
-[[nodiscard]] std::vector<int32_t> sweepsFromText(std::string_view text);
+// The attribute of one UV-warp option (uvwarp/options.h): named as declared (camelCase, the short name the
+// same), an int, double or boolean attribute with the library's default, or for a list a string of whole
+// numbers separated by spaces or commas ("4 8 8").
+struct RedirectOptionAttribute {
+    enum class Kind { Int, Double, Boolean, Text };
+    const uvwarp::OptionSpec* spec = nullptr;
+    Kind kind = Kind::Int;
+    double number = 0.0;  // the default of Int, Double and Boolean attributes
+    std::string text;     // the default of a Text attribute
+};
+[[nodiscard]] std::vector<RedirectOptionAttribute> redirectOptionAttributes();
+
+// Sets the option of `attribute` in `in` from the attribute's value: `number` for Int, Double and Boolean
+// attributes, `text` for Text ones. The library checks it; InvalidInput names dkUvRedirect and the attribute.
+void setRedirectOption(RedirectInputs& in, const RedirectOptionAttribute& attribute, double number,
+                       std::string_view text);
 
 // A file pattern at a tile and frame: <UDIM> replaced by the tile, a frame token in the file name (####,
 // %04d; io::ObjSequence) by the frame; an empty pattern stays empty.

@@ -32,12 +32,10 @@ geom::Mesh meshWithUVs(const MObject& data, const std::string& what) {
 
 const MTypeId DkUvRedirect::id(0x0013A6C5);
 MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, DkUvRedirect::mask,
-    DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::resolution, DkUvRedirect::iterations,
-    DkUvRedirect::tolerance, DkUvRedirect::sweepsPerLevel, DkUvRedirect::orientationPreservation,
-    DkUvRedirect::smoothing, DkUvRedirect::damping, DkUvRedirect::coarseStiffness,
-    DkUvRedirect::coarseRelaxation, DkUvRedirect::levels, DkUvRedirect::maxLevels,
-    DkUvRedirect::coldIterations, DkUvRedirect::densityRadius, DkUvRedirect::output, DkUvRedirect::time,
+    DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::output, DkUvRedirect::time,
     DkUvRedirect::outFile;
+std::vector<RedirectOptionAttribute> DkUvRedirect::optionSpecs;
+std::vector<MObject> DkUvRedirect::options;
 
 MStatus DkUvRedirect::initialize() {
     MFnTypedAttribute typed;
@@ -45,40 +43,38 @@ MStatus DkUvRedirect::initialize() {
     addAttribute(inMesh);
     restMesh = typed.create("restMesh", "rsm", MFnData::kMesh);
     addAttribute(restMesh);
-    const std::tuple<MObject*, const char*, const char*> strings[] = {
-        {&rigidity, "rigidity", "rig"},
-        {&mask, "mask", "msk"},
-        {&orientation, "orientation", "ori"},
-        {&sweepsPerLevel, "sweepsPerLevel", "spl"},
-        {&output, "output", "out"}};
+    const std::tuple<MObject*, const char*, const char*> strings[] = {{&rigidity, "rigidity", "rig"},
+                                                                      {&mask, "mask", "msk"},
+                                                                      {&orientation, "orientation", "ori"},
+                                                                      {&output, "output", "out"}};
     for (const auto& [attribute, name, shortName] : strings) {
         MFnTypedAttribute fn;
         *attribute = fn.create(name, shortName, MFnData::kString);
         addAttribute(*attribute);
     }
-    // The solver's options, with the library's defaults (uvwarp::SolverOptions, TileWarpOptions).
-    const uvwarp::TileWarpOptions defaults;
-    const std::tuple<MObject*, const char*, const char*, MFnNumericData::Type, double> numbers[] = {
-        {&tile, "tile", "til", MFnNumericData::kInt, 1001},
-        {&resolution, "resolution", "res", MFnNumericData::kInt, 0},
-        {&iterations, "iterations", "itr", MFnNumericData::kInt, defaults.solver.iterations},
-        {&tolerance, "tolerance", "tol", MFnNumericData::kDouble, defaults.solver.tolerance},
-        {&orientationPreservation, "orientationPreservation", "orp", MFnNumericData::kDouble,
-         defaults.solver.orientationPreservation},
-        {&smoothing, "smoothing", "smt", MFnNumericData::kDouble, defaults.solver.smoothing},
-        {&damping, "damping", "dmp", MFnNumericData::kDouble, defaults.solver.damping},
-        {&coarseStiffness, "coarseStiffness", "cst", MFnNumericData::kDouble,
-         defaults.solver.coarseStiffness},
-        {&coarseRelaxation, "coarseRelaxation", "crx", MFnNumericData::kDouble,
-         defaults.solver.coarseRelaxation},
-        {&levels, "levels", "lvl", MFnNumericData::kInt, defaults.solver.levels},
-        {&maxLevels, "maxLevels", "mxl", MFnNumericData::kInt, defaults.solver.maxLevels},
-        {&coldIterations, "coldIterations", "cit", MFnNumericData::kInt, defaults.solver.coldIterations},
-        {&densityRadius, "densityRadius", "dnr", MFnNumericData::kInt, defaults.densityOrientationRadius}};
-    for (const auto& [attribute, name, shortName, type, value] : numbers) {
-        MFnNumericAttribute fn;
-        *attribute = fn.create(name, shortName, type, value);
-        addAttribute(*attribute);
+    MFnNumericAttribute tileFn;
+    tile = tileFn.create("tile", "til", MFnNumericData::kInt, 1001);
+    addAttribute(tile);
+    // One attribute per UV-warp option, named as the library declares it, with the library's default.
+    optionSpecs = redirectOptionAttributes();
+    options.clear();
+    for (const RedirectOptionAttribute& a : optionSpecs) {
+        const MString name(std::string(a.spec->name).c_str());
+        MObject attribute;
+        if (a.kind == RedirectOptionAttribute::Kind::Text) {
+            MFnTypedAttribute fn;
+            MFnStringData text;
+            attribute = fn.create(name, name, MFnData::kString, text.create(MString(a.text.c_str())));
+        } else {
+            const MFnNumericData::Type type =
+                a.kind == RedirectOptionAttribute::Kind::Int      ? MFnNumericData::kInt
+                : a.kind == RedirectOptionAttribute::Kind::Double ? MFnNumericData::kDouble
+                                                                  : MFnNumericData::kBoolean;
+            MFnNumericAttribute fn;
+            attribute = fn.create(name, name, type, a.number);
+        }
+        addAttribute(attribute);
+        options.push_back(attribute);
     }
     MFnUnitAttribute unit;
     time = unit.create("time", "tim", MFnUnitAttribute::kTime, 0.0);
@@ -87,28 +83,10 @@ MStatus DkUvRedirect::initialize() {
     typed.setWritable(false);
     typed.setStorable(false);
     addAttribute(outFile);
-    for (MObject* in : {&inMesh,
-                        &restMesh,
-                        &rigidity,
-                        &mask,
-                        &orientation,
-                        &tile,
-                        &resolution,
-                        &iterations,
-                        &tolerance,
-                        &sweepsPerLevel,
-                        &orientationPreservation,
-                        &smoothing,
-                        &damping,
-                        &coarseStiffness,
-                        &coarseRelaxation,
-                        &levels,
-                        &maxLevels,
-                        &coldIterations,
-                        &densityRadius,
-                        &output,
-                        &time})
+    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &tile, &output, &time})
         attributeAffects(*in, outFile);
+    for (const MObject& option : options)
+        attributeAffects(option, outFile);
     return MS::kSuccess;
 }
 
@@ -120,22 +98,23 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
         in.rigidity = block.inputValue(rigidity).asString().asChar();
         in.mask = block.inputValue(mask).asString().asChar();
         in.orientation = block.inputValue(orientation).asString().asChar();
-        in.options.cells = block.inputValue(resolution).asInt();
-        in.options.densityOrientationRadius = block.inputValue(densityRadius).asInt();
-        uvwarp::SolverOptions& solver = in.options.solver;
-        solver.iterations = block.inputValue(iterations).asInt();
-        solver.tolerance = static_cast<float>(block.inputValue(tolerance).asDouble());
-        const std::string sweeps = block.inputValue(sweepsPerLevel).asString().asChar();
-        if (!sweeps.empty()) solver.sweepsPerLevel = sweepsFromText(sweeps);
-        solver.orientationPreservation =
-            static_cast<float>(block.inputValue(orientationPreservation).asDouble());
-        solver.smoothing = static_cast<float>(block.inputValue(smoothing).asDouble());
-        solver.damping = static_cast<float>(block.inputValue(damping).asDouble());
-        solver.coarseStiffness = static_cast<float>(block.inputValue(coarseStiffness).asDouble());
-        solver.coarseRelaxation = static_cast<float>(block.inputValue(coarseRelaxation).asDouble());
-        solver.levels = block.inputValue(levels).asInt();
-        solver.maxLevels = block.inputValue(maxLevels).asInt();
-        solver.coldIterations = block.inputValue(coldIterations).asInt();
+        for (size_t i = 0; i < optionSpecs.size(); ++i) {
+            MDataHandle value = block.inputValue(options[i]);
+            switch (optionSpecs[i].kind) {
+                case RedirectOptionAttribute::Kind::Int:
+                    setRedirectOption(in, optionSpecs[i], value.asInt(), {});
+                    break;
+                case RedirectOptionAttribute::Kind::Double:
+                    setRedirectOption(in, optionSpecs[i], value.asDouble(), {});
+                    break;
+                case RedirectOptionAttribute::Kind::Boolean:
+                    setRedirectOption(in, optionSpecs[i], value.asBool() ? 1.0 : 0.0, {});
+                    break;
+                case RedirectOptionAttribute::Kind::Text:
+                    setRedirectOption(in, optionSpecs[i], 0.0, value.asString().asChar());
+                    break;
+            }
+        }
         const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
         if (node_.needsBuild(in)) {
             node_.build(meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar()), in, frame,

@@ -301,9 +301,9 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
     }
     SECTION("a resolution that is not a power of two") {
         Scene s;
-        s.command.resolution = 24;
+        s.command.options.cells = 24;
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
-                   Catch::Contains("--resolution: 24") && Catch::Contains("power of two"));
+                   Catch::Contains("option resolution: is 24") && Catch::Contains("power of two"));
     }
     SECTION("a mask of another size than the rigidity map") {
         Scene s;
@@ -320,7 +320,7 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("rig.1001.exr") && Catch::Contains("48 texels per side"));
         // With the grid's size given, the map is resampled and the redirect keeps the map's size.
-        s.command.resolution = 32;
+        s.command.options.cells = 32;
         s.command.frames = {1};
         (void)harness::uvwarpCommand(s.command);
         const io::Image redirect = io::readImage(s.redirect(1));

@@ -6,14 +6,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <functional>
 #include <new>
 
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
-#include "deformkit/uvwarp/tile_warp.h"
+#include "deformkit/uvwarp/options.h"
 #include "maya_adapter.h"
 #include "test_support.h"
 
@@ -474,26 +473,93 @@ TEST_CASE(
     changed.options.solver.sweepsPerLevel = {1, 4, 8};
     CHECK(node.needsBuild(changed));
     CHECK_THROWS_WITH(node.solve(changed, 6, pose(6)), Catch::Contains("not built for these inputs"));
-    const std::function<void(uvwarp::SolverOptions&)> changes[] = {[](auto& o) { o.coarseRelaxation = 1.4f; },
-                                                                   [](auto& o) { o.maxLevels = 3; },
-                                                                   [](auto& o) { o.coldIterations = 2; }};
-    for (const auto& change : changes) {
-        maya::RedirectInputs other = still;
-        change(other.options.solver);
-        CHECK(node.needsBuild(other));
-    }
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");
     CHECK_THROWS_WITH(fresh.solve(in, 3, pose(3)), Catch::Contains("rig.1001.0003.exr"));
 }
 
-TEST_CASE("maya adapter: sweepsPerLevel text", "[maya]") {
-    CHECK(maya::sweepsFromText("4 8 8") == std::vector<int32_t>{4, 8, 8});
-    CHECK(maya::sweepsFromText(" 1,4, 8 ") == std::vector<int32_t>{1, 4, 8});
-    CHECK_THROWS_WITH(maya::sweepsFromText("4 x 8"), Catch::Contains("'4 x 8' has 'x'"));
-    CHECK_THROWS_WITH(maya::sweepsFromText("4 -1"), Catch::Contains("negative"));
-    CHECK_THROWS_WITH(maya::sweepsFromText("  "), Catch::Contains("lists no sweeps"));
+TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named and ranged as declared",
+          "[maya][uvwarp]") {
+    // Walks the declaration (uvwarp/options.h): every option has an attribute of its own name and type with
+    // the library's default; a value in range reaches the node's options (and makes the node rebuild), values
+    // just outside it are refused naming the node, the attribute and the range.
+    using Kind = maya::RedirectOptionAttribute::Kind;
+    const std::vector<maya::RedirectOptionAttribute> attributes = maya::redirectOptionAttributes();
+    const std::span<const uvwarp::OptionSpec> specs = uvwarp::optionSpecs();
+    REQUIRE(attributes.size() == specs.size());
+    const uvwarp::TileWarpOptions defaults;
+    maya::RedirectNode node;
+    const geom::Mesh mesh = geom::makeGrid({4, 4, 1.0f, 1.0f});
+    const test::TempDir dir;
+    io::writeImage(dir.path() / "rig.1001.exr", diskMap(16, 0.5, 0.5, 0.2), {io::PixelType::Float, {}});
+    maya::RedirectInputs base;
+    base.rigidity = (dir.path() / "rig.<UDIM>.exr").string();
+    node.build(mesh, base, 1, "dkUvRedirect1");
+    for (size_t i = 0; i < specs.size(); ++i) {
+        const maya::RedirectOptionAttribute& a = attributes[i];
+        const uvwarp::OptionSpec& spec = specs[i];
+        const std::string name(spec.name);
+        CAPTURE(name);
+        REQUIRE(a.spec == &spec);
+        const std::vector<double> value = spec.get(defaults);
+        const double first = value.front();
+        // A value in range other than the default, and values just outside the range.
+        double inRange = 0.0, above = spec.high + 1.0, below = spec.lowOpen ? spec.low : spec.low - 1.0;
+        std::string text;
+        switch (spec.type) {
+            case uvwarp::OptionType::Flag:
+                CHECK(a.kind == Kind::Boolean);
+                CHECK(a.number == first);
+                inRange = first != 0 ? 0.0 : 1.0;
+                break;
+            case uvwarp::OptionType::Integer:
+                CHECK(a.kind == Kind::Int);
+                CHECK(a.number == first);
+                inRange = spec.powerOfTwo ? 8.0 : first < spec.high ? first + 1.0 : first - 1.0;
+                break;
+            case uvwarp::OptionType::Number:
+                CHECK(a.kind == Kind::Double);
+                CHECK(a.number == first);
+                inRange = first < spec.high ? (first + spec.high) / 2 : (spec.low + spec.high) / 2;
+                above = spec.high + 0.5;
+                if (!spec.lowOpen) below = spec.low - 0.5;
+                break;
+            case uvwarp::OptionType::IntegerList:
+                CHECK(a.kind == Kind::Text);
+                CHECK(a.text == "4 8 8");
+                text = "2, 3 5";
+                break;
+        }
+        maya::RedirectInputs in = base;
+        maya::setRedirectOption(in, a, inRange, text);
+        const std::vector<double> got = spec.get(in.options);
+        if (spec.type == uvwarp::OptionType::IntegerList) {
+            CHECK(got == std::vector<double>{2, 3, 5});
+        } else {
+            CHECK(got.front() == (spec.type == uvwarp::OptionType::Number
+                                      ? static_cast<double>(static_cast<float>(inRange))
+                                      : inRange));
+        }
+        CHECK(node.needsBuild(in));
+        const auto refused = [&](double number, const std::string& listText) {
+            maya::RedirectInputs bad = base;
+            CHECK_THROWS_WITH(maya::setRedirectOption(bad, a, number, listText),
+                              Catch::StartsWith("dkUvRedirect: " + name + ": is ") &&
+                                  Catch::EndsWith("(expected " + uvwarp::expectedValue(spec) + ")"));
+        };
+        if (spec.type == uvwarp::OptionType::IntegerList) {
+            refused(0, "4 1001");
+            refused(0, "4 -1");
+            refused(0, "0 0");
+            refused(0, "4 x 8");
+            refused(0, "  ");
+        } else if (spec.type != uvwarp::OptionType::Flag) {
+            refused(above, "");
+            refused(below, "");
+        }
+    }
+    CHECK_FALSE(node.needsBuild(base));
 }
 
 TEST_CASE("uv warp: a warm solve allocates nothing, on one thread or two", "[maya][uvwarp]") {

@@ -146,7 +146,7 @@ TEST_CASE("tile warp: the density heuristic for orientation preservation", "[uvw
     const geom::Mesh plane = uvPlane(8);
     const std::vector<glm::vec3> squeezed = stretched(plane, 0.5f);  // severe compression
     uvwarp::TileWarpOptions options;
-    options.densityOrientationRadius = r;
+    options.orientationDensity = r;
     uvwarp::TileWarp heuristic(plane, 1001, rigidity, {}, options);
     uvwarp::TileWarp painted(plane, 1001, rigidity, {}, {}, density);
     uvwarp::TileWarp uniform(plane, 1001, rigidity);

@@ -9,6 +9,7 @@
 
 namespace deformkit::uvwarp {
 
+// Ranges, defaults and each option's name in the CLI, scenes, Python and Maya: uvwarp/options.h.
 struct SolverOptions {
     // Hierarchy depth (paper §4.4): number of levels including the finest. 0 picks it from the warp mask:
     // down to an 8-cell grid, but no level whose points are farther apart than a third of the widest chart's

@@ -16,6 +16,8 @@
 
 namespace deformkit::uvwarp {
 
+// Every option's range, default and name in each interface (`resolution` for cells, `maskBorderWidth` for
+// derivedMask.borderWidth): uvwarp/options.h, which checks them.
 struct TileWarpOptions {
     // Grid cells per side (a power of two); 0 = the rigidity map's resolution T.
     int32_t cells = 0;
@@ -24,7 +26,7 @@ struct TileWarpOptions {
     int32_t dilationRings = 4;       // geometry-image dilation past chart borders
     // > 0: without a painted orientation map, the paper's heuristic for severe compression
     // (densityOrientationMap of the rigidity map with this window radius, texels); 0: 1 everywhere.
-    int32_t densityOrientationRadius = 0;
+    int32_t orientationDensity = 0;
 };
 
 // The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's

@@ -183,7 +183,12 @@ class MFnEnumAttribute : public MFnAttribute {
 };
 class MFnTypedAttribute : public MFnAttribute {
   public:
-    MObject create(const MString&, const MString&, MFnData::Type);
+    MObject create(const MString&, const MString&, MFnData::Type, const MObject& = MObject::kNullObj,
+                   MStatus* = nullptr);
+};
+class MFnStringData {
+  public:
+    MObject create(const MString&, MStatus* = nullptr);
 };
 class MFnUnitAttribute : public MFnAttribute {
   public:
