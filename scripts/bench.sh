@@ -7,7 +7,8 @@
 #   DEFORMKIT_BUILD_DIR=build-perf ./scripts/bench.sh    benchmarks of another build folder
 #
 # When `blender` is on PATH, scripts/bench_blender.py also times Blender's Lattice and SimpleDeform modifiers
-# on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios (issue 3).
+# on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios
+# (target: ours at least 3x faster than Blender's modifier).
 # With Blender and the staged add-on ($build/blender), tests/bench/blender_slide_frame_change.py also times
 # frame changes of a 99,602-vertex mesh with and without the add-on's slide (about 500 active vertices) and
 # prints their ratio after the table.

@@ -1,5 +1,5 @@
 """Times Blender's Lattice and SimpleDeform modifiers on the benchmarks' 1,001,000-vertex grid, headless,
-as the in-run reference for our FFD and Barr evaluates (issue 3, "Performance").
+as the in-run reference for our FFD and Barr evaluates.
 
     blender -b --factory-startup --python scripts/bench_blender.py -- [--reps N] [--out FILE]
 

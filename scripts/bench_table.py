@@ -23,17 +23,17 @@ REFERENCES = {
     # UV warp: the memory floor makes the same passes over the same arrays as a solve with trivial arithmetic;
     # < 1 is the floor's share of the solve's time. All-thread ratios are in the uvwarp section below.
     "BM_UvWarpSolve1Thread": ("BM_UvWarpFloor1Thread", "floor / solve, same passes, 1 thread"),
-    # Issue 6: the host layer per frame against the same work through the core (target: <= 5% slower).
+    # The host layer per frame against the same work through the core (target: <= 5% slower).
     "BM_HostEvaluate": ("BM_HostDirect", "host / direct core calls, throughput (target >= 0.952)"),
     # A 100-frame, 2-tile shot: its farm plan's tasks run one after the other in one process, against one
     # eval of the whole shot (the cost of cutting it into tasks: scene loading, cold starts per task).
     "BM_FarmRunPlan": ("BM_FarmEval", "farm tasks / one eval, frames per second"),
-    # Ptex (issue 7): a 50k-face float RGB file read whole against a plain read of its bytes, and zlib
+    # Ptex: a 50k-face float RGB file read whole against a plain read of its bytes, and zlib
     # alone inflating the same texels as one stream against the whole read (zlib's share of it); writing it
     # against zlib alone deflating the same texels.
-    # Issue 19: an animated UV-warp frame on Spot (warm solve + redirect map) against the last frame solved
+    # An animated UV-warp frame on Spot (warm solve + redirect map) against the last frame solved
     # cold to convergence, frames per second (the quality gap is the gap_pts counter).
-    # Issue 19, part 5: one 2048^2 iteration while another process holds a core; < 1 is faster than 1 thread.
+    # One 2048^2 iteration while another process holds a core; < 1 is faster than 1 thread (target: <= 1).
     "BM_UvWarpContendedAllThreads": ("BM_UvWarpContended1Thread", "time ratio: all threads / 1, a core taken"),
     "BM_UvWarpContendedChosen": ("BM_UvWarpContended1Thread", "time ratio: chosen team / 1, a core taken"),
     "BM_UvWarpFrame": ("BM_UvWarpFrameConverged", "animated frame / converged cold solve, frames per second"),
@@ -43,7 +43,7 @@ REFERENCES = {
     "BM_PtexVertexValues": ("BM_PtexCornerLoop", "vertex values / minimal corner loop, 1M vertices"),
 }
 
-# Issue 5: paper Table 1 (GTX Titan GPU), ms, and the targets for a 2048^2 solve on a 2-core machine:
+# Paper Table 1 (GTX Titan GPU), ms, and the targets for a 2048^2 solve on 2 cores:
 # within 10x the paper's time, within 3x the memory floor; peak memory <= 64 bytes per finest texel.
 # Paper Table 1 (GTX Titan). Its solve figure is one hierarchical iteration with one sweep per level
 # (docs/decisions.md UV-13): compared with BM_UvWarpIteration; the full solve's ratio is printed too.
@@ -62,7 +62,7 @@ UVWARP_FLOOR_TARGET = 3.0
 UVWARP_BYTES_TARGET = 64.0
 
 
-# Our evaluate benchmark -> (Blender modifier in bench_blender.py's JSON, row label). Issue 3's target:
+# Our evaluate benchmark -> (Blender modifier in bench_blender.py's JSON, row label). The target:
 # ours at least 3x faster than Blender's modifier share.
 BLENDER_PAIRS = [
     ("BM_FfdEvaluate", "lattice", "FFD Bernstein 4x4x4 / Lattice (B-spline)"),
@@ -139,7 +139,7 @@ def print_blender(blender, medians, context):
 
 
 def print_uvwarp(medians):
-    """Issue 5's figures: ms per solve, solve / memory floor, ours / paper, 1-thread speed-up, memory."""
+    """The UV solver's figures: ms per solve, solve / memory floor, ours / paper, 1-thread speed-up, memory."""
     def ms(run):
         return run["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[run["time_unit"]]
 
@@ -151,7 +151,7 @@ def print_uvwarp(medians):
     if not rows:
         return
     print()
-    print("# UV warp (issue 5), all threads; paper = Table 1, GTX Titan GPU. Targets at 2048^2: "
+    print("# UV warp, all threads; paper = Table 1, GTX Titan GPU. Targets at 2048^2: "
           f"<= {UVWARP_PAPER_TARGET:g}x paper, <= {UVWARP_FLOOR_TARGET:g}x floor, "
           f"<= {UVWARP_BYTES_TARGET:g} bytes per texel")
     print(f"{'benchmark':24} {'ms':>10} {'floor ms':>10} {'/ floor':>9} {'paper ms':>9} {'/ paper':>9} "
@@ -187,12 +187,12 @@ def print_uvwarp(medians):
 
 
 def print_host(medians):
-    """Issue 6: the host layer's per-frame overhead over direct core calls (target <= 5%)."""
+    """The host layer's per-frame overhead over direct core calls (target <= 5%)."""
     rows = sorted(n for n in medians if n.startswith("BM_HostOverheadPaired/"))
     if not rows:
         return
     print()
-    print("# Host layer per frame (issue 6): SceneEvaluator vs the same work through the core, frame after frame "
+    print("# Host layer per frame: SceneEvaluator vs the same work through the core, frame after frame "
           "in alternation; target <= 5% more")
     for name in rows:
         run = medians[name]

@@ -1,4 +1,4 @@
-// Farm throughput (issue 6): a 100-frame shot of two UDIM tiles, one object (two 64 x 64 quad grids, one
+// Farm throughput: a 100-frame shot of two UDIM tiles, one object (two 64 x 64 quad grids, one
 // per tile, 8,450 vertices) under a keyframed twist and the UV warp (64 x 64 rigidity maps, 6 iterations per
 // frame, each from the identity: the scene's default). BM_FarmRunPlan runs every task of its farm plan
 // (--chunk 10, 6 warm-up frames, which frames solved from the identity skip; one tile per UV-warp task: 10

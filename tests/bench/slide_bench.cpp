@@ -2,7 +2,7 @@
 // middle whose radius makes 500 (the paper's Maya figure), 10k, 100k or all vertices active. Bind and
 // evaluate are timed apart; evaluate is timed in the steady state of a drag (local maps grown by one
 // evaluate first) on all threads and on one (the speed-up), and the first evaluate after bind, which grows
-// the maps, on its own. Issue target: 100k active vertices evaluated in under one 60 Hz frame (16.7 ms) on
+// the maps, on its own. Target: 100k active vertices evaluated in under one 60 Hz frame (16.7 ms) on
 // 2 cores.
 //
 // In-run reference (scripts/bench_table.py): a soft translate of the same active vertices, what a
@@ -313,7 +313,7 @@ BENCHMARK(BM_SlideSoftTranslate1Thread)
     ->MinTime(0.3)
     ->UseRealTime();
 
-// 100k-vertex mesh, 10k active, all threads (issue target for the changing input: 16 ms on 2 cores).
+// 100k-vertex mesh, 10k active, all threads (target for the changing input: 16 ms on 2 cores).
 BENCHMARK(BM_SlideFrameChangingInput)->Unit(benchmark::kMillisecond)->MinTime(0.5)->UseRealTime();
 BENCHMARK(BM_SlideFrameSteadyInput)->Unit(benchmark::kMillisecond)->MinTime(0.5)->UseRealTime();
 

@@ -1,4 +1,4 @@
-// Content-aware UV warp (Koniaris et al., uvwarp/solver.h and uvwarp/inversion.h), issue 5's performance
+// Content-aware UV warp (Koniaris et al., uvwarp/solver.h and uvwarp/inversion.h): the performance
 // section. Scene: the plane of the solver's unit tests, stretched 1.5x along u, with nine rigid disks
 // (radius 0.07, 3 x 3 lattice) on an elastic background, handed to the solver directly as grid-point fields
 // so the solver is timed and not the rasteriser. One "full solve" = one Solver::solve with the default
@@ -14,7 +14,7 @@
 // it: docs/decisions.md UV-13). BM_UvWarpIteration times exactly that on a warm solver (SolverOptions
 // iterations 1, sweepsPerLevel {1}); our default per-frame solve does 12 iterations with {1, 2, 4} sweeps.
 // Every row with a paper figure carries paper_ratio = our ms / the paper's ms (floor rows: what the floor
-// alone costs against the paper's figure). Issue targets on a 2-core machine: 2048^2 solve within 10x the
+// alone costs against the paper's figure). Targets on 2 cores: 2048^2 solve within 10x the
 // paper's time and within 3x the memory floor (below); peak memory <= 64 bytes per finest-level texel.
 //
 // In-run reference, the memory floor (BM_UvWarpFloor): the same passes over the same arrays, level by level,
@@ -24,7 +24,7 @@
 //
 // BM_UvWarpMemory: peak heap bytes per finest texel from building the caller's fields through the first
 // solve, counted by this program's operator new (peak of live bytes), cross-checked with mallinfo2();
-// and the number of allocations a warm solve makes (the issue asks for none in the iteration loop).
+// and the number of allocations a warm solve makes (target: none in the iteration loop).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 #include <omp.h>
@@ -572,13 +572,13 @@ void BM_UvWarpMemory(benchmark::State& state) {
     }
 }
 
-// ---- Next to other work (issue 19, part 5)
+// ---- Next to other work
 // -----------------------------------------------------------------
 //
 // One warm iteration at 1024^2 (the paper's schedule) while another process keeps one of the machine's cores
 // busy (a shell loop spinning for the benchmark's duration), with the solver's team size fixed at one thread,
 // fixed at all threads, and chosen by the solver (SolverOptions::threads = 0, the default). The reference is
-// the one-thread row: the issue asks that all threads never be slower than one when a core is taken. The
+// the one-thread row: all threads must never be slower than one when a core is taken. The
 // competitor only matters on a machine with few cores (it takes one of 2 here).
 // The competitor is a shell loop started by posix_spawn: a fork of this process would share its pages copy-
 // on-write, and the solver's first writes after it would pay for copying them.

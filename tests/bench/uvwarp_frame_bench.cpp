@@ -1,4 +1,4 @@
-// What a user pays per frame of an animated UV warp (issue 19, part 4): on a real layout (Keenan Crane's
+// What a user pays per frame of an animated UV warp: on a real layout (Keenan Crane's
 // Spot, tests/data/spot, tile 1001) with rigid disks painted inside its charts, a 24-frame animation that
 // stretches the model from 1x to 1.4x along its length, played through one TileWarp. A frame is the geometry
 // image of the deformed mesh, the warm-started solve and the redirect map; frame 1 (the rest pose, which
@@ -11,10 +11,10 @@
 // first frame solved with 2 iterations (docs/decisions.md UV-28, UV-30: presets measured within 2 points of
 // the converged default solve on every probed frame, on Spot and on Bob).
 // Counters:
-// frame_ms (median), target_ratio = frame_ms / the issue's target on 2 cores (1024^2: 33 ms, 2048^2:
+// frame_ms (median), target_ratio = frame_ms / the target on 2 cores (1024^2: 33 ms, 2048^2:
 // 141 ms), solve_ms and redirect_ms (medians; solve includes the geometry image), iterations per frame,
 // reduction_pct (rigid stretch error removed on the last frame, WarpMetrics) and gap_pts = the converged
-// cold solve's reduction minus it (the issue asks for <= 2 points), worst_gap_pts = the largest such gap
+// cold solve's reduction minus it (target: <= 2 points), worst_gap_pts = the largest such gap
 // over frames 4, 7, 13 and 24 (each against that frame's converged solve: a warm start lags most early in
 // the shot, while the motion builds up, and catches up by the last frame), folds on the last frame.
 // BM_UvWarpColdFrame/T/k/r: the first frame of a shot, cold (binding, k default iterations, redirect map) on
@@ -220,7 +220,7 @@ void BM_UvWarpFrame(benchmark::State& state) {
 
 // The first frame of a shot, cold: the tile bound (geometry images, hierarchy) and the last, most stretched
 // frame solved from the identity with `iterations` iterations of the default sweeps, plus its redirect map:
-// what a farm task or a scrub to a new shot pays before warm starts help (the issue's target: 1 s at 2048^2).
+// what a farm task or a scrub to a new shot pays before warm starts help (target: 1 s at 2048^2).
 void BM_UvWarpColdFrame(benchmark::State& state) {
     const auto texels = static_cast<int32_t>(state.range(0));
     const Inputs& in = inputs(texels);

@@ -185,7 +185,7 @@ def checked_case(label, min_edges, floor, **case):
 
 
 def test_spot_stretched_keeps_rigid_disks_inside_charts():
-    # Measured 85.1% (the issue's target for real layouts: 85%).
+    # Measured 85.1% (the target for real layouts: 85%).
     removed, solver_removed = checked_case("Spot 1.4x, disks inside charts", 10000, 0.82, clip_to_charts=True)
     assert abs(solver_removed - removed) < 0.1  # the solver's own figure agrees to within a tenth
 
@@ -199,9 +199,9 @@ def test_spot_stretched_keeps_rigid_disks_that_chart_borders_cut():
 
 def test_spot_bent_keeps_every_grid_triangle():
     # A bend drives points of the grid against the pinned chart borders, where the hierarchy's propagation
-    # used to fold 15 triangles (73 at 512^2) that the neighbours' mean could not repair; every iteration
-    # now ends fold-free (docs/decisions.md, UV-16). spot_case asserts no folded triangle anywhere. Measured
-    # 76.4% (the issue's target for a bend: 75%).
+    # can fold triangles that the neighbours' mean cannot repair; every iteration ends fold-free
+    # (docs/decisions.md, UV-16). spot_case asserts no folded triangle anywhere. Measured
+    # 76.4% (the target for a bend: 75%).
     checked_case("Spot bent, disks inside charts", 10000, 0.73, clip_to_charts=True, pose="bend")
 
 

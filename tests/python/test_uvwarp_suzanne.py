@@ -35,8 +35,7 @@ def test_suzanne_shot_from_blender_keeps_rigid_disks_frame_after_frame():
         print(f"Suzanne frame {frame}: error {before:.4f} -> {after:.4f}")
     print("removed per frame:", " ".join(f"{100 * r:.1f}%" for r in removed))
     # Measured 57.3, 68.8, 74.1, 76.4, 77.4% (frames 2-6): the warm start follows the animation, and the
-    # more the pose deforms the more of its error is removed. Before UV-16 to UV-19 a similar Blender shot of
-    # Suzanne lost 40-49% with 57-1,575 inverted grid cells.
+    # more the pose deforms the more of its error is removed.
     assert removed[-1] > 0.74
     assert all(r > 0.5 for r in removed)
     assert all(b >= a - 0.01 for a, b in zip(removed, removed[1:]))

@@ -3,10 +3,10 @@
 // Private to the FFD (ffd.cpp and ffd_kernels_<isa>.cpp): the kernels of the Bernstein 4x4x4 lattice
 // (divisions 3, 3, 3; translations), one per instruction set (simd/cpu.h).
 //
-// The cubic lattice of issue 3's benchmark. Every point is reached by all 64 controls, so every point reads
-// the same translations: eight points are evaluated together in SoA form (one lane per point), each
-// translation component broadcast once per block. The sum order is the per-point path's (ffd.cpp, windowSum):
-// over (i, j) first, with the k weights applied at the end.
+// The cubic lattice of the FFD benchmark (tests/bench/ffd_bench.cpp). Every point is reached by all 64
+// controls, so every point reads the same translations: eight points are evaluated together in SoA form (one
+// lane per point), each translation component broadcast once per block. The sum order is the per-point path's
+// (ffd.cpp, windowSum): over (i, j) first, with the k weights applied at the end.
 
 #include <cstring>
 

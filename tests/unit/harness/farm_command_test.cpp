@@ -341,8 +341,8 @@ TEST_CASE("farm submit: --sbatch-args splits like a shell", "[harness][farm]") {
 
 TEST_CASE("eval and farm plan check every input before any work: a vertex out of range, no rigidity map",
           "[harness][farm][eval][errors]") {
-    // The second object's slide handle is vertex 99999 of a 60-vertex tube: eval used to write the first
-    // object's frame 1 before finding it, and farm plan accepted it (every task then failed).
+    // The second object's slide handle is vertex 99999 of a 60-vertex tube: eval must find it before it
+    // writes the first object's frame 1, and farm plan before it plans tasks that would all fail.
     Shot shot;
     std::string text = kScene;
     text.replace(text.find(R"({"type": "bend")"), 0,

@@ -543,7 +543,7 @@ io::Image redirectIn(const fs::path& folder, int tile, int frame) {
 
 }  // namespace
 
-// Issue 19, part 3: a frame's redirect map must not depend on where its farm chunk began. A 24-frame shot,
+// A frame's redirect map must not depend on where its farm chunk began. A 24-frame shot,
 // warm-started, in chunks of 8: at the chunk starts (frames 9 and 17, whose warm-up does not reach back to
 // frame 1) the maps of the farm tasks against those of one uninterrupted eval, largest difference over the
 // tile in texels. With the default warm-up (6 frames) it must be at most 0.25 texel; without warm-up it is
@@ -577,7 +577,7 @@ TEST_CASE(
     CHECK(jumps[0] > 0.25);
 }
 
-// Issue 19, part 3, by construction: with every frame solved from the identity (a scene's default) a frame's
+// By construction: with every frame solved from the identity (a scene's default) a frame's
 // map depends on that frame alone, so farm tasks in chunks of 8, without warm-up, write every frame's map
 // byte for byte as one uninterrupted eval does. Warm-started, the same chunks differ (the test could fail).
 TEST_CASE("scene uvwarp: frames solved from the identity make chunked maps the uninterrupted run's bytes",

@@ -1,4 +1,4 @@
-// Invariants of the UV-warp solver on any input (issue 19, part 1), over random cases with a fixed seed:
+// Invariants of the UV-warp solver on any input, over random cases with a fixed seed:
 // every grid triangle keeps its orientation (counted here, not by the solver), no value is NaN, the tile
 // border and masked points stay where they are. And the convergence stop (SolverOptions::tolerance) and the
 // choice of OpenMP team (SolverOptions::threads).

@@ -106,7 +106,7 @@ TEST_CASE("uv warp keeps rigid disks at rest size on a plane stretched 1.5x alon
     INFO("rigid stretch error: identity " << before << ", warp " << after << ", removed "
                                           << 100.0 * (1.0 - after / before) << "%, untangled "
                                           << solver.stats().untangledPoints);
-    CHECK(after <= 0.2 * before);  // the issue's "at least 80% removed"
+    CHECK(after <= 0.2 * before);  // at least 80% removed
     CHECK(uvwarp::countFolds(warp) == 0);
     CHECK(solver.stats().remainingFolds == 0);
 }
@@ -119,7 +119,7 @@ TEST_CASE("uv warp under 0.7x compression removes at least half the rigid error"
     const double after = rigidStretchError(warp, s.rest, s.deformed, s.rigidity);
     INFO("compression 0.7: identity " << before << " warp " << after << " untangled "
                                       << solver.stats().untangledPoints);
-    CHECK(after <= 0.5 * before);  // the issue's "at least 50%": a bounded domain cannot grow every feature
+    CHECK(after <= 0.5 * before);  // at least 50%: a bounded domain cannot grow every feature
     CHECK(uvwarp::countFolds(warp) == 0);
 }
 
@@ -295,8 +295,9 @@ TEST_CASE("uv warp: bad solver input names what is wrong", "[uvwarp]") {
 // cells; the figures in the comments were measured on it.
 namespace {
 
-// The schedule the figures of these tests were measured with (the defaults before UV-19): 12 iterations of
-// sweeps {1, 2, 4}. An option's effect is the test's subject, not the schedule's.
+// The schedule the figures of these tests were measured with: 12 iterations of sweeps {1, 2, 4}, one sweep
+// per level doubling towards the coarsest as the paper's solve does. An option's effect is the test's
+// subject, not the schedule's.
 uvwarp::SolverOptions paperSchedule() {
     uvwarp::SolverOptions options;
     options.iterations = 12;

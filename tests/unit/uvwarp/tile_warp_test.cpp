@@ -59,7 +59,7 @@ TEST_CASE("tile warp: a UV-mapped plane stretched 1.5x keeps its rigid disks, fo
     tile.solve(stretched(mesh, 1.5f));
     const uvwarp::WarpMetrics m = tile.metrics();
     INFO("rigid stretch error: identity " << m.identityStretchError << ", warp " << m.rigidStretchError);
-    CHECK(m.rigidStretchError <= 0.2 * m.identityStretchError);  // at least 80% removed (issue)
+    CHECK(m.rigidStretchError <= 0.2 * m.identityStretchError);  // at least 80% removed
     CHECK(m.foldOvers == 0);
     CHECK(m.maxMaskedDisplacement == 0.0);
     CHECK(m.maxBorderDisplacement == 0.0);
@@ -68,7 +68,7 @@ TEST_CASE("tile warp: a UV-mapped plane stretched 1.5x keeps its rigid disks, fo
     const io::Image redirect = tile.redirect();
     REQUIRE(redirect.width == 128);
     REQUIRE(redirect.channels == 2);
-    // W(W^-1(uv)) = uv within half a texel over the tile (issue).
+    // W(W^-1(uv)) = uv within half a texel over the tile.
     const uvwarp::InversionError e = uvwarp::inversionError(tile.warp(), redirect);
     INFO("inversion error max " << e.maxTexels << " texels, mean " << e.meanTexels);
     CHECK(e.maxTexels < 0.5);

@@ -28,7 +28,7 @@ struct DerivedMaskOptions {
     std::string label = "mesh";  // names the mesh in errors
 };
 
-// The warp mask of `tile` when none is given (issue "Inputs"): a T x T x 1 image, T = `texels`, that is 0
+// The warp mask of `tile` when none is given: a T x T x 1 image, T = `texels`, that is 0
 // at texels whose centre lies outside every UV triangle of the tile (rasterised, top-left rule) and at
 // texels on chart borders, 1 elsewhere. Chart borders are the UV edges of the tile's faces not used as
 // often in one direction as in the other, UVs being welded by value: unwelded per-corner UVs still form

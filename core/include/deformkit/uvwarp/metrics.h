@@ -6,7 +6,7 @@
 
 namespace deformkit::uvwarp {
 
-// Quality figures of a warp (issue "Quality"), measured on the grid.
+// Quality figures of a warp, measured on the solver's grid.
 struct MetricsOptions {
     // Unit of the displacements: texels of a T x T map; 0 measures in grid cells (texels when n = T).
     int32_t texels = 0;

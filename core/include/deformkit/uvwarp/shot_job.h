@@ -28,10 +28,13 @@ namespace deformkit::uvwarp {
 // `uvwarp_shot` and the Blender add-on's bake.
 //
 // - Per tile one TileWarp is bound (rest mesh, rigidity map, mask map or a mask derived from the UVs,
-//   orientation map) and solved frame after frame in ascending order, each frame warm-started from the
-//   previous one; a job starts cold at its first frame (a warm-up frame, ShotJob::warmUpFrames, if it
-//   has any). Tiles are solved frame by frame together, so each frame's deformed positions are asked for
-//   once; memory is one solver per tile of the job (a farm task bounds it with its tile count).
+//   orientation map) and solved frame after frame in ascending order. With the shot's options
+//   (shotOptions(), the default of every host's shot) each frame is solved from the identity, so its maps
+//   depend on that frame alone. With warm start (SolverOptions::warmStart) each frame starts from the
+//   previous one's warp instead, and a job starts cold at its first frame (or at its warm-up frames,
+//   ShotJob::warmUpFrames). Tiles are solved frame by frame together, so each frame's deformed positions
+//   are asked for once; memory is one solver per tile of the job (a farm task bounds it with its tile
+//   count).
 // - Outputs per tile and frame: the redirect map as a 2-channel float EXR (the rigidity map's size) whose
 //   header records how it was made (deformkit:version, deformkit:uvwarp:tile, deformkit:uvwarp:frame,
 //   deformkit:uvwarp:solver and deformkit:uvwarp:inputs, the last two JSON); with a texture, the bake
