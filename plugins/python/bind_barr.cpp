@@ -1,6 +1,6 @@
 // Python bindings of Barr's taper, twist and bend (core/include/deformkit/warp/barr.h): one-off functions
 // taper/twist/bend and Taper/Twist/Bend classes that bind once and evaluate many times, plus the host
-// parameter conversions (barr_host.h). numpy float32 in and out.
+// parameter conversions (barr_dcc.h). numpy float32 in and out.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -13,7 +13,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 #include "numpy_support.h"
 
 namespace py = pybind11;

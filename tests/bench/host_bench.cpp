@@ -19,7 +19,7 @@
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 
 namespace {
 

@@ -19,7 +19,7 @@ constexpr std::array kTypes = {
         detail::makeBeierNeelyDeformer},
     DeformerType{
         "bend",
-        "Maya's nonLinear bend (warp/barr_host.h fromMayaBend) on Barr's bend, bending along handle Y "
+        "Maya's nonLinear bend (warp/barr_dcc.h fromMayaBend) on Barr's bend, bending along handle Y "
         "towards handle +X.",
         detail::makeBendDeformer},
     DeformerType{"ffd",
@@ -51,7 +51,7 @@ constexpr std::array kTypes = {
         "Barr's taper with a handle in the Maya style: the two coordinates across handle Y are scaled by "
         "startScale at lowBound and endScale at highBound, linearly in between, held beyond.",
         detail::makeTaperDeformer},
-    DeformerType{"twist", "Maya's nonLinear twist (warp/barr_host.h fromMayaTwist) on Barr's twist.",
+    DeformerType{"twist", "Maya's nonLinear twist (warp/barr_dcc.h fromMayaTwist) on Barr's twist.",
                  detail::makeTwistDeformer},
     DeformerType{"wires",
                  "Singh and Fiume's Wires (warp/wires.h, the fast path), one wire or several; curves are "

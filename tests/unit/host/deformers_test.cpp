@@ -12,7 +12,7 @@
 #include "deformkit/host/deformers.h"
 #include "deformkit/slide/slider.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/wires.h"
 #include "host/host_test_support.h"

@@ -16,7 +16,7 @@
 #include "deformkit/host/stack.h"
 #include "deformkit/slide/slider.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 #include "deformkit/warp/ffd.h"
 #include "host/host_test_support.h"
 #include "slide/slide_test_support.h"

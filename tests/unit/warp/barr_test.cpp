@@ -15,7 +15,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 #include "deformkit/warp/engine.h"
 
 using namespace deformkit;

@@ -13,7 +13,8 @@
 
 namespace deformkit::warp {
 
-// Barr's (1984) global deformations cast in the framework (paper §4.3): one parameterised
+// Barr's (1984) global deformations, taper (TaperWarp), twist (TwistWarp) and bend (BendWarp), cast in the
+// framework (paper §4.3); as Maya and Blender parameterise them: barr_dcc.h. One parameterised
 // transformation T(v) selected per point by the point's coordinate z along a deformation axis, strength 1,
 // weight 1 on that point's own sample (the per-point sampling of footnote 13). Binding caches each rest
 // point's z; evaluation builds the transformations from the current controls (profile, bend rate...).

@@ -1,4 +1,4 @@
-// "twist", "bend", "taper": Barr's warps with a handle in the Maya style (warp/barr.h, warp/barr_host.h).
+// "twist", "bend", "taper": Barr's warps with a handle in the Maya style (warp/barr.h, warp/barr_dcc.h).
 
 #include <algorithm>
 #include <memory>
@@ -9,7 +9,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/barr.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 #include "deformkit/warp/profile_curve.h"
 #include "host/deformers/families.h"
 #include "host/deformers/param_values.h"

@@ -1,4 +1,4 @@
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/warp/barr_host.h"
+#include "deformkit/warp/barr_dcc.h"
 
 using namespace deformkit;
 using namespace deformkit::warp;

@@ -12,7 +12,8 @@
 
 namespace deformkit::warp {
 
-// The parameterisations hosts expose for taper, twist and bend, mapped onto Barr's parameters (barr.h).
+// Taper, twist and bend as DCCs parameterise them (Maya's nonLinear deformers, Blender's SimpleDeform
+// modifier), mapped onto Barr's parameters (barr.h: TaperWarp, TwistWarp, BendWarp).
 // The Maya mappings are the host layer's twist and bend deformers (host/deformers.h), which the Maya nodes,
 // the Blender add-on and scenes use. The Blender SimpleDeform mappings reproduce Blender's own modifier;
 // the Python module exposes them (blender_simple_deform_params), which the tests use to compare with Blender.
