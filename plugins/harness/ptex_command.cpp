@@ -182,6 +182,25 @@ int8_t parseFaceResolution(const std::string& text) {
                                    "auto or a power of two from 1 to 32768 (texels per face side)"));
 }
 
+namespace {
+
+// How a command writes a Ptex file, as typed: texels per face side (--face-res) and the data type (--type).
+struct PtexOutputOptions {
+    std::string faceRes;
+    std::string type = "float";
+
+    void declare(Command& command, const std::string& faceResHelp) {
+        command.option("--face-res", faceRes, faceResHelp).showDefault();
+        command.option("--type", type, "u8, u16, half or float").showDefault();
+    }
+    void apply(int8_t& faceLog2, ptex::DataType& dataType) const {
+        faceLog2 = parseFaceResolution(faceRes);
+        dataType = parsePtexType(type);
+    }
+};
+
+}  // namespace
+
 void addPtexCommands(CommandLine& cli) {
     Command ptex = cli.group("ptex", "Ptex files: describe, per-vertex values, UDIM conversions");
 
@@ -194,41 +213,32 @@ void addPtexCommands(CommandLine& cli) {
         .option("FILE", *infoFile, "Ptex file (.ptx)")
         .required();
 
-    struct ToVertex {
-        PtexToVertexCommand command;
-        std::string file, mesh, out;
-    };
-    auto tv = std::make_shared<ToVertex>();
+    auto tv = std::make_shared<PtexToVertexCommand>();
     Command toVertex =
         cli.add(ptex, "to-vertex", "Per-vertex values of a Ptex map as a JSON weights file", [tv] {
-            tv->command.ptex = tv->file;
-            tv->command.mesh = tv->mesh;
-            tv->command.out = tv->out;
-            const size_t count = ptexToVertexCommand(tv->command);
-            std::cout << "wrote " << tv->out << ": " << count << " vertex values\n";
+            const size_t count = ptexToVertexCommand(*tv);
+            std::cout << "wrote " << tv->out.string() << ": " << count << " vertex values\n";
             return 0;
         });
-    toVertex.option("FILE", tv->file, "Ptex file painted on MESH").required();
+    toVertex.option("FILE", tv->ptex, "Ptex file painted on MESH").required();
     toVertex.option("MESH", tv->mesh, "mesh (.obj)").required();
     toVertex.option("--out", tv->out, "weights file (.json)").required();
-    toVertex.option("--channel", tv->command.channel, "channel").showDefault();
+    toVertex.option("--channel", tv->channel, "channel").showDefault();
 
     struct ToUdim {
         PtexToUdimCommand command;
-        std::string file, mesh, tiles;
+        std::string tiles;
     };
     auto tu = std::make_shared<ToUdim>();
     Command toUdim =
         cli.add(ptex, "to-udim", "Render a Ptex map into UDIM tile images through the mesh's UVs", [tu] {
-            tu->command.ptex = tu->file;
-            tu->command.mesh = tu->mesh;
             if (!tu->tiles.empty()) tu->command.tiles = parseTiles(tu->tiles);
             for (const auto& f : ptexToUdimCommand(tu->command))
                 std::cout << "wrote " << f.string() << "\n";
             return 0;
         });
-    toUdim.option("FILE", tu->file, "Ptex file painted on MESH").required();
-    toUdim.option("MESH", tu->mesh, "mesh (.obj) with UVs").required();
+    toUdim.option("FILE", tu->command.ptex, "Ptex file painted on MESH").required();
+    toUdim.option("MESH", tu->command.mesh, "mesh (.obj) with UVs").required();
     toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
     toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
     toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
@@ -237,50 +247,41 @@ void addPtexCommands(CommandLine& cli) {
 
     struct FromUdim {
         PtexFromUdimCommand command;
-        std::string mesh, out, faceRes = "auto", type = "float";
+        PtexOutputOptions output{"auto"};
     };
     auto fu = std::make_shared<FromUdim>();
     Command fromUdim =
         cli.add(ptex, "from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs", [fu] {
-            fu->command.mesh = fu->mesh;
-            fu->command.out = fu->out;
-            fu->command.faceLog2 = parseFaceResolution(fu->faceRes);
-            fu->command.type = parsePtexType(fu->type);
+            fu->output.apply(fu->command.faceLog2, fu->command.type);
             const int32_t withoutUVs = ptexFromUdimCommand(fu->command);
             if (withoutUVs > 0) {
                 std::cout << withoutUVs << (withoutUVs == 1 ? " face has" : " faces have")
                           << " no UVs: written as 0\n";
             }
-            std::cout << "wrote " << fu->out << "\n";
+            std::cout << "wrote " << fu->command.out.string() << "\n";
             return 0;
         });
     fromUdim.option("PATTERN", fu->command.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
-    fromUdim.option("MESH", fu->mesh, "mesh (.obj) with UVs").required();
-    fromUdim.option("--out", fu->out, "Ptex file (.ptx)").required();
-    fromUdim.option("--face-res", fu->faceRes, "texels per face side: auto or a power of two").showDefault();
-    fromUdim.option("--type", fu->type, "u8, u16, half or float").showDefault();
+    fromUdim.option("MESH", fu->command.mesh, "mesh (.obj) with UVs").required();
+    fromUdim.option("--out", fu->command.out, "Ptex file (.ptx)").required();
+    fu->output.declare(fromUdim, "texels per face side: auto or a power of two");
 
     struct FromVertex {
         PtexFromVertexCommand command;
-        std::string weights, mesh, out, faceRes = "16", type = "float";
+        PtexOutputOptions output{"16"};
     };
     auto fv = std::make_shared<FromVertex>();
     Command fromVertex =
         cli.add(ptex, "from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file", [fv] {
-            fv->command.weights = fv->weights;
-            fv->command.mesh = fv->mesh;
-            fv->command.out = fv->out;
-            fv->command.faceLog2 = parseFaceResolution(fv->faceRes);
-            fv->command.type = parsePtexType(fv->type);
+            fv->output.apply(fv->command.faceLog2, fv->command.type);
             ptexFromVertexCommand(fv->command);
-            std::cout << "wrote " << fv->out << "\n";
+            std::cout << "wrote " << fv->command.out.string() << "\n";
             return 0;
         });
-    fromVertex.option("WEIGHTS", fv->weights, "weights file (.json), one per vertex").required();
-    fromVertex.option("MESH", fv->mesh, "mesh (.obj)").required();
-    fromVertex.option("--out", fv->out, "Ptex file (.ptx)").required();
-    fromVertex.option("--face-res", fv->faceRes, "texels per face side, a power of two").showDefault();
-    fromVertex.option("--type", fv->type, "u8, u16, half or float").showDefault();
+    fromVertex.option("WEIGHTS", fv->command.weights, "weights file (.json), one per vertex").required();
+    fromVertex.option("MESH", fv->command.mesh, "mesh (.obj)").required();
+    fromVertex.option("--out", fv->command.out, "Ptex file (.ptx)").required();
+    fv->output.declare(fromVertex, "texels per face side, a power of two");
 }
 
 }  // namespace deformkit::harness

@@ -79,6 +79,16 @@ py::dict frameDict(const AxisFrame& f) {
     return d;
 }
 
+// Keyword arguments of bend() for a bend set up from a host's parameters.
+py::dict bendDict(const warp::BendSetup& s) {
+    py::dict d = frameDict(s.frame);
+    d["rate"] = s.params.rate;
+    d["centre"] = s.params.centre;
+    d["lo"] = s.params.lo;
+    d["hi"] = s.params.hi;
+    return d;
+}
+
 }  // namespace
 
 // The one-off function of a profile-driven axial warp (taper, twist): bind to `points`, deform a copy.
@@ -192,13 +202,7 @@ void bindBarr(py::module_& m) {
                                 curvature,
                                 lowBound,
                                 highBound};
-            const warp::BendSetup s = warp::fromMayaBend(maya);
-            py::dict d = frameDict(s.frame);
-            d["rate"] = s.params.rate;
-            d["centre"] = s.params.centre;
-            d["lo"] = s.params.lo;
-            d["hi"] = s.params.hi;
-            return d;
+            return bendDict(warp::fromMayaBend(maya));
         },
         "handle_origin"_a, "handle_x"_a, "handle_y"_a, "curvature"_a, "low_bound"_a = -1.0,
         "high_bound"_a = 1.0,
@@ -235,13 +239,7 @@ void bindBarr(py::module_& m) {
             b.upperLimit = limits.second;
             const std::vector<glm::vec3> pts = pointsOf(points, "Blender SimpleDeform", "points");
             if (mode == "BEND") {
-                const warp::BendSetup s = warp::fromBlenderBend(b, pts);
-                py::dict d = frameDict(s.frame);
-                d["rate"] = s.params.rate;
-                d["centre"] = s.params.centre;
-                d["lo"] = s.params.lo;
-                d["hi"] = s.params.hi;
-                return d;
+                return bendDict(warp::fromBlenderBend(b, pts));
             }
             if (mode != "TWIST" && mode != "TAPER") {
                 throw InvalidInput(

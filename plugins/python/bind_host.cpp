@@ -128,14 +128,10 @@ std::span<glm::vec3> inplacePoints(py::handle points) {
 
 py::list parameterList(const std::vector<host::ParamInfo>& infos) {
     py::list out;
+    using namespace pybind11::literals;
     for (const host::ParamInfo& p : infos) {
-        py::dict d;
-        d["name"] = p.name;
-        d["components"] = p.components;
-        d["rebinds"] = p.rebinds;
-        d["doc"] = p.doc;
-        d["stride"] = p.stride;
-        out.append(std::move(d));
+        out.append(py::dict("name"_a = p.name, "components"_a = p.components, "rebinds"_a = p.rebinds,
+                            "doc"_a = p.doc, "stride"_a = p.stride));
     }
     return out;
 }

@@ -205,28 +205,29 @@ py::array_t<float> gridArray(const uvwarp::WarpGrid& w) {
     return out;
 }
 
+// Figures as a dict, by the names the library reports them under (uvwarp/metrics.h).
+void addFigures(py::dict& d, const std::vector<uvwarp::ReportedFigure>& figures) {
+    for (const uvwarp::ReportedFigure& f : figures) {
+        const py::str name(f.name.data(), f.name.size());
+        if (f.kind == uvwarp::ReportedFigure::Kind::Count) {
+            d[name] = py::int_(static_cast<int64_t>(f.value));
+        } else if (f.kind == uvwarp::ReportedFigure::Kind::Flag) {
+            d[name] = py::bool_(f.value != 0);
+        } else {
+            d[name] = py::float_(f.value);
+        }
+    }
+}
+
 py::dict metricsDict(const uvwarp::WarpMetrics& m) {
     py::dict d;
-    d["rigid_stretch_error"] = m.rigidStretchError;
-    d["identity_stretch_error"] = m.identityStretchError;
-    d["rigid_edges"] = m.rigidEdges;
-    d["skipped_edges"] = m.skippedEdges;
-    d["fold_overs"] = m.foldOvers;
-    d["max_masked_displacement"] = m.maxMaskedDisplacement;
-    d["max_border_displacement"] = m.maxBorderDisplacement;
-    d["points_outside"] = m.pointsOutside;
+    addFigures(d, uvwarp::reportedFigures(m));
     return d;
 }
 
 py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
     py::dict d = metricsDict(m);
-    d["iterations"] = s.iterations;
-    d["levels"] = s.levels;
-    d["untangled_points"] = s.untangledPoints;
-    d["reverted_points"] = s.revertedPoints;
-    d["remaining_folds"] = s.remainingFolds;
-    d["last_move"] = s.lastMove;
-    d["converged"] = s.converged;
+    addFigures(d, uvwarp::reportedFigures(s));
     return d;
 }
 
@@ -411,13 +412,9 @@ class PyProgress final : public Interrupter {
 };
 
 py::dict tileReportDict(const uvwarp::ShotTileReport& t) {
-    py::dict d;
-    d["warped"] = t.warped;
-    d["written"] = t.written;
-    d["baked"] = t.baked;
-    d["replayed"] = t.replayed;
-    d["skipped"] = t.skipped;
-    d["map_changes"] = t.mapChanges;
+    using namespace pybind11::literals;
+    py::dict d("warped"_a = t.warped, "written"_a = t.written, "baked"_a = t.baked, "replayed"_a = t.replayed,
+               "skipped"_a = t.skipped, "map_changes"_a = t.mapChanges);
     const bool solved = t.written + t.replayed > 0;
     d["last_frame"] = solved ? py::object(py::int_(t.lastFrame)) : py::none();
     d["metrics"] = solved ? py::object(metricsDict(t.lastMetrics)) : py::none();

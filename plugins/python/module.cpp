@@ -161,15 +161,10 @@ PYBIND11_MODULE(deformkit, m) {
             py::dict attributes;
             for (const auto& [name, value] : info.attributes)
                 attributes[py::str(name)] = value;
-            py::dict out;
-            out["width"] = info.width;
-            out["height"] = info.height;
-            out["channels"] = info.channels;
-            out["format"] = info.format;
-            out["pixel_type"] = info.pixelType;
-            out["channel_names"] = info.channelNames;
-            out["attributes"] = attributes;
-            return out;
+            using namespace pybind11::literals;
+            return py::dict("width"_a = info.width, "height"_a = info.height, "channels"_a = info.channels,
+                            "format"_a = info.format, "pixel_type"_a = info.pixelType,
+                            "channel_names"_a = info.channelNames, "attributes"_a = attributes);
         },
         py::arg("path"),
         "Read an image's header only: a dict of width, height, channels, format (\"openexr\", \"png\", "

@@ -106,35 +106,28 @@ TrianglePoint closestOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const 
     auto result = [&p](const glm::dvec3& q, const glm::dvec3& bary) {
         return TrianglePoint{glm::dot(p - q, p - q), q, bary};
     };
-    const glm::dvec3 ap = p - a;
+    // The point t of the way along the edge from corner i (at `from`, direction `along`) to corner j.
+    auto onEdge = [&](const glm::dvec3& from, const glm::dvec3& along, double t, int i, int j) {
+        glm::dvec3 bary(0.0);
+        bary[i] = 1.0 - t;
+        bary[j] = t;
+        return result(from + t * along, bary);
+    };
+    // Vertex regions, then the edge regions between them (Ericson's d1..d6 and va, vb, vc).
+    const glm::dvec3 ap = p - a, bp = p - b, cp = p - c;
     const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) return result(a, {1.0, 0.0, 0.0});
-
-    const glm::dvec3 bp = p - b;
     const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
     if (d3 >= 0.0 && d4 <= d3) return result(b, {0.0, 1.0, 0.0});
-
     const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        const double v = d1 / (d1 - d3);
-        return result(a + v * ab, {1.0 - v, v, 0.0});
-    }
-
-    const glm::dvec3 cp = p - c;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return onEdge(a, ab, d1 / (d1 - d3), 0, 1);
     const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
     if (d6 >= 0.0 && d5 <= d6) return result(c, {0.0, 0.0, 1.0});
-
     const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        const double w = d2 / (d2 - d6);
-        return result(a + w * ac, {1.0 - w, 0.0, w});
-    }
-
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return onEdge(a, ac, d2 / (d2 - d6), 0, 2);
     const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
-        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return result(b + w * (c - b), {0.0, 1.0 - w, w});
-    }
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
+        return onEdge(b, c - b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), 1, 2);
 
     const double denom = 1.0 / (va + vb + vc);
     const double v = vb * denom, w = vc * denom;
@@ -342,6 +335,41 @@ Box3 Bvh::bounds() const {
     return nodes_.empty() ? Box3{} : nodes_[0].box;
 }
 
+template <class Key, class Limit, class Visit>
+void Bvh::descend(float rootKey, const Key& key, const Limit& limit, const Visit& visit) const {
+    struct Entry {
+        int32_t node;
+        float key;
+    };
+    std::array<Entry, kStackSize> stack;
+    int top = 0;
+    // An infinite key (a box the ray misses) is pruned even when the limit is infinite too.
+    const auto reaches = [&](float k) { return k != std::numeric_limits<float>::infinity() && k <= limit(); };
+    if (reaches(rootKey)) stack[top++] = {0, rootKey};
+    while (top > 0) {
+        const Entry entry = stack[--top];
+        if (entry.key > limit()) continue;
+        int32_t node = entry.node;
+        while (true) {
+            const Node& n = nodes_[node];
+            if (n.count > 0) {
+                for (int32_t i = n.first; i < n.first + n.count; ++i)
+                    visit(order_[i]);
+                break;
+            }
+            int32_t near = n.first, far = n.first + 1;
+            float nearKey = key(nodes_[near].box), farKey = key(nodes_[far].box);
+            if (farKey < nearKey) {
+                std::swap(near, far);
+                std::swap(nearKey, farKey);
+            }
+            if (!reaches(nearKey)) break;
+            if (reaches(farKey)) stack[top++] = {far, farKey};
+            node = near;
+        }
+    }
+}
+
 Bvh::ClosestPoint Bvh::closestPoint(const glm::vec3& query, float maxDistance) const {
     if (!geom::isFinite(query)) {
         throw InvalidInput(
@@ -357,46 +385,19 @@ Bvh::ClosestPoint Bvh::closestPoint(const glm::vec3& query, float maxDistance) c
     const glm::dvec3 p(query);
     double best2 = static_cast<double>(maxDistance) * maxDistance;
     TrianglePoint best;
-    struct Entry {
-        int32_t node;
-        float distance2;
-    };
-    std::array<Entry, kStackSize> stack;
-    int top = 0;
-    stack[top++] = {0, boxDistance2(nodes_[0].box, query)};
-    while (top > 0) {
-        const Entry entry = stack[--top];
-        if (entry.distance2 > best2) continue;
-        int32_t node = entry.node;
-        while (true) {
-            const Node& n = nodes_[node];
-            if (n.count > 0) {
-                for (int32_t i = n.first; i < n.first + n.count; ++i) {
-                    const int32_t t = order_[i];
-                    const auto& tri = triangles_[t];
-                    const TrianglePoint c =
-                        closestOnTriangle(p, glm::dvec3(points_[tri[0]]), glm::dvec3(points_[tri[1]]),
-                                          glm::dvec3(points_[tri[2]]));
-                    if (c.distance2 < best2 || (result.triangle < 0 && c.distance2 <= best2)) {
-                        best2 = c.distance2;
-                        best = c;
-                        result.triangle = t;
-                    }
-                }
-                break;
+    descend(
+        boxDistance2(nodes_[0].box, query), [&](const Box3& box) { return boxDistance2(box, query); },
+        [&] { return best2; },
+        [&](int32_t t) {
+            const auto& tri = triangles_[t];
+            const TrianglePoint c = closestOnTriangle(
+                p, glm::dvec3(points_[tri[0]]), glm::dvec3(points_[tri[1]]), glm::dvec3(points_[tri[2]]));
+            if (c.distance2 < best2 || (result.triangle < 0 && c.distance2 <= best2)) {
+                best2 = c.distance2;
+                best = c;
+                result.triangle = t;
             }
-            int32_t near = n.first, far = n.first + 1;
-            float nearD2 = boxDistance2(nodes_[near].box, query),
-                  farD2 = boxDistance2(nodes_[far].box, query);
-            if (farD2 < nearD2) {
-                std::swap(near, far);
-                std::swap(nearD2, farD2);
-            }
-            if (nearD2 > best2) break;
-            if (farD2 <= best2) stack[top++] = {far, farD2};
-            node = near;
-        }
-    }
+        });
     if (result.triangle >= 0) {
         result.point = glm::vec3(best.point);
         result.distance = static_cast<float>(std::sqrt(best.distance2));
@@ -423,50 +424,23 @@ std::optional<Bvh::RayHit> Bvh::intersectRay(const glm::vec3& origin, const glm:
     double bestT = tMax;
     int32_t bestTriangle = -1;
     TriangleHit best;
-    struct Entry {
-        int32_t node;
-        float entry;
-    };
-    std::array<Entry, kStackSize> stack;
-    int top = 0;
     auto limit = [&] { return static_cast<float>(bestT) * (1.0f + kBoxSlack) + kBoxSlack; };
-    const float rootEntry = rayBoxEntry(nodes_[0].box, origin, direction, inverse, tMin, tMax);
-    if (rootEntry != std::numeric_limits<float>::infinity()) stack[top++] = {0, rootEntry};
-    while (top > 0) {
-        const Entry entry = stack[--top];
-        if (entry.entry > limit()) continue;
-        int32_t node = entry.node;
-        while (true) {
-            const Node& n = nodes_[node];
-            if (n.count > 0) {
-                for (int32_t i = n.first; i < n.first + n.count; ++i) {
-                    const int32_t t = order_[i];
-                    const auto& tri = triangles_[t];
-                    TriangleHit hit;
-                    if (!intersectTriangle(o, d, glm::dvec3(points_[tri[0]]), glm::dvec3(points_[tri[1]]),
-                                           glm::dvec3(points_[tri[2]]), hit)) {
-                        continue;
-                    }
-                    if (hit.t >= tMin && (hit.t < bestT || (bestTriangle < 0 && hit.t <= bestT))) {
-                        bestT = hit.t;
-                        best = hit;
-                        bestTriangle = t;
-                    }
-                }
-                break;
+    descend(
+        rayBoxEntry(nodes_[0].box, origin, direction, inverse, tMin, tMax),
+        [&](const Box3& box) { return rayBoxEntry(box, origin, direction, inverse, tMin, limit()); }, limit,
+        [&](int32_t t) {
+            const auto& tri = triangles_[t];
+            TriangleHit hit;
+            if (!intersectTriangle(o, d, glm::dvec3(points_[tri[0]]), glm::dvec3(points_[tri[1]]),
+                                   glm::dvec3(points_[tri[2]]), hit)) {
+                return;
             }
-            int32_t near = n.first, far = n.first + 1;
-            float nearT = rayBoxEntry(nodes_[near].box, origin, direction, inverse, tMin, limit());
-            float farT = rayBoxEntry(nodes_[far].box, origin, direction, inverse, tMin, limit());
-            if (farT < nearT) {
-                std::swap(near, far);
-                std::swap(nearT, farT);
+            if (hit.t >= tMin && (hit.t < bestT || (bestTriangle < 0 && hit.t <= bestT))) {
+                bestT = hit.t;
+                best = hit;
+                bestTriangle = t;
             }
-            if (nearT == std::numeric_limits<float>::infinity()) break;
-            if (farT != std::numeric_limits<float>::infinity()) stack[top++] = {far, farT};
-            node = near;
-        }
-    }
+        });
     if (bestTriangle < 0) return std::nullopt;
     RayHit hit;
     hit.t = static_cast<float>(best.t);

@@ -177,4 +177,16 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
     return out;
 }
 
+std::vector<ReportedFigure> reportedFigures(const WarpMetrics& m) {
+    using Kind = ReportedFigure::Kind;
+    return {{"rigid_stretch_error", Kind::Number, m.rigidStretchError},
+            {"identity_stretch_error", Kind::Number, m.identityStretchError},
+            {"rigid_edges", Kind::Count, static_cast<double>(m.rigidEdges)},
+            {"skipped_edges", Kind::Count, static_cast<double>(m.skippedEdges)},
+            {"fold_overs", Kind::Count, static_cast<double>(m.foldOvers)},
+            {"max_masked_displacement", Kind::Number, m.maxMaskedDisplacement},
+            {"max_border_displacement", Kind::Number, m.maxBorderDisplacement},
+            {"points_outside", Kind::Count, static_cast<double>(m.pointsOutside)}};
+}
+
 }  // namespace deformkit::uvwarp

@@ -84,19 +84,20 @@ double tidy(float value) {
 }
 
 json metricsJson(const WarpMetrics& m, const SolveStats& s) {
-    return {{"rigid_stretch_error", m.rigidStretchError},
-            {"identity_stretch_error", m.identityStretchError},
-            {"rigid_edges", m.rigidEdges},
-            {"skipped_edges", m.skippedEdges},
-            {"fold_overs", m.foldOvers},
-            {"max_masked_displacement", m.maxMaskedDisplacement},
-            {"max_border_displacement", m.maxBorderDisplacement},
-            {"points_outside", m.pointsOutside},
-            {"iterations", s.iterations},
-            {"levels", s.levels},
-            {"untangled_points", s.untangledPoints},
-            {"reverted_points", s.revertedPoints},
-            {"remaining_folds", s.remainingFolds}};
+    json j = json::object();
+    for (const std::vector<ReportedFigure>& figures : {reportedFigures(m), reportedFigures(s)}) {
+        for (const ReportedFigure& f : figures) {
+            json& slot = j[std::string(f.name)];
+            if (f.kind == ReportedFigure::Kind::Count) {
+                slot = static_cast<int64_t>(f.value);
+            } else if (f.kind == ReportedFigure::Kind::Flag) {
+                slot = f.value != 0;
+            } else {
+                slot = f.value;
+            }
+        }
+    }
+    return j;
 }
 
 // The options a map was made with, by their declared names (uvwarp/options.h), and the grid in use.

@@ -554,6 +554,17 @@ void Solver::setMaps(const PointField& rigidity, const PointField& mask, const P
     m.fixedFolds = -1;  // other cells may change now: their folds are counted again
 }
 
+std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
+    using Kind = ReportedFigure::Kind;
+    return {{"iterations", Kind::Count, static_cast<double>(s.iterations)},
+            {"levels", Kind::Count, static_cast<double>(s.levels)},
+            {"untangled_points", Kind::Count, static_cast<double>(s.untangledPoints)},
+            {"reverted_points", Kind::Count, static_cast<double>(s.revertedPoints)},
+            {"remaining_folds", Kind::Count, static_cast<double>(s.remainingFolds)},
+            {"last_move", Kind::Number, static_cast<double>(s.lastMove)},
+            {"converged", Kind::Flag, s.converged ? 1.0 : 0.0}};
+}
+
 SolverOptions liveOptions(int32_t cells) {
     SolverOptions options;
     options.iterations = 1;

@@ -127,7 +127,7 @@ void sinCos(const float* t, float* sinOut, float* cosOut, int count) {
 }
 
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
-Affine fromLocal(const OrthoFrame& f, const glm::dmat3& m, const glm::dvec3& t) {
+Affine fromLocal(const OrthoFrame& f, const glm::dmat3& m, const glm::dvec3& t = glm::dvec3(0.0)) {
     const glm::dmat3 basis(glm::dvec3(f.side), glm::dvec3(f.up), glm::dvec3(f.axis));
     const glm::dmat3 linear = basis * m * glm::transpose(basis);
     const glm::dvec3 o(f.origin);
@@ -239,6 +239,11 @@ void AxialWarp::requireBound(size_t count, const char* what) const {
     }
 }
 
+void AxialWarp::requireBound(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    requireBound(points.size(), "points");
+    requireBound(out.size(), "output points");
+}
+
 void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
     requireBound(points.size(), "points");
     requireFinitePoints(points, name_, "point");
@@ -256,13 +261,11 @@ TaperWarp::TaperWarp(const AxisFrame& frame, ProfileCurve profile)
 
 Affine TaperWarp::transformationAt(float z) const {
     const double f = profile_(z);
-    return fromLocal(frame_, glm::dmat3(glm::dvec3(f, 0, 0), glm::dvec3(0, f, 0), glm::dvec3(0, 0, 1)),
-                     glm::dvec3(0.0));
+    return fromLocal(frame_, glm::dmat3(glm::dvec3(f, 0, 0), glm::dvec3(0, f, 0), glm::dvec3(0, 0, 1)));
 }
 
 void TaperWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    requireBound(points.size(), "points");
-    requireBound(out.size(), "output points");
+    requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
     const InlineProfile profile(profile_);
     // Dynamic chunks of 4096 points (here and in twist and bend): a thread the host deschedules does not
@@ -283,13 +286,11 @@ TwistWarp::TwistWarp(const AxisFrame& frame, ProfileCurve angle)
 
 Affine TwistWarp::transformationAt(float z) const {
     const double t = angle_(z), c = std::cos(t), s = std::sin(t);
-    return fromLocal(frame_, glm::dmat3(glm::dvec3(c, s, 0), glm::dvec3(-s, c, 0), glm::dvec3(0, 0, 1)),
-                     glm::dvec3(0.0));
+    return fromLocal(frame_, glm::dmat3(glm::dvec3(c, s, 0), glm::dvec3(-s, c, 0), glm::dvec3(0, 0, 1)));
 }
 
 void TwistWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    requireBound(points.size(), "points");
-    requireBound(out.size(), "output points");
+    requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
     const InlineProfile angle(angle_);
     const int64_t n = static_cast<int64_t>(points.size());
@@ -345,8 +346,7 @@ Affine BendWarp::transformationAt(float z) const {
 }
 
 void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    requireBound(points.size(), "points");
-    requireBound(out.size(), "output points");
+    requireBound(points, out);
     const float k = params_.rate, z0 = params_.centre, lo = params_.lo, hi = params_.hi;
     const OrthoFrame f = frame_;
     if (k == 0.0f) {  // Barr's bend with k = 0 is the identity

@@ -436,8 +436,13 @@ void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* tr
     }
 }
 
+void LatticeWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
+    lattice_.bind(restPoints);
+    lattice_.fields(fields);
+}
+
 Ffd::Ffd(const Lattice& lattice, const FfdOptions& options)
-    : lattice_(lattice, options),
+    : LatticeWarp(lattice, options),
       source_(lattice.controlPoints()),
       target_(source_),
       translation_(source_.size(), glm::vec3(0.0f)) {}
@@ -466,11 +471,6 @@ void Ffd::setTargets(std::span<const glm::vec3> targets) {
     // T_ijk = P*_ijk - P_ijk (§4.1).
     for (size_t c = 0; c < targets.size(); ++c)
         translation_[c] = target_[c] - source_[c];
-}
-
-void Ffd::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
-    lattice_.bind(restPoints);
-    lattice_.fields(fields);
 }
 
 void Ffd::transformations(Transformations& out) const {

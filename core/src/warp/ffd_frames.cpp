@@ -59,7 +59,7 @@ Affine frameToFrame(const Frame& from, const Frame& to, const std::string& eleme
                                    "three linearly independent basis vectors"));
 }
 
-FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : lattice_(lattice, options) {
+FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : LatticeWarp(lattice, options) {
     const std::vector<glm::vec3> points = lattice.controlPoints();
     source_.resize(points.size());
     for (size_t c = 0; c < points.size(); ++c)
@@ -119,11 +119,6 @@ void FfdFrames::update() {
         d[10] = t.translation.y;
         d[11] = t.translation.z;
     }
-}
-
-void FfdFrames::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
-    lattice_.bind(restPoints);
-    lattice_.fields(fields);
 }
 
 void FfdFrames::transformations(Transformations& out) const {

@@ -383,12 +383,4 @@ class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
 _classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
             DEFORMKIT_OT_reset_rest)
 
-
-def register():
-    for cls in _classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(_classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(_classes)

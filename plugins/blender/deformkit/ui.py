@@ -117,12 +117,4 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
 
 _classes = (DEFORMKIT_UL_stack, DEFORMKIT_MT_add, DEFORMKIT_PT_stack)
 
-
-def register():
-    for cls in _classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(_classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(_classes)

@@ -344,10 +344,9 @@ const MTypeId DkMeshWarp::id(0x0013A6C4);
 MObject DkMeshWarp::rebind, DkMeshWarp::restCage, DkMeshWarp::cage;
 
 MStatus DkMeshWarp::initialize() {
-    MFnTypedAttribute typed;
-    restCage = typed.create("restCage", "rcg", MFnData::kMesh);
+    restCage = meshAttribute("restCage", "rcg");
     addAttribute(restCage);
-    cage = typed.create("cage", "cag", MFnData::kMesh);
+    cage = meshAttribute("cage", "cag");
     addAttribute(cage);
     addRebindAttribute(rebind);
     affectsOutput({&restCage, &cage});

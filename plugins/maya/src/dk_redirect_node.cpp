@@ -38,10 +38,9 @@ std::vector<RedirectOptionAttribute> DkUvRedirect::optionSpecs;
 std::vector<MObject> DkUvRedirect::options;
 
 MStatus DkUvRedirect::initialize() {
-    MFnTypedAttribute typed;
-    inMesh = typed.create("inMesh", "inm", MFnData::kMesh);
+    inMesh = meshAttribute("inMesh", "inm");
     addAttribute(inMesh);
-    restMesh = typed.create("restMesh", "rsm", MFnData::kMesh);
+    restMesh = meshAttribute("restMesh", "rsm");
     addAttribute(restMesh);
     const std::tuple<MObject*, const char*, const char*> strings[] = {{&rigidity, "rigidity", "rig"},
                                                                       {&mask, "mask", "msk"},
@@ -79,6 +78,7 @@ MStatus DkUvRedirect::initialize() {
     MFnUnitAttribute unit;
     time = unit.create("time", "tim", MFnUnitAttribute::kTime, 0.0);
     addAttribute(time);
+    MFnTypedAttribute typed;
     outFile = typed.create("outFile", "ouf", MFnData::kString);
     typed.setWritable(false);
     typed.setStorable(false);

@@ -4,12 +4,19 @@
 
 #include <maya/MFloatArray.h>
 #include <maya/MFnMesh.h>
+#include <maya/MFnTypedAttribute.h>
 #include <maya/MIntArray.h>
 #include <maya/MPointArray.h>
 
 #include "deformkit/geom/mesh.h"
 
 namespace deformkit::maya {
+
+// A mesh input attribute (a rest mesh, a cage, the deformed mesh), for the node to add.
+inline MObject meshAttribute(const char* name, const char* shortName) {
+    MFnTypedAttribute typed;
+    return typed.create(name, shortName, MFnData::kMesh);
+}
 
 // Points (the data's object space), faces, and with `withUVs` the current UV set per face corner.
 inline geom::Mesh::Data meshDataOf(const MObject& data, bool withUVs) {

@@ -61,6 +61,10 @@ class Bvh {
         int32_t count = 0;  // leaf: triangle count; inner: 0
     };
     void build();
+    // The descent both queries share (bvh.cpp): nodes in order of key(box), the nearer child first; a node
+    // whose key is not <= limit() is pruned; visit(triangle) for each triangle of a reached leaf.
+    template <class Key, class Limit, class Visit>
+    void descend(float rootKey, const Key& key, const Limit& limit, const Visit& visit) const;
 
     std::vector<glm::vec3> points_;
     std::vector<std::array<int32_t, 3>> triangles_;

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
+#include <vector>
 
 #include "deformkit/uvwarp/grid.h"
 
@@ -41,5 +43,17 @@ struct WarpMetrics {
 [[nodiscard]] WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest,
                                       const PointField& deformed, const PointField& rigidity,
                                       const PointField& mask, const MetricsOptions& options = {});
+
+// One figure of a solve as every host reports it, by one name: the shot job's JSON log and report, Python's
+// metrics().
+struct ReportedFigure {
+    enum class Kind { Number, Count, Flag };
+    std::string_view name;  // snake_case
+    Kind kind = Kind::Number;
+    double value = 0.0;
+};
+
+// The figures of `m`, in the order hosts report them.
+[[nodiscard]] std::vector<ReportedFigure> reportedFigures(const WarpMetrics& m);
 
 }  // namespace deformkit::uvwarp

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/metrics.h"
 
 namespace deformkit::uvwarp {
 
@@ -136,6 +137,10 @@ class Solver {
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+// The figures of the last solve as hosts report them after the warp's (metrics.h): iterations, levels,
+// untangled_points, reverted_points, remaining_folds, last_move, converged.
+[[nodiscard]] std::vector<ReportedFigure> reportedFigures(const SolveStats& s);
 
 // Number of grid triangles with signed area <= 0, counting both diagonal splittings of every cell.
 [[nodiscard]] int32_t countFolds(const WarpGrid& warp);

@@ -75,6 +75,8 @@ class AxialWarp : public Warp {
   protected:
     AxialWarp(const AxisFrame& frame, bool needUp, std::string name);
     void requireBound(size_t count, const char* what) const;
+    // Both spans of an evaluate() hold as many points as were bound.
+    void requireBound(std::span<const glm::vec3> points, std::span<glm::vec3> out) const;
 
     std::string name_;
     bool needUp_;

@@ -148,33 +148,41 @@ class FfdLattice {
     bool bound_ = false;
 };
 
-// Plain FFD as a Warp for the generic engine (bind() builds the sparse fields, transformations() the
-// translations), plus a fast bind/evaluate path that skips the fields and equals the engine to 1e-5.
-// Moving controls (setTargets) never redoes bind work.
-class Ffd : public Warp {
+// What FFD and FFD with frames share: the lattice's weighting fields bound once, as a Warp for the generic
+// engine (bind() with fields builds the sparse fields) and as a fast path (bind() without caches local
+// coordinates only; each warp's evaluate() then deforms points, the bound rest points or the upstream points
+// of the same count, in place).
+class LatticeWarp : public Warp {
+  public:
+    [[nodiscard]] const FfdLattice& lattice() const { return lattice_; }
+    void bind(std::span<const glm::vec3> restPoints, SparseFields& fields) override;
+    void bind(std::span<const glm::vec3> restPoints) { lattice_.bind(restPoints); }
+
+  protected:
+    LatticeWarp(const Lattice& lattice, const FfdOptions& options) : lattice_(lattice, options) {}
+
+    FfdLattice lattice_;
+};
+
+// Plain FFD as a Warp for the generic engine (transformations() gives the translations), plus a fast path
+// that skips the fields and equals the engine to 1e-5. Moving controls (setTargets) never redoes bind work.
+class Ffd : public LatticeWarp {
   public:
     // Targets start equal to the source lattice (the identity).
     explicit Ffd(const Lattice& lattice, const FfdOptions& options = {});
 
-    [[nodiscard]] const FfdLattice& lattice() const { return lattice_; }
     [[nodiscard]] std::span<const glm::vec3> sourcePoints() const { return source_; }
     [[nodiscard]] std::span<const glm::vec3> targets() const { return target_; }
     // P*_ijk in index order, (l+1)(m+1)(n+1) of them. Throws on a wrong count or a non-finite target.
     void setTargets(std::span<const glm::vec3> targets);
 
-    // Warp (generic engine): caches local coordinates and writes the fields.
-    void bind(std::span<const glm::vec3> restPoints, SparseFields& fields) override;
     void transformations(Transformations& out) const override;
-
-    // Fast path: bind caches local coordinates only; evaluate deforms points (the bound rest points or the
-    // upstream points of the same count) in place; painted weights (#points, or empty for 1) and the
-    // envelope scale the displacement as in WarpDeformer.
-    void bind(std::span<const glm::vec3> restPoints) { lattice_.bind(restPoints); }
+    // Fast path: painted weights (#points, or empty for 1) and the envelope scale the displacement as in
+    // WarpDeformer.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
                   float envelope = 1.0f) const;
 
   private:
-    FfdLattice lattice_;
     std::vector<glm::vec3> source_, target_, translation_;
 };
 

@@ -29,12 +29,11 @@ struct Frame {
 // displacement method. Rotating a control's frame rotates the model locally about that control, which
 // plain FFD cannot do (Fig. 13, 14); with translation-only frames (target basis = source basis, source
 // origins = P_ijk) it is FFD exactly. The weights are the bind data: changing any frame redoes no bind work.
-class FfdFrames : public Warp {
+class FfdFrames : public LatticeWarp {
   public:
     // Source frames start at (P_ijk, identity basis), targets equal to them (the identity warp).
     explicit FfdFrames(const Lattice& lattice, const FfdOptions& options = {});
 
-    [[nodiscard]] const FfdLattice& lattice() const { return lattice_; }
     [[nodiscard]] std::span<const Frame> sourceFrames() const { return source_; }
     [[nodiscard]] std::span<const Frame> targetFrames() const { return target_; }
     // The current T_ijk, index order as Lattice::index.
@@ -45,12 +44,8 @@ class FfdFrames : public Warp {
     void setSourceFrames(std::span<const Frame> frames);
     void setTargetFrames(std::span<const Frame> frames);
 
-    // Warp (generic engine).
-    void bind(std::span<const glm::vec3> restPoints, SparseFields& fields) override;
     void transformations(Transformations& out) const override;
-
-    // Fast path, as Ffd: bind caches local coordinates; evaluate deforms in place.
-    void bind(std::span<const glm::vec3> restPoints) { lattice_.bind(restPoints); }
+    // Fast path, as Ffd::evaluate.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
                   float envelope = 1.0f) const;
 
@@ -58,7 +53,6 @@ class FfdFrames : public Warp {
     void update();
     void checkCount(std::span<const Frame> frames, const char* what) const;
 
-    FfdLattice lattice_;
     std::vector<Frame> source_, target_;
     std::vector<Affine> transform_;
     std::vector<float> delta_;  // per control: T_ijk - I as 12 floats (FfdLattice::deform)
