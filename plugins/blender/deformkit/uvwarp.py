@@ -194,7 +194,7 @@ def live_options(cells):
     """The live preset's solver options for a grid of `cells` cells per side: the library's
     (uvwarp::liveOptions): one warm iteration a frame, the coarse levels over-relaxed, sweeps per level by
     the grid's size, measured within 2 points of a converged solve on every probed frame of a smooth
-    animation on two models (docs/uvwarp.md, "What a frame costs"; docs/decisions.md UV-28, UV-30)."""
+    animation on two models (docs/uvwarp.md, "Performance"; docs/decisions.md UV-28, UV-30)."""
     return dict(dk.uv_warp_live_options(cells))
 
 
