@@ -87,7 +87,7 @@ std::string slideSummary(const fs::path& out, const slide::SlideResult& result) 
     std::string text =
         "wrote " + out.string() + ": moved " + std::to_string(result.moved) + ", limited " +
         std::to_string(result.limited) + " (boundary-stopped " + std::to_string(result.boundaryStopped) +
-        ", limit-stopped " + std::to_string(result.limitStopped) + "), flipped triangles " +
+        ", walk-limit-stopped " + std::to_string(result.walkLimitStopped) + "), flipped triangles " +
         std::to_string(result.flippedTriangles) + ", unreachable " + std::to_string(result.unreachable) +
         ", degenerate " + std::to_string(result.degenerateTriangles);
     if (!result.foldScale.empty() && result.foldScale[0] < 1.0) {

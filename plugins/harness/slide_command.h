@@ -37,8 +37,9 @@ struct SlideCommand {
 // IoError / ParseError / InvalidInput (deformkit::Error) before anything is written.
 slide::SlideResult slideCommand(const SlideCommand& command);
 
-// The one summary line the CLI prints: "wrote OUT: moved M, limited L (boundary-stopped B, limit-stopped S),
-// flipped triangles T, unreachable U, degenerate D", then ", fold limit: drag scaled to K" when it applied.
+// The one summary line the CLI prints: "wrote OUT: moved M, limited L (boundary-stopped B,
+// walk-limit-stopped S), flipped triangles T, unreachable U, degenerate D", then ", fold limit: drag scaled
+// to K" when it applied.
 [[nodiscard]] std::string slideSummary(const std::filesystem::path& out, const slide::SlideResult& result);
 
 // "x,y,z" (three finite numbers) for the option `option` (e.g. "--from"); InvalidInput naming it otherwise.

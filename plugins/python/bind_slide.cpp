@@ -195,7 +195,7 @@ struct PySlideResult {
     py::array_t<float> points;
     py::array_t<int32_t> vertices, faces, triangles;
     py::array_t<double> barycentric;
-    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0, limited = 0, flippedTriangles = 0,
+    int32_t moved = 0, boundaryStopped = 0, walkLimitStopped = 0, limited = 0, flippedTriangles = 0,
             unreachable = 0, withoutTangentPlane = 0, degenerateTriangles = 0;
     std::vector<double> foldScale;
 };
@@ -223,7 +223,7 @@ PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& 
     }
     out.moved = r.moved;
     out.boundaryStopped = r.boundaryStopped;
-    out.limitStopped = r.limitStopped;
+    out.walkLimitStopped = r.walkLimitStopped;
     out.limited = r.limited;
     out.flippedTriangles = r.flippedTriangles;
     out.foldScale = r.foldScale;
@@ -384,10 +384,12 @@ void bindSlide(py::module_& m) {
         .def_readonly("moved", &PySlideResult::moved)
         .def_readonly("boundary_stopped", &PySlideResult::boundaryStopped,
                       "moved vertices that reached a mesh boundary and stopped on it")
-        .def_readonly("limit_stopped", &PySlideResult::limitStopped,
-                      "moved vertices stopped after max_walk_triangles triangles")
+        .def_readonly(
+            "walk_limit_stopped", &PySlideResult::walkLimitStopped,
+            "moved vertices whose walk stopped after max_walk_triangles triangles, or whose line left\n"
+            "the triangles it crossed")
         .def_readonly("limited", &PySlideResult::limited,
-                      "moved vertices that travelled less than asked (boundary_stopped + limit_stopped)")
+                      "moved vertices that travelled less than asked (boundary_stopped + walk_limit_stopped)")
         .def_readonly("flipped_triangles", &PySlideResult::flippedTriangles,
                       "triangles with a slid corner whose orientation reversed (a fold of the texture)")
         .def_property_readonly(
@@ -401,10 +403,10 @@ void bindSlide(py::module_& m) {
                       "zero-area triangles touching the region: skipped")
         .def("__repr__", [](const PySlideResult& r) {
             return "<deformkit.SlideResult moved " + std::to_string(r.moved) + ", boundary_stopped " +
-                   std::to_string(r.boundaryStopped) + ", limit_stopped " + std::to_string(r.limitStopped) +
-                   ", flipped_triangles " + std::to_string(r.flippedTriangles) + ", unreachable " +
-                   std::to_string(r.unreachable) + ", degenerate_triangles " +
-                   std::to_string(r.degenerateTriangles) + ">";
+                   std::to_string(r.boundaryStopped) + ", walk_limit_stopped " +
+                   std::to_string(r.walkLimitStopped) + ", flipped_triangles " +
+                   std::to_string(r.flippedTriangles) + ", unreachable " + std::to_string(r.unreachable) +
+                   ", degenerate_triangles " + std::to_string(r.degenerateTriangles) + ">";
         });
 
     py::class_<PySlider>(

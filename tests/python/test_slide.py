@@ -115,7 +115,7 @@ def test_slider_result_fields_are_consistent():
     assert r.vertices.shape == (m,) and r.faces.shape == (m,) and r.triangles.shape == (m, 3)
     assert r.barycentric.shape == (m, 3)
     assert np.all(np.diff(r.vertices) > 0)  # ascending
-    assert (r.moved, r.boundary_stopped, r.limit_stopped, r.unreachable) == (m, 0, 0, 0)
+    assert (r.moved, r.boundary_stopped, r.walk_limit_stopped, r.unreachable) == (m, 0, 0, 0)
     assert (r.degenerate_triangles, r.without_tangent_plane) == (0, 0)
     # The slid point is the barycentric combination of its triangle's rest corners (double here).
     rebuilt = np.einsum("mk,mkc->mc", r.barycentric, pts[r.triangles].astype(np.float64))

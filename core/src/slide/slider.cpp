@@ -37,8 +37,8 @@ Slider::Impl::Counts Slider::Impl::slideOnce(std::span<const glm::dvec3> restDis
 
     const auto count = static_cast<int32_t>(active.size());
     Counts counts;
-    int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, limitStopped) if (count >= detail::kParallelFrom)
+    int32_t moved = 0, boundaryStopped = 0, walkLimitStopped = 0;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : moved, boundaryStopped, walkLimitStopped) if (count >= detail::kParallelFrom)
     for (int32_t i = 0; i < count; ++i) {
         const int32_t v = active[i];
         const double scale = (weights.empty() ? 1.0 : static_cast<double>(weights[v])) * envelope;
@@ -49,7 +49,7 @@ Slider::Impl::Counts Slider::Impl::slideOnce(std::span<const glm::dvec3> restDis
         landing = walk(i, v, target);
         ++moved;
         boundaryStopped += landing.stop == Stop::Boundary ? 1 : 0;
-        limitStopped += landing.stop == Stop::Limit ? 1 : 0;
+        walkLimitStopped += landing.stop == Stop::WalkLimit ? 1 : 0;
         if (!limit) {  // on the cage: the landing's combination of the incoming corners
             const int32_t t = landing.triangle;
             slid[i] = landing.barycentric.x * glm::dvec3(in[surface.vertex(3 * t)]) +
@@ -57,7 +57,7 @@ Slider::Impl::Counts Slider::Impl::slideOnce(std::span<const glm::dvec3> restDis
                       landing.barycentric.z * glm::dvec3(in[surface.vertex(3 * t + 2)]);
         }
     }
-    counts = {moved, boundaryStopped, limitStopped};
+    counts = {moved, boundaryStopped, walkLimitStopped};
     if (!limit) return counts;
 
     // On the limit surface: once every landing's face is in the part, the incoming limit surface's
@@ -318,8 +318,8 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
         }
         result->moved = counts.moved;
         result->boundaryStopped = counts.boundaryStopped;
-        result->limitStopped = counts.limitStopped;
-        result->limited = counts.boundaryStopped + counts.limitStopped;
+        result->walkLimitStopped = counts.walkLimitStopped;
+        result->limited = counts.boundaryStopped + counts.walkLimitStopped;
         result->flippedTriangles = flipped;
         result->foldScale = scales;
         result->unreachable = 0;

@@ -32,7 +32,9 @@ namespace detail {
 // work (a 500-vertex slide takes ~0.2 ms), and far more when the other core is busy (a host's own threads).
 constexpr int32_t kParallelFrom = 4096;
 
-enum class Stop : uint8_t { None, Reached, Boundary, Limit };
+// How a walk ended: WalkLimit after SlideOptions::maxWalkTriangles triangles, or when its line left the
+// triangles it crossed.
+enum class Stop : uint8_t { None, Reached, Boundary, WalkLimit };
 
 struct Landing {
     int32_t triangle = -1;
@@ -145,7 +147,7 @@ struct Slider::Impl {
     // Evaluation (slider.cpp).
 
     struct Counts {
-        int32_t moved = 0, boundaryStopped = 0, limitStopped = 0;
+        int32_t moved = 0, boundaryStopped = 0, walkLimitStopped = 0;
     };
 
     // One slide: the tangent displacements of every handle's rest-frame displacement times its scale

@@ -176,10 +176,10 @@ Slider::Impl::Landing Slider::Impl::walk(int32_t slot, int32_t p, const glm::dve
         // Each step keeps that (one of the entered triangle's two other edges crosses too); a start
         // that broke it would send the walk through triangles the line never meets, so it stops here
         // (counted) rather than wander.
-        if (isLeft(e0) || !isLeft(e1)) return detail::onEdge(edge, mu, Stop::Limit);
+        if (isLeft(e0) || !isLeft(e1)) return detail::onEdge(edge, mu, Stop::WalkLimit);
         const int32_t entry = surface.opposite(edge);
         if (entry < 0) return detail::onEdge(edge, mu, Stop::Boundary);
-        if (step + 1 >= options.maxWalkTriangles) return detail::onEdge(edge, mu, Stop::Limit);
+        if (step + 1 >= options.maxWalkTriangles) return detail::onEdge(edge, mu, Stop::WalkLimit);
         // The entered triangle: entry runs from e1's vertex to e0's vertex; w is the third vertex.
         const int32_t wCorner = SlideSurface::prev(entry);
         // Unfold the entered triangle across the edge e0 -> e1: its third vertex lies right of it.

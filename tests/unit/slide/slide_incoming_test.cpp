@@ -262,7 +262,7 @@ TEST_CASE("slide: vertices that travel less than asked are counted as limited", 
     }
     CHECK(shortened > 0);
     CHECK(result.limited == shortened);
-    CHECK(result.limited == result.boundaryStopped + result.limitStopped);
+    CHECK(result.limited == result.boundaryStopped + result.walkLimitStopped);
 }
 
 TEST_CASE("slide on the limit surface: the part around the region equals the whole mesh's limit",

@@ -48,7 +48,7 @@ struct Worst {
     double offSurface = 0.0;    // largest distance between a moved vertex and its landing point
     double offMesh = 0.0;       // largest distance between a moved vertex and the rest surface (BVH)
     double negativeBary = 0.0;  // most negative barycentric coordinate of a landing
-    int limitStopped = 0;
+    int walkLimitStopped = 0;
     bool finite = true;
 };
 
@@ -80,7 +80,7 @@ void check(const geom::Mesh& mesh, int32_t handle, const glm::dvec3& d, double r
         }
         worst.offSurface = std::max(worst.offSurface, glm::length(at - glm::dvec3(out[l.vertex])) / scale);
     }
-    worst.limitStopped += result.limitStopped;
+    worst.walkLimitStopped += result.walkLimitStopped;
     const geom::Bvh& bvh = bvhOf(mesh);
     for (const SlideLanding& l : result.landings) {
         const glm::vec3 p = out[l.vertex];
@@ -95,7 +95,7 @@ void checkInvariants(const Worst& worst) {
     CHECK(worst.offSurface < 1e-6);
     CHECK(worst.offMesh < 1e-6);  // float positions and a float BVH query: a few ulps of the model's size
     CHECK(worst.negativeBary >= 0.0);
-    CHECK(worst.limitStopped == 0);
+    CHECK(worst.walkLimitStopped == 0);
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ TEST_CASE("slide on a plane is the in-plane translation d times falloff", "[slid
           1e-6 * 2.9);  // Hausdorff to the rest surface, 1e-6 of the diagonal
     CHECK(result.moved == expectedMoved);
     CHECK(result.boundaryStopped == 0);
-    CHECK(result.limitStopped == 0);
+    CHECK(result.walkLimitStopped == 0);
     CHECK(result.unreachable == 0);
     // Every landing reproduces the output through its triangle and barycentric coordinates.
     for (const auto& landing : result.landings) {
@@ -403,7 +403,7 @@ TEST_CASE("slide: a displacement far larger than the region stops at the boundar
         SlideResult result;
         const auto out =
             runSlide(mesh, {{0, 0.5}}, {{glm::dvec3(0.0, 0.0, 30.0)}}, {}, 1.0f, &result, options);
-        CHECK(result.limitStopped > 0);
+        CHECK(result.walkLimitStopped > 0);
         CHECK(result.boundaryStopped == 0);
         for (const auto& p : out)
             CHECK(std::isfinite(p.x + p.y + p.z));

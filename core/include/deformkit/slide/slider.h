@@ -49,8 +49,9 @@ struct SlideOptions {
     // triangle of its region flips, then all of them together if overlapping regions still fold. For a
     // slide that never tears; SlideResult::foldScale says how much of each drag was applied.
     bool foldLimit = false;
-    // Triangles one vertex's walk may cross in one evaluation before it stops (and is counted): the
-    // expansion limit for displacements many times larger than the region.
+    // Triangles one vertex's walk may cross in one evaluation before it stops (counted in
+    // SlideResult::walkLimitStopped): the expansion limit for displacements many times larger than the
+    // region.
     int32_t maxWalkTriangles = 4096;
 };
 
@@ -67,8 +68,10 @@ struct SlideResult {
     std::vector<SlideLanding> landings;  // one per moved vertex, ascending vertex index
     int32_t moved = 0;
     int32_t boundaryStopped = 0;  // reached a mesh boundary (or a degenerate triangle) and stopped on it
-    int32_t limitStopped = 0;     // stopped after maxWalkTriangles triangles
-    int32_t limited = 0;          // travelled less than asked: boundaryStopped + limitStopped
+    // Stopped by the walk's own limit: after SlideOptions::maxWalkTriangles triangles, or when the walk's
+    // line left the triangles it crossed.
+    int32_t walkLimitStopped = 0;
+    int32_t limited = 0;  // travelled less than asked: boundaryStopped + walkLimitStopped
     // Triangles with a slid corner whose orientation reversed against the incoming surface (a fold of the
     // texture); after the fold limit when it is on.
     int32_t flippedTriangles = 0;
