@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "deformkit/error.h"
 #include "deformkit/geom/triangulation.h"
 
 namespace deformkit::slide {
@@ -17,13 +18,20 @@ constexpr double kDegenerateArea2 = 1e-14;
 
 }  // namespace
 
-SlideSurface::SlideSurface(const geom::Mesh& mesh, const std::string& /*source*/) {
+SlideSurface::SlideSurface(const geom::Mesh& mesh, const std::string& source) {
     const int32_t nv = mesh.numVertices();
     points_.resize(nv);
     for (int32_t v = 0; v < nv; ++v)
         points_[v] = glm::dvec3(mesh.points()[v]);
     const geom::Box3 box = mesh.bounds();
     scale_ = nv > 0 ? std::max(static_cast<double>(glm::length(box.max - box.min)), 1e-30) : 1.0;
+    if (!std::isfinite(scale_)) {  // every triangle would count as degenerate against it
+        throw InvalidInput(
+            formatError(source, "bounding box",
+                        "diagonal " + numberText(glm::length(glm::dvec3(box.max) - glm::dvec3(box.min))) +
+                            " overflows single precision",
+                        "a mesh extent below 1e19 scene units"));
+    }
 
     const geom::Triangulation tris = geom::triangulate(mesh);
     const int32_t nt = tris.size();

@@ -21,6 +21,8 @@ namespace deformkit::slide {
 // non-manifold edge or an edge of a degenerate (zero-area) triangle, so a walk treats all three alike.
 class SlideSurface {
   public:
+    // Throws InvalidInput naming `source` for a mesh whose extent single precision cannot measure (a
+    // bounding-box diagonal beyond about 1e19 scene units): degenerate triangles are found relative to it.
     explicit SlideSurface(const geom::Mesh& mesh, const std::string& source = "mesh");
 
     [[nodiscard]] int32_t numVertices() const { return static_cast<int32_t>(points_.size()); }
