@@ -119,8 +119,6 @@ struct Slider::Impl {
     [[nodiscard]] Landing walk(int32_t slot, int32_t p, const glm::dvec2& requested) const;
 
     // Landing on the limit surface (slider_limit_surface.cpp).
-
-    [[nodiscard]] glm::dvec3 cagePoint(const Landing& landing) const;
     [[nodiscard]] glm::dvec3 limitPoint(const Landing& landing) const;
     // The limit point under vertex v, taken through the same face evaluation as its landings so that a
     // vanishing slide moves it by a vanishing amount.

@@ -6,13 +6,6 @@
 
 namespace deformkit::slide {
 
-glm::dvec3 Slider::Impl::cagePoint(const Landing& landing) const {
-    const int32_t t = landing.triangle;
-    return landing.barycentric.x * surface.point(surface.vertex(3 * t)) +
-           landing.barycentric.y * surface.point(surface.vertex(3 * t + 1)) +
-           landing.barycentric.z * surface.point(surface.vertex(3 * t + 2));
-}
-
 glm::dvec3 Slider::Impl::limitPoint(const Landing& landing) const {
     const int32_t t = landing.triangle;
     const int32_t f = surface.face(t);

@@ -162,7 +162,7 @@ TEST_CASE("slide on a sphere stays on the mesh, travels |d| falloff, in the tran
     INFO("checked " << checked << ", travel relative error " << worstTravel << ", direction error (deg) "
                     << glm::degrees(worstDirection));
     CHECK(checked > 50);
-    CHECK(worstTravel < 0.01);  // the issue's 1%
+    CHECK(worstTravel < 0.01);  // travel within 1% of the asked distance
     CHECK(glm::degrees(worstDirection) < 3.0);
     CHECK(test::distanceToSurface(mesh, out) <= 1e-6 * 2.0 * std::sqrt(3.0) * R);
 }
