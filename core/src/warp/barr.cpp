@@ -126,6 +126,24 @@ void sinCos(const float* t, float* sinOut, float* cosOut, int count) {
     }
 }
 
+// Points in blocks of kTrigBlock over all threads (chunks of 16 blocks, 4096 points): each point's angle
+// (angleOf(u)), then the block's sines and cosines in one vectorised pass, then the block's own work
+// (apply(begin, count, t, sin t, cos t)). A point depends on its own inputs only: any schedule gives the
+// same output. The callables are taken by value: what they capture stays in registers, not behind a
+// reference that a store to the output could alias.
+template <class AngleOf, class Apply>
+void forEachAngleBlock(int64_t n, const AngleOf angleOf, const Apply apply) {
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
+        const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
+        float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
+        for (int i = 0; i < count; ++i)
+            t[i] = angleOf(begin + i);
+        sinCos(t, sinT, cosT, count);
+        apply(begin, count, t, sinT, cosT);
+    }
+}
+
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
 Affine fromLocal(const OrthoFrame& f, const glm::dmat3& m, const glm::dvec3& t = glm::dvec3(0.0)) {
     const glm::dmat3 basis(glm::dvec3(f.side), glm::dvec3(f.up), glm::dvec3(f.axis));
@@ -293,25 +311,19 @@ void TwistWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3>
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
     const InlineProfile angle(angle_);
-    const int64_t n = static_cast<int64_t>(points.size());
-    // Blocks of points: the angles first, then their sines and cosines in one vectorised pass. Chunks of 16
-    // blocks = 4096 points.
-#pragma omp parallel for schedule(dynamic, 16)
-    for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
-        const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
-        float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
-        for (int i = 0; i < count; ++i)
-            t[i] = angle(restZ_[begin + i]);
-        sinCos(t, sinT, cosT, count);
-        for (int i = 0; i < count; ++i) {
-            const int64_t u = begin + i;
-            const glm::vec3 p = points[u];
-            const glm::vec3 d = p - o;
-            const glm::vec3 radial = d - glm::dot(d, a) * a;
-            // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
-            out[u] = p + (cosT[i] - 1.0f) * radial + sinT[i] * glm::cross(a, radial);
-        }
-    }
+    const float* z = restZ_.data();
+    forEachAngleBlock(
+        static_cast<int64_t>(points.size()), [angle, z](int64_t u) { return angle(z[u]); },
+        [o, a, points, out](int64_t begin, int count, const float*, const float* sinT, const float* cosT) {
+            for (int i = 0; i < count; ++i) {
+                const int64_t u = begin + i;
+                const glm::vec3 p = points[u];
+                const glm::vec3 d = p - o;
+                const glm::vec3 radial = d - glm::dot(d, a) * a;
+                // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
+                out[u] = p + (cosT[i] - 1.0f) * radial + sinT[i] * glm::cross(a, radial);
+            }
+        });
 }
 
 // ---- bend ----
@@ -353,27 +365,24 @@ void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> 
         if (out.data() != points.data()) std::copy(points.begin(), points.end(), out.begin());
         return;
     }
-    const int64_t n = static_cast<int64_t>(points.size());
-    // Blocks of points as in the twist: angles, then their sines and cosines in one vectorised pass.
-#pragma omp parallel for schedule(dynamic, 16)
-    for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
-        const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
-        float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
-        for (int i = 0; i < count; ++i)
-            t[i] = k * (std::clamp(restZ_[begin + i], lo, hi) - z0);
-        sinCos(t, sinT, cosT, count);
-        for (int i = 0; i < count; ++i) {
-            const int64_t u = begin + i;
-            const glm::vec3 l = f.toLocal(points[u]);
-            const float zc = std::clamp(restZ_[u], lo, hi);
-            const float d = zc - z0;
-            const float c = cosT[i], s = sinT[i];
-            const float along = l.z - zc;  // 0 inside the range for the rest points themselves
-            const float y = c * l.y + s * along + d * versincFrom(t[i], s, c);
-            const float z = z0 + d * sincFrom(t[i], s) - s * l.y + c * along;
-            out[u] = f.origin + l.x * f.side + y * f.up + z * f.axis;
-        }
-    }
+    const float* z = restZ_.data();
+    forEachAngleBlock(
+        static_cast<int64_t>(points.size()),
+        [k, z0, lo, hi, z](int64_t u) { return k * (std::clamp(z[u], lo, hi) - z0); },
+        [f, z0, lo, hi, z, points, out](int64_t begin, int count, const float* t, const float* sinT,
+                                        const float* cosT) {
+            for (int i = 0; i < count; ++i) {
+                const int64_t u = begin + i;
+                const glm::vec3 l = f.toLocal(points[u]);
+                const float zc = std::clamp(z[u], lo, hi);
+                const float d = zc - z0;
+                const float c = cosT[i], s = sinT[i];
+                const float along = l.z - zc;  // 0 inside the range for the rest points themselves
+                const float y = c * l.y + s * along + d * versincFrom(t[i], s, c);
+                const float zz = z0 + d * sincFrom(t[i], s) - s * l.y + c * along;
+                out[u] = f.origin + l.x * f.side + y * f.up + zz * f.axis;
+            }
+        });
 }
 
 }  // namespace deformkit::warp
