@@ -92,6 +92,13 @@ Option Command::option(const std::string& name, std::vector<double>& target, con
     return Option(app_->add_option(name, target, help));
 }
 
+Option Command::option(const std::string& name, std::function<void(const std::string& value)> parse,
+                       const std::string& shownDefault, const std::string& help) {
+    CLI::Option* option = app_->add_option_function<std::string>(name, std::move(parse), help);
+    option->default_str(shownDefault);
+    return Option(option);
+}
+
 void Command::listing(const std::string& name, const std::string& fallback, const std::string& help,
                       std::function<void(const std::string& value)> print) {
     app_->add_option_function<std::string>(

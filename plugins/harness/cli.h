@@ -49,6 +49,10 @@ class Command {
     Option option(const std::string& name, std::vector<int32_t>& target, const std::string& help);
     Option option(const std::string& name, std::vector<double>& target, const std::string& help);
     Option flag(const std::string& name, bool& target, const std::string& help);
+    // An option whose value `parse` reads as soon as it is given (a deformkit::Error it throws is a usage
+    // error, exit 2); `shownDefault` is what --help shows when it is not given.
+    Option option(const std::string& name, std::function<void(const std::string& value)> parse,
+                  const std::string& shownDefault, const std::string& help);
     // An option that, as soon as it is parsed, calls `print` with its value (`fallback` when none is given)
     // and ends the program with exit code 0, as --help does: the command's other options, required ones
     // included, are not needed then.

@@ -184,20 +184,17 @@ int8_t parseFaceResolution(const std::string& text) {
 
 namespace {
 
-// How a command writes a Ptex file, as typed: texels per face side (--face-res) and the data type (--type).
-struct PtexOutputOptions {
-    std::string faceRes;
-    std::string type = "float";
-
-    void declare(Command& command, const std::string& faceResHelp) {
-        command.option("--face-res", faceRes, faceResHelp).showDefault();
-        command.option("--type", type, "u8, u16, half or float").showDefault();
-    }
-    void apply(int8_t& faceLog2, ptex::DataType& dataType) const {
-        faceLog2 = parseFaceResolution(faceRes);
-        dataType = parsePtexType(type);
-    }
-};
+// The options of a command that writes a Ptex file: texels per face side (--face-res) and the data type
+// (--type), read into the command's own fields.
+void addPtexOutputOptions(Command& command, int8_t& faceLog2, ptex::DataType& type,
+                          const std::string& faceRes, const std::string& faceResHelp) {
+    command.option(
+        "--face-res", [&faceLog2](const std::string& text) { faceLog2 = parseFaceResolution(text); }, faceRes,
+        faceResHelp);
+    command.option(
+        "--type", [&type](const std::string& text) { type = parsePtexType(text); }, "float",
+        "u8, u16, half or float");
+}
 
 }  // namespace
 
@@ -245,43 +242,34 @@ void addPtexCommands(CommandLine& cli) {
     toUdim.option("--padding", tu->command.padding, "texels of edge padding around the UV charts")
         .showDefault();
 
-    struct FromUdim {
-        PtexFromUdimCommand command;
-        PtexOutputOptions output{"auto"};
-    };
-    auto fu = std::make_shared<FromUdim>();
+    auto fu = std::make_shared<PtexFromUdimCommand>();
     Command fromUdim =
         cli.add(ptex, "from-udim", "Sample UDIM tile images into a Ptex file through the mesh's UVs", [fu] {
-            fu->output.apply(fu->command.faceLog2, fu->command.type);
-            const int32_t withoutUVs = ptexFromUdimCommand(fu->command);
+            const int32_t withoutUVs = ptexFromUdimCommand(*fu);
             if (withoutUVs > 0) {
                 std::cout << withoutUVs << (withoutUVs == 1 ? " face has" : " faces have")
                           << " no UVs: written as 0\n";
             }
-            std::cout << "wrote " << fu->command.out.string() << "\n";
+            std::cout << "wrote " << fu->out.string() << "\n";
             return 0;
         });
-    fromUdim.option("PATTERN", fu->command.pattern, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
-    fromUdim.option("MESH", fu->command.mesh, "mesh (.obj) with UVs").required();
-    fromUdim.option("--out", fu->command.out, "Ptex file (.ptx)").required();
-    fu->output.declare(fromUdim, "texels per face side: auto or a power of two");
+    fromUdim.option("PATTERN", fu->pattern, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
+    fromUdim.option("MESH", fu->mesh, "mesh (.obj) with UVs").required();
+    fromUdim.option("--out", fu->out, "Ptex file (.ptx)").required();
+    addPtexOutputOptions(fromUdim, fu->faceLog2, fu->type, "auto",
+                         "texels per face side: auto or a power of two");
 
-    struct FromVertex {
-        PtexFromVertexCommand command;
-        PtexOutputOptions output{"16"};
-    };
-    auto fv = std::make_shared<FromVertex>();
+    auto fv = std::make_shared<PtexFromVertexCommand>();
     Command fromVertex =
         cli.add(ptex, "from-vertex", "Bake per-vertex weights (a JSON weights file) into a Ptex file", [fv] {
-            fv->output.apply(fv->command.faceLog2, fv->command.type);
-            ptexFromVertexCommand(fv->command);
-            std::cout << "wrote " << fv->command.out.string() << "\n";
+            ptexFromVertexCommand(*fv);
+            std::cout << "wrote " << fv->out.string() << "\n";
             return 0;
         });
-    fromVertex.option("WEIGHTS", fv->command.weights, "weights file (.json), one per vertex").required();
-    fromVertex.option("MESH", fv->command.mesh, "mesh (.obj)").required();
-    fromVertex.option("--out", fv->command.out, "Ptex file (.ptx)").required();
-    fv->output.declare(fromVertex, "texels per face side, a power of two");
+    fromVertex.option("WEIGHTS", fv->weights, "weights file (.json), one per vertex").required();
+    fromVertex.option("MESH", fv->mesh, "mesh (.obj)").required();
+    fromVertex.option("--out", fv->out, "Ptex file (.ptx)").required();
+    addPtexOutputOptions(fromVertex, fv->faceLog2, fv->type, "16", "texels per face side, a power of two");
 }
 
 }  // namespace deformkit::harness

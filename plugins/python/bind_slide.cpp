@@ -195,9 +195,32 @@ struct PySlideResult {
     py::array_t<float> points;
     py::array_t<int32_t> vertices, faces, triangles;
     py::array_t<double> barycentric;
-    int32_t moved = 0, boundaryStopped = 0, walkLimitStopped = 0, limited = 0, flippedTriangles = 0,
-            unreachable = 0, withoutTangentPlane = 0, degenerateTriangles = 0;
-    std::vector<double> foldScale;
+    slide::SlideResult counts;  // the counts and fold scales; its landings are the arrays above
+};
+
+// SlideResult's counts as read-only attributes of deformkit.SlideResult: name, member, meaning.
+struct SlideCount {
+    const char* name;
+    int32_t slide::SlideResult::*member;
+    const char* doc;
+};
+constexpr SlideCount kSlideCounts[] = {
+    {"moved", &slide::SlideResult::moved, "vertices moved"},
+    {"boundary_stopped", &slide::SlideResult::boundaryStopped,
+     "moved vertices that reached a mesh boundary and stopped on it"},
+    {"walk_limit_stopped", &slide::SlideResult::walkLimitStopped,
+     "moved vertices whose walk stopped after max_walk_triangles triangles, or whose line left\n"
+     "the triangles it crossed"},
+    {"limited", &slide::SlideResult::limited,
+     "moved vertices that travelled less than asked (boundary_stopped + walk_limit_stopped)"},
+    {"flipped_triangles", &slide::SlideResult::flippedTriangles,
+     "triangles with a slid corner whose orientation reversed (a fold of the texture)"},
+    {"unreachable", &slide::SlideResult::unreachable,
+     "vertices within a radius that the region's propagation cannot reach: unmoved"},
+    {"without_tangent_plane", &slide::SlideResult::withoutTangentPlane,
+     "vertices within a radius with only degenerate triangles around: unmoved"},
+    {"degenerate_triangles", &slide::SlideResult::degenerateTriangles,
+     "zero-area triangles touching the region: skipped"},
 };
 
 PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& r) {
@@ -221,15 +244,9 @@ PySlideResult resultOf(const std::vector<glm::vec3>& points, const SlideResult& 
             barycentric[3 * i + k] = l.barycentric[k];
         }
     }
-    out.moved = r.moved;
-    out.boundaryStopped = r.boundaryStopped;
-    out.walkLimitStopped = r.walkLimitStopped;
-    out.limited = r.limited;
-    out.flippedTriangles = r.flippedTriangles;
-    out.foldScale = r.foldScale;
-    out.unreachable = r.unreachable;
-    out.withoutTangentPlane = r.withoutTangentPlane;
-    out.degenerateTriangles = r.degenerateTriangles;
+    for (const SlideCount& c : kSlideCounts)
+        out.counts.*c.member = r.*c.member;
+    out.counts.foldScale = r.foldScale;
     return out;
 }
 
@@ -371,8 +388,9 @@ void bindSlide(py::module_& m) {
         "'falloff' (the paper's: the weight is the falloff, the radius only bounds the region); fold_limit\n"
         "scales the drag down so no triangle of the region flips. Returns the slid points (N, 3) float32.");
 
-    py::class_<PySlideResult>(m, "SlideResult", "The slid points and, per moved vertex, where it landed.")
-        .def_readonly("points", &PySlideResult::points, "(N, 3) float32 slid points")
+    py::class_<PySlideResult> result(m, "SlideResult",
+                                     "The slid points and, per moved vertex, where it landed.");
+    result.def_readonly("points", &PySlideResult::points, "(N, 3) float32 slid points")
         .def_readonly("vertices", &PySlideResult::vertices, "(M,) int32 moved vertices, ascending")
         .def_readonly("faces", &PySlideResult::faces, "(M,) int32 polygon each landed on")
         .def_readonly("triangles", &PySlideResult::triangles,
@@ -381,33 +399,24 @@ void bindSlide(py::module_& m) {
             "barycentric", &PySlideResult::barycentric,
             "(M, 3) float64 barycentric coordinates on `triangles`: on the cage surface the slid point is\n"
             "their combination of the rest positions")
-        .def_readonly("moved", &PySlideResult::moved)
-        .def_readonly("boundary_stopped", &PySlideResult::boundaryStopped,
-                      "moved vertices that reached a mesh boundary and stopped on it")
-        .def_readonly(
-            "walk_limit_stopped", &PySlideResult::walkLimitStopped,
-            "moved vertices whose walk stopped after max_walk_triangles triangles, or whose line left\n"
-            "the triangles it crossed")
-        .def_readonly("limited", &PySlideResult::limited,
-                      "moved vertices that travelled less than asked (boundary_stopped + walk_limit_stopped)")
-        .def_readonly("flipped_triangles", &PySlideResult::flippedTriangles,
-                      "triangles with a slid corner whose orientation reversed (a fold of the texture)")
         .def_property_readonly(
-            "fold_scale", [](const PySlideResult& r) { return arrayOf<double>(r.foldScale); },
+            "fold_scale", [](const PySlideResult& r) { return arrayOf<double>(r.counts.foldScale); },
             "(H,) float64 per handle: the share of its displacement applied (below 1 under the fold limit)")
-        .def_readonly("unreachable", &PySlideResult::unreachable,
-                      "vertices within a radius that the region's propagation cannot reach: unmoved")
-        .def_readonly("without_tangent_plane", &PySlideResult::withoutTangentPlane,
-                      "vertices within a radius with only degenerate triangles around: unmoved")
-        .def_readonly("degenerate_triangles", &PySlideResult::degenerateTriangles,
-                      "zero-area triangles touching the region: skipped")
         .def("__repr__", [](const PySlideResult& r) {
-            return "<deformkit.SlideResult moved " + std::to_string(r.moved) + ", boundary_stopped " +
-                   std::to_string(r.boundaryStopped) + ", walk_limit_stopped " +
-                   std::to_string(r.walkLimitStopped) + ", flipped_triangles " +
-                   std::to_string(r.flippedTriangles) + ", unreachable " + std::to_string(r.unreachable) +
-                   ", degenerate_triangles " + std::to_string(r.degenerateTriangles) + ">";
+            std::string text;
+            for (const SlideCount& c : kSlideCounts) {
+                if (c.member == &slide::SlideResult::limited ||
+                    c.member == &slide::SlideResult::withoutTangentPlane)
+                    continue;  // limited is a sum of two shown; without_tangent_plane is rare
+                text += (text.empty() ? "" : ", ") + std::string(c.name) + " " +
+                        std::to_string(r.counts.*c.member);
+            }
+            return "<deformkit.SlideResult " + text + ">";
         });
+    for (const SlideCount& c : kSlideCounts) {
+        result.def_property_readonly(
+            c.name, [member = c.member](const PySlideResult& r) { return r.counts.*member; }, c.doc);
+    }
 
     py::class_<PySlider>(
         m, "Slider",
