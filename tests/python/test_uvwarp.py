@@ -543,3 +543,23 @@ def test_shot_follows_animated_rigidity_maps(tmp_path):
             assert same == (frame < 3), (tile, frame)
         inputs = json.loads(dk.read_image_info(a / f"redirect.{tile}.0003.exr")["attributes"]["deformkit:uvwarp:inputs"])
         assert inputs["rigidity"] == str(maps / f"rig.{tile}.0003.exr")
+
+
+def test_shot_maps_of_several_channels_read_channel_0_and_say_so(tmp_path):
+    """An RGBA rigidity map in memory (the rigidity in red) gives the one-channel map's redirect maps, with a
+    note; UvWarpSolver, whose maps are one channel, refuses it naming the shape."""
+    pts, counts, idx, uvs, uv_idx = plane()
+    mesh = dk.Mesh(pts, counts, idx, uvs, uv_idx)
+    rig = disks()
+    rgba = np.stack([rig, np.full_like(rig, 0.3), 1 - rig, np.ones_like(rig)], axis=2)
+    out = {}
+    for name, maps in (("one", {1001: rig}), ("rgba", {1001: rgba})):
+        (tmp_path / name).mkdir()
+        report = dk.uvwarp_shot(mesh, [1], lambda f: stretched(pts), maps,
+                                str(tmp_path / name / "r.<UDIM>.####.exr"), iterations=2)
+        out[name] = (dk.read_image(str(tmp_path / name / "r.1001.0001.exr")), report[1001]["notes"])
+    np.testing.assert_array_equal(out["one"][0], out["rgba"][0])
+    assert out["one"][1] == []
+    assert len(out["rgba"][1]) == 1 and "has 4 channels: channel 0 (red) is read" in out["rgba"][1][0]
+    with pytest.raises(dk.InvalidInput, match=r"rigidity: has shape \(64, 64, 4\)"):
+        dk.UvWarpSolver(mesh, 1001, rgba)

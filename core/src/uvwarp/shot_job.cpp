@@ -36,7 +36,7 @@ struct TileMap {
     std::string framePattern;  // an animated map: the tile's files, a frame token in the name
     const io::Image* image = nullptr;
     std::string name;
-    int32_t width = 0, height = 0;
+    int32_t width = 0, height = 0, channels = 0;
 
     [[nodiscard]] bool found() const { return file.has_value() || image != nullptr; }
 };
@@ -147,6 +147,7 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
             map.framePattern = tilePattern;
             map.width = info.width;
             map.height = info.height;
+            map.channels = info.channels;
             for (int frame : frames) {
                 const fs::path path = sequence.framePath(frame);
                 if (!fileExists(path)) {
@@ -171,6 +172,7 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
         map.file = path;
         map.width = info.width;
         map.height = info.height;
+        map.channels = info.channels;
         return map;
     }
     map.name = (source.name.empty() ? std::string("map") : source.name) + " tile " + std::to_string(tile);
@@ -179,6 +181,7 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
     map.image = &it->second;
     map.width = it->second.width;
     map.height = it->second.height;
+    map.channels = it->second.channels;
     return map;
 }
 
@@ -313,10 +316,20 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                                    ", the size of '" + r.name + "'"));
             }
         };
+        // A map of several channels (an RGB or RGBA export of a painted map): channel 0 is read, said once.
+        const auto noteChannels = [&](const TileMap& map, const char* what) {
+            if (map.channels > 1) {
+                plan.report.notes.push_back(std::string(what) + " '" + map.name + "' has " +
+                                            std::to_string(map.channels) +
+                                            " channels: channel 0 (red) is read");
+            }
+        };
+        noteChannels(r, "rigidity map");
         if (j.mask.given()) {
             plan.mask = findTileMap(j.mask, tile, j.frames);
             if (plan.mask.found()) {
                 sameSize(plan.mask, "warp mask");
+                noteChannels(plan.mask, "warp mask");
             } else {
                 plan.report.notes.push_back("no warp mask '" + plan.mask.name + "': derived from the UVs");
             }
@@ -325,6 +338,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             plan.orientation = findTileMap(j.orientation, tile, j.frames);
             if (plan.orientation.found()) {
                 sameSize(plan.orientation, "orientation map");
+                noteChannels(plan.orientation, "orientation map");
             } else {
                 plan.report.notes.push_back("no orientation map '" + plan.orientation.name +
                                             "': orientation preservation as given everywhere");

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <string_view>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
@@ -444,18 +445,25 @@ RedirectNode::Maps RedirectNode::read(const RedirectFiles& files) {
         throw InvalidInput(
             formatError("dkUvRedirect", "rigidity", "is empty", "a rigidity map file pattern"));
     }
+    // A map of several channels (an RGB or RGBA export): channel 0 is used, said once per file.
+    const auto readMap = [&](const std::string& file, const char* role) {
+        io::Image image = io::readImage(file, {0, role});
+        ++mapReads_;
+        if (image.channels > 1 && noted_.insert(file).second) {
+            notes_.push_back(std::string(role) + " '" + file + "' has " + std::to_string(image.channels) +
+                             " channels: channel 0 (red) is read");
+        }
+        return image;
+    };
     Maps maps;
-    maps.rigidity = io::readImage(files.rigidity, {0, "rigidity map"});
-    ++mapReads_;
-    if (!files.mask.empty()) {
-        maps.mask = io::readImage(files.mask, {0, "warp mask"});
-        ++mapReads_;
-    }
-    if (!files.orientation.empty()) {
-        maps.orientation = io::readImage(files.orientation, {0, "orientation map"});
-        ++mapReads_;
-    }
+    maps.rigidity = readMap(files.rigidity, "rigidity map");
+    if (!files.mask.empty()) maps.mask = readMap(files.mask, "warp mask");
+    if (!files.orientation.empty()) maps.orientation = readMap(files.orientation, "orientation map");
     return maps;
+}
+
+std::vector<std::string> RedirectNode::takeNotes() {
+    return std::exchange(notes_, {});
 }
 
 void RedirectNode::build(const geom::Mesh& rest, const RedirectInputs& in, int frame,

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -262,6 +263,8 @@ class RedirectNode {
     [[nodiscard]] int64_t builds() const { return builds_; }
     [[nodiscard]] int64_t mapReads() const { return mapReads_; }  // map files read so far
     [[nodiscard]] bool warmStarted() const { return core_ && core_->warmStarted(); }
+    // What the user should hear once (a map of several channels, read from channel 0), since the last call.
+    [[nodiscard]] std::vector<std::string> takeNotes();
 
   private:
     struct Maps {
@@ -274,6 +277,8 @@ class RedirectNode {
     RedirectFiles loaded_;
     int64_t builds_ = 0;
     int64_t mapReads_ = 0;
+    std::vector<std::string> notes_;
+    std::set<std::string> noted_;  // the files a note was made for
 };
 
 }  // namespace deformkit::maya

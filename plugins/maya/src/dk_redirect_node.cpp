@@ -128,6 +128,8 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
             points_[i] = {static_cast<float>(points[i].x), static_cast<float>(points[i].y),
                           static_cast<float>(points[i].z)};
         const io::Image map = node_.solve(in, frame, points_);
+        for (const std::string& note : node_.takeNotes())
+            MGlobal::displayWarning(MString(name()) + ": " + note.c_str());
         const std::string path = fileAt(block.inputValue(output).asString().asChar(), in.tile, frame);
         io::writeImage(path, map, {io::PixelType::Float, {}});
         block.outputValue(outFile).set(MString(path.c_str()));

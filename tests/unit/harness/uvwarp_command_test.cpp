@@ -457,3 +457,51 @@ TEST_CASE("uvwarp command: faces without UVs are in no tile, left alone and repo
     }
     CHECK(plainReport.tiles[0].notes.empty());
 }
+
+TEST_CASE("uvwarp command: maps of several channels are read from channel 0 and said once per map",
+          "[harness][uvwarp]") {
+    // A rigger's map exported as RGBA (the rigidity in red, other values in the other channels) and a
+    // warp mask as RGB give the bytes of their one-channel forms, with one note each.
+    Scene plain;
+    plain.command.frames = {3};
+    const uvwarp::ShotReport reference = harness::uvwarpCommand(plain.command);
+    CHECK(reference.tiles[0].notes.empty());
+
+    Scene colour;
+    colour.command.frames = {3};
+    const io::Image rigidity = disks();
+    io::Image rgba(kTexels, kTexels, 4);
+    io::Image rgbMask(kTexels, kTexels, 3);
+    for (int y = 0; y < kTexels; ++y) {
+        for (int x = 0; x < kTexels; ++x) {
+            rgba.at(x, y, 0) = rigidity.at(x, y, 0);
+            rgba.at(x, y, 1) = 0.25f;  // other channels hold anything: they are not read
+            rgba.at(x, y, 2) = 1.0f - rigidity.at(x, y, 0);
+            rgba.at(x, y, 3) = 1.0f;
+            for (int c = 0; c < 3; ++c)
+                rgbMask.at(x, y, c) = (c == 0) ? 1.0f : 0.0f;
+        }
+    }
+    io::writeImage(colour.dir / "rig.1001.exr", rgba, {io::PixelType::Float, {}});
+    io::writeImage(colour.dir / "mask.1001.exr", rgbMask, {io::PixelType::Float, {}});
+    io::writeImage(plain.dir / "mask.1001.exr", io::Image(kTexels, kTexels, 1, 1.0f),
+                   {io::PixelType::Float, {}});
+    colour.command.mask = colour.dir / "mask.<UDIM>.exr";
+    plain.command.mask = plain.dir / "mask.<UDIM>.exr";
+    fs::remove(plain.redirect(3));
+    (void)harness::uvwarpCommand(plain.command);
+    const uvwarp::ShotReport report = harness::uvwarpCommand(colour.command);
+    REQUIRE(report.tiles[0].notes.size() == 2);
+    CHECK_THAT(report.tiles[0].notes[0],
+               Catch::Contains("rigidity map '" + (colour.dir / "rig.1001.exr").string() +
+                               "' has 4 channels: channel 0 (red) is read"));
+    CHECK_THAT(report.tiles[0].notes[1], Catch::Contains("mask.1001.exr' has 3 channels: channel 0"));
+    CHECK(test::sameBits(io::readImage(colour.redirect(3)).pixels, io::readImage(plain.redirect(3)).pixels));
+    // Said once in the summary, not per frame.
+    colour.command.frames = {1, 2, 3};
+    fs::remove(colour.redirect(3));
+    const std::vector<std::string> summary = uvwarp::shotSummary(harness::uvwarpCommand(colour.command));
+    CHECK(std::count_if(summary.begin(), summary.end(), [](const std::string& line) {
+              return line.find("4 channels") != std::string::npos;
+          }) == 1);
+}

@@ -479,6 +479,36 @@ TEST_CASE(
     CHECK_THROWS_WITH(fresh.solve(in, 3, pose(3)), Catch::Contains("rig.1001.0003.exr"));
 }
 
+TEST_CASE("maya adapter: the redirect node reads a map of several channels from channel 0, said once",
+          "[maya][uvwarp]") {
+    const test::TempDir dir;
+    const geom::Mesh mesh = geom::makeGrid({8, 8, 1.0f, 1.0f});
+    const io::Image disk = diskMap(32, 0.5, 0.5, 0.2);
+    io::Image rgba(32, 32, 4, 0.5f);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+            rgba.at(x, y, 0) = disk.at(x, y, 0);
+    io::writeImage(dir.path() / "rig.1001.exr", rgba, {io::PixelType::Float, {}});
+    io::writeImage(dir.path() / "one.1001.exr", disk, {io::PixelType::Float, {}});
+    std::vector<glm::vec3> stretched(mesh.points().begin(), mesh.points().end());
+    for (glm::vec3& p : stretched)
+        p.x *= 1.4f;
+    maya::RedirectInputs colour, plain;
+    colour.rigidity = (dir.path() / "rig.<UDIM>.exr").string();
+    plain.rigidity = (dir.path() / "one.<UDIM>.exr").string();
+    maya::RedirectNode a, b;
+    a.build(mesh, colour, 1, "dkUvRedirect1");
+    b.build(mesh, plain, 1, "dkUvRedirect2");
+    CHECK(test::sameBits(a.solve(colour, 1, stretched).pixels, b.solve(plain, 1, stretched).pixels));
+    const std::vector<std::string> notes = a.takeNotes();
+    REQUIRE(notes.size() == 1);
+    CHECK_THAT(notes[0], Catch::Contains("rig.1001.exr' has 4 channels: channel 0 (red) is read"));
+    (void)a.solve(colour, 2, stretched);
+    a.build(mesh, colour, 3, "dkUvRedirect1");  // read again: the note was said
+    CHECK(a.takeNotes().empty());
+    CHECK(b.takeNotes().empty());
+}
+
 TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named and ranged as declared",
           "[maya][uvwarp]") {
     // Walks the declaration (uvwarp/options.h): every option has an attribute of its own name and type with

@@ -222,6 +222,7 @@ class MFnNurbsCurve {
 class MGlobal {
   public:
     static void displayError(const MString&);
+    static void displayWarning(const MString&);
     static MStatus executeCommand(const MString&);
     static MStatus executePythonCommand(const MString&);
 };
