@@ -59,6 +59,10 @@ Option& Option::needs(const Option& other) {
     return *this;
 }
 
+bool Option::given() const {
+    return option_->count() > 0;
+}
+
 Option& Option::typeName(const std::string& name) {
     option_->type_name(name);
     return *this;

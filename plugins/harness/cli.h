@@ -31,6 +31,7 @@ class Option {
     Option& delimiter(char separator);  // a list option takes "a,b,c" too
     Option& needs(const Option& other);
     Option& typeName(const std::string& name);  // what --help shows for the value: INT, FLOAT, FILE...
+    [[nodiscard]] bool given() const;           // after parsing: the command line gave it
 
   private:
     CLI::Option* option_;

@@ -135,6 +135,8 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     if (command.orientation) job.orientation = {*command.orientation, {}, "--orientation"};
     if (command.texture) job.texture = {*command.texture, {}, "--texture"};
     job.options = command.options;
+    job.preset = command.preset;
+    job.presetOwn = command.presetOwn;
     job.filter = command.filter;
     std::ofstream logFile;
     if (command.log) {
@@ -164,7 +166,9 @@ void addUvWarpCommand(CommandLine& cli) {
         // The UV-warp options as parsed, one per declaration (uvwarp/options.h), from the shot's defaults;
         // checked by the library when the command runs.
         std::vector<std::vector<double>> values;
-        std::deque<bool> flags;  // the flags' values (a deque keeps each element's address)
+        std::deque<bool> flags;     // the flags' values (a deque keeps each element's address)
+        std::vector<Option> given;  // per option, to tell what the command line set
+        std::string preset;
     };
     auto o = std::make_shared<Options>();
     const std::span<const uvwarp::OptionSpec> specs = uvwarp::optionSpecs();
@@ -199,7 +203,9 @@ void addUvWarpCommand(CommandLine& cli) {
                     value.kind = uvwarp::OptionValue::Kind::List;
                 }
                 uvwarp::setOption(c.options, specs[i], value, "", uvwarp::cliName(specs[i]));
+                if (o->given[i].given()) c.presetOwn.emplace_back(specs[i].name);
             }
+            if (!o->preset.empty()) c.preset = uvwarp::presetNamed(o->preset, "", "--preset");
             // The progress bar redraws one line in place: only for a person watching a terminal.
             ProgressBar bar(std::cerr);
             const uvwarp::ShotReport report = uvwarpCommand(c, ::isatty(STDERR_FILENO) ? &bar : nullptr);
@@ -239,19 +245,29 @@ void addUvWarpCommand(CommandLine& cli) {
         const std::string help = std::string(spec.meaning) + " (" + uvwarp::expectedValue(spec) + ")";
         switch (spec.type) {
             case uvwarp::OptionType::Flag:
-                uvwarp.flag(names, o->flags[i], std::string(spec.meaning));
+                o->given.push_back(uvwarp.flag(names, o->flags[i], std::string(spec.meaning)));
                 break;
             case uvwarp::OptionType::IntegerList:
-                uvwarp.option(names, o->values[i], help).delimiter(',').typeName("INT").showDefault();
+                o->given.push_back(
+                    uvwarp.option(names, o->values[i], help).delimiter(',').typeName("INT").showDefault());
                 break;
             case uvwarp::OptionType::Integer:
-                uvwarp.option(names, o->values[i].front(), help).typeName("INT").showDefault();
+                o->given.push_back(
+                    uvwarp.option(names, o->values[i].front(), help).typeName("INT").showDefault());
                 break;
             case uvwarp::OptionType::Number:
-                uvwarp.option(names, o->values[i].front(), help).typeName("FLOAT").showDefault();
+                o->given.push_back(
+                    uvwarp.option(names, o->values[i].front(), help).typeName("FLOAT").showDefault());
                 break;
         }
     }
+    uvwarp
+        .option(
+            "--preset", o->preset,
+            "the library's options for a use: shot (the default schedule, each frame from the identity) or "
+            "live (one warm-started iteration a frame, by grid size); options given beside it keep their "
+            "values")
+        .choices({"shot", "live"});
     uvwarp.listing(
         "--list-options", "text",
         "print every UV-warp option (its name here, in scenes and Python, range, default, meaning) "

@@ -41,6 +41,10 @@ struct UvWarpCommand {
     std::vector<int> tiles;                            // empty: every tile the rest mesh's UVs touch
     // The grid (cells: --resolution), solver, derived mask and dilation: every option of uvwarp/options.h.
     uvwarp::TileWarpOptions options = uvwarp::shotOptions();
+    // --preset: the library's preset instead of `options`, but for the options named in presetOwn (given on
+    // the command line), which keep their values from `options`.
+    std::optional<uvwarp::Preset> preset;
+    std::vector<std::string> presetOwn;
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;              // JSON lines, appended: one per tile x frame
 };

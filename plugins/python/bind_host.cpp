@@ -28,6 +28,7 @@
 #include "deformkit/ptex/ptex_mesh.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
+#include "deformkit/uvwarp/options.h"
 #include "numpy_support.h"
 
 namespace py = pybind11;
@@ -166,6 +167,9 @@ py::list entryList(const scene::SceneObject& object) {
         e["label"] = object.uvwarp->label;
         e["path"] = object.uvwarp->path;
         e["options"] = uvwarpOptionsDict(object.uvwarp->options, false);
+        e["preset"] = object.uvwarp->preset
+                          ? py::object(py::str(std::string(uvwarp::presetName(*object.uvwarp->preset))))
+                          : py::object(py::none());
         out.append(std::move(e));
     }
     return out;
@@ -419,7 +423,8 @@ void bindHost(py::module_& m) {
             "entries", [](const Scene& s, size_t object) { return entryList(sceneObject(s, object)); },
             "object_index"_a,
             "The object's stack entries as dicts {type, label, path}; a UV-warp stage, last, also has\n"
-            "options: every UV-warp option it runs with, {camelCase name: value}.");
+            "options (every UV-warp option as the scene sets it, {camelCase name: value}) and preset (the\n"
+            "library's preset it starts from, 'shot' or 'live', or None).");
 
     m.def(
         "read_scene",

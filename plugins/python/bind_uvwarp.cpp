@@ -120,29 +120,49 @@ const uvwarp::OptionSpec* pythonOption(std::string_view name) {
     return nullptr;
 }
 
-// resolution (grid cells per side, None = the rigidity map's size) and the keyword options by their
-// snake_case names (uvwarp/options.h), each checked by the library and named as the caller wrote it. `o`
-// starts as `base`: a solver's defaults (warm start) or a shot's (every frame from the identity,
-// uvwarp::shotOptions).
-TileWarpOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs& kwargs,
-                          const std::string& source, const TileWarpOptions& base = {}) {
-    TileWarpOptions o = base;
+// The options a call asked for: resolution (grid cells per side, None = the rigidity map's size), the keyword
+// options by their snake_case names (uvwarp/options.h, each checked by the library and named as the caller
+// wrote it) and the keyword `preset` ('shot' or 'live'), the library's options but for those given.
+struct CallOptions {
+    TileWarpOptions options;  // starting from the call's base, with the options given
+    std::optional<uvwarp::Preset> preset;
+    std::vector<std::string> own;  // camelCase names of the options given
+
+    // The options of one tile whose maps have `texels` per side.
+    [[nodiscard]] TileWarpOptions forTile(int32_t texels) const {
+        if (!preset) return options;
+        return uvwarp::withPreset(*preset, options.cells != 0 ? options.cells : texels, options, own);
+    }
+};
+
+// `base`: a solver's defaults (warm start) or a shot's (every frame from the identity, uvwarp::shotOptions).
+CallOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs& kwargs,
+                      const std::string& source, const TileWarpOptions& base = {}) {
+    CallOptions o{base, std::nullopt, {}};
     if (resolution) {
         uvwarp::OptionValue value;
         value.numbers = {static_cast<double>(*resolution)};
-        uvwarp::setOption(o, *uvwarp::findOption("resolution"), value, source, "resolution");
+        uvwarp::setOption(o.options, *uvwarp::findOption("resolution"), value, source, "resolution");
+        o.own.emplace_back("resolution");
     }
     for (const auto& [key, value] : kwargs) {
         const std::string k = py::str(key);
+        if (k == "preset") {
+            if (!py::isinstance<py::str>(value))
+                throw InvalidInput(formatError(source, k, "is a " + typeName(value), "'shot' or 'live'"));
+            o.preset = uvwarp::presetNamed(value.cast<std::string>(), source, k);
+            continue;
+        }
         const uvwarp::OptionSpec* spec = pythonOption(k);
         if (spec == nullptr || k == "resolution") {
-            std::string known;
+            std::string known = "preset";
             for (const uvwarp::OptionSpec& s : uvwarp::optionSpecs()) {
-                if (s.name != "resolution") known += (known.empty() ? "" : ", ") + uvwarp::pythonName(s);
+                if (s.name != "resolution") known += ", " + uvwarp::pythonName(s);
             }
             throw InvalidInput(formatError(source, k, "is not an option", known));
         }
-        uvwarp::setOption(o, *spec, optionValueOf(value), source, k);
+        uvwarp::setOption(o.options, *spec, optionValueOf(value), source, k);
+        o.own.emplace_back(spec->name);
     }
     return o;
 }
@@ -170,6 +190,9 @@ py::object optionObject(const uvwarp::OptionSpec& spec, const TileWarpOptions& o
 // The keyword options' part of the docstrings, made from the declaration.
 std::string optionsDoc() {
     std::string doc =
+        "preset: 'shot' (the default schedule, each frame from the identity) or 'live' (one warm-started\n"
+        "iteration a frame, its schedule by the grid's size): the library's options for that use, but for\n"
+        "the options given beside it.\n"
         "options (keywords; the same option is camelCase in scenes and `deformkit uvwarp "
         "--list-options`):\n";
     const TileWarpOptions defaults;
@@ -254,9 +277,10 @@ class PyUvWarpSolver {
                    const std::optional<FloatArray>& mask, const std::optional<int64_t>& resolution,
                    const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
         const std::string source = "UvWarpSolver";
-        options_ = optionsOf(resolution, kwargs, source);
-        warp_ = bindTile(mesh, tile, mapOf(rigidity, source, "rigidity"), optionalMapOf(mask, source, "mask"),
-                         options_, optionalMapOf(orientation, source, "orientation"), source);
+        const io::Image rigidityMap = mapOf(rigidity, source, "rigidity");
+        options_ = optionsOf(resolution, kwargs, source).forTile(rigidityMap.width);
+        warp_ = bindTile(mesh, tile, rigidityMap, optionalMapOf(mask, source, "mask"), options_,
+                         optionalMapOf(orientation, source, "orientation"), source);
         vertices_ = mesh.numVertices();
     }
 
@@ -324,9 +348,9 @@ py::array uvWarp(const geom::Mesh& mesh, int tile, const FloatArray& rigidity, c
                  const std::optional<FloatArray>& mask, const std::optional<int64_t>& resolution,
                  const std::optional<FloatArray>& orientation, const py::kwargs& kwargs) {
     const std::string source = "uv_warp";
-    const TileWarpOptions options = optionsOf(resolution, kwargs, source);
-    const std::vector<glm::vec3> points = deformedOf(deformed, mesh.numVertices(), source);
     const io::Image rigidityMap = mapOf(rigidity, source, "rigidity");
+    const TileWarpOptions options = optionsOf(resolution, kwargs, source).forTile(rigidityMap.width);
+    const std::vector<glm::vec3> points = deformedOf(deformed, mesh.numVertices(), source);
     const io::Image maskMap = optionalMapOf(mask, source, "mask");
     const io::Image orientationMap = optionalMapOf(orientation, source, "orientation");
     io::Image out;
@@ -434,7 +458,10 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                     const std::string& filter, bool skipExisting, const py::object& log,
                     const py::object& progress, const std::string& restName, const py::kwargs& kwargs) {
     uvwarp::ShotJob job;
-    job.options = optionsOf(resolution, kwargs, kShot, uvwarp::shotOptions());
+    const CallOptions options = optionsOf(resolution, kwargs, kShot, uvwarp::shotOptions());
+    job.options = options.options;
+    job.preset = options.preset;
+    job.presetOwn = options.own;
     job.filter = bakeOptionsOf(filter, kShot).filter;
     if (frames.empty()) throw InvalidInput(formatError(kShot, "frames", "is empty", "at least one frame"));
     job.rest = &rest;

@@ -742,7 +742,7 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     uvs = np.empty(len(obj.data.loops) * 2, np.float32)
     obj.data.uv_layers.active.data.foreach_get("uv", uvs)
     solver = dk.UvWarpSolver(rest, counts, indices, uvs.reshape(-1, 2), np.arange(len(indices), dtype=np.int32),
-                             1001, np.ascontiguousarray(disks[::-1]), **addon.uvwarp.live_options(size))
+                             1001, np.ascontiguousarray(disks[::-1]), preset="live")
     solver.solve(positions(obj))  # the operator's first frame
     for frame in (2, 3, 4, 5):
         bpy.context.scene.frame_set(frame)
@@ -756,15 +756,16 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
     assert np.abs(shown - identity).max() > 1e-3  # the twist does warp the texture
     rate = addon.uvwarp.live_rate(obj)
     assert rate is not None and rate[0] > 0.0
-    # The preset by grid size, the library's (docs/decisions.md UV-28, UV-30): the measured schedules of 64 to
-    # 2048 cells, the coarse levels over-relaxed by 1.4.
-    presets = {cells: addon.uvwarp.live_options(cells)["sweeps_per_level"]
+    # The live preset by grid size, the library's (docs/decisions.md UV-30): the measured schedules of 64 to
+    # 2048 cells, the coarse levels over-relaxed by 1.4; preset="live" runs them.
+    presets = {cells: dk.uv_warp_live_options(cells)["sweeps_per_level"]
                for cells in (64, 128, 256, 512, 1024, 2048, 4096)}
     assert presets == {64: [8, 16, 32], 128: [8, 16, 32], 256: [3, 8, 12], 512: [2, 2, 10], 1024: [1, 1, 10],
                        2048: [1, 1, 2, 8], 4096: [1, 1, 2, 8]}
-    assert [addon.uvwarp.live_options(cells)["max_levels"] for cells in (512, 1024, 2048)] == [0, 4, 5]
-    assert all(abs(addon.uvwarp.live_options(cells)["coarse_relaxation"] - 1.4) < 1e-6  # a float32
+    assert [dk.uv_warp_live_options(cells)["max_levels"] for cells in (512, 1024, 2048)] == [0, 4, 5]
+    assert all(abs(dk.uv_warp_live_options(cells)["coarse_relaxation"] - 1.4) < 1e-6  # a float32
                for cells in (128, 1024, 4096))
+    assert {k: solver.options[k] for k in dk.uv_warp_live_options(size)} == dk.uv_warp_live_options(size)
     print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")
 
     # Off: frame changes leave the image alone.

@@ -151,3 +151,50 @@ def test_scenes_take_every_option_by_its_name_and_range(shot):
                 dk.read_scene(scene(folder, {o["name"]: bad}))
     with pytest.raises(dk.InvalidInput, match=r"params.borderWidth: is not a UV-warp option"):
         dk.read_scene(scene(folder, {"borderWidth": 2}))
+
+
+def test_the_live_preset_by_name_in_python_the_command_line_and_scenes(shot):
+    """preset='live' / --preset live / "preset": "live" is the library's live preset for the grid's size
+    (dk.uv_warp_live_options), warm-started; an option given beside it keeps its value."""
+    folder, mesh = shot
+    rigidity = disks(T)
+    live = dk.uv_warp_live_options(T)
+    solver = dk.UvWarpSolver(mesh, 1001, rigidity, preset="live")
+    assert {k: solver.options[k] for k in live} == live and live["warm_start"] and live["iterations"] == 1
+    mine = dk.UvWarpSolver(mesh, 1001, rigidity, preset="live", iterations=3, resolution=8)
+    assert mine.options["iterations"] == 3 and mine.options["resolution"] == 8
+    assert mine.options["sweeps_per_level"] == dk.uv_warp_live_options(8)["sweeps_per_level"]
+    assert dk.UvWarpSolver(mesh, 1001, rigidity, preset="shot").options["warm_start"] is False
+    with pytest.raises(dk.InvalidInput, match=r"UvWarpSolver: preset: is 'fast' \(expected shot or live\)"):
+        dk.UvWarpSolver(mesh, 1001, rigidity, preset="fast")
+
+    base = ["uvwarp", "--rest", folder / "rest.obj", "--deformed", folder / "anim.####.obj", "--frames", "1",
+            "--rigidity", folder / "rig.<UDIM>.exr"]
+    for name, extra, iterations in (("live", [], 1), ("live3", ["--iterations", "3"], 3)):
+        (folder / name).mkdir()
+        done = run(*base, "--out", folder / name / "r.<UDIM>.####.exr", "--preset", "live", *extra)
+        assert done.returncode == 0, done.stderr
+        used = json.loads(dk.read_image_info(str(folder / name / "r.1001.0001.exr"))["attributes"][
+            "deformkit:uvwarp:solver"])
+        assert used["iterations"] == iterations and used["warmStart"] is True
+        assert used["sweepsPerLevel"] == live["sweeps_per_level"]
+        assert used["coarseRelaxation"] == pytest.approx(live["coarse_relaxation"])
+    done = run(*base, "--out", folder / "x" / "r.<UDIM>.####.exr", "--preset", "fast")
+    assert done.returncode == 2 and "--preset" in done.stderr
+
+    path = folder / "scene.json"
+    path.write_text(json.dumps({
+        "deformkit_scene": 1, "frames": [1, 1],
+        "objects": [{"name": "plane", "mesh": "anim.####.obj", "restFrame": 1,
+                     "stack": [{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "preset": "live",
+                                "params": {"iterations": 2}}]}]}))
+    stage = dk.read_scene(str(path)).entries(0)[-1]
+    assert stage["preset"] == "live" and stage["options"]["iterations"] == 2
+    done = run("eval", path, "--out", folder / "eval", "--no-previews")
+    assert done.returncode == 0, done.stderr
+    used = json.loads(dk.read_image_info(str(folder / "eval" / "plane.redirect.1001.0001.exr"))["attributes"][
+        "deformkit:uvwarp:solver"])
+    assert used["iterations"] == 2 and used["warmStart"] is True and used["sweepsPerLevel"] == live["sweeps_per_level"]
+    path.write_text(path.read_text().replace('"live"', '"fast"'))
+    with pytest.raises(dk.InvalidInput, match=r"objects\[0\]\.stack\[0\]\.preset: is 'fast'"):
+        dk.read_scene(str(path))

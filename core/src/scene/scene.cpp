@@ -380,7 +380,7 @@ class Reader {
     SceneUvWarp uvwarp(const json& v, const std::string& path, size_t entry, const geom::Mesh& rest) const {
         onlyKeys(v, path,
                  {"type", "label", "rigidity", "mask", "orientation", "texture", "tiles", "resolution",
-                  "filter", "params"});
+                  "filter", "preset", "params"});
         SceneUvWarp u;
         u.path = path;
         u.label = v.contains("label") ? string(v.at("label"), path + ".label", "a non-empty string")
@@ -418,9 +418,15 @@ class Reader {
         } else {
             u.tiles = meshTiles;
         }
-        if (v.contains("resolution"))
+        if (v.contains("resolution")) {
             uvwarpOption(u.options, *uvwarp::findOption("resolution"), v.at("resolution"),
                          path + ".resolution");
+            u.presetOwn.emplace_back("resolution");
+        }
+        if (v.contains("preset")) {
+            u.preset = uvwarp::presetNamed(string(v.at("preset"), path + ".preset", "\"shot\" or \"live\""),
+                                           source_, path + ".preset");
+        }
         if (v.contains("filter")) {
             const std::string f = string(v.at("filter"), path + ".filter", "\"bilinear\" or \"bicubic\"");
             if (f == "bilinear") {
@@ -444,6 +450,7 @@ class Reader {
                     fail(pp + "." + item.key(), "is not a UV-warp option", "one of: " + known);
                 }
                 uvwarpOption(u.options, *spec, item.value(), pp + "." + item.key());
+                u.presetOwn.emplace_back(spec->name);
             }
         }
         return u;

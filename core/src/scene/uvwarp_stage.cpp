@@ -126,6 +126,8 @@ uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpSt
         };
     }
     job.options = stage.options;
+    job.preset = stage.preset;
+    job.presetOwn = stage.presetOwn;
     job.filter = stage.filter;
     job.skipExisting = run.skipExisting;
     job.log = run.log;

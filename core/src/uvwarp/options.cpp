@@ -375,6 +375,36 @@ void checkOptions(const SolverOptions& options, std::string_view source) {
     checkEveryOption(all, source, true);
 }
 
+std::string_view presetName(Preset preset) {
+    return preset == Preset::Live ? "live" : "shot";
+}
+
+Preset presetNamed(std::string_view name, std::string_view source, std::string_view element) {
+    if (name == "shot") return Preset::Shot;
+    if (name == "live") return Preset::Live;
+    throw InvalidInput(formatError(source, element, "is '" + std::string(name) + "'", "shot or live"));
+}
+
+TileWarpOptions presetOptions(Preset preset, int32_t cells) {
+    TileWarpOptions options = shotOptions();
+    if (preset == Preset::Live) options.solver = liveOptions(cells);
+    options.cells = cells;
+    return options;
+}
+
+TileWarpOptions withPreset(Preset preset, int32_t cells, const TileWarpOptions& options,
+                           std::span<const std::string> own) {
+    TileWarpOptions out = presetOptions(preset, cells);
+    for (const std::string& name : own) {
+        const OptionSpec* spec = findOption(name);
+        if (spec == nullptr)
+            throw InvalidInput(
+                formatError("preset", "option '" + name + "'", "is not an option", "a UV-warp option"));
+        spec->put(out, spec->get(options));
+    }
+    return out;
+}
+
 std::string optionReference(bool markdown) {
     std::string out;
     if (markdown) {

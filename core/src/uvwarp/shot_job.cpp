@@ -48,6 +48,7 @@ struct TilePlan {
     std::vector<std::filesystem::path> outPaths, bakePaths;  // per frame
     std::vector<bool> needed;                                // per frame: an output to write
     int lastNeeded = -1;                                     // index of the last needed frame
+    TileWarpOptions options;                                 // the job's, or its preset's for this tile
     std::optional<TileWarp> warp;                            // bound at the first frame it solves
     io::Image texturePixels, redirect, baked;
     // Animated maps: the rigidity, mask and orientation images last given to the warp, to tell a change.
@@ -224,7 +225,7 @@ struct ShotSolver::Impl {
     // the outputs are solved.
     [[nodiscard]] bool solves(const TilePlan& plan, size_t k) const {
         return plan.report.warped &&
-               (job.options.solver.warmStart ? static_cast<int>(k) <= plan.lastNeeded : plan.needed[k]);
+               (plan.options.solver.warmStart ? static_cast<int>(k) <= plan.lastNeeded : plan.needed[k]);
     }
     void bind(TilePlan& plan, int frame);
     // Animated maps: gives the warp the frame's maps when they differ from the last ones.
@@ -308,6 +309,9 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                            std::to_string(r.width) + " texels per side, not a power of two",
                                            "a power-of-two size, or a grid resolution"));
         }
+        plan.options =
+            j.preset ? withPreset(*j.preset, resolution != 0 ? resolution : r.width, j.options, j.presetOwn)
+                     : j.options;
         // Maps that must have the rigidity map's size.
         const auto sameSize = [&](const TileMap& map, const char* what) {
             if (map.width != r.width || map.height != r.height) {
@@ -442,7 +446,7 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
     }
-    plan.warp.emplace(*job.rest, plan.tile, rigidity, mask, job.options, orientation, job.restName);
+    plan.warp.emplace(*job.rest, plan.tile, rigidity, mask, plan.options, orientation, job.restName);
     if (!plan.rigidity.framePattern.empty()) plan.lastRigidity = rigidity;
     if (!plan.mask.framePattern.empty()) plan.lastMask = mask;
     if (!plan.orientation.framePattern.empty()) plan.lastOrientation = orientation;
@@ -510,7 +514,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             {"deformkit:uvwarp:tile", std::to_string(plan.tile)},
             {"deformkit:uvwarp:frame", std::to_string(frame)},
             {"deformkit:uvwarp:solver",
-             solverJson(job.options, warp.cells(), warp.texels(), warp.stats().levels).dump()},
+             solverJson(plan.options, warp.cells(), warp.texels(), warp.stats().levels).dump()},
             {"deformkit:uvwarp:inputs", frameInputs.dump()}};
         t = Clock::now();
         if (!job.skipExisting || !fileExists(plan.outPaths[k])) {

@@ -305,7 +305,8 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         try:
             report = uvwarp.bake_redirect_maps(context, obj, settings.uv_rigidity, settings.uv_mask, frames,
                                                bpy.path.abspath(settings.uv_output), settings.uv_resolution,
-                                               self.resume, lambda done, total, _: wm.progress_update(done / total))
+                                               self.resume, lambda done, total, _: wm.progress_update(done / total),
+                                               preset=settings.uv_preset)
         except Exception as e:  # noqa: BLE001 - reported to the user
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}

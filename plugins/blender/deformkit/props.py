@@ -116,6 +116,10 @@ class DeformKitStack(bpy.types.PropertyGroup):
                               description="Folder of the redirect maps (redirect.<tile>.<frame>.exr)")
     uv_resolution: IntProperty(name="Resolution", default=0, min=0,
                                description="Solver grid cells per side, a power of two (0: the map's texels)")
+    uv_preset: EnumProperty(name="Preset", default='shot',
+                            items=(('shot', "Shot", "The default schedule, each frame from the identity: the bake"),
+                                   ('live', "Live", "One warm-started iteration a frame, by grid size")),
+                            description="The library's options for the bake (the live mode always runs live)")
 
 
 _classes = (DeformKitEntry, DeformKitStack)

@@ -101,6 +101,7 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         col.template_ID(settings, "uv_mask", open="image.open", text="Mask")
         col.prop(settings, "uv_output")
         col.prop(settings, "uv_resolution")
+        col.prop(settings, "uv_preset")
         row = col.row(align=True)
         row.operator("deformkit.bake_redirect", icon='RENDER_ANIMATION', text="Bake Redirect Maps")
         # Resume keeps the maps that exist (a bake that stopped) and writes the missing ones, with the bytes an

@@ -81,12 +81,14 @@ def evaluated_points(obj, depsgraph, count):
     return points.reshape(-1, 3)
 
 
-def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution=0, resume=False, progress=None):
+def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution=0, resume=False, progress=None,
+                       preset="shot"):
     """Solves every UDIM tile of the object's UVs over `frames` (ascending) with the module's shot job and
     writes REDIRECT_PATTERN's files into out_dir. Each frame is set once and the evaluated mesh read once for
-    all tiles. Each frame is solved from the identity (the shot job's default), so resume keeps the maps that
-    exist and sets only the frames of the missing ones; otherwise every map is written again.
-    progress(done, total, unit) is uvwarp_shot's. Returns the job's report, {tile: dict}."""
+    all tiles. With the shot preset each frame is solved from the identity, so resume keeps the maps that
+    exist and sets only the frames of the missing ones; otherwise every map is written again. preset: the
+    library's ('shot' or 'live'). progress(done, total, unit) is uvwarp_shot's. Returns the job's report,
+    {tile: dict}."""
     scene = context.scene
     if evaluate.has_rest(obj):
         rest = evaluate.rest_points(obj)
@@ -111,7 +113,7 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
                               os.path.join(out_dir, REDIRECT_PATTERN),
                               mask=image_map(mask, "mask") if mask is not None else None,
                               resolution=resolution or None, skip_existing=resume, progress=progress,
-                              rest_name=name)
+                              rest_name=name, preset=preset)
     finally:
         scene.frame_set(current)
 
@@ -190,14 +192,6 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
 
 # ---- live mode: the warp solved on every frame change, shown through the material -----------------------
 
-def live_options(cells):
-    """The live preset's solver options for a grid of `cells` cells per side: the library's
-    (uvwarp::liveOptions): one warm iteration a frame, the coarse levels over-relaxed, sweeps per level by
-    the grid's size, measured within 2 points of a converged solve on every probed frame of a smooth
-    animation on two models (docs/uvwarp.md, "Performance"; docs/decisions.md UV-28, UV-30)."""
-    return dict(dk.uv_warp_live_options(cells))
-
-
 LIVE_IMAGE = "DeformKit Live {}"
 
 # Per object name: its tile's solver, the image it fills, the last frames' times.
@@ -232,9 +226,10 @@ def start_live(obj, rigidity, mask, resolution):
                           f"bake the redirect maps instead")
     _, rigidity_maps = image_map(rigidity, "rigidity")
     mask_map = image_map(mask, "mask")[1][1001] if mask is not None else None
-    cells = resolution or rigidity_maps[1001].shape[0]
+    # The library's live preset: one warm-started iteration a frame, its schedule by the grid's size
+    # (docs/uvwarp.md, "Performance"; docs/decisions.md UV-30).
     solver = dk.UvWarpSolver(points, counts, indices, uvs, order, 1001, rigidity_maps[1001], mask=mask_map,
-                             resolution=resolution or None, **live_options(cells))
+                             resolution=resolution or None, preset="live")
     texels = solver.texels
     name = LIVE_IMAGE.format(obj.name)
     image = bpy.data.images.get(name)

@@ -437,7 +437,8 @@ RedirectFiles redirectFilesAt(const RedirectInputs& in, int frame) {
 
 bool RedirectNode::needsBuild(const RedirectInputs& in) const {
     return !core_ || in.tile != built_.tile || in.rigidity != built_.rigidity || in.mask != built_.mask ||
-           in.orientation != built_.orientation || !sameOptions(in.options, built_.options);
+           in.orientation != built_.orientation || in.preset != built_.preset ||
+           !sameOptions(in.options, built_.options);
 }
 
 RedirectNode::Maps RedirectNode::read(const RedirectFiles& files) {
@@ -470,7 +471,14 @@ void RedirectNode::build(const geom::Mesh& rest, const RedirectInputs& in, int f
                          const std::string& source) {
     const RedirectFiles files = redirectFilesAt(in, frame);
     const Maps maps = read(files);
-    core_ = std::make_unique<RedirectCore>(rest, in.tile, maps.rigidity, maps.mask, in.options, source,
+    // A preset replaces every option but the grid resolution, which the live schedule is chosen by.
+    static const std::vector<std::string> kOwn = {"resolution"};
+    const uvwarp::TileWarpOptions options =
+        in.preset.empty() ? in.options
+                          : uvwarp::withPreset(uvwarp::presetNamed(in.preset, "dkUvRedirect", "preset"),
+                                               in.options.cells != 0 ? in.options.cells : maps.rigidity.width,
+                                               in.options, kOwn);
+    core_ = std::make_unique<RedirectCore>(rest, in.tile, maps.rigidity, maps.mask, options, source,
                                            maps.orientation);
     built_ = in;
     loaded_ = files;

@@ -194,6 +194,8 @@ struct RedirectInputs {
     std::string rigidity;     // required
     std::string mask;         // empty: derived from the UVs
     std::string orientation;  // empty: none (or the density heuristic)
+    // "shot" or "live": the library's preset replaces every option but `resolution`; empty: the options.
+    std::string preset;
     uvwarp::TileWarpOptions options;
 };
 

@@ -32,8 +32,8 @@ geom::Mesh meshWithUVs(const MObject& data, const std::string& what) {
 
 const MTypeId DkUvRedirect::id(0x0013A6C5);
 MObject DkUvRedirect::inMesh, DkUvRedirect::restMesh, DkUvRedirect::rigidity, DkUvRedirect::mask,
-    DkUvRedirect::orientation, DkUvRedirect::tile, DkUvRedirect::output, DkUvRedirect::time,
-    DkUvRedirect::outFile;
+    DkUvRedirect::orientation, DkUvRedirect::preset, DkUvRedirect::tile, DkUvRedirect::output,
+    DkUvRedirect::time, DkUvRedirect::outFile;
 std::vector<RedirectOptionAttribute> DkUvRedirect::optionSpecs;
 std::vector<MObject> DkUvRedirect::options;
 
@@ -83,7 +83,7 @@ MStatus DkUvRedirect::initialize() {
     typed.setWritable(false);
     typed.setStorable(false);
     addAttribute(outFile);
-    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &tile, &output, &time})
+    for (MObject* in : {&inMesh, &restMesh, &rigidity, &mask, &orientation, &preset, &tile, &output, &time})
         attributeAffects(*in, outFile);
     for (const MObject& option : options)
         attributeAffects(option, outFile);
@@ -98,6 +98,7 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
         in.rigidity = block.inputValue(rigidity).asString().asChar();
         in.mask = block.inputValue(mask).asString().asChar();
         in.orientation = block.inputValue(orientation).asString().asChar();
+        in.preset = block.inputValue(preset).asString().asChar();
         for (size_t i = 0; i < optionSpecs.size(); ++i) {
             MDataHandle value = block.inputValue(options[i]);
             switch (optionSpecs[i].kind) {

@@ -26,7 +26,7 @@ class DkUvRedirect : public MPxNode {
     MStatus compute(const MPlug& plug, MDataBlock& block) override;
 
     static const MTypeId id;
-    static MObject inMesh, restMesh, rigidity, mask, orientation, tile, output, time, outFile;
+    static MObject inMesh, restMesh, rigidity, mask, orientation, preset, tile, output, time, outFile;
     // One attribute per UV-warp option (uvwarp/options.h), in the library's order.
     static std::vector<RedirectOptionAttribute> optionSpecs;
     static std::vector<MObject> options;

@@ -509,6 +509,36 @@ TEST_CASE("maya adapter: the redirect node reads a map of several channels from 
     CHECK(b.takeNotes().empty());
 }
 
+TEST_CASE("maya adapter: the redirect node's preset replaces every option but the resolution",
+          "[maya][uvwarp]") {
+    const test::TempDir dir;
+    const geom::Mesh mesh = geom::makeGrid({8, 8, 1.0f, 1.0f});
+    const io::Image disk = diskMap(32, 0.5, 0.5, 0.2);
+    io::writeImage(dir.path() / "rig.1001.exr", disk, {io::PixelType::Float, {}});
+    std::vector<glm::vec3> stretched(mesh.points().begin(), mesh.points().end());
+    for (glm::vec3& p : stretched)
+        p.x *= 1.4f;
+    maya::RedirectInputs in;
+    in.rigidity = (dir.path() / "rig.<UDIM>.exr").string();
+    in.options.solver.iterations = 7;  // replaced by the preset
+    in.options.cells = 16;             // kept: the live schedule is chosen by it
+    in.preset = "live";
+    maya::RedirectNode node;
+    node.build(mesh, in, 1, "dkUvRedirect1");
+    const io::Image first = node.solve(in, 1, stretched);
+    uvwarp::TileWarp direct(mesh, 1001, disk, {}, uvwarp::presetOptions(uvwarp::Preset::Live, 16), {},
+                            "direct");
+    (void)direct.solve(stretched);
+    CHECK(test::sameBits(first.pixels, direct.redirect().pixels));
+    CHECK(direct.stats().iterations == uvwarp::liveOptions(16).coldIterations);
+    maya::RedirectInputs shot = in;
+    shot.preset = "shot";
+    CHECK(node.needsBuild(shot));
+    shot.preset = "fast";
+    CHECK_THROWS_WITH(node.build(mesh, shot, 1, "dkUvRedirect1"),
+                      Catch::Contains("dkUvRedirect: preset: is 'fast' (expected shot or live)"));
+}
+
 TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named and ranged as declared",
           "[maya][uvwarp]") {
     // Walks the declaration (uvwarp/options.h): every option has an attribute of its own name and type with

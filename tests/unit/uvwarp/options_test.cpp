@@ -256,3 +256,36 @@ TEST_CASE("uv warp options: the reference lists every option in every interface'
         CHECK_THAT(text, Catch::Contains(std::string(spec.name) + " (CLI " + uvwarp::cliName(spec) +
                                          ", Python " + uvwarp::pythonName(spec) + "): "));
 }
+
+TEST_CASE("uv warp options: presets by name, resolved for a grid, the caller's own options kept",
+          "[uvwarp][options]") {
+    CHECK(uvwarp::presetNamed("shot", "s", "e") == uvwarp::Preset::Shot);
+    CHECK(uvwarp::presetNamed("live", "s", "e") == uvwarp::Preset::Live);
+    CHECK(uvwarp::presetName(uvwarp::Preset::Live) == "live");
+    CHECK_THROWS_WITH(uvwarp::presetNamed("fast", "cli", "--preset"),
+                      "cli: --preset: is 'fast' (expected shot or live)");
+    // shot: the shot job's options; live: the live schedule of the grid's size, warm-started.
+    CHECK(uvwarp::presetOptions(uvwarp::Preset::Shot, 512).solver == uvwarp::shotOptions().solver);
+    for (int32_t cells : {64, 256, 512, 1024, 2048}) {
+        const uvwarp::TileWarpOptions live = uvwarp::presetOptions(uvwarp::Preset::Live, cells);
+        CHECK(live.solver == uvwarp::liveOptions(cells));
+        CHECK(live.solver.warmStart);
+        CHECK(live.solver.iterations == 1);
+        CHECK(live.cells == cells);
+        uvwarp::checkOptions(live, "live");
+    }
+    // The options the caller set itself keep their values; every other one is the preset's.
+    uvwarp::TileWarpOptions mine = uvwarp::shotOptions();
+    mine.solver.iterations = 3;
+    mine.solver.smoothing = 0.25f;
+    mine.derivedMask.borderWidth = 2;
+    const std::vector<std::string> own = {"iterations", "maskBorderWidth"};
+    const uvwarp::TileWarpOptions o = uvwarp::withPreset(uvwarp::Preset::Live, 1024, mine, own);
+    CHECK(o.solver.iterations == 3);
+    CHECK(o.derivedMask.borderWidth == 2);
+    CHECK(o.solver.smoothing == uvwarp::liveOptions(1024).smoothing);  // not named: the preset's
+    CHECK(o.solver.sweepsPerLevel == uvwarp::liveOptions(1024).sweepsPerLevel);
+    CHECK(o.solver.warmStart);
+    const std::vector<std::string> bogus = {"borderWidth"};
+    CHECK_THROWS_AS(uvwarp::withPreset(uvwarp::Preset::Live, 1024, mine, bogus), InvalidInput);
+}

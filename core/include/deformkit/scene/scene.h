@@ -65,6 +65,10 @@ struct SceneUvWarp {
     // options.cells: the grid resolution (0: the rigidity map's size); every frame from the identity unless
     // the scene's params say "warmStart": true (uvwarp::shotOptions).
     uvwarp::TileWarpOptions options = uvwarp::shotOptions();
+    // "preset": the library's preset ("shot", "live") instead of `options`, but for the options the scene
+    // sets itself (presetOwn: its params and resolution), which keep their values.
+    std::optional<uvwarp::Preset> preset;
+    std::vector<std::string> presetOwn;
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
     std::string path;                                      // "objects[0].stack[2]"
 };

@@ -85,6 +85,24 @@ void checkOptions(const TileWarpOptions& options, std::string_view source);
 // The same for the solver's options only (Solver's constructor).
 void checkOptions(const SolverOptions& options, std::string_view source);
 
+// The library's presets: every option's value for a use, by name in every interface (`--preset live`,
+// "preset": "live", preset="live", the Maya node's preset attribute).
+//   shot  the default schedule (4 iterations of sweeps {4, 8, 8}), each frame from the identity: what a shot
+//         written as files runs (shotOptions()).
+//   live  one warm-started iteration a frame, for a live preview: liveOptions(cells), whose schedule depends
+//         on the grid's size.
+enum class Preset { Shot, Live };
+[[nodiscard]] std::string_view presetName(Preset preset);
+// "shot" or "live"; InvalidInput "<source>: <element>: is '<name>' (expected shot or live)" otherwise.
+[[nodiscard]] Preset presetNamed(std::string_view name, std::string_view source, std::string_view element);
+// Every option of `preset` for a grid of `cells` cells per side (options.cells is `cells`).
+[[nodiscard]] TileWarpOptions presetOptions(Preset preset, int32_t cells);
+// `preset`'s options for a grid of `cells`, but for the options named in `own` (camelCase), which keep their
+// values from `options`: what a caller who chose a preset and set some options itself gets. Throws
+// InvalidInput for a name that is not an option.
+[[nodiscard]] TileWarpOptions withPreset(Preset preset, int32_t cells, const TileWarpOptions& options,
+                                         std::span<const std::string> own);
+
 // The reference of every option: one paragraph each for a terminal, or the Markdown table of
 // docs/uvwarp.md (its default column shows the library's default and, where a shot starts from another,
 // shotOptions()'s).

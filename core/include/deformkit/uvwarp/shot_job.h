@@ -18,6 +18,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/sampling.h"
 #include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/tile_warp.h"
 
 namespace deformkit::uvwarp {
@@ -89,6 +90,11 @@ struct ShotJob {
     // Output files of a tile and frame; bakePath only with a texture. Their folders must exist.
     std::function<std::filesystem::path(int tile, int frame)> outPath, bakePath;
     TileWarpOptions options = shotOptions();  // cells: the grid resolution (0: the rigidity map's size)
+    // A preset instead of `options` (options.h), resolved per tile for its grid (the live preset's schedule
+    // depends on the grid's size); the options named in presetOwn keep their values from `options`, as the
+    // caller set them. Without a preset, `options` as they are.
+    std::optional<Preset> preset;
+    std::vector<std::string> presetOwn;
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // of the bake
     // Keep existing outputs and replay the warm start (a resumed job writes an uninterrupted job's bytes);
     // false writes every output again.
