@@ -65,7 +65,7 @@ DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, con
     warp::SparseFields unused;
     bend.bind(points, unused);
     bend.deform(points);
-    DemoUvWarp demo{tube, {}, {}, {}};
+    DemoUvWarp demo{tube, {}, {}, {}, {}};
     demo.bent.setPoints(points);
 
     uvwarp::TileWarpOptions options;
@@ -76,6 +76,7 @@ DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, con
     tile.solve(points);
     demo.redirect = tile.redirect();
     demo.metrics = tile.metrics();
+    demo.delivered = tile.measure(demo.redirect);
     demo.warpedAlbedo = uvwarp::bakeTexture(albedo, demo.redirect);  // bilinear: no overshoot past [0, 1]
     return demo;
 }
@@ -126,12 +127,14 @@ std::vector<fs::path> writeDemoUvWarp(const geom::Mesh& tube, const io::Image& r
     written.push_back(dir / "uvwarp.png");
     io::writeImage(written.back(), sheet({{&outerBefore, &outerAfter}, {&innerBefore, &innerAfter}}, 8));
 
-    const uvwarp::WarpMetrics& m = demo.metrics;
-    const std::string json =
-        "{\"tile\": 1001, \"rigid_stretch_error\": " + std::to_string(m.rigidStretchError) +
-        ", \"identity_stretch_error\": " + std::to_string(m.identityStretchError) +
-        ", \"fold_overs\": " + std::to_string(m.foldOvers) +
-        ", \"max_masked_displacement\": " + std::to_string(m.maxMaskedDisplacement) + "}\n";
+    // The redirect map's figures (uvwarp/redirect_metrics.h), as the shot log names them.
+    std::string json = "{\"tile\": 1001";
+    for (const uvwarp::ReportedFigure& f : uvwarp::reportedFigures(demo.delivered)) {
+        json += ", \"" + std::string(f.name) + "\": ";
+        json += f.kind == uvwarp::ReportedFigure::Kind::Count ? std::to_string(static_cast<int64_t>(f.value))
+                                                              : std::to_string(f.value);
+    }
+    json += "}\n";
     written.push_back(dir / "metrics.json");
     io::writeFileAtomically(written.back(), json);
     return written;

@@ -7,16 +7,18 @@
 #include "deformkit/geom/mesh.h"
 #include "deformkit/io/image.h"
 #include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/redirect_metrics.h"
 
 namespace deformkit::harness {
 
 // The demo's UV warp: the tube bent (Barr bend) so that one side stretches about 1.5x and the other
 // squashes, and the side tile's texture re-parameterised so the painted rigid features keep their size.
 struct DemoUvWarp {
-    geom::Mesh bent;              // the tube bent, same topology and UVs
-    io::Image redirect;           // tile 1001's W^-1, T x T x 2
-    io::Image warpedAlbedo;       // tile 1001's albedo baked through the redirect
-    uvwarp::WarpMetrics metrics;  // of the side tile's warp
+    geom::Mesh bent;                     // the tube bent, same topology and UVs
+    io::Image redirect;                  // tile 1001's W^-1, T x T x 2
+    io::Image warpedAlbedo;              // tile 1001's albedo baked through the redirect
+    uvwarp::WarpMetrics metrics;         // of the side tile's warp, on the solver's grid (diagnostics)
+    uvwarp::DeliveredMetrics delivered;  // of its redirect map, what the previews show
 };
 
 // resolution: the maps' texels per side; the solver's grid has min(resolution, 256) cells.

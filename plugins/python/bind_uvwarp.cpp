@@ -242,15 +242,13 @@ void addFigures(py::dict& d, const std::vector<uvwarp::ReportedFigure>& figures)
     }
 }
 
-py::dict metricsDict(const uvwarp::WarpMetrics& m) {
+// The figures of a frame: its redirect map's, then the grid's (grid_*), and the solver's when given.
+py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::WarpMetrics& m,
+                     const uvwarp::SolveStats* s = nullptr) {
     py::dict d;
+    addFigures(d, uvwarp::reportedFigures(delivered));
     addFigures(d, uvwarp::reportedFigures(m));
-    return d;
-}
-
-py::dict metricsDict(const uvwarp::WarpMetrics& m, const uvwarp::SolveStats& s) {
-    py::dict d = metricsDict(m);
-    addFigures(d, uvwarp::reportedFigures(s));
+    if (s) addFigures(d, uvwarp::reportedFigures(*s));
     return d;
 }
 
@@ -306,15 +304,17 @@ class PyUvWarpSolver {
     }
 
     py::dict metrics() const {
+        uvwarp::DeliveredMetrics delivered;
         uvwarp::WarpMetrics m;
         uvwarp::SolveStats s;
         {
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(mutex_);
+            delivered = warp_->deliveredMetrics();
             m = warp_->metrics();
             s = warp_->stats();
         }
-        return metricsDict(m, s);
+        return metricsDict(delivered, m, &s);
     }
 
     void reset() {
@@ -441,7 +441,9 @@ py::dict tileReportDict(const uvwarp::ShotTileReport& t) {
                "skipped"_a = t.skipped, "map_changes"_a = t.mapChanges);
     const bool solved = t.written + t.replayed > 0;
     d["last_frame"] = solved ? py::object(py::int_(t.lastFrame)) : py::none();
-    d["metrics"] = solved ? py::object(metricsDict(t.lastMetrics)) : py::none();
+    // Of the last frame written: its redirect map's figures, and its grid's.
+    d["last_written_frame"] = t.written > 0 ? py::object(py::int_(t.lastWrittenFrame)) : py::none();
+    d["metrics"] = t.written > 0 ? py::object(metricsDict(t.lastDelivered, t.lastMetrics)) : py::none();
     py::list files;
     for (const std::filesystem::path& f : t.files)
         files.append(f.string());
@@ -627,7 +629,8 @@ constexpr const char* kShotDoc =
     "deformkit:uvwarp:tile, deformkit:uvwarp:frame, deformkit:uvwarp:solver and deformkit:uvwarp:inputs,\n"
     "the last two JSON; see read_image_info). Returns {tile: report}, ascending, each a dict: warped,\n"
     "written (frames written), baked, replayed (existed, solved for the warm start), skipped (existed, not\n"
-    "solved), last_frame and metrics (of the last frame solved, or None), files (written, in order), notes\n"
+    "solved), last_frame (the last solved), last_written_frame and metrics (its redirect map's figures and\n"
+    "its grid's, as UvWarpSolver.metrics; None when nothing was written), files (written, in order), notes\n"
     "(an unwarped tile, a derived mask, a texture not baked) and summary (printable lines).";
 
 }  // namespace
@@ -667,11 +670,17 @@ void bindUvWarp(py::module_& m) {
              "tile-local (u', v') to read the unwarped texture at for the texel centre ((x + 0.5) / T,\n"
              "1 - (y + 0.5) / T). The identity before any solve.")
         .def("metrics", &PyUvWarpSolver::metrics,
-             "Quality figures of the last solve: rigid_stretch_error and identity_stretch_error (mean\n"
-             "|l_def / l_org - 1| over rigid grid edges with our warp and with none), rigid_edges,\n"
-             "skipped_edges, fold_overs, max_masked_displacement and max_border_displacement (texels),\n"
-             "points_outside, and the solver's iterations, levels, untangled_points, reverted_points, "
-             "remaining_folds,\n"
+             "What the last solve delivers, measured on its redirect map (redirect_metrics.h):\n"
+             "rigid_stretch_error and identity_stretch_error (mean | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) -\n"
+             "f_O(r_a)| - 1 | over 4-connected texel edges in one chart whose content r = R(q) is rigid, "
+             "with the\n"
+             "map and with none), rigid_stretch_removed, rigid_edges, identity_rigid_edges, "
+             "inverted_triangles\n"
+             "(of the map's texel-centre grid, both diagonals), off_chart_texels, chart_texels; the solver's "
+             "grid\n"
+             "figures as diagnostics (grid_rigid_stretch_error, grid_fold_overs, "
+             "grid_max_masked_displacement,\n"
+             "...); and the solve's iterations, levels, untangled_points, reverted_points, remaining_folds,\n"
              "last_move (cells) and converged.")
         .def("reset", &PyUvWarpSolver::reset, "Back to the identity warp (a cut in the shot).")
         .def_property_readonly("warp", &PyUvWarpSolver::warp, "The current warp grid, as solve returns it.")
@@ -737,6 +746,36 @@ void bindUvWarp(py::module_& m) {
         "size\n"
         "(uvwarp::liveOptions; within 2 points of a converged solve on every probed frame of a smooth\n"
         "animation).");
+
+    m.def(
+        "redirect_metrics",
+        [](const geom::Mesh& mesh, int tile, const FloatArray& rigidity, const FloatArray& deformed,
+           const FloatArray& redirect) {
+            const std::string source = "redirect_metrics";
+            const io::Image rigidityMap = mapOf(rigidity, source, "rigidity");
+            const std::vector<glm::vec3> points = deformedOf(deformed, mesh.numVertices(), source);
+            if (redirect.ndim() != 3 || redirect.shape(2) < 2) {
+                throw InvalidInput(
+                    formatError(source, "redirect", "has shape " + shapeOf(redirect), "(T, T, 2) float32"));
+            }
+            const io::Image map = imageOf(redirect, source, "redirect", "(T, T, 2) float32");
+            uvwarp::DeliveredMetrics out;
+            {
+                py::gil_scoped_release release;
+                out = uvwarp::RedirectMetrics(mesh, tile, rigidityMap, source).measure(points, map);
+            }
+            py::dict d;
+            addFigures(d, uvwarp::reportedFigures(out));
+            return d;
+        },
+        py::arg("mesh"), py::arg("tile"), py::arg("rigidity"), py::arg("deformed_points"),
+        py::arg("redirect"),
+        "What a redirect map delivers (deformkit/uvwarp/redirect_metrics.h), for any map: mesh with UVs,\n"
+        "tile, rigidity (T, T) float32, deformed_points (N, 3) float32 (the rest mesh's vertices moved),\n"
+        "redirect (T, T, 2) float32 as redirect_map returns it. Returns {rigid_stretch_error,\n"
+        "identity_stretch_error, rigid_stretch_removed, rigid_edges, identity_rigid_edges, "
+        "inverted_triangles,\n"
+        "off_chart_texels, chart_texels}, the figures UvWarpSolver.metrics() and the shot log report.");
 
     m.def(
         "uv_warp_options",

@@ -81,13 +81,23 @@ def test_stretch_keeps_rigid_disks_and_metrics_match_the_closed_form():
     grid = solver.solve(stretched(pts))
     assert grid.dtype == np.float32 and grid.shape == (T + 1, T + 1, 2)  # n cells: n + 1 points per side
     m = solver.metrics()
+    # The solver's grid figures (diagnostics).
     expected, edges = identity_stretch_error(rig)
-    assert m["rigid_edges"] == edges and m["skipped_edges"] == 0
+    assert m["grid_rigid_edges"] == edges and m["grid_skipped_edges"] == 0
     # The geometry images of a plane moved by a linear map are exact up to float32 rounding of positions ~1.
-    assert m["identity_stretch_error"] == pytest.approx(expected, rel=1e-5)
-    assert m["rigid_stretch_error"] <= 0.2 * m["identity_stretch_error"]  # at least 80% removed
-    assert m["fold_overs"] == 0 and m["remaining_folds"] == 0 and m["points_outside"] == 0
-    assert m["max_border_displacement"] == 0.0 and m["max_masked_displacement"] == 0.0
+    assert m["grid_identity_stretch_error"] == pytest.approx(expected, rel=1e-5)
+    assert m["grid_rigid_stretch_error"] <= 0.2 * m["grid_identity_stretch_error"]  # at least 80% removed
+    assert m["grid_fold_overs"] == 0 and m["remaining_folds"] == 0 and m["grid_points_outside"] == 0
+    assert m["grid_max_border_displacement"] == 0.0 and m["grid_max_masked_displacement"] == 0.0
+    # Through the delivered redirect map: 4-connected texel edges whose texels are both rigid; for the
+    # identity a horizontal edge stretches 1.5x (0.5 off), a vertical one not at all.
+    rigid = rig >= 0.5
+    horizontal = (rigid[:, 1:] & rigid[:, :-1]).sum()
+    vertical = (rigid[1:, :] & rigid[:-1, :]).sum()
+    assert m["identity_rigid_edges"] == horizontal + vertical
+    assert m["identity_stretch_error"] == pytest.approx(0.5 * horizontal / (horizontal + vertical), rel=1e-5)
+    assert m["rigid_stretch_removed"] >= 0.8
+    assert m["inverted_triangles"] == 0 and m["off_chart_texels"] == 0 and m["chart_texels"] == T * T
     assert m["untangled_points"] == 0 and m["iterations"] > 0 and m["levels"] >= 1
     # The tile border does not move: grid[j, i] = (i / n, j / n) there, bit for bit in float32.
     rest = np.stack(np.meshgrid(np.arange(T + 1) / T, np.arange(T + 1) / T, indexing="xy"), axis=2)
@@ -109,7 +119,7 @@ def test_undeformed_pose_redirects_to_texel_centres():
     solver.solve(pts)
     np.testing.assert_allclose(solver.redirect_map(), centres, atol=1e-5)
     m = solver.metrics()
-    assert m["rigid_stretch_error"] == pytest.approx(0.0, abs=1e-5) and m["fold_overs"] == 0
+    assert m["rigid_stretch_error"] == pytest.approx(0.0, abs=1e-5) and m["inverted_triangles"] == 0
     # After a stretch, reset() brings back the identity warp.
     solver.solve(stretched(pts))
     assert np.abs(solver.redirect_map() - centres).max() > 0.5 / T

@@ -179,14 +179,14 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
 
 std::vector<ReportedFigure> reportedFigures(const WarpMetrics& m) {
     using Kind = ReportedFigure::Kind;
-    return {{"rigid_stretch_error", Kind::Number, m.rigidStretchError},
-            {"identity_stretch_error", Kind::Number, m.identityStretchError},
-            {"rigid_edges", Kind::Count, static_cast<double>(m.rigidEdges)},
-            {"skipped_edges", Kind::Count, static_cast<double>(m.skippedEdges)},
-            {"fold_overs", Kind::Count, static_cast<double>(m.foldOvers)},
-            {"max_masked_displacement", Kind::Number, m.maxMaskedDisplacement},
-            {"max_border_displacement", Kind::Number, m.maxBorderDisplacement},
-            {"points_outside", Kind::Count, static_cast<double>(m.pointsOutside)}};
+    return {{"grid_rigid_stretch_error", Kind::Number, m.rigidStretchError},
+            {"grid_identity_stretch_error", Kind::Number, m.identityStretchError},
+            {"grid_rigid_edges", Kind::Count, static_cast<double>(m.rigidEdges)},
+            {"grid_skipped_edges", Kind::Count, static_cast<double>(m.skippedEdges)},
+            {"grid_fold_overs", Kind::Count, static_cast<double>(m.foldOvers)},
+            {"grid_max_masked_displacement", Kind::Number, m.maxMaskedDisplacement},
+            {"grid_max_border_displacement", Kind::Number, m.maxBorderDisplacement},
+            {"grid_points_outside", Kind::Count, static_cast<double>(m.pointsOutside)}};
 }
 
 }  // namespace deformkit::uvwarp

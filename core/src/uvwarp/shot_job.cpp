@@ -84,9 +84,15 @@ double tidy(float value) {
                              : static_cast<double>(value);
 }
 
-json metricsJson(const WarpMetrics& m, const SolveStats& s) {
+// The figures of a frame: the redirect map's when it was made (a frame written), then the grid's and the
+// solver's.
+json metricsJson(const DeliveredMetrics* delivered, const WarpMetrics& m, const SolveStats& s) {
     json j = json::object();
-    for (const std::vector<ReportedFigure>& figures : {reportedFigures(m), reportedFigures(s)}) {
+    std::vector<std::vector<ReportedFigure>> lists;
+    if (delivered) lists.push_back(reportedFigures(*delivered));
+    lists.push_back(reportedFigures(m));
+    lists.push_back(reportedFigures(s));
+    for (const std::vector<ReportedFigure>& figures : lists) {
         for (const ReportedFigure& f : figures) {
             json& slot = j[std::string(f.name)];
             if (f.kind == ReportedFigure::Kind::Count) {
@@ -503,10 +509,16 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     r.lastFrame = frame;
     json seconds = {{"solve", solveSeconds}};
     const bool needed = plan.needed[k];
+    std::optional<DeliveredMetrics> delivered;
     if (needed) {
         t = Clock::now();
         warp.redirect(plan.redirect);
         seconds["invert"] = secondsSince(t);
+        t = Clock::now();
+        delivered = warp.measure(plan.redirect);
+        seconds["measure"] = secondsSince(t);
+        r.lastDelivered = *delivered;
+        r.lastWrittenFrame = frame;
         io::ImageWriteOptions attributes;
         frameInputs["deformed"] = inputName;
         attributes.attributes = {
@@ -553,7 +565,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     }
     seconds["total"] = secondsSince(start);
     json line = baseLine(plan, k, needed ? "written" : warmUp(k) ? "warm-up" : "replayed");
-    line["metrics"] = metricsJson(metrics, warp.stats());
+    line["metrics"] = metricsJson(delivered ? &*delivered : nullptr, metrics, warp.stats());
     line["seconds"] = seconds;
     writeLog(line);
 }
@@ -731,10 +743,12 @@ std::vector<std::string> shotSummary(const ShotReport& report) {
                 line << ", " << t.warmedUp << " warm-up " << (t.warmedUp == 1 ? "frame" : "frames");
             if (t.mapChanges > 0)
                 line << ", maps changed at " << t.mapChanges << (t.mapChanges == 1 ? " frame" : " frames");
-            if (t.written + t.replayed > 0) {
-                line << "; frame " << t.lastFrame << ": rigid stretch error "
-                     << t.lastMetrics.rigidStretchError << " (identity " << t.lastMetrics.identityStretchError
-                     << "), " << t.lastMetrics.foldOvers << " fold-overs";
+            if (t.written > 0) {
+                const DeliveredMetrics& d = t.lastDelivered;
+                line << "; frame " << t.lastWrittenFrame << ": rigid stretch removed " << 100.0 * d.removed
+                     << "% (error " << d.rigidStretchError << ", identity " << d.identityStretchError << "), "
+                     << d.invertedTriangles << " inverted triangles, " << d.offChartTexels
+                     << " off-chart texels in the redirect map";
             }
             lines.push_back(line.str());
         }

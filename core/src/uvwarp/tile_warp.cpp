@@ -1,13 +1,16 @@
 #include "deformkit/uvwarp/tile_warp.h"
 
+#include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/inversion.h"
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/options.h"
+#include "deformkit/uvwarp/redirect_metrics.h"
 #include "memory/large_buffers.h"
 
 namespace deformkit::uvwarp {
@@ -36,6 +39,8 @@ struct TileWarp::Impl {
     int32_t densityRadius = 0;            // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     bool solved = false;
+    std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
+    std::vector<glm::vec3> lastDeformed;       // the last solve's positions (the rest ones before any)
 };
 
 TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
@@ -95,6 +100,8 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     deformkit::detail::copyLarge(m.boundMask.values, m.mask.values);
     m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
                                         orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
+    m.delivered.emplace(rest, tile, rigidity, source);
+    m.lastDeformed.assign(rest.points().begin(), rest.points().end());
 }
 
 TileWarp::~TileWarp() = default;
@@ -104,6 +111,7 @@ TileWarp& TileWarp::operator=(TileWarp&&) noexcept = default;
 const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     Impl& m = *impl_;
     m.imager->sample(deformedPoints, m.deformed);
+    m.lastDeformed.assign(deformedPoints.begin(), deformedPoints.end());
     m.solved = true;
     return m.solver->solve(m.deformed);
 }
@@ -116,6 +124,14 @@ io::Image TileWarp::redirect() const {
     io::Image out;
     redirect(out);
     return out;
+}
+
+DeliveredMetrics TileWarp::measure(const io::Image& redirect) const {
+    return impl_->delivered->measure(impl_->lastDeformed, redirect);
+}
+
+DeliveredMetrics TileWarp::deliveredMetrics() const {
+    return measure(redirect());
 }
 
 WarpMetrics TileWarp::metrics() const {
@@ -156,6 +172,7 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     }
     m.solver->setMaps(newRigidity, newMask, orientationAtPoints);
     m.rigidity = std::move(newRigidity);
+    m.delivered->setRigidity(rigidity);
     m.mask = std::move(newMask);
 }
 

@@ -13,12 +13,17 @@ TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to 
     const harness::DemoAssets assets = harness::makeDemoAssets({});
     const harness::DemoUvWarp demo = harness::makeDemoUvWarp(assets.mesh, assets.rigidity.at(1001),
                                                              assets.mask.at(1001), assets.albedo.at(1001));
+    // What the previews show, measured on the redirect map (redirect_metrics.h). The bend stretches the outer
+    // side ~1.5x and squashes the inner side ~0.5x; compression cannot be fully undone in a bounded tile
+    // (paper §6). docs/uvwarp.md reports 58% of the rigid stretch removed (measured 57.9%): the test asks for
+    // at least 57%, so the docs cannot drift from what the demo does.
+    const uvwarp::DeliveredMetrics& d = demo.delivered;
+    INFO("rigid stretch error: identity " << d.identityStretchError << ", through the map "
+                                          << d.rigidStretchError);
+    CHECK(d.removed >= 0.57);
+    CHECK(d.offChartTexels == 0);
+    // The solver's grid (diagnostics): no fold, masked points and the border still.
     const uvwarp::WarpMetrics& m = demo.metrics;
-    INFO("rigid stretch error: identity " << m.identityStretchError << ", warp " << m.rigidStretchError);
-    // The bend stretches the outer side ~1.5x and squashes the inner side ~0.5x; compression cannot be fully
-    // undone in a bounded tile (paper §6). docs/uvwarp.md reports 55% of the error removed (0.104 -> 0.046,
-    // measured 55.5%): the test asks for at least 54%, so the docs cannot drift from what the demo does.
-    CHECK(m.rigidStretchError < 0.46 * m.identityStretchError);
     CHECK(m.foldOvers == 0);
     CHECK(m.maxMaskedDisplacement == 0.0);
     CHECK(m.maxBorderDisplacement == 0.0);

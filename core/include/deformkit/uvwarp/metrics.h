@@ -8,7 +8,8 @@
 
 namespace deformkit::uvwarp {
 
-// Quality figures of a warp, measured on the solver's grid.
+// Quality figures of a warp, measured on the solver's grid: diagnostics of the solve. What a renderer is
+// handed is measured on the redirect map (redirect_metrics.h).
 struct MetricsOptions {
     // Unit of the displacements: texels of a T x T map; 0 measures in grid cells (texels when n = T).
     int32_t texels = 0;
@@ -45,7 +46,7 @@ struct WarpMetrics {
                                       const PointField& mask, const MetricsOptions& options = {});
 
 // One figure of a solve as every host reports it, by one name: the shot job's JSON log and report, Python's
-// metrics().
+// metrics(). The redirect map's figures (redirect_metrics.h) come first; the grid's are named grid_*.
 struct ReportedFigure {
     enum class Kind { Number, Count, Flag };
     std::string_view name;  // snake_case
@@ -53,7 +54,8 @@ struct ReportedFigure {
     double value = 0.0;
 };
 
-// The figures of `m`, in the order hosts report them.
+// The grid figures of `m` (grid_rigid_stretch_error, ... grid_fold_overs, ...), in the order hosts report
+// them.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const WarpMetrics& m);
 
 }  // namespace deformkit::uvwarp

@@ -12,6 +12,7 @@
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/redirect_metrics.h"
 #include "deformkit/uvwarp/solver.h"
 
 namespace deformkit::uvwarp {
@@ -52,7 +53,13 @@ class TileWarp {
     // W^-1 of the last solve as a T x T x 2 image of tile-local uv (the identity before any solve).
     void redirect(io::Image& out) const;
     [[nodiscard]] io::Image redirect() const;
-    // Quality figures of the last solve (identity vs. ours, folds, masked and border motion).
+    // What the redirect map of the last solve delivers (redirect_metrics.h): the rigid stretch a renderer
+    // shows through it against the identity's, its inverted triangles and off-chart texels. measure() takes
+    // the map already made by redirect(); deliveredMetrics() makes it.
+    [[nodiscard]] DeliveredMetrics measure(const io::Image& redirect) const;
+    [[nodiscard]] DeliveredMetrics deliveredMetrics() const;
+    // The solver's own figures on its grid (diagnostics: identity vs. ours on grid edges, grid folds, masked
+    // and border motion).
     [[nodiscard]] WarpMetrics metrics() const;
     // Back to the identity warp (a cut in the shot).
     void reset();

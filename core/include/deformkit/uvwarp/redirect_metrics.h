@@ -1,0 +1,79 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
+#include "deformkit/uvwarp/metrics.h"
+
+namespace deformkit::uvwarp {
+
+// What a redirect map delivers, measured on the map a renderer reads, not on the solver's grid. Texel q of
+// the tile (its centre, tile-local uv) shows the rest-pose content at r = R(q); f_D is the deformed mesh and
+// f_O the rest mesh as functions of UV (barycentric over the tile's UV triangles).
+struct DeliveredMetrics {
+    // Rigid-stretch error: the mean, over 4-connected texel edges (a, b) whose texels lie in one chart and
+    // whose content r_a and r_b both lies where the rigidity map is >= 0.5, of
+    //   | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) - f_O(r_a)| - 1 |.
+    // The identity's (r = q) is the stretch the texture would show without the warp. Edges whose rest length
+    // is not measurable (below 1e-9 of the rest mesh's bounding-box diagonal) are left out.
+    double rigidStretchError = 0.0;
+    double identityStretchError = 0.0;
+    // 1 - rigidStretchError / identityStretchError: the share of the rigid stretch removed (0 when the
+    // identity has none).
+    double removed = 0.0;
+    int64_t rigidEdges = 0;          // edges averaged over, through the map
+    int64_t identityRigidEdges = 0;  // and for the identity
+    // Triangles of the texel-centre grid of R (every cell split along both diagonals, 4 triangles a cell)
+    // whose signed area in r has the opposite sign of the identity's: where a texture shows folded.
+    int64_t invertedTriangles = 0;
+    // Chart texels (centres inside a UV triangle of the tile) whose r lies in no UV triangle: texels that
+    // show content from outside every chart.
+    int64_t offChartTexels = 0;
+    int64_t chartTexels = 0;
+};
+
+// The delivered figures of one UDIM tile, bound once to the rest mesh's UV triangles of the tile and the
+// rigidity map (which sets the redirect map's size, T x T), measured per frame from the deformed positions
+// and the frame's redirect map. OpenMP over bands of rows, sums in a fixed order: bit-identical for any
+// thread count. Memory: 4 bytes a texel.
+class RedirectMetrics {
+  public:
+    // rest: the mesh with UVs; rigidity: T x T, channel 0 in [0, 1]. `source` names the inputs in errors.
+    // Throws InvalidInput for a mesh without UVs, a tile it has no face in, or a non-square or empty map.
+    RedirectMetrics(const geom::Mesh& rest, int tile, const io::Image& rigidity,
+                    const std::string& source = "tile");
+    ~RedirectMetrics();
+    RedirectMetrics(RedirectMetrics&&) noexcept;
+    RedirectMetrics& operator=(RedirectMetrics&&) noexcept;
+
+    // A new rigidity map of the same size (an animated map).
+    void setRigidity(const io::Image& rigidity);
+    // deformed: #V positions of the rest mesh's vertices; redirect: T x T, channels 0 and 1 the tile-local
+    // r = (u', v') (invertWarp's layout, row 0 at v = 1). Throws InvalidInput for another vertex count or
+    // map size, or a non-finite redirect texel (naming it).
+    [[nodiscard]] DeliveredMetrics measure(std::span<const glm::vec3> deformed,
+                                           const io::Image& redirect) const;
+
+    [[nodiscard]] int32_t texels() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// The figures of `m` as hosts report them (metrics.h): rigid_stretch_error, identity_stretch_error,
+// rigid_stretch_removed, rigid_edges, identity_rigid_edges, inverted_triangles, off_chart_texels,
+// chart_texels.
+[[nodiscard]] std::vector<ReportedFigure> reportedFigures(const DeliveredMetrics& m);
+
+// The inverted triangles of a redirect map alone (DeliveredMetrics::invertedTriangles).
+[[nodiscard]] int64_t countInvertedTriangles(const io::Image& redirect);
+
+}  // namespace deformkit::uvwarp

@@ -1,0 +1,400 @@
+#include "deformkit/uvwarp/redirect_metrics.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/rasterizer.h"
+#include "deformkit/io/sampling.h"
+#include "tile_uvs.h"
+
+namespace deformkit::uvwarp {
+namespace {
+
+// Rows per parallel work item: fixed, so the sums are taken in the same order for any thread count.
+constexpr int32_t kMetricBandRows = 16;
+// Texels per side of a point-location bucket.
+constexpr int32_t kBucketTexels = 4;
+// How far outside a UV triangle (in barycentric terms) a point still counts as inside it: float rounding of
+// a redirect texel that sits on a chart border.
+constexpr double kInsideTolerance = 1e-7;
+
+// Barycentric coordinates of p in the UV triangle t (double; may be negative outside it).
+glm::dvec3 barycentricIn(const std::array<glm::vec2, 3>& t, glm::dvec2 p) {
+    const glm::dvec2 a(t[0]), b(t[1]), c(t[2]);
+    const glm::dvec2 v0 = b - a, v1 = c - a, v2 = p - a;
+    const double den = v0.x * v1.y - v1.x * v0.y;
+    if (den == 0.0) return glm::dvec3(-1.0);  // a degenerate UV triangle contains nothing
+    const double l1 = (v2.x * v1.y - v1.x * v2.y) / den;
+    const double l2 = (v0.x * v2.y - v2.x * v0.y) / den;
+    return {1.0 - l1 - l2, l1, l2};
+}
+
+// Connected components of UV triangles sharing an edge, UVs welded by value: the charts.
+std::vector<int32_t> chartsOf(const detail::TileUVs& uvs) {
+    const size_t n = uvs.uvs.size();
+    std::vector<int32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto find = [&](int32_t i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    const auto key = [](glm::vec2 p) {
+        uint32_t x = 0, y = 0;
+        std::memcpy(&x, &p.x, 4);
+        std::memcpy(&y, &p.y, 4);
+        return (static_cast<uint64_t>(x) << 32) | y;
+    };
+    struct EdgeKey {
+        uint64_t a, b;
+        bool operator==(const EdgeKey&) const = default;
+    };
+    struct EdgeHash {
+        size_t operator()(const EdgeKey& e) const {
+            return std::hash<uint64_t>()(e.a * 0x9E3779B97F4A7C15ULL ^ e.b);
+        }
+    };
+    std::unordered_map<EdgeKey, int32_t, EdgeHash> firstUse;
+    for (size_t t = 0; t < n; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            uint64_t a = key(uvs.uvs[t][k]), b = key(uvs.uvs[t][(k + 1) % 3]);
+            if (a > b) std::swap(a, b);
+            const auto [it, inserted] = firstUse.emplace(EdgeKey{a, b}, static_cast<int32_t>(t));
+            if (!inserted) parent[find(static_cast<int32_t>(t))] = find(it->second);
+        }
+    }
+    std::vector<int32_t> chart(n);
+    for (size_t t = 0; t < n; ++t)
+        chart[t] = find(static_cast<int32_t>(t));
+    return chart;
+}
+
+// What a texel shows: where it sits on the deformed surface, and its content's rest position and rigidity,
+// through the map and for the identity.
+struct TexelSample {
+    int32_t chart = -1;  // -1: not a chart texel
+    bool located = false;
+    bool rigid = false;            // the content at r is rigid (located only)
+    bool identityRigid = false;    // the content at q is
+    glm::dvec3 deformed{0.0};      // f_D(q)
+    glm::dvec3 rest{0.0};          // f_O(r)
+    glm::dvec3 identityRest{0.0};  // f_O(q)
+};
+
+// Sums of one band of rows, added up in band order.
+struct BandSums {
+    double error = 0.0, identityError = 0.0;
+    int64_t edges = 0, identityEdges = 0, offChart = 0, chart = 0, inverted = 0;
+};
+
+// Twice the signed area of (a, b, c).
+double area2(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+glm::dvec2 redirectAt(const io::Image& redirect, int32_t x, int32_t y) {
+    return {redirect.at(x, y, 0), redirect.at(x, y, 1)};
+}
+
+// The inverted texel-centre triangles of R in the cells of rows [y0, y1).
+int64_t invertedInRows(const io::Image& redirect, int32_t y0, int32_t y1) {
+    const int32_t t = redirect.width;
+    // The identity's orientation: texel centres at ((x + 0.5) / T, 1 - (y + 0.5) / T), v falling with y, so
+    // a triangle whose corners run in +x then +y in the image has negative signed area in uv.
+    int64_t inverted = 0;
+    for (int32_t y = y0; y < y1 && y + 1 < t; ++y) {
+        for (int32_t x = 0; x + 1 < t; ++x) {
+            const glm::dvec2 p00 = redirectAt(redirect, x, y), p10 = redirectAt(redirect, x + 1, y),
+                             p01 = redirectAt(redirect, x, y + 1), p11 = redirectAt(redirect, x + 1, y + 1);
+            // Both splittings; every triangle listed as the identity's negatively oriented one.
+            const double areas[4] = {area2(p00, p10, p11), area2(p00, p11, p01), area2(p00, p10, p01),
+                                     area2(p10, p11, p01)};
+            for (double a : areas)
+                inverted += a > 0.0 ? 1 : 0;
+        }
+    }
+    return inverted;
+}
+
+}  // namespace
+
+struct RedirectMetrics::Impl {
+    std::string source;
+    int32_t texels = 0;
+    detail::TileUVs uvs;
+    std::vector<int32_t> chart;          // per UV triangle
+    std::vector<int32_t> texelTriangle;  // per texel: the UV triangle its centre lies in, -1 none
+    std::vector<glm::vec3> restPoints;   // f_O's vertices
+    int32_t buckets = 1;                 // point-location buckets per side
+    std::vector<int32_t> bucketStart, bucketTriangles;
+    io::Image rigidity;      // T x T x 1
+    double minLength = 0.0;  // rest lengths at or below are not measurable
+
+    // The UV triangle holding tile-local r (the lowest index among overlapping ones), or -1.
+    [[nodiscard]] int32_t locate(glm::dvec2 r, glm::dvec3& bary) const {
+        const auto cell = [&](double c) {
+            return std::clamp(static_cast<int32_t>(std::floor(c * buckets)), 0, buckets - 1);
+        };
+        const int32_t b = cell(r.y) * buckets + cell(r.x);
+        for (int32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k) {
+            const int32_t t = bucketTriangles[k];
+            const glm::dvec3 l = barycentricIn(uvs.uvs[t], r);
+            if (l.x >= -kInsideTolerance && l.y >= -kInsideTolerance && l.z >= -kInsideTolerance) {
+                bary = l;
+                return t;
+            }
+        }
+        return -1;
+    }
+
+    [[nodiscard]] glm::dvec3 pointOn(std::span<const glm::vec3> points, int32_t t,
+                                     const glm::dvec3& l) const {
+        const auto& v = uvs.vertices[t];
+        return l.x * glm::dvec3(points[v[0]]) + l.y * glm::dvec3(points[v[1]]) +
+               l.z * glm::dvec3(points[v[2]]);
+    }
+
+    [[nodiscard]] bool rigidAt(glm::dvec2 r) const {
+        float value = 0.0f;
+        io::sampleImage(rigidity,
+                        glm::vec2(static_cast<float>(r.x * texels), static_cast<float>((1.0 - r.y) * texels)),
+                        io::SampleFilter::Bilinear, std::span<float>(&value, 1));
+        return value >= 0.5f;
+    }
+
+    [[nodiscard]] TexelSample sample(std::span<const glm::vec3> deformed, const io::Image& redirect,
+                                     int32_t x, int32_t y) const {
+        TexelSample s;
+        const int32_t t = texelTriangle[static_cast<size_t>(y) * texels + x];
+        if (t < 0) return s;
+        s.chart = chart[t];
+        const glm::dvec2 q((x + 0.5) / texels, 1.0 - (y + 0.5) / texels);
+        const glm::dvec3 lq = barycentricIn(uvs.uvs[t], q);
+        s.deformed = pointOn(deformed, t, lq);
+        s.identityRest = pointOn(restPoints, t, lq);
+        s.identityRigid = rigidity.at(x, y, 0) >= 0.5f;
+        const glm::dvec2 r = redirectAt(redirect, x, y);
+        glm::dvec3 lr;
+        const int32_t tr = locate(r, lr);
+        if (tr >= 0) {
+            s.located = true;
+            s.rest = pointOn(restPoints, tr, lr);
+            s.rigid = rigidAt(r);
+        }
+        return s;
+    }
+
+    void addEdge(const TexelSample& a, const TexelSample& b, BandSums& sums) const {
+        if (a.chart < 0 || a.chart != b.chart) return;
+        const double deformedLength = glm::length(b.deformed - a.deformed);
+        if (a.identityRigid && b.identityRigid) {
+            const double rest = glm::length(b.identityRest - a.identityRest);
+            if (rest > minLength) {
+                sums.identityError += std::abs(deformedLength / rest - 1.0);
+                ++sums.identityEdges;
+            }
+        }
+        if (a.located && b.located && a.rigid && b.rigid) {
+            const double rest = glm::length(b.rest - a.rest);
+            if (rest > minLength) {
+                sums.error += std::abs(deformedLength / rest - 1.0);
+                ++sums.edges;
+            }
+        }
+    }
+};
+
+RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Image& rigidity,
+                                 const std::string& source)
+    : impl_(std::make_unique<Impl>()) {
+    Impl& m = *impl_;
+    m.source = source;
+    m.uvs = detail::collectTileUVs(rest, tile, source);
+    if (m.uvs.uvs.empty()) {
+        throw InvalidInput(formatError(detail::tileSource(source, tile), "", "holds no UV face",
+                                       "a tile of the mesh's UVs"));
+    }
+    m.texels = rigidity.width;
+    setRigidity(rigidity);
+    m.chart = chartsOf(m.uvs);
+    m.restPoints.assign(rest.points().begin(), rest.points().end());
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const glm::vec3& p : m.restPoints) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+    m.minLength = m.restPoints.empty() ? 0.0 : 1e-9 * glm::length(hi - lo);
+
+    // Each texel centre's UV triangle (the rasteriser's top-left rule: one triangle per covered centre).
+    const int32_t t = m.texels;
+    const size_t triangles = m.uvs.uvs.size();
+    std::vector<glm::vec2> corners(triangles * 3);
+    std::vector<std::array<int32_t, 3>> indices(triangles);
+    for (size_t k = 0; k < triangles; ++k) {
+        for (int c = 0; c < 3; ++c) {
+            const glm::vec2 uv = m.uvs.uvs[k][c];
+            corners[3 * k + c] = {uv.x * static_cast<float>(t), (1.0f - uv.y) * static_cast<float>(t)};
+            indices[k][c] = static_cast<int32_t>(3 * k + c);
+        }
+    }
+    geom::AttributeRaster raster;
+    geom::rasterizeAttributes({t, t}, corners, indices, {}, 0, raster);
+    m.texelTriangle = std::move(raster.triangle);
+
+    // Point-location buckets over the tile, each listing the triangles whose UV box overlaps it, ascending.
+    m.buckets = std::max(1, t / kBucketTexels);
+    const int32_t g = m.buckets;
+    std::vector<std::vector<int32_t>> lists(static_cast<size_t>(g) * g);
+    for (size_t k = 0; k < triangles; ++k) {
+        const auto& tri = m.uvs.uvs[k];
+        const float u0 = std::min({tri[0].x, tri[1].x, tri[2].x}),
+                    u1 = std::max({tri[0].x, tri[1].x, tri[2].x});
+        const float v0 = std::min({tri[0].y, tri[1].y, tri[2].y}),
+                    v1 = std::max({tri[0].y, tri[1].y, tri[2].y});
+        const auto cell = [&](float c) {
+            return std::clamp(static_cast<int32_t>(std::floor(c * static_cast<float>(g))), 0, g - 1);
+        };
+        for (int32_t by = cell(v0); by <= cell(v1); ++by)
+            for (int32_t bx = cell(u0); bx <= cell(u1); ++bx)
+                lists[static_cast<size_t>(by) * g + bx].push_back(static_cast<int32_t>(k));
+    }
+    m.bucketStart.assign(lists.size() + 1, 0);
+    for (size_t b = 0; b < lists.size(); ++b)
+        m.bucketStart[b + 1] = m.bucketStart[b] + static_cast<int32_t>(lists[b].size());
+    m.bucketTriangles.reserve(static_cast<size_t>(m.bucketStart.back()));
+    for (const auto& list : lists)
+        m.bucketTriangles.insert(m.bucketTriangles.end(), list.begin(), list.end());
+}
+
+RedirectMetrics::~RedirectMetrics() = default;
+RedirectMetrics::RedirectMetrics(RedirectMetrics&&) noexcept = default;
+RedirectMetrics& RedirectMetrics::operator=(RedirectMetrics&&) noexcept = default;
+
+int32_t RedirectMetrics::texels() const {
+    return impl_->texels;
+}
+
+void RedirectMetrics::setRigidity(const io::Image& rigidity) {
+    Impl& m = *impl_;
+    if (rigidity.width < 1 || rigidity.width != rigidity.height || rigidity.channels < 1 ||
+        rigidity.pixels.size() != static_cast<size_t>(rigidity.width) * rigidity.height * rigidity.channels) {
+        throw InvalidInput(
+            formatError(m.source, "rigidity map",
+                        "is " + std::to_string(rigidity.width) + " x " + std::to_string(rigidity.height),
+                        "a square map of at least 1 texel"));
+    }
+    if (m.texels != 0 && rigidity.width != m.texels) {
+        throw InvalidInput(formatError(m.source, "rigidity map",
+                                       std::to_string(rigidity.width) + " texels per side",
+                                       std::to_string(m.texels) + ", the bound map's size"));
+    }
+    m.rigidity = io::Image(rigidity.width, rigidity.height, 1);
+    for (size_t k = 0; k < m.rigidity.pixels.size(); ++k)
+        m.rigidity.pixels[k] = rigidity.pixels[k * rigidity.channels];
+}
+
+DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed,
+                                          const io::Image& redirect) const {
+    const Impl& m = *impl_;
+    const int32_t t = m.texels;
+    if (deformed.size() != m.restPoints.size()) {
+        throw InvalidInput(
+            formatError(m.source, "deformed positions", std::to_string(deformed.size()) + " points",
+                        std::to_string(m.restPoints.size()) + ", the rest mesh's vertex count"));
+    }
+    if (redirect.width != t || redirect.height != t || redirect.channels < 2) {
+        throw InvalidInput(formatError(m.source, "redirect map",
+                                       "is " + std::to_string(redirect.width) + " x " +
+                                           std::to_string(redirect.height) + " with " +
+                                           std::to_string(redirect.channels) + " channels",
+                                       std::to_string(t) + " x " + std::to_string(t) + " with 2 channels"));
+    }
+    for (int32_t y = 0; y < t; ++y) {
+        for (int32_t x = 0; x < t; ++x) {
+            if (!std::isfinite(redirect.at(x, y, 0)) || !std::isfinite(redirect.at(x, y, 1))) {
+                throw InvalidInput(formatError(
+                    m.source, "redirect map texel (" + std::to_string(x) + ", " + std::to_string(y) + ")",
+                    "is not finite", "finite tile-local uv"));
+            }
+        }
+    }
+    const int32_t bands = (t + kMetricBandRows - 1) / kMetricBandRows;
+    std::vector<BandSums> sums(static_cast<size_t>(bands));
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int32_t b = 0; b < bands; ++b) {
+        const int32_t y0 = b * kMetricBandRows, y1 = std::min(t, y0 + kMetricBandRows);
+        const int32_t rows = std::min(t, y1 + 1) - y0;  // one more row for the band's last vertical edges
+        std::vector<TexelSample> samples(static_cast<size_t>(rows) * t);
+        for (int32_t r = 0; r < rows; ++r)
+            for (int32_t x = 0; x < t; ++x)
+                samples[static_cast<size_t>(r) * t + x] = m.sample(deformed, redirect, x, y0 + r);
+        BandSums& s = sums[static_cast<size_t>(b)];
+        for (int32_t y = y0; y < y1; ++y) {
+            const TexelSample* row = &samples[static_cast<size_t>(y - y0) * t];
+            const TexelSample* below = y + 1 < t ? row + t : nullptr;
+            for (int32_t x = 0; x < t; ++x) {
+                if (row[x].chart >= 0) {
+                    ++s.chart;
+                    if (!row[x].located) ++s.offChart;
+                }
+                if (x + 1 < t) m.addEdge(row[x], row[x + 1], s);
+                if (below) m.addEdge(row[x], below[x], s);
+            }
+        }
+        s.inverted = invertedInRows(redirect, y0, y1);
+    }
+    BandSums total;
+    for (const BandSums& s : sums) {
+        total.error += s.error;
+        total.identityError += s.identityError;
+        total.edges += s.edges;
+        total.identityEdges += s.identityEdges;
+        total.offChart += s.offChart;
+        total.chart += s.chart;
+        total.inverted += s.inverted;
+    }
+    DeliveredMetrics out;
+    out.rigidEdges = total.edges;
+    out.identityRigidEdges = total.identityEdges;
+    out.rigidStretchError = total.edges > 0 ? total.error / static_cast<double>(total.edges) : 0.0;
+    out.identityStretchError =
+        total.identityEdges > 0 ? total.identityError / static_cast<double>(total.identityEdges) : 0.0;
+    out.removed =
+        out.identityStretchError > 0.0 ? 1.0 - out.rigidStretchError / out.identityStretchError : 0.0;
+    out.invertedTriangles = total.inverted;
+    out.offChartTexels = total.offChart;
+    out.chartTexels = total.chart;
+    return out;
+}
+
+std::vector<ReportedFigure> reportedFigures(const DeliveredMetrics& m) {
+    using Kind = ReportedFigure::Kind;
+    return {{"rigid_stretch_error", Kind::Number, m.rigidStretchError},
+            {"identity_stretch_error", Kind::Number, m.identityStretchError},
+            {"rigid_stretch_removed", Kind::Number, m.removed},
+            {"rigid_edges", Kind::Count, static_cast<double>(m.rigidEdges)},
+            {"identity_rigid_edges", Kind::Count, static_cast<double>(m.identityRigidEdges)},
+            {"inverted_triangles", Kind::Count, static_cast<double>(m.invertedTriangles)},
+            {"off_chart_texels", Kind::Count, static_cast<double>(m.offChartTexels)},
+            {"chart_texels", Kind::Count, static_cast<double>(m.chartTexels)}};
+}
+
+int64_t countInvertedTriangles(const io::Image& redirect) {
+    if (redirect.width < 1 || redirect.height < 1 || redirect.channels < 2) {
+        throw InvalidInput(
+            formatError("redirect map", "", "is empty or has fewer than 2 channels", "a T x T x 2 map"));
+    }
+    return invertedInRows(redirect, 0, redirect.height);
+}
+
+}  // namespace deformkit::uvwarp
