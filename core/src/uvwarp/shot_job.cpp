@@ -527,7 +527,8 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             {"deformkit:uvwarp:frame", std::to_string(frame)},
             {"deformkit:uvwarp:solver",
              solverJson(plan.options, warp.cells(), warp.texels(), warp.stats().levels).dump()},
-            {"deformkit:uvwarp:inputs", frameInputs.dump()}};
+            {"deformkit:uvwarp:inputs", frameInputs.dump()},
+            {"deformkit:uvwarp:metrics", metricsJson(&*delivered, metrics, warp.stats()).dump()}};
         t = Clock::now();
         if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
             io::ImageWriteOptions write = attributes;

@@ -315,6 +315,13 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         for tile, result in report.items():
             for note in result["notes"]:  # a tile left unwarped, a mask derived
                 self.report({'WARNING'}, f"tile {tile}: {note}")
+            m = result["metrics"]  # of the last map written, measured on the map itself
+            if m is not None:
+                bad = m["inverted_triangles"] + m["off_chart_texels"]
+                self.report({'WARNING'} if bad else {'INFO'},
+                            f"tile {tile}, frame {result['last_written_frame']}: "
+                            f"{100 * m['rigid_stretch_removed']:.1f}% of the rigid stretch removed, "
+                            f"{m['inverted_triangles']} inverted triangles, {m['off_chart_texels']} off-chart texels")
         written = sum(t["written"] for t in report.values())
         kept = sum(t["replayed"] + t["skipped"] for t in report.values())
         self.report({'INFO'}, f"wrote {written} redirect map{'' if written == 1 else 's'} to {settings.uv_output}"

@@ -208,6 +208,10 @@ TEST_CASE("uvwarp command: redirect maps and bakes per frame, identity for the u
     CHECK(solver.at("iterations") == uvwarp::SolverOptions{}.iterations);
     CHECK(solver.at("smoothing") == 0.1);  // written as the float's shortest decimal
     CHECK(nlohmann::json::parse(attribute(info, "deformkit:uvwarp:inputs")).at("mask") == "derived");
+    // The map carries what it delivers, the log line's figures.
+    const auto delivered = nlohmann::json::parse(attribute(info, "deformkit:uvwarp:metrics"));
+    CHECK(delivered.at("inverted_triangles") == 0);
+    CHECK(delivered.at("chart_texels") == kTexels * kTexels);
 
     // One log line per frame with the metrics: the undeformed frame has no stretch to remove, the 1.5x
     // frame has some and the warp removes most of it.

@@ -38,9 +38,10 @@ namespace deformkit::uvwarp {
 //   are asked for once; memory is one solver per tile of the job (a farm task bounds it with its tile
 //   count).
 // - Outputs per tile and frame: the redirect map as a 2-channel float EXR (the rigidity map's size) whose
-//   header records how it was made (deformkit:version, deformkit:uvwarp:tile, deformkit:uvwarp:frame,
-//   deformkit:uvwarp:solver and deformkit:uvwarp:inputs, the last two JSON); with a texture, the bake
-//   (an EXR bake gets the same attributes). Every file is written atomically.
+//   header records how it was made and what it delivers (deformkit:version, deformkit:uvwarp:tile,
+//   deformkit:uvwarp:frame, and as JSON deformkit:uvwarp:solver, deformkit:uvwarp:inputs and
+//   deformkit:uvwarp:metrics, the log's figures of this map); with a texture, the bake (an EXR bake gets the
+//   same attributes). Every file is written atomically.
 // - Resuming (skipExisting): an output that exists is not written again. So that a resumed job writes the
 //   bytes an uninterrupted one would have, the warm start is replayed: each tile solves every frame up to
 //   its last missing output, frames whose outputs exist only to carry the warm start ("replayed"), and no
