@@ -274,6 +274,22 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
     m.bucketTriangles.reserve(static_cast<size_t>(m.bucketStart.back()));
     for (const auto& list : lists)
         m.bucketTriangles.insert(m.bucketTriangles.end(), list.begin(), list.end());
+
+        // The rasteriser snaps corners to 1/256 texel: a centre it covers within that of an edge may lie just
+        // outside its triangle. A chart texel is one whose centre the point location finds, so that the
+        // identity (r = q) never counts as off-chart.
+#pragma omp parallel for schedule(static)
+    for (int32_t y = 0; y < t; ++y) {
+        for (int32_t x = 0; x < t; ++x) {
+            int32_t& tri = m.texelTriangle[static_cast<size_t>(y) * t + x];
+            if (tri < 0) continue;
+            const glm::dvec2 q((x + 0.5) / t, 1.0 - (y + 0.5) / t);
+            const glm::dvec3 l = barycentricIn(m.uvs.uvs[tri], q);
+            if (l.x >= -kInsideTolerance && l.y >= -kInsideTolerance && l.z >= -kInsideTolerance) continue;
+            glm::dvec3 bary;
+            tri = m.locate(q, bary);
+        }
+    }
 }
 
 RedirectMetrics::~RedirectMetrics() = default;
