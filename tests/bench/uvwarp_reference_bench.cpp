@@ -1,0 +1,124 @@
+// How far the UV-warp solver's PBD solve is from the optimum of the model it approximates, on real layouts:
+// the model's energy (tests/unit/uvwarp/reference_solver.h: segment lengths weighted by rigidity, and the
+// regularisation) minimised to convergence by Levenberg-Marquardt from the PBD solve, fold-free. One run
+// per case (Iterations(1)); what matters is the counters, not the time:
+//   pbd_removed_pct, optimum_removed_pct  the rigid stretch removed on the grid (WarpMetrics), PBD and
+//   optimum gap_pts                               optimum minus PBD energy_ratio                          the
+//   PBD solve's energy over the optimum's (1: at the optimum) delivered_pbd_pct, delivered_optimum_pct  the
+//   same through each warp's redirect map (RedirectMetrics) inverted_pbd, inverted_optimum        the
+//   redirect maps' inverted triangles
+// BM_UvWarpReference/model/pose/cells: model 0 = Spot (its own UVs, rigid disks inside its charts), pose 0 =
+// stretched 1.4x along its length, 1 = bent 0.6 rad per unit along it (about 60 degrees end to end); the
+// default schedule from the identity.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "deformkit/geom/mesh.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/uvwarp/geometry_image.h"
+#include "deformkit/uvwarp/inversion.h"
+#include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/metrics.h"
+#include "deformkit/uvwarp/redirect_metrics.h"
+#include "deformkit/uvwarp/solver.h"
+#include "uvwarp/reference_solver.h"
+
+namespace {
+
+using namespace deformkit;
+using namespace deformkit::uvwarp;
+
+// Rigid disks of radius 0.025 on a 0.1 lattice, kept where the whole disk texel's 3 x 3 lies in a chart.
+io::Image disksInCharts(const io::Image& mask, int32_t t) {
+    io::Image disks(t, t, 1);
+    for (int32_t y = 0; y < t; ++y) {
+        for (int32_t x = 0; x < t; ++x) {
+            const float u = (x + 0.5f) / t, v = 1.0f - (y + 0.5f) / t;
+            float d = 1.0f;
+            for (float cu = 0.05f; cu < 1.0f; cu += 0.1f)
+                for (float cv = 0.05f; cv < 1.0f; cv += 0.1f)
+                    d = std::min(d, std::hypot(u - cu, v - cv));
+            bool inside = true;
+            for (int32_t dy = -1; dy <= 1; ++dy)
+                for (int32_t dx = -1; dx <= 1; ++dx)
+                    inside = inside &&
+                             mask.at(std::clamp(x + dx, 0, t - 1), std::clamp(y + dy, 0, t - 1), 0) >= 0.5f;
+            disks.at(x, y, 0) = d < 0.025f && inside ? 1.0f : 0.0f;
+        }
+    }
+    return disks;
+}
+
+std::vector<glm::vec3> posed(const geom::Mesh& mesh, int pose) {
+    std::vector<glm::vec3> p(mesh.points().begin(), mesh.points().end());
+    glm::vec3 centre(0.0f);
+    for (const glm::vec3& q : p)
+        centre += q / static_cast<float>(p.size());
+    for (glm::vec3& q : p) {
+        if (pose == 0) {
+            q.x = centre.x + 1.4f * (q.x - centre.x);
+        } else {  // bent about z, 0.6 rad per unit along x: the axis onto a circle of radius 1 / 0.6
+            const float k = 0.6f, a = k * (q.x - centre.x), r = q.y - centre.y;
+            q = {centre.x + std::sin(a) * (1.0f / k - r), centre.y + 1.0f / k - std::cos(a) * (1.0f / k - r),
+                 q.z};
+        }
+    }
+    return p;
+}
+
+double removed(const WarpMetrics& m) {
+    return m.identityStretchError > 0 ? 1.0 - m.rigidStretchError / m.identityStretchError : 0.0;
+}
+
+void BM_UvWarpReference(benchmark::State& state) {
+    const int pose = static_cast<int>(state.range(1));
+    const int32_t n = static_cast<int32_t>(state.range(2));
+    const geom::Mesh mesh =
+        io::readObj(std::string(DEFORMKIT_TEST_DATA) + "/spot/spot_quadrangulated.obj").mesh;
+    const std::vector<glm::vec3> deformedPoints = posed(mesh, pose);
+    const GeometryImager imager(mesh, 1001, n);
+    const PointField rest = imager.sample(mesh.points());
+    const PointField deformed = imager.sample(deformedPoints);
+    const io::Image mask = deriveWarpMask(mesh, 1001, n);
+    const io::Image disks = disksInCharts(mask, n);
+    const PointField rigidity = rigidityAtPoints(disks, n);
+    const PointField maskPoints = maskAtPoints(mask, n);
+    for (auto _ : state) {
+        Solver solver(rest, rigidity, maskPoints, {});
+        const WarpGrid pbd = solver.solve(deformed);
+        const PointField movable = solver.levelMovable(0);
+        const test::ReferenceProblem problem{&rest, &deformed, &rigidity, &movable, SolverOptions{}.smoothing,
+                                             1.0};
+        const test::ReferenceResult best = test::minimiseReference(problem, pbd, 40);
+        const RedirectMetrics delivered(mesh, 1001, disks, "spot");
+        const DeliveredMetrics dPbd = delivered.measure(deformedPoints, invertWarp(pbd, n));
+        const DeliveredMetrics dBest = delivered.measure(deformedPoints, invertWarp(best.warp, n));
+        const double pbdRemoved = removed(measureWarp(pbd, rest, deformed, rigidity, maskPoints));
+        const double bestRemoved = removed(measureWarp(best.warp, rest, deformed, rigidity, maskPoints));
+        state.counters["pbd_removed_pct"] = 100 * pbdRemoved;
+        state.counters["optimum_removed_pct"] = 100 * bestRemoved;
+        state.counters["gap_pts"] = 100 * (bestRemoved - pbdRemoved);
+        state.counters["energy_ratio"] = best.startEnergy / best.energy;
+        state.counters["delivered_pbd_pct"] = 100 * dPbd.removed;
+        state.counters["delivered_optimum_pct"] = 100 * dBest.removed;
+        state.counters["inverted_pbd"] = static_cast<double>(dPbd.invertedTriangles);
+        state.counters["inverted_optimum"] = static_cast<double>(dBest.invertedTriangles);
+        state.counters["lm_iterations"] = best.iterations;
+    }
+}
+BENCHMARK(BM_UvWarpReference)
+    ->Args({0, 0, 128})
+    ->Args({0, 1, 128})
+    ->Args({0, 0, 256})
+    ->Args({0, 1, 256})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
