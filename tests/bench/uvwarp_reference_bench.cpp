@@ -8,11 +8,14 @@
 //   same through each warp's redirect map (RedirectMetrics) inverted_pbd, inverted_optimum        the
 //   redirect maps' inverted triangles
 // BM_UvWarpReference/model/pose/cells: model 0 = Spot (its own UVs, rigid disks inside its charts), pose 0 =
-// stretched 1.4x along its length, 1 = bent 0.6 rad per unit along it (about 60 degrees end to end); the
-// default schedule from the identity.
+// stretched 1.4x along its length, 1 = bent 0.6 rad per unit along it (about 60 degrees end to end); model 1
+// = the rigged Fox (tests/data/fox), pose = a frame of its Run clip (18: the one that keeps least of its
+// rigid stretch removed, where skinning collapses a triangle at a front leg to 12% of its area). The default
+// schedule from the identity.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -76,11 +79,22 @@ double removed(const WarpMetrics& m) {
 }
 
 void BM_UvWarpReference(benchmark::State& state) {
+    const int model = static_cast<int>(state.range(0));
     const int pose = static_cast<int>(state.range(1));
     const int32_t n = static_cast<int32_t>(state.range(2));
+    const std::string data = DEFORMKIT_TEST_DATA;
+    // Spot posed here, or the Fox's rest pose and one frame of its Run clip (tests/data/fox).
     const geom::Mesh mesh =
-        io::readObj(std::string(DEFORMKIT_TEST_DATA) + "/spot/spot_quadrangulated.obj").mesh;
-    const std::vector<glm::vec3> deformedPoints = posed(mesh, pose);
+        io::readObj(model == 0 ? data + "/spot/spot_quadrangulated.obj" : data + "/fox/rest.obj").mesh;
+    std::vector<glm::vec3> deformedPoints;
+    if (model == 0) {
+        deformedPoints = posed(mesh, pose);
+    } else {
+        char frame[32];
+        std::snprintf(frame, sizeof(frame), "/fox/anim.%04d.obj", pose);
+        const geom::Mesh frameMesh = io::readObj(data + frame).mesh;
+        deformedPoints.assign(frameMesh.points().begin(), frameMesh.points().end());
+    }
     const GeometryImager imager(mesh, 1001, n);
     const PointField rest = imager.sample(mesh.points());
     const PointField deformed = imager.sample(deformedPoints);
@@ -116,6 +130,9 @@ BENCHMARK(BM_UvWarpReference)
     ->Args({0, 1, 128})
     ->Args({0, 0, 256})
     ->Args({0, 1, 256})
+    ->Args({1, 18, 128})
+    ->Args({1, 18, 256})
+    ->Args({1, 9, 256})
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
