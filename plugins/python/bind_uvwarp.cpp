@@ -244,9 +244,10 @@ void addFigures(py::dict& d, const std::vector<uvwarp::ReportedFigure>& figures)
 
 // The figures of a frame: its redirect map's, then the grid's (grid_*), and the solver's when given.
 py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::WarpMetrics& m,
-                     const uvwarp::SolveStats* s = nullptr) {
+                     const uvwarp::SolveStats* s = nullptr, const uvwarp::FoldRepair* repair = nullptr) {
     py::dict d;
     addFigures(d, uvwarp::reportedFigures(delivered));
+    if (repair) addFigures(d, uvwarp::reportedFigures(*repair));
     addFigures(d, uvwarp::reportedFigures(m));
     if (s) addFigures(d, uvwarp::reportedFigures(*s));
     return d;
@@ -307,14 +308,15 @@ class PyUvWarpSolver {
         uvwarp::DeliveredMetrics delivered;
         uvwarp::WarpMetrics m;
         uvwarp::SolveStats s;
+        uvwarp::FoldRepair repair;
         {
             py::gil_scoped_release release;
             const std::lock_guard<std::mutex> lock(mutex_);
-            delivered = warp_->deliveredMetrics();
+            delivered = warp_->deliveredMetrics(&repair);
             m = warp_->metrics();
             s = warp_->stats();
         }
-        return metricsDict(delivered, m, &s);
+        return metricsDict(delivered, m, &s, &repair);
     }
 
     void reset() {
@@ -443,7 +445,9 @@ py::dict tileReportDict(const uvwarp::ShotTileReport& t) {
     d["last_frame"] = solved ? py::object(py::int_(t.lastFrame)) : py::none();
     // Of the last frame written: its redirect map's figures, and its grid's.
     d["last_written_frame"] = t.written > 0 ? py::object(py::int_(t.lastWrittenFrame)) : py::none();
-    d["metrics"] = t.written > 0 ? py::object(metricsDict(t.lastDelivered, t.lastMetrics)) : py::none();
+    d["metrics"] = t.written > 0
+                       ? py::object(metricsDict(t.lastDelivered, t.lastMetrics, nullptr, &t.lastRepair))
+                       : py::none();
     py::list files;
     for (const std::filesystem::path& f : t.files)
         files.append(f.string());
@@ -668,7 +672,8 @@ void bindUvWarp(py::module_& m) {
         .def("redirect_map", &PyUvWarpSolver::redirectMap,
              "W^-1 of the last solve as a (T, T, 2) float32 image (row 0 at v = 1): texel (x, y) holds the\n"
              "tile-local (u', v') to read the unwarped texture at for the texel centre ((x + 0.5) / T,\n"
-             "1 - (y + 0.5) / T). The identity before any solve.")
+             "1 - (y + 0.5) / T), made fold-free with no chart texel showing off-chart content (the fold\n"
+             "repair, uvwarp/redirect_repair.h). The identity before any solve.")
         .def("metrics", &PyUvWarpSolver::metrics,
              "What the last solve delivers, measured on its redirect map (redirect_metrics.h):\n"
              "rigid_stretch_error and identity_stretch_error (mean | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) -\n"
@@ -676,8 +681,10 @@ void bindUvWarp(py::module_& m) {
              "with the\n"
              "map and with none), rigid_stretch_removed, rigid_edges, identity_rigid_edges, "
              "inverted_triangles\n"
-             "(of the map's texel-centre grid, both diagonals), off_chart_texels, chart_texels; the solver's "
-             "grid\n"
+             "(of the map's texel-centre grid, both diagonals), off_chart_texels, chart_texels; what the "
+             "fold\n"
+             "repair did to the map (repair_inverted_found, repair_texels_moved, repair_passes,\n"
+             "repair_regions_scaled, repair_smallest_scale); the solver's grid\n"
              "figures as diagnostics (grid_rigid_stretch_error, grid_fold_overs, "
              "grid_max_masked_displacement,\n"
              "...); and the solve's iterations, levels, untangled_points, reverted_points, remaining_folds,\n"

@@ -15,6 +15,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/io/sampling.h"
+#include "redirect_cells.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -97,35 +98,6 @@ struct BandSums {
     int64_t edges = 0, identityEdges = 0, offChart = 0, chart = 0, inverted = 0;
 };
 
-// Twice the signed area of (a, b, c).
-double area2(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
-    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-}
-
-glm::dvec2 redirectAt(const io::Image& redirect, int32_t x, int32_t y) {
-    return {redirect.at(x, y, 0), redirect.at(x, y, 1)};
-}
-
-// The inverted texel-centre triangles of R in the cells of rows [y0, y1).
-int64_t invertedInRows(const io::Image& redirect, int32_t y0, int32_t y1) {
-    const int32_t t = redirect.width;
-    // The identity's orientation: texel centres at ((x + 0.5) / T, 1 - (y + 0.5) / T), v falling with y, so
-    // a triangle whose corners run in +x then +y in the image has negative signed area in uv.
-    int64_t inverted = 0;
-    for (int32_t y = y0; y < y1 && y + 1 < t; ++y) {
-        for (int32_t x = 0; x + 1 < t; ++x) {
-            const glm::dvec2 p00 = redirectAt(redirect, x, y), p10 = redirectAt(redirect, x + 1, y),
-                             p01 = redirectAt(redirect, x, y + 1), p11 = redirectAt(redirect, x + 1, y + 1);
-            // Both splittings; every triangle listed as the identity's negatively oriented one.
-            const double areas[4] = {area2(p00, p10, p11), area2(p00, p11, p01), area2(p00, p10, p01),
-                                     area2(p10, p11, p01)};
-            for (double a : areas)
-                inverted += a > 0.0 ? 1 : 0;
-        }
-    }
-    return inverted;
-}
-
 }  // namespace
 
 struct RedirectMetrics::Impl {
@@ -183,7 +155,7 @@ struct RedirectMetrics::Impl {
         s.deformed = pointOn(deformed, t, lq);
         s.identityRest = pointOn(restPoints, t, lq);
         s.identityRigid = rigidity.at(x, y, 0) >= 0.5f;
-        const glm::dvec2 r = redirectAt(redirect, x, y);
+        const glm::dvec2 r = detail::redirectAt(redirect, x, y);
         glm::dvec3 lr;
         const int32_t tr = locate(r, lr);
         if (tr >= 0) {
@@ -296,6 +268,14 @@ RedirectMetrics::~RedirectMetrics() = default;
 RedirectMetrics::RedirectMetrics(RedirectMetrics&&) noexcept = default;
 RedirectMetrics& RedirectMetrics::operator=(RedirectMetrics&&) noexcept = default;
 
+bool RedirectMetrics::mayShow(int32_t x, int32_t y, glm::dvec2 r) const {
+    const Impl& m = *impl_;
+    if (x < 0 || y < 0 || x >= m.texels || y >= m.texels) return true;
+    if (m.texelTriangle[static_cast<size_t>(y) * m.texels + x] < 0) return true;
+    glm::dvec3 bary;
+    return m.locate(r, bary) >= 0;
+}
+
 int32_t RedirectMetrics::texels() const {
     return impl_->texels;
 }
@@ -367,7 +347,7 @@ DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed,
                 if (below) m.addEdge(row[x], below[x], s);
             }
         }
-        s.inverted = invertedInRows(redirect, y0, y1);
+        s.inverted = detail::invertedInRows(redirect, y0, y1);
     }
     BandSums total;
     for (const BandSums& s : sums) {
@@ -410,7 +390,7 @@ int64_t countInvertedTriangles(const io::Image& redirect) {
         throw InvalidInput(
             formatError("redirect map", "", "is empty or has fewer than 2 channels", "a T x T x 2 map"));
     }
-    return invertedInRows(redirect, 0, redirect.height);
+    return detail::invertedInRows(redirect, 0, redirect.height);
 }
 
 }  // namespace deformkit::uvwarp

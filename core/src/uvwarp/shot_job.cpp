@@ -84,12 +84,14 @@ double tidy(float value) {
                              : static_cast<double>(value);
 }
 
-// The figures of a frame: the redirect map's when it was made (a frame written), then the grid's and the
-// solver's.
-json metricsJson(const DeliveredMetrics* delivered, const WarpMetrics& m, const SolveStats& s) {
+// The figures of a frame: the redirect map's and its fold repair's when it was made (a frame written), then
+// the grid's and the solver's.
+json metricsJson(const DeliveredMetrics* delivered, const FoldRepair* repair, const WarpMetrics& m,
+                 const SolveStats& s) {
     json j = json::object();
     std::vector<std::vector<ReportedFigure>> lists;
     if (delivered) lists.push_back(reportedFigures(*delivered));
+    if (repair) lists.push_back(reportedFigures(*repair));
     lists.push_back(reportedFigures(m));
     lists.push_back(reportedFigures(s));
     for (const std::vector<ReportedFigure>& figures : lists) {
@@ -510,14 +512,17 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     json seconds = {{"solve", solveSeconds}};
     const bool needed = plan.needed[k];
     std::optional<DeliveredMetrics> delivered;
+    std::optional<FoldRepair> repair;
     if (needed) {
         t = Clock::now();
-        warp.redirect(plan.redirect);
+        repair = warp.redirect(plan.redirect);
         seconds["invert"] = secondsSince(t);
         t = Clock::now();
         delivered = warp.measure(plan.redirect);
         seconds["measure"] = secondsSince(t);
         r.lastDelivered = *delivered;
+        r.lastRepair = *repair;
+        if (repair->regionsScaled > 0) ++r.scaledBack;
         r.lastWrittenFrame = frame;
         io::ImageWriteOptions attributes;
         frameInputs["deformed"] = inputName;
@@ -528,7 +533,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             {"deformkit:uvwarp:solver",
              solverJson(plan.options, warp.cells(), warp.texels(), warp.stats().levels).dump()},
             {"deformkit:uvwarp:inputs", frameInputs.dump()},
-            {"deformkit:uvwarp:metrics", metricsJson(&*delivered, metrics, warp.stats()).dump()}};
+            {"deformkit:uvwarp:metrics", metricsJson(&*delivered, &*repair, metrics, warp.stats()).dump()}};
         t = Clock::now();
         if (!job.skipExisting || !fileExists(plan.outPaths[k])) {
             io::ImageWriteOptions write = attributes;
@@ -566,7 +571,8 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
     }
     seconds["total"] = secondsSince(start);
     json line = baseLine(plan, k, needed ? "written" : warmUp(k) ? "warm-up" : "replayed");
-    line["metrics"] = metricsJson(delivered ? &*delivered : nullptr, metrics, warp.stats());
+    line["metrics"] =
+        metricsJson(delivered ? &*delivered : nullptr, repair ? &*repair : nullptr, metrics, warp.stats());
     line["seconds"] = seconds;
     writeLog(line);
 }
@@ -749,7 +755,12 @@ std::vector<std::string> shotSummary(const ShotReport& report) {
                 line << "; frame " << t.lastWrittenFrame << ": rigid stretch removed " << 100.0 * d.removed
                      << "% (error " << d.rigidStretchError << ", identity " << d.identityStretchError << "), "
                      << d.invertedTriangles << " inverted triangles, " << d.offChartTexels
-                     << " off-chart texels in the redirect map";
+                     << " off-chart texels in the redirect map (fold repair smoothed "
+                     << t.lastRepair.texelsMoved << (t.lastRepair.texelsMoved == 1 ? " texel)" : " texels)");
+            }
+            if (t.scaledBack > 0) {
+                line << "; " << t.scaledBack << (t.scaledBack == 1 ? " frame" : " frames")
+                     << " had a region's warp scaled back to keep the map fold-free";
             }
             lines.push_back(line.str());
         }

@@ -116,8 +116,11 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     return m.solver->solve(m.deformed);
 }
 
-void TileWarp::redirect(io::Image& out) const {
-    invertWarp(impl_->solver->warp(), impl_->texels, out);
+FoldRepair TileWarp::redirect(io::Image& out) const {
+    const Impl& m = *impl_;
+    invertWarp(m.solver->warp(), m.texels, out);
+    return repairFolds(out,
+                       [&m](int32_t x, int32_t y, glm::dvec2 r) { return m.delivered->mayShow(x, y, r); });
 }
 
 io::Image TileWarp::redirect() const {
@@ -130,8 +133,11 @@ DeliveredMetrics TileWarp::measure(const io::Image& redirect) const {
     return impl_->delivered->measure(impl_->lastDeformed, redirect);
 }
 
-DeliveredMetrics TileWarp::deliveredMetrics() const {
-    return measure(redirect());
+DeliveredMetrics TileWarp::deliveredMetrics(FoldRepair* repair) const {
+    io::Image map;
+    const FoldRepair done = redirect(map);
+    if (repair) *repair = done;
+    return measure(map);
 }
 
 WarpMetrics TileWarp::metrics() const {

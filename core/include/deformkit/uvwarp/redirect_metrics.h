@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
@@ -60,6 +61,10 @@ class RedirectMetrics {
     // map size, or a non-finite redirect texel (naming it).
     [[nodiscard]] DeliveredMetrics measure(std::span<const glm::vec3> deformed,
                                            const io::Image& redirect) const;
+
+    // Whether texel (x, y) may show the rest content at tile-local r without counting as off-chart: true for
+    // a texel outside every chart, and for a chart texel when r lies in a UV triangle of the tile.
+    [[nodiscard]] bool mayShow(int32_t x, int32_t y, glm::dvec2 r) const;
 
     [[nodiscard]] int32_t texels() const;
 

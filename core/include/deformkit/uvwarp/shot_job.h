@@ -20,6 +20,7 @@
 #include "deformkit/uvwarp/metrics.h"
 #include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
+#include "deformkit/uvwarp/redirect_repair.h"
 #include "deformkit/uvwarp/tile_warp.h"
 
 namespace deformkit::uvwarp {
@@ -124,6 +125,8 @@ struct ShotTileReport {
     WarpMetrics lastMetrics;                   // of lastFrame: the solver's grid (diagnostics)
     int lastWrittenFrame = 0;                  // the last frame whose redirect map was written
     DeliveredMetrics lastDelivered;            // of lastWrittenFrame: its redirect map
+    FoldRepair lastRepair;                     // of lastWrittenFrame: what made its map fold-free
+    int32_t scaledBack = 0;                    // written frames whose fold repair scaled a region back
     std::vector<std::filesystem::path> files;  // written, in order
 };
 

@@ -13,6 +13,7 @@
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/metrics.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
+#include "deformkit/uvwarp/redirect_repair.h"
 #include "deformkit/uvwarp/solver.h"
 
 namespace deformkit::uvwarp {
@@ -50,14 +51,17 @@ class TileWarp {
 
     // One frame: deformed positions of the rest mesh's vertices (same count). Returns the warp W.
     const WarpGrid& solve(std::span<const glm::vec3> deformedPoints);
-    // W^-1 of the last solve as a T x T x 2 image of tile-local uv (the identity before any solve).
-    void redirect(io::Image& out) const;
+    // W^-1 of the last solve as a T x T x 2 image of tile-local uv (the identity before any solve), made
+    // fold-free with no texel showing content off the charts (repairFolds, redirect_repair.h). Returns what
+    // the repair did.
+    FoldRepair redirect(io::Image& out) const;
     [[nodiscard]] io::Image redirect() const;
     // What the redirect map of the last solve delivers (redirect_metrics.h): the rigid stretch a renderer
     // shows through it against the identity's, its inverted triangles and off-chart texels. measure() takes
     // the map already made by redirect(); deliveredMetrics() makes it.
     [[nodiscard]] DeliveredMetrics measure(const io::Image& redirect) const;
-    [[nodiscard]] DeliveredMetrics deliveredMetrics() const;
+    // `repair`, when given, receives what the repair did to the map measured.
+    [[nodiscard]] DeliveredMetrics deliveredMetrics(FoldRepair* repair = nullptr) const;
     // The solver's own figures on its grid (diagnostics: identity vs. ours on grid edges, grid folds, masked
     // and border motion).
     [[nodiscard]] WarpMetrics metrics() const;
