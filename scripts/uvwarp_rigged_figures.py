@@ -1,0 +1,107 @@
+"""The UV warp's figures on a rigged shot (rest.obj and anim.NNNN.obj, as scripts/make_rigged_shot.py writes
+them), as docs/uvwarp.md quotes them: rigid disks of radius 0.025 on a 0.1 lattice at texels whose 9 x 9
+neighbourhood (at 1024^2; (2 T / 256 + 1)^2 in general) lies inside the UV charts, every frame solved with
+the shot preset from the identity, measured on the redirect map it delivers (deformkit.redirect_metrics):
+the rigid stretch removed (median and worst frame), the inverted triangles delivered and those the fold
+repair unfolded, off-chart texels, the time a frame takes (solve and map). Usage, from the repository's root:
+
+    python3 scripts/uvwarp_rigged_figures.py tests/data/fox [--texels 1024] [--python build/python]
+        [--first 1] [--option name=value ...]"""
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+
+def chart_texels(mesh, t):
+    """(t, t) bool: texel centres (row 0 at v = 1) inside a UV triangle of the mesh's faces (fans)."""
+    uv = mesh.uvs.astype(np.float64)
+    inside = np.zeros((t, t), bool)
+    offset = 0
+    for count in mesh.face_counts:
+        corners = mesh.uv_indices[offset:offset + count]
+        offset += count
+        for k in range(1, count - 1):
+            a, b, c = uv[corners[0]], uv[corners[k]], uv[corners[k + 1]]
+            lo = np.floor(np.minimum.reduce([a, b, c]) * t).astype(int)
+            hi = np.ceil(np.maximum.reduce([a, b, c]) * t).astype(int)
+            xs, ys = np.arange(max(lo[0], 0), min(hi[0], t)), np.arange(max(t - hi[1], 0), min(t - lo[1], t))
+            if not len(xs) or not len(ys):
+                continue
+            x, y = np.meshgrid(xs, ys)
+            p = np.stack([(x + 0.5) / t, 1 - (y + 0.5) / t], -1) - a
+            e0, e1 = b - a, c - a
+            den = e0[0] * e1[1] - e1[0] * e0[1]
+            if den == 0:
+                continue
+            l1 = (p[..., 0] * e1[1] - e1[0] * p[..., 1]) / den
+            l2 = (e0[0] * p[..., 1] - p[..., 0] * e0[1]) / den
+            ok = (l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)
+            inside[y[ok], x[ok]] = True
+    return inside
+
+
+def rigid_disks(inside, t):
+    y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
+    u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
+    centres = np.arange(0.05, 1, 0.1)
+    d = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
+    interior = inside.copy()
+    r = max(1, t // 256)
+    for dy in range(-r, r + 1):
+        for dx in range(-r, r + 1):
+            interior &= np.roll(np.roll(inside, dy, 0), dx, 1)
+    return ((d < 0.025) & interior).astype(np.float32)
+
+
+def value(text):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("shot")
+    parser.add_argument("--texels", type=int, default=1024)
+    parser.add_argument("--python", default="build/python")
+    parser.add_argument("--first", type=int, default=1, help="first frame measured (2 skips a rest pose)")
+    parser.add_argument("--option", action="append", default=[], help="a solver option, name=value")
+    args = parser.parse_args()
+    sys.path.insert(0, os.path.abspath(args.python))
+    import deformkit as dk
+
+    t = args.texels
+    rest = dk.read_mesh(os.path.join(args.shot, "rest.obj"))
+    rigidity = rigid_disks(chart_texels(rest, t), t)
+    options = dict(preset="shot")
+    options.update({k: value(v) for k, v in (o.split("=", 1) for o in args.option)})
+    solver = dk.UvWarpSolver(rest, 1001, rigidity, **options)
+    frames = sorted(int(name[5:9]) for name in os.listdir(args.shot) if name.startswith("anim."))
+    removed, inverted, unfolded, off_chart, seconds = [], 0, 0, 0, []
+    for frame in (f for f in frames if f >= args.first):
+        posed = dk.read_mesh(os.path.join(args.shot, f"anim.{frame:04d}.obj"))
+        start = time.perf_counter()
+        solver.solve(posed.points)
+        redirect = solver.redirect_map()
+        seconds.append(time.perf_counter() - start)
+        m = dk.redirect_metrics(rest, 1001, rigidity, posed.points, redirect)
+        removed.append(m["rigid_stretch_removed"])
+        inverted += m["inverted_triangles"]
+        off_chart += m["off_chart_texels"]
+        unfolded += solver.metrics()["repair_inverted_found"]
+    removed = np.array(removed)
+    print(f"{args.shot} at {t}^2, {int(rigidity.sum())} rigid texels, {len(removed)} frames: rigid stretch removed "
+          f"{100 * np.median(removed):.1f}% median, {100 * removed.min():.1f}% worst (frame "
+          f"{args.first + int(removed.argmin())}); {inverted} inverted triangles delivered ({unfolded} unfolded by "
+          f"the repair), {off_chart} off-chart texels; {1e3 * np.median(seconds):.0f} ms a frame (solve and map)")
+    print("per frame removed:", " ".join(f"{100 * r:.1f}" for r in removed))
+
+
+if __name__ == "__main__":
+    main()
