@@ -57,6 +57,8 @@ def rigid_disks(inside, t):
 
 
 def value(text):
+    if text in ("true", "false"):
+        return text == "true"
     for kind in (int, float):
         try:
             return kind(text)
