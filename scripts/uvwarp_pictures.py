@@ -19,6 +19,8 @@ import tempfile
 
 import numpy as np
 
+from uvwarp_rigged_figures import chart_texels
+
 SHOTS = {
     "suzanne": dict(rest="tests/data/suzanne/suzanne.0001.obj", deformed="tests/data/suzanne/suzanne.####.obj",
                     frames=(1, 6), frame=6, texels=512, margin=8, grid=16,
@@ -29,30 +31,6 @@ SHOTS = {
                 view=["--view", "-1,-0.1,0.05", "--width", "640", "--height", "400",
                       "--frame", "-17,20,-45,17,70,30"]),
 }
-
-
-def chart_texels(mesh, t):
-    """(t, t) bool: texel centres (row 0 at v = 1) inside a UV triangle of the mesh's faces (fans)."""
-    yy, xx = np.mgrid[0:t, 0:t]
-    u, v = (xx + 0.5) / t, 1 - (yy + 0.5) / t
-    covered = np.zeros((t, t), bool)
-    offset = 0
-    for count in mesh.face_counts:
-        corners = mesh.uvs[mesh.uv_indices[offset:offset + count]].astype(np.float64)
-        offset += count
-        for k in range(1, count - 1):
-            a, b, c = corners[0], corners[k], corners[k + 1]
-            lo = np.floor(np.minimum(np.minimum(a, b), c) * t).astype(int).clip(0, t - 1)
-            hi = np.ceil(np.maximum(np.maximum(a, b), c) * t).astype(int).clip(0, t - 1)
-            rows, cols = slice(t - 1 - hi[1], t - lo[1]), slice(lo[0], hi[0] + 1)
-            px, py = u[rows, cols], v[rows, cols]
-
-            def edge(p, q):
-                return (q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0])
-
-            w = np.stack([edge(b, c), edge(c, a), edge(a, b)])
-            covered[rows, cols] |= (w >= 0).all(0) | (w <= 0).all(0)
-    return covered
 
 
 def make(name, shot, deformkit, dk, images, keep):

@@ -8,41 +8,18 @@ texel-centre grid, no chart texel showing content off the charts, finite maps. T
 printed and held to floors just under what is measured, at 256^2 to stay quick (docs/uvwarp.md gives the
 1024^2 figures against the targets)."""
 import os
+import sys
 
 import numpy as np
 
 import deformkit as dk
 
+# The chart coverage and the disk layout of the figures docs/uvwarp.md quotes (scripts/uvwarp_rigged_figures.py).
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+from uvwarp_rigged_figures import chart_texels, rigid_disks  # noqa: E402
+
 SHOT = os.path.join(os.path.dirname(__file__), "..", "data", "fox")
 T = 256
-
-
-def charts(mesh, t):
-    """(t, t) bool: texel centres inside a UV triangle (fan triangulation), by barycentric tests."""
-    uv = mesh.uvs.astype(np.float64)
-    inside = np.zeros((t, t), bool)
-    offset = 0
-    for count in mesh.face_counts:
-        corners = mesh.uv_indices[offset:offset + count]
-        offset += count
-        for k in range(1, count - 1):
-            a, b, c = uv[corners[0]], uv[corners[k]], uv[corners[k + 1]]
-            lo = np.floor(np.minimum.reduce([a, b, c]) * t).astype(int)
-            hi = np.ceil(np.maximum.reduce([a, b, c]) * t).astype(int)
-            xs = np.arange(max(lo[0], 0), min(hi[0], t))
-            ys = np.arange(max(t - hi[1], 0), min(t - lo[1], t))
-            if not len(xs) or not len(ys):
-                continue
-            x, y = np.meshgrid(xs, ys)
-            p = np.stack([(x + 0.5) / t, 1 - (y + 0.5) / t], -1) - a
-            e0, e1 = b - a, c - a
-            den = e0[0] * e1[1] - e1[0] * e0[1]
-            if den == 0:
-                continue
-            l1 = (p[..., 0] * e1[1] - e1[0] * p[..., 1]) / den
-            l2 = (e0[0] * p[..., 1] - p[..., 0] * e0[1]) / den
-            inside[y[(l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)], x[(l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)]] = True
-    return inside
 
 
 def uv_triangles(mesh):
@@ -98,26 +75,13 @@ def off_chart_texels(redirect, inside, triangles, t):
     return int((~found).sum())
 
 
-def rigid_disks(inside, t):
-    """Rigidity 1 in disks of radius 0.025 on a 0.1 lattice, where a texel's 3 x 3 is inside a chart."""
-    y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
-    u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
-    d = np.min([np.hypot(u - cu, v - cv) for cu in np.arange(0.05, 1, 0.1) for cv in np.arange(0.05, 1, 0.1)],
-               axis=0)
-    interior = inside.copy()
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            interior &= np.roll(np.roll(inside, dy, 0), dx, 1)
-    return ((d < 0.025) & interior).astype(np.float32)
-
-
 def test_the_fox_running_keeps_its_rigid_disks_through_every_frame():
     rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
     assert rest.udim_tiles() == [1001]
-    rigidity = rigid_disks(charts(rest, T), T)
+    rigidity = rigid_disks(chart_texels(rest, T), T)
     assert rigidity.sum() > 2000
     solver = dk.UvWarpSolver(rest, 1001, rigidity, preset="shot")
-    inside, triangles = charts(rest, T), uv_triangles(rest)
+    inside, triangles = chart_texels(rest, T), uv_triangles(rest)
     removed, repaired = [], []
     for frame in range(1, 25):
         posed = dk.read_mesh(os.path.join(SHOT, f"anim.{frame:04d}.obj"))
@@ -153,7 +117,7 @@ def test_random_poses_and_rigid_layouts_give_fold_free_on_chart_maps():
     rng = np.random.default_rng(7)
     cases, unfolded = 0, 0
     for t in (512, 1024):
-        inside = charts(rest, t)
+        inside = chart_texels(rest, t)
         y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
         u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
         for case in range(4):
