@@ -19,4 +19,13 @@ io::Image makeImage(int w, int h, int c, F f) {
     return image;
 }
 
+// A square RGB texture whose values are multiples of 1/256 (exact in half floats, so a half EXR bake keeps
+// them): channel c at (x, y) is ((7 x + 13 y + 29 c) mod 256) / 256.
+inline io::Image exactHalfTexture(int texels) {
+    return makeImage(texels, texels, 3, [](int c, double x, double y) {
+        return static_cast<double>((static_cast<int>(x) * 7 + static_cast<int>(y) * 13 + c * 29) % 256) /
+               256.0;
+    });
+}
+
 }  // namespace deformkit::test

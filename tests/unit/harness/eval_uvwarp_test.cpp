@@ -24,6 +24,7 @@
 #include "deformkit/uvwarp/tile_warp.h"
 #include "eval_command.h"
 #include "farm_command.h"
+#include "farm_plan_edits.h"
 #include "mesh_support.h"
 #include "scene/uvwarp_scene_support.h"
 #include "test_support.h"
@@ -74,7 +75,7 @@ TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed
                 // The bake: bakeTexture through the same redirect, written as a half-float EXR. Its texels
                 // are bilinear blends of multiples of 1/256 in [0, 1): half floats keep 11 significant
                 // bits, so each is within 2^-12 of the float value.
-                const io::Image bake = uvwarp::bakeTexture(texture(), expected);
+                const io::Image bake = uvwarp::bakeTexture(test::exactHalfTexture(kTexels), expected);
                 const io::Image baked = io::readImage(command.outDir / ("tubes.bake.1001." +
                                                                         std::string(frame == 1   ? "0001"
                                                                                     : frame == 2 ? "0002"
@@ -265,12 +266,7 @@ TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm]
     CHECK(plan.tasks[1].tiles == std::vector<int>{1001, 1002});
     const fs::path planFile = harness::farmPlanPath(planCommand);
     const std::string good = test::readText(planFile);
-    struct Case {
-        const char* from;
-        const char* to;
-        const char* message;
-    };
-    const Case cases[] = {
+    const test::PlanEdit cases[] = {
         {"\"tiles\":[1001,1002]", "\"tiles\":[1002,1001]",
          ": tasks[1].tiles[1]: is 1001 (expected tiles in ascending order, each once)"},
         {"\"tiles\":[1001,1002]", "\"tiles\":[5]",
@@ -279,18 +275,7 @@ TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm]
          ": tasks[1].outputs[2]: is \"tubes.redirect.1002.0001.exr\", the scene makes "
          "\"tubes.redirect.1001.0002.exr\""},
     };
-    for (const Case& c : cases) {
-        std::string text = good;
-        const size_t at = text.find(c.from);
-        REQUIRE(at != std::string::npos);
-        text.replace(at, std::strlen(c.from), c.to);
-        test::writeText(planFile, text);
-        CAPTURE(c.to);
-        const std::string what = test::errorOf<InvalidInput>([&] {
-            (void)harness::farmRunCommand({planFile, 1});
-        });
-        CHECK_THAT(what, Contains(planFile.string() + c.message));
-    }
+    test::checkPlanEdits(good, planFile, cases);
     planCommand.tilesPerTask = 0;
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(planCommand); }),
                Contains("--tiles-per-task: is 0"));

@@ -18,6 +18,7 @@
 #include "deformkit/scene/farm_plan.h"
 #include "eval_command.h"
 #include "farm_command.h"
+#include "farm_plan_edits.h"
 #include "mesh_support.h"
 #include "test_support.h"
 
@@ -222,12 +223,7 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
         CHECK(harness::farmExitCode(ParseError("x")) == 2);
     }
     SECTION("bad values name their JSON path") {
-        struct Case {
-            const char* from;
-            const char* to;
-            const char* message;
-        };
-        const Case cases[] = {
+        const test::PlanEdit cases[] = {
             {"\"frames\":[4,6]", "\"frames\":[4,9]", ": tasks[1].frames: is [4,9], 6 frames"},
             {"\"frames\":[7,7]", "\"frames\":[7]", ": tasks[2].frames: is [7] (expected [first, last])"},
             {"\"bent.0006.obj\"],\"tiles\":[]", "\"bent.0006.obj\"],\"tiles\":[1001]",
@@ -240,18 +236,7 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
              ": tasks[1].outputs[0]: is \"tube.4.obj\", the scene makes "
              "\"tube.0004.obj\""},
         };
-        for (const Case& c : cases) {
-            std::string text = good;
-            const size_t at = text.find(c.from);
-            REQUIRE(at != std::string::npos);
-            text.replace(at, std::strlen(c.from), c.to);
-            test::writeText(planFile, text);
-            CAPTURE(c.to);
-            const std::string what = test::errorOf<InvalidInput>([&] {
-                (void)harness::farmRunCommand({planFile, 1});
-            });
-            CHECK_THAT(what, Contains(planFile.string() + c.message));
-        }
+        test::checkPlanEdits(good, planFile, cases);
     }
     SECTION("a missing plan is bad input; an unwritable output folder is worth a retry") {
         const fs::path missing = shot.dir / "nope.json";

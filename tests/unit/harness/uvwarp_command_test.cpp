@@ -13,6 +13,7 @@
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/tile_warp.h"
+#include "image_support.h"
 #include "progress_bar.h"
 #include "test_support.h"
 #include "uvwarp_command.h"
@@ -70,16 +71,6 @@ io::Image disks(int t = kTexels) {
     return image;
 }
 
-// A colour texture whose values are multiples of 1/256: exact in half floats, so a half EXR bake keeps them.
-io::Image texture() {
-    io::Image image(kTexels, kTexels, 3);
-    for (int y = 0; y < kTexels; ++y)
-        for (int x = 0; x < kTexels; ++x)
-            for (int c = 0; c < 3; ++c)
-                image.at(x, y, c) = static_cast<float>((x * 7 + y * 13 + c * 29) % 256) / 256.0f;
-    return image;
-}
-
 // The scene: rest.obj, anim.0001-0003.obj (undeformed, 1.25x and 1.5x along u), rig.1001.exr, col.1001.exr
 // and an out folder.
 struct Scene {
@@ -92,7 +83,7 @@ struct Scene {
         for (int f = 1; f <= 3; ++f)
             test::writeText(dir / ("anim.000" + std::to_string(f) + ".obj"), planeObj(stretch[f - 1], tileU));
         io::writeImage(dir / "rig.1001.exr", disks(), {io::PixelType::Float, {}});
-        io::writeImage(dir / "col.1001.exr", texture(), {io::PixelType::Float, {}});
+        io::writeImage(dir / "col.1001.exr", test::exactHalfTexture(kTexels), {io::PixelType::Float, {}});
         fs::create_directories(dir / "out");
         command.rest = dir / "rest.obj";
         command.deformed = dir / "anim.####.obj";
@@ -183,7 +174,7 @@ TEST_CASE("uvwarp command: redirect maps and bakes per frame, identity for the u
     CHECK(distanceFromIdentity(first) < 1e-5);
     // Baked through the identity, the texture comes back: bilinear weights (1, 0) at texel centres, up to
     // float rounding (1e-6), then stored as half, which holds the texture's multiples of 1/256 exactly.
-    const io::Image tex = texture(), bakedFirst = io::readImage(s.baked(1));
+    const io::Image tex = test::exactHalfTexture(kTexels), bakedFirst = io::readImage(s.baked(1));
     REQUIRE(bakedFirst.pixels.size() == tex.pixels.size());
     double worst = 0.0;
     for (size_t k = 0; k < tex.pixels.size(); ++k)

@@ -16,6 +16,7 @@
 #include "deformkit/host/stack.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "image_support.h"
 #include "mesh_support.h"
 #include "test_support.h"
 
@@ -51,16 +52,6 @@ inline io::Image disks() {
     return image;
 }
 
-// Values that are multiples of 1/256 (exact in half floats).
-inline io::Image texture() {
-    io::Image image(kTexels, kTexels, 3);
-    for (int y = 0; y < kTexels; ++y)
-        for (int x = 0; x < kTexels; ++x)
-            for (int c = 0; c < 3; ++c)
-                image.at(x, y, c) = static_cast<float>((x * 7 + y * 13 + c * 29) % 256) / 256.0f;
-    return image;
-}
-
 // Frames 1..3: a twist about Y that grows (stretching the tubes' surfaces along their diagonals), then
 // the UV warp with rigidity maps for both tiles and a texture for tile 1001 only.
 inline const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
@@ -80,7 +71,7 @@ struct Shot {
         floats.type = io::PixelType::Float;
         io::writeImage(dir / "rig.1001.exr", disks(), floats);
         io::writeImage(dir / "rig.1002.exr", disks(), floats);
-        io::writeImage(dir / "col.1001.exr", texture(), floats);
+        io::writeImage(dir / "col.1001.exr", test::exactHalfTexture(kTexels), floats);
         scene = dir / "shot.json";
         test::writeText(scene, kScene);
     }

@@ -10,30 +10,13 @@
 #include "deformkit/uvwarp/metrics.h"
 #include "deformkit/uvwarp/solver.h"
 #include "reference_solver.h"
+#include "uvwarp_test_support.h"
 
 using namespace deformkit;
 using uvwarp::PointField;
 using uvwarp::WarpGrid;
 
 namespace {
-
-PointField pointField(int32_t cells, int32_t channels, const std::function<void(float, float, float*)>& f) {
-    PointField out;
-    out.cells = cells;
-    out.channels = channels;
-    out.values.resize(static_cast<size_t>(cells + 1) * (cells + 1) * channels);
-    for (int32_t j = 0; j <= cells; ++j)
-        for (int32_t i = 0; i <= cells; ++i)
-            f(static_cast<float>(i) / cells, static_cast<float>(j) / cells, &out.values[out.index(i, j)]);
-    return out;
-}
-
-float latticeDisks(float u, float v) {
-    for (float cu : {0.25f, 0.5f, 0.75f})
-        for (float cv : {0.25f, 0.5f, 0.75f})
-            if (std::hypot(u - cu, v - cv) < 0.07f) return 1.0f;
-    return 0.0f;
-}
 
 double removedOn(const WarpGrid& w, const PointField& rest, const PointField& deformed,
                  const PointField& rigidity, const PointField& mask) {
@@ -47,12 +30,12 @@ TEST_CASE("uv warp reference: Levenberg-Marquardt lowers the model's energy belo
           "[uvwarp][reference]") {
     const int32_t n = 64;
     const PointField rest =
-        pointField(n, 3, [](float u, float v, float* p) { p[0] = u, p[1] = v, p[2] = 0; });
+        test::pointField(n, 3, [](float u, float v, float* p) { p[0] = u, p[1] = v, p[2] = 0; });
     const PointField deformed =
-        pointField(n, 3, [](float u, float v, float* p) { p[0] = 1.5f * u, p[1] = v, p[2] = 0; });
+        test::pointField(n, 3, [](float u, float v, float* p) { p[0] = 1.5f * u, p[1] = v, p[2] = 0; });
     const PointField rigidity =
-        pointField(n, 1, [](float u, float v, float* p) { p[0] = latticeDisks(u, v); });
-    const PointField mask = pointField(n, 1, [](float, float, float* p) { p[0] = 1.0f; });
+        test::pointField(n, 1, [](float u, float v, float* p) { p[0] = test::latticeDisks(u, v); });
+    const PointField mask = test::pointField(n, 1, [](float, float, float* p) { p[0] = 1.0f; });
     uvwarp::Solver solver(rest, rigidity, mask, {});
     const WarpGrid pbd = solver.solve(deformed);
     const PointField movable = solver.levelMovable(0);

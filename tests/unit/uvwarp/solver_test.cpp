@@ -10,31 +10,13 @@
 
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/solver.h"
+#include "uvwarp_test_support.h"
 
 using namespace deformkit;
 using uvwarp::PointField;
 using uvwarp::WarpGrid;
 
 namespace {
-
-PointField field(int32_t cells, int32_t channels, const std::function<void(float, float, float*)>& f) {
-    PointField out;
-    out.cells = cells;
-    out.channels = channels;
-    out.values.resize(static_cast<size_t>(cells + 1) * (cells + 1) * channels);
-    for (int32_t j = 0; j <= cells; ++j)
-        for (int32_t i = 0; i <= cells; ++i)
-            f(static_cast<float>(i) / cells, static_cast<float>(j) / cells, &out.values[out.index(i, j)]);
-    return out;
-}
-
-// Rigid disks of radius 0.07 on a 3 x 3 lattice over an elastic background.
-float disks(float u, float v) {
-    for (float cu : {0.25f, 0.5f, 0.75f})
-        for (float cv : {0.25f, 0.5f, 0.75f})
-            if (std::hypot(u - cu, v - cv) < 0.07f) return 1.0f;
-    return 0.0f;
-}
 
 // Independent bilinear look-up of a 3-channel field (the test's own, not the solver's).
 glm::dvec3 lookup(const PointField& f, double u, double v) {
@@ -79,18 +61,19 @@ struct Scene {
 
 Scene stretchedPlane(int32_t cells, float stretch) {
     Scene s;
-    s.rest = field(cells, 3, [](float u, float v, float* p) {
+    s.rest = test::pointField(cells, 3, [](float u, float v, float* p) {
         p[0] = u;
         p[1] = v;
         p[2] = 0.0f;
     });
-    s.deformed = field(cells, 3, [&](float u, float v, float* p) {
+    s.deformed = test::pointField(cells, 3, [&](float u, float v, float* p) {
         p[0] = stretch * u;
         p[1] = v;
         p[2] = 0.0f;
     });
-    s.rigidity = field(cells, 1, [](float u, float v, float* p) { p[0] = disks(u, v); });
-    s.mask = field(cells, 1, [](float, float, float* p) { p[0] = 1.0f; });
+    s.rigidity =
+        test::pointField(cells, 1, [](float u, float v, float* p) { p[0] = test::latticeDisks(u, v); });
+    s.mask = test::pointField(cells, 1, [](float, float, float* p) { p[0] = 1.0f; });
     return s;
 }
 
@@ -148,7 +131,8 @@ TEST_CASE("uv warp: extreme compression keeps every grid triangle positive", "[u
 TEST_CASE("uv warp: masked points and the tile border do not move", "[uvwarp]") {
     Scene s = stretchedPlane(64, 1.5f);
     // A masked vertical stripe through the middle disk's column.
-    s.mask = field(64, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.5f) < 0.05f ? 0.0f : 1.0f; });
+    s.mask = test::pointField(
+        64, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.5f) < 0.05f ? 0.0f : 1.0f; });
     uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
     const WarpGrid& warp = solver.solve(s.deformed);
     const WarpGrid identity = WarpGrid::identity(64);
@@ -222,7 +206,7 @@ TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]"
     std::vector<double> changes;
     for (int f = 1; f <= 8; ++f) {
         const float stretch = 1.3f + 0.01f * f;
-        s.deformed = field(n, 3, [&](float u, float v, float* p) {
+        s.deformed = test::pointField(n, 3, [&](float u, float v, float* p) {
             p[0] = stretch * u;
             p[1] = v;
             p[2] = 0.0f;
@@ -246,7 +230,7 @@ TEST_CASE("uv warp: the same bytes for 1 and 2 threads", "[uvwarp]") {
     for (const int32_t cells : {64, 256}) {
         Scene s = stretchedPlane(cells, 0.6f);
         if (cells == 256)
-            s.mask = field(cells, 1, [](float u, float v, float* p) {
+            s.mask = test::pointField(cells, 1, [](float u, float v, float* p) {
                 p[0] = (u < 0.3f && v < 0.3f) || std::fmod(u * 7.0f, 1.0f) < 0.15f ? 0.0f : 1.0f;
             });
         const int saved = omp_get_max_threads();
@@ -533,7 +517,7 @@ TEST_CASE("uv warp: orientation preservation turns rigid segments back to their 
     // u-edges falls with it (0.20, 0.20, 0.14, 0.10 rad for 0, 0.05, 0.5, 1), paid for in stretch.
     const int n = 64;
     Scene sheared = stretchedPlane(n, 1.0f);
-    sheared.deformed = field(n, 3, [](float u, float v, float* p) {
+    sheared.deformed = test::pointField(n, 3, [](float u, float v, float* p) {
         p[0] = u + 0.5f * v;
         p[1] = v;
         p[2] = 0.0f;
@@ -567,7 +551,8 @@ TEST_CASE("uv warp: the hierarchy's rigidity and masks follow Eq. 7 and 8", "[uv
     // border. A masked stripe and the disks make every rule matter.
     const int n = 64;
     Scene s = stretchedPlane(n, 1.5f);
-    s.mask = field(n, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.55f) < 0.04f ? 0.0f : 1.0f; });
+    s.mask = test::pointField(
+        n, 1, [](float u, float, float* p) { p[0] = std::abs(u - 0.55f) < 0.04f ? 0.0f : 1.0f; });
     uvwarp::SolverOptions fourLevels;
     fourLevels.levels = 4;  // the automatic depth stops at 3 for this mask's charts
     uvwarp::Solver solver(s.rest, s.rigidity, s.mask, fourLevels);

@@ -111,4 +111,26 @@ inline uvwarp::WarpGrid warpFrom(int32_t cells, const std::function<glm::dvec2(d
     return grid;
 }
 
+// A point field of `cells` + 1 points a side with `channels` values per point, f(u, v, out) at the grid point
+// (i / cells, j / cells).
+inline uvwarp::PointField pointField(int32_t cells, int32_t channels,
+                                     const std::function<void(float, float, float*)>& f) {
+    uvwarp::PointField out;
+    out.cells = cells;
+    out.channels = channels;
+    out.values.resize(static_cast<size_t>(cells + 1) * (cells + 1) * channels);
+    for (int32_t j = 0; j <= cells; ++j)
+        for (int32_t i = 0; i <= cells; ++i)
+            f(static_cast<float>(i) / cells, static_cast<float>(j) / cells, &out.values[out.index(i, j)]);
+    return out;
+}
+
+// Rigid disks of radius 0.07 on a 3 x 3 lattice over an elastic background: 1 inside a disk, else 0.
+inline float latticeDisks(float u, float v) {
+    for (float cu : {0.25f, 0.5f, 0.75f})
+        for (float cv : {0.25f, 0.5f, 0.75f})
+            if (std::hypot(u - cu, v - cv) < 0.07f) return 1.0f;
+    return 0.0f;
+}
+
 }  // namespace deformkit::test
