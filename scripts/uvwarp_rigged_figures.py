@@ -1,5 +1,5 @@
 """The UV warp's figures on a rigged shot (rest.obj and anim.NNNN.obj, as scripts/make_rigged_shot.py writes
-them), as docs/uvwarp.md quotes them: rigid disks of radius 0.025 on a 0.1 lattice at texels whose 9 x 9
+them), as docs/uvwarp_quality.md quotes them: rigid disks of radius 0.025 on a 0.1 lattice at texels whose 9 x 9
 neighbourhood (at 1024^2; (2 T / 256 + 1)^2 in general) lies inside the UV charts, every frame solved with
 the shot preset from the identity, measured on the redirect map it delivers (deformkit.redirect_metrics):
 the rigid stretch removed (median and worst frame), the inverted triangles delivered and those the fold

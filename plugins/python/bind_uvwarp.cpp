@@ -253,6 +253,13 @@ py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::Wa
     return d;
 }
 
+// A redirect map argument: (T, T, >= 2) float32, channels 0 and 1 the tile-local (u', v').
+io::Image redirectOf(const FloatArray& a, const std::string& source, const char* expected) {
+    if (a.ndim() != 3 || a.shape(2) < 2)
+        throw InvalidInput(formatError(source, "redirect", "has shape " + shapeOf(a), expected));
+    return imageOf(a, source, "redirect", expected);
+}
+
 std::vector<glm::vec3> deformedOf(const FloatArray& a, int32_t vertices, const std::string& source) {
     if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != vertices) {
         throw InvalidInput(formatError(source, "deformed_points", "has shape " + shapeOf(a),
@@ -761,11 +768,7 @@ void bindUvWarp(py::module_& m) {
             const std::string source = "redirect_metrics";
             const io::Image rigidityMap = mapOf(rigidity, source, "rigidity");
             const std::vector<glm::vec3> points = deformedOf(deformed, mesh.numVertices(), source);
-            if (redirect.ndim() != 3 || redirect.shape(2) < 2) {
-                throw InvalidInput(
-                    formatError(source, "redirect", "has shape " + shapeOf(redirect), "(T, T, 2) float32"));
-            }
-            const io::Image map = imageOf(redirect, source, "redirect", "(T, T, 2) float32");
+            const io::Image map = redirectOf(redirect, source, "(T, T, 2) float32");
             uvwarp::DeliveredMetrics out;
             {
                 py::gil_scoped_release release;
@@ -823,11 +826,7 @@ void bindUvWarp(py::module_& m) {
             const std::string source = "apply_redirect";
             const uvwarp::BakeOptions options = bakeOptionsOf(filter, source);
             const io::Image tex = imageOf(texture, source, "texture", "(H, W) or (H, W, C) float32");
-            if (redirect.ndim() != 3 || redirect.shape(2) < 2) {
-                throw InvalidInput(
-                    formatError(source, "redirect", "has shape " + shapeOf(redirect), "(R, R, 2) float32"));
-            }
-            const io::Image map = imageOf(redirect, source, "redirect", "(R, R, 2) float32");
+            const io::Image map = redirectOf(redirect, source, "(R, R, 2) float32");
             io::Image out;
             {
                 py::gil_scoped_release release;

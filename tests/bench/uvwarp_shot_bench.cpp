@@ -47,7 +47,7 @@ double median(std::vector<double> v) {
 }
 
 // Rigid disks of radius 0.025 on a 0.1 lattice, at texels whose 7 x 7 neighbourhood lies inside the derived
-// warp mask (3 texels off its border band: about docs/uvwarp.md's 4-texel margin inside the charts).
+// warp mask (3 texels off its border band: about docs/uvwarp_quality.md's 4-texel margin inside the charts).
 io::Image disks(const geom::Mesh& mesh) {
     const io::Image mask = deriveWarpMask(mesh, 1001, kTexels);
     io::Image rigidity(kTexels, kTexels, 1);

@@ -5,7 +5,7 @@ a 24-frame OBJ shot. Rigid disks are painted inside its charts; every frame is s
 that hold on any input are asserted on every frame, and again over random poses and random rigid layouts,
 each checked here in numpy apart from the library's own count: no inverted triangle of the redirect map's
 texel-centre grid, no chart texel showing content off the charts, finite maps. The quality figures are
-printed and held to floors just under what is measured, at 256^2 to stay quick (docs/uvwarp.md gives the
+printed and held to floors just under what is measured, at 256^2 to stay quick (docs/uvwarp_quality.md gives the
 1024^2 figures against the targets)."""
 import os
 import sys
@@ -14,7 +14,7 @@ import numpy as np
 
 import deformkit as dk
 
-# The chart coverage and the disk layout of the figures docs/uvwarp.md quotes (scripts/uvwarp_rigged_figures.py).
+# The chart coverage and the disk layout of the figures docs/uvwarp_quality.md quotes (scripts/uvwarp_rigged_figures.py).
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
 from uvwarp_rigged_figures import chart_texels, rigid_disks  # noqa: E402
 
