@@ -123,8 +123,8 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     (void)uvwarp::shotTiles(rest, command.rest.string(), command.tiles,
                             "--tiles");  // before the frames are read
 
-    const uvwarp::DeformedFrames frames =
-        uvwarp::objSequenceFrames(command.deformed, command.frames, "--deformed");
+    const uvwarp::DeformedFrames frames = uvwarp::animatedFrames(
+        command.deformed, command.frames, "--deformed", rest, command.rest.string(), command.cacheStart);
 
     job.rest = &rest;
     job.restName = command.rest.string();
@@ -169,6 +169,8 @@ void addUvWarpCommand(CommandLine& cli) {
         std::deque<bool> flags;     // the flags' values (a deque keeps each element's address)
         std::vector<Option> given;  // per option, to tell what the command line set
         std::string preset;
+        double cacheStart = 0.0;
+        std::optional<Option> cacheStartGiven;
     };
     auto o = std::make_shared<Options>();
     const std::span<const uvwarp::OptionSpec> specs = uvwarp::optionSpecs();
@@ -192,6 +194,7 @@ void addUvWarpCommand(CommandLine& cli) {
             if (!o->bake.empty()) c.bake = o->bake;
             if (!o->tiles.empty()) c.tiles = parseTiles(o->tiles);
             if (!o->log.empty()) c.log = o->log;
+            if (o->cacheStartGiven->given()) c.cacheStart = o->cacheStart;
             c.filter = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
             for (size_t i = 0; i < specs.size(); ++i) {
                 uvwarp::OptionValue value;
@@ -214,8 +217,15 @@ void addUvWarpCommand(CommandLine& cli) {
             return 0;
         });
     uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj)").required();
-    uvwarp.option("--deformed", o->deformed, "deformed frames, e.g. 'anim.####.obj' (# per digit) or %04d")
+    uvwarp
+        .option("--deformed", o->deformed,
+                "deformed frames: an OBJ sequence 'anim.####.obj' (# per digit) or %04d, or a point cache "
+                "'anim.pc2' / 'anim.mdd'")
         .required();
+    o->cacheStartGiven.emplace(
+        uvwarp.option("--cache-start", o->cacheStart,
+                      "frame of a point cache's first sample (default: a PC2's start frame, an "
+                      "MDD's 1)"));
     uvwarp.option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15").required();
     uvwarp.option("--rigidity", o->rigidity, "rigidity maps, e.g. 'rig.<UDIM>.exr' (1 = rigid)").required();
     uvwarp.option("--mask", o->mask,

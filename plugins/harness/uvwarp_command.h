@@ -23,13 +23,16 @@
 // Frame tokens: #### (one # per digit, zero padded) or %04d (io::ObjSequence); UDIM tokens: <UDIM>,
 // <UVTILE>, %(UDIM)d, _MAPID_ (io/udim.h). Output folders must exist. Besides the shot job's own checks,
 // the command checks before anything is written that the patterns have their tokens, the rest mesh has UVs
-// and every frame file exists. Reading a frame whose vertex count differs from the rest mesh's is an error
-// naming the file; outputs of earlier frames stay complete.
+// and every frame is there (a file of the sequence, a sample of the cache). Reading a frame whose vertex
+// count differs from the rest mesh's is an error naming the file; outputs of earlier frames stay complete.
 namespace deformkit::harness {
 
 struct UvWarpCommand {
-    std::filesystem::path rest;                 // OBJ with UVs (UDIM tiles 1001 + floor(u) + 10 floor(v))
-    std::filesystem::path deformed;             // frame pattern of OBJs with the rest mesh's vertex count
+    std::filesystem::path rest;  // OBJ with UVs (UDIM tiles 1001 + floor(u) + 10 floor(v))
+    // The deformed frames: an OBJ sequence ('anim.####.obj') or a point cache ('anim.pc2', 'anim.mdd') with
+    // the rest mesh's vertex count (io::AnimatedPositions).
+    std::filesystem::path deformed;
+    std::optional<double> cacheStart;           // the frame of a point cache's first sample (io::PointCache)
     std::vector<int> frames;                    // ascending, e.g. parseFrames("1-24")
     std::filesystem::path rigidity;             // UDIM pattern; channel 0 in [0, 1]
     std::optional<std::filesystem::path> mask;  // UDIM pattern; channel 0 >= 0.5 may warp

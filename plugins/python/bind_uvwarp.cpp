@@ -469,7 +469,8 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                     const py::object& orientation, const py::object& texture, const py::object& bake,
                     const std::optional<std::vector<int>>& tiles, const std::optional<int64_t>& resolution,
                     const std::string& filter, bool skipExisting, const py::object& log,
-                    const py::object& progress, const std::string& restName, const py::kwargs& kwargs) {
+                    const py::object& progress, const std::string& restName,
+                    const std::optional<double>& cacheStart, const py::kwargs& kwargs) {
     uvwarp::ShotJob job;
     const CallOptions options = optionsOf(resolution, kwargs, kShot, uvwarp::shotOptions());
     job.options = options.options;
@@ -507,15 +508,21 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                               std::string(kShot) + ": out", std::string(kShot) + ": bake");
     job.skipExisting = skipExisting;
 
-    // The deformed positions: an OBJ sequence, or a callable (frame) -> (N, 3) or ((N, 3), name) called with
-    // the GIL held. The callable's array is copied: the job keeps it while Python code runs in progress().
+    // The deformed positions: an OBJ sequence or a point cache, or a callable (frame) -> (N, 3) or ((N, 3),
+    // name) called with the GIL held. The callable's array is copied: the job keeps it while Python code runs
+    // in progress().
     uvwarp::DeformedFrames sequence;
     if (isPath(deformed)) {
-        sequence = uvwarp::objSequenceFrames(deformed.cast<std::filesystem::path>(), frames,
-                                             std::string(kShot) + ": deformed");
+        sequence = uvwarp::animatedFrames(deformed.cast<std::filesystem::path>(), frames,
+                                          std::string(kShot) + ": deformed", rest, restName, cacheStart);
     } else if (!PyCallable_Check(deformed.ptr())) {
-        throw InvalidInput(formatError(kShot, "deformed", "is a " + typeName(deformed),
-                                       "a callable frame -> (N, 3) float32, or an OBJ sequence pattern"));
+        throw InvalidInput(
+            formatError(kShot, "deformed", "is a " + typeName(deformed),
+                        "a callable frame -> (N, 3) float32, an OBJ sequence pattern or a point "
+                        "cache (.pc2, .mdd)"));
+    } else if (cacheStart) {
+        throw InvalidInput(formatError(kShot, "cache_start", "is given with a callable 'deformed'",
+                                       "cache_start only with a point cache (.pc2, .mdd)"));
     }
     if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
         throw InvalidInput(formatError(kShot, "progress", "is a " + typeName(progress),
@@ -613,14 +620,15 @@ constexpr const char* kShotDoc =
     "tile's texture baked through it), the job of `deformkit uvwarp` and of scenes (uvwarp/shot_job.h).\n\n"
     "uvwarp_shot(mesh, frames, deformed, rigidity, out, mask=None, orientation=None, texture=None,\n"
     "            bake=None, tiles=None, resolution=None, filter='bilinear', skip_existing=True, log=None,\n"
-    "            progress=None, rest_name='rest mesh', **options)\n"
+    "            progress=None, rest_name='rest mesh', cache_start=None, **options)\n"
     "uvwarp_shot(points, face_counts, face_indices, uvs, uv_indices, frames, deformed, rigidity, out,\n"
     "            ...)\n\n"
     "mesh: a deformkit.Mesh with UVs, or its arrays as UvWarpSolver takes them. frames: ascending ints.\n"
     "deformed: a callable frame -> (N, 3) float32 positions of the rest mesh's vertices, or -> (positions,\n"
     "name) to name the frame's input in the headers; called once per frame the job solves, in order: the\n"
     "frames whose outputs are missing (warm-started, every frame up to the last of them). Or an OBJ\n"
-    "sequence pattern ('anim.####.obj', '%04d').\n"
+    "sequence pattern ('anim.####.obj', '%04d'), or a point cache ('anim.pc2', 'anim.mdd'; cache_start:\n"
+    "the frame of its first sample, default a PC2's start frame, an MDD's 1).\n"
     "rigidity, mask, orientation, texture: a UDIM pattern ('rig.<UDIM>.exr'), or images in memory as\n"
     "{tile: (T, T) or (T, T, C) float32} (row 0 at v = 1, channel 0 used except for the texture), named\n"
     "by the argument in messages and headers, or (label, {tile: array}) to name them. A tile without a\n"
@@ -846,7 +854,7 @@ void bindUvWarp(py::module_& m) {
           py::arg("orientation") = py::none(), py::arg("texture") = py::none(), py::arg("bake") = py::none(),
           py::arg("tiles") = py::none(), py::arg("resolution") = py::none(), py::arg("filter") = "bilinear",
           py::arg("skip_existing") = true, py::arg("log") = py::none(), py::arg("progress") = py::none(),
-          py::arg("rest_name") = "rest mesh", kShotDoc);
+          py::arg("rest_name") = "rest mesh", py::arg("cache_start") = py::none(), kShotDoc);
     m.def(
         "uvwarp_shot",
         [](const FloatArray& points, const IntArray& counts, const IntArray& indices,
@@ -856,18 +864,19 @@ void bindUvWarp(py::module_& m) {
            const py::object& texture, const py::object& bake, const std::optional<std::vector<int>>& tiles,
            const std::optional<int64_t>& resolution, const std::string& filter, bool skipExisting,
            const py::object& log, const py::object& progress, const std::string& restName,
-           const py::kwargs& kwargs) {
+           const std::optional<double>& cacheStart, const py::kwargs& kwargs) {
             const geom::Mesh mesh =
                 meshOf(points, counts, indices, uvs, uvIndices, kShot, std::string(kShot) + " mesh");
             return uvwarpShot(mesh, frames, deformed, rigidity, out, mask, orientation, texture, bake, tiles,
-                              resolution, filter, skipExisting, log, progress, restName, kwargs);
+                              resolution, filter, skipExisting, log, progress, restName, cacheStart, kwargs);
         },
         py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("uvs"),
         py::arg("uv_indices"), py::arg("frames"), py::arg("deformed"), py::arg("rigidity"), py::arg("out"),
         py::arg("mask") = py::none(), py::arg("orientation") = py::none(), py::arg("texture") = py::none(),
         py::arg("bake") = py::none(), py::arg("tiles") = py::none(), py::arg("resolution") = py::none(),
         py::arg("filter") = "bilinear", py::arg("skip_existing") = true, py::arg("log") = py::none(),
-        py::arg("progress") = py::none(), py::arg("rest_name") = "rest mesh", kShotDoc);
+        py::arg("progress") = py::none(), py::arg("rest_name") = "rest mesh",
+        py::arg("cache_start") = py::none(), kShotDoc);
     m.def(
         "tile_frame_path",
         [](const std::filesystem::path& pattern, int tile, int frame) {

@@ -232,6 +232,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindUvWarp(m);
     python::bindHost(m);
     python::bindPtex(m);
+    python::bindPointCache(m);
 
     m.def(
         "make_capped_tube", [] { return geom::makeCappedTube(); },

@@ -153,14 +153,13 @@ ObjContent ObjSequence::read(int frame) {
     ObjContent content = readObj(path);
     const geom::Mesh& mesh = content.mesh;
     if (!haveReference_) {
-        referencePath_ = path;
-        referenceVertices_ = mesh.numVertices();
-        referenceCounts_.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
-        referenceIndices_.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());
-        haveReference_ = true;
+        setReference(mesh, path);
+        referenceIsFrame_ = true;
         return content;
     }
-    const std::string expected = "the topology of the first frame read, '" + referencePath_.string() + "'";
+    const std::string expected =
+        (referenceIsFrame_ ? "the topology of the first frame read, '" : "the topology of '") +
+        referencePath_.string() + "'";
     if (mesh.numVertices() != referenceVertices_) {
         throw InvalidInput(formatError(path.string(), "",
                                        "has " + std::to_string(mesh.numVertices()) + " vertices instead of " +
@@ -185,14 +184,25 @@ ObjContent ObjSequence::read(int frame) {
                 std::span<const int32_t>(referenceIndices_)
                     .subspan(std::min(offset, referenceIndices_.size()),
                              std::min<size_t>(referenceCounts_[f], referenceIndices_.size() - offset));
-            throw InvalidInput(formatError(
-                path.string(), "face " + std::to_string(f),
-                "has " + describeFace(mine) + " where the first frame has " + describeFace(theirs),
-                expected));
+            throw InvalidInput(formatError(path.string(), "face " + std::to_string(f),
+                                           "has " + describeFace(mine) + " where " +
+                                               (referenceIsFrame_ ? std::string("the first frame")
+                                                                  : referencePath_.filename().string()) +
+                                               " has " + describeFace(theirs),
+                                           expected));
         }
         offset += size;
     }
     return content;
+}
+
+void ObjSequence::setReference(const geom::Mesh& mesh, const fs::path& path) {
+    referencePath_ = path;
+    referenceIsFrame_ = false;
+    referenceVertices_ = mesh.numVertices();
+    referenceCounts_.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
+    referenceIndices_.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());
+    haveReference_ = true;
 }
 
 }  // namespace deformkit::io

@@ -17,6 +17,21 @@ std::string frameText(double frame) {
     return "frame " + numberText(frame);
 }
 
+// Runs `read`, naming the scene and `element` in front of any error's message: an IoError stays one when
+// `keepIoErrors`, everything else is InvalidInput.
+template <class F>
+void namedBy(const std::string& source, const std::string& element, const std::string& prefix, F&& read,
+             bool keepIoErrors = true) {
+    try {
+        read();
+    } catch (const IoError& e) {
+        if (keepIoErrors) throw IoError(formatError(source, element, prefix + e.what()));
+        throw InvalidInput(formatError(source, element, prefix + e.what()));
+    } catch (const Error& e) {
+        throw InvalidInput(formatError(source, element, prefix + e.what()));
+    }
+}
+
 }  // namespace
 
 SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
@@ -27,7 +42,13 @@ SceneEvaluator::SceneEvaluator(Scene scene) : scene_(std::move(scene)) {
         ob.deformed = so.rest;
         ob.stack.setRest(so.rest);
         ob.restVersion = ob.sceneRestVersion = ob.stack.restVersion();
-        if (!so.sequence.empty()) ob.sequence = std::make_unique<io::ObjSequence>(so.sequence);
+        if (!so.sequence.empty()) {
+            namedBy(scene_.source, so.sequenceElement, "", [&] {
+                ob.sequence =
+                    std::make_unique<io::AnimatedPositions>(so.sequence, so.sequenceElement, so.cacheStart);
+                ob.sequence->setReference(so.rest, so.meshFile.string());
+            });
+        }
         for (size_t i = 0; i < so.stack.size(); ++i) {
             const SceneDeformer& sd = so.stack[i];
             try {
@@ -116,13 +137,8 @@ void SceneEvaluator::check(std::span<const int> frames) {
         }
         if (!ob.sequence) continue;
         for (const int frame : frames) {
-            const std::filesystem::path file = ob.sequence->framePath(frame);
-            std::error_code ec;
-            if (!std::filesystem::is_regular_file(file, ec)) {
-                throw IoError(formatError(scene_.source, so.path + ".mesh",
-                                          frameText(frame) + ": " + file.string() + " does not exist",
-                                          "a file for every frame of the sequence " + so.sequence.string()));
-            }
+            namedBy(scene_.source, so.sequenceElement, frameText(frame) + ": ",
+                    [&] { ob.sequence->requireFrames(std::span<const int>(&frame, 1)); });
         }
     }
 }
@@ -130,34 +146,17 @@ void SceneEvaluator::check(std::span<const int> frames) {
 void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3> points) {
     const SceneObject& so = scene_.objects[object];
     Object& ob = objects_[object];
-    const std::string element = so.path + ".mesh";
+    const std::string& element = so.sequenceElement;
     if (frame != std::floor(frame) || std::abs(frame) > 1.0e9) {
         throw InvalidInput(formatError(scene_.source, element,
-                                       frameText(frame) + " of the sequence " + so.sequence.string(),
-                                       "whole frames for an object whose mesh is a frame sequence"));
+                                       frameText(frame) + " of the animated input " + so.sequence.string(),
+                                       "whole frames for an object with an animated input"));
     }
     const int whole = static_cast<int>(frame);
-    const std::filesystem::path file = ob.sequence->framePath(whole);
-    io::ObjContent content;
-    try {
-        content = io::readObj(file);
-    } catch (const Error& e) {
-        throw InvalidInput(formatError(scene_.source, element, frameText(frame) + ": " + e.what(),
-                                       "an OBJ for every evaluated frame of " + so.sequence.string()));
-    }
-    const geom::Mesh& m = content.mesh;
-    const geom::Mesh& rest = so.rest;
-    if (!std::ranges::equal(m.faceCounts(), rest.faceCounts()) ||
-        !std::ranges::equal(m.faceIndices(), rest.faceIndices()) || m.numVertices() != rest.numVertices()) {
-        throw InvalidInput(formatError(scene_.source, element,
-                                       frameText(frame) + ": " + file.string() + " has " +
-                                           std::to_string(m.numVertices()) + " vertices and " +
-                                           std::to_string(m.numFaces()) + " faces",
-                                       "the connectivity of the rest frame " + so.meshFile.string() + " (" +
-                                           std::to_string(rest.numVertices()) + " vertices, " +
-                                           std::to_string(rest.numFaces()) + " faces)"));
-    }
-    std::copy(m.points().begin(), m.points().end(), points.begin());
+    namedBy(
+        scene_.source, element, frameText(frame) + ": ", [&] { ob.sequence->read(whole, ob.frameInput); },
+        false);
+    std::copy(ob.frameInput.begin(), ob.frameInput.end(), points.begin());
 }
 
 host::DeformerStack& SceneEvaluator::stack(size_t object) {

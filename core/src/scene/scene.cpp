@@ -10,6 +10,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
+#include "deformkit/io/animated_positions.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/read_file.h"
 #include "deformkit/io/udim.h"
@@ -458,7 +459,7 @@ class Reader {
 
     SceneObject object(const json& v, const std::string& path, int firstFrame) const {
         requireObject(v, path, "{\"name\": ..., \"mesh\": ..., \"stack\": [...]}");
-        onlyKeys(v, path, {"name", "mesh", "restFrame", "stack"});
+        onlyKeys(v, path, {"name", "mesh", "restFrame", "deformed", "cacheStart", "stack"});
         SceneObject o;
         o.path = path;
         if (!v.contains("name")) fail(path + ".name", "is missing", "a name");
@@ -473,8 +474,32 @@ class Reader {
         }
         if (!v.contains("mesh")) fail(path + ".mesh", "is missing", "an OBJ file name");
         o.meshFile = file(v.at("mesh"), path + ".mesh", "an OBJ file name");
-        if (io::ObjSequence::isPattern(o.meshFile.filename().string())) {
+        const bool meshIsSequence = io::ObjSequence::isPattern(o.meshFile.filename().string());
+        if (v.contains("deformed")) {
+            if (meshIsSequence) {
+                fail(path + ".deformed", "is given with the sequence " + o.meshFile.string() + " as the mesh",
+                     "either \"mesh\" a frame sequence, or \"mesh\" the rest OBJ and \"deformed\" its "
+                     "animation");
+            }
+            o.sequence = file(v.at("deformed"), path + ".deformed",
+                              "an OBJ sequence ('anim.####.obj') or a point cache ('anim.pc2', 'anim.mdd')");
+            o.sequenceElement = path + ".deformed";
+            if (!io::AnimatedPositions::accepts(o.sequence)) {
+                fail(path + ".deformed",
+                     "is " + o.sequence.string() + ", which has no frame token and is no point cache",
+                     io::AnimatedPositions::kForms);
+            }
+        }
+        if (v.contains("cacheStart")) {
+            if (!io::pointCacheFormat(o.sequence)) {
+                fail(path + ".cacheStart", "is given without a point cache",
+                     "cacheStart only with \"deformed\" a point cache (.pc2, .mdd)");
+            }
+            o.cacheStart = number(v.at("cacheStart"), path + ".cacheStart");
+        }
+        if (meshIsSequence) {
             o.sequence = o.meshFile;
+            o.sequenceElement = path + ".mesh";
             o.restFrame =
                 v.contains("restFrame") ? integer(v.at("restFrame"), path + ".restFrame") : firstFrame;
             o.meshFile = io::ObjSequence(o.sequence).framePath(o.restFrame);

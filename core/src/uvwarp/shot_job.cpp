@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/animated_positions.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
@@ -713,26 +714,17 @@ std::vector<int> shotTiles(const geom::Mesh& rest, const std::string& restName, 
     return tiles.empty() ? meshTiles : tiles;
 }
 
-DeformedFrames objSequenceFrames(const fs::path& pattern, const std::vector<int>& frames,
-                                 const std::string& name) {
-    if (!io::ObjSequence::isPattern(pattern.string())) {
-        throw InvalidInput(formatError(name, pattern.string(), "has no frame token",
-                                       "an OBJ sequence such as 'anim.####.obj' (one # per digit) or "
-                                       "'anim.%04d.obj'"));
-    }
-    auto sequence = std::make_shared<io::ObjSequence>(pattern);
-    for (int frame : frames) {
-        const fs::path path = sequence->framePath(frame);
-        if (!fileExists(path)) {
-            throw IoError(formatError(path.string(), "frame " + std::to_string(frame), "is missing",
-                                      "a file for every frame of '" + pattern.string() + "'"));
-        }
-    }
-    auto content = std::make_shared<io::ObjContent>();
-    return [sequence, content](int frame, std::string& frameName) -> std::span<const glm::vec3> {
-        frameName = sequence->framePath(frame).string();
-        *content = sequence->read(frame);
-        return content->mesh.points();
+DeformedFrames animatedFrames(const fs::path& path, const std::vector<int>& frames, const std::string& name,
+                              const geom::Mesh& rest, const std::string& restName,
+                              std::optional<double> cacheFirstFrame) {
+    auto source = std::make_shared<io::AnimatedPositions>(path, name, cacheFirstFrame);
+    if (source->isCache()) source->setReference(rest, restName);
+    source->requireFrames(frames);
+    auto points = std::make_shared<std::vector<glm::vec3>>();
+    return [source, points](int frame, std::string& frameName) -> std::span<const glm::vec3> {
+        frameName = source->frameName(frame);
+        source->read(frame, *points);
+        return *points;
     };
 }
 

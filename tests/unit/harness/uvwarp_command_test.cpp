@@ -14,6 +14,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "image_support.h"
+#include "point_cache_support.h"
 #include "progress_bar.h"
 #include "test_support.h"
 #include "uvwarp_command.h"
@@ -501,4 +502,69 @@ TEST_CASE("uvwarp command: maps of several channels are read from channel 0 and 
     CHECK(std::count_if(summary.begin(), summary.end(), [](const std::string& line) {
               return line.find("4 channels") != std::string::npos;
           }) == 1);
+}
+
+TEST_CASE("uvwarp command: a PC2 or MDD cache of the shot writes the maps and bakes of its OBJ sequence",
+          "[harness][uvwarp][point_cache]") {
+    // The OBJ sequence's positions, as the OBJ reader gives them (float32), written into caches by the test's
+    // own encoder; the caches' frames 1-3 are the sequence's.
+    std::vector<std::vector<glm::vec3>> positions;
+    Scene s;
+    for (int f = 1; f <= 3; ++f) {
+        const io::ObjContent obj = io::readObj(s.dir / ("anim.000" + std::to_string(f) + ".obj"));
+        const auto p = obj.mesh.points();
+        positions.emplace_back(p.begin(), p.end());
+    }
+    test::writeText(s.dir / "anim.pc2", test::pc2Bytes(1.0f, 1.0f, positions));
+    // MDD starting at frame 0 as Blender's exporter times it; --cache-start 1 numbers it from 1.
+    test::writeText(s.dir / "anim.mdd", test::mddBytes({0.0f, 1.0f / 24, 2.0f / 24}, positions));
+    s.command.texture = s.dir / "col.<UDIM>.exr";
+    s.command.bake = s.dir / "out/col.<UDIM>.####.exr";
+    (void)harness::uvwarpCommand(s.command);
+
+    for (const char* cache : {"anim.pc2", "anim.mdd"}) {
+        CAPTURE(cache);
+        Scene c;
+        c.command.deformed = s.dir / cache;
+        if (std::string(cache) == "anim.mdd") c.command.cacheStart = 1.0;
+        c.command.texture = c.dir / "col.<UDIM>.exr";
+        c.command.bake = c.dir / "out/col.<UDIM>.####.exr";
+        const uvwarp::ShotReport report = harness::uvwarpCommand(c.command);
+        CHECK(report.tiles.at(0).written == 3);
+        for (int f = 1; f <= 3; ++f) {
+            // The pixels bit for bit; the headers differ only where they name the frame's input.
+            CHECK(io::readImage(c.redirect(f)).pixels == io::readImage(s.redirect(f)).pixels);
+            CHECK(io::readImage(c.baked(f)).pixels == io::readImage(s.baked(f)).pixels);
+            const io::ImageInfo mine = io::readImageInfo(c.redirect(f)),
+                                theirs = io::readImageInfo(s.redirect(f));
+            CHECK(attribute(mine, "deformkit:uvwarp:metrics") ==
+                  attribute(theirs, "deformkit:uvwarp:metrics"));
+            CHECK(attribute(mine, "deformkit:uvwarp:solver") == attribute(theirs, "deformkit:uvwarp:solver"));
+            const auto inputs = nlohmann::json::parse(attribute(mine, "deformkit:uvwarp:inputs"));
+            CHECK_THAT(inputs.dump(), Catch::Contains(std::string(cache) + " frame " + std::to_string(f)));
+        }
+    }
+
+    // Bad caches stop the command before anything is written, naming the file and what is wrong.
+    Scene bad;
+    bad.command.deformed = s.dir / "anim.pc2";
+    bad.command.frames = {2, 3, 4};
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(bad.command); }),
+               Catch::Contains("anim.pc2: frame 4: is not in the cache (expected one of its frames (1-3))"));
+    bad.command.frames = {1, 2, 3};
+    bad.command.deformed = s.dir / "anim.mdd";  // frames 1-3 by default
+    bad.command.cacheStart = 5.0;
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(bad.command); }),
+               Catch::Contains("anim.mdd: frame 1: is not in the cache (expected one of its frames (5-7))"));
+    std::vector<std::vector<glm::vec3>> fewer = positions;
+    for (auto& frame : fewer)
+        frame.pop_back();
+    test::writeText(bad.dir / "short.pc2", test::pc2Bytes(1.0f, 1.0f, fewer));
+    bad.command.deformed = bad.dir / "short.pc2";
+    bad.command.cacheStart.reset();
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(bad.command); }),
+        Catch::Contains("short.pc2: header: has 288 vertices per frame (expected 289 vertices, as the rest "
+                        "mesh"));
+    CHECK(test::filesIn(bad.dir / "out").empty());
 }

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
 #include "mesh_support.h"
+#include "point_cache_support.h"
 #include "test_support.h"
 
 // Objects whose mesh is a frame sequence (an animated input under the stack, as after skinning).
@@ -30,9 +32,9 @@ geom::Mesh tubeAt(int frame, int rings = 5, int sides = 8) {
     return geom::Mesh(std::move(d), "tube");
 }
 
-std::string sceneText(const std::string& objectExtra) {
-    return R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "tube", "mesh": "anim.####.obj", )" +
-           objectExtra + R"("stack": [
+std::string sceneText(const std::string& objectExtra, const std::string& mesh = "anim.####.obj") {
+    return R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [{"name": "tube", "mesh": ")" + mesh +
+           R"(", )" + objectExtra + R"("stack": [
       {"type": "twist", "envelope": 0.5, "params": {"endAngle": {"keys": [{"frame": 1, "value": 0.2, "interpolation": "linear"},
                                                                 {"frame": 3, "value": 1.0}]}}}]}]})";
 }
@@ -82,8 +84,8 @@ TEST_CASE("sequence input: missing, fractional and mismatched frames name the sc
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 4); }),
                Contains(source + ": objects[0].mesh: frame 4: ") && Contains("anim.0004.obj"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 1.5); }),
-               Contains(source + ": objects[0].mesh: frame 1.5 of the sequence ") &&
-                   Contains("(expected whole frames for an object whose mesh is a frame sequence)"));
+               Contains(source + ": objects[0].mesh: frame 1.5 of the animated input ") &&
+                   Contains("(expected whole frames for an object with an animated input)"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)evaluator.evaluate(0, 3); }),
                Contains(source + ": objects[0].mesh: frame 3: ") && Contains("anim.0003.obj"));
     // Frames that exist still evaluate after the errors.
@@ -100,4 +102,72 @@ TEST_CASE("sequence input: missing, fractional and mismatched frames name the sc
     CHECK_THAT(test::errorOf<InvalidInput>(
                    [&] { (void)scene::parseScene(sceneText(R"("restFrame": 9, )"), dir / "shot.json"); }),
                Contains(source + ": objects[0].mesh: names the sequence ") && Contains("rest frame 9"));
+}
+
+TEST_CASE(
+    "sequence input: a point cache or an OBJ sequence under \"deformed\" drives the stack as the mesh "
+    "sequence does",
+    "[host][evaluator][point_cache]") {
+    test::TempDir dir;
+    std::vector<std::vector<glm::vec3>> positions;
+    for (int f = 1; f <= 3; ++f) {
+        io::writeObj(dir / ("anim.000" + std::to_string(f) + ".obj"), tubeAt(f));
+        // As the OBJ reader gives them, so that every input carries the same floats.
+        const io::ObjContent obj = io::readObj(dir / ("anim.000" + std::to_string(f) + ".obj"));
+        const auto p = obj.mesh.points();
+        positions.emplace_back(p.begin(), p.end());
+    }
+    io::writeObj(dir / "tube.obj", tubeAt(1));
+    test::writeText(dir / "anim.pc2", test::pc2Bytes(1.0f, 1.0f, positions));
+    test::writeText(dir / "anim.mdd", test::mddBytes({0.0f, 0.5f, 1.0f}, positions));
+    scene::SceneEvaluator reference(scene::parseScene(sceneText(""), dir / "shot.json"));
+    for (const std::string& extra :
+         {std::string(R"("deformed": "anim.pc2", )"), std::string(R"("deformed": "anim.mdd", )"),
+          std::string(R"("deformed": "anim.mdd", "cacheStart": 1, )"),
+          std::string(R"("deformed": "anim.%04d.obj", )")}) {
+        CAPTURE(extra);
+        scene::SceneEvaluator evaluator(scene::parseScene(sceneText(extra, "tube.obj"), dir / "shot.json"));
+        const std::vector<int> frames{1, 2, 3};
+        evaluator.check(frames);
+        for (int f = 1; f <= 3; ++f) {
+            const geom::Mesh& want = reference.evaluate(0, f);
+            const geom::Mesh& got = evaluator.evaluate(0, f);
+            CHECK(test::sameBits(got.points(), want.points()));
+        }
+    }
+
+    const std::string source = (dir / "shot.json").string();
+    auto parse = [&](const std::string& extra, const std::string& mesh = "tube.obj") {
+        return scene::parseScene(sceneText(extra, mesh), dir / "shot.json");
+    };
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)parse(R"("deformed": "anim.obj", )"); }),
+               Contains(source + ": objects[0].deformed: is ") && Contains("no point cache"));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)parse(R"("deformed": "anim.pc2", )", "anim.####.obj"); }),
+        Contains(source + ": objects[0].deformed: is given with the sequence "));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)parse(R"("cacheStart": 1, )"); }),
+               Contains(source + ": objects[0].cacheStart: is given without a point cache"));
+    // The cache's vertex count against the rest mesh's, and its frames against the evaluated ones.
+    io::writeObj(dir / "fine.obj", tubeAt(1, 6, 8));
+    CHECK_THAT(test::errorOf<InvalidInput>(
+                   [&] { scene::SceneEvaluator e(parse(R"("deformed": "anim.pc2", )", "fine.obj")); }),
+               Contains(source + ": objects[0].deformed: ") &&
+                   Contains("anim.pc2: header: has 40 vertices") &&
+                   Contains("expected 48 vertices, as the rest mesh"));
+    scene::SceneEvaluator late(parse(R"("deformed": "anim.pc2", )"));
+    const std::vector<int> beyond{3, 4};
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { late.check(beyond); }),
+               Contains(source + ": objects[0].deformed: frame 4: ") && Contains("is not in the cache"));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)late.evaluate(0, 4); }),
+               Contains(source + ": objects[0].deformed: frame 4: ") &&
+                   Contains("expected one of its frames 1 to 3"));
+    // A frame is read alone: a NaN in frame 1 does not stop frames 2 and 3.
+    auto broken = positions;
+    broken[0][5].x = std::numeric_limits<float>::quiet_NaN();
+    test::writeText(dir / "broken.pc2", test::pc2Bytes(1.0f, 1.0f, broken));
+    scene::SceneEvaluator partial(parse(R"("deformed": "broken.pc2", )"));
+    CHECK(test::sameBits(partial.evaluate(0, 3).points(), reference.evaluate(0, 3).points()));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)partial.evaluate(0, 1); }),
+        Contains(source + ": objects[0].deformed: frame 1: ") && Contains("broken.pc2: frame 1: vertex 5"));
 }

@@ -24,6 +24,9 @@ class ObjSequence {
     // Reads one frame; throws IoError if it is missing and InvalidInput (naming the file and the first
     // differing face) if its topology differs from the first frame read through this object.
     [[nodiscard]] ObjContent read(int frame);
+    // Makes `mesh` (read from `path`) the reference every frame read must match, in place of the first
+    // frame read.
+    void setReference(const geom::Mesh& mesh, const std::filesystem::path& path);
 
     // True when `pattern` has a frame token (#... or %0Nd).
     [[nodiscard]] static bool isPattern(const std::string& pattern);
@@ -33,6 +36,7 @@ class ObjSequence {
     std::string prefix_, suffix_;  // file name around the token
     int padding_ = 0;
     bool haveReference_ = false;
+    bool referenceIsFrame_ = false;        // the reference is the first frame read (not setReference's)
     std::filesystem::path referencePath_;  // the first frame read, named in topology errors
     int32_t referenceVertices_ = 0;
     std::vector<int32_t> referenceCounts_, referenceIndices_;

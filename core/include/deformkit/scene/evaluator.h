@@ -10,7 +10,7 @@
 
 #include "deformkit/geom/mesh.h"
 #include "deformkit/host/stack.h"
-#include "deformkit/io/obj_sequence.h"
+#include "deformkit/io/animated_positions.h"
 #include "deformkit/scene/scene.h"
 
 namespace deformkit::scene {
@@ -35,17 +35,18 @@ class SceneEvaluator {
 
     // Object `object`'s deformed mesh at `frame` (frames may be fractional; curves hold their end values
     // outside their keys): the rest mesh's connectivity with the stack's output positions. The stack's
-    // input is the rest positions, or for an object with an input sequence that frame's positions (whole
-    // frames only; the file must exist and have the rest mesh's connectivity). The reference stays valid
-    // until the next evaluate() of that object. Throws InvalidInput for an object index out of range, and
-    // naming the scene, the object's "mesh" and the file for a sequence frame that is missing, fractional
-    // or of another connectivity.
+    // input is the rest positions, or for an object with an animated input that frame's positions (whole
+    // frames only; an OBJ must exist and have the rest mesh's connectivity, a point cache the rest mesh's
+    // vertex count and the frame). The reference stays valid until the next evaluate() of that object.
+    // Throws InvalidInput for an object index out of range, and naming the scene, the object's "mesh" (or
+    // "deformed") and the file for an input frame that is missing, fractional or of another connectivity.
     const geom::Mesh& evaluate(size_t object, double frame);
 
     // Checks, before any work, what evaluating `frames` would find wrong that does not depend on the frame's
     // deformation: every object's stack set at the first frame and bound (a slide vertex out of range, a
-    // bind-time value a deformer rejects), and for an object whose mesh is a frame sequence, that each
-    // frame's file exists. Throws InvalidInput / IoError as evaluate() names them. No evaluation is counted.
+    // bind-time value a deformer rejects), and for an object with an animated input, that each frame is
+    // there (an OBJ of the sequence, a sample of the cache). Throws InvalidInput / IoError as evaluate()
+    // names them. No evaluation is counted.
     void check(std::span<const int> frames);
 
     // evaluate() calls for the object so far: a host feeding one evaluation to several consumers (a mesh
@@ -63,11 +64,13 @@ class SceneEvaluator {
         // Per stack entry: set every parameter each frame (an animated [bind] parameter can reset an
         // animated counterpart that the scene holds constant), or only the animated ones.
         std::vector<bool> setAll;
-        // The object's input sequence (SceneObject::sequence), when it has one.
-        std::unique_ptr<io::ObjSequence> sequence;
-        std::vector<glm::vec3> input;   // the sequence's positions at the frame evaluated
-        uint64_t restVersion = 0;       // the stack's rest version `deformed` was copied from
-        uint64_t sceneRestVersion = 0;  // the stack's rest version holding the scene's rest mesh
+        // The object's animated input (SceneObject::sequence: an OBJ sequence or a point cache), when it has
+        // one.
+        std::unique_ptr<io::AnimatedPositions> sequence;
+        std::vector<glm::vec3> input;       // the sequence's positions at the frame evaluated
+        std::vector<glm::vec3> frameInput;  // as read, before the copy into `input`
+        uint64_t restVersion = 0;           // the stack's rest version `deformed` was copied from
+        uint64_t sceneRestVersion = 0;      // the stack's rest version holding the scene's rest mesh
         int64_t evaluations = 0;
     };
 

@@ -77,11 +77,14 @@ struct SceneObject {
     std::string name;                // unique; names the output files, so letters, digits, '_', '-', '.' only
     std::filesystem::path meshFile;  // the rest OBJ, resolved against the scene file's folder
     geom::Mesh rest;
-    // An animated input (the scene's "mesh" is a frame pattern such as anim.####.obj): each frame's
-    // positions, read from the sequence, enter the stack in place of the rest positions (a deformer stack
-    // after skinning). The rest mesh is the sequence's frame restFrame. Empty for a static mesh.
+    // An animated input: each frame's positions enter the stack in place of the rest positions (a deformer
+    // stack after skinning). Either the scene's "mesh" is a frame pattern such as anim.####.obj (the rest
+    // mesh is then its frame restFrame), or "deformed" names an OBJ sequence or a point cache (.pc2, .mdd)
+    // over the rest mesh "mesh" (io::AnimatedPositions). Empty for a static mesh.
     std::filesystem::path sequence;
     int restFrame = 0;
+    std::optional<double> cacheStart;  // "cacheStart": the frame of a point cache's first sample
+    std::string sequenceElement;       // the JSON path that named the input: "objects[0].mesh" or ".deformed"
     std::vector<io::FaceGroup> groups;  // of the rest OBJ, written back with every frame
     std::vector<SceneDeformer> stack;   // the geometric deformers, in order
     std::optional<SceneUvWarp> uvwarp;  // the texture-space stage after them, when the scene has one

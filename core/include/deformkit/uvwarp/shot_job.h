@@ -195,11 +195,15 @@ void setOutputPatterns(ShotJob& job, const std::filesystem::path& out, const std
 [[nodiscard]] std::vector<int> shotTiles(const geom::Mesh& rest, const std::string& restName,
                                          const std::vector<int>& tiles, const std::string& tilesName);
 
-// The deformed frames of an OBJ sequence ("anim.####.obj", io::ObjSequence tokens): checks now that the
-// pattern has a frame token (InvalidInput naming `name`) and that a file exists for every one of `frames`
-// (IoError naming the first missing one); then reads each frame when asked, named by its path.
-[[nodiscard]] DeformedFrames objSequenceFrames(const std::filesystem::path& pattern,
-                                               const std::vector<int>& frames, const std::string& name);
+// The deformed frames of an OBJ sequence ("anim.####.obj") or a point cache ("anim.pc2", "anim.mdd"), read
+// through io::AnimatedPositions: checks now that `path` is either (InvalidInput naming `name`), that a cache
+// has the vertex count of `rest` (read from `restName`) and that every one of `frames` is there (IoError
+// naming a sequence's first missing file, InvalidInput naming a cache's missing frame); then reads each
+// frame when asked, named by its file or as "anim.pc2 frame 7". `cacheFirstFrame` as io::PointCache.
+[[nodiscard]] DeformedFrames animatedFrames(const std::filesystem::path& path, const std::vector<int>& frames,
+                                            const std::string& name, const geom::Mesh& rest,
+                                            const std::string& restName,
+                                            std::optional<double> cacheFirstFrame = std::nullopt);
 
 // One line per warped tile ("tile 1001: 24 frames written (24 baked), 0 replayed, 0 skipped (outputs exist);
 // frame 24: rigid stretch removed 84.3% (error 0.041, identity 0.262), 0 inverted triangles, 0 off-chart

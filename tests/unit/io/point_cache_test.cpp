@@ -1,0 +1,225 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/primitives.h"
+#include "deformkit/io/animated_positions.h"
+#include "deformkit/io/obj.h"
+#include "deformkit/io/point_cache.h"
+#include "point_cache_support.h"
+#include "test_support.h"
+
+using namespace deformkit;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+// `frames` frames of `vertices` random positions (fixed seed), some large, some tiny, some negative.
+std::vector<std::vector<glm::vec3>> randomFrames(int frames, int vertices, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> mantissa(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> exponent(-20, 20);
+    std::vector<std::vector<glm::vec3>> out(static_cast<size_t>(frames));
+    for (auto& frame : out)
+        for (int v = 0; v < vertices; ++v)
+            frame.emplace_back(std::ldexp(mantissa(rng), exponent(rng)),
+                               std::ldexp(mantissa(rng), exponent(rng)),
+                               std::ldexp(mantissa(rng), exponent(rng)));
+    return out;
+}
+
+std::vector<glm::vec3> read(io::PointCache& cache, int frame) {
+    std::vector<glm::vec3> points;
+    cache.read(frame, points);
+    return points;
+}
+
+}  // namespace
+
+TEST_CASE("point cache: PC2 and MDD written by hand read back bit for bit, frames from start and sampling",
+          "[io][point_cache]") {
+    const test::TempDir dir;
+    const auto frames = randomFrames(5, 7, 11);
+
+    SECTION("PC2, start 10, one frame per sample") {
+        test::writeText(dir / "a.pc2", test::pc2Bytes(10.0f, 1.0f, frames));
+        io::PointCache cache(dir / "a.pc2");
+        CHECK(cache.format() == io::PointCacheFormat::Pc2);
+        CHECK(cache.vertexCount() == 7);
+        CHECK(cache.sampleCount() == 5);
+        CHECK(cache.frames() == std::vector<int>{10, 11, 12, 13, 14});
+        // Random access, in any order.
+        for (int frame : {13, 10, 14, 11, 12})
+            CHECK(test::sameBits(read(cache, frame), frames[static_cast<size_t>(frame - 10)]));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 15); }),
+                   Contains("a.pc2: frame 15: is not in the cache (expected one of its frames 10 to 14)"));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 9); }), Contains("frame 9"));
+    }
+    SECTION("PC2 with half a frame per sample: only the whole frames are frames") {
+        test::writeText(dir / "a.pc2", test::pc2Bytes(-1.0f, 0.5f, frames));
+        io::PointCache cache(dir / "a.pc2");
+        CHECK(cache.frames() == std::vector<int>{-1, 0, 1});
+        CHECK(test::sameBits(read(cache, 0), frames[2]));
+        CHECK(test::sameBits(read(cache, 1), frames[4]));
+        CHECK(cache.sampleFrame(1) == -0.5);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 2); }),
+                   Contains("expected one of its frames -1 to 1 every 0.5"));
+    }
+    SECTION("PC2 with the first frame set by the reader") {
+        test::writeText(dir / "a.pc2", test::pc2Bytes(10.0f, 1.0f, frames));
+        io::PointCache cache(dir / "a.pc2", 1.0);
+        CHECK(cache.frames() == std::vector<int>{1, 2, 3, 4, 5});
+        CHECK(test::sameBits(read(cache, 1), frames[0]));
+    }
+    SECTION("MDD: big-endian, frames from 1 unless told, times checked") {
+        test::writeText(dir / "a.MDD", test::mddBytes({0.0f, 0.04f, 0.08f, 0.12f, 0.16f}, frames));
+        io::PointCache cache(dir / "a.MDD");
+        CHECK(cache.format() == io::PointCacheFormat::Mdd);
+        CHECK(cache.frames() == std::vector<int>{1, 2, 3, 4, 5});
+        CHECK(cache.times() == std::vector<float>{0.0f, 0.04f, 0.08f, 0.12f, 0.16f});
+        for (int frame = 1; frame <= 5; ++frame)
+            CHECK(test::sameBits(read(cache, frame), frames[static_cast<size_t>(frame - 1)]));
+        io::PointCache fromZero(dir / "a.MDD", 0.0);
+        CHECK(fromZero.frames() == std::vector<int>{0, 1, 2, 3, 4});
+        CHECK(test::sameBits(read(fromZero, 4), frames[4]));
+    }
+}
+
+TEST_CASE("point cache: the writer's files parse by hand, bit for bit, in both formats",
+          "[io][point_cache]") {
+    const test::TempDir dir;
+    const auto frames = randomFrames(4, 9, 23);
+    for (const char* name : {"w.pc2", "w.mdd"}) {
+        CAPTURE(name);
+        const fs::path path = dir / name;
+        io::PointCacheWriter writer(path, 9, 4, 3, 25.0);
+        for (const auto& frame : frames)
+            writer.append(frame);
+        CHECK_FALSE(fs::exists(path));  // nothing at the path before finish()
+        writer.finish();
+        const std::string expected =
+            std::string(name) == "w.pc2"
+                ? test::pc2Bytes(3.0f, 1.0f, frames)
+                : test::mddBytes({0.0f, 1.0f / 25.0f, 2.0f / 25.0f, 3.0f / 25.0f}, frames);
+        CHECK(test::readText(path) == expected);
+        io::PointCache cache(path, std::string(name) == "w.mdd" ? std::optional<double>(3.0) : std::nullopt);
+        CHECK(cache.frames() == std::vector<int>{3, 4, 5, 6});
+    }
+    CHECK(test::filesIn(dir.path()) == std::vector<fs::path>{"w.mdd", "w.pc2"});  // no staging file left
+}
+
+TEST_CASE("point cache: a writer that does not finish leaves the earlier file and no other",
+          "[io][point_cache]") {
+    const test::TempDir dir;
+    const auto frames = randomFrames(2, 3, 5);
+    test::writeText(dir / "c.pc2", "earlier");
+    {
+        io::PointCacheWriter writer(dir / "c.pc2", 3, 2, 1);
+        writer.append(frames[0]);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { writer.finish(); }),
+                   Contains("c.pc2: has 1 of its 2 frames"));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { writer.append(std::vector<glm::vec3>(4)); }),
+                   Contains("c.pc2: frame 2: has 4 vertices (expected 3 vertices"));
+        std::vector<glm::vec3> bad = frames[1];
+        bad[2].y = std::numeric_limits<float>::quiet_NaN();
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { writer.append(bad); }),
+                   Contains("c.pc2: frame 2: vertex 2: is not finite"));
+    }
+    CHECK(test::readText(dir / "c.pc2") == "earlier");
+    CHECK(test::filesIn(dir.path()) == std::vector<fs::path>{"c.pc2"});
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { io::PointCacheWriter(dir / "c.abc", 3, 2, 1); }),
+               Contains("c.abc") && Contains(".pc2 or .mdd"));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { io::PointCacheWriter(dir / "c.pc2", 3, 0, 1); }),
+               Contains("at least one frame and one vertex"));
+}
+
+TEST_CASE("point cache: bad caches are refused naming the file, the frame and the vertex",
+          "[io][point_cache]") {
+    const test::TempDir dir;
+    const auto frames = randomFrames(3, 4, 7);
+    const fs::path pc2 = dir / "bad.pc2", mdd = dir / "bad.mdd";
+    auto open = [](const fs::path& path) { io::PointCache cache(path); };
+
+    SECTION("truncated: the first incomplete frame is named") {
+        const std::string whole = test::pc2Bytes(1.0f, 1.0f, frames);
+        test::writeText(pc2, whole.substr(0, whole.size() - 5));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("bad.pc2: frame 3: is cut short: the file has 171 bytes, 2 whole frames") &&
+                       Contains("expected 176 bytes for 3 frames of 4 vertices"));
+        test::writeText(pc2, whole.substr(0, 20));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("bad.pc2: header: is cut short"));
+        const std::string m = test::mddBytes({0.0f, 1.0f, 2.0f}, frames);
+        test::writeText(mdd, m.substr(0, 12));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(mdd); }),
+                   Contains("bad.mdd: frame times: are cut short"));
+    }
+    SECTION("overlong, wrong magic, wrong version, bad sampling, decreasing times") {
+        test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, frames) + "xx");
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("has 2 bytes after its last frame"));
+        std::string wrong = test::pc2Bytes(1.0f, 1.0f, frames);
+        wrong[0] = 'Q';
+        test::writeText(pc2, wrong);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("does not start with POINTCACHE2"));
+        test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, frames, 2));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("has version 2 (expected PC2 version 1)"));
+        test::writeText(pc2, test::pc2Bytes(1.0f, 0.0f, frames));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }), Contains("has the sampling 0"));
+        test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, {}));
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }), Contains("has 0 vertices and 0 frames"));
+        test::writeText(mdd, test::mddBytes({0.0f, 2.0f, 1.0f}, frames));
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { open(mdd); }),
+            Contains("bad.mdd: frame time 2: is 1 after 2 (expected finite times in seconds, increasing)"));
+    }
+    SECTION("a NaN or an infinity names the frame and the vertex when the frame is read") {
+        auto nan = frames;
+        nan[1][3].z = std::numeric_limits<float>::quiet_NaN();
+        test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, nan));
+        io::PointCache cache(pc2);
+        CHECK(test::sameBits(read(cache, 1), frames[0]));  // the other frames read
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 2); }),
+                   Contains("bad.pc2: frame 2: vertex 3: is (") && Contains("nan)") &&
+                       Contains("expected finite coordinates"));
+        auto inf = frames;
+        inf[2][0].x = -std::numeric_limits<float>::infinity();
+        test::writeText(mdd, test::mddBytes({0.0f, 1.0f, 2.0f}, inf));
+        io::PointCache big(mdd);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(big, 3); }),
+                   Contains("bad.mdd: frame 3: vertex 0: is (-inf"));
+    }
+    SECTION("a vertex count other than the rest mesh's, a frame outside the cache") {
+        test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, frames));
+        io::AnimatedPositions positions(pc2, "--deformed");
+        const geom::Mesh rest = geom::makeGrid({2, 2, 1.0f, 1.0f});  // 9 vertices
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { positions.setReference(rest, "rest.obj"); }),
+            Contains("bad.pc2: header: has 4 vertices per frame (expected 9 vertices, as the rest mesh "
+                     "'rest.obj')"));
+        const std::vector<int> wanted{2, 3, 4};
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { positions.requireFrames(wanted); }),
+                   Contains("bad.pc2: frame 4: is not in the cache (expected one of its frames (1-3))"));
+        CHECK(positions.frameName(2) == pc2.string() + " frame 2");
+    }
+    SECTION("missing file, and a path that is neither a sequence nor a cache") {
+        CHECK_THAT(test::errorOf<IoError>([&] { open(dir / "none.pc2"); }),
+                   Contains("none.pc2: does not exist"));
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { io::AnimatedPositions(dir / "anim.obj", "--deformed"); }),
+            Contains("--deformed: ") && Contains("has no frame token and is no point cache") &&
+                Contains("'anim.pc2', 'anim.mdd'"));
+        CHECK_THAT(test::errorOf<InvalidInput>(
+                       [&] { io::AnimatedPositions(dir / "a.####.obj", "--deformed", 1.0); }),
+                   Contains("is an OBJ sequence, given a cache's first frame 1"));
+    }
+}
