@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string_view>
 
 #include <glm/geometric.hpp>
@@ -22,6 +23,7 @@
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/io/point_cache.h"
 #include "deformkit/io/preview.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
@@ -200,10 +202,41 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
                                     command.contactColumns, command.contactMaxWidth);
         if (command.movie) checkSize("movie frame rate", command.movieFrameRate, 1, 1000);
     }
+    if (!command.cache.empty() && command.cache != "pc2" && command.cache != "mdd") {
+        throw InvalidInput(
+            formatError("--cache", command.cache, "is not a point cache format", "pc2 or mdd"));
+    }
+    if (!command.objs && command.cache.empty()) {
+        throw InvalidInput(formatError("--no-objs", "", "is given without --cache",
+                                       "--cache pc2 or --cache mdd to write the frames instead of OBJs"));
+    }
+    if (!command.cache.empty()) {
+        for (size_t i = 1; i < report.frames.size(); ++i) {
+            if (report.frames[i] != report.frames[i - 1] + 1) {
+                throw InvalidInput(formatError("--cache", command.cache,
+                                               "cannot hold the frames " +
+                                                   std::to_string(report.frames[i - 1]) + " and " +
+                                                   std::to_string(report.frames[i]) + " with a gap",
+                                               "consecutive frames (a cache has one frame per sample)"));
+            }
+        }
+        if (command.cache == "mdd") checkSize("frame rate", command.movieFrameRate, 1, 1000);
+    }
     // Every input checked before anything is written: the stacks bound (vertex ranges, bind-time values),
     // sequence files, and below the UV-warp stages' maps.
     evaluator.check(report.frames);
     io::createFolder(command.outDir);
+
+    // One point cache per object, moved into place complete when every frame is in.
+    std::vector<std::unique_ptr<io::PointCacheWriter>> caches(numObjects);
+    if (!command.cache.empty() && !report.frames.empty()) {
+        for (size_t o = 0; o < numObjects; ++o) {
+            caches[o] = std::make_unique<io::PointCacheWriter>(
+                command.outDir / (scene.objects[o].name + "." + command.cache),
+                scene.objects[o].rest.numVertices(), static_cast<int32_t>(report.frames.size()),
+                report.frames.front(), command.movieFrameRate);
+        }
+    }
 
     std::vector<geom::Box3> restBounds;       // per object
     std::vector<io::Image> sheets;            // per object
@@ -237,9 +270,12 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         const int frame = report.frames[i];
         for (size_t o = 0; o < numObjects; ++o) {
             const geom::Mesh& mesh = evaluator.evaluate(o, frame);
-            const fs::path file = command.outDir / scene::frameFileName(scene.objects[o].name, frame);
-            io::writeObj(file, mesh, scene.objects[o].groups);
-            report.files.push_back(file);
+            if (command.objs) {
+                const fs::path file = command.outDir / scene::frameFileName(scene.objects[o].name, frame);
+                io::writeObj(file, mesh, scene.objects[o].groups);
+                report.files.push_back(file);
+            }
+            if (caches[o]) caches[o]->append(mesh.points());
             if (previews) {
                 io::PreviewOptions frameView = view;
                 frameView.frame = framingBox(restBounds[o], mesh.bounds());
@@ -268,6 +304,12 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
             if (progress) *progress << "eval: " << scene.objects[o].name << " uvwarp " << line << "\n";
             report.uvwarpLines.push_back(scene.objects[o].name + " " + line);
         }
+    }
+    for (const auto& cache : caches) {
+        if (!cache) continue;
+        cache->finish();
+        report.files.push_back(cache->path());
+        if (progress) *progress << "eval: point cache " << cache->path().string() << " written\n";
     }
     for (size_t o = 0; o < numObjects; ++o)
         report.binds.push_back(evaluator.stack(o).bindCount());
@@ -300,7 +342,7 @@ void addEvalCommand(CommandLine& cli) {
     struct Options {
         EvalCommand command;
         std::string scene, frames, out;
-        bool noPreviews = false;
+        bool noPreviews = false, noObjs = false;
     };
     auto o = std::make_shared<Options>();
     o->out = o->command.outDir.string();
@@ -312,6 +354,7 @@ void addEvalCommand(CommandLine& cli) {
             c.outDir = o->out;
             if (!o->frames.empty()) c.frames = parseFrames(o->frames);
             c.previews = !o->noPreviews;
+            c.objs = !o->noObjs;
             const EvalReport report = evalCommand(c, &std::cout);
             std::cout << "eval: wrote " << report.files.size() << " files to " << o->out << "/\n";
             for (const std::string& note : report.notes)
@@ -329,7 +372,13 @@ void addEvalCommand(CommandLine& cli) {
     eval.option("--preview-height", o->command.previewHeight, "preview height in pixels").showDefault();
     eval.flag("--movie", o->command.movie,
               "also encode <object>.mp4 from the previews when ffmpeg is on PATH");
-    eval.option("--fps", o->command.movieFrameRate, "movie frame rate").showDefault();
+    eval.option(
+            "--cache", o->command.cache,
+            "also write <object>.pc2 or <object>.mdd: every frame in one point cache (consecutive frames)")
+        .choices({"pc2", "mdd"});
+    eval.flag("--no-objs", o->noObjs, "write the point cache instead of the per-frame OBJs (needs --cache)");
+    eval.option("--fps", o->command.movieFrameRate, "frame rate of the movies and of an MDD cache's times")
+        .showDefault();
 }
 
 }  // namespace deformkit::harness

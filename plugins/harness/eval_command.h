@@ -11,6 +11,8 @@
 // frame, as a DCC plays it back, and writes every object's deformed mesh per frame, with previews:
 //
 //   DIR/<object>.<frame>.obj   frame zero padded to 4 digits (-0001 for frame -1), rest UVs and groups kept
+//   DIR/<object>.pc2 / .mdd    with `cache`: one point cache per object holding every evaluated frame
+//                              (io/point_cache.h), beside the OBJs or, without `objs`, instead of them
 //   DIR/<object>.<frame>.png   shaded preview (io::renderPreview), one camera per object: the default view
 //                              framing the object's rest bounding box, so previews of a shot do not jump
 //   DIR/<object>.contact.png   the object's previews tiled in frame order, each downscaled
@@ -32,6 +34,10 @@ struct EvalCommand {
     std::vector<int> frames;
     std::filesystem::path outDir = "eval-out";
 
+    // "pc2" or "mdd": also write each object's frames as one point cache, its first sample the first frame
+    // (the frames must be consecutive: a cache holds one frame per sample). Empty: no cache.
+    std::string cache;
+    bool objs = true;                // write the per-frame OBJs (false needs `cache`)
     bool previews = true;            // write the PNG previews and contact sheets
     int32_t previewWidth = 480;      // pixels, 1 to 16384
     int32_t previewHeight = 360;     // pixels, 1 to 16384
@@ -40,14 +46,14 @@ struct EvalCommand {
     // Encode DIR/<object>.mp4 from the previews with ffmpeg (its default MP4 codec, yuv420p); needs
     // `previews`. When no ffmpeg is on PATH the movies are skipped and EvalReport::notes says so.
     bool movie = false;
-    int32_t movieFrameRate = 24;  // frames per second, >= 1
+    int32_t movieFrameRate = 24;  // frames per second, >= 1: the movies', and an MDD cache's times
 };
 
 struct EvalReport {
     std::vector<int> frames;  // evaluated, ascending
     // Written: per frame, per object in scene order, the OBJ then the preview; then per object with a UV
-    // warp its maps, tile by tile, frame by frame; then per object its contact sheet, then per object its
-    // movie (previews, sheets and movies only when made).
+    // warp its maps, tile by tile, frame by frame; then per object its point cache, its contact sheet, then
+    // per object its movie (OBJs, caches, previews, sheets and movies only when made).
     std::vector<std::filesystem::path> files;
     std::vector<int64_t> binds;        // per object: binds done by its stack over the run
     std::vector<int64_t> evaluations;  // per object: stack evaluations over the run (one per frame)

@@ -370,6 +370,22 @@ sed 's/endAngle/endAngel/' "$work/shot.json" >"$work/bad_shot.json"
 expect eval-bad-param 2 "$dk" eval "$work/bad_shot.json" --out "$work/eval-bad"
 contains eval-bad-param "$work/err" "objects[0].stack[0].params.endAngel"
 [ ! -e "$work/eval-bad" ] || { echo "FAIL eval-bad-param: output folder created"; failures=$((failures + 1)); }
+# The shot as a point cache instead of OBJs, fed back to uvwarp as its deformed frames; bad caches are exit 2
+# naming the file and the frame.
+expect eval-pc2 0 "$dk" eval "$work/shot.json" --out "$work/eval-pc2" --no-previews --cache pc2 --no-objs
+contains eval-pc2 "$work/out" "point cache"
+[ "$(ls "$work/eval-pc2")" = "grid.pc2" ] || { echo "FAIL eval-pc2: expected grid.pc2 alone"; failures=$((failures + 1)); }
+[ "$(stat -c %s "$work/eval-pc2/grid.pc2")" -eq $((32 + 2 * 121 * 12)) ] || { echo "FAIL eval-pc2: size"; failures=$((failures + 1)); }
+expect uvwarp-pc2 0 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-2 \
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
+contains uvwarp-pc2 "$work/out" "2 frames written"
+expect uvwarp-pc2-frame 2 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-3 \
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
+contains uvwarp-pc2-frame "$work/err" "grid.pc2: frame 3: is not in the cache"
+head -c 1000 "$work/eval-pc2/grid.pc2" >"$work/cut.pc2"
+expect uvwarp-pc2-cut 2 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/cut.pc2" --frames 1-2 \
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
+contains uvwarp-pc2-cut "$work/err" "cut.pc2: frame 1: is cut short"
 
 # eval with the UV warp as the scene's last stage, then a farm plan of frame-range x tile tasks.
 cat >"$work/uvshot.json" <<JSON

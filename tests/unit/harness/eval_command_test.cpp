@@ -19,6 +19,7 @@
 #include "deformkit/scene/uvwarp_stage.h"
 #include "eval_command.h"
 #include "mesh_support.h"
+#include "point_cache_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -106,6 +107,61 @@ TEST_CASE("eval command: writes every object at every frame, equal to the stack 
     command.outDir = dir / "five";
     CHECK(harness::evalCommand(command).files.size() == 2);
     CHECK(std::filesystem::is_regular_file(dir / "five" / "tube.0005.obj"));
+}
+
+TEST_CASE(
+    "eval command: one point cache per object holds the OBJs' positions bit for bit, beside or instead "
+    "of them",
+    "[harness][eval][point_cache]") {
+    test::TempDir dir;
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.outDir = dir / "objs";
+    command.previews = false;
+    (void)harness::evalCommand(command);
+
+    // The caches the test expects: the written OBJs' positions (which round-trip float32), encoded by the
+    // test's own writer: PC2 starting at the first frame, MDD timed (frame - first) / fps.
+    std::vector<std::vector<glm::vec3>> tube, still;
+    for (int frame = 1; frame <= 3; ++frame) {
+        for (auto* frames : {&tube, &still}) {
+            const io::ObjContent obj =
+                io::readObj(command.outDir / scene::frameFileName(frames == &tube ? "tube" : "still", frame));
+            frames->emplace_back(obj.mesh.points().begin(), obj.mesh.points().end());
+        }
+    }
+    command.cache = "pc2";
+    command.outDir = dir / "pc2";
+    harness::EvalReport report = harness::evalCommand(command);
+    CHECK(test::readText(command.outDir / "tube.pc2") == test::pc2Bytes(1.0f, 1.0f, tube));
+    CHECK(test::readText(command.outDir / "still.pc2") == test::pc2Bytes(1.0f, 1.0f, still));
+    CHECK(report.files.size() == 8);  // six OBJs and two caches
+    CHECK(std::filesystem::is_regular_file(command.outDir / "tube.0002.obj"));
+
+    command.cache = "mdd";
+    command.objs = false;
+    command.movieFrameRate = 25;
+    command.outDir = dir / "mdd";
+    report = harness::evalCommand(command);
+    CHECK(test::readText(command.outDir / "tube.mdd") == test::mddBytes({0.0f, 1.0f / 25, 2.0f / 25}, tube));
+    CHECK(test::filesIn(command.outDir) == std::vector<std::filesystem::path>{"still.mdd", "tube.mdd"});
+    CHECK(report.files.size() == 2);
+
+    // Refused before anything is written: frames with a gap, --no-objs without a cache, another format.
+    command.outDir = dir / "refused";
+    command.frames = {1, 3};
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(command); }),
+               Contains("--cache: mdd: cannot hold the frames 1 and 3 with a gap"));
+    command.frames = {};
+    command.cache = "";
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(command); }),
+               Contains("--no-objs: is given without --cache"));
+    command.cache = "abc";
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(command); }),
+               Contains("--cache: abc: is not a point cache format (expected pc2 or mdd)"));
+    CHECK_FALSE(std::filesystem::exists(dir / "refused"));
 }
 
 TEST_CASE("eval command: a bad scene names the file and JSON path and writes nothing",
