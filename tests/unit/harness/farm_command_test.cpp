@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,10 +17,12 @@
 #include "deformkit/error.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/scene/farm_plan.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "eval_command.h"
 #include "farm_command.h"
 #include "farm_plan_edits.h"
 #include "mesh_support.h"
+#include "point_cache_support.h"
 #include "test_support.h"
 
 using namespace deformkit;
@@ -191,6 +194,59 @@ TEST_CASE("farm run: the tasks write the bytes of deformkit eval, and a rerun sk
     CHECK(test::readText(shot.dir / "farm" / "bent.0005.obj") ==
           test::readText(shot.dir / "eval" / "bent.0005.obj"));
     CHECK(fs::last_write_time(shot.dir / "farm" / "tube.0005.obj") == past);
+}
+
+TEST_CASE(
+    "farm run: an object driven by a point cache writes eval's bytes, each task reading only its frames",
+    "[harness][farm][point_cache]") {
+    Shot shot;
+    // Frames 1-7 of a tube swaying along x, written by eval as the OBJs and the PC2 of one object.
+    test::writeText(shot.dir / "sway.json", R"({"deformkit_scene": 1, "frames": [1, 7], "objects": [
+      {"name": "tube", "mesh": "tube.obj", "stack": [{"type": "bend", "params": {"curvature": {"keys": [
+        {"frame": 1, "value": 0.1}, {"frame": 7, "value": 0.9}]}}}]}]})");
+    harness::EvalCommand sway;
+    sway.scene = shot.dir / "sway.json";
+    sway.outDir = shot.dir / "sway";
+    sway.previews = false;
+    sway.cache = "pc2";
+    (void)harness::evalCommand(sway);
+    // Frame 1 of the cache is broken with a NaN: a task of frames 4-6 never reads it.
+    std::string bytes = test::readText(shot.dir / "sway" / "tube.pc2");
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(bytes.data() + 32 + 4, &nan, 4);  // sample 0, vertex 0, y
+    test::writeText(shot.dir / "sway.pc2", bytes);
+    test::writeText(shot.dir / "cached.json", R"({"deformkit_scene": 1, "frames": [1, 7], "objects": [
+      {"name": "tube", "mesh": "tube.obj", "deformed": "sway.pc2", "stack": [{"type": "twist", "params": {
+        "handleY": [0, 1, 0], "endAngle": {"keys": [{"frame": 1, "value": 0}, {"frame": 7, "value": 1.5}]}}}]}]})");
+    test::writeText(shot.dir / "sequence.json", R"({"deformkit_scene": 1, "frames": [1, 7], "objects": [
+      {"name": "tube", "mesh": "tube.obj", "deformed": "sway/tube.####.obj", "stack": [{"type": "twist", "params": {
+        "handleY": [0, 1, 0], "endAngle": {"keys": [{"frame": 1, "value": 0}, {"frame": 7, "value": 1.5}]}}}]}]})");
+
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.dir / "cached.json";
+    planCommand.chunk = 3;
+    planCommand.outDir = shot.dir / "farm";
+    (void)harness::farmPlanCommand(planCommand);
+    const scene::FarmTaskReport report = harness::farmRunCommand({harness::farmPlanPath(planCommand), 1});
+    CHECK(report.written == std::vector<int>{4, 5, 6});
+    harness::EvalCommand reference;
+    reference.scene = shot.dir / "sequence.json";
+    reference.outDir = shot.dir / "eval";
+    reference.previews = false;
+    reference.frames = {4, 5, 6};
+    (void)harness::evalCommand(reference);
+    for (int f = 4; f <= 6; ++f) {
+        const std::string name = scene::frameFileName("tube", f);
+        CHECK(test::readText(shot.dir / "farm" / name) == test::readText(shot.dir / "eval" / name));
+    }
+    CHECK(test::readText(shot.dir / "farm" / "tube.0004.obj") !=
+          test::readText(shot.dir / "sway" / "tube.0004.obj"));
+    // The task holding frame 1 stops there, naming the scene, the object's input, the cache and the vertex.
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)harness::farmRunCommand({harness::farmPlanPath(planCommand), 0});
+               }),
+               Contains("cached.json: objects[0].deformed: frame 1: ") &&
+                   Contains("sway.pc2: frame 1: vertex 0: is ("));
 }
 
 TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file and the JSON path or index",
