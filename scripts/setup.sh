@@ -20,6 +20,7 @@ packages=(
     catch2 libbenchmark-dev
     libomp-dev zlib1g-dev
     libcli11-dev nlohmann-json3-dev
+    libassimp-dev                    # glTF, FBX, PLY and Collada meshes
     python3 python3-dev pybind11-dev python3-numpy python3-pytest
     clang libclang-rt-14-dev         # libFuzzer and sanitizers
     g++-aarch64-linux-gnu            # tests/build: the SIMD sources compile for a non-x86 target

@@ -9,7 +9,9 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/io/point_cache.h"
 #include "deformkit/io/udim.h"
 
 namespace deformkit::harness {
@@ -17,14 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool isMeshPath(const fs::path& p) {
-    std::string ext = p.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    return ext == ".obj";
-}
-
 void describeMesh(const fs::path& file, std::ostream& out) {
-    const io::ObjContent obj = io::readObj(file);
+    const io::ObjContent obj = io::readMesh(file);
     const geom::Mesh& m = obj.mesh;
     std::map<int32_t, int32_t> sizes;
     for (int32_t c : m.faceCounts())
@@ -103,6 +99,21 @@ void describeImage(const fs::path& file, std::ostream& out) {
         out << "attribute   " << key << " = " << value << "\n";
 }
 
+void describeCache(const fs::path& file, std::ostream& out) {
+    const io::PointCache cache(file);
+    const std::vector<int> frames = cache.frames();
+    out << "point cache " << file.string() << "\n";
+    out << "format      " << io::formatName(cache.format()) << "\n";
+    out << "vertices    " << cache.vertexCount() << "\n";
+    out << "samples     " << cache.sampleCount() << " (every " << cache.sampling() << " frame)\n";
+    out << "frames      ";
+    if (frames.empty()) {
+        out << "none\n";
+    } else {
+        out << frames.front() << "-" << frames.back() << " (" << frames.size() << " whole frames)\n";
+    }
+}
+
 void describeUdim(const fs::path& pattern, std::ostream& out) {
     const std::vector<io::UdimFile> files = io::findUdimFiles(pattern);
     out << "udim        " << pattern.string() << "\n";
@@ -130,21 +141,32 @@ void describe(const fs::path& file, std::ostream& out) {
         throw IoError(
             formatError(file.string(), "", "no such file", "an existing mesh, image or UDIM pattern"));
     }
-    if (isMeshPath(file)) {
+    if (io::meshFormat(file)) {
         describeMesh(file, out);
-    } else {
+    } else if (io::pointCacheFormat(file)) {
+        describeCache(file, out);
+    } else if (io::isImageFileName(file)) {
         describeImage(file, out);
+    } else {
+        throw InvalidInput(
+            formatError(file.string(), "", "is neither a mesh, a point cache nor an image",
+                        std::string("a mesh (") + io::kMeshExtensions +
+                            "), a point cache (.pc2, .mdd) or an image OpenImageIO reads (.exr, "
+                            ".png, .tif, .jpg, ...)"));
     }
 }
 
 void addInfoCommand(CommandLine& cli) {
     auto file = std::make_shared<std::string>();
     Command info =
-        cli.add("info", "Describe a mesh (.obj), an image, or the tiles of a UDIM pattern", [file] {
+        cli.add("info", "Describe a mesh, a point cache, an image, or the tiles of a UDIM pattern", [file] {
             describe(*file, std::cout);
             return 0;
         });
-    info.option("FILE", *file, "mesh, image, or pattern with <UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
+    info.option(
+            "FILE", *file,
+            "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae), point cache (.pc2, .mdd), image, or pattern with "
+            "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_")
         .required();
 }
 

@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "deformkit/scene/weights_file.h"
@@ -47,7 +48,7 @@ geom::Box3 parseBox(const std::string& text) {
 }  // namespace
 
 void preview(const PreviewCommand& command) {
-    const io::ObjContent obj = io::readObj(command.mesh);
+    const io::ObjContent obj = io::readMesh(command.mesh);
     std::optional<io::PreviewTexture> texture;
     if (command.texture) texture = io::loadPreviewTexture(*command.texture);
     if (command.weights && command.weightsPtex) {

@@ -9,6 +9,7 @@
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/ptex/ptex_mesh.h"
@@ -100,7 +101,7 @@ void ptexInfo(const fs::path& file, std::ostream& out) {
 }
 
 size_t ptexToVertexCommand(const PtexToVertexCommand& command) {
-    const geom::Mesh mesh = io::readObj(command.mesh).mesh;
+    const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     const std::vector<float> weights =
         ptex::weightsFromPtex(mesh, command.mesh.string(), command.ptex, command.channel, "");
     io::writeFileAtomically(command.out, scene::formatWeightsFile(weights));
@@ -112,7 +113,7 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
         throw InvalidInput(formatError("--out", "", "'" + command.out + "' has no UDIM token",
                                        "a pattern such as 'map.<UDIM>.exr'"));
     }
-    const geom::Mesh mesh = io::readObj(command.mesh).mesh;
+    const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     const ptex::PtexFile file = ptex::readPtex(command.ptex);
     const ptex::PtexMesh ptexMesh(mesh, command.mesh.string());
     ptex::ToUdimOptions options;
@@ -129,7 +130,7 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
 }
 
 int32_t ptexFromUdimCommand(const PtexFromUdimCommand& command) {
-    const geom::Mesh mesh = io::readObj(command.mesh).mesh;
+    const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     std::vector<ptex::UdimTile> tiles;
     for (const io::UdimFile& f : io::findUdimFiles(command.pattern))
         tiles.push_back({f.tile, io::readImage(f.path)});
@@ -148,7 +149,7 @@ void ptexFromVertexCommand(const PtexFromVertexCommand& command) {
     if (command.faceLog2 < 0) {
         throw InvalidInput(formatError("--face-res", "", "is auto", "a power of two (texels per face side)"));
     }
-    const geom::Mesh mesh = io::readObj(command.mesh).mesh;
+    const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     const std::vector<float> weights =
         scene::readWeightsFile(command.weights, static_cast<size_t>(mesh.numVertices()));
     const ptex::PtexMesh ptexMesh(mesh, command.mesh.string());

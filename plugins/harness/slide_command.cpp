@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "deformkit/error.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "deformkit/scene/weights_file.h"
@@ -62,7 +63,7 @@ slide::Falloff parseFalloff(std::string_view text, const std::string& option) {
 }
 
 slide::SlideResult slideCommand(const SlideCommand& command) {
-    io::ObjContent obj = io::readObj(command.mesh);
+    io::ObjContent obj = io::readMesh(command.mesh);
     const size_t count = static_cast<size_t>(obj.mesh.numVertices());
     if (command.weights && command.weightsPtex) {
         throw InvalidInput(

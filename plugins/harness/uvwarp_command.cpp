@@ -15,6 +15,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
@@ -118,7 +119,7 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     uvwarp::ShotJob job;
     uvwarp::setOutputPatterns(job, command.out, command.bake.value_or(fs::path()), "--out", "--bake");
 
-    const io::ObjContent restObj = io::readObj(command.rest);
+    const io::ObjContent restObj = io::readMesh(command.rest);
     const geom::Mesh& rest = restObj.mesh;
     (void)uvwarp::shotTiles(rest, command.rest.string(), command.tiles,
                             "--tiles");  // before the frames are read

@@ -13,6 +13,7 @@
 
 #include "bindings.h"
 #include "deformkit/error.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "numpy_support.h"
@@ -261,7 +262,7 @@ std::string meshName(py::handle mesh, const geom::Mesh& m) {
 
 geom::Mesh meshFrom(py::handle mesh) {
     if (py::isinstance<geom::Mesh>(mesh)) return mesh.cast<geom::Mesh>();
-    return io::readObj(mesh.cast<std::filesystem::path>()).mesh;
+    return io::readMesh(mesh.cast<std::filesystem::path>()).mesh;
 }
 
 }  // namespace

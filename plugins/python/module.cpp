@@ -14,6 +14,7 @@
 #include "deformkit/geom/primitives.h"
 #include "deformkit/interrupter.h"
 #include "deformkit/io/image.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
 #include "deformkit/io/udim.h"
@@ -127,9 +128,10 @@ PYBIND11_MODULE(deformkit, m) {
         "read_mesh",
         [](const std::filesystem::path& path) {
             py::gil_scoped_release release;
-            return io::readObj(path).mesh;
+            return io::readMesh(path).mesh;
         },
-        py::arg("path"), "Read an OBJ file.");
+        py::arg("path"),
+        "Read a mesh: OBJ, glTF (.gltf, .glb), FBX, PLY or Collada (.dae); docs/io.md says what each gives.");
     m.def(
         "write_mesh",
         [](const std::filesystem::path& path, const geom::Mesh& mesh) {

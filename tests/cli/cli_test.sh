@@ -37,6 +37,13 @@ expect unknown-option 2 "$dk" info --bogus x
 expect missing-mesh 2 "$dk" info "$work/nope.obj"
 contains missing-mesh "$work/err" "nope.obj"
 
+# Meshes in other formats (assimp): a PLY reads; a file that is neither a mesh, a cache nor an image names them.
+printf 'ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n' >"$work/quad.ply"
+expect info-ply 0 "$dk" info "$work/quad.ply"
+contains info-ply "$work/out" "faces       1 (triangles 0, quads 1, n-gons 0)"
+echo "not a mesh" >"$work/notes.txt"
+expect info-unknown 2 "$dk" info "$work/notes.txt"
+contains info-unknown "$work/err" "is neither a mesh, a point cache nor an image (expected a mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n' >"$work/bad.obj"
 expect bad-index 2 "$dk" info "$work/bad.obj"
 contains bad-index "$work/err" "line 4"
@@ -376,6 +383,8 @@ expect eval-pc2 0 "$dk" eval "$work/shot.json" --out "$work/eval-pc2" --no-previ
 contains eval-pc2 "$work/out" "point cache"
 [ "$(ls "$work/eval-pc2")" = "grid.pc2" ] || { echo "FAIL eval-pc2: expected grid.pc2 alone"; failures=$((failures + 1)); }
 [ "$(stat -c %s "$work/eval-pc2/grid.pc2")" -eq $((32 + 2 * 121 * 12)) ] || { echo "FAIL eval-pc2: size"; failures=$((failures + 1)); }
+expect info-pc2 0 "$dk" info "$work/eval-pc2/grid.pc2"
+contains info-pc2 "$work/out" "frames      1-2 (2 whole frames)"
 expect uvwarp-pc2 0 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-2 \
     --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
 contains uvwarp-pc2 "$work/out" "2 frames written"

@@ -318,4 +318,12 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
     discardPendingOiioErrors();
 }
 
+bool isImageFileName(const fs::path& path) {
+    if (path.extension().empty()) return false;
+    discardPendingOiioErrors();
+    const bool known = OIIO::ImageInput::create(path.string(), false) != nullptr;
+    discardPendingOiioErrors();
+    return known;
+}
+
 }  // namespace deformkit::io

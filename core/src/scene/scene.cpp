@@ -11,6 +11,7 @@
 #include "deformkit/error.h"
 #include "deformkit/host/deformers.h"
 #include "deformkit/io/animated_positions.h"
+#include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/read_file.h"
 #include "deformkit/io/udim.h"
@@ -472,8 +473,10 @@ class Reader {
                      "letters, digits, '_', '-' and '.' only, not starting with '.' (it names output files)");
             }
         }
-        if (!v.contains("mesh")) fail(path + ".mesh", "is missing", "an OBJ file name");
-        o.meshFile = file(v.at("mesh"), path + ".mesh", "an OBJ file name");
+        if (!v.contains("mesh"))
+            fail(path + ".mesh", "is missing", "a mesh file name (.obj, .gltf, .glb, .fbx, .ply, .dae)");
+        o.meshFile =
+            file(v.at("mesh"), path + ".mesh", "a mesh file name (.obj, .gltf, .glb, .fbx, .ply, .dae)");
         const bool meshIsSequence = io::ObjSequence::isPattern(o.meshFile.filename().string());
         if (v.contains("deformed")) {
             if (meshIsSequence) {
@@ -514,9 +517,9 @@ class Reader {
                  "restFrame only with a frame sequence (\"mesh\": \"anim.####.obj\")");
         }
         if (!isRegularFile(o.meshFile, path + ".mesh"))
-            fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "an OBJ file");
+            fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "a mesh file");
         try {
-            io::ObjContent content = io::readObj(o.meshFile);
+            io::ObjContent content = io::readMesh(o.meshFile);
             o.rest = std::move(content.mesh);
             o.groups = std::move(content.groups);
         } catch (const Error& e) {

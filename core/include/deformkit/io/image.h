@@ -60,6 +60,9 @@ struct ImageInfo {
 // Reads only the header.
 [[nodiscard]] ImageInfo readImageInfo(const std::filesystem::path& path);
 
+// True when OpenImageIO has a reader for the file name's extension (the file is not opened).
+[[nodiscard]] bool isImageFileName(const std::filesystem::path& path);
+
 // Writes atomically (temporary file in the same folder, then rename): on failure no partial file is
 // left and an existing file is intact. The format follows the extension. Throws InvalidInput for an
 // empty image, a pixel count that does not match width * height * channels, or a pixel type the format

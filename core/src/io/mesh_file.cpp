@@ -1,0 +1,132 @@
+#include "deformkit/io/mesh_file.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <assimp/Importer.hpp>
+#include <cctype>
+#include <map>
+#include <string>
+#include <system_error>
+#include <tuple>
+#include <vector>
+
+#include "deformkit/error.h"
+
+namespace deformkit::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Exact position key for welding assimp's per-corner vertices.
+using PositionKey = std::tuple<float, float, float>;
+
+ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
+    const std::string name = path.string();
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (!fs::exists(status)) throw IoError(formatError(name, "", "does not exist", "an existing mesh file"));
+    if (!fs::is_regular_file(status))
+        throw IoError(formatError(name, "", "is not a regular file", "a mesh file"));
+
+    Assimp::Importer importer;
+    // Meshes stay apart (one group each) while their vertices move to world space.
+    importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
+    const aiScene* scene =
+        importer.ReadFile(path.string(), aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
+    if (!scene) {
+        throw InvalidInput(formatError(name, "",
+                                       std::string("cannot be read as a mesh: ") + importer.GetErrorString(),
+                                       "a valid glTF, FBX, PLY or Collada file"));
+    }
+    const bool weld = format == MeshFormat::Fbx || format == MeshFormat::Collada;
+    geom::Mesh::Data data;
+    std::vector<FaceGroup> groups;
+    bool anyUVs = false;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+        anyUVs = anyUVs || scene->mMeshes[m]->HasTextureCoords(0);
+    std::map<PositionKey, int32_t> welded;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+        const aiMesh& mesh = *scene->mMeshes[m];
+        const bool uvs = mesh.HasTextureCoords(0);
+        // Vertex k of this mesh is point pointOf[k]; its UV is uv base + k.
+        std::vector<int32_t> pointOf(mesh.mNumVertices);
+        for (unsigned k = 0; k < mesh.mNumVertices; ++k) {
+            const aiVector3D& p = mesh.mVertices[k];
+            const glm::vec3 point(p.x, p.y, p.z);
+            if (weld) {
+                const auto [it, added] =
+                    welded.try_emplace({point.x, point.y, point.z}, static_cast<int32_t>(data.points.size()));
+                if (added) data.points.push_back(point);
+                pointOf[k] = it->second;
+            } else {
+                pointOf[k] = static_cast<int32_t>(data.points.size());
+                data.points.push_back(point);
+            }
+        }
+        const auto uvBase = static_cast<int32_t>(data.uvs.size());
+        if (uvs) {
+            for (unsigned k = 0; k < mesh.mNumVertices; ++k)
+                data.uvs.emplace_back(mesh.mTextureCoords[0][k].x, mesh.mTextureCoords[0][k].y);
+        }
+        FaceGroup group;
+        group.name = mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
+        for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+            const aiFace& face = mesh.mFaces[f];
+            // Corners in order; a corner welded onto the one before it is dropped (a sliver of coincident
+            // points), and a face left with fewer than 3 corners (points, lines, such slivers) is left out.
+            std::vector<unsigned> corners;
+            for (unsigned c = 0; c < face.mNumIndices; ++c) {
+                const unsigned k = face.mIndices[c];
+                if (!corners.empty() && pointOf[corners.back()] == pointOf[k]) continue;
+                corners.push_back(k);
+            }
+            while (corners.size() > 1 && pointOf[corners.back()] == pointOf[corners.front()])
+                corners.pop_back();
+            if (corners.size() < 3) continue;
+            group.faces.push_back(static_cast<int32_t>(data.faceCounts.size()));
+            data.faceCounts.push_back(static_cast<int32_t>(corners.size()));
+            for (const unsigned k : corners) {
+                data.faceIndices.push_back(pointOf[k]);
+                if (anyUVs) data.uvIndices.push_back(uvs ? uvBase + static_cast<int32_t>(k) : -1);
+            }
+        }
+        if (!group.faces.empty()) groups.push_back(std::move(group));
+    }
+    if (data.faceCounts.empty()) {
+        throw InvalidInput(formatError(name, "",
+                                       "has no polygon (" + std::to_string(scene->mNumMeshes) + " meshes)",
+                                       "a file with at least one mesh of polygons"));
+    }
+    ObjContent content{geom::Mesh(std::move(data), name), std::move(groups)};
+    return content;
+}
+
+}  // namespace
+
+std::optional<MeshFormat> meshFormat(const fs::path& path) {
+    std::string extension = path.extension().string();
+    for (char& c : extension)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".obj") return MeshFormat::Obj;
+    if (extension == ".gltf" || extension == ".glb") return MeshFormat::Gltf;
+    if (extension == ".fbx") return MeshFormat::Fbx;
+    if (extension == ".ply") return MeshFormat::Ply;
+    if (extension == ".dae") return MeshFormat::Collada;
+    return std::nullopt;
+}
+
+ObjContent readMesh(const fs::path& path) {
+    const std::optional<MeshFormat> format = meshFormat(path);
+    if (!format) {
+        throw InvalidInput(formatError(path.string(), "",
+                                       path.extension().empty()
+                                           ? "has no extension"
+                                           : "has the extension '" + path.extension().string() + "'",
+                                       std::string("a mesh file: ") + kMeshExtensions));
+    }
+    if (*format == MeshFormat::Obj) return readObj(path);
+    return readWithAssimp(path, *format);
+}
+
+}  // namespace deformkit::io

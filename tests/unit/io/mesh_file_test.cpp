@@ -1,0 +1,129 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/io/mesh_file.h"
+#include "deformkit/io/obj.h"
+#include "test_support.h"
+
+// Meshes through assimp (glTF, PLY here; FBX and Collada as Blender writes them in
+// tests/blender/test_mesh_formats.py) against what the files say, written by hand.
+
+using namespace deformkit;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A quad (0,0,0) (1,0,0) (1,1,0) (0,1,0) as two triangles, float32 positions, UVs (0,1) (1,1) (1,0) (0,0) in
+// glTF's convention (v down), uint16 indices 0 1 2 0 2 3: 92 bytes, base64. The node translates it by
+// (1, 2, 3) and the second node uses the same mesh untranslated.
+const char* kGltf = R"({"asset": {"version": "2.0"},
+ "scene": 0, "scenes": [{"nodes": [0, 1]}],
+ "nodes": [{"mesh": 0, "name": "moved", "translation": [1, 2, 3]}, {"mesh": 1, "name": "still"}],
+ "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]},
+            {"name": "bare", "primitives": [{"attributes": {"POSITION": 0}, "indices": 2}]}],
+ "buffers": [{"byteLength": 92, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAgD8AAIA/AACAPwAAgD8AAAAAAAAAAAAAAAAAAAEAAgAAAAIAAwA="}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                 {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+               {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+               {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]})";
+
+// An ASCII PLY: a quad and a triangle over five vertices in a deliberate order, with texture coordinates.
+const char* kPly = R"(ply
+format ascii 1.0
+element vertex 5
+property float x
+property float y
+property float z
+property float s
+property float t
+element face 2
+property list uchar int vertex_indices
+end_header
+0 0 0 0 0
+2 0 0 1 0
+2 1 0 1 0.5
+0 1 0 0 0.5
+1 2 0 0.5 1
+4 0 1 2 3
+3 3 2 4
+)";
+
+std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
+    return {m.points().begin(), m.points().end()};
+}
+
+}  // namespace
+
+TEST_CASE("mesh files: a glTF's nodes place its meshes, one group each, vertices in the file's order",
+          "[io][mesh_file]") {
+    const test::TempDir dir;
+    test::writeText(dir / "quad.gltf", kGltf);
+    const io::ObjContent content = io::readMesh(dir / "quad.gltf");
+    const geom::Mesh& m = content.mesh;
+    REQUIRE(m.numVertices() == 8);  // the two meshes' vertices, each mesh's in its accessor's order
+    CHECK(pointsOf(m) ==
+          std::vector<glm::vec3>{
+              {1, 2, 3}, {2, 2, 3}, {2, 3, 3}, {1, 3, 3}, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+    CHECK(std::vector<int32_t>(m.faceIndices().begin(), m.faceIndices().end()) ==
+          std::vector<int32_t>{0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7});
+    // UVs in DeformKit's convention (v up: 1 - glTF's v); the mesh without UVs has none on its faces.
+    REQUIRE(m.hasUVs());
+    const std::vector<glm::vec2> expectedUVs{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int c = 0; c < 6; ++c) {
+        const int32_t uv = m.uvIndices()[c];
+        CHECK(m.uvs()[uv] == expectedUVs[static_cast<size_t>(m.faceIndices()[c])]);
+    }
+    for (int c = 6; c < 12; ++c)
+        CHECK(m.uvIndices()[c] == -1);
+    REQUIRE(content.groups.size() == 2);
+    CHECK(content.groups[0].name == "quad");
+    CHECK(content.groups[0].faces == std::vector<int32_t>{0, 1});
+    CHECK(content.groups[1].name == "bare");
+    CHECK(content.groups[1].faces == std::vector<int32_t>{2, 3});
+}
+
+TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_file]") {
+    const test::TempDir dir;
+    test::writeText(dir / "two.PLY", kPly);
+    const geom::Mesh m = io::readMesh(dir / "two.PLY").mesh;
+    CHECK(pointsOf(m) == std::vector<glm::vec3>{{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, {1, 2, 0}});
+    CHECK(std::vector<int32_t>(m.faceCounts().begin(), m.faceCounts().end()) == std::vector<int32_t>{4, 3});
+    CHECK(std::vector<int32_t>(m.faceIndices().begin(), m.faceIndices().end()) ==
+          std::vector<int32_t>{0, 1, 2, 3, 3, 2, 4});
+    REQUIRE(m.hasUVs());
+    CHECK(m.uvs()[m.uvIndices()[6]] == glm::vec2(0.5f, 1.0f));
+    CHECK(m.uvs()[m.uvIndices()[2]] == glm::vec2(1.0f, 0.5f));
+}
+
+TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and the formats",
+          "[io][mesh_file]") {
+    const test::TempDir dir;
+    test::writeText(dir / "t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    CHECK(io::readMesh(dir / "t.obj").mesh.numFaces() == 1);
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "t.stl"); }),
+        Contains("t.stl: has the extension '.stl' (expected a mesh file: .obj, .gltf, .glb, .fbx, .ply, "
+                 ".dae)"));
+    CHECK_THAT(test::errorOf<IoError>([&] { (void)io::readMesh(dir / "none.glb"); }),
+               Contains("none.glb: does not exist"));
+    test::writeText(dir / "broken.glb", "glTF but not really");
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "broken.glb"); }),
+               Contains("broken.glb: cannot be read as a mesh: "));
+    // Vertices and no face.
+    test::writeText(
+        dir / "cloud.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+        "z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "cloud.ply"); }),
+        Contains("cloud.ply: ") && (Contains("has no polygon") || Contains("cannot be read as a mesh")));
+    CHECK(io::meshFormat("a.GLTF") == io::MeshFormat::Gltf);
+    CHECK(io::meshFormat("a.Dae") == io::MeshFormat::Collada);
+    CHECK_FALSE(io::meshFormat("a.exr"));
+}
