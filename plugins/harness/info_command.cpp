@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
+#include "deformkit/geom/weld.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
@@ -33,6 +34,12 @@ void describeMesh(const fs::path& file, std::ostream& out) {
     out << "faces       " << m.numFaces() << " (triangles " << sizes[3] << ", quads " << sizes[4]
         << ", n-gons " << sizes[5] << ")\n";
     out << "edges       " << m.halfEdges().numEdges() << "\n";
+    const geom::Welding weld = geom::weldVertices(m, 0.0, file.string());
+    if (weld.merged() > 0) {
+        out << "split       " << weld.merged() << " vertices are copies of a coincident vertex ("
+            << weld.firstOf.size()
+            << " distinct): connectivity-based tools (slide, previews' normals, mesh warp) weld them\n";
+    }
     if (obj.repairedFaces > 0) {
         out << "repaired    " << obj.repairedFaces << (obj.repairedFaces == 1 ? " polygon" : " polygons")
             << " that visited a vertex twice (first on line " << obj.firstRepairedLine

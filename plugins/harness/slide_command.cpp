@@ -96,6 +96,10 @@ std::string slideSummary(const fs::path& out, const slide::SlideResult& result) 
         scale << result.foldScale[0];
         text += ", fold limit: drag scaled to " + scale.str();
     }
+    if (result.welded > 0) {
+        text += "; " + std::to_string(result.welded) +
+                " split vertices welded onto a coincident vertex (counts are of welded vertices)";
+    }
     return text;
 }
 
@@ -124,7 +128,7 @@ void addSlideCommand(CommandLine& cli) {
         std::cout << slideSummary(o->out, result) << "\n";
         return 0;
     });
-    slide.option("MESH", o->mesh, "mesh (.obj)").required();
+    slide.option("MESH", o->mesh, "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     slide.option("--handle", o->command.handle.vertex, "handle vertex index (0-based)").required();
     slide.option("--from", o->from, "start locator x,y,z").required();
     slide.option("--to", o->to, "end locator x,y,z: the handle region slides by to - from").required();
@@ -155,6 +159,10 @@ void addSlideCommand(CommandLine& cli) {
         .option("--max-walk", o->command.options.maxWalkTriangles,
                 "triangles one vertex may cross before it stops")
         .positive()
+        .showDefault();
+    slide
+        .option("--weld-tolerance", o->command.options.weldTolerance,
+                "split vertices within this distance are one vertex (0: exactly coincident)")
         .showDefault();
 }
 

@@ -39,7 +39,7 @@ slide::SlideResult slideCommand(const SlideCommand& command);
 
 // The one summary line the CLI prints: "wrote OUT: moved M, limited L (boundary-stopped B,
 // walk-limit-stopped S), flipped triangles T, unreachable U, degenerate D", then ", fold limit: drag scaled
-// to K" when it applied.
+// to K" when it applied and "; W split vertices welded onto a coincident vertex ..." when the mesh had some.
 [[nodiscard]] std::string slideSummary(const std::filesystem::path& out, const slide::SlideResult& result);
 
 // "x,y,z" (three finite numbers) for the option `option` (e.g. "--from"); InvalidInput naming it otherwise.

@@ -44,8 +44,9 @@ const char* regionName(RegionMetric metric) {
 }
 
 slide::SlideOptions optionsOf(const std::string& surface, int64_t maxWalk, const std::string& paintedWeights,
-                              bool foldLimit, const std::string& source) {
+                              bool foldLimit, double weldTolerance, const std::string& source) {
     slide::SlideOptions o;
+    o.weldTolerance = weldTolerance;  // checked by the slider
     if (paintedWeights == "scale") {
         o.weights = slide::PaintedWeights::ScaleFalloff;
     } else if (paintedWeights == "falloff") {
@@ -219,6 +220,8 @@ constexpr SlideCount kSlideCounts[] = {
      "vertices within a radius that the region's propagation cannot reach: unmoved"},
     {"without_tangent_plane", &slide::SlideResult::withoutTangentPlane,
      "vertices within a radius with only degenerate triangles around: unmoved"},
+    {"welded", &slide::SlideResult::welded,
+     "split vertices welded onto a coincident vertex at bind (the counts are of welded vertices)"},
     {"degenerate_triangles", &slide::SlideResult::degenerateTriangles,
      "zero-area triangles touching the region: skipped"},
 };
@@ -268,21 +271,23 @@ class PySlider {
     PySlider(const FloatArray& points, const IntArray& counts, const IntArray& indices,
              const std::optional<int64_t>& handle, const std::optional<double>& radius,
              const std::string& region, const std::optional<std::vector<py::dict>>& handles,
-             const std::string& surface, int64_t maxWalk, const std::string& paintedWeights, bool foldLimit) {
+             const std::string& surface, int64_t maxWalk, const std::string& paintedWeights, bool foldLimit,
+             double weldTolerance) {
         bind(points, counts, indices, handle, radius, region, handles, surface, maxWalk, paintedWeights,
-             foldLimit);
+             foldLimit, weldTolerance);
     }
 
     void bind(const FloatArray& points, const IntArray& counts, const IntArray& indices,
               const std::optional<int64_t>& handle, const std::optional<double>& radius,
               const std::string& region, const std::optional<std::vector<py::dict>>& handles,
-              const std::string& surface, int64_t maxWalk, const std::string& paintedWeights,
-              bool foldLimit) {
+              const std::string& surface, int64_t maxWalk, const std::string& paintedWeights, bool foldLimit,
+              double weldTolerance) {
         const std::string source = "Slider";
         const geom::Mesh mesh =
             meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
         std::vector<SlideHandle> h = handlesOf(handle, radius, region, handles, source);
-        const slide::SlideOptions options = optionsOf(surface, maxWalk, paintedWeights, foldLimit, source);
+        const slide::SlideOptions options =
+            optionsOf(surface, maxWalk, paintedWeights, foldLimit, weldTolerance, source);
         std::shared_ptr<Slider> bound;
         {
             py::gil_scoped_release release;
@@ -343,7 +348,7 @@ void bindSlide(py::module_& m) {
            const FloatArray& displacement, double radius, py::object falloff,
            const std::optional<FloatArray>& weights, float envelope, const std::string& region,
            const std::string& surface, const std::optional<std::filesystem::path>& weightsPtex,
-           int32_t weightsChannel, const std::string& paintedWeights, bool foldLimit) {
+           int32_t weightsChannel, const std::string& paintedWeights, bool foldLimit, double weldTolerance) {
             const std::string source = "slide";
             const geom::Mesh mesh =
                 meshOf(points, counts, indices, std::nullopt, std::nullopt, source, source + " mesh");
@@ -353,7 +358,8 @@ void bindSlide(py::module_& m) {
             }
             const std::vector<SlideHandle> handles = {
                 {vertexOf(handle, source, "handle"), radius, regionOf(region, source, "region")}};
-            const slide::SlideOptions options = optionsOf(surface, 4096, paintedWeights, foldLimit, source);
+            const slide::SlideOptions options =
+                optionsOf(surface, 4096, paintedWeights, foldLimit, weldTolerance, source);
             const std::vector<SlideDrive> drives = {
                 {displacementsOf(displacement, 1, source)[0], falloffOf(falloff, source, "falloff")}};
             const std::vector<float> w =
@@ -372,7 +378,7 @@ void bindSlide(py::module_& m) {
         py::arg("displacement"), py::arg("radius"), py::arg("falloff") = "smooth",
         py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("region") = "euclidean",
         py::arg("surface") = "cage", py::arg("weights_ptex") = py::none(), py::arg("weights_channel") = 0,
-        py::arg("painted_weights") = "scale", py::arg("fold_limit") = false,
+        py::arg("painted_weights") = "scale", py::arg("fold_limit") = false, py::arg("weld_tolerance") = 0.0,
         "Slide vertices over the surface (Pinskiy, 'Sliding deformation'): the region within `radius` of "
         "the\n"
         "`handle` vertex moves by `displacement` (3,) times the falloff, along the surface, so the shape "
@@ -425,24 +431,26 @@ void bindSlide(py::module_& m) {
         .def(py::init<const FloatArray&, const IntArray&, const IntArray&, const std::optional<int64_t>&,
                       const std::optional<double>&, const std::string&,
                       const std::optional<std::vector<py::dict>>&, const std::string&, int64_t,
-                      const std::string&, bool>(),
+                      const std::string&, bool, double>(),
              py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
              py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
              py::arg("handles") = py::none(), py::arg("surface") = "cage",
              py::arg("max_walk_triangles") = 4096, py::arg("painted_weights") = "scale",
-             py::arg("fold_limit") = false,
+             py::arg("fold_limit") = false, py::arg("weld_tolerance") = 0.0,
              "Bind to the rest mesh (points (N, 3), face_counts, face_indices) and one handle (handle, "
              "radius,\n"
              "region) or several: handles=[{'vertex': i, 'radius': r, 'region': 'geodesic'}, ...] ('region'\n"
              "optional, default 'euclidean'). surface 'cage' or 'limit'; max_walk_triangles bounds one "
              "vertex's\n"
              "walk in one evaluation. painted_weights 'scale' or 'falloff' (the paper's rule); fold_limit\n"
-             "scales each drag down so no triangle of its region flips.")
+             "scales each drag down so no triangle of its region flips. Split vertices (coincident, or "
+             "within\n"
+             "weld_tolerance) are welded: the slide walks across seams and every copy moves as the others.")
         .def("bind", &PySlider::bind, py::arg("points"), py::arg("face_counts"), py::arg("face_indices"),
              py::arg("handle") = py::none(), py::arg("radius") = py::none(), py::arg("region") = "euclidean",
              py::arg("handles") = py::none(), py::arg("surface") = "cage",
              py::arg("max_walk_triangles") = 4096, py::arg("painted_weights") = "scale",
-             py::arg("fold_limit") = false,
+             py::arg("fold_limit") = false, py::arg("weld_tolerance") = 0.0,
              "Bind again, to a new rest mesh or handle set; arguments as the constructor.")
         .def(
             "evaluate", &PySlider::evaluate, py::arg("displacement"), py::arg("falloff") = "smooth",

@@ -82,6 +82,10 @@ contains slide-spot "$work/out" "moved 290, limited 0"
 expect slide-spot-fold 0 "$dk" slide "$spot" --handle 1858 --from 0,0,0 --to 0.0283,0.0717,-0.0088 --radius 0.2588 \
     --fold-limit --out "$work/spot_fold_limit.obj"
 contains slide-spot-fold "$work/out" "flipped triangles 0,"
+# A glTF as pipelines hand it over (every triangle with its own vertices): the slide welds its split vertices.
+expect slide-glb 0 "$dk" slide "$repo/tests/data/fox/Fox.glb" --handle 100 --from 0,0,0 --to 1,1,0 --radius 20 --out "$work/fox_slid.obj"
+contains slide-glb "$work/out" "unreachable 0,"
+contains slide-glb "$work/out" "1438 split vertices welded onto a coincident vertex"
 mkdir -p "$work/examples"
 sed 's|"../../demo-out/tube.obj"|"../demo/tube.obj"|' "$repo/docs/examples/slide_limb.json" >"$work/examples/slide_limb.json"
 expect slide-limb 0 "$dk" eval "$work/examples/slide_limb.json" --out "$work/limb-out" --no-previews

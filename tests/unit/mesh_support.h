@@ -3,7 +3,10 @@
 // Meshes shared by the host and harness tests: a quad tube around the Y axis, with or without UVs.
 
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -66,6 +69,68 @@ inline geom::Mesh tube(const TubeOptions& o = {}) {
     geom::Mesh::Data d;
     appendTube(d, o);
     return geom::Mesh(std::move(d), "tube");
+}
+
+// A split copy of `mesh`: the test's own splitting, written from the file formats' rule. `perCorner`: every
+// face corner its own vertex (as an unindexed glTF); otherwise one vertex per (vertex, UV) pair used by a
+// corner (as a glTF split at UV seams). Split vertices are numbered in the order corners first use them,
+// face by face; `original` receives each one's vertex in `mesh`.
+inline geom::Mesh splitCopy(const geom::Mesh& mesh, bool perCorner, std::vector<int32_t>& original) {
+    geom::Mesh::Data data;
+    data.faceCounts.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
+    data.uvs.assign(mesh.uvs().begin(), mesh.uvs().end());
+    std::map<std::pair<int32_t, int32_t>, int32_t> made;
+    original.clear();
+    for (size_t c = 0; c < mesh.faceIndices().size(); ++c) {
+        const int32_t v = mesh.faceIndices()[c];
+        const int32_t uv = mesh.hasUVs() ? mesh.uvIndices()[c] : -1;
+        int32_t index = -1;
+        if (!perCorner) {
+            const auto it = made.find({v, uv});
+            if (it != made.end()) index = it->second;
+        }
+        if (index < 0) {
+            index = static_cast<int32_t>(data.points.size());
+            data.points.push_back(mesh.points()[v]);
+            original.push_back(v);
+            if (!perCorner) made[{v, uv}] = index;
+        }
+        data.faceIndices.push_back(index);
+        if (mesh.hasUVs()) data.uvIndices.push_back(uv);
+    }
+    return geom::Mesh(std::move(data), perCorner ? "split per corner" : "split at UV seams");
+}
+
+// `mesh` with its vertices renumbered by `order` (new vertex i is old vertex order[i]); faces, corners and
+// UVs unchanged. The slide depends on vertex numbering (its propagation visits vertices in index order), so
+// the reference of a split mesh is the shared-vertex mesh numbered as the weld numbers it: by first copy.
+inline geom::Mesh renumbered(const geom::Mesh& mesh, const std::vector<int32_t>& order,
+                             std::vector<int32_t>& newIndex) {
+    geom::Mesh::Data data;
+    newIndex.assign(order.size(), -1);
+    for (size_t i = 0; i < order.size(); ++i) {
+        newIndex[static_cast<size_t>(order[i])] = static_cast<int32_t>(i);
+        data.points.push_back(mesh.points()[order[i]]);
+    }
+    data.faceCounts.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
+    for (int32_t v : mesh.faceIndices())
+        data.faceIndices.push_back(newIndex[static_cast<size_t>(v)]);
+    data.uvs.assign(mesh.uvs().begin(), mesh.uvs().end());
+    data.uvIndices.assign(mesh.uvIndices().begin(), mesh.uvIndices().end());
+    return geom::Mesh(std::move(data), "renumbered");
+}
+
+// The order in which `splitCopy`'s copies first appear, as original vertices: the weld's numbering.
+inline std::vector<int32_t> firstCopyOrder(const std::vector<int32_t>& original, int32_t vertices) {
+    std::vector<uint8_t> seen(static_cast<size_t>(vertices), 0);
+    std::vector<int32_t> order;
+    for (int32_t v : original) {
+        if (!seen[static_cast<size_t>(v)]) {
+            seen[static_cast<size_t>(v)] = 1;
+            order.push_back(v);
+        }
+    }
+    return order;
 }
 
 }  // namespace deformkit::test

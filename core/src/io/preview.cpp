@@ -11,6 +11,7 @@
 #include "deformkit/geom/normals.h"
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/geom/triangulation.h"
+#include "deformkit/geom/weld.h"
 #include "deformkit/io/udim.h"
 #include "geom/rasterize_triangle.h"
 
@@ -111,7 +112,16 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
         const float z = std::max(view[v].z, 1e-6f);
         screen[v] = {0.5f * o.width + focal * view[v].x / z, 0.5f * o.height - focal * view[v].y / z};
     }
-    const std::vector<glm::vec3> normals = geom::vertexNormals(mesh);
+    // Normals over the welded mesh: split vertices (UV seams, a glTF's per-triangle corners) shade smoothly
+    // across the split, as the surface they describe.
+    std::vector<glm::vec3> normals(static_cast<size_t>(mesh.numVertices()));
+    const geom::Welding weld = geom::weldVertices(mesh, 0.0, "preview");
+    if (weld.merged() > 0) {
+        const std::vector<glm::vec3> welded = geom::vertexNormals(weld.mesh);
+        geom::scatterToCopies<glm::vec3>(weld, welded, normals);
+    } else {
+        normals = geom::vertexNormals(mesh);
+    }
     const geom::Triangulation tris = geom::triangulate(mesh);
 
     Image image(o.width, o.height, 3);

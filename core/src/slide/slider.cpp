@@ -82,7 +82,6 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
         throw InvalidInput(
             formatError(source, "maxWalkTriangles", std::to_string(options.maxWalkTriangles), "at least 1"));
     }
-    const geom::ManifoldReport& report = rest.halfEdges().report();
     for (size_t h = 0; h < handles.size(); ++h) {
         const SlideHandle& handle = handles[h];
         const std::string element =
@@ -95,17 +94,31 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
             throw InvalidInput(formatError(source, element, "radius " + std::to_string(handle.radius),
                                            "a finite radius > 0"));
         }
-        if (std::binary_search(report.isolatedVertices.begin(), report.isolatedVertices.end(),
-                               handle.vertex) ||
-            std::find(report.isolatedVertices.begin(), report.isolatedVertices.end(), handle.vertex) !=
-                report.isolatedVertices.end()) {
+    }
+    // Split vertices (coincident copies, as glTF and FBX files have them) are welded: the slide binds on the
+    // welded mesh and hands its results back to every copy.
+    auto weld = std::make_unique<geom::Welding>(geom::weldVertices(rest, options.weldTolerance, source));
+    if (weld->merged() == 0) weld.reset();
+    const geom::Mesh& surfaceMesh = weld ? weld->mesh : rest;
+    const std::vector<SlideHandle> fileHandles = handles;
+    if (weld) {
+        for (SlideHandle& handle : handles)
+            handle.vertex = weld->weldedOf[static_cast<size_t>(handle.vertex)];
+    }
+    const geom::ManifoldReport& report = surfaceMesh.halfEdges().report();
+    for (size_t h = 0; h < handles.size(); ++h) {
+        const SlideHandle& handle = handles[h];
+        const std::string element =
+            "handle " + std::to_string(h) + " (vertex " + std::to_string(fileHandles[h].vertex) + ")";
+        if (std::find(report.isolatedVertices.begin(), report.isolatedVertices.end(), handle.vertex) !=
+            report.isolatedVertices.end()) {
             throw InvalidInput(formatError(source, element, "no face uses this vertex",
                                            "a handle on the surface (a vertex of at least one face)"));
         }
         bool nonManifold = std::find(report.nonManifoldVertices.begin(), report.nonManifoldVertices.end(),
                                      handle.vertex) != report.nonManifoldVertices.end();
         for (int32_t e : report.nonManifoldEdges) {
-            const auto ends = rest.halfEdges().edgeVertices(e);
+            const auto ends = surfaceMesh.halfEdges().edgeVertices(e);
             nonManifold = nonManifold || ends[0] == handle.vertex || ends[1] == handle.vertex;
         }
         if (nonManifold) {
@@ -114,13 +127,14 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
         }
     }
 
-    impl_ = std::make_unique<Impl>(rest, std::move(handles), options, source);
+    impl_ = std::make_unique<Impl>(surfaceMesh, std::move(handles), options, source);
     Impl& m = *impl_;
     for (const SlideHandle& handle : m.handles) {
         if (!m.surface.hasFrame(handle.vertex)) {
-            throw InvalidInput(formatError(source, "handle vertex " + std::to_string(handle.vertex),
-                                           "every face around the handle is degenerate (zero area)",
-                                           "a handle with a tangent plane"));
+            throw InvalidInput(formatError(
+                source,
+                "handle vertex " + std::to_string(weld ? weld->firstOf[handle.vertex] : handle.vertex),
+                "every face around the handle is degenerate (zero area)", "a handle with a tangent plane"));
         }
         m.regions.push_back(
             buildSupportRegion(m.surface, m.mesh, handle.vertex, handle.radius, handle.region));
@@ -204,6 +218,40 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
     }
 
     if (options.surface == SurfaceMode::Limit) m.bindLimit();
+
+    if (weld) {
+        // The file's view: every copy of a welded vertex, in the welded vertex's place.
+        m.fileHandles = fileHandles;
+        for (const SupportRegion& region : m.regions) {
+            SupportRegion file = region;
+            file.handle = weld->firstOf[static_cast<size_t>(region.handle)];
+            file.vertices.clear();
+            file.normalizedDistance.clear();
+            file.a1Local.clear();
+            file.a2Local.clear();
+            for (size_t k = 0; k < region.vertices.size(); ++k) {
+                for (int32_t copy : weld->copiesOf(region.vertices[k])) {
+                    file.vertices.push_back(copy);
+                    file.normalizedDistance.push_back(region.normalizedDistance[k]);
+                    file.a1Local.push_back(region.a1Local[k]);
+                    file.a2Local.push_back(region.a2Local[k]);
+                }
+            }
+            m.fileRegions.push_back(std::move(file));
+        }
+        for (int32_t v : m.active) {
+            for (int32_t copy : weld->copiesOf(v))
+                m.fileActive.push_back(copy);
+        }
+        std::sort(m.fileActive.begin(), m.fileActive.end());
+        m.fileFaceOffsets.assign(1, 0);
+        for (int32_t count : rest.faceCounts())
+            m.fileFaceOffsets.push_back(m.fileFaceOffsets.back() + count);
+        m.fileFaceIndices.assign(rest.faceIndices().begin(), rest.faceIndices().end());
+        m.weldedPoints.resize(weld->firstOf.size());
+        m.weldedIn.resize(weld->firstOf.size());
+        m.weld = std::move(weld);
+    }
 }
 
 Slider::~Slider() = default;
@@ -211,25 +259,96 @@ Slider::Slider(Slider&&) noexcept = default;
 Slider& Slider::operator=(Slider&&) noexcept = default;
 
 int32_t Slider::numVertices() const {
-    return impl_->surface.numVertices();
+    return impl_->weld ? static_cast<int32_t>(impl_->weld->weldedOf.size()) : impl_->surface.numVertices();
 }
 int32_t Slider::numHandles() const {
     return static_cast<int32_t>(impl_->handles.size());
 }
 const std::vector<SlideHandle>& Slider::handles() const {
-    return impl_->handles;
+    return impl_->weld ? impl_->fileHandles : impl_->handles;
 }
 const SupportRegion& Slider::region(int32_t handle) const {
-    return impl_->regions.at(handle);
+    return impl_->weld ? impl_->fileRegions.at(handle) : impl_->regions.at(handle);
 }
 std::span<const int32_t> Slider::activeVertices() const {
-    return impl_->active;
+    return impl_->weld ? impl_->fileActive : impl_->active;
+}
+int32_t Slider::weldedVertices() const {
+    return impl_->weld ? impl_->weld->merged() : 0;
 }
 
 void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                       std::span<const float> weights, float envelope, SlideResult* result) {
     Impl& m = *impl_;
     const std::lock_guard<std::mutex> lock(m.mutex);
+    if (!m.weld) {
+        m.evaluateSurface(drives, points, weights, envelope, result);
+        if (result) result->welded = 0;
+        return;
+    }
+    const geom::Welding& weld = *m.weld;
+    const auto nv = static_cast<int32_t>(weld.weldedOf.size());
+    if (points.size() != static_cast<size_t>(nv)) {
+        throw InvalidInput(formatError(m.source, "points", std::to_string(points.size()) + " given",
+                                       std::to_string(nv) + ", one per vertex"));
+    }
+    if (!weights.empty() && weights.size() != static_cast<size_t>(nv)) {
+        throw InvalidInput(formatError(m.source, "weights", std::to_string(weights.size()) + " given",
+                                       std::to_string(nv) + ", one per vertex"));
+    }
+    // The copies the slide reads must be finite, named by their file index (the welded vertex reads its first
+    // copy; the others follow it).
+    for (int32_t v : m.fileActive) {
+        const glm::vec3& p = points[v];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(v), "not finite",
+                                           "finite x, y, z"));
+        }
+    }
+    for (size_t w = 0; w < weld.firstOf.size(); ++w)
+        m.weldedIn[w] = m.weldedPoints[w] = points[static_cast<size_t>(weld.firstOf[w])];
+    std::span<const float> weldedWeights;
+    if (!weights.empty()) {
+        m.weldedWeights.resize(weld.firstOf.size());
+        for (size_t w = 0; w < weld.firstOf.size(); ++w)
+            m.weldedWeights[w] = weights[static_cast<size_t>(weld.firstOf[w])];
+        weldedWeights = m.weldedWeights;
+    }
+    m.evaluateSurface(drives, m.weldedPoints, weldedWeights, envelope, result);
+    // Every copy of a moved vertex moves as it does: to the same position when it came in at the first
+    // copy's position, by the same displacement otherwise (a tolerance weld).
+    for (int32_t w : m.active) {
+        const glm::vec3 in = m.weldedIn[w], out = m.weldedPoints[w];
+        if (in == out) continue;
+        for (int32_t copy : weld.copiesOf(w)) {
+            glm::vec3& p = points[static_cast<size_t>(copy)];
+            p = p == in ? out : p + (out - in);
+        }
+    }
+    if (result) {
+        // Landings per file vertex, on the file's faces and their corners' file vertices.
+        std::vector<SlideLanding> landings;
+        for (const SlideLanding& landing : result->landings) {
+            const int32_t fileFace = weld.fileFaceOf[static_cast<size_t>(landing.face)];
+            for (int32_t copy : weld.copiesOf(landing.vertex)) {
+                SlideLanding out = landing;
+                out.vertex = copy;
+                out.face = fileFace;
+                for (int k = 0; k < 3; ++k)
+                    out.triangle[k] = m.fileCornerVertex(fileFace, landing.triangle[k]);
+                landings.push_back(out);
+            }
+        }
+        std::sort(landings.begin(), landings.end(),
+                  [](const SlideLanding& a, const SlideLanding& b) { return a.vertex < b.vertex; });
+        result->landings = std::move(landings);
+        result->welded = weld.merged();
+    }
+}
+
+void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
+                                   std::span<const float> weights, float envelope, SlideResult* result) {
+    Impl& m = *this;
     const int32_t nv = m.surface.numVertices();
     if (drives.size() != m.handles.size()) {
         throw InvalidInput(formatError(m.source, "slide drives", std::to_string(drives.size()) + " given",

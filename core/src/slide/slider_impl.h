@@ -18,6 +18,7 @@
 
 #include "deformkit/geom/limit_surface.h"
 #include "deformkit/geom/mesh.h"
+#include "deformkit/geom/weld.h"
 #include "deformkit/slide/region.h"
 #include "deformkit/slide/slider.h"
 #include "deformkit/slide/surface.h"
@@ -94,6 +95,30 @@ struct Slider::Impl {
     std::unique_ptr<detail::LocalLimit> limit;
     int32_t degenerateTriangles = 0;
     std::mutex mutex;
+
+    // A rest mesh with split vertices (geom/weld.h) is bound welded: everything above is on the welded mesh,
+    // and the public interface speaks of the file's vertices through these. Null when nothing was welded.
+    std::unique_ptr<geom::Welding> weld;
+    std::vector<SlideHandle> fileHandles;    // the handles as given (file vertices)
+    std::vector<SupportRegion> fileRegions;  // the regions with every copy of each welded vertex
+    std::vector<int32_t> fileActive;         // every copy of the active vertices, ascending
+    std::vector<glm::vec3> weldedPoints;     // scratch: the incoming points of the welded vertices
+    std::vector<glm::vec3> weldedIn;         // scratch: the same before the slide
+    std::vector<float> weldedWeights;        // scratch: each welded vertex's first copy's weight
+    std::vector<int32_t> fileFaceOffsets;    // the file's faces: corners [offsets[f], offsets[f + 1])
+    std::vector<int32_t> fileFaceIndices;    // of fileFaceIndices
+
+    // The file vertex at the corner of file face `face` whose welded vertex is `welded`.
+    [[nodiscard]] int32_t fileCornerVertex(int32_t face, int32_t welded) const {
+        for (int32_t c = fileFaceOffsets[face]; c < fileFaceOffsets[face + 1]; ++c) {
+            if (weld->weldedOf[static_cast<size_t>(fileFaceIndices[c])] == welded) return fileFaceIndices[c];
+        }
+        return -1;
+    }
+
+    // The evaluation on the surface's own vertices (the welded ones when `weld` is set).
+    void evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
+                         std::span<const float> weights, float envelope, SlideResult* result);
 
     Impl(const geom::Mesh& rest, std::vector<SlideHandle> h, const SlideOptions& o, std::string s)
         : source(std::move(s)), mesh(rest), options(o), handles(std::move(h)), surface(rest, source) {}

@@ -13,6 +13,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/half_edge.h"
+#include "deformkit/geom/weld.h"
 #include "warp/point_text.h"
 
 namespace deformkit::warp {
@@ -134,14 +135,24 @@ float meshWarpFalloff(float t, float a, float b) {
     return y * y * (1.0f + 2.0f * x);
 }
 
-MeshWarp::MeshWarp(const geom::Mesh& cage, const MeshWarpOptions& options, const std::string& source)
+MeshWarp::MeshWarp(const geom::Mesh& fileCage, const MeshWarpOptions& options, const std::string& source)
     : options_(options), source_(source) {
     checkOptions(options_, source_);
-    const int32_t n = cage.numVertices();
-    if (n == 0 || cage.numFaces() == 0) {
+    if (fileCage.numVertices() == 0 || fileCage.numFaces() == 0) {
         throw InvalidInput(
             formatError(source_, "cage", "has no vertices or no faces", "a control mesh with faces"));
     }
+    // A cage with split vertices (UV seams, per-triangle corners) is welded: its control vertices are its
+    // positions, each with its whole edge star.
+    geom::Welding weld = geom::weldVertices(fileCage, options_.weldTolerance, source_ + " cage");
+    cageVertices_ = fileCage.numVertices();
+    const bool welded = weld.merged() > 0;
+    if (welded) {
+        controlOf_ = std::move(weld.weldedOf);
+        firstCopy_ = std::move(weld.firstOf);
+    }
+    const geom::Mesh& cage = welded ? weld.mesh : fileCage;
+    const int32_t n = cage.numVertices();
     geom::requireManifold(cage, source_ + " cage");
     const geom::HalfEdgeMesh& he = cage.halfEdges();
     rest_.assign(cage.points().begin(), cage.points().end());
@@ -152,8 +163,8 @@ MeshWarp::MeshWarp(const geom::Mesh& cage, const MeshWarpOptions& options, const
     for (int32_t i = 0; i < n; ++i) {
         const auto nb = he.vertexNeighbors(i);
         if (nb.empty()) {
-            throw InvalidInput(formatError(source_, "cage vertex " + std::to_string(i), "has no edges",
-                                           "every control vertex on at least one edge"));
+            throw InvalidInput(formatError(source_, "cage vertex " + std::to_string(cageVertexOf(i)),
+                                           "has no edges", "every control vertex on at least one edge"));
         }
         const int32_t k = static_cast<int32_t>(nb.size());
         Eigen::MatrixXd e(k, 3);
@@ -162,9 +173,11 @@ MeshWarp::MeshWarp(const geom::Mesh& cage, const MeshWarpOptions& options, const
             const glm::vec3 edge = rest_[nb[j]] - rest_[i];
             const float len2 = glm::dot(edge, edge);
             if (!(len2 > 0.0f)) {
-                throw InvalidInput(formatError(
-                    source_, "cage edge (" + std::to_string(i) + ", " + std::to_string(nb[j]) + ")",
-                    "has zero length", "distinct positions at the ends of every edge"));
+                throw InvalidInput(formatError(source_,
+                                               "cage edge (" + std::to_string(cageVertexOf(i)) + ", " +
+                                                   std::to_string(cageVertexOf(nb[j])) + ")",
+                                               "has zero length",
+                                               "distinct positions at the ends of every edge"));
             }
             neighbors_.push_back(nb[j]);
             edges_.push_back(edge);
@@ -196,10 +209,10 @@ MeshWarp::MeshWarp(const geom::Mesh& cage, const MeshWarpOptions& options, const
 }
 
 void MeshWarp::setTarget(std::span<const glm::vec3> targetCagePoints) {
-    if (targetCagePoints.size() != rest_.size()) {
+    if (targetCagePoints.size() != static_cast<size_t>(cageVertices_)) {
         throw InvalidInput(
             formatError(source_, "target cage", "has " + std::to_string(targetCagePoints.size()) + " points",
-                        std::to_string(rest_.size()) + " points, the rest cage's vertex count"));
+                        std::to_string(cageVertices_) + " points, the rest cage's vertex count"));
     }
     for (size_t i = 0; i < targetCagePoints.size(); ++i) {
         if (!geom::isFinite(targetCagePoints[i])) {
@@ -208,7 +221,12 @@ void MeshWarp::setTarget(std::span<const glm::vec3> targetCagePoints) {
                                            "finite coordinates"));
         }
     }
-    target_.assign(targetCagePoints.begin(), targetCagePoints.end());
+    if (firstCopy_.empty()) {
+        target_.assign(targetCagePoints.begin(), targetCagePoints.end());
+    } else {
+        for (size_t i = 0; i < firstCopy_.size(); ++i)
+            target_[i] = targetCagePoints[static_cast<size_t>(firstCopy_[i])];
+    }
 }
 
 float MeshWarp::weight(int32_t i, const glm::vec3& p) const {

@@ -8,7 +8,9 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/box.h"
 #include "deformkit/geom/primitives.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/io/preview.h"
+#include "mesh_support.h"
 
 using namespace deformkit;
 
@@ -171,4 +173,28 @@ TEST_CASE("preview: weight colours run blue, cyan, green, yellow, red", "[io][pr
     CHECK(same(io::weightColor(-2.0f), {0, 0, 1}));
     CHECK(same(io::weightColor(7.0f), {1, 0, 0}));
     CHECK(same(io::weightColor(std::nanf("")), {0, 0, 1}));
+}
+
+TEST_CASE("preview: split vertices shade as the shared-vertex mesh, pixel for pixel", "[io][preview][weld]") {
+    const geom::Mesh spot = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
+    io::PreviewOptions options;
+    options.width = 160;
+    options.height = 120;
+    const io::Image shared = io::renderPreview(spot, options);
+    for (const bool perCorner : {false, true}) {
+        CAPTURE(perCorner);
+        std::vector<int32_t> original;
+        const geom::Mesh split = test::splitCopy(spot, perCorner, original);
+        CHECK(io::renderPreview(split, options).pixels == shared.pixels);
+    }
+    // Without the weld each split face would shade alone: the faceted picture differs.
+    geom::Mesh::Data apart;
+    std::vector<int32_t> original;
+    const geom::Mesh split = test::splitCopy(spot, true, original);
+    apart.points.assign(split.points().begin(), split.points().end());
+    for (glm::vec3& p : apart.points)
+        p.x += 1e-7f * static_cast<float>(&p - apart.points.data() & 1);  // copies no longer coincide
+    apart.faceCounts.assign(split.faceCounts().begin(), split.faceCounts().end());
+    apart.faceIndices.assign(split.faceIndices().begin(), split.faceIndices().end());
+    CHECK(io::renderPreview(geom::Mesh(std::move(apart), "apart"), options).pixels != shared.pixels);
 }

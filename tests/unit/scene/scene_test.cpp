@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -215,4 +216,28 @@ TEST_CASE("scene: Bezier auto keys and vector keys evaluate as hand-computed cur
     const scene::SceneParameter& d = evaluator.scene().objects[0].stack[2].params[0];
     CHECK(d.value.at(9.999) == std::vector<double>{0, 0, 0});
     CHECK(d.value.at(10) == std::vector<double>{1, 2, 3});
+}
+
+TEST_CASE("scene: a rest mesh in another format (PLY) reads as its OBJ does", "[host][scene][mesh_file]") {
+    test::TempDir dir;
+    // The same quad and triangle as a PLY and as an OBJ.
+    test::writeText(
+        dir / "two.ply",
+        "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float "
+        "z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n2 0 0\n2 1 "
+        "0\n0 1 0\n1 2 0\n4 0 1 2 3\n3 3 2 4\n");
+    test::writeText(dir / "two.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 1 2 0\nf 1 2 3 4\nf 4 3 5\n");
+    auto sceneWith = [](const std::string& mesh) {
+        return R"({"deformkit_scene": 1, "frames": [1, 2], "objects": [{"name": "t", "mesh": ")" + mesh +
+               R"(", "stack": [{"type": "twist", "params": {"endAngle": 0.5}}]}]})";
+    };
+    scene::SceneEvaluator ply(scene::parseScene(sceneWith("two.ply"), dir / "a.json"));
+    scene::SceneEvaluator obj(scene::parseScene(sceneWith("two.obj"), dir / "b.json"));
+    CHECK(test::sameBits(ply.evaluate(0, 2).points(), obj.evaluate(0, 2).points()));
+    CHECK(std::ranges::equal(ply.scene().objects[0].rest.faceIndices(),
+                             obj.scene().objects[0].rest.faceIndices()));
+    test::writeText(dir / "two.stl", "solid two\nendsolid\n");
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)scene::parseScene(sceneWith("two.stl"), dir / "c.json"); }),
+        Contains("objects[0].mesh") && Contains(".obj, .gltf, .glb, .fbx, .ply, .dae"));
 }

@@ -15,6 +15,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/warp/mesh_warp.h"
+#include "mesh_support.h"
 
 using namespace deformkit;
 using namespace deformkit::warp;
@@ -481,4 +482,39 @@ TEST_CASE("mesh warp: bad input names the element", "[mesh_warp][errors]") {
     const std::vector<glm::vec3> nanRest{{0, 0, 0}, {NAN, 0, 0}};
     SparseFields f;
     CHECK_THROWS_WITH(warp.bind(nanRest, f), Catch::Contains("rest point 1"));
+}
+
+TEST_CASE("mesh warp: a cage with split vertices warps as the shared-vertex cage, bit for bit",
+          "[mesh_warp][weld]") {
+    const geom::Mesh cage = geom::makeSphere({});
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::vector<glm::vec3> points(600);
+    for (glm::vec3& p : points)
+        p = glm::vec3(unit(rng), unit(rng), unit(rng)) * 0.8f;
+    std::vector<glm::vec3> target(cage.points().begin(), cage.points().end());
+    for (glm::vec3& p : target)
+        p += glm::vec3(unit(rng), unit(rng), unit(rng)) * 0.1f;
+    for (const bool perCorner : {false, true}) {
+        CAPTURE(perCorner);
+        std::vector<int32_t> original, newIndex;
+        const geom::Mesh split = test::splitCopy(cage, perCorner, original);
+        const geom::Mesh shared =
+            test::renumbered(cage, test::firstCopyOrder(original, cage.numVertices()), newIndex);
+        std::vector<glm::vec3> sharedTarget(target.size()), splitTarget;
+        for (size_t v = 0; v < target.size(); ++v)
+            sharedTarget[static_cast<size_t>(newIndex[v])] = target[v];
+        for (int32_t v : original)
+            splitTarget.push_back(target[static_cast<size_t>(v)]);
+        std::vector<glm::vec3> want = points, got = points;
+        warp::meshWarp(want, shared, sharedTarget);
+        warp::meshWarp(got, split, splitTarget);
+        CHECK(std::memcmp(got.data(), want.data(), got.size() * sizeof(glm::vec3)) == 0);
+        CHECK(warp::MeshWarp(split).numControlVertices() == cage.numVertices());
+        CHECK(warp::MeshWarp(split).numCageVertices() == split.numVertices());
+        double moved = 0.0;
+        for (size_t k = 0; k < points.size(); ++k)
+            moved = std::max(moved, static_cast<double>(glm::length(got[k] - points[k])));
+        CHECK(moved > 0.01);
+    }
 }

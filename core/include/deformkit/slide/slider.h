@@ -53,6 +53,11 @@ struct SlideOptions {
     // SlideResult::walkLimitStopped): the expansion limit for displacements many times larger than the
     // region.
     int32_t maxWalkTriangles = 4096;
+    // Vertices within this distance of each other (scene units) are one vertex of the surface: split
+    // vertices, as glTF, FBX and game-engine files have them at UV seams and hard edges, are welded
+    // (geom/weld.h) so the slide walks across seams, and every copy moves as the others. 0: exactly equal
+    // positions.
+    double weldTolerance = 0.0;
 };
 
 // Where a moved vertex landed: a triangle of the rest mesh's fan triangulation, given by its polygon and
@@ -79,6 +84,10 @@ struct SlideResult {
     int32_t unreachable = 0;          // within a radius but not reachable by the propagation: unmoved (bind)
     int32_t withoutTangentPlane = 0;  // within a radius but only degenerate triangles around: unmoved (bind)
     int32_t degenerateTriangles = 0;  // zero-area triangles touching an active vertex: skipped (bind)
+    // File vertices welded onto another (split copies; SlideOptions::weldTolerance). The counts above are of
+    // the welded vertices (positions): a vertex the file splits in three counts once; landings list every
+    // copy.
+    int32_t welded = 0;
 };
 
 // The sliding deformer (Pinskiy, "Sliding deformation"): bind once per rest mesh and handle set, evaluate
@@ -115,14 +124,17 @@ class Slider {
     [[nodiscard]] int32_t numHandles() const;
     [[nodiscard]] const std::vector<SlideHandle>& handles() const;
     [[nodiscard]] const SupportRegion& region(int32_t handle) const;
-    // Vertices in at least one handle's region (union), ascending.
+    // Vertices in at least one handle's region (union), ascending; every copy of a welded vertex.
     [[nodiscard]] std::span<const int32_t> activeVertices() const;
+    // File vertices welded onto another at bind (SlideOptions::weldTolerance); 0 for a mesh without split
+    // vertices.
+    [[nodiscard]] int32_t weldedVertices() const;
 
     // points: #V positions of the surface to slide over (the rest positions, or a deformed copy with the
     // rest mesh's connectivity), replaced in place by the slid positions. drives: one per handle, the
     // displacements in the space of `points`. weights: #V painted weights in [0, 1] (empty: all 1), acting
-    // as options.weights says. envelope scales every slide. Throws InvalidInput for a wrong count or a
-    // non-finite value, naming it, before anything is written.
+    // as options.weights says (a welded vertex takes its first copy's weight). envelope scales every slide.
+    // Throws InvalidInput for a wrong count or a non-finite value, naming it, before anything is written.
     void evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                   std::span<const float> weights = {}, float envelope = 1.0f, SlideResult* result = nullptr);
 

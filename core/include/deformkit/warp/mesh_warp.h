@@ -27,6 +27,9 @@ struct MeshWarpOptions {
     // Singular values of a control vertex's edge matrix below this fraction of the largest are treated
     // as zero (a planar or collinear star); see A_i in MeshWarp.
     double rankTolerance = 1e-6;
+    // Cage vertices within this distance (scene units) are one control vertex: a cage with split vertices
+    // (glTF, FBX) is welded (geom/weld.h). 0: exactly coincident ones.
+    double weldTolerance = 0.0;
 };
 
 // f_ab(t) of §6: 1 for t <= a, 0 for t >= b, the C1 cubic 1 - (3x^2 - 2x^3), x = (t - a) / (b - a), between.
@@ -55,7 +58,9 @@ class MeshWarp : public Warp {
                       const std::string& source = "mesh warp");
 
     // #cage vertices target positions (same order and topology as the rest cage). Throws InvalidInput
-    // if the count differs or a coordinate is not finite. Until called, the target is the rest cage.
+    // if the count differs or a coordinate is not finite. Until called, the target is the rest cage. A cage
+    // with split vertices (coincident copies, geom/weld.h) is welded at construction: its control vertices
+    // are its positions, each target read from the position's first copy.
     void setTarget(std::span<const glm::vec3> targetCagePoints);
 
     // Fields on the rest surface (#points positions): only control vertices with non-zero weight at a
@@ -72,7 +77,11 @@ class MeshWarp : public Warp {
     // Rank of the rest edge matrix of control vertex i (3 for a star spanning space).
     [[nodiscard]] int32_t starRank(int32_t controlVertex) const { return rank_[controlVertex]; }
 
+    // Control vertices: the cage's vertices, or its positions when it has split vertices.
     [[nodiscard]] int32_t numControlVertices() const { return static_cast<int32_t>(rest_.size()); }
+    [[nodiscard]] int32_t numCageVertices() const { return cageVertices_; }
+    // The control vertex of cage vertex v (v itself unless the cage was welded).
+    [[nodiscard]] int32_t controlVertexOf(int32_t v) const { return controlOf_.empty() ? v : controlOf_[v]; }
     [[nodiscard]] const MeshWarpOptions& options() const { return options_; }
     [[nodiscard]] std::span<const glm::vec3> restCage() const { return rest_; }
     [[nodiscard]] std::span<const glm::vec3> targetCage() const { return target_; }
@@ -93,6 +102,12 @@ class MeshWarp : public Warp {
     std::vector<double> pinv_;        // per neighbour entry: the 3 column entries of E^+ (3 x k), column j
     std::vector<float> longest_;      // |E_im| per control vertex
     std::vector<int32_t> rank_;
+    int32_t cageVertices_ = 0;
+    std::vector<int32_t> controlOf_;  // per cage vertex: its control vertex (empty: the identity)
+    std::vector<int32_t> firstCopy_;  // per control vertex: its first cage vertex (empty: the identity)
+    [[nodiscard]] int32_t cageVertexOf(int32_t control) const {
+        return firstCopy_.empty() ? control : firstCopy_[control];
+    }
 };
 
 // One-off: bind `cage` to `points` and deform them towards `targetCagePoints` in place, with Maya's

@@ -45,6 +45,12 @@ class SlideDeformer final : public Deformer {
                                    .rebinds = true,
                                    .doc = "1 scales the drag down so that no triangle of the region flips"},
                                   {0.0});
+        weld_ =
+            addParameter({.name = "weldTolerance",
+                          .rebinds = true,
+                          .doc = "split vertices within this distance (scene units, >= 0) are one vertex; 0 "
+                                 "welds exactly coincident ones"},
+                         {0.0});
         displacement_ = addParameter(
             {.name = "displacement", .doc = "end locator minus start locator, scene units"}, {0.0, 0.0, 0.0});
         falloff_ = addParameter({.name = "falloff", .doc = "0 smooth, 1 linear, 2 falloffRamp"}, {0.0});
@@ -65,6 +71,8 @@ class SlideDeformer final : public Deformer {
             requireIntegers(index, value, 0, 1);
         if (index == falloff_) requireIntegers(index, value, 0, 2);
         if (index == radius_ && !(value[0] > 0.0)) fail(index, "is " + numberText(value[0]), "a number > 0");
+        if (index == weld_ && !(value[0] >= 0.0))
+            fail(index, "is " + numberText(value[0]), "a distance >= 0");
         if (index == ramp_) {
             try {
                 (void)makeRamp(value);
@@ -92,6 +100,7 @@ class SlideDeformer final : public Deformer {
         options.weights = value(painted_)[0] == 0.0 ? slide::PaintedWeights::ScaleFalloff
                                                     : slide::PaintedWeights::AreFalloff;
         options.foldLimit = value(foldLimit_)[0] != 0.0;
+        options.weldTolerance = value(weld_)[0];
         slider_ = std::make_unique<slide::Slider>(rest, std::vector<slide::SlideHandle>{handle}, options,
                                                   context());
     }
@@ -123,7 +132,7 @@ class SlideDeformer final : public Deformer {
         return slide::Falloff::ramp(values, "samples");
     }
 
-    size_t vertex_, radius_, geodesic_, limit_, painted_, foldLimit_, displacement_, falloff_, ramp_;
+    size_t vertex_, radius_, geodesic_, limit_, painted_, foldLimit_, weld_, displacement_, falloff_, ramp_;
     std::unique_ptr<slide::Slider> slider_;
     std::array<slide::SlideDrive, 1> drive_;
     double falloffKind_ = -1.0;  // the falloff drive_ holds: its kind and ramp (-1: none yet)

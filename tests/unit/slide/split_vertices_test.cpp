@@ -1,0 +1,167 @@
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "deformkit/error.h"
+#include "deformkit/geom/half_edge.h"
+#include "deformkit/geom/weld.h"
+#include "deformkit/slide/slider.h"
+#include "mesh_support.h"
+#include "slide_real_meshes.h"
+#include "test_support.h"
+
+// Meshes as glTF, FBX and game-engine files hand them over: vertices split wherever UVs break, or every
+// triangle with its own corners. The slide welds them (geom/weld.h) and must give, copy by copy, exactly the
+// slide of the mesh with shared vertices.
+
+using namespace deformkit;
+using namespace deformkit::slide;
+using Catch::Contains;
+
+namespace {
+
+struct Case {
+    std::vector<SlideHandle> handles;
+    std::vector<SlideDrive> drives;
+    SlideOptions options;
+    std::vector<float> weights;  // per original vertex, or empty
+};
+
+Case randomCase(const geom::Mesh& mesh, std::mt19937& rng) {
+    const double size = test::diagonal(mesh.points());
+    std::uniform_int_distribution<int32_t> vertex(0, mesh.numVertices() - 1);
+    std::uniform_real_distribution<double> unit(0.0, 1.0), signedUnit(-1.0, 1.0);
+    Case c;
+    const int handles = unit(rng) < 0.3 ? 2 : 1;
+    for (int h = 0; h < handles; ++h) {
+        const RegionMetric metric = unit(rng) < 0.5 ? RegionMetric::Euclidean : RegionMetric::Geodesic;
+        c.handles.push_back({vertex(rng), size * (0.05 + 0.15 * unit(rng)), metric});
+        SlideDrive drive;
+        drive.displacement = glm::dvec3(signedUnit(rng), signedUnit(rng), signedUnit(rng)) * (0.08 * size);
+        c.drives.push_back(drive);
+    }
+    c.options.foldLimit = unit(rng) < 0.4;
+    if (unit(rng) < 0.25) c.options.surface = SurfaceMode::Limit;
+    if (unit(rng) < 0.3) {
+        c.weights.resize(static_cast<size_t>(mesh.numVertices()));
+        for (float& w : c.weights)
+            w = static_cast<float>(unit(rng));
+    }
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("slide on split vertices: every copy moves bit for bit as the shared vertex, on Spot and Bob",
+          "[slide][weld]") {
+    std::mt19937 rng(20261204);
+    int moved = 0, cases = 0;
+    for (const geom::Mesh* mesh : {&test::spot(), &test::bob()}) {
+        for (const bool perCorner : {false, true}) {
+            std::vector<int32_t> original;
+            const geom::Mesh split = test::splitCopy(*mesh, perCorner, original);
+            CAPTURE(split.numVertices(), mesh->numVertices(), perCorner);
+            REQUIRE(split.numVertices() > mesh->numVertices());
+            // The file's first copy of each original vertex (for handles given on the split mesh), and the
+            // reference: the shared-vertex mesh numbered by first copies.
+            std::vector<int32_t> firstCopy(static_cast<size_t>(mesh->numVertices()), -1), order;
+            for (int32_t k = 0; k < split.numVertices(); ++k) {
+                if (firstCopy[static_cast<size_t>(original[k])] < 0) {
+                    firstCopy[static_cast<size_t>(original[k])] = k;
+                    order.push_back(original[k]);
+                }
+            }
+            std::vector<int32_t> newIndex;
+            const geom::Mesh shared = test::renumbered(*mesh, order, newIndex);
+            for (int n = 0; n < 6; ++n, ++cases) {
+                Case c = randomCase(*mesh, rng);
+                for (SlideHandle& h : c.handles)
+                    h.vertex = newIndex[static_cast<size_t>(h.vertex)];
+                if (!c.weights.empty()) {
+                    std::vector<float> permuted(c.weights.size());
+                    for (size_t v = 0; v < c.weights.size(); ++v)
+                        permuted[static_cast<size_t>(newIndex[v])] = c.weights[v];
+                    c.weights = std::move(permuted);
+                }
+                CAPTURE(n, c.handles[0].vertex, c.options.foldLimit, c.weights.size(),
+                        c.options.surface == SurfaceMode::Limit);
+                SlideResult want;
+                const std::vector<glm::vec3> expected =
+                    slide::slide(shared, c.handles, c.drives, c.weights, 1.0f, c.options, &want);
+                Case s = c;
+                for (SlideHandle& h : s.handles)
+                    h.vertex = firstCopy[static_cast<size_t>(order[static_cast<size_t>(h.vertex)])];
+                if (!c.weights.empty()) {
+                    s.weights.resize(static_cast<size_t>(split.numVertices()));
+                    for (int32_t k = 0; k < split.numVertices(); ++k)
+                        s.weights[k] =
+                            c.weights[static_cast<size_t>(newIndex[static_cast<size_t>(original[k])])];
+                }
+                SlideResult got;
+                const std::vector<glm::vec3> out =
+                    slide::slide(split, s.handles, s.drives, s.weights, 1.0f, s.options, &got);
+                int mismatches = 0;
+                for (int32_t k = 0; k < split.numVertices(); ++k) {
+                    const glm::vec3& a = out[k];
+                    const glm::vec3& b =
+                        expected[static_cast<size_t>(newIndex[static_cast<size_t>(original[k])])];
+                    mismatches += std::memcmp(&a, &b, sizeof a) != 0 ? 1 : 0;
+                }
+                CHECK(mismatches == 0);
+                CHECK(got.moved == want.moved);
+                CHECK(got.flippedTriangles == want.flippedTriangles);
+                CHECK(got.unreachable == want.unreachable);
+                CHECK(got.unreachable == 0);
+                CHECK(got.foldScale == want.foldScale);
+                CHECK(got.welded == split.numVertices() - mesh->numVertices());
+                // Landings: one per moved copy, on the same face and the same corners (as the file numbers
+                // them) with the same barycentric coordinates.
+                size_t copiesMoved = 0;
+                for (const SlideLanding& l : want.landings)
+                    for (int32_t k = 0; k < split.numVertices(); ++k)
+                        copiesMoved += newIndex[static_cast<size_t>(original[k])] == l.vertex ? 1 : 0;
+                REQUIRE(got.landings.size() == copiesMoved);
+                std::map<int32_t, const SlideLanding*> byVertex;
+                for (const SlideLanding& l : want.landings)
+                    byVertex[l.vertex] = &l;
+                for (const SlideLanding& l : got.landings) {
+                    const SlideLanding& w = *byVertex.at(newIndex[static_cast<size_t>(original[l.vertex])]);
+                    CHECK(l.face == w.face);
+                    for (int k = 0; k < 3; ++k) {
+                        CHECK(newIndex[static_cast<size_t>(original[l.triangle[k]])] == w.triangle[k]);
+                        CHECK(l.barycentric[k] == w.barycentric[k]);
+                    }
+                }
+                moved += want.moved;
+            }
+        }
+    }
+    CHECK(cases == 24);
+    CHECK(moved > 1000);  // the drags are real
+}
+
+TEST_CASE("slide on split vertices: without welding the split mesh tears", "[slide][weld]") {
+    // What the weld prevents: the Fox-like case of every triangle on its own, the handle's triangle alone
+    // moves and the others stay, a crack.
+    std::vector<int32_t> original;
+    const geom::Mesh split = test::splitCopy(test::spot(), true, original);
+    const geom::Welding weld = geom::weldVertices(split);
+    CHECK(weld.merged() == split.numVertices() - test::spot().numVertices());
+    CHECK(weld.mesh.numFaces() == test::spot().numFaces());
+    CHECK(weld.mesh.halfEdges().report().components == test::spot().halfEdges().report().components);
+    // A tolerance joins copies a little apart; a negative one is refused.
+    geom::Mesh::Data data;
+    data.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1e-4f, 1, 0}, {1, 0, 0}, {1, 1, 0}};
+    data.faceCounts = {3, 3};
+    data.faceIndices = {0, 1, 2, 4, 5, 3};
+    const geom::Mesh apart(std::move(data), "apart");
+    CHECK(geom::weldVertices(apart).merged() == 1);  // vertex 4 onto 1
+    CHECK(geom::weldVertices(apart, 1e-3).merged() == 2);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)geom::weldVertices(apart, -1.0, "apart.obj"); }),
+               Contains("apart.obj: weld tolerance: is -1"));
+}
