@@ -12,8 +12,6 @@ split vertices (one per distinct position, UV and normal), FBX and Collada are w
 
 import os
 import sys
-import tempfile
-import traceback
 
 import addon_utils
 import bpy
@@ -22,6 +20,9 @@ import numpy as np
 STAGE = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, STAGE)
 import deformkit as addon  # noqa: E402  (the add-on package; its compiled module is addon.core.dk)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_tests  # noqa: E402
 
 dk = addon.core.dk
 FOX = os.path.join(os.environ.get("DEFORMKIT_TEST_DATA", os.path.join(os.path.dirname(__file__), "..", "data")),
@@ -93,18 +94,7 @@ def test_formats_read_as_the_obj(folder):
 def main():
     addon_utils.enable("io_scene_gltf2")
     addon_utils.enable("io_scene_fbx")
-    failures = 0
-    with tempfile.TemporaryDirectory() as folder:
-        for test in (test_formats_read_as_the_obj,):
-            try:
-                test(folder)
-                print("PASS", test.__name__)
-            except Exception:  # noqa: BLE001  (every test runs; each failure is printed)
-                failures += 1
-                print("FAIL", test.__name__)
-                traceback.print_exc()
-    if failures:
-        sys.exit(1)
+    blender_tests.run((test_formats_read_as_the_obj,))
 
 
 main()

@@ -10,11 +10,8 @@ bit. Blender's Mesh Cache modifier numbers a cache's samples from its own Frame 
 frame is not used in its Frame mode), so it is set to the caches' first frame, 1.
 """
 
-import math
 import os
 import sys
-import tempfile
-import traceback
 
 import addon_utils
 import bpy
@@ -23,6 +20,9 @@ import numpy as np
 STAGE = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, STAGE)
 import deformkit as addon  # noqa: E402  (the add-on package; its compiled module is addon.core.dk)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_tests  # noqa: E402
 
 dk = addon.core.dk
 FRAMES = range(1, 7)
@@ -125,18 +125,7 @@ def test_deformkit_caches_shown_by_blender(folder):
 def main():
     addon_utils.enable("io_export_pc2")
     addon_utils.enable("io_shape_mdd")
-    failures = 0
-    with tempfile.TemporaryDirectory() as folder:
-        for test in (test_blender_exports_read_by_deformkit, test_deformkit_caches_shown_by_blender):
-            try:
-                test(folder)
-                print("PASS", test.__name__)
-            except Exception:  # noqa: BLE001  (every test runs; each failure is printed)
-                failures += 1
-                print("FAIL", test.__name__)
-                traceback.print_exc()
-    if failures:
-        sys.exit(1)
+    blender_tests.run((test_blender_exports_read_by_deformkit, test_deformkit_caches_shown_by_blender))
 
 
 main()

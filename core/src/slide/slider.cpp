@@ -287,15 +287,7 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
         return;
     }
     const geom::Welding& weld = *m.weld;
-    const auto nv = static_cast<int32_t>(weld.weldedOf.size());
-    if (points.size() != static_cast<size_t>(nv)) {
-        throw InvalidInput(formatError(m.source, "points", std::to_string(points.size()) + " given",
-                                       std::to_string(nv) + ", one per vertex"));
-    }
-    if (!weights.empty() && weights.size() != static_cast<size_t>(nv)) {
-        throw InvalidInput(formatError(m.source, "weights", std::to_string(weights.size()) + " given",
-                                       std::to_string(nv) + ", one per vertex"));
-    }
+    m.requireCounts(static_cast<int32_t>(weld.weldedOf.size()), points.size(), weights.size());
     // The copies the slide reads must be finite, named by their file index (the welded vertex reads its first
     // copy; the others follow it).
     for (int32_t v : m.fileActive) {
@@ -346,6 +338,17 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
     }
 }
 
+void Slider::Impl::requireCounts(int32_t vertices, size_t points, size_t weights) const {
+    if (points != static_cast<size_t>(vertices)) {
+        throw InvalidInput(formatError(source, "points", std::to_string(points) + " given",
+                                       std::to_string(vertices) + ", one per vertex"));
+    }
+    if (weights != 0 && weights != static_cast<size_t>(vertices)) {
+        throw InvalidInput(formatError(source, "weights", std::to_string(weights) + " given",
+                                       std::to_string(vertices) + ", one per vertex"));
+    }
+}
+
 void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                                    std::span<const float> weights, float envelope, SlideResult* result) {
     Impl& m = *this;
@@ -361,14 +364,7 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
                                            "not finite", "finite x, y, z"));
         }
     }
-    if (points.size() != static_cast<size_t>(nv)) {
-        throw InvalidInput(formatError(m.source, "points", std::to_string(points.size()) + " given",
-                                       std::to_string(nv) + ", one per vertex"));
-    }
-    if (!weights.empty() && weights.size() != static_cast<size_t>(nv)) {
-        throw InvalidInput(formatError(m.source, "weights", std::to_string(weights.size()) + " given",
-                                       std::to_string(nv) + ", one per vertex"));
-    }
+    m.requireCounts(nv, points.size(), weights.size());
     for (size_t i = 0; i < weights.size(); ++i) {
         if (!std::isfinite(weights[i])) {
             throw InvalidInput(formatError(m.source, "weight of vertex " + std::to_string(i), "not finite",

@@ -116,6 +116,8 @@ struct Slider::Impl {
         return -1;
     }
 
+    // InvalidInput unless there is one point per vertex and no weight or one per vertex.
+    void requireCounts(int32_t vertices, size_t points, size_t weights) const;
     // The evaluation on the surface's own vertices (the welded ones when `weld` is set).
     void evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                          std::span<const float> weights, float envelope, SlideResult* result);

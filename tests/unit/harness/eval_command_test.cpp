@@ -38,6 +38,16 @@ const char* kScene = R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
        "params": {"curvature": 0.8}}]},
   {"name": "still", "mesh": "tube.obj", "stack": []}]})";
 
+// Writes the tube and kScene into `dir`: a command evaluating them into dir/<out>.
+harness::EvalCommand shotIn(const test::TempDir& dir, const std::string& out = "out") {
+    io::writeObj(dir / "tube.obj", test::tube(kTube));
+    test::writeText(dir / "shot.json", kScene);
+    harness::EvalCommand command;
+    command.scene = dir / "shot.json";
+    command.outDir = dir / out;
+    return command;
+}
+
 }  // namespace
 
 TEST_CASE("eval command: file names pad the frame to 4 digits after the sign", "[harness][eval]") {
@@ -114,11 +124,7 @@ TEST_CASE(
     "of them",
     "[harness][eval][point_cache]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", test::tube(kTube));
-    test::writeText(dir / "shot.json", kScene);
-    harness::EvalCommand command;
-    command.scene = dir / "shot.json";
-    command.outDir = dir / "objs";
+    harness::EvalCommand command = shotIn(dir, "objs");
     command.previews = false;
     (void)harness::evalCommand(command);
 
@@ -298,11 +304,7 @@ TEST_CASE("eval command: previews of the rest pose equal the renderer's view of 
 TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a whole factor",
           "[harness][eval][preview]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", test::tube(kTube));
-    test::writeText(dir / "shot.json", kScene);
-    harness::EvalCommand command;
-    command.scene = dir / "shot.json";
-    command.outDir = dir / "out";
+    harness::EvalCommand command = shotIn(dir);
     command.frames = {-1, 0, 1, 2, 3, 5, 8};  // negative frames and gaps
     command.previewWidth = 481;  // odd sizes: the last column and row of each preview are dropped
     command.previewHeight = 361;
@@ -351,11 +353,7 @@ TEST_CASE("eval command: contact sheet tiles are the previews box filtered by a 
 TEST_CASE("eval command: bad preview sizes are rejected before anything is written",
           "[harness][eval][errors]") {
     test::TempDir dir;
-    io::writeObj(dir / "tube.obj", test::tube(kTube));
-    test::writeText(dir / "shot.json", kScene);
-    harness::EvalCommand command;
-    command.scene = dir / "shot.json";
-    command.outDir = dir / "out";
+    harness::EvalCommand command = shotIn(dir);
     command.previewWidth = 0;
     CHECK_THROWS_WITH(harness::evalCommand(command), Contains("preview width") && Contains("is 0"));
     command.previewWidth = 480;
