@@ -16,6 +16,8 @@ REFERENCES = {
     "BM_BarrEvaluateEngine": ("BM_BarrEvaluate", "generic engine / fast path"),
     "BM_WiresEngineEvaluate": ("BM_WiresEvaluate", "generic engine / fast path"),
     "BM_FfdEvaluatePortable": ("BM_FfdEvaluate", "portable kernel / runtime-selected kernel"),
+    "BM_FfdBSplineEvaluate": ("BM_FfdEvaluate", "B-spline / Bernstein evaluate (requirement: at most 2)"),
+    "BM_FfdFramesEvaluate": ("BM_FfdEvaluate", "with frames / Bernstein evaluate (requirement: at most 4)"),
     # Same active vertices, falloff and drag, 1 thread: < 1 is the share of the slide's time that a plain
     # soft translate (off the surface) would take; the rest is the cost of staying on the surface.
     "BM_SlideEvaluate1Thread": ("BM_SlideSoftTranslate1Thread", "slide / soft translate, same vertices, 1 thread"),

@@ -50,14 +50,23 @@ const Input& input() {
     return in;
 }
 
-void BM_FfdBind(benchmark::State& state) {
+void bindLoop(benchmark::State& state, const FfdOptions& options) {
     const Input& in = input();
-    Ffd ffd(in.lattice);
+    Ffd ffd(in.lattice, options);
     for (auto _ : state) {
         ffd.bind(in.rest);
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(in.rest.size()));
+}
+
+void BM_FfdBind(benchmark::State& state) {
+    bindLoop(state, {});
+}
+
+// A spline basis binds its points' weights too (the evaluate then only sums them).
+void BM_FfdBSplineBind(benchmark::State& state) {
+    bindLoop(state, {FfdBasis::BSpline});
 }
 
 template <class W>
@@ -121,6 +130,7 @@ void BM_FfdSetTargets(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_FfdBind)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FfdBSplineBind)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate1Thread)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluatePortable)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -285,6 +285,20 @@ void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
         local_[u] = glm::vec3(s * scale);
         active_[u] = (inside || extrapolate) ? 1 : 0;
     }
+    // The 4x4x4 lattice in a spline basis: the weights now, so an evaluation only sums (deformWindow444).
+    windowWeights_.clear();
+    const bool window = lattice_.divisions == glm::ivec3(3) && !options_.basis.all(FfdBasis::Bernstein);
+    constexpr int kBlock = detail::kBlock;
+    constexpr size_t kBlockFloats = 3 * 4 * kBlock;
+    if (window) {
+        const int64_t blocks = (n + kBlock - 1) / kBlock;
+        windowWeights_.assign(static_cast<size_t>(blocks) * kBlockFloats, 0.0f);
+#pragma omp parallel for schedule(dynamic, 512)
+        for (int64_t b = 0; b < blocks; ++b) {
+            windowWeightsOf(b * kBlock, static_cast<int>(std::min<int64_t>(kBlock, n - b * kBlock)),
+                            windowWeights_.data() + static_cast<size_t>(b) * kBlockFloats);
+        }
+    }
     bound_ = true;
 }
 
@@ -342,7 +356,8 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
     const glm::ivec3 div = lattice_.divisions;
     const int32_t ny = div.y + 1, nz = div.z + 1;
     const float* data = deltas.data();
-    if (options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
+    const bool blocks = options_.kernel != FfdKernel::PerPoint;
+    if (blocks && options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
         deformBernstein444(points, data, weights, envelope);
         return;
     }
@@ -351,6 +366,11 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
     bool window = true;
     for (int a = 0; a < 3; ++a)
         window = window && (options_.basis[a] == FfdBasis::Bernstein ? div[a] == 3 : div[a] >= 3);
+    // The 4x4x4 lattice: a spline basis with translations (weights from bind), or any basis with affine maps.
+    if (blocks && window && div == glm::ivec3(3) && (stride == 12 || !windowWeights_.empty())) {
+        deformWindow444(points, data, stride, weights, envelope);
+        return;
+    }
 
 #pragma omp parallel for schedule(dynamic, 4096)
     for (int64_t u = 0; u < n; ++u) {
@@ -432,6 +452,112 @@ void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* tr
             if (!active_[u]) continue;
             const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
             points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+        }
+    }
+}
+
+// The kernels that sum a 4x4x4 window with given weights, for this CPU.
+using Window444Kernel = void (*)(const detail::WeightBlock&, const float*, detail::DisplacementBlock&);
+using Frames444Kernel = void (*)(const detail::WeightBlock&, const float*, detail::AffineBlock&);
+
+Window444Kernel window444Kernel(FfdKernel choice) {
+#ifdef DEFORMKIT_SIMD_X86
+    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::window444Avx2;
+#endif
+    (void)choice;
+    return detail::window444Baseline;
+}
+
+using BernsteinWeightsKernel = void (*)(const detail::LocalBlock&, detail::WeightBlock&);
+
+BernsteinWeightsKernel bernsteinWeightsKernel(FfdKernel choice) {
+#ifdef DEFORMKIT_SIMD_X86
+    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2)
+        return detail::bernsteinWeights444Avx2;
+#endif
+    (void)choice;
+    return detail::bernsteinWeights444Baseline;
+}
+
+Frames444Kernel frames444Kernel(FfdKernel choice) {
+#ifdef DEFORMKIT_SIMD_X86
+    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::frames444Avx2;
+#endif
+    (void)choice;
+    return detail::frames444Baseline;
+}
+
+void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data, int32_t stride,
+                                 std::span<const float> weights, float envelope) const {
+    const Window444Kernel translate = window444Kernel(options_.kernel);
+    const Frames444Kernel affine = frames444Kernel(options_.kernel);
+    const BernsteinWeightsKernel bernstein = bernsteinWeightsKernel(options_.kernel);
+    const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
+    const int64_t n = numBoundPoints();
+    constexpr int kBlock = detail::kBlock;
+    const int64_t blocks = (n + kBlock - 1) / kBlock;
+    // Each block reads and writes its own points only: the output does not depend on the schedule.
+#pragma omp parallel for schedule(dynamic, 512)
+    for (int64_t b = 0; b < blocks; ++b) {
+        const int64_t begin = b * kBlock;
+        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
+        detail::WeightBlock in;
+        if (!windowWeights_.empty()) {
+            std::memcpy(in.w, windowWeights_.data() + static_cast<size_t>(b) * sizeof(in.w) / sizeof(float),
+                        sizeof(in.w));
+        } else if (allBernstein) {
+            // Inactive lanes keep their weights: their sums are computed and not used.
+            detail::LocalBlock local{};
+            for (int lane = 0; lane < count; ++lane) {
+                const glm::vec3& l = local_[begin + lane];
+                local.x[lane] = l.x;
+                local.y[lane] = l.y;
+                local.z[lane] = l.z;
+            }
+            bernstein(local, in);
+        } else {
+            windowWeightsOf(begin, count, &in.w[0][0][0]);
+        }
+        if (stride == 3) {
+            detail::DisplacementBlock d;
+            translate(in, data, d);
+            for (int lane = 0; lane < count; ++lane) {
+                const int64_t u = begin + lane;
+                if (!active_[u]) continue;
+                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+                points[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+            }
+        } else {
+            detail::AffineBlock m;
+            affine(in, data, m);
+            for (int lane = 0; lane < count; ++lane) {
+                const int64_t u = begin + lane;
+                if (!active_[u]) continue;
+                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+                const glm::vec3 p = points[u];
+                const glm::vec3 d = glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
+                                    glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
+                                    glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
+                                    glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
+                points[u] = p + k * d;
+            }
+        }
+    }
+}
+
+void FfdLattice::windowWeightsOf(int64_t begin, int count, float* block) const {
+    constexpr int kBlock = detail::kBlock;
+    std::fill(block, block + 3 * 4 * kBlock, 0.0f);
+    for (int lane = 0; lane < count; ++lane) {
+        const int64_t u = begin + lane;
+        if (!active_[u]) continue;
+        float w[kMaxBernsteinDegree + 1];
+        for (int a = 0; a < 3; ++a) {
+            int32_t first = 0;
+            const int32_t taps = axisWeights(a, local_[u][a], first, w);
+            // Divisions 3: every point's window starts at control 0 (first is never below 0).
+            for (int32_t i = 0; i < taps; ++i)
+                block[(a * 4 + first + i) * kBlock + lane] = w[i];
         }
     }
 }

@@ -1,12 +1,13 @@
 #pragma once
 
-// Private to the FFD (ffd.cpp and ffd_kernels_<isa>.cpp): the kernels of the Bernstein 4x4x4 lattice
-// (divisions 3, 3, 3; translations), one per instruction set (simd/cpu.h).
+// Private to the FFD (ffd.cpp and ffd_kernels_<isa>.cpp): the kernels of the 4x4x4 lattice (divisions 3, 3,
+// 3; translations), one per instruction set (simd/cpu.h): the Bernstein cubic, whose weights the kernel
+// computes, and any basis whose weights the caller gives per point (the B-splines).
 //
 // The cubic lattice of the FFD benchmark (tests/bench/ffd_bench.cpp). Every point is reached by all 64
 // controls, so every point reads the same translations: eight points are evaluated together in SoA form (one
 // lane per point), each translation component broadcast once per block. The sum order is the per-point path's
-// (ffd.cpp, windowSum): over (i, j) first, with the k weights applied at the end.
+// (ffd.cpp, windowSum): over (i, j) first, with the k weights applied at the end, so both give the same bits.
 
 #include <cstring>
 
@@ -20,15 +21,29 @@ constexpr int kBlock = 8;  // points per SoA block: one AVX register of floats
 struct LocalBlock {
     alignas(32) float x[kBlock], y[kBlock], z[kBlock];
 };
+// Eight points' weights of the 4 controls along each axis: w[axis][control][lane].
+struct WeightBlock {
+    alignas(32) float w[3][4][kBlock];
+};
 // Their displacements D(p), SoA.
 struct DisplacementBlock {
     alignas(32) float x[kBlock], y[kBlock], z[kBlock];
 };
+// Their summed affine maps (FFD with frames: 12 floats per control, the sum before it is applied), SoA.
+struct AffineBlock {
+    alignas(32) float a[12][kBlock];
+};
 
 // translations: 64 controls x 3 floats in Lattice::index order. The same bytes from each.
 void bernstein444Baseline(const LocalBlock& in, const float* translations, DisplacementBlock& out);
+void window444Baseline(const WeightBlock& in, const float* translations, DisplacementBlock& out);
+void frames444Baseline(const WeightBlock& in, const float* affine, AffineBlock& out);
+void bernsteinWeights444Baseline(const LocalBlock& in, WeightBlock& out);
 #ifdef DEFORMKIT_SIMD_X86
 void bernstein444Avx2(const LocalBlock& in, const float* translations, DisplacementBlock& out);
+void window444Avx2(const WeightBlock& in, const float* translations, DisplacementBlock& out);
+void frames444Avx2(const WeightBlock& in, const float* affine, AffineBlock& out);
+void bernsteinWeights444Avx2(const LocalBlock& in, WeightBlock& out);
 #endif
 
 namespace {
@@ -39,19 +54,9 @@ namespace {
 // elsewhere.
 typedef float Float8 __attribute__((vector_size(32)));
 
-[[gnu::always_inline]] inline void bernstein444(const LocalBlock& in, const float* deltas,
-                                                DisplacementBlock& out) {
-    Float8 w[3][4];
-    const float* coords[3] = {in.x, in.y, in.z};
-    for (int a = 0; a < 3; ++a) {
-        Float8 x;  // copied in, not returned: an 8-float vector return is AVX ABI (-Wpsabi)
-        std::memcpy(&x, coords[a], sizeof(x));
-        const Float8 s = x / 3.0f, r = 1.0f - s;  // as basisWeights' closed-form cubic
-        w[a][0] = r * r * r;
-        w[a][1] = 3.0f * s * r * r;
-        w[a][2] = 3.0f * s * s * r;
-        w[a][3] = s * s * s;
-    }
+// D = sum_ijk w0_i w1_j w2_k delta_ijk over the 64 controls, for eight lanes.
+[[gnu::always_inline]] inline void sum444(const Float8 (&w)[3][4], const float* deltas,
+                                          DisplacementBlock& out) {
     Float8 acc[12] = {};  // control k of the (i, j) run, component e: acc[3 k + e]
     for (int i = 0; i < 4; ++i) {
         for (int j = 0; j < 4; ++j) {
@@ -67,6 +72,72 @@ typedef float Float8 __attribute__((vector_size(32)));
     std::memcpy(out.x, &d[0], sizeof(out.x));
     std::memcpy(out.y, &d[1], sizeof(out.y));
     std::memcpy(out.z, &d[2], sizeof(out.z));
+}
+
+// The Bernstein cubic's weights of eight points, as basisWeights' closed form computes them per point.
+[[gnu::always_inline]] inline void bernsteinWeights(const LocalBlock& in, Float8 (&w)[3][4]) {
+    const float* coords[3] = {in.x, in.y, in.z};
+    for (int a = 0; a < 3; ++a) {
+        Float8 x;  // copied in, not returned: an 8-float vector return is AVX ABI (-Wpsabi)
+        std::memcpy(&x, coords[a], sizeof(x));
+        const Float8 s = x / 3.0f, r = 1.0f - s;
+        w[a][0] = r * r * r;
+        w[a][1] = 3.0f * s * r * r;
+        w[a][2] = 3.0f * s * s * r;
+        w[a][3] = s * s * s;
+    }
+}
+
+[[gnu::always_inline]] inline void bernstein444(const LocalBlock& in, const float* deltas,
+                                                DisplacementBlock& out) {
+    Float8 w[3][4];
+    bernsteinWeights(in, w);
+    sum444(w, deltas, out);
+}
+
+[[gnu::always_inline]] inline void bernsteinWeights444(const LocalBlock& in, WeightBlock& out) {
+    Float8 w[3][4];
+    bernsteinWeights(in, w);
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 4; ++c)
+            std::memcpy(out.w[a][c], &w[a][c], sizeof(Float8));
+}
+
+[[gnu::always_inline]] inline void window444(const WeightBlock& in, const float* deltas,
+                                             DisplacementBlock& out) {
+    Float8 w[3][4];
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 4; ++c)
+            std::memcpy(&w[a][c], in.w[a][c], sizeof(Float8));
+    sum444(w, deltas, out);
+}
+
+// The same sum with 12 floats per control (affine maps): one pass over (i, j) per control k of the run, so
+// 12 accumulators stay in registers; each element's sum keeps the per-point path's order.
+[[gnu::always_inline]] inline void frames444(const WeightBlock& in, const float* deltas, AffineBlock& out) {
+    Float8 w[3][4];
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 4; ++c)
+            std::memcpy(&w[a][c], in.w[a][c], sizeof(Float8));
+    Float8 sum[4][12];
+    for (int k = 0; k < 4; ++k) {
+        Float8 acc[12] = {};
+        for (int i = 0; i < 4; ++i) {
+            for (int j = 0; j < 4; ++j) {
+                const Float8 wij = w[0][i] * w[1][j];
+                const float* row = deltas + ((i * 4 + j) * 4 + k) * 12;
+                for (int v = 0; v < 12; ++v)
+                    acc[v] += wij * row[v];
+            }
+        }
+        for (int v = 0; v < 12; ++v)
+            sum[k][v] = acc[v];
+    }
+    for (int e = 0; e < 12; ++e) {
+        const Float8 d =
+            w[2][0] * sum[0][e] + w[2][1] * sum[1][e] + w[2][2] * sum[2][e] + w[2][3] * sum[3][e];
+        std::memcpy(out.a[e], &d, sizeof(out.a[e]));
+    }
 }
 
 }  // namespace

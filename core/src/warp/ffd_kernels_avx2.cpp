@@ -13,5 +13,17 @@ void bernstein444Avx2(const LocalBlock& in, const float* translations, Displacem
     bernstein444(in, translations, out);
 }
 
+void window444Avx2(const WeightBlock& in, const float* translations, DisplacementBlock& out) {
+    window444(in, translations, out);
+}
+
+void frames444Avx2(const WeightBlock& in, const float* affine, AffineBlock& out) {
+    frames444(in, affine, out);
+}
+
+void bernsteinWeights444Avx2(const LocalBlock& in, WeightBlock& out) {
+    bernsteinWeights444(in, out);
+}
+
 }  // namespace deformkit::warp::detail
 #endif

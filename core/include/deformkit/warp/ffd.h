@@ -78,12 +78,12 @@ struct Lattice {
 inline constexpr int32_t kMaxFfdDivisions = 1024;
 inline constexpr int32_t kMaxBernsteinDegree = 64;
 
-// Which kernel the fast path may use for the common Bernstein 4x4x4 lattice (divisions 3, 3, 3). Auto takes
-// the AVX2 kernel when the CPU has it (checked at run time; the build sets no -march) and the environment
-// variable DEFORMKIT_SIMD is not "baseline", else the portable one. Portable forces the portable kernel: for
-// tests and benchmarks that compare the two. Neither uses fused multiply-add: both give the same bytes, on
-// any CPU and for any thread count.
-enum class FfdKernel { Auto, Portable };
+// Which kernel the fast path may use for the 4x4x4 lattice (divisions 3, 3, 3; translations), Bernstein or
+// spline. Auto takes the AVX2 kernel when the CPU has it (checked at run time; the build sets no -march) and
+// the environment variable DEFORMKIT_SIMD is not "baseline", else the portable one. Portable forces the
+// portable kernel; PerPoint the per-point path of other lattices (for tests and benchmarks that compare
+// them). None uses fused multiply-add: all give the same bytes, on any CPU and for any thread count.
+enum class FfdKernel { Auto, Portable, PerPoint };
 
 struct FfdOptions {
     FfdBases basis = FfdBasis::Bernstein;
@@ -138,6 +138,14 @@ class FfdLattice {
     // kernel options_.kernel selects (ffd.cpp).
     void deformBernstein444(std::span<glm::vec3> points, const float* translations,
                             std::span<const float> weights, float envelope) const;
+    // The same lattice in any basis whose weights fit the 4x4x4 window (B-splines), and any basis with affine
+    // maps (stride 12, FFD with frames): each point's weights as the per-point path computes them (at bind
+    // for splines), the sum in eight-lane blocks; the per-point path's bytes.
+    void deformWindow444(std::span<glm::vec3> points, const float* data, int32_t stride,
+                         std::span<const float> weights, float envelope) const;
+    // The window weights of points begin .. begin + count - 1 into a block ([axis][control][lane], 8 lanes;
+    // zero for inactive points and lanes past count).
+    void windowWeightsOf(int64_t begin, int count, float* block) const;
 
     Lattice lattice_;
     FfdOptions options_;
@@ -145,6 +153,9 @@ class FfdLattice {
     std::vector<float> binomial_[3];  // Bernstein coefficients C(d, i) per axis
     std::vector<glm::vec3> local_;    // per bound point: (s l, t m, u n), lattice units
     std::vector<uint8_t> active_;     // per bound point: 1 if the warp reaches it
+    // For deformWindow444: each point's weights of the 4 controls per axis, computed at bind, in blocks of 8
+    // points ([block][axis][control][lane], 0 for inactive points and past the end). Empty otherwise.
+    std::vector<float> windowWeights_;
     bool bound_ = false;
 };
 
