@@ -42,33 +42,38 @@ ProfileCurve profileOf(const FloatArray& z, const FloatArray& v, const char* sou
     return ProfileCurve(floatsOf(z, source, "z_samples"), floatsOf(v, source, "value_samples"), source);
 }
 
-// Deforms a copy of `points` with a bound warp; returns a new (n, 3) float32 array.
+// Deforms `points` with a bound warp into a new (n, 3) float32 array: the input is read in place and the
+// warp writes the output directly (no other copy).
 py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::optional<FloatArray>& weights,
                        float envelope, const char* source) {
-    std::vector<glm::vec3> pts = pointsOf(points, source, "points");
-    std::vector<float> w;
+    const std::span<const glm::vec3> in = pointsView(points, source, "points");
+    std::span<const float> w;
     if (weights) {
-        w = floatsOf(*weights, source, "weights");
-        if (w.size() != pts.size()) {
+        if (weights->ndim() != 1) {
+            throw InvalidInput(
+                formatError(source, "weights", "has shape " + shapeOf(*weights), "a 1-D array"));
+        }
+        w = {weights->data(), static_cast<size_t>(weights->shape(0))};
+        if (w.size() != in.size()) {
             throw InvalidInput(formatError(source, "weights", "has " + std::to_string(w.size()) + " entries",
-                                           std::to_string(pts.size()) + " entries, one per point"));
+                                           std::to_string(in.size()) + " entries, one per point"));
         }
     }
+    py::array_t<float> out({static_cast<py::ssize_t>(in.size()), static_cast<py::ssize_t>(3)});
+    const std::span<glm::vec3> pts(reinterpret_cast<glm::vec3*>(out.mutable_data()), in.size());
     {
         py::gil_scoped_release release;
-        warp.deform(pts, w, envelope);
+        warp.deform(in, pts, w, envelope);
     }
-    py::array_t<float> out({static_cast<py::ssize_t>(pts.size()), static_cast<py::ssize_t>(3)});
-    std::memcpy(out.mutable_data(), pts.data(), pts.size() * sizeof(glm::vec3));
     return out;
 }
 
+// The direct path's bind (no engine fields), reading the rest points in place.
 template <class W>
 void bindRest(W& warp, const FloatArray& rest, const char* source) {
-    const std::vector<glm::vec3> pts = pointsOf(rest, source, "rest_points");
-    warp::SparseFields fields;
+    const std::span<const glm::vec3> pts = pointsView(rest, source, "rest_points");
     py::gil_scoped_release release;
-    warp.bind(pts, fields);
+    warp.bind(pts);
 }
 
 py::dict frameDict(const AxisFrame& f) {

@@ -154,33 +154,36 @@ py::array_t<float> latticeArray(std::span<const glm::vec3> pts, const Lattice& l
     return out;
 }
 
-// Binds `warp` to `points` and deforms a copy of them, without the GIL.
+// Binds `warp` to `points` (read in place) and deforms the copy it returns, without the GIL.
 template <class W>
 py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::optional<FloatArray>& weights,
                               float envelope, const char* source) {
-    std::vector<glm::vec3> pts = pointsOf(points, source, "points");
-    const std::vector<float> w = weightsOf(weights, pts.size(), source);
+    const std::span<const glm::vec3> in = pointsView(points, source, "points");
+    const std::span<const float> w = weightsView(weights, in.size(), source);
+    auto [out, pts] = outputCopy(in);
     {
         py::gil_scoped_release release;
-        warp.bind(pts);
+        warp.bind(in);
         warp.evaluate(pts, w, envelope);
     }
-    return toArray(pts);
+    return out;
 }
 
-// Evaluates a bound warp on `points` (the rest points when None).
+// Evaluates a bound warp on a copy of `points` (the rest points when None).
 template <class W>
 py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& rest,
                                  const std::optional<FloatArray>& points,
                                  const std::optional<FloatArray>& weights, float envelope,
                                  const char* source) {
-    std::vector<glm::vec3> pts = points ? pointsOf(*points, source, "points") : rest;
-    const std::vector<float> w = weightsOf(weights, pts.size(), source);
+    const std::span<const glm::vec3> in =
+        points ? pointsView(*points, source, "points") : std::span<const glm::vec3>(rest);
+    const std::span<const float> w = weightsView(weights, in.size(), source);
+    auto [out, pts] = outputCopy(in);
     {
         py::gil_scoped_release release;
         warp.evaluate(pts, w, envelope);
     }
-    return toArray(pts);
+    return out;
 }
 
 // The bound classes keep their rest points so evaluate() without points deforms the rest shape.

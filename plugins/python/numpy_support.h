@@ -10,6 +10,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -47,6 +48,16 @@ inline std::vector<glm::vec3> pointsOf(const FloatArray& a, const std::string& s
     std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
     if (!out.empty()) std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
     return out;
+}
+
+// The same (n, 3) float32 array as a view, no copy (FloatArray is C-contiguous float32: pybind11 converts
+// anything else when the argument is taken). Valid while `a` lives.
+inline std::span<const glm::vec3> pointsView(const FloatArray& a, const std::string& source,
+                                             const std::string& name) {
+    if (a.ndim() != 2 || a.shape(1) != 3) {
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
+    }
+    return {reinterpret_cast<const glm::vec3*>(a.data()), static_cast<size_t>(a.shape(0))};
 }
 
 // A 1-D int array as indices or counts.
@@ -97,6 +108,27 @@ inline std::vector<float> weightsOf(const std::optional<FloatArray>& weights, si
                                        "(" + std::to_string(count) + ",), one per point"));
     }
     return std::vector<float>(weights->data(), weights->data() + count);
+}
+
+// The same check, as a view of the array's data (valid while it lives); empty for None.
+inline std::span<const float> weightsView(const std::optional<FloatArray>& weights, size_t count,
+                                          const std::string& source) {
+    if (!weights) return {};
+    if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != count) {
+        throw InvalidInput(formatError(source, "weights", "has shape " + shapeOf(*weights),
+                                       "(" + std::to_string(count) + ",), one per point"));
+    }
+    return {weights->data(), count};
+}
+
+// A new (n, 3) float32 array holding a copy of `points`, and its data as points: for deformers that work in
+// place, the one copy the caller gets back.
+inline std::pair<pybind11::array_t<float>, std::span<glm::vec3>> outputCopy(
+    std::span<const glm::vec3> points) {
+    pybind11::array_t<float> out({static_cast<pybind11::ssize_t>(points.size()), pybind11::ssize_t{3}});
+    const std::span<glm::vec3> view(reinterpret_cast<glm::vec3*>(out.mutable_data()), points.size());
+    if (!points.empty()) std::memcpy(view.data(), points.data(), points.size_bytes());
+    return {std::move(out), view};
 }
 
 // An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.

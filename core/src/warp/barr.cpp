@@ -16,11 +16,16 @@ namespace deformkit::warp {
 namespace {
 
 void requireFinitePoints(std::span<const glm::vec3> points, const std::string& source, const char* what) {
-    for (size_t i = 0; i < points.size(); ++i) {
-        if (!geom::isFinite(points[i])) {
-            throw InvalidInput(formatError(source, std::string(what) + " " + std::to_string(i),
-                                           "is " + detail::pointText(points[i]), "finite coordinates"));
-        }
+    // In parallel, naming the first bad point whatever the schedule.
+    const auto n = static_cast<int64_t>(points.size());
+    int64_t first = n;
+#pragma omp parallel for schedule(static) reduction(min : first) if (n >= 65536)
+    for (int64_t i = 0; i < n; ++i) {
+        if (!geom::isFinite(points[i])) first = std::min(first, i);
+    }
+    if (first < n) {
+        throw InvalidInput(formatError(source, std::string(what) + " " + std::to_string(first),
+                                       "is " + detail::pointText(points[first]), "finite coordinates"));
     }
 }
 
@@ -220,13 +225,19 @@ void AxialWarp::setFrame(const AxisFrame& frame) {
     bound_ = false;
 }
 
-void AxialWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
+void AxialWarp::bind(std::span<const glm::vec3> restPoints) {
     requireFinitePoints(restPoints, name_, "rest point");
     const size_t n = restPoints.size();
     restZ_.resize(n);
 #pragma omp parallel for schedule(static)
     for (int64_t u = 0; u < static_cast<int64_t>(n); ++u)
         restZ_[u] = frame_.toLocal(restPoints[u]).z;
+    bound_ = true;
+}
+
+void AxialWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields) {
+    bind(restPoints);
+    const size_t n = restPoints.size();
     fields.offsets.resize(n + 1);
     fields.transform.resize(n);
     fields.strength.assign(n, 1.0f);
@@ -235,8 +246,6 @@ void AxialWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields
         fields.offsets[u] = static_cast<int32_t>(u);
     for (size_t u = 0; u < n; ++u)
         fields.transform[u] = static_cast<int32_t>(u);
-    scratch_.resize(n);
-    bound_ = true;
 }
 
 void AxialWarp::transformations(Transformations& out) const {
@@ -268,8 +277,24 @@ void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weigh
     if (!std::isfinite(envelope)) {
         throw InvalidInput(formatError(name_, "envelope", "is not finite", "a number, usually in [0, 1]"));
     }
+    if (envelope == 1.0f && weights.empty()) {
+        evaluate(points, points);  // what the envelope gives for k = 1, without the copy
+        return;
+    }
+    scratch_.resize(points.size());
     evaluate(points, scratch_);
     applyEnvelope(points, scratch_, weights, envelope, points);
+}
+
+void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                       std::span<const float> weights, float envelope) {
+    requireBound(points.size(), "points");
+    requireFinitePoints(points, name_, "point");
+    if (!std::isfinite(envelope)) {
+        throw InvalidInput(formatError(name_, "envelope", "is not finite", "a number, usually in [0, 1]"));
+    }
+    evaluate(points, out);
+    if (envelope != 1.0f || !weights.empty()) applyEnvelope(points, out, weights, envelope, out);
 }
 
 // ---- taper ----

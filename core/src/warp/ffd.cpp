@@ -285,19 +285,13 @@ void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
         local_[u] = glm::vec3(s * scale);
         active_[u] = (inside || extrapolate) ? 1 : 0;
     }
-    // The 4x4x4 lattice in a spline basis: the weights now, so an evaluation only sums (deformWindow444).
-    windowWeights_.clear();
-    const bool window = lattice_.divisions == glm::ivec3(3) && !options_.basis.all(FfdBasis::Bernstein);
-    constexpr int kBlock = detail::kBlock;
-    constexpr size_t kBlockFloats = 3 * 4 * kBlock;
-    if (window) {
-        const int64_t blocks = (n + kBlock - 1) / kBlock;
-        windowWeights_.assign(static_cast<size_t>(blocks) * kBlockFloats, 0.0f);
-#pragma omp parallel for schedule(dynamic, 512)
-        for (int64_t b = 0; b < blocks; ++b) {
-            windowWeightsOf(b * kBlock, static_cast<int>(std::min<int64_t>(kBlock, n - b * kBlock)),
-                            windowWeights_.data() + static_cast<size_t>(b) * kBlockFloats);
-        }
+    // The 4x4x4 lattice in a spline basis: its weights are kept from the second evaluation on
+    // (deformWindow444).
+    windowSpline_ = lattice_.divisions == glm::ivec3(3) && !options_.basis.all(FfdBasis::Bernstein);
+    {
+        const std::lock_guard<std::mutex> lock(*windowCache_.mutex);
+        windowCache_.weights.clear();
+        windowCache_.evaluations = 0;
     }
     bound_ = true;
 }
@@ -367,7 +361,7 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
     for (int a = 0; a < 3; ++a)
         window = window && (options_.basis[a] == FfdBasis::Bernstein ? div[a] == 3 : div[a] >= 3);
     // The 4x4x4 lattice: a spline basis with translations (weights from bind), or any basis with affine maps.
-    if (blocks && window && div == glm::ivec3(3) && (stride == 12 || !windowWeights_.empty())) {
+    if (blocks && window && div == glm::ivec3(3) && (stride == 12 || windowSpline_)) {
         deformWindow444(points, data, stride, weights, envelope);
         return;
     }
@@ -495,16 +489,33 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
     const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
     const int64_t n = numBoundPoints();
     constexpr int kBlock = detail::kBlock;
+    constexpr size_t kBlockFloats = sizeof(detail::WeightBlock::w) / sizeof(float);
     const int64_t blocks = (n + kBlock - 1) / kBlock;
+    // Spline weights: read from the cache, or computed, and kept on the second evaluation since the bind. An
+    // evaluation that finds another one filling the cache computes its own.
+    const float* cached = nullptr;
+    float* keep = nullptr;
+    std::unique_lock<std::mutex> filling;
+    if (windowSpline_) {
+        std::unique_lock<std::mutex> lock(*windowCache_.mutex, std::try_to_lock);
+        if (lock.owns_lock()) {
+            if (!windowCache_.weights.empty()) {
+                cached = windowCache_.weights.data();
+            } else if (++windowCache_.evaluations >= 2) {
+                windowCache_.weights.resize(static_cast<size_t>(blocks) * kBlockFloats);
+                keep = windowCache_.weights.data();
+            }
+            filling = std::move(lock);  // held while this evaluation reads or fills the cache
+        }
+    }
     // Each block reads and writes its own points only: the output does not depend on the schedule.
 #pragma omp parallel for schedule(dynamic, 512)
     for (int64_t b = 0; b < blocks; ++b) {
         const int64_t begin = b * kBlock;
         const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
         detail::WeightBlock in;
-        if (!windowWeights_.empty()) {
-            std::memcpy(in.w, windowWeights_.data() + static_cast<size_t>(b) * sizeof(in.w) / sizeof(float),
-                        sizeof(in.w));
+        if (cached != nullptr) {
+            std::memcpy(in.w, cached + static_cast<size_t>(b) * kBlockFloats, sizeof(in.w));
         } else if (allBernstein) {
             // Inactive lanes keep their weights: their sums are computed and not used.
             detail::LocalBlock local{};
@@ -517,6 +528,8 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
             bernstein(local, in);
         } else {
             windowWeightsOf(begin, count, &in.w[0][0][0]);
+            if (keep != nullptr)
+                std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
         }
         if (stride == 3) {
             detail::DisplacementBlock d;

@@ -52,6 +52,9 @@ class AxialWarp : public Warp {
     // Fields: point u -> transformation u, strength 1, weight 1 (paper §4.3.1: w = 1 only where
     // M(u) . z = v). Changing the frame requires binding again; changing the controls does not.
     void bind(std::span<const glm::vec3> restPoints, SparseFields& fields) override;
+    // The direct path's bind: the rest axis coordinates only, no engine fields (what evaluate() and
+    // deform() need; the Python functions bind this way).
+    void bind(std::span<const glm::vec3> restPoints);
     // Per-point transformations T(z_u) for the engine (Eq. 3 with one entry per point).
     void transformations(Transformations& out) const override;
 
@@ -66,6 +69,9 @@ class AxialWarp : public Warp {
     // weights: #points painted weights or empty for 1. Throws InvalidInput if not bound, on a count
     // mismatch, or a non-finite point.
     void deform(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
+    // The same into `out` (as many points, not aliasing `points`): no copy of the input.
+    void deform(std::span<const glm::vec3> points, std::span<glm::vec3> out, std::span<const float> weights,
+                float envelope);
 
     void setFrame(const AxisFrame& frame);
     [[nodiscard]] const OrthoFrame& frame() const { return frame_; }

@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -153,9 +155,26 @@ class FfdLattice {
     std::vector<float> binomial_[3];  // Bernstein coefficients C(d, i) per axis
     std::vector<glm::vec3> local_;    // per bound point: (s l, t m, u n), lattice units
     std::vector<uint8_t> active_;     // per bound point: 1 if the warp reaches it
-    // For deformWindow444: each point's weights of the 4 controls per axis, computed at bind, in blocks of 8
-    // points ([block][axis][control][lane], 0 for inactive points and past the end). Empty otherwise.
-    std::vector<float> windowWeights_;
+    // For deformWindow444 in a spline basis: each point's weights of the 4 controls per axis in blocks of 8
+    // points ([block][axis][control][lane], 0 for inactive points and past the end). The first evaluation
+    // after a bind computes them on the fly (a one-off pays no 48 bytes a point); the second keeps them, so
+    // an animation only sums. Copies of the lattice start without them.
+    struct WeightCache {
+        std::vector<float> weights;
+        int evaluations = 0;  // since the bind
+        std::unique_ptr<std::mutex> mutex = std::make_unique<std::mutex>();
+        WeightCache() = default;
+        WeightCache(const WeightCache&) : WeightCache() {}
+        WeightCache& operator=(const WeightCache&) {
+            weights.clear();
+            evaluations = 0;
+            return *this;
+        }
+        WeightCache(WeightCache&&) noexcept = default;
+        WeightCache& operator=(WeightCache&&) noexcept = default;
+    };
+    mutable WeightCache windowCache_;
+    bool windowSpline_ = false;  // bound to a 4x4x4 lattice in a spline basis
     bool bound_ = false;
 };
 

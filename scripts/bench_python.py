@@ -1,0 +1,122 @@
+"""What the Python path costs over the work: the deformkit module's one-off functions and bound evaluates
+against the C++ benchmarks of the same work, measured in the same run, on the benchmarks' 1,001,000-vertex
+grids (tests/bench/barr_bench.cpp, ffd_bench.cpp; the grids, lattice and targets are rebuilt here).
+
+    python3 scripts/bench_python.py [--build build] [--reps 9]
+
+The reference of a one-off (taper(), ffd(), ...) is the C++ bind + evaluate; of a bound evaluate
+(Taper.evaluate, Ffd.evaluate) the C++ evaluate. Requirements: a one-off at most 1.3x its reference, a bound
+evaluate at most 1.1x. Medians of --reps calls; the C++ medians from --reps repetitions of the benchmark
+binaries run just before. Both sides on every core (OMP_WAIT_POLICY=passive, as scripts/bench.sh sets).
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def grid(cells_x, cells_y, size_x, size_y):
+    """geom::makeGrid's vertices: (i / cx * size_x, j / cy * size_y, 0), row-major, float32."""
+    u = (np.arange(cells_x + 1, dtype=np.float32) / cells_x * size_x).astype(np.float32)
+    v = (np.arange(cells_y + 1, dtype=np.float32) / cells_y * size_y).astype(np.float32)
+    points = np.zeros((cells_y + 1, cells_x + 1, 3), np.float32)
+    points[:, :, 0] = u[None, :]
+    points[:, :, 1] = v[:, None]
+    return points.reshape(-1, 3)
+
+
+def cpp_medians(build, binary, pattern, reps):
+    """Median real time (ms) per benchmark name of one benchmark binary, filtered."""
+    with tempfile.NamedTemporaryFile(suffix=".json") as out:
+        subprocess.run([os.path.join(build, "bin", binary), f"--benchmark_filter={pattern}",
+                        f"--benchmark_repetitions={reps}", "--benchmark_report_aggregates_only=true",
+                        f"--benchmark_out={out.name}", "--benchmark_out_format=json"],
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        data = json.load(open(out.name))
+    medians = {}
+    for b in data["benchmarks"]:
+        if b.get("aggregate_name") != "median":
+            continue
+        scale = {"ms": 1.0, "us": 1e-3, "ns": 1e-6}[b["time_unit"]]
+        medians[b["run_name"].split("/min_time")[0].replace("/real_time", "")] = b["real_time"] * scale
+    return medians
+
+
+def median_ms(call, reps):
+    call()  # warm: first-touch allocations and thread start-up are not what a script pays per call
+    times = []
+    for _ in range(reps):
+        start = time.perf_counter()
+        call()
+        times.append((time.perf_counter() - start) * 1e3)
+    return statistics.median(times)
+
+
+def main(argv):
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--build", default=os.path.join(ROOT, "build"))
+    parser.add_argument("--reps", type=int, default=9)
+    args = parser.parse_args(argv)
+    sys.path.insert(0, os.path.join(args.build, "python"))
+    import deformkit as dk  # noqa: E402  (the build's module)
+
+    barr = cpp_medians(args.build, "bench_barr", "BM_BarrBind|BM_BarrEvaluate/", args.reps)
+    ffd = cpp_medians(args.build, "bench_ffd", "BM_FfdBind|BM_FfdBSplineBind|BM_FfdEvaluate/|BM_FfdBSplineEvaluate",
+                      args.reps)
+
+    # tests/bench/barr_bench.cpp: the axis along the grid's long side through its middle, bend out of plane.
+    points = grid(1000, 999, 4.0, 1.0)
+    origin, axis, up = (np.array(v, np.float32) for v in ((0, 0.5, 0), (1, 0, 0), (0, 0, 1)))
+    taper_z, taper_v = np.array([0, 1, 2.5, 4], np.float32), np.array([1, 0.6, 1.3, 0.4], np.float32)
+    twist_z, twist_v = np.array([0, 2, 4], np.float32), np.array([0, 1, 3], np.float32)
+    bound_taper = dk.Taper(points, origin, axis, taper_z, taper_v)
+    rows = [
+        ("taper()", lambda: dk.taper(points, origin, axis, taper_z, taper_v), barr["BM_BarrBind/0"] +
+         barr["BM_BarrEvaluate/0"], "bind + evaluate", 1.3),
+        ("twist()", lambda: dk.twist(points, origin, axis, twist_z, twist_v), barr["BM_BarrBind/1"] +
+         barr["BM_BarrEvaluate/1"], "bind + evaluate", 1.3),
+        ("bend()", lambda: dk.bend(points, origin, axis, up, 0.8, 2.0, 0.5, 3.5), barr["BM_BarrBind/2"] +
+         barr["BM_BarrEvaluate/2"], "bind + evaluate", 1.3),
+        ("Taper.evaluate", lambda: bound_taper.evaluate(points), barr["BM_BarrEvaluate/0"], "evaluate", 1.1),
+    ]
+    # tests/bench/ffd_bench.cpp: a 4x4x4 lattice around the unit grid, every control moved.
+    fpoints = grid(1000, 999, 1.0, 1.0)
+    lorigin = np.array([-0.05, -0.05, -0.5], np.float32)
+    axes = np.array([[1.1, 0, 0], [0, 1.1, 0], [0, 0, 1.0]], np.float32)
+    divisions = np.array([3, 3, 3], np.int32)
+    bound_ffd = dk.Ffd(lorigin, axes, divisions)
+    c = np.arange(64, dtype=np.float32)
+    target = bound_ffd.source_points.reshape(-1, 3) + np.stack(
+        [0.02 * np.sin(0.7 * c), 0.03 * np.cos(1.3 * c), 0.1 * np.sin(0.4 * c)], -1).astype(np.float32)
+    target = target.reshape(4, 4, 4, 3).astype(np.float32)
+    bound_ffd.bind(fpoints)
+    bound_ffd.set_target(target)
+    rows += [
+        ("ffd()", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target), ffd["BM_FfdBind"] +
+         ffd["BM_FfdEvaluate"], "bind + evaluate", 1.3),
+        ("ffd(basis='bspline')", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target, basis="bspline"),
+         ffd["BM_FfdBSplineBind"] + ffd["BM_FfdBSplineEvaluate"], "bind + evaluate", 1.3),
+        ("Ffd.evaluate", lambda: bound_ffd.evaluate(fpoints), ffd["BM_FfdEvaluate"], "evaluate", 1.1),
+    ]
+    print(f"{'Python call':24} {'Python':>9} {'C++':>9}  {'reference':16} {'ratio':>6}  requirement")
+    failed = 0
+    for name, call, reference, what, limit in rows:
+        ms = median_ms(call, args.reps)
+        ratio = ms / reference
+        ok = ratio <= limit
+        failed += 0 if ok else 1
+        print(f"{name:24} {ms:7.2f} ms {reference:6.2f} ms  {what:16} {ratio:5.2f}x  <= {limit}x "
+              f"{'met' if ok else 'NOT MET'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
