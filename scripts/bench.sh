@@ -6,6 +6,7 @@
 #   ./scripts/bench.sh --quick         1 repetition (a smoke run)
 #   DEFORMKIT_BUILD_DIR=build-perf ./scripts/bench.sh    benchmarks of another build folder
 #
+# Then scripts/bench_python.py prints what the Python module costs over the C++ benchmarks of the same work.
 # When `blender` is on PATH, scripts/bench_blender.py also times Blender's Lattice and SimpleDeform modifiers
 # on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios
 # (target: ours at least 3x faster than Blender's modifier).
@@ -63,4 +64,11 @@ if command -v blender >/dev/null 2>&1 && [ -f "$build/blender/deformkit/__init__
     cat "$out/blender_slide.txt"
 else
     echo "Blender slide frame change skipped: blender or the staged add-on ($build/blender) is missing"
+fi
+if [ -d "$build/python" ]; then
+    echo "running the Python module against the C++ benchmarks (scripts/bench_python.py) ..." >&2
+    echo
+    /usr/bin/python3 scripts/bench_python.py --build "$build" --reps $((reps < 5 ? 5 : reps))
+else
+    echo "Python comparison skipped: no Python module in $build/python"
 fi
