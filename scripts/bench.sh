@@ -68,7 +68,8 @@ fi
 if [ -d "$build/python" ]; then
     echo "running the Python module against the C++ benchmarks (scripts/bench_python.py) ..." >&2
     echo
-    /usr/bin/python3 scripts/bench_python.py --build "$build" --reps $((reps < 5 ? 5 : reps))
+    /usr/bin/python3 scripts/bench_python.py --build "$build" --reps $((reps < 5 ? 5 : reps)) \
+        ${blender_json[@]+"${blender_json[@]}"}
 else
     echo "Python comparison skipped: no Python module in $build/python"
 fi

@@ -2,12 +2,15 @@
 against the C++ benchmarks of the same work, measured in the same run, on the benchmarks' 1,001,000-vertex
 grids (tests/bench/barr_bench.cpp, ffd_bench.cpp; the grids, lattice and targets are rebuilt here).
 
-    python3 scripts/bench_python.py [--build build] [--reps 9]
+    python3 scripts/bench_python.py [--build build] [--reps 9] [--blender blender.json]
 
 The reference of a one-off (taper(), ffd(), ...) is the C++ bind + evaluate; of a bound evaluate
 (Taper.evaluate, Ffd.evaluate) the C++ evaluate. Requirements: a one-off at most 1.3x its reference, a bound
 evaluate at most 1.1x. Medians of --reps calls; the C++ medians from --reps repetitions of the benchmark
 binaries run just before. Both sides on every core (OMP_WAIT_POLICY=passive, as scripts/bench.sh sets).
+With --blender (scripts/bench_blender.py's output, same run) each one-off is also set against Blender's
+modifier doing the same on the same grid (its share: evaluation with the modifier minus without, taken pair
+by pair); requirement: the one-off at least 3x faster.
 """
 import argparse
 import json
@@ -64,7 +67,9 @@ def main(argv):
     parser = argparse.ArgumentParser()
     parser.add_argument("--build", default=os.path.join(ROOT, "build"))
     parser.add_argument("--reps", type=int, default=9)
+    parser.add_argument("--blender", help="scripts/bench_blender.py's JSON, for the Blender column")
     args = parser.parse_args(argv)
+    shares = json.load(open(args.blender))["modifier_share_ms"] if args.blender else {}
     sys.path.insert(0, os.path.join(args.build, "python"))
     import deformkit as dk  # noqa: E402  (the build's module)
 
@@ -80,12 +85,13 @@ def main(argv):
     bound_taper = dk.Taper(points, origin, axis, taper_z, taper_v)
     rows = [
         ("taper()", lambda: dk.taper(points, origin, axis, taper_z, taper_v), barr["BM_BarrBind/0"] +
-         barr["BM_BarrEvaluate/0"], "bind + evaluate", 1.3),
+         barr["BM_BarrEvaluate/0"], "bind + evaluate", 1.3, "taper"),
         ("twist()", lambda: dk.twist(points, origin, axis, twist_z, twist_v), barr["BM_BarrBind/1"] +
-         barr["BM_BarrEvaluate/1"], "bind + evaluate", 1.3),
+         barr["BM_BarrEvaluate/1"], "bind + evaluate", 1.3, "twist"),
         ("bend()", lambda: dk.bend(points, origin, axis, up, 0.8, 2.0, 0.5, 3.5), barr["BM_BarrBind/2"] +
-         barr["BM_BarrEvaluate/2"], "bind + evaluate", 1.3),
-        ("Taper.evaluate", lambda: bound_taper.evaluate(points), barr["BM_BarrEvaluate/0"], "evaluate", 1.1),
+         barr["BM_BarrEvaluate/2"], "bind + evaluate", 1.3, "bend"),
+        ("Taper.evaluate", lambda: bound_taper.evaluate(points), barr["BM_BarrEvaluate/0"], "evaluate", 1.1,
+         None),
     ]
     # tests/bench/ffd_bench.cpp: a 4x4x4 lattice around the unit grid, every control moved.
     fpoints = grid(1000, 999, 1.0, 1.0)
@@ -101,20 +107,22 @@ def main(argv):
     bound_ffd.set_target(target)
     rows += [
         ("ffd()", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target), ffd["BM_FfdBind"] +
-         ffd["BM_FfdEvaluate"], "bind + evaluate", 1.3),
+         ffd["BM_FfdEvaluate"], "bind + evaluate", 1.3, "lattice"),
         ("ffd(basis='bspline')", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target, basis="bspline"),
-         ffd["BM_FfdBSplineBind"] + ffd["BM_FfdBSplineEvaluate"], "bind + evaluate", 1.3),
-        ("Ffd.evaluate", lambda: bound_ffd.evaluate(fpoints), ffd["BM_FfdEvaluate"], "evaluate", 1.1),
+         ffd["BM_FfdBSplineBind"] + ffd["BM_FfdBSplineEvaluate"], "bind + evaluate", 1.3, "lattice"),
+        ("Ffd.evaluate", lambda: bound_ffd.evaluate(fpoints), ffd["BM_FfdEvaluate"], "evaluate", 1.1, None),
     ]
-    print(f"{'Python call':24} {'Python':>9} {'C++':>9}  {'reference':16} {'ratio':>6}  requirement")
-    failed = 0
-    for name, call, reference, what, limit in rows:
+    print(f"{'Python call':24} {'Python':>9} {'C++':>9}  {'reference':16} {'ratio':>6}  {'requirement':18}"
+          + ("  Blender share  Blender / Python (>= 3)" if shares else ""))
+    for name, call, reference, what, limit, modifier in rows:
         ms = median_ms(call, args.reps)
         ratio = ms / reference
-        ok = ratio <= limit
-        failed += 0 if ok else 1
-        print(f"{name:24} {ms:7.2f} ms {reference:6.2f} ms  {what:16} {ratio:5.2f}x  <= {limit}x "
-              f"{'met' if ok else 'NOT MET'}")
+        line = (f"{name:24} {ms:7.2f} ms {reference:6.2f} ms  {what:16} {ratio:5.2f}x  "
+                f"{'<= ' + str(limit) + 'x ' + ('met' if ratio <= limit else 'NOT MET'):18}")
+        if shares and modifier in shares:
+            faster = shares[modifier] / ms
+            line += f"  {shares[modifier]:9.1f} ms  {faster:5.1f}x {'met' if faster >= 3 else 'NOT MET'}"
+        print(line)
     return 0
 
 
