@@ -9,6 +9,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -163,8 +164,12 @@ py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::opti
     auto [out, pts] = outputCopy(in);
     {
         py::gil_scoped_release release;
-        warp.bind(in);
-        warp.evaluate(pts, w, envelope);
+        if constexpr (std::is_same_v<W, Ffd>) {
+            warp.bindAndEvaluate(in, pts, w, envelope);  // no bind cache where it can do without
+        } else {
+            warp.bind(in);
+            warp.evaluate(pts, w, envelope);
+        }
     }
     return out;
 }

@@ -260,6 +260,64 @@ glm::vec3 FfdLattice::localCoordinates(const glm::vec3& p) const {
     return glm::vec3(toLocal_ * (glm::dvec3(p) - glm::dvec3(lattice_.origin)));
 }
 
+glm::vec3 FfdLattice::boundCoordinates(const glm::vec3& p, const glm::dvec3& scale, bool& inside) const {
+    const glm::dvec3 s = toLocal_ * (glm::dvec3(p) - glm::dvec3(lattice_.origin));
+    inside = true;
+    for (int a = 0; a < 3; ++a)
+        inside = inside && s[a] >= -kInsideTolerance && s[a] <= 1.0 + kInsideTolerance;
+    return glm::vec3(s * scale);
+}
+
+bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
+                               const float* translations, std::span<const float> weights,
+                               float envelope) const {
+    if (options_.kernel == FfdKernel::PerPoint || !options_.basis.all(FfdBasis::Bernstein) ||
+        lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size()) {
+        return false;
+    }
+    const auto n = static_cast<int64_t>(restPoints.size());
+    int64_t bad = n;  // bind's check, naming the first non-finite point whatever the schedule
+#pragma omp parallel for schedule(static) reduction(min : bad) if (n >= 65536)
+    for (int64_t u = 0; u < n; ++u) {
+        if (!geom::isFinite(restPoints[u])) bad = std::min(bad, u);
+    }
+    if (bad < n) {
+        throw InvalidInput(formatError("FFD bind", "point " + std::to_string(bad),
+                                       "is not finite: " + detail::pointText(restPoints[bad]),
+                                       "finite positions"));
+    }
+    if (!weights.empty() && weights.size() != points.size()) return false;  // evaluate() names the mismatch
+    const Bernstein444Kernel kernel = bernstein444Kernel(options_.kernel);
+    const glm::dvec3 scale(lattice_.divisions);
+    const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
+    constexpr int kBlock = detail::kBlock;
+    const int64_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(dynamic, 512)
+    for (int64_t b = 0; b < blocks; ++b) {
+        const int64_t begin = b * kBlock;
+        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
+        detail::LocalBlock in{};
+        bool active[kBlock] = {};
+        for (int lane = 0; lane < count; ++lane) {
+            bool inside = true;
+            const glm::vec3 l = boundCoordinates(restPoints[begin + lane], scale, inside);
+            active[lane] = inside || extrapolate;
+            in.x[lane] = l.x;
+            in.y[lane] = l.y;
+            in.z[lane] = l.z;
+        }
+        detail::DisplacementBlock d;
+        kernel(in, translations, d);
+        for (int lane = 0; lane < count; ++lane) {
+            const int64_t u = begin + lane;
+            if (!active[lane]) continue;
+            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+            points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+        }
+    }
+    return true;
+}
+
 void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
     // Validate first: a rejected bind leaves the previous one in place.
     const int64_t n = static_cast<int64_t>(restPoints.size());
@@ -278,11 +336,8 @@ void FfdLattice::bind(std::span<const glm::vec3> restPoints) {
     // by one thread from its own inputs only, so the output does not depend on the schedule.
 #pragma omp parallel for schedule(dynamic, 4096)
     for (int64_t u = 0; u < n; ++u) {
-        const glm::dvec3 s = toLocal_ * (glm::dvec3(restPoints[u]) - glm::dvec3(lattice_.origin));
         bool inside = true;
-        for (int a = 0; a < 3; ++a)
-            inside = inside && s[a] >= -kInsideTolerance && s[a] <= 1.0 + kInsideTolerance;
-        local_[u] = glm::vec3(s * scale);
+        local_[u] = boundCoordinates(restPoints[u], scale, inside);
         active_[u] = (inside || extrapolate) ? 1 : 0;
     }
     // The 4x4x4 lattice in a spline basis: its weights are kept from the second evaluation on
@@ -618,6 +673,16 @@ void Ffd::transformations(Transformations& out) const {
     out.affine.resize(translation_.size());
     for (size_t c = 0; c < translation_.size(); ++c)
         out.affine[c] = Affine::translate(translation_[c]);
+}
+
+void Ffd::bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
+                          std::span<const float> weights, float envelope) {
+    if (lattice_.deformUnbound(restPoints, points, reinterpret_cast<const float*>(translation_.data()),
+                               weights, envelope)) {
+        return;
+    }
+    bind(restPoints);
+    evaluate(points, weights, envelope);
 }
 
 void Ffd::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) const {

@@ -528,6 +528,42 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
     CHECK(cases == 12);
 }
 
+TEST_CASE("ffd: a one-off without the bind cache gives bind + evaluate's bytes", "[warp][ffd][simd]") {
+    std::mt19937 rng(61);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (const glm::ivec3 divisions : {glm::ivec3(3), glm::ivec3(3, 2, 4)}) {  // the fused path, the fallback
+        for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
+            const Lattice l = skewLattice(divisions);
+            const auto target = randomTargets(l, rng, 0.5f);
+            const auto rest = samplePoints(l, rng, 5003, -0.2f, 1.2f);
+            std::vector<float> weights(rest.size());
+            for (auto& w : weights)
+                w = unit(rng);
+            std::vector<glm::vec3> upstream = rest;
+            for (auto& p : upstream)
+                p += glm::vec3(0.01f, -0.02f, 0.03f);
+            Ffd bound(l, {FfdBasis::Bernstein, outside});
+            bound.setTargets(target);
+            bound.bind(rest);
+            std::vector<glm::vec3> want = upstream, got = upstream;
+            bound.evaluate(want, weights, 0.7f);
+            Ffd once(l, {FfdBasis::Bernstein, outside});
+            once.setTargets(target);
+            once.bindAndEvaluate(rest, got, weights, 0.7f);
+            CHECK(std::memcmp(got.data(), want.data(), got.size() * sizeof(glm::vec3)) == 0);
+            CHECK(maxError(want, upstream) > 1e-3f);
+        }
+    }
+    // The bind's error, from either path.
+    const Lattice l = skewLattice({3, 3, 3});
+    std::vector<glm::vec3> rest(20, glm::vec3(0.5f));
+    rest[13].y = std::numeric_limits<float>::quiet_NaN();
+    std::vector<glm::vec3> points = rest;
+    Ffd once(l);
+    CHECK_THROWS_WITH(once.bindAndEvaluate(rest, points),
+                      Catch::Contains("FFD bind: point 13: is not finite"));
+}
+
 TEST_CASE("ffd: bad input names the element", "[warp][ffd][errors]") {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     Lattice l = skewLattice({3, 0, 3});

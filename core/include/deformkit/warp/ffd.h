@@ -116,6 +116,11 @@ class FfdLattice {
     // point.
     void bind(std::span<const glm::vec3> restPoints);
     [[nodiscard]] bool isBound() const { return bound_; }
+    // A one-off without the bind cache: bind(restPoints) then deform(points, translations, 3, ...), the same
+    // bytes, each point's coordinates computed where it is deformed (no per-point memory). Done for the
+    // Bernstein 4x4x4 lattice only; returns false (doing nothing) otherwise. Throws as bind() does.
+    bool deformUnbound(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
+                       const float* translations, std::span<const float> weights, float envelope) const;
     [[nodiscard]] int32_t numBoundPoints() const { return static_cast<int32_t>(local_.size()); }
 
     // Weighting fields from the cache, non-zero weights only, strength 1. With FfdOutside::None a point
@@ -136,6 +141,8 @@ class FfdLattice {
                 std::span<const float> weights, float envelope) const;
 
   private:
+    // A point's local coordinates times the divisions, and whether it lies in the lattice (bind's formula).
+    [[nodiscard]] glm::vec3 boundCoordinates(const glm::vec3& p, const glm::dvec3& scale, bool& inside) const;
     // deform() for Bernstein divisions (3, 3, 3) with translations: SoA blocks of 8 points through the
     // kernel options_.kernel selects (ffd.cpp).
     void deformBernstein444(std::span<glm::vec3> points, const float* translations,
@@ -209,6 +216,10 @@ class Ffd : public LatticeWarp {
     void transformations(Transformations& out) const override;
     // Fast path: painted weights (#points, or empty for 1) and the envelope scale the displacement as in
     // WarpDeformer.
+    // A one-off: bind(restPoints) then evaluate(points, ...), the same bytes; on the Bernstein 4x4x4
+    // lattice without keeping the bind cache (the warp is then left unbound).
+    void bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
+                         std::span<const float> weights = {}, float envelope = 1.0f);
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
                   float envelope = 1.0f) const;
 
