@@ -5,7 +5,7 @@ grids (tests/bench/barr_bench.cpp, ffd_bench.cpp; the grids, lattice and targets
     python3 scripts/bench_python.py [--build build] [--reps 9] [--blender blender.json]
 
 The reference of a one-off (taper(), ffd(), ...) is the C++ bind + evaluate; of a bound evaluate
-(Taper.evaluate, Ffd.evaluate) the C++ evaluate. Requirements: a one-off at most 1.3x its reference, a bound
+(Taper.evaluate, Ffd.evaluate; with out=, into a buffer the caller reuses) the C++ evaluate. Requirements: a one-off at most 1.3x its reference, a bound
 evaluate at most 1.1x. Medians of --reps calls; the C++ medians from --reps repetitions of the benchmark
 binaries run just before. Both sides on every core (OMP_WAIT_POLICY=passive, as scripts/bench.sh sets).
 With --blender (scripts/bench_blender.py's output, same run) each one-off is also set against Blender's
@@ -83,6 +83,7 @@ def main(argv):
     taper_z, taper_v = np.array([0, 1, 2.5, 4], np.float32), np.array([1, 0.6, 1.3, 0.4], np.float32)
     twist_z, twist_v = np.array([0, 2, 4], np.float32), np.array([0, 1, 3], np.float32)
     bound_taper = dk.Taper(points, origin, axis, taper_z, taper_v)
+    taper_out = np.empty_like(points)  # a caller's buffer, reused from call to call
     rows = [
         ("taper()", lambda: dk.taper(points, origin, axis, taper_z, taper_v), barr["BM_BarrBind/0"] +
          barr["BM_BarrEvaluate/0"], "bind + evaluate", 1.3, "taper"),
@@ -92,6 +93,8 @@ def main(argv):
          barr["BM_BarrEvaluate/2"], "bind + evaluate", 1.3, "bend"),
         ("Taper.evaluate", lambda: bound_taper.evaluate(points), barr["BM_BarrEvaluate/0"], "evaluate", 1.1,
          None),
+        ("Taper.evaluate(out=)", lambda: bound_taper.evaluate(points, out=taper_out), barr["BM_BarrEvaluate/0"],
+         "evaluate", 1.1, None),
     ]
     # tests/bench/ffd_bench.cpp: a 4x4x4 lattice around the unit grid, every control moved.
     fpoints = grid(1000, 999, 1.0, 1.0)
@@ -104,6 +107,7 @@ def main(argv):
         [0.02 * np.sin(0.7 * c), 0.03 * np.cos(1.3 * c), 0.1 * np.sin(0.4 * c)], -1).astype(np.float32)
     target = target.reshape(4, 4, 4, 3).astype(np.float32)
     bound_ffd.bind(fpoints)
+    ffd_out = np.empty_like(fpoints)
     bound_ffd.set_target(target)
     rows += [
         ("ffd()", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target), ffd["BM_FfdBind"] +
@@ -111,6 +115,8 @@ def main(argv):
         ("ffd(basis='bspline')", lambda: dk.ffd(fpoints, lorigin, axes, divisions, target, basis="bspline"),
          ffd["BM_FfdBSplineBind"] + ffd["BM_FfdBSplineEvaluate"], "bind + evaluate", 1.3, "lattice"),
         ("Ffd.evaluate", lambda: bound_ffd.evaluate(fpoints), ffd["BM_FfdEvaluate"], "evaluate", 1.1, None),
+        ("Ffd.evaluate(out=)", lambda: bound_ffd.evaluate(fpoints, out=ffd_out), ffd["BM_FfdEvaluate"], "evaluate",
+         1.1, None),
     ]
     print(f"{'Python call':24} {'Python':>9} {'C++':>9}  {'reference':16} {'ratio':>6}  {'requirement':18}"
           + ("  Blender share  Blender / Python (>= 3)" if shares else ""))

@@ -45,7 +45,7 @@ ProfileCurve profileOf(const FloatArray& z, const FloatArray& v, const char* sou
 // Deforms `points` with a bound warp into a new (n, 3) float32 array: the input is read in place and the
 // warp writes the output directly (no other copy).
 py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::optional<FloatArray>& weights,
-                       float envelope, const char* source) {
+                       float envelope, const char* source, const py::object& outArg = py::none()) {
     const std::span<const glm::vec3> in = pointsView(points, source, "points");
     std::span<const float> w;
     if (weights) {
@@ -59,11 +59,14 @@ py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::opt
                                            std::to_string(in.size()) + " entries, one per point"));
         }
     }
-    py::array_t<float> out({static_cast<py::ssize_t>(in.size()), static_cast<py::ssize_t>(3)});
-    const std::span<glm::vec3> pts(reinterpret_cast<glm::vec3*>(out.mutable_data()), in.size());
+    auto [out, pts] = outputArray(outArg, in.size(), source);
     {
         py::gil_scoped_release release;
-        warp.deform(in, pts, w, envelope);
+        if (pts.data() == in.data()) {
+            warp.deform(pts, w, envelope);  // out is the input: in place
+        } else {
+            warp.deform(in, pts, w, envelope);
+        }
     }
     return out;
 }
@@ -133,10 +136,11 @@ void bindProfileWarpClass(py::module_& m, const char* name, const char* doc) {
             "z_samples"_a, "value_samples"_a)
         .def(
             "evaluate",
-            [name](W& w, const FloatArray& points, const std::optional<FloatArray>& weights, float envelope) {
-                return run(w, points, weights, envelope, name);
-            },
-            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f);
+            [name](W& w, const FloatArray& points, const std::optional<FloatArray>& weights, float envelope,
+                   const py::object& out) { return run(w, points, weights, envelope, name, out); },
+            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f, "out"_a = py::none(),
+            "Deform points (N, 3) into a new array, or into out: a writable (N, 3) float32 array reused from "
+            "call to call (no allocation; it may be points itself).");
 }
 
 void bindBarr(py::module_& m) {
@@ -194,8 +198,11 @@ void bindBarr(py::module_& m) {
         .def(
             "evaluate",
             [](warp::BendWarp& w, const FloatArray& points, const std::optional<FloatArray>& weights,
-               float envelope) { return run(w, points, weights, envelope, "Bend"); },
-            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f);
+               float envelope,
+               const py::object& out) { return run(w, points, weights, envelope, "Bend", out); },
+            "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f, "out"_a = py::none(),
+            "Deform points (N, 3) into a new array, or into out: a writable (N, 3) float32 array reused from "
+            "call to call (no allocation; it may be points itself).");
 
     m.def(
         "maya_bend_params",

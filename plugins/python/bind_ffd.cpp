@@ -178,14 +178,15 @@ py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::opti
 template <class W>
 py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& rest,
                                  const std::optional<FloatArray>& points,
-                                 const std::optional<FloatArray>& weights, float envelope,
-                                 const char* source) {
+                                 const std::optional<FloatArray>& weights, float envelope, const char* source,
+                                 const py::object& outArg) {
     const std::span<const glm::vec3> in =
         points ? pointsView(*points, source, "points") : std::span<const glm::vec3>(rest);
     const std::span<const float> w = weightsView(weights, in.size(), source);
-    auto [out, pts] = outputCopy(in);
+    auto [out, pts] = outputArray(outArg, in.size(), source);
     {
         py::gil_scoped_release release;
+        if (pts.data() != in.data()) std::memcpy(pts.data(), in.data(), in.size_bytes());
         warp.evaluate(pts, w, envelope);
     }
     return out;
@@ -305,11 +306,14 @@ void bindFfd(py::module_& m) {
         .def(
             "evaluate",
             [](const PyFfd& self, const std::optional<FloatArray>& points,
-               const std::optional<FloatArray>& weights, float envelope) {
-                return evaluateBound(self.ffd, self.rest, points, weights, envelope, "Ffd.evaluate");
+               const std::optional<FloatArray>& weights, float envelope, const py::object& out) {
+                return evaluateBound(self.ffd, self.rest, points, weights, envelope, "Ffd.evaluate", out);
             },
             py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
-            "Deform points (N, 3), the bound rest points when None; returns (N, 3) float32.");
+            py::arg("out") = py::none(),
+            "Deform points (N, 3), the bound rest points when None; returns (N, 3) float32: a new array, or\n"
+            "out, a writable (N, 3) float32 array reused from call to call (no allocation; it may be "
+            "points).");
 
     py::class_<PyFfdFrames>(m, "FfdFrames",
                             "FFD with coordinate-frame features, bound once, evaluated many times.")
@@ -346,10 +350,12 @@ void bindFfd(py::module_& m) {
         .def(
             "evaluate",
             [](const PyFfdFrames& self, const std::optional<FloatArray>& points,
-               const std::optional<FloatArray>& weights, float envelope) {
-                return evaluateBound(self.frames, self.rest, points, weights, envelope, "FfdFrames.evaluate");
+               const std::optional<FloatArray>& weights, float envelope, const py::object& out) {
+                return evaluateBound(self.frames, self.rest, points, weights, envelope, "FfdFrames.evaluate",
+                                     out);
             },
-            py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f);
+            py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
+            py::arg("out") = py::none(), "As Ffd.evaluate.");
 }
 
 }  // namespace deformkit::python

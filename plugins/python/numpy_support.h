@@ -131,6 +131,30 @@ inline std::pair<pybind11::array_t<float>, std::span<glm::vec3>> outputCopy(
     return {std::move(out), view};
 }
 
+// Where a deformer writes `count` points: a new (count, 3) float32 array when `out` is None, else the
+// caller's array, which must be a writable C-contiguous (count, 3) float32 array (InvalidInput naming
+// `source` and "out" otherwise): reusing it spares the allocation. Returns the array and its points.
+inline std::pair<pybind11::array_t<float>, std::span<glm::vec3>> outputArray(const pybind11::object& out,
+                                                                             size_t count,
+                                                                             const std::string& source) {
+    namespace py = pybind11;
+    if (out.is_none()) {
+        py::array_t<float> fresh({static_cast<py::ssize_t>(count), py::ssize_t{3}});
+        return {fresh, {reinterpret_cast<glm::vec3*>(fresh.mutable_data()), count}};
+    }
+    const std::string expected =
+        "None or a writable C-contiguous (" + std::to_string(count) + ", 3) float32 array";
+    if (!py::isinstance<py::array_t<float, py::array::c_style>>(out)) {
+        throw InvalidInput(formatError(source, "out", "is not a C-contiguous float32 array", expected));
+    }
+    auto a = py::reinterpret_borrow<py::array_t<float, py::array::c_style>>(out);
+    if (a.ndim() != 2 || a.shape(1) != 3 || static_cast<size_t>(a.shape(0)) != count || !a.writeable()) {
+        throw InvalidInput(formatError(
+            source, "out", "has shape " + shapeOf(a) + (a.writeable() ? "" : ", read-only"), expected));
+    }
+    return {a, {reinterpret_cast<glm::vec3*>(a.mutable_data()), count}};
+}
+
 // An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.
 inline io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
                          const std::string& expected = "(H, W) or (H, W, C) float32") {
