@@ -147,6 +147,38 @@ Bernstein444Kernel bernstein444Kernel(FfdKernel choice) {
     return detail::bernstein444Baseline;
 }
 
+// The Bernstein 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates
+// and whether the warp reaches it; points[u] += envelope * weight * D(u) for those it reaches. Each block
+// reads and writes its own points only: the output does not depend on the schedule.
+template <class Local>
+void bernsteinBlocks(int64_t n, Bernstein444Kernel kernel, const float* translations,
+                     std::span<glm::vec3> points, std::span<const float> weights, float envelope,
+                     const Local& local) {
+    constexpr int kBlock = detail::kBlock;
+    const int64_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(dynamic, 512)
+    for (int64_t b = 0; b < blocks; ++b) {
+        const int64_t begin = b * kBlock;
+        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
+        detail::LocalBlock in{};
+        bool active[kBlock] = {};
+        for (int lane = 0; lane < count; ++lane) {
+            const glm::vec3 l = local(begin + lane, active[lane]);
+            in.x[lane] = l.x;
+            in.y[lane] = l.y;
+            in.z[lane] = l.z;
+        }
+        detail::DisplacementBlock d;
+        kernel(in, translations, d);
+        for (int lane = 0; lane < count; ++lane) {
+            const int64_t u = begin + lane;
+            if (!active[lane]) continue;
+            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+            points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+        }
+    }
+}
+
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
 inline int32_t basisWeights(FfdBasis basis, FfdEnds ends, int32_t d, const float* binomial, float x,
                             int32_t& first, float* w) {
@@ -287,34 +319,15 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
                                        "finite positions"));
     }
     if (!weights.empty() && weights.size() != points.size()) return false;  // evaluate() names the mismatch
-    const Bernstein444Kernel kernel = bernstein444Kernel(options_.kernel);
     const glm::dvec3 scale(lattice_.divisions);
     const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
-    constexpr int kBlock = detail::kBlock;
-    const int64_t blocks = (n + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 512)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const int64_t begin = b * kBlock;
-        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
-        detail::LocalBlock in{};
-        bool active[kBlock] = {};
-        for (int lane = 0; lane < count; ++lane) {
-            bool inside = true;
-            const glm::vec3 l = boundCoordinates(restPoints[begin + lane], scale, inside);
-            active[lane] = inside || extrapolate;
-            in.x[lane] = l.x;
-            in.y[lane] = l.y;
-            in.z[lane] = l.z;
-        }
-        detail::DisplacementBlock d;
-        kernel(in, translations, d);
-        for (int lane = 0; lane < count; ++lane) {
-            const int64_t u = begin + lane;
-            if (!active[lane]) continue;
-            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-            points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
-        }
-    }
+    bernsteinBlocks(n, bernstein444Kernel(options_.kernel), translations, points, weights, envelope,
+                    [&](int64_t u, bool& active) {
+                        bool inside = true;
+                        const glm::vec3 l = boundCoordinates(restPoints[u], scale, inside);
+                        active = inside || extrapolate;
+                        return l;
+                    });
     return true;
 }
 
@@ -478,31 +491,11 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
 
 void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* translations,
                                     std::span<const float> weights, float envelope) const {
-    const Bernstein444Kernel kernel = bernstein444Kernel(options_.kernel);
-    const int64_t n = numBoundPoints();
-    constexpr int kBlock = detail::kBlock;
-    const int64_t blocks = (n + kBlock - 1) / kBlock;
-    // Each block reads and writes its own points only: the output does not depend on the schedule.
-#pragma omp parallel for schedule(dynamic, 512)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const int64_t begin = b * kBlock;
-        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
-        detail::LocalBlock in{};
-        for (int lane = 0; lane < count; ++lane) {
-            const glm::vec3& l = local_[begin + lane];
-            in.x[lane] = l.x;
-            in.y[lane] = l.y;
-            in.z[lane] = l.z;
-        }
-        detail::DisplacementBlock d;
-        kernel(in, translations, d);
-        for (int lane = 0; lane < count; ++lane) {
-            const int64_t u = begin + lane;
-            if (!active_[u]) continue;
-            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-            points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
-        }
-    }
+    bernsteinBlocks(numBoundPoints(), bernstein444Kernel(options_.kernel), translations, points, weights,
+                    envelope, [&](int64_t u, bool& active) {
+                        active = active_[u] != 0;
+                        return local_[u];
+                    });
 }
 
 // The kernels that sum a 4x4x4 window with given weights, for this CPU.

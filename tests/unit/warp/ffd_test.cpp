@@ -27,6 +27,23 @@ using deformkit::test::viaEngine;
 
 namespace {
 
+// Painted weights in [0, 1], one per point.
+std::vector<float> randomWeights(size_t count, std::mt19937& rng) {
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<float> weights(count);
+    for (auto& w : weights)
+        w = unit(rng);
+    return weights;
+}
+
+// The rest points moved a little, as an upstream deformer's output.
+std::vector<glm::vec3> shifted(const std::vector<glm::vec3>& rest) {
+    std::vector<glm::vec3> out = rest;
+    for (auto& p : out)
+        p += glm::vec3(0.01f, -0.02f, 0.03f);
+    return out;
+}
+
 // A skewed parallelepiped, not axis-aligned, not orthogonal.
 Lattice skewLattice(glm::ivec3 divisions) {
     Lattice l;
@@ -390,7 +407,6 @@ TEST_CASE("ffd: B-spline is local, a control moves only points in its support", 
 
 TEST_CASE("ffd: fast path equals the generic engine with painted weights and envelope", "[warp][ffd]") {
     std::mt19937 rng(18);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (FfdBasis basis : kAllBases) {
         for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
             const Lattice l = skewLattice({4, 3, 5});
@@ -398,13 +414,9 @@ TEST_CASE("ffd: fast path equals the generic engine with painted weights and env
             Ffd ffd(l, {basis, outside, FfdKernel::Auto, ends});
             ffd.setTargets(randomTargets(l, rng, 0.5f));
             const auto rest = samplePoints(l, rng, 3000, -0.2f, 1.2f);
-            std::vector<float> weights(rest.size());
-            for (auto& w : weights)
-                w = unit(rng);
+            const std::vector<float> weights = randomWeights(rest.size(), rng);
             // Evaluate at upstream points that differ from the rest points, as a deformer stack would.
-            std::vector<glm::vec3> upstream = rest;
-            for (auto& p : upstream)
-                p += glm::vec3(0.01f, -0.02f, 0.03f);
+            const std::vector<glm::vec3> upstream = shifted(rest);
             WarpDeformer deformer(ffd);
             deformer.bind(rest);
             std::vector<glm::vec3> generic = upstream;
@@ -447,17 +459,12 @@ TEST_CASE("ffd: the AVX2 and portable Bernstein 4x4x4 kernels give the same byte
     // trivially exact.
     INFO("AVX2 kernel available: " << ffdHasAvx2Kernel());
     std::mt19937 rng(23);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
         const Lattice l = skewLattice({3, 3, 3});
         const auto target = randomTargets(l, rng, 0.5f);
         const auto rest = samplePoints(l, rng, 10001, -0.2f, 1.2f);
-        std::vector<float> weights(rest.size());
-        for (auto& w : weights)
-            w = unit(rng);
-        std::vector<glm::vec3> upstream = rest;
-        for (auto& p : upstream)
-            p += glm::vec3(0.01f, -0.02f, 0.03f);
+        const std::vector<float> weights = randomWeights(rest.size(), rng);
+        const std::vector<glm::vec3> upstream = shifted(rest);
         Ffd fast(l, {FfdBasis::Bernstein, outside, FfdKernel::Auto});
         Ffd portable(l, {FfdBasis::Bernstein, outside, FfdKernel::Portable});
         std::vector<glm::vec3> a = upstream, b = upstream;
@@ -490,7 +497,6 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
     // The block kernels sum each point's per-point weights in the per-point path's order: every basis and end
     // rule, mixed bases, points outside the lattice, block tails, painted weights, 1 and 2 threads.
     std::mt19937 rng(41);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     const FfdBasis bases[] = {FfdBasis::BSpline, FfdBasis::CatmullRom, FfdBasis::Cardinal,
                               FfdBasis::Linear,  FfdBasis::Bernstein,  FfdBasis::Bernstein};
     int cases = 0;
@@ -501,9 +507,7 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
             const Lattice l = skewLattice({3, 3, 3});
             const auto target = randomTargets(l, rng, 0.5f);
             const auto rest = samplePoints(l, rng, 4099, -0.2f, 1.2f);
-            std::vector<float> weights(rest.size());
-            for (auto& w : weights)
-                w = unit(rng);
+            const std::vector<float> weights = randomWeights(rest.size(), rng);
             std::vector<glm::vec3> reference = rest;
             Ffd perPoint(l, {basis, FfdOutside::Extrapolate, FfdKernel::PerPoint, ends});
             perPoint.setTargets(target);
@@ -530,18 +534,13 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
 
 TEST_CASE("ffd: a one-off without the bind cache gives bind + evaluate's bytes", "[warp][ffd][simd]") {
     std::mt19937 rng(61);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (const glm::ivec3 divisions : {glm::ivec3(3), glm::ivec3(3, 2, 4)}) {  // the fused path, the fallback
         for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
             const Lattice l = skewLattice(divisions);
             const auto target = randomTargets(l, rng, 0.5f);
             const auto rest = samplePoints(l, rng, 5003, -0.2f, 1.2f);
-            std::vector<float> weights(rest.size());
-            for (auto& w : weights)
-                w = unit(rng);
-            std::vector<glm::vec3> upstream = rest;
-            for (auto& p : upstream)
-                p += glm::vec3(0.01f, -0.02f, 0.03f);
+            const std::vector<float> weights = randomWeights(rest.size(), rng);
+            const std::vector<glm::vec3> upstream = shifted(rest);
             Ffd bound(l, {FfdBasis::Bernstein, outside});
             bound.setTargets(target);
             bound.bind(rest);
