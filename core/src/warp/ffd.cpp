@@ -136,16 +136,16 @@ void windowSum(const float* data, int32_t ny, int32_t nz, const int32_t* first, 
     }
 }
 
-// The Bernstein 4x4x4 kernel (ffd_kernels.h) for this CPU; Portable forces the baseline build.
-using Bernstein444Kernel = void (*)(const detail::LocalBlock&, const float*, detail::DisplacementBlock&);
-
-Bernstein444Kernel bernstein444Kernel(FfdKernel choice) {
+// The 4x4x4 kernels (ffd_kernels.h) for this CPU; Portable forces the baseline build.
+const detail::FfdKernels& ffdKernels(FfdKernel choice) {
 #ifdef DEFORMKIT_SIMD_X86
-    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::bernstein444Avx2;
+    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::kAvx2FfdKernels;
 #endif
     (void)choice;
-    return detail::bernstein444Baseline;
+    return detail::kBaselineFfdKernels;
 }
+
+using Bernstein444Kernel = decltype(detail::FfdKernels::bernstein444);
 
 // The Bernstein 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates
 // and whether the warp reaches it; points[u] += envelope * weight * D(u) for those it reaches. Each block
@@ -321,7 +321,7 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
     if (!weights.empty() && weights.size() != points.size()) return false;  // evaluate() names the mismatch
     const glm::dvec3 scale(lattice_.divisions);
     const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
-    bernsteinBlocks(n, bernstein444Kernel(options_.kernel), translations, points, weights, envelope,
+    bernsteinBlocks(n, ffdKernels(options_.kernel).bernstein444, translations, points, weights, envelope,
                     [&](int64_t u, bool& active) {
                         bool inside = true;
                         const glm::vec3 l = boundCoordinates(restPoints[u], scale, inside);
@@ -491,49 +491,16 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
 
 void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* translations,
                                     std::span<const float> weights, float envelope) const {
-    bernsteinBlocks(numBoundPoints(), bernstein444Kernel(options_.kernel), translations, points, weights,
+    bernsteinBlocks(numBoundPoints(), ffdKernels(options_.kernel).bernstein444, translations, points, weights,
                     envelope, [&](int64_t u, bool& active) {
                         active = active_[u] != 0;
                         return local_[u];
                     });
 }
 
-// The kernels that sum a 4x4x4 window with given weights, for this CPU.
-using Window444Kernel = void (*)(const detail::WeightBlock&, const float*, detail::DisplacementBlock&);
-using Frames444Kernel = void (*)(const detail::WeightBlock&, const float*, detail::AffineBlock&);
-
-Window444Kernel window444Kernel(FfdKernel choice) {
-#ifdef DEFORMKIT_SIMD_X86
-    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::window444Avx2;
-#endif
-    (void)choice;
-    return detail::window444Baseline;
-}
-
-using BernsteinWeightsKernel = void (*)(const detail::LocalBlock&, detail::WeightBlock&);
-
-BernsteinWeightsKernel bernsteinWeightsKernel(FfdKernel choice) {
-#ifdef DEFORMKIT_SIMD_X86
-    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2)
-        return detail::bernsteinWeights444Avx2;
-#endif
-    (void)choice;
-    return detail::bernsteinWeights444Baseline;
-}
-
-Frames444Kernel frames444Kernel(FfdKernel choice) {
-#ifdef DEFORMKIT_SIMD_X86
-    if (choice == FfdKernel::Auto && simd::activeIsa() == simd::Isa::Avx2) return detail::frames444Avx2;
-#endif
-    (void)choice;
-    return detail::frames444Baseline;
-}
-
 void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data, int32_t stride,
                                  std::span<const float> weights, float envelope) const {
-    const Window444Kernel translate = window444Kernel(options_.kernel);
-    const Frames444Kernel affine = frames444Kernel(options_.kernel);
-    const BernsteinWeightsKernel bernstein = bernsteinWeightsKernel(options_.kernel);
+    const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
     const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
     const int64_t n = numBoundPoints();
     constexpr int kBlock = detail::kBlock;
@@ -573,7 +540,7 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
                 local.y[lane] = l.y;
                 local.z[lane] = l.z;
             }
-            bernstein(local, in);
+            kernels.bernsteinWeights444(local, in);
         } else {
             windowWeightsOf(begin, count, &in.w[0][0][0]);
             if (keep != nullptr)
@@ -581,7 +548,7 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
         }
         if (stride == 3) {
             detail::DisplacementBlock d;
-            translate(in, data, d);
+            kernels.window444(in, data, d);
             for (int lane = 0; lane < count; ++lane) {
                 const int64_t u = begin + lane;
                 if (!active_[u]) continue;
@@ -590,7 +557,7 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
             }
         } else {
             detail::AffineBlock m;
-            affine(in, data, m);
+            kernels.frames444(in, data, m);
             for (int lane = 0; lane < count; ++lane) {
                 const int64_t u = begin + lane;
                 if (!active_[u]) continue;

@@ -34,16 +34,18 @@ struct AffineBlock {
     alignas(32) float a[12][kBlock];
 };
 
-// translations: 64 controls x 3 floats in Lattice::index order. The same bytes from each.
-void bernstein444Baseline(const LocalBlock& in, const float* translations, DisplacementBlock& out);
-void window444Baseline(const WeightBlock& in, const float* translations, DisplacementBlock& out);
-void frames444Baseline(const WeightBlock& in, const float* affine, AffineBlock& out);
-void bernsteinWeights444Baseline(const LocalBlock& in, WeightBlock& out);
+// One instruction set's kernels (as the UV-warp solver's SolverKernels). translations: 64 controls x 3 floats
+// in Lattice::index order; affine: 64 controls x 12 floats. Every build gives the same bytes.
+struct FfdKernels {
+    void (*bernstein444)(const LocalBlock& in, const float* translations, DisplacementBlock& out);
+    void (*window444)(const WeightBlock& in, const float* translations, DisplacementBlock& out);
+    void (*frames444)(const WeightBlock& in, const float* affine, AffineBlock& out);
+    void (*bernsteinWeights444)(const LocalBlock& in, WeightBlock& out);
+};
+
+extern const FfdKernels kBaselineFfdKernels;
 #ifdef DEFORMKIT_SIMD_X86
-void bernstein444Avx2(const LocalBlock& in, const float* translations, DisplacementBlock& out);
-void window444Avx2(const WeightBlock& in, const float* translations, DisplacementBlock& out);
-void frames444Avx2(const WeightBlock& in, const float* affine, AffineBlock& out);
-void bernsteinWeights444Avx2(const LocalBlock& in, WeightBlock& out);
+extern const FfdKernels kAvx2FfdKernels;
 #endif
 
 namespace {

@@ -9,21 +9,7 @@
 
 namespace deformkit::warp::detail {
 
-void bernstein444Avx2(const LocalBlock& in, const float* translations, DisplacementBlock& out) {
-    bernstein444(in, translations, out);
-}
-
-void window444Avx2(const WeightBlock& in, const float* translations, DisplacementBlock& out) {
-    window444(in, translations, out);
-}
-
-void frames444Avx2(const WeightBlock& in, const float* affine, AffineBlock& out) {
-    frames444(in, affine, out);
-}
-
-void bernsteinWeights444Avx2(const LocalBlock& in, WeightBlock& out) {
-    bernsteinWeights444(in, out);
-}
+const FfdKernels kAvx2FfdKernels = {bernstein444, window444, frames444, bernsteinWeights444};
 
 }  // namespace deformkit::warp::detail
 #endif
