@@ -161,9 +161,10 @@ py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::opti
                               float envelope, const char* source) {
     const std::span<const glm::vec3> in = pointsView(points, source, "points");
     const std::span<const float> w = weightsView(weights, in.size(), source);
-    auto [out, pts] = outputCopy(in);
+    auto [out, pts] = outputArray(py::none(), in.size(), source);
     {
         py::gil_scoped_release release;
+        if (!in.empty()) std::memcpy(pts.data(), in.data(), in.size_bytes());
         if constexpr (std::is_same_v<W, Ffd>) {
             warp.bindAndEvaluate(in, pts, w, envelope);  // no bind cache where it can do without
         } else {

@@ -121,16 +121,6 @@ inline std::span<const float> weightsView(const std::optional<FloatArray>& weigh
     return {weights->data(), count};
 }
 
-// A new (n, 3) float32 array holding a copy of `points`, and its data as points: for deformers that work in
-// place, the one copy the caller gets back.
-inline std::pair<pybind11::array_t<float>, std::span<glm::vec3>> outputCopy(
-    std::span<const glm::vec3> points) {
-    pybind11::array_t<float> out({static_cast<pybind11::ssize_t>(points.size()), pybind11::ssize_t{3}});
-    const std::span<glm::vec3> view(reinterpret_cast<glm::vec3*>(out.mutable_data()), points.size());
-    if (!points.empty()) std::memcpy(view.data(), points.data(), points.size_bytes());
-    return {std::move(out), view};
-}
-
 // Where a deformer writes `count` points: a new (count, 3) float32 array when `out` is None, else the
 // caller's array, which must be a writable C-contiguous (count, 3) float32 array (InvalidInput naming
 // `source` and "out" otherwise): reusing it spares the allocation. Returns the array and its points.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 
@@ -58,9 +59,10 @@ std::vector<int32_t> groupRoots(const Mesh& mesh, double tolerance) {
     const auto n = static_cast<int32_t>(points.size());
     std::vector<int32_t> parent(points.size());
     std::iota(parent.begin(), parent.end(), 0);
-    const FaceSharing sharing(mesh);
+    std::optional<FaceSharing> sharing;  // built at the first candidate pair: most meshes have none
     auto unite = [&](int32_t a, int32_t b) {
-        if (sharing.share(a, b)) return;
+        if (!sharing) sharing.emplace(mesh);
+        if (sharing->share(a, b)) return;
         a = findRoot(parent, a);
         b = findRoot(parent, b);
         if (a == b) return;
@@ -147,6 +149,7 @@ Welding weldVertices(const Mesh& mesh, double tolerance, const std::string& sour
     for (size_t v = 0; v < points.size(); ++v)
         w.copies[static_cast<size_t>(fill[static_cast<size_t>(w.weldedOf[v])]++)] = static_cast<int32_t>(v);
 
+    if (w.merged() == 0) return w;  // nothing to weld: no welded mesh (callers use the file's)
     Mesh::Data data;
     data.points.reserve(w.firstOf.size());
     for (int32_t v : w.firstOf)

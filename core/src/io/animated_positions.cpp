@@ -44,10 +44,6 @@ void AnimatedPositions::setReference(const geom::Mesh& rest, const std::string& 
     }
 }
 
-std::vector<int> AnimatedPositions::frames() const {
-    return cache_ ? cache_->frames() : sequence_->frames();
-}
-
 void AnimatedPositions::requireFrames(std::span<const int> frames) const {
     for (const int frame : frames) {
         if (cache_) {

@@ -110,8 +110,7 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
     std::span<const glm::vec3> input = rest.points();
     // The input sequence drives the scene's rest mesh only, not one a host set since.
     if (ob.sequence && ob.restVersion == ob.sceneRestVersion) {
-        ob.input.resize(points.size());
-        readInput(object, frame, ob.input);
+        readInput(object, frame);
         input = ob.input;
     }
     try {
@@ -143,7 +142,7 @@ void SceneEvaluator::check(std::span<const int> frames) {
     }
 }
 
-void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3> points) {
+void SceneEvaluator::readInput(size_t object, double frame) {
     const SceneObject& so = scene_.objects[object];
     Object& ob = objects_[object];
     const std::string& element = so.sequenceElement;
@@ -154,9 +153,7 @@ void SceneEvaluator::readInput(size_t object, double frame, std::span<glm::vec3>
     }
     const int whole = static_cast<int>(frame);
     namedBy(
-        scene_.source, element, frameText(frame) + ": ", [&] { ob.sequence->read(whole, ob.frameInput); },
-        false);
-    std::copy(ob.frameInput.begin(), ob.frameInput.end(), points.begin());
+        scene_.source, element, frameText(frame) + ": ", [&] { ob.sequence->read(whole, ob.input); }, false);
 }
 
 host::DeformerStack& SceneEvaluator::stack(size_t object) {

@@ -18,7 +18,7 @@ struct Welding {
     // The welded mesh: one vertex per group of coincident vertices, at the position of the group's first
     // (lowest-index) vertex, numbered in the order of those first vertices; the faces on welded vertices in
     // the file's order (a face whose corners weld together, a sliver of coincident points, is left out);
-    // every face corner keeps its UV.
+    // every face corner keeps its UV. Empty when nothing was welded (merged() == 0): the file's mesh is it.
     Mesh mesh;
     std::vector<int32_t> weldedOf;     // per file vertex: its welded vertex
     std::vector<int32_t> firstOf;      // per welded vertex: its first file vertex

@@ -37,14 +37,11 @@ class AnimatedPositions {
 
     [[nodiscard]] const std::filesystem::path& path() const { return path_; }
     [[nodiscard]] bool isCache() const { return cache_ != nullptr; }
-    [[nodiscard]] const PointCache* cache() const { return cache_.get(); }
 
     // Every frame read must match `rest` (read from `restName`): an OBJ frame its connectivity, a cache its
     // vertex count, checked now (InvalidInput naming the cache and both counts).
     void setReference(const geom::Mesh& rest, const std::string& restName);
 
-    // The frames there are, ascending: the sequence's files, the cache's whole-frame samples.
-    [[nodiscard]] std::vector<int> frames() const;
     // Checks that every one of `frames` is there: IoError naming the first missing file of a sequence,
     // InvalidInput naming the cache, the frame and the frames it has.
     void requireFrames(std::span<const int> frames) const;

@@ -67,16 +67,16 @@ class SceneEvaluator {
         // The object's animated input (SceneObject::sequence: an OBJ sequence or a point cache), when it has
         // one.
         std::unique_ptr<io::AnimatedPositions> sequence;
-        std::vector<glm::vec3> input;       // the sequence's positions at the frame evaluated
-        std::vector<glm::vec3> frameInput;  // as read, before the copy into `input`
-        uint64_t restVersion = 0;           // the stack's rest version `deformed` was copied from
-        uint64_t sceneRestVersion = 0;      // the stack's rest version holding the scene's rest mesh
+        std::vector<glm::vec3> input;   // the sequence's positions at the frame evaluated
+        uint64_t restVersion = 0;       // the stack's rest version `deformed` was copied from
+        uint64_t sceneRestVersion = 0;  // the stack's rest version holding the scene's rest mesh
         int64_t evaluations = 0;
     };
 
     void setFrame(size_t object, double frame, bool all);
-    // The input sequence's positions at `frame` into points (#V); errors as evaluate() says.
-    void readInput(size_t object, double frame, std::span<glm::vec3> points);
+    // The input sequence's positions at `frame` into the object's `input` (#V: the reference checked the
+    // count); errors as evaluate() says.
+    void readInput(size_t object, double frame);
 
     Scene scene_;
     std::vector<Object> objects_;
