@@ -92,6 +92,10 @@ Option Command::option(const std::string& name, std::vector<int32_t>& target, co
     return Option(app_->add_option(name, target, help));
 }
 
+Option Command::option(const std::string& name, std::vector<std::string>& target, const std::string& help) {
+    return Option(app_->add_option(name, target, help));
+}
+
 Option Command::option(const std::string& name, std::vector<double>& target, const std::string& help) {
     return Option(app_->add_option(name, target, help));
 }
@@ -183,6 +187,7 @@ void addCommands(CommandLine& cli) {
     addWarpCommand(cli);
     addSlideCommand(cli);
     addUvWarpCommand(cli);
+    addReportCommand(cli);
     addPtexCommands(cli);
     addDeformersCommand(cli);
 }

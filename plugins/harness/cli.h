@@ -49,6 +49,7 @@ class Command {
     Option option(const std::string& name, float& target, const std::string& help);
     Option option(const std::string& name, std::vector<int32_t>& target, const std::string& help);
     Option option(const std::string& name, std::vector<double>& target, const std::string& help);
+    Option option(const std::string& name, std::vector<std::string>& target, const std::string& help);
     Option flag(const std::string& name, bool& target, const std::string& help);
     // An option whose value `parse` reads as soon as it is given (a deformkit::Error it throws is a usage
     // error, exit 2); `shownDefault` is what --help shows when it is not given.
@@ -96,7 +97,8 @@ void addInfoCommand(CommandLine& cli);       // info_command.cpp
 void addPreviewCommand(CommandLine& cli);    // preview_command.cpp
 void addDemoCommand(CommandLine& cli);       // demo_command.cpp
 void addEvalCommand(CommandLine& cli);       // eval_command.cpp
-void addFarmCommands(CommandLine& cli);      // farm_command.cpp: farm plan, run, submit
+void addFarmCommands(CommandLine& cli);      // farm_command.cpp: farm plan, run, submit, report
+void addReportCommand(CommandLine& cli);     // report_command.cpp
 void addWarpCommand(CommandLine& cli);       // warp_command.cpp
 void addSlideCommand(CommandLine& cli);      // slide_command.cpp
 void addUvWarpCommand(CommandLine& cli);     // uvwarp_command.cpp

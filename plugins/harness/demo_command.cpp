@@ -58,6 +58,9 @@ std::vector<fs::path> demo(const DemoCommand& command) {
                                        assets.albedo, command.outDir)) {
         written.push_back(std::move(f));
     }
+    for (fs::path& f :
+         writeDemoUvWarpShot(assets.mesh, std::min<int32_t>(command.resolution, 256), command.outDir))
+        written.push_back(std::move(f));
     return written;
 }
 

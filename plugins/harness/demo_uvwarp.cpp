@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/obj.h"
+#include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/preview.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/html_report.h"
+#include "deformkit/uvwarp/shot_job.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "deformkit/warp/barr.h"
 
@@ -55,16 +59,25 @@ io::Image sheet(const std::vector<std::vector<const io::Image*>>& rows, int32_t 
 
 }  // namespace
 
-DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, const io::Image& mask,
-                          const io::Image& albedo) {
-    // Bend about the axis frame's "up" (+x) over the tube's length: the bend radius 1/k ~ 1.9 puts the
-    // -x side (1 unit further out) at ~1.5x stretch and the +x side at ~0.5x.
+namespace {
+
+// The tube bent about the axis frame's "up" (+x) over its length, `amount` of the demo's pose: at 1 the
+// bend radius 1/k ~ 1.9 puts the -x side (1 unit further out) at ~1.5x stretch and the +x side at ~0.5x.
+std::vector<glm::vec3> bentTube(const geom::Mesh& tube, float amount) {
     const warp::AxisFrame axis{{0, 0, 0}, {0, 1, 0}, {1, 0, 0}};
-    warp::BendWarp bend(axis, {std::numbers::pi_v<float> / 2 / 3.0f, 0.5f, 0.5f, 3.5f});
+    warp::BendWarp bend(axis, {amount * std::numbers::pi_v<float> / 2 / 3.0f, 0.5f, 0.5f, 3.5f});
     std::vector<glm::vec3> points(tube.points().begin(), tube.points().end());
     warp::SparseFields unused;
     bend.bind(points, unused);
     bend.deform(points);
+    return points;
+}
+
+}  // namespace
+
+DemoUvWarp makeDemoUvWarp(const geom::Mesh& tube, const io::Image& rigidity, const io::Image& mask,
+                          const io::Image& albedo) {
+    const std::vector<glm::vec3> points = bentTube(tube, 1.0f);
     DemoUvWarp demo{tube, {}, {}, {}, {}};
     demo.bent.setPoints(points);
 
@@ -137,6 +150,50 @@ std::vector<fs::path> writeDemoUvWarp(const geom::Mesh& tube, const io::Image& r
     json += "}\n";
     written.push_back(dir / "metrics.json");
     io::writeFileAtomically(written.back(), json);
+    return written;
+}
+
+std::vector<fs::path> writeDemoUvWarpShot(const geom::Mesh& tube, int32_t cells, const fs::path& outDir) {
+    // Absolute names: the maps' headers then name files a report finds from any folder.
+    const fs::path root = fs::absolute(outDir), dir = root / "uvwarp" / "shot";
+    io::createFolder(dir);
+    std::vector<fs::path> written;
+    std::vector<int> frames;
+    for (int frame = 1; frame <= kDemoShotFrames; ++frame) {
+        geom::Mesh bent = tube;
+        bent.setPoints(bentTube(tube, static_cast<float>(frame) / kDemoShotFrames));
+        written.push_back(dir / io::ObjSequence("tube.####.obj").framePath(frame).filename());
+        io::writeObj(written.back(), bent);
+        frames.push_back(frame);
+    }
+    uvwarp::ShotJob job;
+    job.rest = &tube;
+    job.restName = (root / "tube.obj").string();
+    job.frames = frames;
+    job.tiles = {1001};
+    job.rigidity = {root / "rigidity.<UDIM>.exr", {}, "rigidity"};
+    job.mask = {root / "mask.<UDIM>.exr", {}, "mask"};
+    job.texture = {root / "albedo.<UDIM>.png", {}, "texture"};
+    uvwarp::setOutputPatterns(job, dir / "redirect.<UDIM>.####.exr", dir / "albedo.<UDIM>.####.png",
+                              "redirect", "bake");
+    job.options.cells = cells;
+    job.skipExisting = false;
+    std::ostringstream log;
+    job.log = &log;
+    const fs::path deformed = dir / "tube.####.obj";
+    const uvwarp::ShotReport report =
+        uvwarp::runShotJob(job, uvwarp::animatedFrames(deformed, frames, "demo shot", tube, job.restName));
+    for (const uvwarp::ShotTileReport& tile : report.tiles)
+        written.insert(written.end(), tile.files.begin(), tile.files.end());
+    written.push_back(dir / "uvwarp.jsonl");
+    io::writeFileAtomically(written.back(), log.str());
+    uvwarp::ShotLog lines;
+    uvwarp::readShotLogFile(written.back(), lines);
+    uvwarp::HtmlReportOptions page;
+    page.title = "DeformKit demo: the tube bending, UV warp of tile 1001";
+    const uvwarp::HtmlReportResult result =
+        uvwarp::writeHtmlReport(lines, root / "uvwarp" / "report.html", page);
+    written.insert(written.end(), result.files.begin(), result.files.end());
     return written;
 }
 

@@ -33,4 +33,13 @@ std::vector<std::filesystem::path> writeDemoUvWarp(const geom::Mesh& tube, const
                                                    const std::map<int, io::Image>& albedo,
                                                    const std::filesystem::path& outDir);
 
+// The demo's UV-warp shot: the tube bent a little more each frame up to makeDemoUvWarp's pose, over
+// kDemoShotFrames frames, written as `deformkit uvwarp` would from the demo's files in outDir (tube.obj,
+// rigidity, mask and albedo maps): demo-out/uvwarp/shot/ holds the bent tube per frame (tube.####.obj),
+// the redirect maps and bakes, and the shot's log (uvwarp.jsonl); demo-out/uvwarp/report.html is the
+// shot's page (uvwarp/html_report.h).
+inline constexpr int kDemoShotFrames = 8;
+std::vector<std::filesystem::path> writeDemoUvWarpShot(const geom::Mesh& tube, int32_t cells,
+                                                       const std::filesystem::path& outDir);
+
 }  // namespace deformkit::harness

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <sstream>
 #include <string_view>
 
 #include <glm/geometric.hpp>
@@ -28,6 +29,7 @@
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/scene.h"
 #include "deformkit/scene/uvwarp_stage.h"
+#include "deformkit/uvwarp/html_report.h"
 
 namespace deformkit::harness {
 
@@ -150,6 +152,35 @@ void checkSize(const char* what, int32_t value, int32_t lo, int32_t hi) {
     }
 }
 
+// The UV-warp stages' log written as DIR/uvwarp.jsonl and the shot's page (EvalCommand::report).
+void writeShotPage(const EvalCommand& command, EvalReport& report, const std::string& logText,
+                   std::ostream* progress) {
+    if (logText.empty()) {
+        report.notes.push_back("no UV-warp stage wrote a frame: no report");
+        return;
+    }
+    const fs::path logFile = command.outDir / "uvwarp.jsonl";
+    io::writeFileAtomically(logFile, logText);
+    report.files.push_back(logFile);
+    uvwarp::ShotLog log;
+    uvwarp::readShotLogFile(logFile, log);
+    uvwarp::HtmlReportOptions options;
+    options.title = "Shot " + command.scene.stem().string();
+    std::string frames;
+    if (!report.frames.empty()) {
+        frames =
+            " --frames " + std::to_string(report.frames.front()) + "-" + std::to_string(report.frames.back());
+    }
+    options.rerun.push_back("deformkit eval " + fs::absolute(command.scene).string() + frames + " --out " +
+                            fs::absolute(command.outDir).string() + " --report " +
+                            fs::absolute(*command.report).string());
+    const uvwarp::HtmlReportResult page = uvwarp::writeHtmlReport(log, *command.report, options);
+    report.files.insert(report.files.end(), page.files.begin(), page.files.end());
+    for (const std::string& note : page.notes)
+        report.notes.push_back("report: " + note);
+    if (progress) *progress << "eval: report " << command.report->string() << " written\n";
+}
+
 }  // namespace
 
 ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32_t previewHeight,
@@ -256,6 +287,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
 
     // The UV-warp stages: one shot solver per object with a stage, fed the frame the OBJ is written from.
     std::vector<std::optional<uvwarp::ShotSolver>> stages(numObjects);
+    std::ostringstream uvwarpLog;
     for (size_t o = 0; o < numObjects; ++o) {
         const scene::SceneObject& object = scene.objects[o];
         if (!object.uvwarp || report.frames.empty()) continue;
@@ -263,6 +295,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         run.frames = report.frames;
         run.tiles = object.uvwarp->tiles;
         run.outDir = command.outDir;
+        if (command.report) run.log = &uvwarpLog;
         stages[o] = scene::uvwarpStageSolver(scene, o, run);
     }
 
@@ -311,6 +344,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         report.files.push_back(cache->path());
         if (progress) *progress << "eval: point cache " << cache->path().string() << " written\n";
     }
+    if (command.report) writeShotPage(command, report, uvwarpLog.str(), progress);
     for (size_t o = 0; o < numObjects; ++o)
         report.binds.push_back(evaluator.stack(o).bindCount());
     for (size_t o = 0; o < numObjects; ++o)
@@ -341,7 +375,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
 void addEvalCommand(CommandLine& cli) {
     struct Options {
         EvalCommand command;
-        std::string scene, frames, out;
+        std::string scene, frames, out, report;
         bool noPreviews = false, noObjs = false;
     };
     auto o = std::make_shared<Options>();
@@ -355,6 +389,7 @@ void addEvalCommand(CommandLine& cli) {
             if (!o->frames.empty()) c.frames = parseFrames(o->frames);
             c.previews = !o->noPreviews;
             c.objs = !o->noObjs;
+            if (!o->report.empty()) c.report = o->report;
             const EvalReport report = evalCommand(c, &std::cout);
             std::cout << "eval: wrote " << report.files.size() << " files to " << o->out << "/\n";
             for (const std::string& note : report.notes)
@@ -376,6 +411,9 @@ void addEvalCommand(CommandLine& cli) {
             "--cache", o->command.cache,
             "also write <object>.pc2 or <object>.mdd: every frame in one point cache (consecutive frames)")
         .choices({"pc2", "mdd"});
+    eval.option(
+        "--report", o->report,
+        "with UV-warp stages: an HTML page of the shot (deformkit report), their log as <out>/uvwarp.jsonl");
     eval.flag("--no-objs", o->noObjs, "write the point cache instead of the per-frame OBJs (needs --cache)");
     eval.option("--fps", o->command.movieFrameRate, "frame rate of the movies and of an MDD cache's times")
         .showDefault();

@@ -21,6 +21,7 @@
 //   DIR/<object>.redirect.<tile>.<frame>.exr, DIR/<object>.bake.<tile>.<frame>.<ext>
 //                              the UV-warp stage of an object that has one (scene/uvwarp_stage.h): every
 //                              tile's frames solved in order, warm-started
+//   DIR/uvwarp.jsonl, REPORT   with `report`: the stages' log and the shot's HTML page
 //
 // Every file is written atomically; DIR is created when missing. Frames are evaluated in ascending order
 // through one scene::SceneEvaluator, so each deformer binds once and animated parameters only change its
@@ -47,6 +48,9 @@ struct EvalCommand {
     // `previews`. When no ffmpeg is on PATH the movies are skipped and EvalReport::notes says so.
     bool movie = false;
     int32_t movieFrameRate = 24;  // frames per second, >= 1: the movies', and an MDD cache's times
+    // With UV-warp stages: their log as DIR/uvwarp.jsonl and an HTML page of the shot here
+    // (uvwarp/html_report.h); relative to the working folder. Without a stage, a note.
+    std::optional<std::filesystem::path> report;
 };
 
 struct EvalReport {

@@ -10,6 +10,7 @@
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/ptex/ptex_mesh.h"
 #include "process.h"
+#include "report_command.h"
 #include "uvwarp_command.h"
 
 namespace deformkit::harness {
@@ -90,7 +91,46 @@ std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const 
     return args;
 }
 
-std::string farmSubmitCommand(const FarmSubmitCommand& command) {
+std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, const fs::path& planFile,
+                                                   const fs::path& deformkit,
+                                                   const std::vector<std::string>& extra,
+                                                   const std::string& arrayJob) {
+    const fs::path planAbs = absolutePath(planFile);
+    std::vector<std::string> args = {
+        "--parsable",
+        "--dependency=afterany:" + arrayJob,
+        "--job-name=deformkit-report-" + plan.scene.stem().string(),
+        "--output=" + (planAbs.parent_path() / (planAbs.stem().string() + "-report.%j.out")).string(),
+    };
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.push_back("--wrap=exec " + shellQuote(absolutePath(deformkit).string()) + " report --plan " +
+                   shellQuote(planAbs.string()));
+    return args;
+}
+
+namespace {
+
+// Runs sbatch; returns the job id it prints (--parsable: "jobid" or "jobid;cluster").
+std::string submitJob(const fs::path& sbatch, const std::vector<std::string>& args, const char* what) {
+    const ProgramResult result = runProgram(sbatch, args);
+    if (result.status != 0) {
+        std::string said = trim(result.err.empty() ? result.out : result.err);
+        for (char& c : said)
+            if (c == '\n') c = ' ';
+        throw Error(formatError(sbatch.string(), "",
+                                "exited with status " + std::to_string(result.status) + ": " + said, what));
+    }
+    std::string id = trim(result.out);
+    id = id.substr(0, id.find_first_of(";\n"));
+    if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
+        throw Error(formatError(sbatch.string(), "", "printed \"" + trim(result.out) + "\"", "a job id"));
+    }
+    return id;
+}
+
+}  // namespace
+
+std::string farmSubmitCommand(const FarmSubmitCommand& command, std::string* reportJob) {
     const scene::FarmPlan plan = scene::readFarmPlan(command.plan);
     const fs::path sbatch = findProgram(command.sbatch);
     if (sbatch.empty()) {
@@ -107,21 +147,14 @@ std::string farmSubmitCommand(const FarmSubmitCommand& command) {
             throw Error(
                 formatError("/proc/self/exe", "", "cannot be read", "the path of the running deformkit"));
     }
-    const ProgramResult result =
-        runProgram(sbatch, farmSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs));
-    if (result.status != 0) {
-        std::string said = trim(result.err.empty() ? result.out : result.err);
-        for (char& c : said)
-            if (c == '\n') c = ' ';
-        throw Error(formatError(sbatch.string(), "",
-                                "exited with status " + std::to_string(result.status) + ": " + said,
-                                "the job array accepted"));
-    }
-    // --parsable prints "jobid" or "jobid;cluster".
-    std::string id = trim(result.out);
-    id = id.substr(0, id.find_first_of(";\n"));
-    if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
-        throw Error(formatError(sbatch.string(), "", "printed \"" + trim(result.out) + "\"", "a job id"));
+    const std::string id =
+        submitJob(sbatch, farmSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs),
+                  "the job array accepted");
+    if (command.report) {
+        const std::string report = submitJob(
+            sbatch, farmReportSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs, id),
+            "the report job accepted");
+        if (reportJob) *reportJob = report;
     }
     return id;
 }
@@ -229,19 +262,51 @@ void addFarmCommands(CommandLine& cli) {
         bool slurm = false;
     };
     auto s = std::make_shared<SubmitOptions>();
-    Command submit =
-        cli.add(farm, "submit", "Submit a plan as a job array, one element per task; prints the job id",
-                [s, farmExit] {
-                    return farmExit([&] {
-                        s->command.plan = s->plan;
-                        s->command.sbatchArgs = splitArguments(s->sbatchArgs, "--sbatch-args");
-                        std::cout << farmSubmitCommand(s->command) << "\n";
-                    });
-                });
+    Command submit = cli.add(
+        farm, "submit", "Submit a plan as a job array, one element per task; prints the job id",
+        [s, farmExit] {
+            return farmExit([&] {
+                s->command.plan = s->plan;
+                s->command.sbatchArgs = splitArguments(s->sbatchArgs, "--sbatch-args");
+                std::string reportJob;
+                std::cout << farmSubmitCommand(s->command, &reportJob) << "\n";
+                if (!reportJob.empty()) {
+                    std::cerr << "farm: report job " << reportJob
+                              << " writes report.html into the plan's output folder after the tasks\n";
+                }
+            });
+        });
     submit.flag("--slurm", s->slurm, "submit with Slurm's sbatch (the one scheduler supported)").required();
+    submit.flag(
+        "--report", s->command.report,
+        "also submit a job that writes the shot's HTML page after every task (deformkit report --plan)");
     submit.option("PLAN", s->plan, "plan (.json) from deformkit farm plan").required();
     submit.option("--sbatch-args", s->sbatchArgs,
                   "extra sbatch options, e.g. \"--partition=batch --time=1:00:00\"");
+
+    struct ReportOptions {
+        ReportCommand command;
+        std::string plan;
+        std::vector<std::string> logs;
+    };
+    auto r2 = std::make_shared<ReportOptions>();
+    Command report =
+        cli.add(farm, "report",
+                "Write the shot's HTML page from the tasks' logs, listing missing or failed tasks "
+                "(deformkit report --plan)",
+                [r2] {
+                    r2->command.plan = r2->plan;
+                    r2->command.logs.assign(r2->logs.begin(), r2->logs.end());
+                    const ReportCommandResult result = reportCommand(r2->command);
+                    std::cout << "farm: report " << result.page.string() << " (" << result.logLines
+                              << " log lines, " << result.report.problems
+                              << (result.report.problems == 1 ? " problem" : " problems") << ")\n";
+                    return 0;
+                });
+    report.option("PLAN", r2->plan, "plan (.json) from deformkit farm plan").required();
+    report.option("--log", r2->logs,
+                  "the tasks' logs or folders of them; default: <plan name>.*.log beside the plan");
+    report.option("--out", r2->command.out, "the page; default: report.html in the plan's output folder");
 }
 
 }  // namespace deformkit::harness

@@ -14,7 +14,9 @@
 //
 //   deformkit farm plan SCENE --frames A-B --chunk N [--tiles-per-task T] --out DIR [--plan PLAN.json]
 //   deformkit farm run PLAN --task K
-//   deformkit farm submit --slurm PLAN [--sbatch-args "..."]
+//   deformkit farm submit --slurm PLAN [--sbatch-args "..."] [--report]
+//   deformkit farm report PLAN [--out report.html]      the shot's page from the tasks' logs
+//   (report_command.h)
 //
 // Exit codes of `farm run`: 0 done, 2 bad input a retry cannot cure, 1 anything else.
 namespace deformkit::harness {
@@ -57,7 +59,19 @@ struct FarmSubmitCommand {
     std::vector<std::string> sbatchArgs;  // extra sbatch options, after DeformKit's (so they win)
     std::filesystem::path deformkit;      // the binary the tasks run; empty: this process's executable
     std::string sbatch = "sbatch";        // looked up on PATH unless it holds a '/'
+    // Also submit a job that runs after the array, whatever its tasks' exit codes (afterany), and writes
+    // the shot's page: `deformkit report --plan PLAN` (report.html in the plan's output folder).
+    bool report = false;
 };
+
+// The sbatch arguments of the report job after job array `arrayJob`: --parsable, --dependency=afterany,
+// --job-name, --output beside the plan (<plan name>-report.%j.out, not read as a task's log), the extra
+// arguments, and --wrap running "exec DEFORMKIT report --plan PLAN".
+[[nodiscard]] std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan,
+                                                                 const std::filesystem::path& planFile,
+                                                                 const std::filesystem::path& deformkit,
+                                                                 const std::vector<std::string>& extra,
+                                                                 const std::string& arrayJob);
 
 // The sbatch arguments (without the program) that submit `plan` as a job array, one element per task, its
 // index the task: --parsable --array=0-(N-1) --job-name --output beside the plan, the extra arguments,
@@ -67,9 +81,10 @@ struct FarmSubmitCommand {
                                                            const std::filesystem::path& deformkit,
                                                            const std::vector<std::string>& extra);
 
-// Reads the plan, runs sbatch and returns the job id it prints. InvalidInput when sbatch is not found
-// (naming PATH), as readFarmPlan for a bad plan; Error with sbatch's output when it fails.
-std::string farmSubmitCommand(const FarmSubmitCommand& command);
+// Reads the plan, runs sbatch and returns the job id it prints; with `report`, sets `reportJob` to the
+// report job's id. InvalidInput when sbatch is not found (naming PATH), as readFarmPlan for a bad plan;
+// Error with sbatch's output when it fails.
+std::string farmSubmitCommand(const FarmSubmitCommand& command, std::string* reportJob = nullptr);
 
 // Splits a shell-like argument string: whitespace separates, '...' and "..." quote, backslash escapes
 // outside single quotes. InvalidInput naming `option` for an unterminated quote.

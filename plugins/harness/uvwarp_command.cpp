@@ -21,6 +21,7 @@
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/grid.h"
+#include "deformkit/uvwarp/html_report.h"
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/options.h"
 #include "deformkit/version.h"
@@ -140,6 +141,7 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     job.presetOwn = command.presetOwn;
     job.filter = command.filter;
     std::ofstream logFile;
+    std::ostringstream logLines;  // for the page when there is no log file
     if (command.log) {
         logFile.open(*command.log, std::ios::app | std::ios::binary);
         if (!logFile) {
@@ -147,10 +149,23 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
                                       "a writable file in an existing folder"));
         }
         job.log = &logFile;
+    } else if (command.report) {
+        job.log = &logLines;
     }
     uvwarp::ShotReport report = uvwarp::runShotJob(job, frames, interrupter);
     if (command.log && !logFile.flush()) {
         throw IoError(formatError(command.log->string(), "", "cannot write the log", "a writable file"));
+    }
+    if (command.report) {
+        uvwarp::ShotLog log;
+        if (command.log) {
+            logFile.close();
+            uvwarp::readShotLogFile(*command.log, log);
+        } else {
+            std::istringstream in(logLines.str());
+            uvwarp::readShotLog(in, "this run", log);
+        }
+        (void)uvwarp::writeHtmlReport(log, *command.report);
     }
     return report;
 }
@@ -162,8 +177,8 @@ constexpr std::pair<std::string_view, const char*> kOptionAliases[] = {{"sweepsP
 void addUvWarpCommand(CommandLine& cli) {
     struct Options {
         UvWarpCommand command;
-        std::string frames, tiles, mask, orientation, texture, bake, log, filter = "bilinear", rest, deformed,
-                                                                          rigidity, out;
+        std::string frames, tiles, mask, orientation, texture, bake, log, report, filter = "bilinear", rest,
+                                                                                  deformed, rigidity, out;
         // The UV-warp options as parsed, one per declaration (uvwarp/options.h), from the shot's defaults;
         // checked by the library when the command runs.
         std::vector<std::vector<double>> values;
@@ -195,6 +210,7 @@ void addUvWarpCommand(CommandLine& cli) {
             if (!o->bake.empty()) c.bake = o->bake;
             if (!o->tiles.empty()) c.tiles = parseTiles(o->tiles);
             if (!o->log.empty()) c.log = o->log;
+            if (!o->report.empty()) c.report = o->report;
             if (o->cacheStartGiven->given()) c.cacheStart = o->cacheStart;
             c.filter = o->filter == "bicubic" ? io::SampleFilter::Bicubic : io::SampleFilter::Bilinear;
             for (size_t i = 0; i < specs.size(); ++i) {
@@ -215,6 +231,7 @@ void addUvWarpCommand(CommandLine& cli) {
             const uvwarp::ShotReport report = uvwarpCommand(c, ::isatty(STDERR_FILENO) ? &bar : nullptr);
             for (const std::string& line : uvwarp::shotSummary(report))
                 std::cout << "uvwarp: " << line << "\n";
+            if (c.report) std::cout << "uvwarp: report " << c.report->string() << "\n";
             return 0;
         });
     uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj)").required();
@@ -244,6 +261,10 @@ void addUvWarpCommand(CommandLine& cli) {
     bake.needs(texture);
     uvwarp.option("--tiles", o->tiles, "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
     uvwarp.option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
+    uvwarp.option(
+        "--report", o->report,
+        "HTML page of the shot, written at the end (deformkit report): plots over frames, heatmaps at "
+        "the worst frame");
     uvwarp.option("--filter", o->filter, "bake filter: bilinear or bicubic")
         .choices({"bilinear", "bicubic"})
         .showDefault();

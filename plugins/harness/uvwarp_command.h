@@ -18,6 +18,7 @@
 //   deformkit uvwarp --rest rest.obj --deformed 'anim.####.obj' --frames 1-24 --rigidity 'rig.<UDIM>.exr'
 //       [--mask 'mask.<UDIM>.exr'] [--texture 'col.<UDIM>.exr' --bake 'out/col.<UDIM>.####.exr']
 //       --out 'out/redirect.<UDIM>.####.exr' [--tiles 1001,1002] [--resolution N] [--log log.jsonl]
+//       [--report report.html]
 //       [every UV-warp option of uvwarp/options.h as --kebab-case: --iterations 4 --sweeps-per-level 4,8,8]
 //
 // Frame tokens: #### (one # per digit, zero padded) or %04d (io::ObjSequence); UDIM tokens: <UDIM>,
@@ -50,6 +51,9 @@ struct UvWarpCommand {
     std::vector<std::string> presetOwn;
     io::SampleFilter filter = io::SampleFilter::Bilinear;  // bake filter
     std::optional<std::filesystem::path> log;              // JSON lines, appended: one per tile x frame
+    // An HTML page of the shot (uvwarp/html_report.h) written at the end: from the log file when there is
+    // one (every run it holds, merged), else from this run's lines.
+    std::optional<std::filesystem::path> report;
 };
 
 // Runs the command. `interrupter`: progress (a progress bar on a terminal) and cancellation; may be null.

@@ -11,6 +11,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
@@ -166,21 +167,28 @@ struct RedirectMetrics::Impl {
         return s;
     }
 
-    void addEdge(const TexelSample& a, const TexelSample& b, BandSums& sums) const {
+    // Adds edge (a, b) to the sums and to a's texel sums (error, edges; identity error, edges).
+    void addEdge(const TexelSample& a, const TexelSample& b, BandSums& sums, glm::dvec4& texel) const {
         if (a.chart < 0 || a.chart != b.chart) return;
         const double deformedLength = glm::length(b.deformed - a.deformed);
         if (a.identityRigid && b.identityRigid) {
             const double rest = glm::length(b.identityRest - a.identityRest);
             if (rest > minLength) {
-                sums.identityError += std::abs(deformedLength / rest - 1.0);
+                const double error = std::abs(deformedLength / rest - 1.0);
+                sums.identityError += error;
                 ++sums.identityEdges;
+                texel.z += error;
+                texel.w += 1.0;
             }
         }
         if (a.located && b.located && a.rigid && b.rigid) {
             const double rest = glm::length(b.rest - a.rest);
             if (rest > minLength) {
-                sums.error += std::abs(deformedLength / rest - 1.0);
+                const double error = std::abs(deformedLength / rest - 1.0);
+                sums.error += error;
                 ++sums.edges;
+                texel.x += error;
+                texel.y += 1.0;
             }
         }
     }
@@ -299,8 +307,8 @@ void RedirectMetrics::setRigidity(const io::Image& rigidity) {
         m.rigidity.pixels[k] = rigidity.pixels[k * rigidity.channels];
 }
 
-DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed,
-                                          const io::Image& redirect) const {
+DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed, const io::Image& redirect,
+                                          DeliveredTexels* texels) const {
     const Impl& m = *impl_;
     const int32_t t = m.texels;
     if (deformed.size() != m.restPoints.size()) {
@@ -324,6 +332,16 @@ DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed,
             }
         }
     }
+    if (texels) {
+        const float none = std::numeric_limits<float>::quiet_NaN();
+        texels->stretch = io::Image(t, t, 1);
+        texels->identityStretch = io::Image(t, t, 1);
+        std::fill(texels->stretch.pixels.begin(), texels->stretch.pixels.end(), none);
+        std::fill(texels->identityStretch.pixels.begin(), texels->identityStretch.pixels.end(), none);
+        texels->folds = io::Image(t, t, 1);
+        texels->offChart = io::Image(t, t, 1);
+        texels->chart = io::Image(t, t, 1);
+    }
     const int32_t bands = (t + kMetricBandRows - 1) / kMetricBandRows;
     std::vector<BandSums> sums(static_cast<size_t>(bands));
 #pragma omp parallel for schedule(dynamic, 1)
@@ -339,12 +357,23 @@ DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed,
             const TexelSample* row = &samples[static_cast<size_t>(y - y0) * t];
             const TexelSample* below = y + 1 < t ? row + t : nullptr;
             for (int32_t x = 0; x < t; ++x) {
-                if (row[x].chart >= 0) {
-                    ++s.chart;
-                    if (!row[x].located) ++s.offChart;
+                const bool offChart = row[x].chart >= 0 && !row[x].located;
+                if (row[x].chart >= 0) ++s.chart;
+                if (offChart) ++s.offChart;
+                glm::dvec4 texel(0.0);  // this texel's edges: error, count; identity error, count
+                if (x + 1 < t) m.addEdge(row[x], row[x + 1], s, texel);
+                if (below) m.addEdge(row[x], below[x], s, texel);
+                if (texels) {
+                    if (texel.y > 0.0) texels->stretch.at(x, y, 0) = static_cast<float>(texel.x / texel.y);
+                    if (texel.w > 0.0) {
+                        texels->identityStretch.at(x, y, 0) = static_cast<float>(texel.z / texel.w);
+                    }
+                    texels->offChart.at(x, y, 0) = offChart ? 1.0f : 0.0f;
+                    texels->chart.at(x, y, 0) = row[x].chart >= 0 ? 1.0f : 0.0f;
+                    if (below && x + 1 < t && detail::invertedInCell(redirect, x, y) > 0) {
+                        texels->folds.at(x, y, 0) = 1.0f;
+                    }
                 }
-                if (x + 1 < t) m.addEdge(row[x], row[x + 1], s);
-                if (below) m.addEdge(row[x], below[x], s);
             }
         }
         s.inverted = detail::invertedInRows(redirect, y0, y1);

@@ -377,6 +377,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             {"rigidity", plan.rigidity.name},
             {"mask", plan.mask.found() ? plan.mask.name : std::string("derived")},
             {"orientation", plan.orientation.found() ? plan.orientation.name : std::string("none")}};
+        if (plan.texture.found()) plan.inputs["texture"] = plan.texture.name;
         s.plans.push_back(std::move(plan));
     }
     if (!s.plans.empty() &&
@@ -435,7 +436,8 @@ io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
 void nameFrameMaps(const TilePlan& plan, int frame, json& inputs) {
     for (const auto& [map, key] : {std::pair<const TileMap*, const char*>{&plan.rigidity, "rigidity"},
                                    {&plan.mask, "mask"},
-                                   {&plan.orientation, "orientation"}}) {
+                                   {&plan.orientation, "orientation"},
+                                   {&plan.texture, "texture"}}) {
         if (!map->framePattern.empty()) inputs[key] = mapFile(*map, frame)->string();
     }
 }

@@ -40,6 +40,18 @@ struct DeliveredMetrics {
     int64_t chartTexels = 0;
 };
 
+// Where on the tile measure()'s figures come from, texel by texel (a shot report's heatmaps). T x T x 1
+// images, rows from the top, as the redirect map.
+struct DeliveredTexels {
+    // Per texel: the mean of | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) - f_O(r_a)| - 1 | over the edges to its
+    // right and lower neighbours that measure() averages through the map; NaN where it counts none.
+    io::Image stretch;
+    io::Image identityStretch;  // the same for the identity (r = q)
+    io::Image folds;     // 1 where the texel is the top-left corner of a cell with an inverted triangle
+    io::Image offChart;  // 1 at an off-chart texel
+    io::Image chart;     // 1 at a chart texel (its centre in a UV triangle of the tile)
+};
+
 // The delivered figures of one UDIM tile, bound once to the rest mesh's UV triangles of the tile and the
 // rigidity map (which sets the redirect map's size, T x T), measured per frame from the deformed positions
 // and the frame's redirect map. OpenMP over bands of rows, sums in a fixed order: bit-identical for any
@@ -57,10 +69,11 @@ class RedirectMetrics {
     // A new rigidity map of the same size (an animated map).
     void setRigidity(const io::Image& rigidity);
     // deformed: #V positions of the rest mesh's vertices; redirect: T x T, channels 0 and 1 the tile-local
-    // r = (u', v') (invertWarp's layout, row 0 at v = 1). Throws InvalidInput for another vertex count or
-    // map size, or a non-finite redirect texel (naming it).
-    [[nodiscard]] DeliveredMetrics measure(std::span<const glm::vec3> deformed,
-                                           const io::Image& redirect) const;
+    // r = (u', v') (invertWarp's layout, row 0 at v = 1). `texels`, when given, receives where the figures
+    // come from. Throws InvalidInput for another vertex count or map size, or a non-finite redirect texel
+    // (naming it).
+    [[nodiscard]] DeliveredMetrics measure(std::span<const glm::vec3> deformed, const io::Image& redirect,
+                                           DeliveredTexels* texels = nullptr) const;
 
     // Whether texel (x, y) may show the rest content at tile-local r without counting as off-chart: true for
     // a texel outside every chart, and for a chart texel when r lies in a UV triangle of the tile.

@@ -1,0 +1,111 @@
+#include "report_command.h"
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+#include "cli.h"
+#include "deformkit/error.h"
+#include "deformkit/scene/farm_plan.h"
+#include "deformkit/uvwarp/shot_log.h"
+
+namespace deformkit::harness {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The logs a folder holds, by name.
+std::vector<fs::path> logsIn(const fs::path& folder, const std::string& prefix = {}) {
+    std::vector<fs::path> out;
+    std::error_code ec;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+        const std::string name = entry.path().filename().string();
+        const std::string ext = entry.path().extension().string();
+        if (entry.is_regular_file(ec) && (ext == ".jsonl" || ext == ".log") && name.rfind(prefix, 0) == 0) {
+            out.push_back(entry.path());
+        }
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+}  // namespace
+
+ReportCommandResult reportCommand(const ReportCommand& command) {
+    uvwarp::HtmlReportOptions options;
+    if (!command.title.empty()) options.title = command.title;
+    options.rerun = command.rerun;
+    std::vector<fs::path> logs;
+    for (const fs::path& log : command.logs) {
+        std::error_code ec;
+        if (fs::is_directory(log, ec)) {
+            const std::vector<fs::path> inside = logsIn(log);
+            logs.insert(logs.end(), inside.begin(), inside.end());
+        } else {
+            logs.push_back(log);
+        }
+    }
+    fs::path page = command.out;
+    if (command.plan) {
+        const scene::FarmPlan plan = scene::readFarmPlan(*command.plan);
+        const fs::path planFile = fs::absolute(*command.plan);
+        if (command.logs.empty()) logs = logsIn(planFile.parent_path(), planFile.stem().string() + ".");
+        for (size_t k = 0; k < plan.tasks.size(); ++k) {
+            const scene::FarmTask& task = plan.tasks[k];
+            options.tasks.push_back(
+                {static_cast<int>(k), task.firstFrame, task.lastFrame, task.tiles,
+                 "deformkit farm run " + planFile.string() + " --task " + std::to_string(k)});
+        }
+        options.searchFolders.push_back(plan.outDir);
+        options.rerun.push_back("deformkit farm submit --slurm " + planFile.string() +
+                                "   # every task: finished frames are skipped");
+        if (page.empty()) page = plan.outDir / "report.html";
+        if (options.title == uvwarp::HtmlReportOptions{}.title)
+            options.title = "Farm shot " + plan.scene.stem().string();
+    }
+    if (logs.empty()) {
+        throw InvalidInput(formatError(
+            "report", "", "has no log to read",
+            command.plan ? "logs given, or " + command.plan->stem().string() + ".*.log beside the plan"
+                         : std::string("a JSON-lines shot log (uvwarp --log, farm run)")));
+    }
+    if (page.empty()) page = logs.front().parent_path() / "report.html";
+    uvwarp::ShotLog log;
+    for (const fs::path& file : logs)
+        uvwarp::readShotLogFile(file, log);
+    ReportCommandResult result;
+    result.page = page;
+    result.logLines = static_cast<int64_t>(log.lines.size());
+    result.report = uvwarp::writeHtmlReport(log, page, options);
+    return result;
+}
+
+void addReportCommand(CommandLine& cli) {
+    struct Options {
+        ReportCommand command;
+        std::vector<std::string> logs;
+        std::string plan;
+    };
+    auto o = std::make_shared<Options>();
+    Command report = cli.add(
+        "report",
+        "Write a UV-warp shot's logs as one HTML page: plots over frames, heatmaps at the worst frame", [o] {
+            ReportCommand& c = o->command;
+            c.logs.assign(o->logs.begin(), o->logs.end());
+            if (!o->plan.empty()) c.plan = o->plan;
+            const ReportCommandResult r = reportCommand(c);
+            std::cout << "report: wrote " << r.page.string() << " (" << r.logLines << " log lines, "
+                      << r.report.files.size() - 1 << " pictures beside it; " << r.report.problems
+                      << (r.report.problems == 1 ? " problem" : " problems") << ")\n";
+            for (const std::string& note : r.report.notes)
+                std::cout << "report: " << note << "\n";
+            return 0;
+        });
+    report.option("LOGS", o->logs, "JSON-lines logs (uvwarp --log, farm run), or folders of them; any order");
+    report.option("--plan", o->plan, "a farm plan: check its tasks; without LOGS read its Slurm logs");
+    report.option("--out", o->command.out,
+                  "the page; default: report.html beside the logs (a plan's output folder)");
+    report.option("--title", o->command.title, "the page's title");
+}
+
+}  // namespace deformkit::harness

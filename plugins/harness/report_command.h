@@ -1,0 +1,39 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "deformkit/uvwarp/html_report.h"
+
+// `deformkit report`: a UV-warp shot's logs as one HTML page (uvwarp/html_report.h):
+//
+//   deformkit report LOG... [--out report.html] [--title TEXT]
+//   deformkit report --plan PLAN.json [LOG...] [--out report.html]    a farm shot (also `farm report PLAN`)
+//
+// Logs are read in any order and merged; a folder stands for the logs in it (*.jsonl, *.log). With a farm
+// plan, a task whose frames are missing is listed with the command that runs it again; without logs, the
+// plan's Slurm logs are read (<plan folder>/<plan name>.*.log, as `farm submit --slurm` names them).
+namespace deformkit::harness {
+
+struct ReportCommand {
+    std::vector<std::filesystem::path> logs;
+    std::optional<std::filesystem::path> plan;
+    // The page; empty: report.html in the plan's output folder, else beside the first log.
+    std::filesystem::path out;
+    std::string title;
+    std::vector<std::string> rerun;  // command lines shown as given (a host that knows how it ran)
+};
+
+struct ReportCommandResult {
+    std::filesystem::path page;
+    uvwarp::HtmlReportResult report;
+    int64_t logLines = 0;
+};
+
+// Throws InvalidInput when there is no log to read (none given and none beside the plan), IoError when the
+// page cannot be written, as readFarmPlan for a bad plan. Broken logs are reported in the page.
+ReportCommandResult reportCommand(const ReportCommand& command);
+
+}  // namespace deformkit::harness
