@@ -18,6 +18,7 @@ void bindUvWarp(pybind11::module_& m);
 void bindHost(pybind11::module_& m);
 void bindPtex(pybind11::module_& m);
 void bindPointCache(pybind11::module_& m);
+void bindShotReport(pybind11::module_& m);
 
 // Every UV-warp option of `options` (uvwarp/options.h) as {name: value}, the names in snake_case (Python's
 // keywords) or camelCase (scenes'): bool, int, float or a list of ints.

@@ -235,6 +235,7 @@ PYBIND11_MODULE(deformkit, m) {
     python::bindHost(m);
     python::bindPtex(m);
     python::bindPointCache(m);
+    python::bindShotReport(m);
 
     m.def(
         "make_capped_tube", [] { return geom::makeCappedTube(); },

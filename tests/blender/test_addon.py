@@ -9,6 +9,8 @@ changing frames) and compares the mesh's vertex positions with the same deformat
 
 import json
 import os
+import pathlib
+import re
 import shutil
 import sys
 import tempfile
@@ -385,7 +387,9 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     obj.deformkit.uv_output = out
     assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3) == {'FINISHED'}
     files = sorted(os.listdir(out))
-    assert files == [f"redirect.1001.{f:04d}.exr" for f in (1, 2, 3)], files
+    assert files == [f"redirect.1001.{f:04d}.exr" for f in (1, 2, 3)] + ["report.html", "report_files",
+                                                                            "uvwarp.jsonl"], files
+    check_bake_report(obj, out, disk)
 
     # The same solve through the module: the mesh's own positions at each frame, the painted disk (row 0 at
     # v = 1, so Blender's bottom-up rows flipped), each frame from the identity (a shot's default): the same
@@ -419,9 +423,10 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     # an old modification time set here).
     old = 10**18  # ns: 2001
 
-    def files_now():
+    def files_now():  # the maps (the log and the report tell each bake)
         return {name: (os.stat(os.path.join(out, name)).st_mtime_ns == old,
-                       open(os.path.join(out, name), "rb").read()) for name in sorted(os.listdir(out))}
+                       open(os.path.join(out, name), "rb").read())
+                for name in sorted(os.listdir(out)) if name.startswith("redirect.")}
 
     for name in os.listdir(out):
         os.utime(os.path.join(out, name), ns=(old, old))
@@ -438,7 +443,8 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
         assert bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=3, resume=True) == {'FINISHED'}
     finally:
         bpy.app.handlers.frame_change_post.remove(record)
-    assert frames_set == [2, 3], frames_set  # the last one puts the scene back on its frame
+    # Frame 2 for its map, the worst frame for the report's heatmaps, then the scene back on its frame.
+    assert frames_set[0] == 2 and frames_set[-1] == 3 and len(frames_set) == 3, frames_set
     resumed = files_now()
     assert {name: data for name, (_, data) in resumed.items()} == {name: data for name, (_, data) in first.items()}
     assert [resumed[name][0] for name in sorted(first)] == [True, False, True], resumed.keys()
@@ -464,6 +470,33 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     assert redirect.image.source == 'SEQUENCE' and redirect.image_user.frame_duration == 3
     bpy.data.images.remove(redirect.image)
     shutil.rmtree(out, ignore_errors=True)
+
+
+def check_bake_report(obj, out, disk):
+    """The bake's shot report: written beside the maps, its figures those of the bake's log, its heatmaps made
+    from the evaluated object and the painted image (neither is a file), and an operator that opens it."""
+    page = os.path.join(out, "report.html")
+    assert obj.deformkit.uv_report == page
+    lines = [json.loads(line) for line in open(os.path.join(out, "uvwarp.jsonl"))]
+    assert [(l["tile"], l["frame"], l["status"]) for l in lines] == [(1001, f, "written") for f in (1, 2, 3)]
+    html = open(page, encoding="utf-8").read()
+    data = json.loads(re.search(r'<script type="application/json" id="deformkit-shot">(.*?)</script>', html,
+                                re.S).group(1))
+    tile = data["tiles"][0]
+    assert tile["frames"] == [1, 2, 3]
+    assert tile["rigid_stretch_removed"] == [l["metrics"]["rigid_stretch_removed"] for l in lines]
+    worst = min(lines, key=lambda l: l["metrics"]["rigid_stretch_removed"])
+    assert tile["worst_frame"] == worst["frame"]
+    assert "measured again from its files: the same" in html, "the heatmaps' inputs differ from the bake's"
+    assert html.count("data:image/png;base64,") == 4 and "no heatmaps" not in html
+    opened = []
+    real = addon.ops.webbrowser.open
+    addon.ops.webbrowser.open = opened.append
+    try:
+        assert bpy.ops.deformkit.open_uvwarp_report() == {'FINISHED'}
+    finally:
+        addon.ops.webbrowser.open = real
+    assert opened == [pathlib.Path(page).resolve().as_uri()], opened
 
 
 def test_bake_errors_are_reports():

@@ -2,6 +2,8 @@
 shape. Failures are operator reports."""
 
 import os
+import pathlib
+import webbrowser
 
 import bpy
 import numpy as np
@@ -324,8 +326,31 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
                             f"{m['inverted_triangles']} inverted triangles, {m['off_chart_texels']} off-chart texels")
         written = sum(t["written"] for t in report.values())
         kept = sum(t["replayed"] + t["skipped"] for t in report.values())
+        page = next((t["report"] for t in report.values() if "report" in t), "")
+        settings.uv_report = page
         self.report({'INFO'}, f"wrote {written} redirect map{'' if written == 1 else 's'} to {settings.uv_output}"
-                              + (f", kept {kept} that exist" if kept else ""))
+                              + (f", kept {kept} that exist" if kept else "")
+                              + (f"; shot report {page} (Open Report in the UV Warp panel)" if page else ""))
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_open_uvwarp_report(bpy.types.Operator):
+    """Open the last bake's shot report (plots over frames, heatmaps at the worst frame) in the web browser"""
+    bl_idname = "deformkit.open_uvwarp_report"
+    bl_label = "Open DeformKit Shot Report"
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and bool(obj.deformkit.uv_report)
+
+    def execute(self, context):
+        page = _mesh_object(context).deformkit.uv_report
+        if not os.path.isfile(page):
+            self.report({'ERROR'}, f"no shot report {page}; bake the redirect maps again")
+            return {'CANCELLED'}
+        webbrowser.open(pathlib.Path(page).resolve().as_uri())
+        self.report({'INFO'}, f"opened {page}")
         return {'FINISHED'}
 
 
@@ -388,7 +413,8 @@ class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
+_classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_open_uvwarp_report,
+            DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
             DEFORMKIT_OT_reset_rest)
 
 register, unregister = bpy.utils.register_classes_factory(_classes)

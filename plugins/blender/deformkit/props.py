@@ -116,6 +116,8 @@ class DeformKitStack(bpy.types.PropertyGroup):
                               description="Folder of the redirect maps (redirect.<tile>.<frame>.exr)")
     uv_resolution: IntProperty(name="Resolution", default=0, min=0,
                                description="Solver grid cells per side, a power of two (0: the map's texels)")
+    uv_report: StringProperty(name="Shot Report", subtype='FILE_PATH',
+                              description="The last bake's shot report (report.html in the output folder)")
     uv_preset: EnumProperty(name="Preset", default='shot',
                             items=(('shot', "Shot", "The default schedule, each frame from the identity: the bake"),
                                    ('live', "Live", "One warm-started iteration a frame, by grid size")),

@@ -107,6 +107,8 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         # Resume keeps the maps that exist (a bake that stopped) and writes the missing ones, with the bytes an
         # uninterrupted bake writes.
         row.operator("deformkit.bake_redirect", icon='FILE_REFRESH', text="Resume").resume = True
+        if settings.uv_report:
+            col.operator("deformkit.open_uvwarp_report", icon='URL', text="Open Report")
         live = uvwarp.live_active(obj)
         col.operator("deformkit.uvwarp_live", icon='PAUSE' if live else 'PLAY',
                      text="Stop Live UV Warp" if live else "Live UV Warp", depress=live)

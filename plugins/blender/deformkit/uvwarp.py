@@ -24,8 +24,11 @@ class UvWarpError(Exception):
     """A problem with the object, its UVs or its maps: shown to the user."""
 
 
-# The bake's output files in the output folder: redirect.1001.0007.exr (tile, frame padded to 4 digits).
+# The bake's output files in the output folder: redirect.1001.0007.exr (tile, frame padded to 4 digits),
+# the shot's log and its page (deformkit.shot_report).
 REDIRECT_PATTERN = "redirect.<UDIM>.####.exr"
+LOG_NAME = "uvwarp.jsonl"
+REPORT_NAME = "report.html"
 
 
 def redirect_name(tile, frame):
@@ -87,8 +90,9 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
     writes REDIRECT_PATTERN's files into out_dir. Each frame is set once and the evaluated mesh read once for
     all tiles. With the shot preset each frame is solved from the identity, so resume keeps the maps that
     exist and sets only the frames of the missing ones; otherwise every map is written again. preset: the
-    library's ('shot' or 'live'). progress(done, total, unit) is uvwarp_shot's. Returns the job's report,
-    {tile: dict}."""
+    library's ('shot' or 'live'). progress(done, total, unit) is uvwarp_shot's. Also writes the shot's log
+    (LOG_NAME) and its HTML page (REPORT_NAME) into out_dir. Returns the job's report, {tile: dict}, each with
+    'report': the page's path."""
     scene = context.scene
     if evaluate.has_rest(obj):
         rest = evaluate.rest_points(obj)
@@ -108,12 +112,24 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
         return points, f"{name} evaluated at frame {frame}"
 
     current = scene.frame_current
+    log = os.path.join(out_dir, LOG_NAME)
+    if not resume and os.path.exists(log):
+        os.remove(log)  # every map is written again: the log tells this bake alone
+    rigidity_map = image_map(rigidity, "rigidity")
     try:
-        return dk.uvwarp_shot(*mesh, list(frames), deformed, image_map(rigidity, "rigidity"),
-                              os.path.join(out_dir, REDIRECT_PATTERN),
-                              mask=image_map(mask, "mask") if mask is not None else None,
-                              resolution=resolution or None, skip_existing=resume, progress=progress,
-                              rest_name=name, preset=preset)
+        report = dk.uvwarp_shot(*mesh, list(frames), deformed, rigidity_map,
+                                os.path.join(out_dir, REDIRECT_PATTERN),
+                                mask=image_map(mask, "mask") if mask is not None else None,
+                                resolution=resolution or None, skip_existing=resume, progress=progress,
+                                rest_name=name, preset=preset, log=log)
+        # The shot's page: the evaluated object and a painted rigidity image are not files, so they are
+        # handed over; the report sets the worst frames again.
+        page = dk.shot_report(log, os.path.join(out_dir, REPORT_NAME), title=f"{obj.name}: UV warp bake",
+                              rest=dk.Mesh(*mesh), deformed=lambda frame: deformed(frame)[0],
+                              rigidity=rigidity_map[1] if isinstance(rigidity_map, tuple) else None)
+        for result in report.values():
+            result["report"] = page["page"]
+        return report
     finally:
         scene.frame_set(current)
 
