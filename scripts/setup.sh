@@ -26,6 +26,7 @@ packages=(
     g++-aarch64-linux-gnu            # tests/build: the SIMD sources compile for a non-x86 target
     slurm-wlm munge                  # farm tests: single-node Slurm
     blender                          # the Blender add-on's tests (headless Blender 3.4)
+    chromium                         # the shot report's test opens the page in a real browser
     assimp-testmodels                # OBJ files as exporters write them (another library's test models)
 )
 

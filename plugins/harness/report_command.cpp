@@ -5,7 +5,9 @@
 #include <memory>
 
 #include "cli.h"
+#include "commands.h"
 #include "deformkit/error.h"
+#include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/farm_plan.h"
 #include "deformkit/uvwarp/shot_log.h"
 
@@ -57,6 +59,22 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
                  "deformkit farm run " + planFile.string() + " --task " + std::to_string(k)});
         }
         options.searchFolders.push_back(plan.outDir);
+        // The heatmaps' geometry as the tasks made it: the plan's scene evaluated at the worst frame (the
+        // mesh tasks' OBJs may not be there). Read when first asked for.
+        const fs::path sceneFile = plan.scene;
+        options.geometry = [sceneFile, evaluator = std::shared_ptr<scene::SceneEvaluator>()](
+                               const std::string& object,
+                               int frame) mutable -> std::optional<uvwarp::ReportGeometry> {
+            if (!evaluator) evaluator = std::make_shared<scene::SceneEvaluator>(readScene(sceneFile));
+            const scene::Scene& s = evaluator->scene();
+            for (size_t o = 0; o < s.objects.size(); ++o) {
+                if (s.objects[o].name != object) continue;
+                const geom::Mesh& mesh = evaluator->evaluate(o, frame);
+                return uvwarp::ReportGeometry{
+                    s.objects[o].rest, std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end())};
+            }
+            return std::nullopt;
+        };
         options.rerun.push_back("deformkit farm submit --slurm " + planFile.string() +
                                 "   # every task: finished frames are skipped");
         if (page.empty()) page = plan.outDir / "report.html";

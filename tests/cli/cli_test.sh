@@ -61,6 +61,9 @@ done
 for f in tube_slid.obj checker.1001.png checker.1002.png before.png after.png slide.png; do
     [ -s "$work/demo/slide/$f" ] || { echo "FAIL demo: slide/$f missing"; failures=$((failures + 1)); }
 done
+for f in uvwarp/report.html uvwarp/shot/uvwarp.jsonl uvwarp/shot/redirect.1001.0008.exr; do
+    [ -s "$work/demo/$f" ] || { echo "FAIL demo: $f missing"; failures=$((failures + 1)); }
+done
 for f in tube.obj tube_slid.obj falloff.ptx before.png after.png ptex.png; do
     [ -s "$work/demo/ptex/$f" ] || { echo "FAIL demo: ptex/$f missing"; failures=$((failures + 1)); }
 done
@@ -289,6 +292,20 @@ expect uvwarp 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr
 contains uvwarp "$work/out" "uvwarp: tile 1001: 2 frames written (2 baked), 0 replayed, 0 skipped"
 [ "$(wc -l <"$work/uv/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
 [ -s "$work/uv/out/albedo.1001.0002.png" ] || { echo "FAIL uvwarp: bake missing"; failures=$((failures + 1)); }
+# The shot's page: from the run (--report), and from logs merged with a broken one (its file and line in the
+# page, exit 0); no log at all is exit 2.
+expect uvwarp-report 0 uvwarp --frames 1-2 --out "$work/uv/rep/redirect.<UDIM>.####.exr" --report "$work/uv/rep/report.html"
+contains uvwarp-report "$work/out" "uvwarp: report $work/uv/rep/report.html"
+contains uvwarp-report "$work/uv/rep/report.html" "measured again from its files: the same"
+contains uvwarp-report "$work/uv/rep/report.html" 'data-tile="1001" data-written="2"'
+printf '{"tile":1001,"frame":3,"status":"written"}\n{"tile":1001,"frame":4,"sta' >"$work/uv/broken.jsonl"
+expect report 0 "$dk" report "$work/uv/log.jsonl" "$work/uv/broken.jsonl" --out "$work/uv/report.html"
+contains report "$work/out" "report: wrote $work/uv/report.html (2 log lines, 8 pictures beside it; 2 problems)"
+contains report "$work/uv/report.html" "broken.jsonl:1: is a written frame without metrics.rigid_stretch_removed"
+contains report "$work/uv/report.html" "broken.jsonl:2: is not JSON"
+contains report "$work/uv/report.html" "deformkit uvwarp --rest $work/grid.obj"
+expect report-no-log 2 "$dk" report
+contains report-no-log "$work/err" "report: has no log to read"
 expect uvwarp-info 0 "$dk" info "$work/uv/out/redirect.1001.0002.exr"
 contains uvwarp-info "$work/out" "64 x 64"
 contains uvwarp-info "$work/out" "channels    2"
@@ -409,12 +426,29 @@ cat >"$work/uvshot.json" <<JSON
 JSON
 expect eval-uvwarp 0 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv" --no-previews
 contains eval-uvwarp "$work/out" "grid uvwarp tile 1001: 2 frames written"
+expect eval-uvwarp-report 0 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv-r" --no-previews --report "$work/eval-uv-r/shot.html"
+contains eval-uvwarp-report "$work/out" "eval: report $work/eval-uv-r/shot.html written"
+contains eval-uvwarp-report "$work/eval-uv-r/uvwarp.jsonl" '"object":"grid"'
+contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "measured again from its files: the same"
+contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "deformkit eval $work/uvshot.json --frames 1-2"
 expect eval-uvwarp-info 0 "$dk" info "$work/eval-uv/grid.redirect.1001.0002.exr"
 contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"
 contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
 expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
 contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 6'
+# The farm's page from the tasks' logs as Slurm names them: task 2 (frame 1's map) has not run yet, then runs
+# and its log also holds an error line.
+cp "$work/out" "$work/farm-uv/farm_plan.77_3.log"
+expect farm-report-missing 0 "$dk" farm report "$work/farm-uv/farm_plan.json"
+contains farm-report-missing "$work/out" "farm: report $work/farm-uv/report.html (1 log lines, 1 problem)"
+contains farm-report-missing "$work/farm-uv/report.html" 'data-task="2">task 2 (frames 1–1, tiles 1001): no log line'
+contains farm-report-missing "$work/farm-uv/report.html" "deformkit farm run $work/farm-uv/farm_plan.json --task 2"
+"$dk" farm run "$work/farm-uv/farm_plan.json" --task 2 >"$work/farm-uv/farm_plan.77_2.log" 2>&1
+echo "deformkit: error: an earlier attempt failed" >>"$work/farm-uv/farm_plan.77_2.log"
+expect farm-report 0 "$dk" report --plan "$work/farm-uv/farm_plan.json"
+contains farm-report "$work/out" "(2 log lines, 8 pictures beside it; 1 problem)"
+contains farm-report "$work/farm-uv/report.html" "farm_plan.77_2.log:2: is not JSON: 'deformkit: error: an earlier attempt failed'"
 # Each frame from the identity (a scene's default): the task of frame 2 writes eval's bytes, warmed up or not.
 cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
     { echo "FAIL farm-run-tiles: the task of frame 2 should write eval's frame 2"; failures=$((failures + 1)); }

@@ -26,6 +26,10 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
+// Bytes of inline thumbnails a page holds at most (base64): with the plots and the figures' data, a page of
+// 240 frames x 10 tiles stays under 5 MB.
+constexpr size_t kInlineBudget = size_t{3} << 20;
+
 std::string escape(std::string_view s) {
     std::string out;
     out.reserve(s.size());
@@ -424,6 +428,7 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
 
     // Tiles.
     std::string rerunGuess;
+    size_t inlineBytes = 0;
     const io::ImageWriteOptions png;
     for (const Series& s : all) {
         const ShotTileSeries& t = *s.s;
@@ -458,10 +463,18 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
             io::writeImage(thumb, detail::shrinkTo(picture.image, options.thumbnail), png);
             result.files.push_back(full);
             result.files.push_back(thumb);
+            // Thumbnails are inline up to a budget that keeps the page small (whatever the tile count and
+            // the textures); past it they are read from beside the page.
+            std::string source = base64(fileBytes(thumb));
+            if (inlineBytes + source.size() <= kInlineBudget) {
+                inlineBytes += source.size();
+                source = "data:image/png;base64," + source;
+            } else {
+                source = escape((filesName / (base + ".thumb.png")).generic_string());
+            }
             html << "<figure><a href=\"" << escape((filesName / (base + ".png")).generic_string())
-                 << "\"><img alt=\"" << escape(picture.caption) << "\" src=\"data:image/png;base64,"
-                 << base64(fileBytes(thumb)) << "\"></a><figcaption>" << escape(picture.caption)
-                 << "</figcaption></figure>";
+                 << "\"><img alt=\"" << escape(picture.caption) << "\" src=\"" << source
+                 << "\"></a><figcaption>" << escape(picture.caption) << "</figcaption></figure>";
         }
         html << "</div>\n";
         if (!pictures.pictures.empty() && pictures.remeasured) {

@@ -1,10 +1,19 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <filesystem>
+
+#include "deformkit/error.h"
+#include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/inversion.h"
+#include "deformkit/uvwarp/shot_log.h"
 #include "demo_assets.h"
 #include "demo_uvwarp.h"
+#include "test_support.h"
 
 using namespace deformkit;
+namespace fs = std::filesystem;
 
 TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to rest size, without folds",
           "[harness]") {
@@ -33,4 +42,40 @@ TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to 
     // The bent mesh keeps the tube's topology and UVs.
     CHECK(demo.bent.numVertices() == assets.mesh.numVertices());
     CHECK(demo.bent.hasUVs());
+}
+
+TEST_CASE("demo uv warp shot: the bend over eight frames as files, its log and its page", "[harness]") {
+    test::TempDir dir;
+    const harness::DemoAssets assets = harness::makeDemoAssets({64});
+    // The shot reads the demo's files, as `deformkit uvwarp` would.
+    io::writeObj(dir / "tube.obj", assets.mesh);
+    for (const auto& [tile, image] : assets.rigidity)
+        io::writeImage(dir / ("rigidity." + std::to_string(tile) + ".exr"), image);
+    for (const auto& [tile, image] : assets.mask)
+        io::writeImage(dir / ("mask." + std::to_string(tile) + ".exr"), image);
+    for (const auto& [tile, image] : assets.albedo)
+        io::writeImage(dir / ("albedo." + std::to_string(tile) + ".png"), image);
+    const std::vector<fs::path> files = harness::writeDemoUvWarpShot(assets.mesh, 64, dir.path());
+    const fs::path shot = fs::absolute(dir.path()) / "uvwarp" / "shot";
+    for (int frame = 1; frame <= harness::kDemoShotFrames; ++frame) {
+        const std::string f = std::to_string(frame);
+        for (const std::string name :
+             {"tube.000" + f + ".obj", "redirect.1001.000" + f + ".exr", "albedo.1001.000" + f + ".png"})
+            CHECK(std::find(files.begin(), files.end(), shot / name) != files.end());
+    }
+    // One written line a frame, frame 8 the demo's pose; the page holds the log's figures.
+    uvwarp::ShotLog log;
+    uvwarp::readShotLogFile(shot / "uvwarp.jsonl", log);
+    REQUIRE(log.lines.size() == harness::kDemoShotFrames);
+    CHECK(log.problems.empty());
+    double worst = 1.0;
+    for (const uvwarp::ShotLogLine& line : log.lines) {
+        CHECK(line.status == "written");
+        CHECK(line.metrics.at("inverted_triangles") == 0.0);
+        worst = std::min(worst, line.metrics.at("rigid_stretch_removed"));
+    }
+    const std::string page = test::readText(fs::absolute(dir.path()) / "uvwarp" / "report.html");
+    CHECK_THAT(page, Catch::Contains("data-worst-removed=\"" + numberText(worst) + "\""));
+    CHECK_THAT(page, Catch::Contains("measured again from its files: the same"));
+    CHECK_THAT(page, Catch::Contains("texture through the map (the bake)"));
 }

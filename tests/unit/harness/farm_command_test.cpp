@@ -353,6 +353,27 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
         recorded += a + "\n";
     CHECK(test::readText(shot.dir / "sbatch.args") == recorded);
 
+    // With the report: a second job after the array, whatever its tasks' exit codes, writing the shot's page.
+    test::writeText(fake,
+                    "#!/bin/sh\nfor a in \"$@\"; do printf '%s\\n' \"$a\"; done >>\"$0.args\"\n"
+                    "if [ -e \"$0.n\" ]; then echo 4243; else touch \"$0.n\"; echo '4242;c1'; fi\n");
+    fs::remove(shot.dir / "sbatch.args");
+    submit.report = true;
+    std::string reportJob;
+    CHECK(harness::farmSubmitCommand(submit, &reportJob) == "4242");
+    CHECK(reportJob == "4243");
+    const std::vector<std::string> reportArgs = harness::farmReportSbatchArguments(
+        plan, planFile, "/opt/dk/bin/deformkit", {"--partition=batch"}, "4242");
+    CHECK(reportArgs == std::vector<std::string>{
+                            "--parsable", "--dependency=afterany:4242", "--job-name=deformkit-report-shot",
+                            "--output=" + (planAbs.parent_path() / "farm_plan-report.%j.out").string(),
+                            "--partition=batch",
+                            "--wrap=exec '/opt/dk/bin/deformkit' report --plan '" + planAbs.string() + "'"});
+    for (const std::string& a : reportArgs)
+        recorded += a + "\n";
+    CHECK(test::readText(shot.dir / "sbatch.args") == recorded);
+    submit.report = false;
+
     // sbatch refusing the job: its message, exit code 1.
     test::writeText(fake, "#!/bin/sh\necho 'sbatch: error: invalid partition specified: nope' >&2\nexit 1\n");
     try {

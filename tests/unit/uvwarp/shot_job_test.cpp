@@ -24,54 +24,9 @@ namespace {
 constexpr int kTexels = 32;
 constexpr int kFrames = 4;
 
-// Two charts, one per tile (1001 and 1002), 12 x 12 quads each; the rest positions are the tile-local UVs
-// (the second chart lifted to z = 1).
-geom::Mesh twoTiles() {
-    const auto chart = [](glm::vec2 lo, float z) {
-        return test::planarChart(lo, lo + glm::vec2(1.0f), 12, 12,
-                                 [lo, z](glm::vec2 uv) { return glm::vec3(uv - lo, z); });
-    };
-    const geom::Mesh a = chart({0.0f, 0.0f}, 0.0f), b = chart({1.0f, 0.0f}, 1.0f);
-    geom::Mesh::Data data;
-    for (const geom::Mesh* m : {&a, &b}) {
-        const auto offset = static_cast<int32_t>(data.points.size());
-        const auto uvOffset = static_cast<int32_t>(data.uvs.size());
-        data.points.insert(data.points.end(), m->points().begin(), m->points().end());
-        data.uvs.insert(data.uvs.end(), m->uvs().begin(), m->uvs().end());
-        data.faceCounts.insert(data.faceCounts.end(), m->faceCounts().begin(), m->faceCounts().end());
-        for (int32_t i : m->faceIndices())
-            data.faceIndices.push_back(i + offset);
-        for (int32_t i : m->uvIndices())
-            data.uvIndices.push_back(i + uvOffset);
-    }
-    return geom::Mesh(std::move(data), "two tiles");
-}
-
-// Frame f stretches u by 1 + 0.15 (f - 1) and bends the sheet slightly, so every frame differs.
-std::vector<glm::vec3> deformedAt(const geom::Mesh& rest, int frame) {
-    std::vector<glm::vec3> points(rest.points().begin(), rest.points().end());
-    const float s = 1.0f + 0.15f * static_cast<float>(frame - 1);
-    for (glm::vec3& p : points) {
-        p.x *= s;
-        p.z += 0.05f * static_cast<float>(frame - 1) * p.x * p.x;
-    }
-    return points;
-}
-
-// Rigid disks in the middle of a tile's map.
-io::Image disks() {
-    io::Image image(kTexels, kTexels, 1);
-    for (int y = 0; y < kTexels; ++y)
-        for (int x = 0; x < kTexels; ++x)
-            for (double c : {0.3, 0.7})
-                if (std::hypot((x + 0.5) / kTexels - c, 1.0 - (y + 0.5) / kTexels - 0.5) < 0.12)
-                    image.at(x, y, 0) = 1.0f;
-    return image;
-}
-
 struct Shot {
     test::TempDir dir;
-    geom::Mesh rest = twoTiles();
+    geom::Mesh rest = test::twoTileCharts();
     uvwarp::ShotJob job;
     int asked = 0;  // deformed-frame requests
     std::vector<glm::vec3> frame;
@@ -82,7 +37,7 @@ struct Shot {
         job.rest = &rest;
         job.restName = "two tiles";
         job.frames = {1, 2, 3, 4};
-        job.rigidity.images = {{1001, disks()}, {1002, disks()}};
+        job.rigidity.images = {{1001, test::twoDisks(kTexels)}, {1002, test::twoDisks(kTexels)}};
         job.rigidity.name = "painted rigidity";
         job.outPath = [this](int tile, int f) {
             return dir / ("redirect." + std::to_string(tile) + "." + std::to_string(f) + ".exr");
@@ -92,7 +47,7 @@ struct Shot {
         return [this](int f, std::string& name) -> std::span<const glm::vec3> {
             ++asked;
             name = "frame " + std::to_string(f);
-            frame = deformedAt(rest, f);
+            frame = test::stretchedAndBent(rest, f);
             return frame;
         };
     }
@@ -135,9 +90,9 @@ TEST_CASE("shot job: each tile equals a TileWarp solved frame by frame; each fra
     CHECK(shot.asked == kFrames);  // not frames x tiles
     REQUIRE(report.tiles.size() == 2);
     for (const int tile : {1001, 1002}) {
-        uvwarp::TileWarp reference(shot.rest, tile, disks());
+        uvwarp::TileWarp reference(shot.rest, tile, test::twoDisks(kTexels));
         for (int f = 1; f <= kFrames; ++f) {
-            reference.solve(deformedAt(shot.rest, f));
+            reference.solve(test::stretchedAndBent(shot.rest, f));
             const io::Image written = io::readImage(shot.out(tile, f));
             CHECK(test::sameBits(written.pixels, reference.redirect().pixels));
         }
@@ -166,8 +121,8 @@ TEST_CASE("shot job: each tile equals a TileWarp solved frame by frame; each fra
 
 TEST_CASE("shot job: maps from files give the pixels of the same maps in memory", "[uvwarp][shot_job]") {
     Shot memory, files;
-    io::writeImage(files.dir / "rig.1001.exr", disks(), {io::PixelType::Float, {}});
-    io::writeImage(files.dir / "rig.1002.exr", disks(), {io::PixelType::Float, {}});
+    io::writeImage(files.dir / "rig.1001.exr", test::twoDisks(kTexels), {io::PixelType::Float, {}});
+    io::writeImage(files.dir / "rig.1002.exr", test::twoDisks(kTexels), {io::PixelType::Float, {}});
     files.job.rigidity = {};
     files.job.rigidity.pattern = files.dir / "rig.<UDIM>.exr";
     (void)uvwarp::runShotJob(memory.job, memory.frames());
@@ -192,7 +147,7 @@ TEST_CASE("shot job: animated maps are given to the warp when they change, and o
         for (int f = 1; f <= kFrames; ++f) {
             const fs::path file = animated.dir / ("rig." + std::to_string(tile) + "." +
                                                   std::to_string(f).insert(0, 4 - 1, '0') + ".exr");
-            io::writeImage(file, f <= 2 ? disks() : none, {io::PixelType::Float, {}});
+            io::writeImage(file, f <= 2 ? test::twoDisks(kTexels) : none, {io::PixelType::Float, {}});
         }
     }
     animated.job.rigidity = {};
@@ -204,10 +159,10 @@ TEST_CASE("shot job: animated maps are given to the warp when they change, and o
         CHECK(t.mapChanges == 1);
     CHECK_THAT(uvwarp::shotSummary(report)[0], Contains("maps changed at 1 frame"));
     for (const int tile : {1001, 1002}) {
-        uvwarp::TileWarp reference(animated.rest, tile, disks());
+        uvwarp::TileWarp reference(animated.rest, tile, test::twoDisks(kTexels));
         for (int f = 1; f <= kFrames; ++f) {
             if (f == 3) reference.setMaps(none);
-            reference.solve(deformedAt(animated.rest, f));
+            reference.solve(test::stretchedAndBent(animated.rest, f));
             const io::Image written = io::readImage(animated.out(tile, f));
             CHECK(test::sameBits(written.pixels, reference.redirect().pixels));
             const bool same = test::sameBits(written.pixels, io::readImage(still.out(tile, f)).pixels);
@@ -224,8 +179,8 @@ TEST_CASE("shot job: animated maps are given to the warp when they change, and o
     for (const int tile : {1001, 1002})
         for (const int f : {1, 2, 4})
             io::writeImage(
-                missing.dir / ("rig." + std::to_string(tile) + ".000" + std::to_string(f) + ".exr"), disks(),
-                {io::PixelType::Float, {}});
+                missing.dir / ("rig." + std::to_string(tile) + ".000" + std::to_string(f) + ".exr"),
+                test::twoDisks(kTexels), {io::PixelType::Float, {}});
     missing.job.rigidity = {};
     missing.job.rigidity.pattern = missing.dir / "rig.<UDIM>.####.exr";
     CHECK_THAT(test::errorOf<Error>([&] { (void)uvwarp::runShotJob(missing.job, missing.frames()); }),
@@ -236,18 +191,20 @@ TEST_CASE("shot job: animated maps are given to the warp when they change, and o
 TEST_CASE("tile warp: new maps keep the warm start; a map of another size is refused", "[uvwarp]") {
     // setMaps with the same maps changes nothing: the next solve gives the bytes of a warp never given them
     // (the warp and its velocities are kept, not reset).
-    const geom::Mesh rest = twoTiles();
-    uvwarp::TileWarp a(rest, 1001, disks()), b(rest, 1001, disks());
-    a.solve(deformedAt(rest, 2));
-    b.solve(deformedAt(rest, 2));
-    b.setMaps(disks());
-    CHECK(test::sameBits(a.solve(deformedAt(rest, 3)).u, b.solve(deformedAt(rest, 3)).u));
+    const geom::Mesh rest = test::twoTileCharts();
+    uvwarp::TileWarp a(rest, 1001, test::twoDisks(kTexels)), b(rest, 1001, test::twoDisks(kTexels));
+    a.solve(test::stretchedAndBent(rest, 2));
+    b.solve(test::stretchedAndBent(rest, 2));
+    b.setMaps(test::twoDisks(kTexels));
+    CHECK(test::sameBits(a.solve(test::stretchedAndBent(rest, 3)).u,
+                         b.solve(test::stretchedAndBent(rest, 3)).u));
     CHECK_THAT(test::errorOf<InvalidInput>([&] { b.setMaps(io::Image(16, 16, 1)); }),
                Contains("rigidity map") && Contains("16 texels per side") && Contains("32"));
-    io::Image outOfRange = disks();
+    io::Image outOfRange = test::twoDisks(kTexels);
     outOfRange.at(3, 4, 0) = 2.0f;
     CHECK_THROWS_AS(b.setMaps(outOfRange), InvalidInput);
-    CHECK(test::sameBits(a.solve(deformedAt(rest, 4)).u, b.solve(deformedAt(rest, 4)).u));  // unchanged
+    CHECK(test::sameBits(a.solve(test::stretchedAndBent(rest, 4)).u,
+                         b.solve(test::stretchedAndBent(rest, 4)).u));  // unchanged
 }
 
 TEST_CASE("shot job: a cancelled job leaves complete files and a rerun writes an uninterrupted job's bytes",
@@ -292,7 +249,7 @@ TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp]
     uvwarp::ShotSolver solver(shot.job);
     CHECK(solver.units() == 2 * kFrames);
     CHECK(solver.lastNeededFrame() == kFrames);
-    const std::vector<glm::vec3> second = deformedAt(shot.rest, 2);
+    const std::vector<glm::vec3> second = test::stretchedAndBent(shot.rest, 2);
     CHECK_THAT(test::errorOf<InvalidInput>([&] { solver.solveFrame(2, second, "f2"); }),
                Contains("frame 2") && Contains("out of order") && Contains("frame 1"));
     const std::vector<glm::vec3> few(10);
@@ -335,7 +292,7 @@ TEST_CASE("shot job: bad input names the input and what was expected", "[uvwarp]
 
 TEST_CASE("shot job: shotTiles gives the asked tiles or every tile of the UVs, and names what is wrong",
           "[uvwarp][shot_job][errors]") {
-    const geom::Mesh rest = twoTiles();
+    const geom::Mesh rest = test::twoTileCharts();
     CHECK(uvwarp::shotTiles(rest, "rest.obj", {}, "--tiles") == std::vector<int>{1001, 1002});
     CHECK(uvwarp::shotTiles(rest, "rest.obj", {1002}, "--tiles") == std::vector<int>{1002});
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
@@ -363,8 +320,8 @@ TEST_CASE("shot job: by default each frame's map depends on that frame alone", "
     (void)uvwarp::runShotJob(last.job, last.frames());
     for (const int tile : {1001, 1002}) {
         for (int f = 3; f <= kFrames; ++f) {
-            uvwarp::TileWarp alone(whole.rest, tile, disks(), {}, uvwarp::shotOptions());
-            alone.solve(deformedAt(whole.rest, f));
+            uvwarp::TileWarp alone(whole.rest, tile, test::twoDisks(kTexels), {}, uvwarp::shotOptions());
+            alone.solve(test::stretchedAndBent(whole.rest, f));
             const io::Image written = io::readImage(whole.out(tile, f));
             CHECK(test::sameBits(written.pixels, alone.redirect().pixels));
             CHECK(test::readText(last.out(tile, f)) == test::readText(whole.out(tile, f)));

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
 #include "deformkit/uvwarp/grid.h"
 
 #if defined(_OPENMP)
@@ -48,6 +49,52 @@ inline geom::Mesh planarChart(glm::vec2 lo, glm::vec2 hi, int cellsU, int cellsV
         }
     }
     return geom::Mesh(std::move(data), "chart");
+}
+
+// Two charts, one per tile (1001 and 1002), 12 x 12 quads each; the rest positions are the tile-local UVs
+// (the second chart lifted to z = 1).
+inline geom::Mesh twoTileCharts() {
+    const auto chart = [](glm::vec2 lo, float z) {
+        return planarChart(lo, lo + glm::vec2(1.0f), 12, 12,
+                           [lo, z](glm::vec2 uv) { return glm::vec3(uv - lo, z); });
+    };
+    const geom::Mesh a = chart({0.0f, 0.0f}, 0.0f), b = chart({1.0f, 0.0f}, 1.0f);
+    geom::Mesh::Data data;
+    for (const geom::Mesh* m : {&a, &b}) {
+        const auto offset = static_cast<int32_t>(data.points.size());
+        const auto uvOffset = static_cast<int32_t>(data.uvs.size());
+        data.points.insert(data.points.end(), m->points().begin(), m->points().end());
+        data.uvs.insert(data.uvs.end(), m->uvs().begin(), m->uvs().end());
+        data.faceCounts.insert(data.faceCounts.end(), m->faceCounts().begin(), m->faceCounts().end());
+        for (int32_t i : m->faceIndices())
+            data.faceIndices.push_back(i + offset);
+        for (int32_t i : m->uvIndices())
+            data.uvIndices.push_back(i + uvOffset);
+    }
+    return geom::Mesh(std::move(data), "two tiles");
+}
+
+// Frame f of a shot of twoTileCharts(): u stretched by 1 + 0.15 (f - 1) and the sheet bent slightly, so every
+// frame differs.
+inline std::vector<glm::vec3> stretchedAndBent(const geom::Mesh& rest, int frame) {
+    std::vector<glm::vec3> points(rest.points().begin(), rest.points().end());
+    const float s = 1.0f + 0.15f * static_cast<float>(frame - 1);
+    for (glm::vec3& p : points) {
+        p.x *= s;
+        p.z += 0.05f * static_cast<float>(frame - 1) * p.x * p.x;
+    }
+    return points;
+}
+
+// Two rigid disks in the middle of a texels x texels map (rows from the top).
+inline io::Image twoDisks(int texels) {
+    io::Image image(texels, texels, 1);
+    for (int y = 0; y < texels; ++y)
+        for (int x = 0; x < texels; ++x)
+            for (double c : {0.3, 0.7})
+                if (std::hypot((x + 0.5) / texels - c, 1.0 - (y + 0.5) / texels - 0.5) < 0.12)
+                    image.at(x, y, 0) = 1.0f;
+    return image;
 }
 
 // An open cylinder of radius 1 around the y axis, y in [0, height], `segments` quads around and `rows`
