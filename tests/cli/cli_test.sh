@@ -407,8 +407,10 @@ contains eval-pc2 "$work/out" "point cache"
 expect info-pc2 0 "$dk" info "$work/eval-pc2/grid.pc2"
 contains info-pc2 "$work/out" "frames      1-2 (2 whole frames)"
 expect uvwarp-pc2 0 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-2 \
-    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr" --report "$work/uv-pc2/report.html"
 contains uvwarp-pc2 "$work/out" "2 frames written"
+# The page reads the worst frame's positions from the cache the header names ("grid.pc2 frame N").
+contains uvwarp-pc2 "$work/uv-pc2/report.html" "measured again from its files: the same"
 expect uvwarp-pc2-frame 2 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-3 \
     --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
 contains uvwarp-pc2-frame "$work/err" "grid.pc2: frame 3: is not in the cache"

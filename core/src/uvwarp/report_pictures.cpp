@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <regex>
+#include <charconv>
 
 #include <nlohmann/json.hpp>
 
@@ -99,13 +99,16 @@ std::string text(const json& j, const char* key) {
 // The deformed positions a header names: a mesh file, or "<cache> frame <n>".
 std::optional<std::vector<glm::vec3>> deformedFrom(const std::string& name,
                                                    const std::vector<fs::path>& folders, std::string& why) {
-    static const std::regex kCacheFrame(R"((.+) frame (-?[0-9]+))");
-    std::smatch m;
-    if (std::regex_match(name, m, kCacheFrame)) {
-        if (const std::optional<fs::path> file = findFile(m[1].str(), folders)) {
+    // io::PointCache::frameName's "<cache> frame <n>".
+    const size_t at = name.rfind(" frame ");
+    const std::string number = at == std::string::npos ? std::string() : name.substr(at + 7);
+    int frame = 0;
+    const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), frame);
+    if (!number.empty() && error == std::errc() && end == number.data() + number.size()) {
+        if (const std::optional<fs::path> file = findFile(name.substr(0, at), folders)) {
             io::PointCache cache(*file);
             std::vector<glm::vec3> points;
-            cache.read(std::stoi(m[2].str()), points);
+            cache.read(frame, points);
             return points;
         }
     }
