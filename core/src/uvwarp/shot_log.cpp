@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <string_view>
 #include <tuple>
@@ -25,30 +26,40 @@ std::string quotedStart(std::string_view text) {
     return "'" + out + "'";
 }
 
-bool wholeNumber(const json& j) {
-    return j.is_number_integer() || j.is_number_unsigned();
+// A whole number within int's range, or nullopt.
+std::optional<int> wholeNumber(const json& j) {
+    if (j.is_number_unsigned()) {
+        const auto v = j.get<uint64_t>();
+        if (v <= static_cast<uint64_t>(std::numeric_limits<int>::max())) return static_cast<int>(v);
+    } else if (j.is_number_integer()) {
+        const auto v = j.get<int64_t>();
+        if (v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max())
+            return static_cast<int>(v);
+    }
+    return std::nullopt;
 }
 
 // The line parsed, or the problem with it.
 std::optional<std::string> parse(const json& j, ShotLogLine& out) {
     if (!j.is_object()) return "is not a JSON object";
     const auto frame = j.find("frame");
-    if (frame == j.end() || !wholeNumber(*frame)) return "has no whole-number \"frame\"";
-    out.frame = frame->get<int>();
+    const std::optional<int> frameNumber = frame == j.end() ? std::nullopt : wholeNumber(*frame);
+    if (!frameNumber) return "has no whole-number \"frame\"";
+    out.frame = *frameNumber;
     const auto status = j.find("status");
     if (status == j.end() || !status->is_string() || !kStatuses.contains(status->get<std::string>())) {
         return "has no \"status\" of written, replayed, skipped, unwarped or warm-up";
     }
     out.status = status->get<std::string>();
     if (const auto task = j.find("task"); task != j.end()) {
-        if (!wholeNumber(*task) || task->get<int64_t>() < 0) return "has a \"task\" that is not a task index";
-        out.task = task->get<int>();
+        out.task = wholeNumber(*task);
+        if (!out.task || *out.task < 0) return "has a \"task\" that is not a task index";
     }
     if (const auto tile = j.find("tile"); tile != j.end()) {
-        if (!wholeNumber(*tile) || tile->get<int64_t>() < 1001 || tile->get<int64_t>() > 9999) {
+        out.tile = wholeNumber(*tile);
+        if (!out.tile || *out.tile < 1001 || *out.tile > 9999) {
             return "has a \"tile\" that is not a UDIM tile (1001 to 9999)";
         }
-        out.tile = tile->get<int>();
     }
     for (const auto& [key, slot] : {std::pair<const char*, std::string*>{"object", &out.object},
                                     {"redirect", &out.redirect},
