@@ -342,7 +342,7 @@ def test_shot_writes_the_solvers_maps_frame_by_frame_with_provenance(tmp_path):
                 assert (a["deformkit:uvwarp:tile"], a["deformkit:uvwarp:frame"]) == (str(tile), str(frame))
                 assert json.loads(a["deformkit:uvwarp:inputs"]) == {
                     "rest": "two planes", "rigidity": f"rigidity tile {tile}", "mask": "derived",
-                    "orientation": "none", "deformed": f"pose {frame}"}
+                    "orientation": "none", "texture": f"texture tile {tile}", "deformed": f"pose {frame}"}
                 used = json.loads(a["deformkit:uvwarp:solver"])
                 assert (used["iterations"], used["cells"], used["texels"], used["warmStart"]) == (4, S, S, True)
         metrics = solver.metrics()

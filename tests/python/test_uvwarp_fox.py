@@ -151,3 +151,32 @@ def test_random_poses_and_rigid_layouts_give_fold_free_on_chart_maps():
             assert inverted_triangles(broken) > 0
     print(f"{cases} random poses and layouts: {unfolded} inverted triangles unfolded, none delivered")
     assert cases == 16 and unfolded > 100
+
+
+def test_a_grid_coarser_than_the_map_delivers_no_off_chart_texel():
+    """A grid of a quarter or half the map's size cannot follow a chart border texel by texel: its inverse
+    sends texels next to borders to content off the charts (thousands a frame on the Fox at 1024^2 with a
+    256-cell grid, the repair reports them). What is delivered shows none, and no fold."""
+    rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
+    frames = np.stack([dk.read_mesh(os.path.join(SHOT, f"anim.{f:04d}.obj")).points for f in range(1, 25)])
+    triangles = uv_triangles(rest)
+    rng = np.random.default_rng(11)
+    t = 512
+    inside = chart_texels(rest, t)
+    placed = 0
+    for cells in (128, 256):
+        for case in range(2):
+            rigidity = rigid_disks(inside, t) if case == 0 else (inside & (rng.random((t, t)) < 0.3)).astype(
+                np.float32)
+            solver = dk.UvWarpSolver(rest, 1001, rigidity, resolution=cells, warm_start=False)
+            for frame in rng.choice(24, 2, replace=False):
+                solver.solve(frames[frame])
+                m = solver.metrics()
+                redirect = solver.redirect_map()
+                label = f"{cells} cells case {case} frame {frame + 1}"
+                assert m["inverted_triangles"] == 0 and inverted_triangles(redirect) == 0, label
+                assert m["off_chart_texels"] == 0, label
+                assert off_chart_texels(redirect, inside, triangles, t) == 0, label
+                placed += m["repair_off_chart_found"]
+    print(f"grids of 128 and 256 cells on 512^2 maps: {placed} texels placed back on their charts, none delivered off")
+    assert placed > 100

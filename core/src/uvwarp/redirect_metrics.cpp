@@ -105,7 +105,9 @@ struct RedirectMetrics::Impl {
     std::string source;
     int32_t texels = 0;
     detail::TileUVs uvs;
-    std::vector<int32_t> chart;          // per UV triangle
+    std::vector<int32_t> chart;  // per UV triangle
+    // Per UV triangle: corner a and the rows of the inverse of (b - a, c - a), for mayShow's quick test.
+    std::vector<std::array<glm::dvec2, 3>> inverse;
     std::vector<int32_t> texelTriangle;  // per texel: the UV triangle its centre lies in, -1 none
     std::vector<glm::vec3> restPoints;   // f_O's vertices
     int32_t buckets = 1;                 // point-location buckets per side
@@ -128,6 +130,30 @@ struct RedirectMetrics::Impl {
             }
         }
         return -1;
+    }
+
+    // Whether r lies in UV triangle t with a margin far beyond this test's rounding: a quick yes before
+    // locate() (most content comes from the texel's own triangle).
+    [[nodiscard]] bool insideWithMargin(int32_t t, glm::dvec2 r) const {
+        const auto& [a, row0, row1] = inverse[static_cast<size_t>(t)];
+        const glm::dvec2 p = r - a;
+        const double l1 = row0.x * p.x + row0.y * p.y, l2 = row1.x * p.x + row1.y * p.y;
+        constexpr double kMargin = 1e-6;
+        return l1 >= kMargin && l2 >= kMargin && l1 + l2 <= 1.0 - kMargin;
+    }
+
+    // Whether r lies on a UV triangle: the same answer as locate() >= 0, quicker. The texel's own triangle
+    // `own` and then r's bucket are tried with a margin (a sure yes); only a point near an edge is located.
+    [[nodiscard]] bool onChart(int32_t own, glm::dvec2 r) const {
+        if (insideWithMargin(own, r)) return true;
+        const auto cell = [&](double c) {
+            return std::clamp(static_cast<int32_t>(std::floor(c * buckets)), 0, buckets - 1);
+        };
+        const int32_t b = cell(r.y) * buckets + cell(r.x);
+        for (int32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k)
+            if (insideWithMargin(bucketTriangles[k], r)) return true;
+        glm::dvec3 bary;
+        return locate(r, bary) >= 0;
     }
 
     [[nodiscard]] glm::dvec3 pointOn(std::span<const glm::vec3> points, int32_t t,
@@ -207,6 +233,15 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
     m.texels = rigidity.width;
     setRigidity(rigidity);
     m.chart = chartsOf(m.uvs);
+    m.inverse.reserve(m.uvs.uvs.size());
+    for (const auto& tri : m.uvs.uvs) {
+        const glm::dvec2 a(tri[0]), e0 = glm::dvec2(tri[1]) - a, e1 = glm::dvec2(tri[2]) - a;
+        const double den = e0.x * e1.y - e1.x * e0.y;
+        // A degenerate triangle gets rows that accept nothing (l1 = l2 = 0).
+        m.inverse.push_back(den == 0.0 ? std::array<glm::dvec2, 3>{a, glm::dvec2(0.0), glm::dvec2(0.0)}
+                                       : std::array<glm::dvec2, 3>{a, glm::dvec2(e1.y, -e1.x) / den,
+                                                                   glm::dvec2(-e0.y, e0.x) / den});
+    }
     m.restPoints.assign(rest.points().begin(), rest.points().end());
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     for (const glm::vec3& p : m.restPoints) {
@@ -279,9 +314,18 @@ RedirectMetrics& RedirectMetrics::operator=(RedirectMetrics&&) noexcept = defaul
 bool RedirectMetrics::mayShow(int32_t x, int32_t y, glm::dvec2 r) const {
     const Impl& m = *impl_;
     if (x < 0 || y < 0 || x >= m.texels || y >= m.texels) return true;
-    if (m.texelTriangle[static_cast<size_t>(y) * m.texels + x] < 0) return true;
-    glm::dvec3 bary;
-    return m.locate(r, bary) >= 0;
+    const int32_t own = m.texelTriangle[static_cast<size_t>(y) * m.texels + x];
+    return own < 0 || m.onChart(own, r);
+}
+
+void RedirectMetrics::refusedInRow(const io::Image& redirect, int32_t y,
+                                   std::vector<int32_t>& refused) const {
+    const Impl& m = *impl_;
+    const int32_t* own = &m.texelTriangle[static_cast<size_t>(y) * m.texels];
+    for (int32_t x = 0; x < m.texels; ++x) {
+        if (own[x] < 0) continue;
+        if (!m.onChart(own[x], detail::redirectAt(redirect, x, y))) refused.push_back(x);
+    }
 }
 
 int32_t RedirectMetrics::texels() const {

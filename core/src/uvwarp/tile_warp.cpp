@@ -119,8 +119,11 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
 FoldRepair TileWarp::redirect(io::Image& out) const {
     const Impl& m = *impl_;
     invertWarp(m.solver->warp(), m.texels, out);
-    return repairFolds(out,
-                       [&m](int32_t x, int32_t y, glm::dvec2 r) { return m.delivered->mayShow(x, y, r); });
+    return repairFolds(
+        out, [&m](int32_t x, int32_t y, glm::dvec2 r) { return m.delivered->mayShow(x, y, r); },
+        [&m](const io::Image& map, int32_t y, std::vector<int32_t>& refused) {
+            m.delivered->refusedInRow(map, y, refused);
+        });
 }
 
 io::Image TileWarp::redirect() const {

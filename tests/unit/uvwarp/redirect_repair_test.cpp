@@ -197,18 +197,22 @@ TEST_CASE("the repair ends every fold of random maps, near the folds, keeping co
 
 TEST_CASE("a fold the smoothing cannot end is removed by scaling its region back", "[uvwarp][repair]") {
     const int32_t t = 32;
-    SECTION("no move allowed") {
+    SECTION("no content allowed but a texel's own centre") {
         io::Image map = smoothMap(t, 0.04);
         map.at(10, 12, 0) += 3.0f / t;  // folds the cells around texel (10, 12)
         const ContentCheck nothing = [](int32_t, int32_t, glm::dvec2) { return false; };
         REQUIRE(invertedReference(map) > 0);
+        int64_t displaced = 0;
+        for (int32_t y = 0; y < t; ++y)
+            for (int32_t x = 0; x < t; ++x)
+                displaced += map.at(x, y, 0) != centreOf(x, y, t).x || map.at(x, y, 1) != centreOf(x, y, t).y;
         const FoldRepair r = repairFolds(map, nothing);
         CHECK(invertedReference(map) == 0);
+        // Every displaced texel shows refused content: each goes back to its own centre before any smoothing.
+        CHECK(r.offChartFound == displaced);
         CHECK(r.texelsMoved == 0);
-        CHECK(r.regionsScaled == 1);
-        CHECK(r.smallestScale == 0.0);
-        // The region (every displaced texel, 8-connected: the smooth map's interior) is the identity, the one
-        // state accepted without asking.
+        CHECK(r.regionsScaled == 0);
+        // The map is the identity, the one state accepted without asking.
         for (int32_t y = 0; y < t; ++y) {
             for (int32_t x = 0; x < t; ++x) {
                 CHECK(map.at(x, y, 0) == static_cast<float>((x + 0.5f) / static_cast<float>(t)));

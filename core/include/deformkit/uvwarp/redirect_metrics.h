@@ -78,6 +78,9 @@ class RedirectMetrics {
     // Whether texel (x, y) may show the rest content at tile-local r without counting as off-chart: true for
     // a texel outside every chart, and for a chart texel when r lies in a UV triangle of the tile.
     [[nodiscard]] bool mayShow(int32_t x, int32_t y, glm::dvec2 r) const;
+    // Appends the columns x of row y of `redirect` (T x T, channels 0 and 1 r) whose content mayShow
+    // refuses, ascending.
+    void refusedInRow(const io::Image& redirect, int32_t y, std::vector<int32_t>& refused) const;
 
     [[nodiscard]] int32_t texels() const;
 

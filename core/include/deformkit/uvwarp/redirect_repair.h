@@ -14,10 +14,15 @@ namespace deformkit::uvwarp {
 // Whether texel (x, y) of a redirect map may show the rest content at tile-local r (RedirectMetrics::mayShow:
 // a chart texel only content on a chart).
 using ContentCheck = std::function<bool(int32_t x, int32_t y, glm::dvec2 r)>;
+// The same question for a whole row of a map, answered at once (RedirectMetrics::refusedInRow): appends
+// to `refused` the columns x of row y whose content mayShow would refuse, ascending.
+using ContentRowCheck =
+    std::function<void(const io::Image& redirect, int32_t y, std::vector<int32_t>& refused)>;
 
 // What repairFolds did to a map.
 struct FoldRepair {
     int64_t invertedFound = 0;   // inverted triangles of the map it was given
+    int64_t offChartFound = 0;   // texels of it showing content mayShow refuses
     int64_t texelsMoved = 0;     // smoothing moves made
     int32_t passes = 0;          // smoothing passes run
     int32_t regionsScaled = 0;   // regions whose displacement was scaled back (the guarantee)
@@ -26,11 +31,14 @@ struct FoldRepair {
 
 // Makes a redirect map (T x T x >= 2, channels 0 and 1 tile-local r, invertWarp's layout) fold-free: on
 // return no triangle of its texel-centre grid is inverted (DeliveredMetrics::invertedTriangles = 0), and no
-// texel that `mayShow` was asked about shows content it refuses, whatever the map it was given.
+// texel shows content `mayShow` refuses, whatever the map it was given.
 //
 // The PL inverse of a fold-free warp is fold-free, but sampled at texel centres it can fold where the warp is
 // strongly anisotropic (a cell stretched ten times one way, or crushed to a sliver): the interpolant's
-// triangles straddle the kinks of W^-1. Two steps:
+// triangles straddle the kinks of W^-1. And a grid coarser than the map cannot follow a chart border texel by
+// texel: texels next to a border can show content from off the chart. Three steps:
+//  0. Content: every displaced texel whose content `mayShow` refuses moves towards its own centre (which a
+//     texel may always show), to the farthest allowed point a bisection of the segment finds.
 //  1. Smoothing: the corners of inverted cells move to the mean of their 8 neighbours (exact for an affine
 //     map, so where R is locally affine it barely moves), in ascending order, pass after pass over the cells
 //     still inverted; after every 16 passes the moved set grows by a ring. A mean `mayShow` refuses (past a
@@ -40,11 +48,14 @@ struct FoldRepair {
 //     own centre that holds one has its displacement scaled by 1/2, 1/4, ... down to 0 until neither a fold
 //     nor refused content is left in the cells it touches. At 0 the region is the identity, fold-free and on
 //     chart, so this always ends.
-// Texels on the tile's border never move. Serial over the few texels concerned after one parallel scan:
+// Smoothing never moves texels on the tile's border. Serial over the texels concerned after parallel scans:
 // bit-identical for any thread count. Throws InvalidInput for a map that is not square with >= 2 channels.
-FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow);
+// `refusedInRow`, when given, must agree with mayShow; it makes step 0's scan of every texel cheaper.
+FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow,
+                       const ContentRowCheck& refusedInRow = {});
 
-// The figures of `r` as hosts report them (metrics.h): repair_inverted_found, repair_texels_moved,
+// The figures of `r` as hosts report them (metrics.h): repair_inverted_found, repair_off_chart_found,
+// repair_texels_moved,
 // repair_passes, repair_regions_scaled, repair_smallest_scale.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const FoldRepair& r);
 
