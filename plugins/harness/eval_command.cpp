@@ -1,6 +1,7 @@
 #include "eval_command.h"
 #include <iostream>
 #include "cli.h"
+#include "report_command.h"
 #include "uvwarp_command.h"
 
 #include "commands.h"
@@ -166,6 +167,8 @@ void writeShotPage(const EvalCommand& command, EvalReport& report, const std::st
     uvwarp::readShotLogFile(logFile, log);
     uvwarp::HtmlReportOptions options;
     options.title = "Shot " + command.scene.stem().string();
+    // The heatmaps' geometry from the scene itself: the shot may be written as point caches alone.
+    options.geometry = sceneGeometry(fs::absolute(command.scene).lexically_normal());
     std::string frames;
     if (!report.frames.empty()) {
         frames =

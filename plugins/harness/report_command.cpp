@@ -33,6 +33,22 @@ std::vector<fs::path> logsIn(const fs::path& folder, const std::string& prefix =
 
 }  // namespace
 
+std::function<std::optional<uvwarp::ReportGeometry>(const std::string&, int)> sceneGeometry(
+    const fs::path& scene) {
+    return [scene, evaluator = std::shared_ptr<scene::SceneEvaluator>()](
+               const std::string& object, int frame) mutable -> std::optional<uvwarp::ReportGeometry> {
+        if (!evaluator) evaluator = std::make_shared<scene::SceneEvaluator>(readScene(scene));
+        const scene::Scene& s = evaluator->scene();
+        for (size_t o = 0; o < s.objects.size(); ++o) {
+            if (s.objects[o].name != object) continue;
+            const geom::Mesh& mesh = evaluator->evaluate(o, frame);
+            return uvwarp::ReportGeometry{s.objects[o].rest,
+                                          std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end())};
+        }
+        return std::nullopt;
+    };
+}
+
 ReportCommandResult reportCommand(const ReportCommand& command) {
     uvwarp::HtmlReportOptions options;
     if (!command.title.empty()) options.title = command.title;
@@ -59,28 +75,15 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
                  "deformkit farm run " + planFile.string() + " --task " + std::to_string(k)});
         }
         options.searchFolders.push_back(plan.outDir);
-        // The heatmaps' geometry as the tasks made it: the plan's scene evaluated at the worst frame (the
-        // mesh tasks' OBJs may not be there). Read when first asked for.
-        const fs::path sceneFile = plan.scene;
-        options.geometry = [sceneFile, evaluator = std::shared_ptr<scene::SceneEvaluator>()](
-                               const std::string& object,
-                               int frame) mutable -> std::optional<uvwarp::ReportGeometry> {
-            if (!evaluator) evaluator = std::make_shared<scene::SceneEvaluator>(readScene(sceneFile));
-            const scene::Scene& s = evaluator->scene();
-            for (size_t o = 0; o < s.objects.size(); ++o) {
-                if (s.objects[o].name != object) continue;
-                const geom::Mesh& mesh = evaluator->evaluate(o, frame);
-                return uvwarp::ReportGeometry{
-                    s.objects[o].rest, std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end())};
-            }
-            return std::nullopt;
-        };
+        // The heatmaps' geometry as the tasks made it (the mesh tasks' OBJs may not be there).
+        options.geometry = sceneGeometry(plan.scene);
         options.rerun.push_back("deformkit farm submit --slurm " + planFile.string() +
                                 "   # every task: finished frames are skipped");
         if (page.empty()) page = plan.outDir / "report.html";
         if (options.title == uvwarp::HtmlReportOptions{}.title)
             options.title = "Farm shot " + plan.scene.stem().string();
     }
+    if (command.scene) options.geometry = sceneGeometry(*command.scene);
     if (logs.empty()) {
         throw InvalidInput(formatError(
             "report", "", "has no log to read",
@@ -102,7 +105,7 @@ void addReportCommand(CommandLine& cli) {
     struct Options {
         ReportCommand command;
         std::vector<std::string> logs;
-        std::string plan;
+        std::string plan, scene;
     };
     auto o = std::make_shared<Options>();
     Command report = cli.add(
@@ -111,6 +114,7 @@ void addReportCommand(CommandLine& cli) {
             ReportCommand& c = o->command;
             c.logs.assign(o->logs.begin(), o->logs.end());
             if (!o->plan.empty()) c.plan = o->plan;
+            if (!o->scene.empty()) c.scene = o->scene;
             const ReportCommandResult r = reportCommand(c);
             std::cout << "report: wrote " << r.page.string() << " (" << r.logLines << " log lines, "
                       << r.report.files.size() - 1 << " pictures beside it; " << r.report.problems
@@ -124,6 +128,8 @@ void addReportCommand(CommandLine& cli) {
     report.option("--out", o->command.out,
                   "the page; default: report.html beside the logs (a plan's output folder)");
     report.option("--title", o->command.title, "the page's title");
+    report.option("--scene", o->scene,
+                  "an eval shot's scene: the heatmaps' geometry evaluated from it (no per-frame OBJs needed)");
 }
 
 }  // namespace deformkit::harness

@@ -433,6 +433,14 @@ contains eval-uvwarp-report "$work/out" "eval: report $work/eval-uv-r/shot.html 
 contains eval-uvwarp-report "$work/eval-uv-r/uvwarp.jsonl" '"object":"grid"'
 contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "measured again from its files: the same"
 contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "deformkit eval $work/uvshot.json --frames 1-2"
+# Written as a point cache alone (no per-frame OBJ): the page's heatmaps come from the scene itself.
+expect eval-uvwarp-report-cache 0 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv-c" --no-previews --cache pc2 --no-objs \
+    --report "$work/eval-uv-c/shot.html"
+contains eval-uvwarp-report-cache "$work/eval-uv-c/shot.html" "measured again from its files: the same"
+expect report-scene 0 "$dk" report "$work/eval-uv-c/uvwarp.jsonl" --scene "$work/uvshot.json" --out "$work/eval-uv-c/again.html"
+contains report-scene "$work/eval-uv-c/again.html" "measured again from its files: the same"
+expect report-no-scene 0 "$dk" report "$work/eval-uv-c/uvwarp.jsonl" --out "$work/eval-uv-c/bare.html"
+contains report-no-scene "$work/out" "grid tile 1001: no heatmaps: the deformed mesh 'grid.000"
 expect eval-uvwarp-info 0 "$dk" info "$work/eval-uv/grid.redirect.1001.0002.exr"
 contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"
