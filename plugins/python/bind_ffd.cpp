@@ -164,12 +164,11 @@ py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::opti
     auto [out, pts] = outputArray(py::none(), in.size(), source);
     {
         py::gil_scoped_release release;
-        if (!in.empty()) std::memcpy(pts.data(), in.data(), in.size_bytes());
         if constexpr (std::is_same_v<W, Ffd>) {
-            warp.bindAndEvaluate(in, pts, w, envelope);  // no bind cache where it can do without
+            warp.bindAndEvaluate(in, in, pts, w, envelope);  // no bind cache where it can do without
         } else {
             warp.bind(in);
-            warp.evaluate(pts, w, envelope);
+            warp.evaluate(in, pts, w, envelope);
         }
     }
     return out;
@@ -187,8 +186,7 @@ py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& re
     auto [out, pts] = outputArray(outArg, in.size(), source);
     {
         py::gil_scoped_release release;
-        if (pts.data() != in.data()) std::memcpy(pts.data(), in.data(), in.size_bytes());
-        warp.evaluate(pts, w, envelope);
+        warp.evaluate(in, pts, w, envelope);  // into out, or in place when out is the input
     }
     return out;
 }

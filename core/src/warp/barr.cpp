@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -27,6 +28,20 @@ void requireFinitePoints(std::span<const glm::vec3> points, const std::string& s
         throw InvalidInput(formatError(source, std::string(what) + " " + std::to_string(first),
                                        "is " + detail::pointText(points[first]), "finite coordinates"));
     }
+}
+
+// 1 when the point's coordinates are finite, 0 otherwise, without a branch (a loop's flag, kept with &).
+inline int finiteBits(const glm::vec3& p) {
+    constexpr float kLargest = std::numeric_limits<float>::max();
+    return static_cast<int>(std::abs(p.x) <= kLargest) & static_cast<int>(std::abs(p.y) <= kLargest) &
+           static_cast<int>(std::abs(p.z) <= kLargest);
+}
+
+// The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
+int64_t firstNonFinite(std::span<const glm::vec3> points) {
+    for (size_t u = 0; u < points.size(); ++u)
+        if (!geom::isFinite(points[u])) return static_cast<int64_t>(u);
+    return static_cast<int64_t>(points.size());
 }
 
 // sin(t)/t and (1 - cos t)/t, stable at and near t = 0.
@@ -136,17 +151,21 @@ void sinCos(const float* t, float* sinOut, float* cosOut, int count) {
 // (apply(begin, count, t, sin t, cos t)). A point depends on its own inputs only: any schedule gives the
 // same output. The callables are taken by value: what they capture stays in registers, not behind a
 // reference that a store to the output could alias.
+// apply returns the first point of its block that is not finite, or n: forEachAngleBlock returns the
+// first of the whole run.
 template <class AngleOf, class Apply>
-void forEachAngleBlock(int64_t n, const AngleOf angleOf, const Apply apply) {
-#pragma omp parallel for schedule(dynamic, 16)
+int64_t forEachAngleBlock(int64_t n, const AngleOf angleOf, const Apply apply) {
+    int64_t bad = n;
+#pragma omp parallel for schedule(dynamic, 16) reduction(min : bad)
     for (int64_t begin = 0; begin < n; begin += kTrigBlock) {
         const int count = static_cast<int>(std::min<int64_t>(kTrigBlock, n - begin));
         float t[kTrigBlock], sinT[kTrigBlock], cosT[kTrigBlock];
         for (int i = 0; i < count; ++i)
             t[i] = angleOf(begin + i);
         sinCos(t, sinT, cosT, count);
-        apply(begin, count, t, sinT, cosT);
+        bad = std::min(bad, apply(begin, count, t, sinT, cosT));
     }
+    return bad;
 }
 
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
@@ -289,11 +308,14 @@ void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weigh
 void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> out,
                        std::span<const float> weights, float envelope) {
     requireBound(points.size(), "points");
-    requireFinitePoints(points, name_, "point");
     if (!std::isfinite(envelope)) {
         throw InvalidInput(formatError(name_, "envelope", "is not finite", "a number, usually in [0, 1]"));
     }
-    evaluate(points, out);
+    const int64_t bad = evaluateFinite(points, out);
+    if (bad < static_cast<int64_t>(points.size())) {
+        throw InvalidInput(formatError(name_, "point " + std::to_string(bad),
+                                       "is " + detail::pointText(points[bad]), "finite coordinates"));
+    }
     if (envelope != 1.0f || !weights.empty()) applyEnvelope(points, out, weights, envelope, out);
 }
 
@@ -308,18 +330,30 @@ Affine TaperWarp::transformationAt(float z) const {
 }
 
 void TaperWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    (void)run(points, out, false);
+}
+
+int64_t TaperWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    return run(points, out, true);
+}
+
+int64_t TaperWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
     const InlineProfile profile(profile_);
+    const auto n = static_cast<int64_t>(points.size());
+    int finite = 1;
     // Dynamic chunks of 4096 points (here and in twist and bend): a thread the host deschedules does not
     // hold up the others. Each point depends on its own inputs only: any schedule gives the same output.
-#pragma omp parallel for schedule(dynamic, 4096)
-    for (int64_t u = 0; u < static_cast<int64_t>(points.size()); ++u) {
+#pragma omp parallel for schedule(dynamic, 4096) reduction(& : finite)
+    for (int64_t u = 0; u < n; ++u) {
         const glm::vec3 p = points[u];
+        if (check) finite &= finiteBits(p);
         const glm::vec3 d = p - o;
         const glm::vec3 radial = d - glm::dot(d, a) * a;
         out[u] = p + (profile(restZ_[u]) - 1.0f) * radial;
     }
+    return check && finite == 0 ? firstNonFinite(points) : n;
 }
 
 // ---- twist ----
@@ -333,21 +367,34 @@ Affine TwistWarp::transformationAt(float z) const {
 }
 
 void TwistWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    (void)run(points, out, false);
+}
+
+int64_t TwistWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    return run(points, out, true);
+}
+
+int64_t TwistWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
     const InlineProfile angle(angle_);
     const float* z = restZ_.data();
-    forEachAngleBlock(
-        static_cast<int64_t>(points.size()), [angle, z](int64_t u) { return angle(z[u]); },
-        [o, a, points, out](int64_t begin, int count, const float*, const float* sinT, const float* cosT) {
+    const auto n = static_cast<int64_t>(points.size());
+    return forEachAngleBlock(
+        n, [angle, z](int64_t u) { return angle(z[u]); },
+        [o, a, points, out, n, check](int64_t begin, int count, const float*, const float* sinT,
+                                      const float* cosT) {
+            int finite = 1;
             for (int i = 0; i < count; ++i) {
                 const int64_t u = begin + i;
                 const glm::vec3 p = points[u];
+                if (check) finite &= finiteBits(p);
                 const glm::vec3 d = p - o;
                 const glm::vec3 radial = d - glm::dot(d, a) * a;
                 // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
                 out[u] = p + (cosT[i] - 1.0f) * radial + sinT[i] * glm::cross(a, radial);
             }
+            return check && finite == 0 ? begin + firstNonFinite(points.subspan(begin, count)) : n;
         });
 }
 
@@ -383,21 +430,31 @@ Affine BendWarp::transformationAt(float z) const {
 }
 
 void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    (void)run(points, out, false);
+}
+
+int64_t BendWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
+    return run(points, out, true);
+}
+
+int64_t BendWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
     requireBound(points, out);
     const float k = params_.rate, z0 = params_.centre, lo = params_.lo, hi = params_.hi;
     const OrthoFrame f = frame_;
+    const auto n = static_cast<int64_t>(points.size());
     if (k == 0.0f) {  // Barr's bend with k = 0 is the identity
         if (out.data() != points.data()) std::copy(points.begin(), points.end(), out.begin());
-        return;
+        return check ? firstNonFinite(points) : n;
     }
     const float* z = restZ_.data();
-    forEachAngleBlock(
-        static_cast<int64_t>(points.size()),
-        [k, z0, lo, hi, z](int64_t u) { return k * (std::clamp(z[u], lo, hi) - z0); },
-        [f, z0, lo, hi, z, points, out](int64_t begin, int count, const float* t, const float* sinT,
-                                        const float* cosT) {
+    return forEachAngleBlock(
+        n, [k, z0, lo, hi, z](int64_t u) { return k * (std::clamp(z[u], lo, hi) - z0); },
+        [f, z0, lo, hi, z, points, out, n, check](int64_t begin, int count, const float* t, const float* sinT,
+                                                  const float* cosT) {
+            int finite = 1;
             for (int i = 0; i < count; ++i) {
                 const int64_t u = begin + i;
+                if (check) finite &= finiteBits(points[u]);
                 const glm::vec3 l = f.toLocal(points[u]);
                 const float zc = std::clamp(z[u], lo, hi);
                 const float d = zc - z0;
@@ -407,6 +464,7 @@ void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> 
                 const float zz = z0 + d * sincFrom(t[i], s) - s * l.y + c * along;
                 out[u] = f.origin + l.x * f.side + y * f.up + zz * f.axis;
             }
+            return check && finite == 0 ? begin + firstNonFinite(points.subspan(begin, count)) : n;
         });
 }
 

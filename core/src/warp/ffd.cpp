@@ -148,12 +148,13 @@ const detail::FfdKernels& ffdKernels(FfdKernel choice) {
 using Bernstein444Kernel = decltype(detail::FfdKernels::bernstein444);
 
 // The Bernstein 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates
-// and whether the warp reaches it; points[u] += envelope * weight * D(u) for those it reaches. Each block
-// reads and writes its own points only: the output does not depend on the schedule.
+// and whether the warp reaches it; out[u] = points[u] + envelope * weight * D(u) for those it reaches,
+// points[u] for the others (out may be points). Each block reads and writes its own points only: the output
+// does not depend on the schedule.
 template <class Local>
 void bernsteinBlocks(int64_t n, Bernstein444Kernel kernel, const float* translations,
-                     std::span<glm::vec3> points, std::span<const float> weights, float envelope,
-                     const Local& local) {
+                     std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                     std::span<const float> weights, float envelope, const Local& local) {
     constexpr int kBlock = detail::kBlock;
     const int64_t blocks = (n + kBlock - 1) / kBlock;
 #pragma omp parallel for schedule(dynamic, 512)
@@ -172,9 +173,12 @@ void bernsteinBlocks(int64_t n, Bernstein444Kernel kernel, const float* translat
         kernel(in, translations, d);
         for (int lane = 0; lane < count; ++lane) {
             const int64_t u = begin + lane;
-            if (!active[lane]) continue;
+            if (!active[lane]) {
+                out[u] = points[u];
+                continue;
+            }
             const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-            points[u] += k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+            out[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
         }
     }
 }
@@ -300,11 +304,12 @@ glm::vec3 FfdLattice::boundCoordinates(const glm::vec3& p, const glm::dvec3& sca
     return glm::vec3(s * scale);
 }
 
-bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
-                               const float* translations, std::span<const float> weights,
-                               float envelope) const {
+bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> points,
+                               std::span<glm::vec3> out, const float* translations,
+                               std::span<const float> weights, float envelope) const {
     if (options_.kernel == FfdKernel::PerPoint || !options_.basis.all(FfdBasis::Bernstein) ||
-        lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size()) {
+        lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size() ||
+        out.size() != points.size()) {
         return false;
     }
     const auto n = static_cast<int64_t>(restPoints.size());
@@ -321,7 +326,7 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
     if (!weights.empty() && weights.size() != points.size()) return false;  // evaluate() names the mismatch
     const glm::dvec3 scale(lattice_.divisions);
     const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
-    bernsteinBlocks(n, ffdKernels(options_.kernel).bernstein444, translations, points, weights, envelope,
+    bernsteinBlocks(n, ffdKernels(options_.kernel).bernstein444, translations, points, out, weights, envelope,
                     [&](int64_t u, bool& active) {
                         bool inside = true;
                         const glm::vec3 l = boundCoordinates(restPoints[u], scale, inside);
@@ -394,16 +399,19 @@ void FfdLattice::fields(SparseFields& out) const {
     }
 }
 
-void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> deltas, int32_t stride,
-                        std::span<const float> weights, float envelope) const {
+void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                        std::span<const float> deltas, int32_t stride, std::span<const float> weights,
+                        float envelope) const {
     if (!bound_) {
         throw InvalidInput(formatError("FFD", "evaluate", "called before bind", "bind(restPoints) first"));
     }
     const int64_t n = numBoundPoints();
-    if (static_cast<int64_t>(points.size()) != n) {
-        throw InvalidInput(formatError("FFD evaluate", "points",
-                                       "has " + std::to_string(points.size()) + " points",
-                                       std::to_string(n) + " points, as bound"));
+    for (const auto& [name, size] :
+         {std::pair<const char*, size_t>{"points", points.size()}, {"output", out.size()}}) {
+        if (static_cast<int64_t>(size) != n) {
+            throw InvalidInput(formatError("FFD evaluate", name, "has " + std::to_string(size) + " points",
+                                           std::to_string(n) + " points, as bound"));
+        }
     }
     if (!weights.empty() && static_cast<int64_t>(weights.size()) != n) {
         throw InvalidInput(formatError("FFD evaluate", "painted weights",
@@ -420,7 +428,7 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
     const float* data = deltas.data();
     const bool blocks = options_.kernel != FfdKernel::PerPoint;
     if (blocks && options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
-        deformBernstein444(points, data, weights, envelope);
+        deformBernstein444(points, out, data, weights, envelope);
         return;
     }
     // Every point's weights fit a 4x4x4 window of controls: along each axis a spline with >= 3 divisions,
@@ -430,13 +438,16 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
         window = window && (options_.basis[a] == FfdBasis::Bernstein ? div[a] == 3 : div[a] >= 3);
     // The 4x4x4 lattice: a spline basis with translations (weights from bind), or any basis with affine maps.
     if (blocks && window && div == glm::ivec3(3) && (stride == 12 || windowSpline_)) {
-        deformWindow444(points, data, stride, weights, envelope);
+        deformWindow444(points, out, data, stride, weights, envelope);
         return;
     }
 
 #pragma omp parallel for schedule(dynamic, 4096)
     for (int64_t u = 0; u < n; ++u) {
-        if (!active_[u]) continue;
+        if (!active_[u]) {
+            out[u] = points[u];
+            continue;
+        }
         const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
         float w[3][kMaxBernsteinDegree + 1];
         int32_t first[3], count[3];
@@ -485,21 +496,23 @@ void FfdLattice::deform(std::span<glm::vec3> points, std::span<const float> delt
             d = glm::vec3(acc[0], acc[1], acc[2]) * p.x + glm::vec3(acc[3], acc[4], acc[5]) * p.y +
                 glm::vec3(acc[6], acc[7], acc[8]) * p.z + glm::vec3(acc[9], acc[10], acc[11]);
         }
-        points[u] = p + k * d;
+        out[u] = p + k * d;
     }
 }
 
-void FfdLattice::deformBernstein444(std::span<glm::vec3> points, const float* translations,
-                                    std::span<const float> weights, float envelope) const {
-    bernsteinBlocks(numBoundPoints(), ffdKernels(options_.kernel).bernstein444, translations, points, weights,
-                    envelope, [&](int64_t u, bool& active) {
+void FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                                    const float* translations, std::span<const float> weights,
+                                    float envelope) const {
+    bernsteinBlocks(numBoundPoints(), ffdKernels(options_.kernel).bernstein444, translations, points, out,
+                    weights, envelope, [&](int64_t u, bool& active) {
                         active = active_[u] != 0;
                         return local_[u];
                     });
 }
 
-void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data, int32_t stride,
-                                 std::span<const float> weights, float envelope) const {
+void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                                 const float* data, int32_t stride, std::span<const float> weights,
+                                 float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
     const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
     const int64_t n = numBoundPoints();
@@ -551,23 +564,29 @@ void FfdLattice::deformWindow444(std::span<glm::vec3> points, const float* data,
             kernels.window444(in, data, d);
             for (int lane = 0; lane < count; ++lane) {
                 const int64_t u = begin + lane;
-                if (!active_[u]) continue;
+                if (!active_[u]) {
+                    out[u] = points[u];
+                    continue;
+                }
                 const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-                points[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+                out[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
             }
         } else {
             detail::AffineBlock m;
             kernels.frames444(in, data, m);
             for (int lane = 0; lane < count; ++lane) {
                 const int64_t u = begin + lane;
-                if (!active_[u]) continue;
+                if (!active_[u]) {
+                    out[u] = points[u];
+                    continue;
+                }
                 const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
                 const glm::vec3 p = points[u];
                 const glm::vec3 d = glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
                                     glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
                                     glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
                                     glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
-                points[u] = p + k * d;
+                out[u] = p + k * d;
             }
         }
     }
@@ -635,19 +654,20 @@ void Ffd::transformations(Transformations& out) const {
         out.affine[c] = Affine::translate(translation_[c]);
 }
 
-void Ffd::bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
-                          std::span<const float> weights, float envelope) {
-    if (lattice_.deformUnbound(restPoints, points, reinterpret_cast<const float*>(translation_.data()),
+void Ffd::bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
+                          std::span<glm::vec3> out, std::span<const float> weights, float envelope) {
+    if (lattice_.deformUnbound(restPoints, in, out, reinterpret_cast<const float*>(translation_.data()),
                                weights, envelope)) {
         return;
     }
     bind(restPoints);
-    evaluate(points, weights, envelope);
+    evaluate(in, out, weights, envelope);
 }
 
-void Ffd::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) const {
-    lattice_.deform(points, {reinterpret_cast<const float*>(translation_.data()), translation_.size() * 3}, 3,
-                    weights, envelope);
+void Ffd::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> weights,
+                   float envelope) const {
+    lattice_.deform(in, out, {reinterpret_cast<const float*>(translation_.data()), translation_.size() * 3},
+                    3, weights, envelope);
 }
 
 }  // namespace deformkit::warp

@@ -128,8 +128,9 @@ void FfdFrames::transformations(Transformations& out) const {
     out.affine.assign(transform_.begin(), transform_.end());
 }
 
-void FfdFrames::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) const {
-    lattice_.deform(points, delta_, 12, weights, envelope);
+void FfdFrames::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
+                         std::span<const float> weights, float envelope) const {
+    lattice_.deform(in, out, delta_, 12, weights, envelope);
 }
 
 }  // namespace deformkit::warp

@@ -368,6 +368,31 @@ TEST_CASE("Barr: bad input is named", "[barr][warp][errors]") {
     CHECK_FALSE(bend.isBound());
 }
 
+TEST_CASE("Barr: deform into another buffer checks its input as it reads it", "[barr][warp][errors]") {
+    // Many blocks, so the parallel pass sees the bad points in several threads; the first one is named, and
+    // a finite input gives the in-place deform's bytes.
+    const TestFrame tf;
+    std::vector<glm::vec3> rest(200000);
+    for (size_t u = 0; u < rest.size(); ++u)
+        rest[u] = {std::sin(0.001f * u), std::cos(0.0013f * u), -1.0f + 2.0f * u / rest.size()};
+    TaperWarp taper(tf.frame(), ProfileCurve({-1.0f, 1.0f}, {0.5f, 1.5f}));
+    TwistWarp twist(tf.frame(), ProfileCurve({-1.0f, 1.0f}, {-1.0f, 2.0f}));
+    BendWarp bend(tf.frame(), {0.8f, 0.0f, -0.5f, 0.5f});
+    BendWarp straight(tf.frame(), {0.0f, 0.0f, -0.5f, 0.5f});
+    for (AxialWarp* w : std::initializer_list<AxialWarp*>{&taper, &twist, &bend, &straight}) {
+        w->bind(rest);
+        std::vector<glm::vec3> out(rest.size()), inPlace = rest;
+        w->deform(rest, out, {}, 1.0f);
+        w->deform(inPlace);
+        CHECK(out == inPlace);
+        std::vector<glm::vec3> bad = rest;
+        bad[150000].y = std::numeric_limits<float>::infinity();
+        bad[70001].z = std::nanf("");
+        CHECK_THROWS_WITH(w->deform(bad, out, {}, 0.5f),
+                          Contains("point 70001") && Contains("nan") && Contains("finite coordinates"));
+    }
+}
+
 TEST_CASE("host: Maya bend maps onto Barr's bend (hand-worked)", "[barr][warp][host]") {
     MayaBend maya;
     maya.handleOrigin = {1, 0, 0};

@@ -93,6 +93,10 @@ TEST_CASE("ffd frames: translation-only frames equal plain FFD", "[warp][ffd][fr
             frames.bind(pts);
             frames.evaluate(fast);
             CHECK(maxError(fast, plain) < 1e-5f);
+            // Into another buffer: the in-place bytes.
+            std::vector<glm::vec3> into(pts.size());
+            frames.evaluate(pts, into, {}, 1.0f);
+            CHECK(std::memcmp(into.data(), fast.data(), into.size() * sizeof(glm::vec3)) == 0);
         }
     }
 }

@@ -563,6 +563,47 @@ TEST_CASE("ffd: a one-off without the bind cache gives bind + evaluate's bytes",
                       Catch::Contains("FFD bind: point 13: is not finite"));
 }
 
+TEST_CASE("ffd: evaluating into another buffer gives the in-place bytes on every path", "[warp][ffd][simd]") {
+    // The Bernstein blocks, spline weights computed then kept, the per-point path (a 3 x 2 x 4 lattice), the
+    // one-off without the bind cache; points outside an FfdOutside::None lattice are copied unchanged.
+    std::mt19937 rng(71);
+    int cases = 0;
+    for (const glm::ivec3 divisions : {glm::ivec3(3), glm::ivec3(3, 2, 4)}) {
+        for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+            const Lattice l = skewLattice(divisions);
+            const auto target = randomTargets(l, rng, 0.5f);
+            const auto rest = samplePoints(l, rng, 4099, -0.2f, 1.2f);
+            const std::vector<float> weights = randomWeights(rest.size(), rng);
+            const std::vector<glm::vec3> upstream = shifted(rest);
+            Ffd ffd(l, {basis, FfdOutside::None});
+            ffd.setTargets(target);
+            ffd.bind(rest);
+            for (int round = 0; round < 3; ++round) {  // spline weights computed, kept, read back
+                std::vector<glm::vec3> inPlace = upstream, out(upstream.size(), glm::vec3(-7.0f));
+                ffd.evaluate(inPlace, weights, 0.7f);
+                ffd.evaluate(upstream, out, weights, 0.7f);
+                CHECK(std::memcmp(out.data(), inPlace.data(), out.size() * sizeof(glm::vec3)) == 0);
+            }
+            Ffd once(l, {basis, FfdOutside::None});
+            once.setTargets(target);
+            std::vector<glm::vec3> inPlace = upstream, out(upstream.size(), glm::vec3(-7.0f));
+            ffd.evaluate(inPlace, weights, 0.7f);
+            once.bindAndEvaluate(rest, upstream, out, weights, 0.7f);
+            CHECK(std::memcmp(out.data(), inPlace.data(), out.size() * sizeof(glm::vec3)) == 0);
+            CHECK(maxError(inPlace, upstream) > 1e-3f);
+            ++cases;
+        }
+    }
+    CHECK(cases == 4);
+    const Lattice l = skewLattice({3, 3, 3});
+    Ffd ffd(l);
+    const std::vector<glm::vec3> rest(10, glm::vec3(0.5f));
+    ffd.bind(rest);
+    std::vector<glm::vec3> shortOut(9);
+    CHECK_THROWS_WITH(ffd.evaluate(rest, shortOut, {}, 1.0f),
+                      Catch::Contains("output: has 9 points") && Catch::Contains("10 points, as bound"));
+}
+
 TEST_CASE("ffd: bad input names the element", "[warp][ffd][errors]") {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     Lattice l = skewLattice({3, 0, 3});

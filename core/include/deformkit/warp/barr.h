@@ -69,7 +69,8 @@ class AxialWarp : public Warp {
     // weights: #points painted weights or empty for 1. Throws InvalidInput if not bound, on a count
     // mismatch, or a non-finite point.
     void deform(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
-    // The same into `out` (as many points, not aliasing `points`): no copy of the input.
+    // The same into `out` (as many points, not aliasing `points`): no copy of the input, read once (its
+    // finiteness checked as it is deformed; on that error `out` holds partial results).
     void deform(std::span<const glm::vec3> points, std::span<glm::vec3> out, std::span<const float> weights,
                 float envelope);
 
@@ -80,6 +81,10 @@ class AxialWarp : public Warp {
 
   protected:
     AxialWarp(const AxisFrame& frame, bool needUp, std::string name);
+    // evaluate() that also finds the first point that is not finite (points.size() when all are), in the
+    // same pass: deform() into another buffer reads its input once.
+    [[nodiscard]] virtual int64_t evaluateFinite(std::span<const glm::vec3> points,
+                                                 std::span<glm::vec3> out) const = 0;
     void requireBound(size_t count, const char* what) const;
     // Both spans of an evaluate() hold as many points as were bound.
     void requireBound(std::span<const glm::vec3> points, std::span<glm::vec3> out) const;
@@ -108,6 +113,9 @@ class TaperWarp final : public AxialWarp {
     [[nodiscard]] Affine transformationAt(float z) const override;
 
   private:
+    [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
+                                         std::span<glm::vec3> out) const override;
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
     ProfileCurve profile_;
 };
 
@@ -125,6 +133,9 @@ class TwistWarp final : public AxialWarp {
     [[nodiscard]] Affine transformationAt(float z) const override;
 
   private:
+    [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
+                                         std::span<glm::vec3> out) const override;
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
     ProfileCurve angle_;
 };
 
@@ -152,6 +163,9 @@ class BendWarp final : public AxialWarp {
     [[nodiscard]] Affine transformationAt(float z) const override;
 
   private:
+    [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
+                                         std::span<glm::vec3> out) const override;
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
     BendParams params_;
 };
 

@@ -119,8 +119,10 @@ class FfdLattice {
     // A one-off without the bind cache: bind(restPoints) then deform(points, translations, 3, ...), the same
     // bytes, each point's coordinates computed where it is deformed (no per-point memory). Done for the
     // Bernstein 4x4x4 lattice only; returns false (doing nothing) otherwise. Throws as bind() does.
-    bool deformUnbound(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
-                       const float* translations, std::span<const float> weights, float envelope) const;
+    // `in` and `out` as deform()'s.
+    bool deformUnbound(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
+                       std::span<glm::vec3> out, const float* translations, std::span<const float> weights,
+                       float envelope) const;
     [[nodiscard]] int32_t numBoundPoints() const { return static_cast<int32_t>(local_.size()); }
 
     // Weighting fields from the cache, non-zero weights only, strength 1. With FfdOutside::None a point
@@ -138,20 +140,26 @@ class FfdLattice {
     // translation) when stride is 12. OpenMP over points; allocates nothing; bit-identical for any thread
     // count.
     void deform(std::span<glm::vec3> points, std::span<const float> deltas, int32_t stride,
-                std::span<const float> weights, float envelope) const;
+                std::span<const float> weights, float envelope) const {
+        deform(points, points, deltas, stride, weights, envelope);
+    }
+    // The same from `in` into `out` (as many points; the same span, or not overlapping): out[u] = in[u] +
+    // envelope * weight[u] * D_u(in[u]), one pass over the input instead of a copy and a pass.
+    void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> deltas,
+                int32_t stride, std::span<const float> weights, float envelope) const;
 
   private:
     // A point's local coordinates times the divisions, and whether it lies in the lattice (bind's formula).
     [[nodiscard]] glm::vec3 boundCoordinates(const glm::vec3& p, const glm::dvec3& scale, bool& inside) const;
     // deform() for Bernstein divisions (3, 3, 3) with translations: SoA blocks of 8 points through the
     // kernel options_.kernel selects (ffd.cpp).
-    void deformBernstein444(std::span<glm::vec3> points, const float* translations,
-                            std::span<const float> weights, float envelope) const;
+    void deformBernstein444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
+                            const float* translations, std::span<const float> weights, float envelope) const;
     // The same lattice in any basis whose weights fit the 4x4x4 window (B-splines), and any basis with affine
     // maps (stride 12, FFD with frames): each point's weights as the per-point path computes them (at bind
     // for splines), the sum in eight-lane blocks; the per-point path's bytes.
-    void deformWindow444(std::span<glm::vec3> points, const float* data, int32_t stride,
-                         std::span<const float> weights, float envelope) const;
+    void deformWindow444(std::span<const glm::vec3> in, std::span<glm::vec3> out, const float* data,
+                         int32_t stride, std::span<const float> weights, float envelope) const;
     // The window weights of points begin .. begin + count - 1 into a block ([axis][control][lane], 8 lanes;
     // zero for inactive points and lanes past count).
     void windowWeightsOf(int64_t begin, int count, float* block) const;
@@ -219,9 +227,18 @@ class Ffd : public LatticeWarp {
     // A one-off: bind(restPoints) then evaluate(points, ...), the same bytes; on the Bernstein 4x4x4
     // lattice without keeping the bind cache (the warp is then left unbound).
     void bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<glm::vec3> points,
-                         std::span<const float> weights = {}, float envelope = 1.0f);
+                         std::span<const float> weights = {}, float envelope = 1.0f) {
+        bindAndEvaluate(restPoints, points, points, weights, envelope);
+    }
+    // The same from `in` into `out` (FfdLattice::deform's in and out).
+    void bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
+                         std::span<glm::vec3> out, std::span<const float> weights, float envelope);
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
-                  float envelope = 1.0f) const;
+                  float envelope = 1.0f) const {
+        evaluate(points, points, weights, envelope);
+    }
+    void evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> weights,
+                  float envelope) const;
 
   private:
     std::vector<glm::vec3> source_, target_, translation_;

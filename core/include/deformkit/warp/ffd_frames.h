@@ -47,7 +47,12 @@ class FfdFrames : public LatticeWarp {
     void transformations(Transformations& out) const override;
     // Fast path, as Ffd::evaluate.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {},
-                  float envelope = 1.0f) const;
+                  float envelope = 1.0f) const {
+        evaluate(points, points, weights, envelope);
+    }
+    // The same from `in` into `out` (FfdLattice::deform's in and out).
+    void evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> weights,
+                  float envelope) const;
 
   private:
     void update();
