@@ -128,8 +128,9 @@ void addReportCommand(CommandLine& cli) {
     report.option("--out", o->command.out,
                   "the page; default: report.html beside the logs (a plan's output folder)");
     report.option("--title", o->command.title, "the page's title");
-    report.option("--scene", o->scene,
-                  "an eval shot's scene: the heatmaps' geometry evaluated from it (no per-frame OBJs needed)");
+    report.option(
+        "--scene", o->scene,
+        "an eval shot's scene: the heatmaps' geometry evaluated from it (no per-frame OBJs needed)");
 }
 
 }  // namespace deformkit::harness
