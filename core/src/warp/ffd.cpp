@@ -145,16 +145,13 @@ const detail::FfdKernels& ffdKernels(FfdKernel choice) {
     return detail::kBaselineFfdKernels;
 }
 
-using Bernstein444Kernel = decltype(detail::FfdKernels::bernstein444);
-
-// The Bernstein 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates
-// and whether the warp reaches it; out[u] = points[u] + envelope * weight * D(u) for those it reaches,
-// points[u] for the others (out may be points). Each block reads and writes its own points only: the output
-// does not depend on the schedule.
-template <class Local>
-void bernsteinBlocks(int64_t n, Bernstein444Kernel kernel, const float* translations,
-                     std::span<const glm::vec3> points, std::span<glm::vec3> out,
-                     std::span<const float> weights, float envelope, const Local& local) {
+// The 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates and
+// whether the warp reaches it, kernel(local block, displacements) their displacements D; out[u] = points[u] +
+// envelope * weight * D(u) for those it reaches, points[u] for the others (out may be points). Each block
+// reads and writes its own points only: the output does not depend on the schedule.
+template <class Local, class Kernel>
+void blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> points, std::span<glm::vec3> out,
+               std::span<const float> weights, float envelope, const Local& local) {
     constexpr int kBlock = detail::kBlock;
     const int64_t blocks = (n + kBlock - 1) / kBlock;
 #pragma omp parallel for schedule(dynamic, 512)
@@ -170,7 +167,7 @@ void bernsteinBlocks(int64_t n, Bernstein444Kernel kernel, const float* translat
             in.z[lane] = l.z;
         }
         detail::DisplacementBlock d;
-        kernel(in, translations, d);
+        kernel(in, d);
         for (int lane = 0; lane < count; ++lane) {
             const int64_t u = begin + lane;
             if (!active[lane]) {
@@ -307,7 +304,9 @@ glm::vec3 FfdLattice::boundCoordinates(const glm::vec3& p, const glm::dvec3& sca
 bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> points,
                                std::span<glm::vec3> out, const float* translations,
                                std::span<const float> weights, float envelope) const {
-    if (options_.kernel == FfdKernel::PerPoint || !options_.basis.all(FfdBasis::Bernstein) ||
+    const bool bernstein = options_.basis.all(FfdBasis::Bernstein);
+    const bool bspline = options_.basis.all(FfdBasis::BSpline) && options_.ends == FfdEnds::Extrapolate;
+    if (options_.kernel == FfdKernel::PerPoint || !(bernstein || bspline) ||
         lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size() ||
         out.size() != points.size()) {
         return false;
@@ -326,13 +325,31 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
     if (!weights.empty() && weights.size() != points.size()) return false;  // evaluate() names the mismatch
     const glm::dvec3 scale(lattice_.divisions);
     const bool extrapolate = options_.outside == FfdOutside::Extrapolate;
-    bernsteinBlocks(n, ffdKernels(options_.kernel).bernstein444, translations, points, out, weights, envelope,
-                    [&](int64_t u, bool& active) {
-                        bool inside = true;
-                        const glm::vec3 l = boundCoordinates(restPoints[u], scale, inside);
-                        active = inside || extrapolate;
-                        return l;
-                    });
+    const auto local = [&](int64_t u, bool& active) {
+        bool inside = true;
+        const glm::vec3 l = boundCoordinates(restPoints[u], scale, inside);
+        active = inside || extrapolate;
+        return l;
+    };
+    const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
+    if (bernstein) {
+        blocks444(
+            n,
+            [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
+                kernels.bernstein444(in, translations, d);
+            },
+            points, out, weights, envelope, local);
+    } else {
+        // The spline weights as deformWindow444 computes them (inactive lanes' sums are not used).
+        blocks444(
+            n,
+            [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
+                detail::WeightBlock w;
+                kernels.bsplineWeights444(in, w);
+                kernels.window444(w, translations, d);
+            },
+            points, out, weights, envelope, local);
+    }
     return true;
 }
 
@@ -503,11 +520,17 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
 void FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
                                     const float* translations, std::span<const float> weights,
                                     float envelope) const {
-    bernsteinBlocks(numBoundPoints(), ffdKernels(options_.kernel).bernstein444, translations, points, out,
-                    weights, envelope, [&](int64_t u, bool& active) {
-                        active = active_[u] != 0;
-                        return local_[u];
-                    });
+    const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
+    blocks444(
+        numBoundPoints(),
+        [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
+            kernels.bernstein444(in, translations, d);
+        },
+        points, out, weights, envelope,
+        [&](int64_t u, bool& active) {
+            active = active_[u] != 0;
+            return local_[u];
+        });
 }
 
 void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
@@ -515,6 +538,8 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
                                  float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
     const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
+    // Cubic B-splines with extrapolated ends (the default): their weights in eight lanes too.
+    const bool allBSpline = options_.basis.all(FfdBasis::BSpline) && options_.ends == FfdEnds::Extrapolate;
     const int64_t n = numBoundPoints();
     constexpr int kBlock = detail::kBlock;
     constexpr size_t kBlockFloats = sizeof(detail::WeightBlock::w) / sizeof(float);
@@ -544,8 +569,7 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
         detail::WeightBlock in;
         if (cached != nullptr) {
             std::memcpy(in.w, cached + static_cast<size_t>(b) * kBlockFloats, sizeof(in.w));
-        } else if (allBernstein) {
-            // Inactive lanes keep their weights: their sums are computed and not used.
+        } else if (allBernstein || allBSpline) {
             detail::LocalBlock local{};
             for (int lane = 0; lane < count; ++lane) {
                 const glm::vec3& l = local_[begin + lane];
@@ -553,7 +577,21 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
                 local.y[lane] = l.y;
                 local.z[lane] = l.z;
             }
-            kernels.bernsteinWeights444(local, in);
+            if (allBernstein) {
+                // Inactive lanes keep their weights: their sums are computed and not used.
+                kernels.bernsteinWeights444(local, in);
+            } else {
+                // As windowWeightsOf: 0 for inactive points and lanes past the end (a cache keeps them).
+                kernels.bsplineWeights444(local, in);
+                for (int lane = 0; lane < kBlock; ++lane) {
+                    if (lane < count && active_[begin + lane]) continue;
+                    for (int a = 0; a < 3; ++a)
+                        for (int c = 0; c < 4; ++c)
+                            in.w[a][c][lane] = 0.0f;
+                }
+                if (keep != nullptr)
+                    std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
+            }
         } else {
             windowWeightsOf(begin, count, &in.w[0][0][0]);
             if (keep != nullptr)

@@ -41,6 +41,7 @@ struct FfdKernels {
     void (*window444)(const WeightBlock& in, const float* translations, DisplacementBlock& out);
     void (*frames444)(const WeightBlock& in, const float* affine, AffineBlock& out);
     void (*bernsteinWeights444)(const LocalBlock& in, WeightBlock& out);
+    void (*bsplineWeights444)(const LocalBlock& in, WeightBlock& out);
 };
 
 extern const FfdKernels kBaselineFfdKernels;
@@ -103,6 +104,35 @@ typedef float Float8 __attribute__((vector_size(32)));
     for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 4; ++c)
             std::memcpy(out.w[a][c], &w[a][c], sizeof(Float8));
+}
+
+// The uniform cubic B-spline's window weights on 3 divisions with linearly extrapolated end controls: the
+// per-point path's arithmetic (ffd.cpp, basisWeights with FfdEnds::Extrapolate and splineWeights) lane by
+// lane, so the same bits. The span is clamp(floor(x), 0, 2), here (x >= 1) + (x >= 2); u = x - span; the
+// end spans fold the missing control into their neighbours; control c of the window takes b[c - span + 1].
+[[gnu::always_inline]] inline void bsplineWeights444(const LocalBlock& in, WeightBlock& out) {
+    typedef int Int8 __attribute__((vector_size(32)));
+    const float* coords[3] = {in.x, in.y, in.z};
+    const Float8 zero = {}, one = zero + 1.0f;
+    for (int a = 0; a < 3; ++a) {
+        Float8 x;
+        std::memcpy(&x, coords[a], sizeof(x));
+        const Int8 pastOne = x >= 1.0f, pastTwo = x >= 2.0f;  // all bits set where true
+        const Int8 first = pastOne == 0, middle = pastOne & (pastTwo == 0);
+        const Float8 span = (pastOne ? one : zero) + (pastTwo ? one : zero);
+        const Float8 u = x - span, u2 = u * u, u3 = u2 * u, v = 1.0f - u;
+        const Float8 b0 = v * v * v / 6.0f;
+        const Float8 b1 = (3.0f * u3 - 6.0f * u2 + 4.0f) / 6.0f;
+        const Float8 b2 = (-3.0f * u3 + 3.0f * u2 + 3.0f * u + 1.0f) / 6.0f;
+        const Float8 b3 = u3 / 6.0f;
+        // Span 0: b1 += 2 b0, b2 -= b0; span 2: b2 += 2 b3, b1 -= b3.
+        const Float8 b1First = b1 + 2.0f * b0, b2First = b2 - b0;
+        const Float8 b2Last = b2 + 2.0f * b3, b1Last = b1 - b3;
+        const Float8 w[4] = {first ? b1First : (middle ? b0 : zero), first ? b2First : (middle ? b1 : b0),
+                             first ? b3 : (middle ? b2 : b1Last), first ? zero : (middle ? b3 : b2Last)};
+        for (int c = 0; c < 4; ++c)
+            std::memcpy(out.w[a][c], &w[c], sizeof(Float8));
+    }
 }
 
 [[gnu::always_inline]] inline void window444(const WeightBlock& in, const float* deltas,

@@ -495,12 +495,15 @@ TEST_CASE("ffd: the AVX2 and portable Bernstein 4x4x4 kernels give the same byte
 TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit for bit the per-point path",
           "[warp][ffd][simd]") {
     // The block kernels sum each point's per-point weights in the per-point path's order: every basis and end
-    // rule, mixed bases, points outside the lattice, block tails, painted weights, 1 and 2 threads.
+    // rule, mixed bases, points outside the lattice (deformed, or left as they are), block tails, painted
+    // weights, 1 and 2 threads.
     std::mt19937 rng(41);
     const FfdBasis bases[] = {FfdBasis::BSpline, FfdBasis::CatmullRom, FfdBasis::Cardinal,
                               FfdBasis::Linear,  FfdBasis::Bernstein,  FfdBasis::Bernstein};
     int cases = 0;
-    for (FfdEnds ends : {FfdEnds::Extrapolate, FfdEnds::Repeat}) {
+    for (const auto& [ends, outside] : {std::pair{FfdEnds::Extrapolate, FfdOutside::Extrapolate},
+                                        std::pair{FfdEnds::Repeat, FfdOutside::Extrapolate},
+                                        std::pair{FfdEnds::Extrapolate, FfdOutside::None}}) {
         for (int combo = 0; combo < 6; ++combo) {
             FfdBases basis = bases[combo];
             if (combo == 5) basis = FfdBases{FfdBasis::BSpline, FfdBasis::Bernstein, FfdBasis::CatmullRom};
@@ -509,12 +512,12 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
             const auto rest = samplePoints(l, rng, 4099, -0.2f, 1.2f);
             const std::vector<float> weights = randomWeights(rest.size(), rng);
             std::vector<glm::vec3> reference = rest;
-            Ffd perPoint(l, {basis, FfdOutside::Extrapolate, FfdKernel::PerPoint, ends});
+            Ffd perPoint(l, {basis, outside, FfdKernel::PerPoint, ends});
             perPoint.setTargets(target);
             perPoint.bind(rest);
             perPoint.evaluate(reference, weights, 0.7f);
             for (FfdKernel kernel : {FfdKernel::Auto, FfdKernel::Portable}) {
-                Ffd ffd(l, {basis, FfdOutside::Extrapolate, kernel, ends});
+                Ffd ffd(l, {basis, outside, kernel, ends});
                 ffd.setTargets(target);
                 ffd.bind(rest);
                 for (int threads : {1, 2, 1}) {  // weights computed, kept, read back
@@ -529,24 +532,26 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
             ++cases;
         }
     }
-    CHECK(cases == 12);
+    CHECK(cases == 18);
 }
 
 TEST_CASE("ffd: a one-off without the bind cache gives bind + evaluate's bytes", "[warp][ffd][simd]") {
     std::mt19937 rng(61);
-    for (const glm::ivec3 divisions : {glm::ivec3(3), glm::ivec3(3, 2, 4)}) {  // the fused path, the fallback
+    for (const auto& [divisions, basis] :  // the fused paths (Bernstein, B-spline), the fallback
+         {std::pair{glm::ivec3(3), FfdBasis::Bernstein}, std::pair{glm::ivec3(3), FfdBasis::BSpline},
+          std::pair{glm::ivec3(3, 2, 4), FfdBasis::Bernstein}}) {
         for (FfdOutside outside : {FfdOutside::None, FfdOutside::Extrapolate}) {
             const Lattice l = skewLattice(divisions);
             const auto target = randomTargets(l, rng, 0.5f);
             const auto rest = samplePoints(l, rng, 5003, -0.2f, 1.2f);
             const std::vector<float> weights = randomWeights(rest.size(), rng);
             const std::vector<glm::vec3> upstream = shifted(rest);
-            Ffd bound(l, {FfdBasis::Bernstein, outside});
+            Ffd bound(l, {basis, outside});
             bound.setTargets(target);
             bound.bind(rest);
             std::vector<glm::vec3> want = upstream, got = upstream;
             bound.evaluate(want, weights, 0.7f);
-            Ffd once(l, {FfdBasis::Bernstein, outside});
+            Ffd once(l, {basis, outside});
             once.setTargets(target);
             once.bindAndEvaluate(rest, got, weights, 0.7f);
             CHECK(std::memcmp(got.data(), want.data(), got.size() * sizeof(glm::vec3)) == 0);
