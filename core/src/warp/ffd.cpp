@@ -305,7 +305,7 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
                                std::span<glm::vec3> out, const float* translations,
                                std::span<const float> weights, float envelope) const {
     const bool bernstein = options_.basis.all(FfdBasis::Bernstein);
-    const bool bspline = options_.basis.all(FfdBasis::BSpline) && options_.ends == FfdEnds::Extrapolate;
+    const bool bspline = options_.basis.all(FfdBasis::BSpline);
     if (options_.kernel == FfdKernel::PerPoint || !(bernstein || bspline) ||
         lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size() ||
         out.size() != points.size()) {
@@ -345,7 +345,8 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
             n,
             [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
                 detail::WeightBlock w;
-                kernels.bsplineWeights444(in, w);
+                (options_.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444
+                                                  : kernels.bsplineWeights444)(in, w);
                 kernels.window444(w, translations, d);
             },
             points, out, weights, envelope, local);
@@ -538,8 +539,10 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
                                  float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
     const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
-    // Cubic B-splines with extrapolated ends (the default): their weights in eight lanes too.
-    const bool allBSpline = options_.basis.all(FfdBasis::BSpline) && options_.ends == FfdEnds::Extrapolate;
+    // Cubic B-splines (either end rule): their weights in eight lanes too.
+    const bool allBSpline = options_.basis.all(FfdBasis::BSpline);
+    const auto bsplineWeights =
+        options_.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444 : kernels.bsplineWeights444;
     const int64_t n = numBoundPoints();
     constexpr int kBlock = detail::kBlock;
     constexpr size_t kBlockFloats = sizeof(detail::WeightBlock::w) / sizeof(float);
@@ -582,7 +585,7 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
                 kernels.bernsteinWeights444(local, in);
             } else {
                 // As windowWeightsOf: 0 for inactive points and lanes past the end (a cache keeps them).
-                kernels.bsplineWeights444(local, in);
+                bsplineWeights(local, in);
                 for (int lane = 0; lane < kBlock; ++lane) {
                     if (lane < count && active_[begin + lane]) continue;
                     for (int a = 0; a < 3; ++a)

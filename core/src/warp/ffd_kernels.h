@@ -42,6 +42,7 @@ struct FfdKernels {
     void (*frames444)(const WeightBlock& in, const float* affine, AffineBlock& out);
     void (*bernsteinWeights444)(const LocalBlock& in, WeightBlock& out);
     void (*bsplineWeights444)(const LocalBlock& in, WeightBlock& out);
+    void (*bsplineRepeatWeights444)(const LocalBlock& in, WeightBlock& out);
 };
 
 extern const FfdKernels kBaselineFfdKernels;
@@ -132,6 +133,42 @@ typedef float Float8 __attribute__((vector_size(32)));
                              first ? b3 : (middle ? b2 : b1Last), first ? zero : (middle ? b3 : b2Last)};
         for (int c = 0; c < 4; ++c)
             std::memcpy(out.w[a][c], &w[c], sizeof(Float8));
+    }
+}
+
+// The same with the end controls repeated (FfdEnds::Repeat, Blender's Lattice): cell = floor(x), u = x -
+// cell, span = clamp(cell, -2, 4); tap c of the span lands on control clamp(span - 1 + c, 0, 3), the taps
+// that land on one control added in order from 0, as the per-point path does. floor by truncation: exact for
+// |x| < 2^23, and beyond it x is a whole number (u = 0, the span clamped either way).
+[[gnu::always_inline]] inline void bsplineRepeatWeights444(const LocalBlock& in, WeightBlock& out) {
+    typedef int Int8 __attribute__((vector_size(32)));
+    const float* coords[3] = {in.x, in.y, in.z};
+    const Float8 zero = {}, one = zero + 1.0f;
+    constexpr float kWhole = 8388608.0f;  // 2^23: every float at or beyond it is a whole number
+    for (int a = 0; a < 3; ++a) {
+        Float8 x;
+        std::memcpy(&x, coords[a], sizeof(x));
+        const Int8 huge = (x >= kWhole) | (x <= -kWhole);
+        const Float8 clamped = huge ? zero : x;  // truncated below, safely within int's range
+        const Float8 truncated = __builtin_convertvector(__builtin_convertvector(clamped, Int8), Float8);
+        const Float8 cell = truncated - (truncated > clamped ? one : zero);
+        const Float8 u = huge ? zero : x - cell, u2 = u * u, u3 = u2 * u, v = 1.0f - u;
+        const Float8 b[4] = {v * v * v / 6.0f, (3.0f * u3 - 6.0f * u2 + 4.0f) / 6.0f,
+                             (-3.0f * u3 + 3.0f * u2 + 3.0f * u + 1.0f) / 6.0f, u3 / 6.0f};
+        // The span: from cell, or past the lattice on x's side when x is huge.
+        Float8 span = huge ? (x > zero ? zero + 4.0f : zero - 2.0f) : cell;
+        span = span < -2.0f ? zero - 2.0f : span;
+        span = span > 4.0f ? zero + 4.0f : span;
+        Float8 w[4] = {zero, zero, zero, zero};
+        for (int c = 0; c < 4; ++c) {
+            Float8 k = span + static_cast<float>(c - 1);
+            k = k < 0.0f ? zero : k;
+            k = k > 3.0f ? zero + 3.0f : k;
+            for (int control = 0; control < 4; ++control)
+                w[control] = k == static_cast<float>(control) ? w[control] + b[c] : w[control];
+        }
+        for (int control = 0; control < 4; ++control)
+            std::memcpy(out.w[a][control], &w[control], sizeof(Float8));
     }
 }
 

@@ -9,8 +9,8 @@
 
 namespace deformkit::warp::detail {
 
-const FfdKernels kAvx2FfdKernels = {bernstein444, window444, frames444, bernsteinWeights444,
-                                    bsplineWeights444};
+const FfdKernels kAvx2FfdKernels = {bernstein444,        window444,         frames444,
+                                    bernsteinWeights444, bsplineWeights444, bsplineRepeatWeights444};
 
 }  // namespace deformkit::warp::detail
 #endif

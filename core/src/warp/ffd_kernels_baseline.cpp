@@ -2,7 +2,7 @@
 
 namespace deformkit::warp::detail {
 
-const FfdKernels kBaselineFfdKernels = {bernstein444, window444, frames444, bernsteinWeights444,
-                                        bsplineWeights444};
+const FfdKernels kBaselineFfdKernels = {bernstein444,        window444,         frames444,
+                                        bernsteinWeights444, bsplineWeights444, bsplineRepeatWeights444};
 
 }  // namespace deformkit::warp::detail

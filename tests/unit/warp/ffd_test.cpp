@@ -509,7 +509,10 @@ TEST_CASE("ffd: every basis on the 4x4x4 lattice takes the block kernels, bit fo
             if (combo == 5) basis = FfdBases{FfdBasis::BSpline, FfdBasis::Bernstein, FfdBasis::CatmullRom};
             const Lattice l = skewLattice({3, 3, 3});
             const auto target = randomTargets(l, rng, 0.5f);
-            const auto rest = samplePoints(l, rng, 4099, -0.2f, 1.2f);
+            auto rest = samplePoints(l, rng, 4099, -0.2f, 1.2f);
+            // Far outside too: thousands of lattice widths away, and beyond 2^23 lattice units.
+            for (const float far : {-3.0e3f, 2.5e3f, -1.0e8f, 4.0e8f})
+                rest.push_back(l.origin + far * l.axes[0] + 0.5f * l.axes[1] - 0.25f * far * l.axes[2]);
             const std::vector<float> weights = randomWeights(rest.size(), rng);
             std::vector<glm::vec3> reference = rest;
             Ffd perPoint(l, {basis, outside, FfdKernel::PerPoint, ends});

@@ -157,8 +157,7 @@ class FfdDeformer final : public LatticeDeformer {
     }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
         if (atInput()) ffd_->bind(in);
-        std::copy(in.begin(), in.end(), out.begin());  // the fast path deforms in place
-        ffd_->evaluate(out);
+        ffd_->evaluate(in, out, {}, 1.0f);
     }
 
   private:
@@ -213,8 +212,7 @@ class FfdFramesDeformer final : public LatticeDeformer {
     }
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out) override {
         if (atInput()) ffd_->bind(in);
-        std::copy(in.begin(), in.end(), out.begin());  // the fast path deforms in place
-        ffd_->evaluate(out);
+        ffd_->evaluate(in, out, {}, 1.0f);
     }
 
   private:
