@@ -30,11 +30,10 @@ void requireFinitePoints(std::span<const glm::vec3> points, const std::string& s
     }
 }
 
-// 1 when the point's coordinates are finite, 0 otherwise, without a branch (a loop's flag, kept with &).
+// 1 when the point's coordinates are finite, 0 otherwise, without a branch (a loop's flag, kept with &):
+// x * 0 is 0 for a finite x and NaN for an infinite or NaN one.
 inline int finiteBits(const glm::vec3& p) {
-    constexpr float kLargest = std::numeric_limits<float>::max();
-    return static_cast<int>(std::abs(p.x) <= kLargest) & static_cast<int>(std::abs(p.y) <= kLargest) &
-           static_cast<int>(std::abs(p.z) <= kLargest);
+    return static_cast<int>(p.x * 0.0f + p.y * 0.0f + p.z * 0.0f == 0.0f);
 }
 
 // The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
