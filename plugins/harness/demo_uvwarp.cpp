@@ -188,7 +188,8 @@ std::vector<fs::path> writeDemoUvWarpShot(const geom::Mesh& tube, int32_t cells,
     written.push_back(dir / "uvwarp.jsonl");
     io::writeFileAtomically(written.back(), log.str());
     uvwarp::ShotLog lines;
-    uvwarp::readShotLogFile(written.back(), lines);
+    std::istringstream text(log.str());
+    uvwarp::readShotLog(text, written.back().string(), lines);
     uvwarp::HtmlReportOptions page;
     page.title = "DeformKit demo: the tube bending, UV warp of tile 1001";
     const uvwarp::HtmlReportResult result =

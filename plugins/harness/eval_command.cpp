@@ -164,7 +164,8 @@ void writeShotPage(const EvalCommand& command, EvalReport& report, const std::st
     io::writeFileAtomically(logFile, logText);
     report.files.push_back(logFile);
     uvwarp::ShotLog log;
-    uvwarp::readShotLogFile(logFile, log);
+    std::istringstream lines(logText);
+    uvwarp::readShotLog(lines, logFile.string(), log);
     uvwarp::HtmlReportOptions options;
     options.title = "Shot " + command.scene.stem().string();
     // The heatmaps' geometry from the scene itself: the shot may be written as point caches alone.

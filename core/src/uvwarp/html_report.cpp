@@ -8,6 +8,7 @@
 #include <functional>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -178,21 +179,26 @@ std::string plot(const Series& series, const std::vector<double>& v, std::string
     return o.str();
 }
 
-// "redirect.1001.0019.exr" at tile 1001, frame 19 -> "redirect.<UDIM>.####.exr".
-std::string pattern(const std::string& name, int tile, int frame) {
+// "redirect.1001.0019.exr" at tile 1001, frame 19 -> "redirect.<UDIM>.####.exr"; without a frame, the tile
+// alone ("rig.1001.exr" -> "rig.<UDIM>.exr").
+std::string pattern(const std::string& name, int tile, std::optional<int> frame = std::nullopt) {
     const fs::path path(name);
     std::string file = path.filename().string();
     if (const size_t at = file.rfind(std::to_string(tile)); tile > 0 && at != std::string::npos) {
         file.replace(at, 4, "<UDIM>");
     }
     // The frame's digits nearest the end, zero padded or not.
-    for (size_t end = file.size(); end > 0; --end) {
+    for (size_t end = file.size(); frame && end > 0; --end) {
         if (!std::isdigit(static_cast<unsigned char>(file[end - 1]))) continue;
         size_t begin = end;
         while (begin > 0 && std::isdigit(static_cast<unsigned char>(file[begin - 1])))
             --begin;
-        if (std::stoll(file.substr(begin, end - begin)) == frame) {
-            const bool minus = begin > 0 && file[begin - 1] == '-' && frame < 0;
+        const std::string digits = file.substr(begin, end - begin);
+        const size_t nonZero = digits.find_first_not_of('0');
+        const bool minus = begin > 0 && file[begin - 1] == '-' && *frame < 0;
+        if ((nonZero == std::string::npos ? "0" : digits.substr(nonZero)) ==
+                std::to_string(std::abs(*frame)) &&
+            (*frame >= 0 || minus)) {
             file.replace(minus ? begin - 1 : begin, end - begin + (minus ? 1 : 0),
                          std::string(end - begin, '#'));
         }
@@ -239,14 +245,14 @@ std::string rerunFromHeader(const ShotTileSeries& s, const json& header) {
                        shellWord(cache != std::string::npos ? deformed.substr(0, cache)
                                                             : pattern(deformed, 0, worst.frame)) +
                        " --frames " + frames + " --rigidity " +
-                       shellWord(pattern(inputs.value("rigidity", ""), s.tile, -1000000)) + " --out " +
+                       shellWord(pattern(inputs.value("rigidity", ""), s.tile)) + " --out " +
                        shellWord(pattern(worst.line->redirect, s.tile, worst.frame));
     if (inputs.contains("mask") && inputs["mask"] != "derived") {
-        line += " --mask " + shellWord(pattern(inputs.value("mask", ""), s.tile, -1000000));
+        line += " --mask " + shellWord(pattern(inputs.value("mask", ""), s.tile));
     }
     if (inputs.contains("texture") && !worst.line->bake.empty()) {
-        line += " --texture " + shellWord(pattern(inputs.value("texture", ""), s.tile, -1000000)) +
-                " --bake " + shellWord(pattern(worst.line->bake, s.tile, worst.frame));
+        line += " --texture " + shellWord(pattern(inputs.value("texture", ""), s.tile)) + " --bake " +
+                shellWord(pattern(worst.line->bake, s.tile, worst.frame));
     }
     if (solver.contains("cells")) line += " --resolution " + std::to_string(solver["cells"].get<int64_t>());
     const TileWarpOptions defaults = shotOptions();
@@ -497,8 +503,8 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
             result.notes.push_back((t.object.empty() ? "" : t.object + " ") + "tile " +
                                    std::to_string(t.tile) + ": " + note);
         }
-        if (!pictures.header.empty()) {
-            const json header = json::parse(pictures.header);
+        if (!pictures.header.is_null()) {
+            const json& header = pictures.header;
             html << "<details><summary>Inputs and options (the header of " << escape(worst.line->redirect)
                  << ")</summary><table>";
             for (const auto& [key, value] : header.items()) {

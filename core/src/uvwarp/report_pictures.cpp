@@ -170,7 +170,7 @@ TilePictures tilePictures(const ShotTileSeries& series, const HtmlReportOptions&
             const json parsed = json::parse(value, nullptr, false);
             header[key] = parsed.is_discarded() || !parsed.is_object() ? json(value) : parsed;
         }
-        out.header = header.dump();
+        out.header = header;
         const json inputs = header.value("deformkit:uvwarp:inputs", json::object());
         const io::Image redirect = io::readImage(*mapFile);
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "deformkit/uvwarp/html_report.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
 
@@ -22,8 +24,8 @@ inline constexpr int32_t kReportPictureSide = 2048;
 struct TilePictures {
     std::vector<ReportPicture> pictures;         // remaining stretch, identity stretch, plain, warped
     std::optional<DeliveredMetrics> remeasured;  // the worst frame measured again from its files
-    std::string header;                          // the map's provenance: inputs, solver, version (JSON)
-    std::vector<std::string> notes;              // what could not be made, and why
+    nlohmann::json header;           // the map's provenance (inputs, solver, version); null when not read
+    std::vector<std::string> notes;  // what could not be made, and why
 };
 
 // Where a name from a log or a header is: as it is, then in each of `folders`; nullopt when nowhere.

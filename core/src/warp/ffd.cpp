@@ -145,6 +145,15 @@ const detail::FfdKernels& ffdKernels(FfdKernel choice) {
     return detail::kBaselineFfdKernels;
 }
 
+// The kernel giving the 4x4x4 window weights of eight points at once for these options: the Bernstein cubic
+// or a cubic B-spline (either end rule) on every axis; nullptr for the other bases (their per-point path).
+decltype(detail::FfdKernels::bernsteinWeights444) laneWeights444(const detail::FfdKernels& kernels,
+                                                                 const FfdOptions& options) {
+    if (options.basis.all(FfdBasis::Bernstein)) return kernels.bernsteinWeights444;
+    if (!options.basis.all(FfdBasis::BSpline)) return nullptr;
+    return options.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444 : kernels.bsplineWeights444;
+}
+
 // The 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates and
 // whether the warp reaches it, kernel(local block, displacements) their displacements D; out[u] = points[u] +
 // envelope * weight * D(u) for those it reaches, points[u] for the others (out may be points). Each block
@@ -341,12 +350,12 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
             points, out, weights, envelope, local);
     } else {
         // The spline weights as deformWindow444 computes them (inactive lanes' sums are not used).
+        const auto splineWeights = laneWeights444(kernels, options_);
         blocks444(
             n,
             [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
                 detail::WeightBlock w;
-                (options_.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444
-                                                  : kernels.bsplineWeights444)(in, w);
+                splineWeights(in, w);
                 kernels.window444(w, translations, d);
             },
             points, out, weights, envelope, local);
@@ -538,11 +547,8 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
                                  const float* data, int32_t stride, std::span<const float> weights,
                                  float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
-    const bool allBernstein = options_.basis.all(FfdBasis::Bernstein);
-    // Cubic B-splines (either end rule): their weights in eight lanes too.
-    const bool allBSpline = options_.basis.all(FfdBasis::BSpline);
-    const auto bsplineWeights =
-        options_.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444 : kernels.bsplineWeights444;
+    // Weights in eight lanes (Bernstein, cubic B-splines), or point by point for the other bases.
+    const auto laneWeights = laneWeights444(kernels, options_);
     const int64_t n = numBoundPoints();
     constexpr int kBlock = detail::kBlock;
     constexpr size_t kBlockFloats = sizeof(detail::WeightBlock::w) / sizeof(float);
@@ -572,63 +578,46 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
         detail::WeightBlock in;
         if (cached != nullptr) {
             std::memcpy(in.w, cached + static_cast<size_t>(b) * kBlockFloats, sizeof(in.w));
-        } else if (allBernstein || allBSpline) {
-            detail::LocalBlock local{};
-            for (int lane = 0; lane < count; ++lane) {
-                const glm::vec3& l = local_[begin + lane];
-                local.x[lane] = l.x;
-                local.y[lane] = l.y;
-                local.z[lane] = l.z;
-            }
-            if (allBernstein) {
-                // Inactive lanes keep their weights: their sums are computed and not used.
-                kernels.bernsteinWeights444(local, in);
-            } else {
-                // As windowWeightsOf: 0 for inactive points and lanes past the end (a cache keeps them).
-                bsplineWeights(local, in);
-                for (int lane = 0; lane < kBlock; ++lane) {
-                    if (lane < count && active_[begin + lane]) continue;
-                    for (int a = 0; a < 3; ++a)
-                        for (int c = 0; c < 4; ++c)
-                            in.w[a][c][lane] = 0.0f;
-                }
-                if (keep != nullptr)
-                    std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
-            }
         } else {
-            windowWeightsOf(begin, count, &in.w[0][0][0]);
+            if (laneWeights != nullptr) {
+                // Inactive lanes get weights too: their sums are computed and not used.
+                detail::LocalBlock local{};
+                for (int lane = 0; lane < count; ++lane) {
+                    const glm::vec3& l = local_[begin + lane];
+                    local.x[lane] = l.x;
+                    local.y[lane] = l.y;
+                    local.z[lane] = l.z;
+                }
+                laneWeights(local, in);
+            } else {
+                windowWeightsOf(begin, count, &in.w[0][0][0]);
+            }
             if (keep != nullptr)
                 std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
         }
+        // Translations (stride 3) or affine maps (stride 12): each active point's displacement.
+        detail::DisplacementBlock d;
+        detail::AffineBlock m;
         if (stride == 3) {
-            detail::DisplacementBlock d;
             kernels.window444(in, data, d);
-            for (int lane = 0; lane < count; ++lane) {
-                const int64_t u = begin + lane;
-                if (!active_[u]) {
-                    out[u] = points[u];
-                    continue;
-                }
-                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-                out[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
-            }
         } else {
-            detail::AffineBlock m;
             kernels.frames444(in, data, m);
-            for (int lane = 0; lane < count; ++lane) {
-                const int64_t u = begin + lane;
-                if (!active_[u]) {
-                    out[u] = points[u];
-                    continue;
-                }
-                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-                const glm::vec3 p = points[u];
-                const glm::vec3 d = glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
-                                    glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
-                                    glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
-                                    glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
-                out[u] = p + k * d;
+        }
+        for (int lane = 0; lane < count; ++lane) {
+            const int64_t u = begin + lane;
+            const glm::vec3 p = points[u];
+            if (!active_[u]) {
+                out[u] = p;
+                continue;
             }
+            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+            const glm::vec3 shift = stride == 3
+                                        ? glm::vec3(d.x[lane], d.y[lane], d.z[lane])
+                                        : glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
+                                              glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
+                                              glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
+                                              glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
+            out[u] = p + k * shift;
         }
     }
 }

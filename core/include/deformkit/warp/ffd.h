@@ -171,7 +171,7 @@ class FfdLattice {
     std::vector<glm::vec3> local_;    // per bound point: (s l, t m, u n), lattice units
     std::vector<uint8_t> active_;     // per bound point: 1 if the warp reaches it
     // For deformWindow444 in a spline basis: each point's weights of the 4 controls per axis in blocks of 8
-    // points ([block][axis][control][lane], 0 for inactive points and past the end). The first evaluation
+    // points ([block][axis][control][lane]; inactive points' weights are never used). The first evaluation
     // after a bind computes them on the fly (a one-off pays no 48 bytes a point); the second keeps them, so
     // an animation only sums. Copies of the lattice start without them.
     struct WeightCache {
