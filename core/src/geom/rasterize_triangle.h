@@ -65,6 +65,32 @@ inline int64_t lastCentreAtOrBelow(int64_t v) {
 
 }  // namespace rasterizer_detail
 
+// The barycentrics rasterizeTriangle hands its visitor, as a function of the pixel: from the unsnapped
+// corners (raster coordinates), so they reproduce the pixel centre exactly. A caller that keeps only which
+// triangle covers a pixel gets the visitor's barycentrics back, bit for bit, from at().
+class BarycentricFrame {
+  public:
+    BarycentricFrame(const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2)
+        : q0x_(p0.x), q0y_(p0.y), q1x_(p1.x), q1y_(p1.y), q2x_(p2.x), q2y_(p2.y) {
+        const double exactArea = (q1x_ - q0x_) * (q2y_ - q0y_) - (q1y_ - q0y_) * (q2x_ - q0x_);
+        inverseArea_ = exactArea == 0.0 ? 0.0 : 1.0 / exactArea;
+    }
+    // False for a triangle of zero area, which covers no pixel.
+    [[nodiscard]] bool valid() const { return inverseArea_ != 0.0; }
+    // (b0, b1, b2) at the centre of pixel (x, y).
+    [[nodiscard]] glm::vec3 at(int64_t x, int64_t y) const {
+        const double cx = static_cast<double>(x) + 0.5, cy = static_cast<double>(y) + 0.5;
+        const double b1 = ((cx - q0x_) * (q2y_ - q0y_) - (cy - q0y_) * (q2x_ - q0x_)) * inverseArea_;
+        const double b2 = ((q1x_ - q0x_) * (cy - q0y_) - (q1y_ - q0y_) * (cx - q0x_)) * inverseArea_;
+        const double b0 = ((q1x_ - cx) * (q2y_ - cy) - (q1y_ - cy) * (q2x_ - cx)) * inverseArea_;
+        return {static_cast<float>(b0), static_cast<float>(b1), static_cast<float>(b2)};
+    }
+
+  private:
+    double q0x_, q0y_, q1x_, q1y_, q2x_, q2y_;
+    double inverseArea_ = 0.0;
+};
+
 // Calls visit(x, y, barycentric) for every pixel whose centre lies inside triangle (p0, p1, p2), given in
 // raster coordinates, either winding; barycentric (b0, b1, b2) sums to 1 and reproduces the centre.
 // Pixel centres on an edge follow the top-left rule, so a pixel is visited exactly once by a set of
@@ -101,10 +127,8 @@ void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::v
 
     // Barycentrics come from the unsnapped vertices so they reproduce the pixel centre exactly; only
     // coverage uses the snapped ones.
-    const double q0x = p0.x, q0y = p0.y, q1x = p1.x, q1y = p1.y, q2x = p2.x, q2y = p2.y;
-    const double exactArea = (q1x - q0x) * (q2y - q0y) - (q1y - q0y) * (q2x - q0x);
-    if (exactArea == 0.0) return;
-    const double inverseArea = 1.0 / exactArea;
+    const BarycentricFrame barycentrics(p0, p1, p2);
+    if (!barycentrics.valid()) return;
 
     const int64_t x0 = std::max<int64_t>(0, rd::firstCentreAtOrAbove(std::min({v0.x, v1.x, v2.x})));
     const int64_t x1 =
@@ -129,16 +153,9 @@ void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::v
 
     for (int64_t y = y0; y <= y1; ++y) {
         int64_t w0 = rowValue[0], w1 = rowValue[1], w2 = rowValue[2];
-        const double cy = static_cast<double>(y) + 0.5;
         for (int64_t x = x0; x <= x1; ++x) {
-            if ((w0 | w1 | w2) >= 0) {
-                const double cx = static_cast<double>(x) + 0.5;
-                const double b1 = ((cx - q0x) * (q2y - q0y) - (cy - q0y) * (q2x - q0x)) * inverseArea;
-                const double b2 = ((q1x - q0x) * (cy - q0y) - (q1y - q0y) * (cx - q0x)) * inverseArea;
-                const double b0 = ((q1x - cx) * (q2y - cy) - (q1y - cy) * (q2x - cx)) * inverseArea;
-                visit(static_cast<int32_t>(x), static_cast<int32_t>(y),
-                      glm::vec3(static_cast<float>(b0), static_cast<float>(b1), static_cast<float>(b2)));
-            }
+            if ((w0 | w1 | w2) >= 0)
+                visit(static_cast<int32_t>(x), static_cast<int32_t>(y), barycentrics.at(x, y));
             w0 += stepX[0];
             w1 += stepX[1];
             w2 += stepX[2];

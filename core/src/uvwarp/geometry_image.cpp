@@ -135,21 +135,21 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     const int32_t side = cells + 1;
     const size_t count = static_cast<size_t>(side) * side;
     const auto n = static_cast<float>(cells);
-    deformkit::detail::assignLarge(pointTriangle_, count, -1);
-    deformkit::detail::assignLarge(pointB_, count, 0.0f);
-    deformkit::detail::assignLarge(pointC_, count, 0.0f);
+    // Per point during the bind: its covering triangle, -1 if none.
+    std::vector<int32_t> pointTriangle;
+    deformkit::detail::assignLarge(pointTriangle, count, -1);
 
     // Point (i, j) is the centre of raster pixel (i, j): raster coordinates uv * n + 0.5.
     const geom::RasterGrid grid{side, side};
+    rasterCorners_.resize(static_cast<size_t>(numTriangles) * 3);
     for (int32_t t = 0; t < numTriangles; ++t) {
         const auto& c = uvs.uvs[t];
-        rasterizeTriangle(grid, c[0] * n + 0.5f, c[1] * n + 0.5f, c[2] * n + 0.5f,
-                          [&](int32_t x, int32_t y, const glm::vec3& b) {
-                              const size_t k = static_cast<size_t>(y) * side + x;
-                              pointTriangle_[k] = t;
-                              pointB_[k] = b[1];
-                              pointC_[k] = b[2];
-                          });
+        glm::vec2* corners = &rasterCorners_[static_cast<size_t>(t) * 3];
+        for (int k = 0; k < 3; ++k)
+            corners[k] = c[k] * n + 0.5f;
+        rasterizeTriangle(grid, corners[0], corners[1], corners[2], [&](int32_t x, int32_t y, const glm::vec3&) {
+            pointTriangle[static_cast<size_t>(y) * side + x] = t;
+        });
     }
 
     // Points on a chart's outline that the top-left rule left out: walk each border edge row by row.
@@ -175,7 +175,7 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                 std::min(static_cast<double>(cells), std::floor(xHi + kBorderTolerance)));
             for (int32_t i = iLo; i <= iHi; ++i) {
                 const size_t k = static_cast<size_t>(j) * side + i;
-                if (pointTriangle_[k] >= 0) continue;
+                if (pointTriangle[k] >= 0) continue;
                 if (distanceToSegment(i, j, ax, ay, bx, by) > kBorderTolerance) continue;
                 // Barycentrics of the point in the border's triangle, clamped onto the triangle.
                 const auto& c = uvs.uvs[t];
@@ -194,27 +194,36 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                 b1 = std::max(b1, 0.0);
                 b2 = std::max(b2, 0.0);
                 const double sum = b0 + b1 + b2;
-                pointTriangle_[k] = t;
-                pointB_[k] = static_cast<float>(b1 / sum);
-                pointC_[k] = static_cast<float>(b2 / sum);
+                pointTriangle[k] = t;
+                outlinePoint_.push_back(static_cast<int32_t>(k));
+                outlineTriangle_.push_back(t);
+                outlineB_.push_back(static_cast<float>(b1 / sum));
+                outlineC_.push_back(static_cast<float>(b2 / sum));
             }
         }
     }
 
-    deformkit::detail::assignLarge(coverage_, count, uint8_t{0});
     std::vector<uint8_t> ring;
     deformkit::detail::assignLarge(ring, count, kUnassigned);
     numCovered_ = 0;
     for (size_t k = 0; k < count; ++k) {
-        coverage_[k] = pointTriangle_[k] >= 0 ? 1 : 0;
-        numCovered_ += coverage_[k];
+        if (pointTriangle[k] < 0) continue;
+        ring[k] = 0;
+        ++numCovered_;
     }
+    // The dilation starts from the covered points next to an uncovered one (the others have no uncovered
+    // 8-neighbour to reach).
     std::vector<int32_t> frontier;
-    deformkit::detail::reserveLarge(frontier, static_cast<size_t>(numCovered_));
-    for (size_t k = 0; k < count; ++k) {
-        if (coverage_[k]) {
-            ring[k] = 0;
-            frontier.push_back(static_cast<int32_t>(k));
+    for (int32_t j = 0; j < side; ++j) {
+        for (int32_t i = 0; i < side; ++i) {
+            const size_t k = static_cast<size_t>(j) * side + i;
+            if (ring[k] != 0) continue;
+            bool edge = false;
+            for (int32_t dj = -1; dj <= 1 && !edge; ++dj)
+                for (int32_t di = -1; di <= 1 && !edge; ++di)
+                    edge = i + di >= 0 && j + dj >= 0 && i + di < side && j + dj < side &&
+                           ring[static_cast<size_t>(j + dj) * side + i + di] != 0;
+            if (edge) frontier.push_back(static_cast<int32_t>(k));
         }
     }
 
@@ -280,7 +289,7 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     }
 
     if (numCovered_ + numDilated() < static_cast<int64_t>(count)) {
-        const std::vector<int32_t> nearest = nearestCovered(pointTriangle_, side);
+        const std::vector<int32_t> nearest = nearestCovered(pointTriangle, side);
         const auto far = static_cast<size_t>(static_cast<int64_t>(count) - numCovered_ - numDilated());
         deformkit::detail::reserveLarge(farPoint_, far);
         deformkit::detail::reserveLarge(farSource_, far);
@@ -290,6 +299,21 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
             farSource_.push_back(nearest[k]);
         }
     }
+
+    // The rasteriser's triangles as runs per row (the outline points keep their own entries).
+    for (const int32_t k : outlinePoint_)
+        pointTriangle[static_cast<size_t>(k)] = -1;
+    rowRunBegin_.assign(static_cast<size_t>(side) + 1, 0);
+    for (int32_t j = 0; j < side; ++j) {
+        rowRunBegin_[j] = static_cast<int64_t>(runStart_.size());
+        const int32_t* row = pointTriangle.data() + static_cast<size_t>(j) * side;
+        for (int32_t i = 0; i < side; ++i) {
+            if (i > 0 && row[i] == row[i - 1]) continue;
+            runStart_.push_back(i);
+            runTriangle_.push_back(row[i]);
+        }
+    }
+    rowRunBegin_[side] = static_cast<int64_t>(runStart_.size());
 }
 
 void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& out) const {
@@ -313,20 +337,32 @@ void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& ou
     float* values = out.values.data();
     const glm::vec3* p = positions.data();
 
+    const auto blend = [&](size_t k, int32_t t, float b, float c) {
+        const float a = 1.0f - b - c;
+        const glm::vec3 value = a * p[cornerA_[t]] + b * p[cornerB_[t]] + c * p[cornerC_[t]];
+        values[3 * k] = value.x;
+        values[3 * k + 1] = value.y;
+        values[3 * k + 2] = value.z;
+    };
 #pragma omp parallel for schedule(static)
     for (int32_t j = 0; j < side; ++j) {
         const size_t row = static_cast<size_t>(j) * side;
-        for (int32_t i = 0; i < side; ++i) {
-            const size_t k = row + i;
-            const int32_t t = pointTriangle_[k];
+        for (int64_t r = rowRunBegin_[j]; r < rowRunBegin_[j + 1]; ++r) {
+            const int32_t t = runTriangle_[r];
             if (t < 0) continue;
-            const float b = pointB_[k], c = pointC_[k], a = 1.0f - b - c;
-            const glm::vec3 value = a * p[cornerA_[t]] + b * p[cornerB_[t]] + c * p[cornerC_[t]];
-            values[3 * k] = value.x;
-            values[3 * k + 1] = value.y;
-            values[3 * k + 2] = value.z;
+            const int32_t end = r + 1 < rowRunBegin_[j + 1] ? runStart_[r + 1] : side;
+            const glm::vec2* corners = &rasterCorners_[static_cast<size_t>(t) * 3];
+            const geom::BarycentricFrame frame(corners[0], corners[1], corners[2]);
+            for (int32_t i = runStart_[r]; i < end; ++i) {
+                const glm::vec3 b = frame.at(i, j);
+                blend(row + i, t, b[1], b[2]);
+            }
         }
     }
+    const auto outline = static_cast<int64_t>(outlinePoint_.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t o = 0; o < outline; ++o)
+        blend(static_cast<size_t>(outlinePoint_[o]), outlineTriangle_[o], outlineB_[o], outlineC_[o]);
     for (size_t r = 1; r < ringBegin_.size(); ++r) {
 #pragma omp parallel for schedule(static)
         for (int64_t d = ringBegin_[r - 1]; d < ringBegin_[r]; ++d) {
@@ -352,6 +388,22 @@ void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& ou
         o[1] = s[1];
         o[2] = s[2];
     }
+}
+
+std::vector<uint8_t> GeometryImager::coverage() const {
+    const int32_t side = cells_ + 1;
+    std::vector<uint8_t> covered(static_cast<size_t>(side) * side, 0);
+    for (int32_t j = 0; j < side; ++j) {
+        for (int64_t r = rowRunBegin_[j]; r < rowRunBegin_[j + 1]; ++r) {
+            const int32_t end = r + 1 < rowRunBegin_[j + 1] ? runStart_[r + 1] : side;
+            if (runTriangle_[r] >= 0)
+                std::fill(covered.begin() + static_cast<ptrdiff_t>(j) * side + runStart_[r],
+                          covered.begin() + static_cast<ptrdiff_t>(j) * side + end, uint8_t{1});
+        }
+    }
+    for (const int32_t k : outlinePoint_)
+        covered[static_cast<size_t>(k)] = 1;
+    return covered;
 }
 
 PointField GeometryImager::sample(std::span<const glm::vec3> positions) const {

@@ -27,12 +27,12 @@ glm::dvec3 valueAt(const PointField& f, int32_t i, int32_t j) {
 }
 
 // Chebyshev distance from point (i, j) to the nearest covered point (brute force).
-int chebyshevToCovered(const GeometryImager& imager, int32_t i, int32_t j) {
+int chebyshevToCovered(const GeometryImager& imager, const std::vector<uint8_t>& coverage, int32_t i, int32_t j) {
     const int32_t side = imager.side();
     int best = std::numeric_limits<int>::max();
     for (int32_t b = 0; b < side; ++b) {
         for (int32_t a = 0; a < side; ++a) {
-            if (imager.coverage()[static_cast<size_t>(b) * side + a])
+            if (coverage[static_cast<size_t>(b) * side + a])
                 best = std::min(best, std::max(std::abs(a - i), std::abs(b - j)));
         }
     }
@@ -52,6 +52,7 @@ TEST_CASE("geometry image of an affine chart is the affine function, dilated by 
     GeometryImageOptions options;
     options.dilationRings = 4;
     const GeometryImager imager(mesh, 1002, n, options);
+    const std::vector<uint8_t> coverage = imager.coverage();
     const PointField f = imager.sample(mesh.points());
     REQUIRE(f.cells == n);
     REQUIRE(f.channels == 3);
@@ -62,10 +63,10 @@ TEST_CASE("geometry image of an affine chart is the affine function, dilated by 
         for (int32_t i = 0; i <= n; ++i) {
             const double u = static_cast<double>(i) / n, v = static_cast<double>(j) / n;
             const bool inside = u > 0.2 && u < 0.7 && v > 0.3 && v < 0.9;
-            const bool isCovered = imager.coverage()[static_cast<size_t>(j) * (n + 1) + i] != 0;
+            const bool isCovered = coverage[static_cast<size_t>(j) * (n + 1) + i] != 0;
             REQUIRE(isCovered == inside);
             const glm::dvec3 got = valueAt(f, i, j);
-            const int ring = chebyshevToCovered(imager, i, j);
+            const int ring = chebyshevToCovered(imager, coverage, i, j);
             if (isCovered) {
                 // Barycentrics and positions are float32: values of size ~5 carry ~1e-6 rounding.
                 ++covered;
@@ -81,14 +82,14 @@ TEST_CASE("geometry image of an affine chart is the affine function, dilated by 
                 double best = std::numeric_limits<double>::max();
                 for (int32_t b = 0; b <= n; ++b) {
                     for (int32_t a = 0; a <= n; ++a) {
-                        if (imager.coverage()[static_cast<size_t>(b) * (n + 1) + a])
+                        if (coverage[static_cast<size_t>(b) * (n + 1) + a])
                             best = std::min(best, std::hypot(a - i, b - j));
                     }
                 }
                 bool matchesNearest = false;
                 for (int32_t b = 0; b <= n; ++b) {
                     for (int32_t a = 0; a <= n; ++a) {
-                        if (!imager.coverage()[static_cast<size_t>(b) * (n + 1) + a]) continue;
+                        if (!coverage[static_cast<size_t>(b) * (n + 1) + a]) continue;
                         if (std::abs(std::hypot(a - i, b - j) - best) > 1e-9) continue;
                         matchesNearest =
                             matchesNearest || glm::length(got - affine(static_cast<double>(a) / n,
@@ -133,6 +134,7 @@ TEST_CASE("geometry image of a cylinder with a UV seam", "[uvwarp][geometry_imag
     const geom::Mesh mesh = test::seamCylinder(segments, rows, height, {0.125f, 0.2f}, {0.875f, 0.8f});
     const int32_t n = 64;
     const GeometryImager imager(mesh, 1001, n);
+    const std::vector<uint8_t> coverage = imager.coverage();
     const PointField f = imager.sample(mesh.points());
 
     // Reference: a brute-force search of the quads' fan triangles (0, 1, 2), (0, 2, 3) in double.
@@ -170,16 +172,16 @@ TEST_CASE("geometry image of a cylinder with a UV seam", "[uvwarp][geometry_imag
             const double u = double(i) / n, v = double(j) / n;
             glm::dvec3 expected;
             const bool inside = reference(u, v, expected);
-            const bool covered = imager.coverage()[static_cast<size_t>(j) * (n + 1) + i] != 0;
+            const bool covered = coverage[static_cast<size_t>(j) * (n + 1) + i] != 0;
             REQUIRE(covered == inside);
             if (!covered) continue;
             ++checked;
             // float32 barycentrics and unit-size positions.
             CHECK(glm::length(valueAt(f, i, j) - expected) < 1e-5);
-            if (i < n && imager.coverage()[static_cast<size_t>(j) * (n + 1) + i + 1])
+            if (i < n && coverage[static_cast<size_t>(j) * (n + 1) + i + 1])
                 maxCoveredStep =
                     std::max(maxCoveredStep, glm::length(valueAt(f, i + 1, j) - valueAt(f, i, j)));
-            if (j < n && imager.coverage()[static_cast<size_t>(j + 1) * (n + 1) + i])
+            if (j < n && coverage[static_cast<size_t>(j + 1) * (n + 1) + i])
                 maxCoveredStep =
                     std::max(maxCoveredStep, glm::length(valueAt(f, i, j + 1) - valueAt(f, i, j)));
         }
@@ -197,17 +199,17 @@ TEST_CASE("geometry image of a cylinder with a UV seam", "[uvwarp][geometry_imag
     // covered value (a linear continuation moves one step per ring, diagonally at most sqrt(2) steps).
     for (int32_t j = 0; j <= n; ++j) {
         for (int32_t i = 0; i <= n; ++i) {
-            if (imager.coverage()[static_cast<size_t>(j) * (n + 1) + i]) continue;
+            if (coverage[static_cast<size_t>(j) * (n + 1) + i]) continue;
             const glm::dvec3 got = valueAt(f, i, j);
             REQUIRE(std::isfinite(got.x));
             REQUIRE(std::isfinite(got.y));
             REQUIRE(std::isfinite(got.z));
-            const int ring = chebyshevToCovered(imager, i, j);
+            const int ring = chebyshevToCovered(imager, coverage, i, j);
             if (ring > 4) continue;
             double nearest = std::numeric_limits<double>::max();
             for (int32_t b = std::max(0, j - ring); b <= std::min(n, j + ring); ++b) {
                 for (int32_t a = std::max(0, i - ring); a <= std::min(n, i + ring); ++a) {
-                    if (imager.coverage()[static_cast<size_t>(b) * (n + 1) + a])
+                    if (coverage[static_cast<size_t>(b) * (n + 1) + a])
                         nearest = std::min(nearest, glm::length(got - valueAt(f, a, b)));
                 }
             }
@@ -335,11 +337,12 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         CHECK(report.worstFace == 0);
         CHECK(report.worst == Approx(0.08f));
         const GeometryImager imager(overhanging, 1001, 8, options);
+        const std::vector<uint8_t> coverage = imager.coverage();
         // The tile's left column (u = 0) is covered from v = 0.2 to 0.6 (points j = 2..4 of 8 cells) by the
         // overhanging face, and the geometry image there is the face's own position (u, v, 0).
         const PointField field = imager.sample(overhanging.points());
         for (int32_t j = 2; j <= 4; ++j) {
-            CHECK(imager.coverage()[static_cast<size_t>(j) * 9] == 1);
+            CHECK(coverage[static_cast<size_t>(j) * 9] == 1);
             const float* p = &field.values[3 * (static_cast<size_t>(j) * 9)];
             CHECK(p[0] == Approx(0.0f).margin(1e-6));
             CHECK(p[1] == Approx(j / 8.0f).margin(1e-6));
@@ -364,8 +367,7 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         CHECK(mixed.udimTiles() == std::vector<int>{1001});
         const GeometryImager alone(chart, 1001, 8, options);
         const GeometryImager withExtra(mixed, 1001, 8, options);
-        CHECK(std::vector<uint8_t>(withExtra.coverage().begin(), withExtra.coverage().end()) ==
-              std::vector<uint8_t>(alone.coverage().begin(), alone.coverage().end()));
+        CHECK(withExtra.coverage() == alone.coverage());
         std::vector<glm::vec3> moved(mixed.points().begin(), mixed.points().end());
         moved.back() = {7.0f, -3.0f, 2.0f};  // the face without UVs moves: nothing in the tile changes
         CHECK(withExtra.sample(moved).values == alone.sample(chart.points()).values);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
@@ -51,7 +52,8 @@ class GeometryImager {
     [[nodiscard]] int32_t side() const { return cells_ + 1; }
     [[nodiscard]] int32_t numVertices() const { return numVertices_; }
     // (n + 1)^2 flags, point (i, j) at j * (n + 1) + i: 1 where a UV triangle of the tile covers the point.
-    [[nodiscard]] std::span<const uint8_t> coverage() const { return coverage_; }
+    // Made on each call from the imager's runs (it keeps no per-point data).
+    [[nodiscard]] std::vector<uint8_t> coverage() const;
     // How many points are covered, reached by the dilation rings, and filled by the nearest covered point.
     [[nodiscard]] int64_t numCovered() const { return numCovered_; }
     [[nodiscard]] int64_t numDilated() const { return static_cast<int64_t>(dilatedPoint_.size()); }
@@ -72,10 +74,18 @@ class GeometryImager {
     std::string label_;
     // Tile triangles, structure of arrays: vertex indices into the positions.
     std::vector<int32_t> cornerA_, cornerB_, cornerC_;
-    // Per point: covering triangle (-1 if none) and barycentrics of corners B and C.
-    std::vector<int32_t> pointTriangle_;
-    std::vector<float> pointB_, pointC_;
-    std::vector<uint8_t> coverage_;
+    // Raster coordinates of each triangle's UV corners (uv * n + 0.5), 3 per triangle: a covered point's
+    // barycentrics are computed again from them each frame, as the rasteriser computed them.
+    std::vector<glm::vec2> rasterCorners_;
+    // The rasterised triangles, run-length coded per row of points (a few bytes a row, not 12 a point): row j
+    // holds runs r in [rowRunBegin_[j], rowRunBegin_[j + 1]), run r covering points [runStart_[r], the next
+    // run's start or the row's end) with triangle runTriangle_[r] (-1: not covered by the rasteriser).
+    std::vector<int64_t> rowRunBegin_;
+    std::vector<int32_t> runStart_, runTriangle_;
+    // Points on a chart's outline covered by the border walk (not the rasteriser), with their triangle and
+    // the barycentrics of corners B and C.
+    std::vector<int32_t> outlinePoint_, outlineTriangle_;
+    std::vector<float> outlineB_, outlineC_;
     int64_t numCovered_ = 0;
     // Dilation rings: ring r holds dilatedPoint_[ringBegin_[r - 1], ringBegin_[r]); dilated point d is
     // sum_k weight_[k] * value(source_[k]) over k in [entryBegin_[d], entryBegin_[d + 1]).
