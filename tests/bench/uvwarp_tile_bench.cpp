@@ -7,9 +7,9 @@
 // bind_ratio = bind / solve (target <= 0.25); peak_bytes_per_cell = the process's peak resident memory over
 // the run (VmHWM, reset before the inputs are made) less its resident memory before them, per cell of the
 // T x T grid (target <= 40, so that a 16384^2 tile fits a 24 GB machine), the inputs (rigidity map) and the
-// delivered map included; reduction_pct, inverted, off_chart: the delivered map's figures (redirect_metrics.h:
-// rigid stretch removed, inverted texel triangles, off-chart texels). The quality target: at 8192^2 within
-// 2 points of 2048^2.
+// delivered map included; reduction_pct, inverted, off_chart: the delivered map's figures
+// (redirect_metrics.h: rigid stretch removed, inverted texel triangles, off-chart texels). The quality
+// target: at 8192^2 within 2 points of 2048^2.
 //
 // Sizes above 2048 take minutes and gigabytes: scripts/uvwarp_tile_scale.sh runs each size in a process of
 // its own (--benchmark_filter=BM_UvWarpTileScale/8192), from 1024^2 to 16384^2, and prints the table.

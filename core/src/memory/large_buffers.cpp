@@ -5,6 +5,9 @@
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 namespace deformkit::detail {
 
@@ -20,6 +23,12 @@ void adviseHugePages(void* data, size_t bytes) {
 #else
     (void)data;
     (void)bytes;
+#endif
+}
+
+void releaseFreedMemory() {
+#ifdef __GLIBC__
+    (void)malloc_trim(0);
 #endif
 }
 

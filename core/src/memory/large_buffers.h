@@ -21,6 +21,12 @@ constexpr size_t kLargeBuffer = size_t{4} << 20;
 // Harmless where they are unavailable.
 void adviseHugePages(void* data, size_t bytes);
 
+// Gives the pages of freed heap memory back to the system. A UV-warp tile's bind frees several buffers of
+// its size (rasters, maps at grid points); glibc serves buffers this large from its heap once a freed mapping
+// has raised its mmap threshold, and keeps their pages when they are freed, so the process would go on
+// holding about 13 bytes a texel it no longer uses. glibc: malloc_trim(0); elsewhere nothing.
+void releaseFreedMemory();
+
 // A capacity of at least n elements whose allocation, with the allocator's own header, fills whole huge
 // pages: Linux places an anonymous mapping of a whole number of huge pages on a huge-page boundary, so all of
 // the buffer can be backed by huge pages, not only the aligned pages inside it. Only where that adds at most

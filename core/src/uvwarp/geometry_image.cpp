@@ -147,9 +147,10 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
         glm::vec2* corners = &rasterCorners_[static_cast<size_t>(t) * 3];
         for (int k = 0; k < 3; ++k)
             corners[k] = c[k] * n + 0.5f;
-        rasterizeTriangle(grid, corners[0], corners[1], corners[2], [&](int32_t x, int32_t y, const glm::vec3&) {
-            pointTriangle[static_cast<size_t>(y) * side + x] = t;
-        });
+        rasterizeTriangle(grid, corners[0], corners[1], corners[2],
+                          [&](int32_t x, int32_t y, const glm::vec3&) {
+                              pointTriangle[static_cast<size_t>(y) * side + x] = t;
+                          });
     }
 
     // Points on a chart's outline that the top-left rule left out: walk each border edge row by row.

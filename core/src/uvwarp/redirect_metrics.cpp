@@ -108,9 +108,13 @@ struct RedirectMetrics::Impl {
     std::vector<int32_t> chart;  // per UV triangle
     // Per UV triangle: corner a and the rows of the inverse of (b - a, c - a), for mayShow's quick test.
     std::vector<std::array<glm::dvec2, 3>> inverse;
-    std::vector<int32_t> texelTriangle;  // per texel: the UV triangle its centre lies in, -1 none
-    std::vector<glm::vec3> restPoints;   // f_O's vertices
-    int32_t buckets = 1;                 // point-location buckets per side
+    // Per texel, the UV triangle its centre lies in (-1 none), run-length coded per row: row y holds runs r
+    // in [rowRunBegin[y], rowRunBegin[y + 1]), run r from column runStart[r] to the next run's start (or the
+    // row's end) with triangle runTriangle[r]. A few bytes a row, not 4 a texel.
+    std::vector<int64_t> rowRunBegin;
+    std::vector<int32_t> runStart, runTriangle;
+    std::vector<glm::vec3> restPoints;  // f_O's vertices
+    int32_t buckets = 1;                // point-location buckets per side
     std::vector<int32_t> bucketStart, bucketTriangles;
     io::Image rigidity;      // T x T x 1
     double minLength = 0.0;  // rest lengths at or below are not measurable
@@ -171,10 +175,16 @@ struct RedirectMetrics::Impl {
         return value >= 0.5f;
     }
 
+    // The UV triangle texel (x, y)'s centre lies in, -1 none.
+    [[nodiscard]] int32_t texelTriangle(int32_t x, int32_t y) const {
+        const auto first = runStart.begin() + rowRunBegin[y], last = runStart.begin() + rowRunBegin[y + 1];
+        return runTriangle[static_cast<size_t>(std::upper_bound(first, last, x) - runStart.begin() - 1)];
+    }
+
     [[nodiscard]] TexelSample sample(std::span<const glm::vec3> deformed, const io::Image& redirect,
                                      int32_t x, int32_t y) const {
         TexelSample s;
-        const int32_t t = texelTriangle[static_cast<size_t>(y) * texels + x];
+        const int32_t t = texelTriangle(x, y);
         if (t < 0) return s;
         s.chart = chart[t];
         const glm::dvec2 q((x + 0.5) / texels, 1.0 - (y + 0.5) / texels);
@@ -264,7 +274,7 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
     }
     geom::AttributeRaster raster;
     geom::rasterizeAttributes({t, t}, corners, indices, {}, 0, raster);
-    m.texelTriangle = std::move(raster.triangle);
+    std::vector<int32_t> texelTriangle = std::move(raster.triangle);
 
     // Point-location buckets over the tile, each listing the triangles whose UV box overlaps it, ascending.
     m.buckets = std::max(1, t / kBucketTexels);
@@ -296,7 +306,7 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
 #pragma omp parallel for schedule(static)
     for (int32_t y = 0; y < t; ++y) {
         for (int32_t x = 0; x < t; ++x) {
-            int32_t& tri = m.texelTriangle[static_cast<size_t>(y) * t + x];
+            int32_t& tri = texelTriangle[static_cast<size_t>(y) * t + x];
             if (tri < 0) continue;
             const glm::dvec2 q((x + 0.5) / t, 1.0 - (y + 0.5) / t);
             const glm::dvec3 l = barycentricIn(m.uvs.uvs[tri], q);
@@ -305,6 +315,17 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
             tri = m.locate(q, bary);
         }
     }
+    m.rowRunBegin.assign(static_cast<size_t>(t) + 1, 0);
+    for (int32_t y = 0; y < t; ++y) {
+        m.rowRunBegin[y] = static_cast<int64_t>(m.runStart.size());
+        const int32_t* row = texelTriangle.data() + static_cast<size_t>(y) * t;
+        for (int32_t x = 0; x < t; ++x) {
+            if (x > 0 && row[x] == row[x - 1]) continue;
+            m.runStart.push_back(x);
+            m.runTriangle.push_back(row[x]);
+        }
+    }
+    m.rowRunBegin[t] = static_cast<int64_t>(m.runStart.size());
 }
 
 RedirectMetrics::~RedirectMetrics() = default;
@@ -314,22 +335,28 @@ RedirectMetrics& RedirectMetrics::operator=(RedirectMetrics&&) noexcept = defaul
 bool RedirectMetrics::mayShow(int32_t x, int32_t y, glm::dvec2 r) const {
     const Impl& m = *impl_;
     if (x < 0 || y < 0 || x >= m.texels || y >= m.texels) return true;
-    const int32_t own = m.texelTriangle[static_cast<size_t>(y) * m.texels + x];
+    const int32_t own = m.texelTriangle(x, y);
     return own < 0 || m.onChart(own, r);
 }
 
 void RedirectMetrics::refusedInRow(const io::Image& redirect, int32_t y,
                                    std::vector<int32_t>& refused) const {
     const Impl& m = *impl_;
-    const int32_t* own = &m.texelTriangle[static_cast<size_t>(y) * m.texels];
-    for (int32_t x = 0; x < m.texels; ++x) {
-        if (own[x] < 0) continue;
-        if (!m.onChart(own[x], detail::redirectAt(redirect, x, y))) refused.push_back(x);
+    for (int64_t run = m.rowRunBegin[y]; run < m.rowRunBegin[y + 1]; ++run) {
+        const int32_t own = m.runTriangle[run];
+        if (own < 0) continue;
+        const int32_t end = run + 1 < m.rowRunBegin[y + 1] ? m.runStart[run + 1] : m.texels;
+        for (int32_t x = m.runStart[run]; x < end; ++x)
+            if (!m.onChart(own, detail::redirectAt(redirect, x, y))) refused.push_back(x);
     }
 }
 
 int32_t RedirectMetrics::texels() const {
     return impl_->texels;
+}
+
+const io::Image& RedirectMetrics::rigidity() const {
+    return impl_->rigidity;
 }
 
 void RedirectMetrics::setRigidity(const io::Image& rigidity) {

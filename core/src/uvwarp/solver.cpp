@@ -102,20 +102,40 @@ int32_t appendRuns(int32_t from, int32_t to, int32_t gap, const In& in, std::vec
     return count;
 }
 
+// Runs per row and part (a row's runs of each of `parts` kinds): append(j, p, out) appends part p of row j's
+// runs to `out` (appendRuns) and returns how many. Afterwards runs [runs[2r], runs[2r + 1]) for r in
+// [begin[j parts + p], begin[j parts + p + 1]) are part p of row j. Rows are found in parallel, each into a
+// list of its own, then laid end to end in row order: the same arrays as one pass over the rows.
+template <class Append>
+void collectRuns(int32_t rows, int32_t parts, const Append& append, std::vector<int32_t>& begin,
+                 std::vector<int32_t>& runs) {
+    std::vector<std::vector<int32_t>> rowRuns(static_cast<size_t>(rows));
+    begin.assign(static_cast<size_t>(rows) * parts + 1, 0);
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(rows))
+    for (int32_t j = 0; j < rows; ++j)
+        for (int32_t p = 0; p < parts; ++p)
+            begin[static_cast<size_t>(j) * parts + p + 1] = append(j, p, rowRuns[j]);
+    for (size_t k = 1; k < begin.size(); ++k)
+        begin[k] += begin[k - 1];
+    runs.resize(2 * static_cast<size_t>(begin.back()));
+#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(rows))
+    for (int32_t j = 0; j < rows; ++j)
+        std::copy(rowRuns[j].begin(), rowRuns[j].end(),
+                  runs.begin() + 2 * static_cast<ptrdiff_t>(begin[static_cast<size_t>(j) * parts]));
+}
+
 // Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) where in(i, j) holds, r in
 // [begin[j], begin[j + 1]); runs closer than kRunGap are merged.
 template <class In>
 void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>& begin,
               std::vector<int32_t>& runs) {
-    begin.assign(static_cast<size_t>(rows) + 1, 0);
-    runs.clear();
-    int32_t count = 0;
-    for (int32_t j = 0; j < rows; ++j) {
-        begin[j] = count;
-        count += appendRuns(
-            0, columns, kRunGap, [&](int32_t i) { return in(i, j); }, runs);
-    }
-    begin[rows] = count;
+    collectRuns(
+        rows, 1,
+        [&](int32_t j, int32_t, std::vector<int32_t>& out) {
+            return appendRuns(
+                0, columns, kRunGap, [&](int32_t i) { return in(i, j); }, out);
+        },
+        begin, runs);
 }
 
 // The kernels' view of a level whose points are at u[j * row + i * step].
@@ -439,28 +459,24 @@ void detail::findSetRuns(Level& level) {
     const int32_t c = level.cells;
     // Per row and set, the runs of segments it projects. A gap shorter than a pair of lanes costs a sweep
     // nothing (the pair is computed whole), so runs are merged across it.
-    level.setRunBegin.assign(static_cast<size_t>(c) * detail::kSets + 1, 0);
-    level.setRuns.clear();
-    int32_t count = 0;
-    for (int32_t j = 0; j < c; ++j) {
-        for (int32_t set = 0; set < detail::kSets; ++set) {
-            level.setRunBegin[static_cast<size_t>(j) * detail::kSets + set] = count;
+    collectRuns(
+        c, detail::kSets,
+        [&](int32_t j, int32_t set, std::vector<int32_t>& out) {
             const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
             const detail::EdgeType e = detail::kEdgeTypes[type];
             const int32_t step = detail::setStep(type);
             int32_t gMin = 0, gMax = 0;
             detail::setLanes(type, first, j, c, gMin, gMax);
-            count += appendRuns(
+            return appendRuns(
                 gMin, gMax, kRunGapLanes,
                 [&](int32_t g) {
                     const int32_t i = first + g * step;
                     return detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
                                                     level.rigidity[level.index(i + e.bi, j + e.bj)]);
                 },
-                level.setRuns);
-        }
-    }
-    level.setRunBegin[static_cast<size_t>(c) * detail::kSets] = count;
+                out);
+        },
+        level.setRunBegin, level.setRuns);
 }
 
 void Solver::Impl::findLevelRuns(Level& level) {

@@ -1,5 +1,6 @@
 #include "deformkit/uvwarp/tile_warp.h"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -26,6 +27,25 @@ void requireSquare(const io::Image& map, const std::string& source, int tile, co
     }
 }
 
+// A mask at grid points (0 or 1, maskAtPoints) as one byte a point, and back.
+std::vector<uint8_t> maskBytes(const PointField& mask) {
+    std::vector<uint8_t> bytes;
+    deformkit::detail::assignLarge(bytes, mask.values.size(), uint8_t{0});
+    for (size_t k = 0; k < bytes.size(); ++k)
+        bytes[k] = mask.values[k] >= 0.5f ? 1 : 0;
+    return bytes;
+}
+
+PointField maskField(const std::vector<uint8_t>& bytes, int32_t cells) {
+    PointField mask;
+    mask.cells = cells;
+    mask.channels = 1;
+    deformkit::detail::assignLarge(mask.values, bytes.size(), 0.0f);
+    for (size_t k = 0; k < bytes.size(); ++k)
+        mask.values[k] = bytes[k];
+    return mask;
+}
+
 }  // namespace
 
 struct TileWarp::Impl {
@@ -34,16 +54,19 @@ struct TileWarp::Impl {
     int32_t texels = 0;
     int32_t cells = 0;
     std::unique_ptr<GeometryImager> imager;
-    PointField deformed, rigidity, mask;  // f_O lives in the solver
-    PointField boundMask;                 // the constructor's mask (given or derived): setMaps' default
-    int32_t densityRadius = 0;            // TileWarpOptions::orientationDensity
+    // f_D of the last solve (f_O lives in the solver; the rigidity map, in `delivered`).
+    PointField deformed;
+    // The warp mask at grid points (maskAtPoints: 0 or 1), a byte a point; boundMask is the constructor's
+    // (given or derived): setMaps' default.
+    std::vector<uint8_t> mask, boundMask;
+    int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     bool solved = false;
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
     std::vector<glm::vec3> lastDeformed;       // the last solve's positions (the rest ones before any)
 };
 
-TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
                    const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
@@ -78,14 +101,15 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
     m.imager->sample(rest.points(), restImage);
 
     const MapLabel rigidityLabel{source + " rigidity map", tile};
-    m.rigidity = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
+    const PointField rigidityAtGrid = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
+    PointField maskAtGrid;
     if (derive) {
         DerivedMaskOptions maskOptions = options.derivedMask;
         maskOptions.label = source;
-        m.mask = maskAtPoints(deriveWarpMask(rest, tile, m.texels, maskOptions), m.cells,
-                              {source + " derived mask", tile});
+        maskAtGrid = maskAtPoints(deriveWarpMask(rest, tile, m.texels, maskOptions), m.cells,
+                                  {source + " derived mask", tile});
     } else {
-        m.mask = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
+        maskAtGrid = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
     }
     m.densityRadius = options.orientationDensity;
     PointField orientationAtPoints;
@@ -95,13 +119,18 @@ TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, 
         orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
                                                {source + " density orientation", tile});
     }
-    m.boundMask.cells = m.mask.cells;
-    m.boundMask.channels = m.mask.channels;
-    deformkit::detail::copyLarge(m.boundMask.values, m.mask.values);
-    m.solver = std::make_unique<Solver>(std::move(restImage), m.rigidity, m.mask, options.solver,
+    m.solver = std::make_unique<Solver>(std::move(restImage), rigidityAtGrid, maskAtGrid, options.solver,
                                         orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
+    m.mask = maskBytes(maskAtGrid);
+    m.boundMask = m.mask;
     m.delivered.emplace(rest, tile, rigidity, source);
     m.lastDeformed.assign(rest.points().begin(), rest.points().end());
+}
+
+TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+                   const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
+    : TileWarp(Bind{}, rest, tile, rigidity, mask, options, orientation, source) {
+    deformkit::detail::releaseFreedMemory();  // the bind's rasters and maps at grid points
 }
 
 TileWarp::~TileWarp() = default;
@@ -148,7 +177,13 @@ WarpMetrics TileWarp::metrics() const {
     MetricsOptions options;
     options.texels = m.texels;
     const PointField& rest = m.solver->restGeometry();
-    return measureWarp(m.solver->warp(), rest, m.solved ? m.deformed : rest, m.rigidity, m.mask, options);
+    WarpMetrics figures;
+    {
+        const PointField rigidity = rigidityAtGridPoints(), mask = maskField(m.mask, m.cells);
+        figures = measureWarp(m.solver->warp(), rest, m.solved ? m.deformed : rest, rigidity, mask, options);
+    }
+    deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
+    return figures;
 }
 
 void TileWarp::reset() {
@@ -170,8 +205,8 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     if (!mask.pixels.empty()) sameSize(mask, "warp mask");
     if (!orientation.pixels.empty()) sameSize(orientation, "orientation map");
     PointField newRigidity = rigidityAtPoints(rigidity, m.cells, {m.source + " rigidity map", m.tile});
-    PointField newMask =
-        mask.pixels.empty() ? m.boundMask : maskAtPoints(mask, m.cells, {m.source + " warp mask", m.tile});
+    PointField newMask = mask.pixels.empty() ? maskField(m.boundMask, m.cells)
+                                             : maskAtPoints(mask, m.cells, {m.source + " warp mask", m.tile});
     PointField orientationAtPoints;
     if (!orientation.pixels.empty()) {
         orientationAtPoints = rigidityAtPoints(orientation, m.cells, {m.source + " orientation map", m.tile});
@@ -180,9 +215,12 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
                                                {m.source + " density orientation", m.tile});
     }
     m.solver->setMaps(newRigidity, newMask, orientationAtPoints);
-    m.rigidity = std::move(newRigidity);
     m.delivered->setRigidity(rigidity);
-    m.mask = std::move(newMask);
+    m.mask = maskBytes(newMask);
+    newRigidity = {};
+    newMask = {};
+    orientationAtPoints = {};
+    deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
 }
 
 int TileWarp::tile() const {
@@ -200,11 +238,11 @@ const WarpGrid& TileWarp::warp() const {
 const SolveStats& TileWarp::stats() const {
     return impl_->solver->stats();
 }
-const PointField& TileWarp::rigidityAtGridPoints() const {
-    return impl_->rigidity;
+PointField TileWarp::rigidityAtGridPoints() const {
+    return rigidityAtPoints(impl_->delivered->rigidity(), impl_->cells);
 }
-const PointField& TileWarp::maskAtGridPoints() const {
-    return impl_->mask;
+PointField TileWarp::maskAtGridPoints() const {
+    return maskField(impl_->mask, impl_->cells);
 }
 
 }  // namespace deformkit::uvwarp

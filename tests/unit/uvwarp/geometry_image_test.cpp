@@ -27,7 +27,8 @@ glm::dvec3 valueAt(const PointField& f, int32_t i, int32_t j) {
 }
 
 // Chebyshev distance from point (i, j) to the nearest covered point (brute force).
-int chebyshevToCovered(const GeometryImager& imager, const std::vector<uint8_t>& coverage, int32_t i, int32_t j) {
+int chebyshevToCovered(const GeometryImager& imager, const std::vector<uint8_t>& coverage, int32_t i,
+                       int32_t j) {
     const int32_t side = imager.side();
     int best = std::numeric_limits<int>::max();
     for (int32_t b = 0; b < side; ++b) {

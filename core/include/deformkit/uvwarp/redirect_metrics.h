@@ -55,7 +55,8 @@ struct DeliveredTexels {
 // The delivered figures of one UDIM tile, bound once to the rest mesh's UV triangles of the tile and the
 // rigidity map (which sets the redirect map's size, T x T), measured per frame from the deformed positions
 // and the frame's redirect map. OpenMP over bands of rows, sums in a fixed order: bit-identical for any
-// thread count. Memory: 4 bytes a texel.
+// thread count. Memory: 4 bytes a texel (the rigidity map's channel 0); the UV triangles under the texels are
+// kept as runs per row.
 class RedirectMetrics {
   public:
     // rest: the mesh with UVs; rigidity: T x T, channel 0 in [0, 1]. `source` names the inputs in errors.
@@ -83,6 +84,8 @@ class RedirectMetrics {
     void refusedInRow(const io::Image& redirect, int32_t y, std::vector<int32_t>& refused) const;
 
     [[nodiscard]] int32_t texels() const;
+    // The bound rigidity map's channel 0 (T x T x 1).
+    [[nodiscard]] const io::Image& rigidity() const;
 
   private:
     struct Impl;

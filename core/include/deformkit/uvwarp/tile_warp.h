@@ -78,10 +78,16 @@ class TileWarp {
     [[nodiscard]] int32_t cells() const;
     [[nodiscard]] const WarpGrid& warp() const;
     [[nodiscard]] const SolveStats& stats() const;
-    [[nodiscard]] const PointField& rigidityAtGridPoints() const;
-    [[nodiscard]] const PointField& maskAtGridPoints() const;
+    // The rigidity map at grid points (rigidityAtPoints), made on each call.
+    [[nodiscard]] PointField rigidityAtGridPoints() const;
+    // The warp mask at grid points (0 or 1), made on each call.
+    [[nodiscard]] PointField maskAtGridPoints() const;
 
   private:
+    struct Bind {};  // the constructor's work, before the memory it freed is given back
+    TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+             const TileWarpOptions& options, const io::Image& orientation, const std::string& source);
+
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
