@@ -1,12 +1,16 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/rasterizer.h"
+#include "deformkit/geom/triangulation.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/geometry_image.h"
 #include "uvwarp_test_support.h"
@@ -428,4 +432,54 @@ TEST_CASE("geometry image of a real layout: Spot's corners past tile 1001 are ta
     options.label = "spot";
     const GeometryImager imager(spot, 1001, 256, options);
     CHECK(imager.numCovered() > 256 * 256 / 4);
+}
+
+TEST_CASE("the geometry image of a real layout is the rasteriser's barycentric blend, bit for bit",
+          "[uvwarp][geometry_image]") {
+    // The imager keeps each row's covering triangles as runs and computes the barycentrics again each frame.
+    // Reference: the triangles of tile 1001 rasterised here by geom::rasterizeAttributes with the corner
+    // attributes (0, 0), (1, 0), (0, 1), which hands back the rasteriser's barycentrics (b, c) of corners B
+    // and C, blended as (1 - b - c) A + b B + c C. Every point the rasteriser covers must match exactly, on
+    // Spot's own UVs and random positions (fixed seed); the others are chart outlines and dilation.
+    const geom::Mesh spot = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
+    const geom::Triangulation tris = geom::triangulate(spot);
+    const auto faceIndices = spot.faceIndices();
+    const auto uvIndices = spot.uvIndices();
+    std::mt19937 random(20261204);
+    std::uniform_real_distribution<float> jitter(-0.5f, 0.5f);
+    std::vector<glm::vec3> positions(spot.points().begin(), spot.points().end());
+    for (glm::vec3& p : positions)
+        p += glm::vec3(jitter(random), jitter(random), jitter(random));
+    for (const int32_t n : {64, 256}) {
+        std::vector<glm::vec2> corners;
+        std::vector<std::array<int32_t, 3>> triangles, vertices;
+        std::vector<float> attributes;
+        for (int32_t t = 0; t < tris.size(); ++t) {
+            if (spot.faceUdimTile(tris.face[t]) != 1001) continue;
+            const auto& c = tris.corners[t];
+            const auto k = static_cast<int32_t>(corners.size());
+            for (int m = 0; m < 3; ++m)
+                corners.push_back(spot.uvs()[uvIndices[c[m]]] * static_cast<float>(n) + 0.5f);
+            triangles.push_back({k, k + 1, k + 2});
+            vertices.push_back({faceIndices[c[0]], faceIndices[c[1]], faceIndices[c[2]]});
+            attributes.insert(attributes.end(), {0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f});
+        }
+        geom::AttributeRaster raster;
+        geom::rasterizeAttributes({n + 1, n + 1}, corners, triangles, attributes, 2, raster);
+        const GeometryImager imager(spot, 1001, n);
+        const PointField image = imager.sample(positions);
+        int64_t compared = 0, differing = 0;
+        for (size_t k = 0; k < raster.triangle.size(); ++k) {
+            const int32_t t = raster.triangle[k];
+            if (t < 0) continue;
+            const float b = raster.values[2 * k], c = raster.values[2 * k + 1], a = 1.0f - b - c;
+            const auto& v = vertices[static_cast<size_t>(t)];
+            const glm::vec3 expected = a * positions[v[0]] + b * positions[v[1]] + c * positions[v[2]];
+            const glm::vec3 got(image.values[3 * k], image.values[3 * k + 1], image.values[3 * k + 2]);
+            ++compared;
+            differing += got == expected ? 0 : 1;
+        }
+        CHECK(compared > int64_t{n + 1} * (n + 1) / 4);
+        CHECK(differing == 0);
+    }
 }

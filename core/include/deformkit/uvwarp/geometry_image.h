@@ -20,8 +20,9 @@ namespace deformkit::uvwarp {
 // (geom::triangulate) and rasterised at the (n + 1)^2 grid points, point (i, j) being the raster pixel
 // centre of tile-local uv (i / n, j / n) (raster coordinates uv * n + 0.5, top-left rule). Points within
 // 1/1000 of a cell of a chart border count as covered too, so a chart's outline is sampled. Where UV
-// triangles overlap, the last one in face order wins. A covered point stores its triangle and
-// barycentric coordinates; its value is the barycentric blend of the triangle's 3D corners.
+// triangles overlap, the last one in face order wins. A covered point's value is the barycentric blend of
+// its triangle's 3D corners; the imager keeps the covering triangles as runs per row and computes the
+// barycentrics each frame as the rasteriser does (a few bytes a row, not 12 a point).
 //
 // Dilation past chart borders, so bilinear look-ups near seams read valid data: uncovered points are
 // filled ring by ring (ring r: Chebyshev distance r from the covered points), each from points of earlier
