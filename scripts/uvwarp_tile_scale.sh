@@ -22,7 +22,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for t in "${sizes[@]}"; do
     echo "running ${t}^2 ..." >&2
-    "$exe" --benchmark_filter="BM_UvWarpTileScale/$t/" --benchmark_out="$out/$t.json" \
+    DEFORMKIT_TILE_SIZES="$t" "$exe" --benchmark_out="$out/$t.json" \
         --benchmark_out_format=json >"$out/$t.log" 2>&1 || {
         cat "$out/$t.log" >&2
         exit 1

@@ -12,14 +12,16 @@
 // target: at 8192^2 within 2 points of 2048^2.
 //
 // Sizes above 2048 take minutes and gigabytes: scripts/uvwarp_tile_scale.sh runs each size in a process of
-// its own (--benchmark_filter=BM_UvWarpTileScale/8192), from 1024^2 to 16384^2, and prints the table.
+// its own (DEFORMKIT_TILE_SIZES=8192), from 1024^2 to 16384^2, and prints the table.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -155,14 +157,21 @@ void BM_UvWarpTileScale(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_UvWarpTileScale)
-    ->Arg(1024)
-    ->Arg(2048)
-    ->Arg(4096)
-    ->Arg(8192)
-    ->Arg(16384)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond)
-    ->UseRealTime();
-
-BENCHMARK_MAIN();
+// Sizes from DEFORMKIT_TILE_SIZES ("1024 2048 ... 16384"), 1024 and 2048 without it: scripts/bench.sh runs
+// every benchmark five times, and the larger sizes take minutes and gigabytes each.
+int main(int argc, char** argv) {
+    const char* sizes = std::getenv("DEFORMKIT_TILE_SIZES");
+    std::istringstream list(sizes != nullptr ? sizes : "1024 2048");
+    for (int64_t texels = 0; list >> texels;) {
+        benchmark::RegisterBenchmark("BM_UvWarpTileScale", BM_UvWarpTileScale)
+            ->Arg(texels)
+            ->Iterations(1)
+            ->Unit(benchmark::kSecond)
+            ->UseRealTime();
+    }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
