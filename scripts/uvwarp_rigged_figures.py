@@ -59,6 +59,8 @@ def rigid_disks(inside, t):
 def value(text):
     if text in ("true", "false"):
         return text == "true"
+    if "," in text:  # a list: sweeps_per_level=4,8,16
+        return [value(part) for part in text.split(",")]
     for kind in (int, float):
         try:
             return kind(text)

@@ -26,6 +26,17 @@ void adviseHugePages(void* data, size_t bytes) {
 #endif
 }
 
+void prefault(void* data, size_t bytes) {
+    constexpr int64_t kPage = 4096;
+    auto* begin = static_cast<unsigned char*>(data);
+    const auto pages = static_cast<int64_t>((bytes + kPage - 1) / kPage);
+    if (data == nullptr || pages == 0) return;
+        // Pages in blocks of 2 MiB, so that a thread's pages share huge pages.
+#pragma omp parallel for schedule(static, 512)
+    for (int64_t page = 0; page < pages; ++page)
+        begin[page * kPage] = 0;
+}
+
 void releaseFreedMemory() {
 #ifdef __GLIBC__
     (void)malloc_trim(0);

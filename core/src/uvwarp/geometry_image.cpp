@@ -206,15 +206,21 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
 
     std::vector<uint8_t> ring;
     deformkit::detail::assignLarge(ring, count, kUnassigned);
-    numCovered_ = 0;
-    for (size_t k = 0; k < count; ++k) {
-        if (pointTriangle[k] < 0) continue;
-        ring[k] = 0;
-        ++numCovered_;
+    int64_t covered = 0;
+#pragma omp parallel for schedule(static) reduction(+ : covered)
+    for (int32_t j = 0; j < side; ++j) {
+        for (int32_t i = 0; i < side; ++i) {
+            const size_t k = static_cast<size_t>(j) * side + i;
+            if (pointTriangle[k] < 0) continue;
+            ring[k] = 0;
+            ++covered;
+        }
     }
+    numCovered_ = covered;
     // The dilation starts from the covered points next to an uncovered one (the others have no uncovered
-    // 8-neighbour to reach).
-    std::vector<int32_t> frontier;
+    // 8-neighbour to reach), in ascending order: rows found in parallel, then laid end to end.
+    std::vector<std::vector<int32_t>> frontierRows(static_cast<size_t>(side));
+#pragma omp parallel for schedule(dynamic, 16)
     for (int32_t j = 0; j < side; ++j) {
         for (int32_t i = 0; i < side; ++i) {
             const size_t k = static_cast<size_t>(j) * side + i;
@@ -224,9 +230,13 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                 for (int32_t di = -1; di <= 1 && !edge; ++di)
                     edge = i + di >= 0 && j + dj >= 0 && i + di < side && j + dj < side &&
                            ring[static_cast<size_t>(j + dj) * side + i + di] != 0;
-            if (edge) frontier.push_back(static_cast<int32_t>(k));
+            if (edge) frontierRows[j].push_back(static_cast<int32_t>(k));
         }
     }
+    std::vector<int32_t> frontier;
+    for (const std::vector<int32_t>& row : frontierRows)
+        frontier.insert(frontier.end(), row.begin(), row.end());
+    frontierRows = {};
 
     // Dilation rings (breadth-first over 8-neighbours from the covered points).
     auto inside = [&](int32_t i, int32_t j) { return i >= 0 && j >= 0 && i < side && j < side; };

@@ -15,6 +15,7 @@ void WarpGrid::setIdentity(int32_t n) {
     const int32_t side = n + 1;
     deformkit::detail::assignLarge(u, static_cast<size_t>(side) * side, 0.0f);
     deformkit::detail::assignLarge(v, u.size(), 0.0f);
+#pragma omp parallel for schedule(static) if (side > 64)
     for (int32_t j = 0; j < side; ++j) {
         for (int32_t i = 0; i < side; ++i) {
             const size_t k = static_cast<size_t>(j) * side + i;

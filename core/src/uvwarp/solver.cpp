@@ -56,6 +56,7 @@ int32_t widestChartRadius(const PointField& mask) {
     std::vector<int32_t> d;
     deformkit::detail::assignLarge(d, static_cast<size_t>(side) * side, 0);
     const auto at = [&](int32_t i, int32_t j) -> int32_t& { return d[static_cast<size_t>(j) * side + i]; };
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(side))
     for (int32_t j = 0; j < side; ++j)
         for (int32_t i = 0; i < side; ++i) {
             const bool border = i == 0 || j == 0 || i == side - 1 || j == side - 1;
@@ -404,10 +405,13 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
     std::vector<uint8_t> movable, coarser;
     deformkit::detail::assignLarge(movable, static_cast<size_t>(side()) * side(), uint8_t{0});
     const auto markFixed = [](Level& level, const std::vector<uint8_t>& canMove) {
-        for (size_t k = 0; k < canMove.size(); ++k)
+        const auto count = static_cast<int64_t>(canMove.size());
+#pragma omp parallel for schedule(static) if (kParallelRows * kParallelRows < count)
+        for (int64_t k = 0; k < count; ++k)
             if (canMove[k] == 0) level.rigidity[k] = detail::fixedRigidity(level.rigidity[k]);
     };
     Level& finest = levels[0];
+#pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(cells))
     for (int32_t j = 0; j <= cells; ++j) {
         for (int32_t i = 0; i <= cells; ++i) {
             const size_t k = finest.index(i, j);
