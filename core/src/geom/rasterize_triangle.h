@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -97,9 +98,11 @@ class BarycentricFrame {
 // triangles that tile a region without overlap (shared edges are never drawn twice or skipped).
 // Degenerate (zero-area) triangles and pixels outside the grid are skipped. Vertex coordinates are snapped
 // to 1/256 pixel, as GPUs do, which makes the rule exact.
+// Rows [rowBegin, rowEnd) of the grid only: the same pixels, with the same barycentrics, as the whole grid's
+// rasterisation visits in those rows.
 template <class Visit>
-void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
-                       Visit&& visit) {
+void rasterizeTriangleRows(const RasterGrid& grid, int32_t rowBegin, int32_t rowEnd, const glm::vec2& p0,
+                           const glm::vec2& p1, const glm::vec2& p2, Visit&& visit) {
     namespace rd = rasterizer_detail;
     const glm::vec2* corners[3] = {&p0, &p1, &p2};
     for (int k = 0; k < 3; ++k) {
@@ -133,9 +136,10 @@ void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::v
     const int64_t x0 = std::max<int64_t>(0, rd::firstCentreAtOrAbove(std::min({v0.x, v1.x, v2.x})));
     const int64_t x1 =
         std::min<int64_t>(grid.width - 1, rd::lastCentreAtOrBelow(std::max({v0.x, v1.x, v2.x})));
-    const int64_t y0 = std::max<int64_t>(0, rd::firstCentreAtOrAbove(std::min({v0.y, v1.y, v2.y})));
-    const int64_t y1 =
-        std::min<int64_t>(grid.height - 1, rd::lastCentreAtOrBelow(std::max({v0.y, v1.y, v2.y})));
+    const int64_t y0 =
+        std::max<int64_t>(std::max(rowBegin, 0), rd::firstCentreAtOrAbove(std::min({v0.y, v1.y, v2.y})));
+    const int64_t y1 = std::min<int64_t>(std::min(rowEnd, grid.height) - 1,
+                                         rd::lastCentreAtOrBelow(std::max({v0.y, v1.y, v2.y})));
     if (x0 > x1 || y0 > y1) return;
 
     // Edge k is opposite vertex k. A bias of -1 turns "> 0" into ">= 0" for edges that do not own their
@@ -162,6 +166,58 @@ void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::v
         }
         for (int k = 0; k < 3; ++k)
             rowValue[k] += stepY[k];
+    }
+}
+
+template <class Visit>
+void rasterizeTriangle(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1, const glm::vec2& p2,
+                       Visit&& visit) {
+    rasterizeTriangleRows(grid, 0, grid.height, p0, p1, p2, std::forward<Visit>(visit));
+}
+
+// Rasterises triangles 0 .. count - 1 in order, corners(t, p0, p1, p2) giving triangle t's raster corners,
+// and calls visit(t, x, y, barycentric) for each pixel as rasterizeTriangle does: the pixels of every
+// triangle, in triangle order per pixel, so a visitor that keeps the last triangle gets the serial result.
+// Rows are split into bands rasterised in parallel (OpenMP), each band's triangles in ascending order; visit
+// must be safe to call for pixels of different rows at once. The errors of rasterizeTriangle are thrown
+// before any pixel is visited, by the first triangle that raises one.
+template <class Corners, class Visit>
+void rasterizeTrianglesInBands(const RasterGrid& grid, int32_t count, Corners&& corners, Visit&& visit) {
+    namespace rd = rasterizer_detail;
+    if (grid.width <= 0 || grid.height <= 0 || count <= 0) return;
+    constexpr int32_t kBandRows = 64;
+    const int32_t bands = (grid.height + kBandRows - 1) / kBandRows;
+    // Each triangle's bands (from its corners' rows, one row of margin for snapping), ascending; and the
+    // checks rasterizeTriangle would make, in its order.
+    std::vector<std::vector<int32_t>> inBand(static_cast<size_t>(bands));
+    glm::vec2 p[3];
+    for (int32_t t = 0; t < count; ++t) {
+        corners(t, p[0], p[1], p[2]);
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(p[k].x) || !std::isfinite(p[k].y)) rd::throwBadVertex(k, p[k]);
+        const float minX = std::min({p[0].x, p[1].x, p[2].x}), maxX = std::max({p[0].x, p[1].x, p[2].x});
+        const float minY = std::min({p[0].y, p[1].y, p[2].y}), maxY = std::max({p[0].y, p[1].y, p[2].y});
+        if (maxX < 0.0f || maxY < 0.0f || minX > static_cast<float>(grid.width) ||
+            minY > static_cast<float>(grid.height))
+            continue;
+        for (int k = 0; k < 3; ++k)
+            if (std::abs(p[k].x) > rd::kMaxCoordinate || std::abs(p[k].y) > rd::kMaxCoordinate)
+                rd::throwBadVertex(k, p[k]);
+        const auto lastRow = static_cast<float>(grid.height - 1);
+        const auto first = static_cast<int32_t>(std::clamp(std::floor(minY) - 1.0f, 0.0f, lastRow));
+        const auto last = static_cast<int32_t>(std::clamp(std::ceil(maxY) + 1.0f, 0.0f, lastRow));
+        for (int32_t b = first / kBandRows; b <= last / kBandRows; ++b)
+            inBand[static_cast<size_t>(b)].push_back(t);
+    }
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int32_t b = 0; b < bands; ++b) {
+        glm::vec2 q[3];
+        const int32_t rowBegin = b * kBandRows, rowEnd = std::min(grid.height, rowBegin + kBandRows);
+        for (const int32_t t : inBand[static_cast<size_t>(b)]) {
+            corners(t, q[0], q[1], q[2]);
+            rasterizeTriangleRows(grid, rowBegin, rowEnd, q[0], q[1], q[2],
+                                  [&](int32_t x, int32_t y, const glm::vec3& bary) { visit(t, x, y, bary); });
+        }
     }
 }
 

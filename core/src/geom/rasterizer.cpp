@@ -5,6 +5,7 @@
 #include <string>
 
 #include "deformkit/error.h"
+#include "memory/large_buffers.h"
 
 namespace deformkit::geom {
 
@@ -44,23 +45,28 @@ void rasterizeAttributes(const RasterGrid& grid, std::span<const glm::vec2> posi
     out.width = grid.width;
     out.height = grid.height;
     out.channels = channels;
-    out.values.assign(numPixels * channels, 0.0f);
-    out.triangle.assign(numPixels, -1);
+    deformkit::detail::assignLarge(out.values, numPixels * channels, 0.0f);
+    deformkit::detail::assignLarge(out.triangle, numPixels, -1);
 
-    for (size_t t = 0; t < triangles.size(); ++t) {
-        const auto& tri = triangles[t];
-        const float* a0 = attributes.data() + static_cast<size_t>(tri[0]) * channels;
-        const float* a1 = attributes.data() + static_cast<size_t>(tri[1]) * channels;
-        const float* a2 = attributes.data() + static_cast<size_t>(tri[2]) * channels;
-        rasterizeTriangle(grid, positions[tri[0]], positions[tri[1]], positions[tri[2]],
-                          [&](int32_t x, int32_t y, const glm::vec3& b) {
-                              const size_t pixel = static_cast<size_t>(y) * grid.width + x;
-                              out.triangle[pixel] = static_cast<int32_t>(t);
-                              float* value = out.values.data() + pixel * channels;
-                              for (int32_t c = 0; c < channels; ++c)
-                                  value[c] = b[0] * a0[c] + b[1] * a1[c] + b[2] * a2[c];
-                          });
-    }
+    rasterizeTrianglesInBands(
+        grid, static_cast<int32_t>(triangles.size()),
+        [&](int32_t t, glm::vec2& a, glm::vec2& b, glm::vec2& c) {
+            const auto& tri = triangles[static_cast<size_t>(t)];
+            a = positions[tri[0]];
+            b = positions[tri[1]];
+            c = positions[tri[2]];
+        },
+        [&](int32_t t, int32_t x, int32_t y, const glm::vec3& b) {
+            const auto& tri = triangles[static_cast<size_t>(t)];
+            const float* a0 = attributes.data() + static_cast<size_t>(tri[0]) * channels;
+            const float* a1 = attributes.data() + static_cast<size_t>(tri[1]) * channels;
+            const float* a2 = attributes.data() + static_cast<size_t>(tri[2]) * channels;
+            const size_t pixel = static_cast<size_t>(y) * grid.width + x;
+            out.triangle[pixel] = t;
+            float* value = out.values.data() + pixel * channels;
+            for (int32_t c = 0; c < channels; ++c)
+                value[c] = b[0] * a0[c] + b[1] * a1[c] + b[2] * a2[c];
+        });
 }
 
 }  // namespace deformkit::geom

@@ -11,6 +11,7 @@
 #include "geom/rasterize_triangle.h"
 #include "lookup.h"
 #include "memory/large_buffers.h"
+#include "row_runs.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -142,16 +143,20 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     // Point (i, j) is the centre of raster pixel (i, j): raster coordinates uv * n + 0.5.
     const geom::RasterGrid grid{side, side};
     rasterCorners_.resize(static_cast<size_t>(numTriangles) * 3);
-    for (int32_t t = 0; t < numTriangles; ++t) {
-        const auto& c = uvs.uvs[t];
-        glm::vec2* corners = &rasterCorners_[static_cast<size_t>(t) * 3];
+    for (int32_t t = 0; t < numTriangles; ++t)
         for (int k = 0; k < 3; ++k)
-            corners[k] = c[k] * n + 0.5f;
-        rasterizeTriangle(grid, corners[0], corners[1], corners[2],
-                          [&](int32_t x, int32_t y, const glm::vec3&) {
-                              pointTriangle[static_cast<size_t>(y) * side + x] = t;
-                          });
-    }
+            rasterCorners_[static_cast<size_t>(t) * 3 + k] = uvs.uvs[t][k] * n + 0.5f;
+    geom::rasterizeTrianglesInBands(
+        grid, numTriangles,
+        [&](int32_t t, glm::vec2& a, glm::vec2& b, glm::vec2& c) {
+            const glm::vec2* corners = &rasterCorners_[static_cast<size_t>(t) * 3];
+            a = corners[0];
+            b = corners[1];
+            c = corners[2];
+        },
+        [&](int32_t t, int32_t x, int32_t y, const glm::vec3&) {
+            pointTriangle[static_cast<size_t>(y) * side + x] = t;
+        });
 
     // Points on a chart's outline that the top-left rule left out: walk each border edge row by row.
     for (size_t e = 0; e < uvs.borderEdges.size(); ++e) {
@@ -314,17 +319,7 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     // The rasteriser's triangles as runs per row (the outline points keep their own entries).
     for (const int32_t k : outlinePoint_)
         pointTriangle[static_cast<size_t>(k)] = -1;
-    rowRunBegin_.assign(static_cast<size_t>(side) + 1, 0);
-    for (int32_t j = 0; j < side; ++j) {
-        rowRunBegin_[j] = static_cast<int64_t>(runStart_.size());
-        const int32_t* row = pointTriangle.data() + static_cast<size_t>(j) * side;
-        for (int32_t i = 0; i < side; ++i) {
-            if (i > 0 && row[i] == row[i - 1]) continue;
-            runStart_.push_back(i);
-            runTriangle_.push_back(row[i]);
-        }
-    }
-    rowRunBegin_[side] = static_cast<int64_t>(runStart_.size());
+    detail::encodeRowRuns(pointTriangle, side, side, rowRunBegin_, runStart_, runTriangle_);
 }
 
 void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& out) const {

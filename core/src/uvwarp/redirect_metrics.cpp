@@ -16,7 +16,9 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/io/sampling.h"
+#include "memory/large_buffers.h"
 #include "redirect_cells.h"
+#include "row_runs.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -315,17 +317,7 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
             tri = m.locate(q, bary);
         }
     }
-    m.rowRunBegin.assign(static_cast<size_t>(t) + 1, 0);
-    for (int32_t y = 0; y < t; ++y) {
-        m.rowRunBegin[y] = static_cast<int64_t>(m.runStart.size());
-        const int32_t* row = texelTriangle.data() + static_cast<size_t>(y) * t;
-        for (int32_t x = 0; x < t; ++x) {
-            if (x > 0 && row[x] == row[x - 1]) continue;
-            m.runStart.push_back(x);
-            m.runTriangle.push_back(row[x]);
-        }
-    }
-    m.rowRunBegin[t] = static_cast<int64_t>(m.runStart.size());
+    detail::encodeRowRuns(texelTriangle, t, t, m.rowRunBegin, m.runStart, m.runTriangle);
 }
 
 RedirectMetrics::~RedirectMetrics() = default;
@@ -373,8 +365,13 @@ void RedirectMetrics::setRigidity(const io::Image& rigidity) {
                                        std::to_string(rigidity.width) + " texels per side",
                                        std::to_string(m.texels) + ", the bound map's size"));
     }
-    m.rigidity = io::Image(rigidity.width, rigidity.height, 1);
-    for (size_t k = 0; k < m.rigidity.pixels.size(); ++k)
+    m.rigidity.width = rigidity.width;
+    m.rigidity.height = rigidity.height;
+    m.rigidity.channels = 1;
+    const auto count = static_cast<int64_t>(rigidity.width) * rigidity.height;
+    deformkit::detail::assignLarge(m.rigidity.pixels, static_cast<size_t>(count), 0.0f);
+#pragma omp parallel for schedule(static)
+    for (int64_t k = 0; k < count; ++k)
         m.rigidity.pixels[k] = rigidity.pixels[k * rigidity.channels];
 }
 

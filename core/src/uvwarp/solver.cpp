@@ -48,31 +48,59 @@ const detail::SolverKernels& kernelsFor(simd::Isa isa) {
 }
 
 // The largest distance, in cells (chessboard: 8-neighbour steps), from a point that may move (mask >= 0.5,
-// not on the tile border) to the nearest point that may not: the half-width of the widest chart. Two passes
-// of the exact chessboard distance transform.
+// not on the tile border) to the nearest point that may not: the half-width of the widest chart. The exact
+// chessboard distance transform of Meijster, Roerdink and Hesselink (2000), separable: per column the
+// distance to the nearest fixed point of the column, then per row the lower envelope of
+// max(|x - i|, g(i)); columns, then rows, in parallel.
 int32_t widestChartRadius(const PointField& mask) {
     const int32_t side = mask.side();
-    const int32_t far = 2 * side;
-    std::vector<int32_t> d;
-    deformkit::detail::assignLarge(d, static_cast<size_t>(side) * side, 0);
-    const auto at = [&](int32_t i, int32_t j) -> int32_t& { return d[static_cast<size_t>(j) * side + i]; };
+    std::vector<int32_t> g;  // per point: the distance to the nearest fixed point of its column
+    deformkit::detail::assignLarge(g, static_cast<size_t>(side) * side, 0);
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(side))
-    for (int32_t j = 0; j < side; ++j)
-        for (int32_t i = 0; i < side; ++i) {
-            const bool border = i == 0 || j == 0 || i == side - 1 || j == side - 1;
-            at(i, j) = border || mask.values[mask.index(i, j)] < 0.5f ? 0 : far;
+    for (int32_t i = 0; i < side; ++i) {
+        const bool borderColumn = i == 0 || i == side - 1;
+        const auto at = [&](int32_t j) -> int32_t& { return g[static_cast<size_t>(j) * side + i]; };
+        for (int32_t j = 1; j < side; ++j) {
+            const bool fixed = borderColumn || j == side - 1 || mask.values[mask.index(i, j)] < 0.5f;
+            at(j) = fixed ? 0 : at(j - 1) + 1;
         }
-    for (int32_t j = 1; j < side; ++j)
-        for (int32_t i = 1; i < side - 1; ++i)
-            at(i, j) = std::min(
-                {at(i, j), at(i - 1, j) + 1, at(i - 1, j - 1) + 1, at(i, j - 1) + 1, at(i + 1, j - 1) + 1});
+        for (int32_t j = side - 2; j >= 0; --j)
+            at(j) = std::min(at(j), at(j + 1) + 1);
+    }
     int32_t widest = 0;
-    for (int32_t j = side - 2; j >= 0; --j)
-        for (int32_t i = side - 2; i >= 1; --i) {
-            at(i, j) = std::min(
-                {at(i, j), at(i + 1, j) + 1, at(i + 1, j + 1) + 1, at(i, j + 1) + 1, at(i - 1, j + 1) + 1});
-            widest = std::max(widest, at(i, j));
+#pragma omp parallel reduction(max : widest) if (kParallelRows < static_cast <int64_t>(side))
+    {
+        std::vector<int32_t> s(static_cast<size_t>(side)), t(static_cast<size_t>(side));
+#pragma omp for schedule(static)
+        for (int32_t j = 0; j < side; ++j) {
+            const int32_t* row = g.data() + static_cast<size_t>(j) * side;
+            const auto f = [&](int32_t x, int32_t i) { return std::max(std::abs(x - i), row[i]); };
+            // The first x from which column u's term is below column i's (i < u).
+            const auto sep = [&](int32_t i, int32_t u) {
+                return row[i] <= row[u] ? std::max(i + row[u], (i + u) / 2)
+                                        : std::min(u - row[i], (i + u) / 2);
+            };
+            int32_t q = 0;
+            s[0] = 0;
+            t[0] = 0;
+            for (int32_t u = 1; u < side; ++u) {
+                while (q >= 0 && f(t[q], s[q]) > f(t[q], u))
+                    --q;
+                if (q < 0) {
+                    q = 0;
+                    s[0] = u;
+                } else if (const int32_t w = 1 + sep(s[q], u); w < side) {
+                    ++q;
+                    s[q] = u;
+                    t[q] = w;
+                }
+            }
+            for (int32_t u = side - 1; u >= 0; --u) {
+                widest = std::max(widest, f(u, s[q]));
+                if (u == t[q]) --q;
+            }
         }
+    }
     return widest;
 }
 

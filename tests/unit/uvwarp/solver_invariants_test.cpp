@@ -3,6 +3,7 @@
 // border and masked points stay where they are. And the convergence stop (SolverOptions::tolerance) and the
 // choice of OpenMP team (SolverOptions::threads).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -307,12 +308,24 @@ TEST_CASE("uv warp: the same bytes whichever team each iteration runs on", "[uvw
 // point to a fixed one (mask < 0.5 or the tile border), computed here by brute force.
 TEST_CASE("uv warp: the automatic depth follows the widest chart", "[uvwarp][options]") {
     const int32_t cells = 64;
-    for (int32_t gap : {0, 40, 24, 12, 6}) {  // fixed vertical lines every `gap` cells (0: none)
+    // Fixed vertical lines every `gap` cells (0: none); then (gap < 0) random fixed rectangles, fixed seed.
+    std::mt19937 random(64);
+    for (int32_t gap : {0, 40, 24, 12, 6, -1, -2, -3, -4, -5, -6, -7, -8}) {
         Case c = planeCase(cells);
+        std::vector<std::array<int32_t, 4>> boxes;  // i0, j0, i1, j1
+        for (int32_t b = 0; gap < 0 && b < -gap; ++b) {
+            const auto i0 = static_cast<int32_t>(random() % cells),
+                       j0 = static_cast<int32_t>(random() % cells);
+            boxes.push_back(
+                {i0, j0, i0 + static_cast<int32_t>(random() % 6), j0 + static_cast<int32_t>(random() % 20)});
+        }
         for (int32_t j = 0; j <= cells; ++j)
             for (int32_t i = 0; i <= cells; ++i) {
                 const size_t k = c.mask.index(i, j);
-                c.mask.values[k] = gap > 0 && i % gap == 0 ? 0.0f : 1.0f;
+                bool fixedHere = gap > 0 && i % gap == 0;
+                for (const auto& box : boxes)
+                    fixedHere = fixedHere || (i >= box[0] && i <= box[2] && j >= box[1] && j <= box[3]);
+                c.mask.values[k] = fixedHere ? 0.0f : 1.0f;
             }
         const auto fixed = [&](int32_t i, int32_t j) {
             return i == 0 || j == 0 || i == cells || j == cells || c.mask.values[c.mask.index(i, j)] < 0.5f;
