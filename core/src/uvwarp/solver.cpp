@@ -402,12 +402,12 @@ struct Solver::Impl : detail::SolverState {
         return std::sqrt(largest);
     }
 
-    void buildMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation);
+    // `rigidity` becomes the finest level's map (pass it with std::move to keep one copy).
+    void buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation);
     static void findLevelRuns(Level& level);
 };
 
-void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
-                             const PointField& orientation) {
+void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation) {
     detail::requireField(rigidity, cells, 1, source, "rigidity");
     detail::requireField(mask, cells, 1, source, "mask");
     if (!orientation.values.empty()) detail::requireField(orientation, cells, 1, source, "orientation map");
@@ -420,7 +420,10 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
     }
     for (Level& level : levels) {
         const size_t count = static_cast<size_t>(level.side()) * level.side();
-        deformkit::detail::assignLarge(level.rigidity, count, 0.0f);
+        if (&level == &levels.front())
+            level.rigidity = std::move(rigidity.values);  // R of the finest level: the map itself
+        else
+            deformkit::detail::assignLarge(level.rigidity, count, 0.0f);
         if (orientation.values.empty()) {
             level.orientation.clear();
             level.orientation.shrink_to_fit();
@@ -444,7 +447,6 @@ void Solver::Impl::buildMaps(const PointField& rigidity, const PointField& mask,
         for (int32_t i = 0; i <= cells; ++i) {
             const size_t k = finest.index(i, j);
             const bool border = i == 0 || j == 0 || i == cells || j == cells;
-            finest.rigidity[k] = rigidity.values[k];
             movable[k] = (!border && mask.values[k] >= 0.5f) ? 1 : 0;
             if (!finest.orientation.empty())
                 finest.orientation[k] = std::clamp(orientation.values[k], 0.0f, 1.0f);
@@ -524,7 +526,7 @@ void Solver::Impl::findLevelRuns(Level& level) {
         level.cellRunBegin, level.cellRuns);
 }
 
-Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointField& mask,
+Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
                const SolverOptions& options, const PointField& orientation, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
@@ -576,7 +578,7 @@ Solver::Solver(PointField restGeometry, const PointField& rigidity, const PointF
     m.untangleWork.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.untangleNext.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.rowFolds.assign(static_cast<size_t>(m.cells) + 1, 0);
-    m.buildMaps(rigidity, mask, orientation);
+    m.buildMaps(std::move(rigidity), mask, orientation);
     m.grid = WarpGrid::identity(m.cells);
     const size_t n = m.grid.numPoints();
     deformkit::detail::assignLarge(m.velU, n, 0.0f);
@@ -588,9 +590,9 @@ Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
-void Solver::setMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation) {
+void Solver::setMaps(PointField rigidity, const PointField& mask, const PointField& orientation) {
     Impl& m = *impl_;
-    m.buildMaps(rigidity, mask, orientation);
+    m.buildMaps(std::move(rigidity), mask, orientation);
     // A point the new maps fix stays where it is: without its velocity, prediction would carry it on.
     const detail::Level& finest = m.levels[0];
     for (size_t k = 0; k < m.velU.size(); ++k) {

@@ -101,7 +101,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigi
     m.imager->sample(rest.points(), restImage);
 
     const MapLabel rigidityLabel{source + " rigidity map", tile};
-    const PointField rigidityAtGrid = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
+    PointField rigidityAtGrid = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
     PointField maskAtGrid;
     if (derive) {
         DerivedMaskOptions maskOptions = options.derivedMask;
@@ -119,8 +119,9 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigi
         orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
                                                {source + " density orientation", tile});
     }
-    m.solver = std::make_unique<Solver>(std::move(restImage), rigidityAtGrid, maskAtGrid, options.solver,
-                                        orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
+    m.solver =
+        std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid, options.solver,
+                                 orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
     m.mask = maskBytes(maskAtGrid);
     m.boundMask = m.mask;
     m.delivered.emplace(rest, tile, rigidity, source);
@@ -214,7 +215,7 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
         orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
                                                {m.source + " density orientation", m.tile});
     }
-    m.solver->setMaps(newRigidity, newMask, orientationAtPoints);
+    m.solver->setMaps(std::move(newRigidity), newMask, orientationAtPoints);
     m.delivered->setRigidity(rigidity);
     m.mask = maskBytes(newMask);
     newRigidity = {};

@@ -98,14 +98,14 @@ struct SolveStats {
 // Inputs are fields on the (n + 1)^2 grid points (grid.h): restGeometry f_O (3 channels), rigidity R in
 // [0, 1], mask M (0 or 1; tile-border points never move whatever the mask says), and optionally an
 // orientation-preservation map in [0, 1] (empty: 1 everywhere). The solver keeps f_O (rest lengths are
-// measured through it): pass it with std::move to keep one copy.
+// measured through it) and R (its finest level's map): pass them with std::move to keep one copy.
 //
 // Memory: 16 bytes per fine grid point for positions and velocities, 12 for f_O, 5 for rigidity and
 // movability, about 4.4 more for the coarser levels (+ 4 per point with an orientation map); no allocation
 // in a solve once the fold-repair scratch has grown to the largest fold count seen.
 class Solver {
   public:
-    Solver(PointField restGeometry, const PointField& rigidity, const PointField& mask,
+    Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
            const SolverOptions& options = {}, const PointField& orientation = {},
            const std::string& source = "tile");
     ~Solver();
@@ -114,7 +114,7 @@ class Solver {
 
     // New rigidity / mask / orientation maps (a painter's edit): rebuilds the per-level hierarchies (Eq.
     // 7-8). The warp is kept; a point the new mask fixes stays where it is (its velocity is dropped).
-    void setMaps(const PointField& rigidity, const PointField& mask, const PointField& orientation = {});
+    void setMaps(PointField rigidity, const PointField& mask, const PointField& orientation = {});
     // One frame: deformedGeometry f_D (3 channels, same grid). Returns the warp W.
     const WarpGrid& solve(const PointField& deformedGeometry);
     // Back to the identity warp with zero velocity (a cut in the shot).
