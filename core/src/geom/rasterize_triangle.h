@@ -64,6 +64,30 @@ inline int64_t lastCentreAtOrBelow(int64_t v) {
                                    "finite raster coordinates within +-2^21 pixels"));
 }
 
+// The checks of a triangle before it is rasterised: throws for a corner that is not finite, and for one too
+// far from the grid (kMaxCoordinate) when the triangle's box reaches the grid; false when it does not (or the
+// grid is empty), so the triangle covers no pixel.
+inline bool touchesGrid(const RasterGrid& grid, const glm::vec2& p0, const glm::vec2& p1,
+                        const glm::vec2& p2) {
+    const glm::vec2* corners[3] = {&p0, &p1, &p2};
+    for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(corners[k]->x) || !std::isfinite(corners[k]->y)) throwBadVertex(k, *corners[k]);
+    }
+    if (grid.width <= 0 || grid.height <= 0) return false;
+    // Pixel centres lie in [0.5, size - 0.5]; snapping moves a vertex by at most 1/512 pixel.
+    const float minX = std::min({p0.x, p1.x, p2.x}), maxX = std::max({p0.x, p1.x, p2.x});
+    const float minY = std::min({p0.y, p1.y, p2.y}), maxY = std::max({p0.y, p1.y, p2.y});
+    if (maxX < 0.0f || maxY < 0.0f || minX > static_cast<float>(grid.width) ||
+        minY > static_cast<float>(grid.height)) {
+        return false;
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (std::abs(corners[k]->x) > kMaxCoordinate || std::abs(corners[k]->y) > kMaxCoordinate)
+            throwBadVertex(k, *corners[k]);
+    }
+    return true;
+}
+
 }  // namespace rasterizer_detail
 
 // The barycentrics rasterizeTriangle hands its visitor, as a function of the pixel: from the unsnapped
@@ -104,24 +128,7 @@ template <class Visit>
 void rasterizeTriangleRows(const RasterGrid& grid, int32_t rowBegin, int32_t rowEnd, const glm::vec2& p0,
                            const glm::vec2& p1, const glm::vec2& p2, Visit&& visit) {
     namespace rd = rasterizer_detail;
-    const glm::vec2* corners[3] = {&p0, &p1, &p2};
-    for (int k = 0; k < 3; ++k) {
-        if (!std::isfinite(corners[k]->x) || !std::isfinite(corners[k]->y))
-            rd::throwBadVertex(k, *corners[k]);
-    }
-    if (grid.width <= 0 || grid.height <= 0) return;
-    // Pixel centres lie in [0.5, size - 0.5]; snapping moves a vertex by at most 1/512 pixel.
-    const float minX = std::min({p0.x, p1.x, p2.x}), maxX = std::max({p0.x, p1.x, p2.x});
-    const float minY = std::min({p0.y, p1.y, p2.y}), maxY = std::max({p0.y, p1.y, p2.y});
-    if (maxX < 0.0f || maxY < 0.0f || minX > static_cast<float>(grid.width) ||
-        minY > static_cast<float>(grid.height)) {
-        return;
-    }
-    for (int k = 0; k < 3; ++k) {
-        if (std::abs(corners[k]->x) > rd::kMaxCoordinate || std::abs(corners[k]->y) > rd::kMaxCoordinate) {
-            rd::throwBadVertex(k, *corners[k]);
-        }
-    }
+    if (!rd::touchesGrid(grid, p0, p1, p2)) return;
 
     rd::FixedPoint v0 = rd::snap(p0), v1 = rd::snap(p1), v2 = rd::snap(p2);
     const int64_t area = rd::edgeFunction(v0, v1, v2);
@@ -193,16 +200,8 @@ void rasterizeTrianglesInBands(const RasterGrid& grid, int32_t count, Corners&& 
     glm::vec2 p[3];
     for (int32_t t = 0; t < count; ++t) {
         corners(t, p[0], p[1], p[2]);
-        for (int k = 0; k < 3; ++k)
-            if (!std::isfinite(p[k].x) || !std::isfinite(p[k].y)) rd::throwBadVertex(k, p[k]);
-        const float minX = std::min({p[0].x, p[1].x, p[2].x}), maxX = std::max({p[0].x, p[1].x, p[2].x});
+        if (!rd::touchesGrid(grid, p[0], p[1], p[2])) continue;
         const float minY = std::min({p[0].y, p[1].y, p[2].y}), maxY = std::max({p[0].y, p[1].y, p[2].y});
-        if (maxX < 0.0f || maxY < 0.0f || minX > static_cast<float>(grid.width) ||
-            minY > static_cast<float>(grid.height))
-            continue;
-        for (int k = 0; k < 3; ++k)
-            if (std::abs(p[k].x) > rd::kMaxCoordinate || std::abs(p[k].y) > rd::kMaxCoordinate)
-                rd::throwBadVertex(k, p[k]);
         const auto lastRow = static_cast<float>(grid.height - 1);
         const auto first = static_cast<int32_t>(std::clamp(std::floor(minY) - 1.0f, 0.0f, lastRow));
         const auto last = static_cast<int32_t>(std::clamp(std::ceil(maxY) + 1.0f, 0.0f, lastRow));
