@@ -4,7 +4,7 @@
 // image of the deformed mesh, the warm-started solve and the redirect map; frame 1 (the rest pose, which
 // starts the shot) is left out of the medians.
 //
-// BM_UvWarpFrame/T/schedule: schedule 0 = the default SolverOptions (4 iterations of sweeps {4, 8, 8}),
+// BM_UvWarpFrame/T/schedule: schedule 0 = the default SolverOptions (4 iterations, sweeps by grid size),
 // 1 = uvwarp::liveOptions(1024), the live preset at 1024^2: one iteration of sweeps {1, 1, 10} per frame on
 // at most 4 levels (the paper's per-frame figure is one iteration, UV-13), 2 = liveOptions(2048): one
 // iteration of {1, 1, 2, 8} on at most 5 levels; both with the coarse levels over-relaxed by 1.4 and the

@@ -242,7 +242,6 @@ def test_bad_input_names_what_is_wrong():
                                 ("tolerance", 2.0, "tolerance: is 2.0"),
                                 ("warm_start", 1, r"warm_start: is 1 \(expected true or false\)"),
                                 ("warm_start", None, r"warm_start: is a NoneType \(expected true or false\)"),
-                                ("sweeps_per_level", [], r"sweeps_per_level: is \[\]"),
                                 ("sweeps_per_level", [0, 0], r"sweeps_per_level: is \[0, 0\].*not all 0"),
                                 ("sweeps_per_level", [1, -2], r"sweeps_per_level: is \[1, -2\]"),
                                 ("sweeps_per_level", [1, "a"], "sweeps_per_level: is a list holding a str"),

@@ -71,6 +71,7 @@ const OptionSpec kSpecs[] = {
     {.name = "sweepsPerLevel",
      .type = OptionType::IntegerList,
      .high = 1000,
+     .zeroMeans = "by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048",
      .meaning = "Constraint-projection sweeps (all 8 parallel sets) per iteration at each hierarchy level, "
                 "finest first; levels beyond the list use its last value.",
      .solver = true,
@@ -263,10 +264,12 @@ bool validOptionValue(const OptionSpec& spec, const OptionValue& value) {
         case OptionType::Flag:
             return value.kind == OptionValue::Kind::Boolean && value.numbers.size() == 1;
         case OptionType::IntegerList:
-            return value.kind == OptionValue::Kind::List && !value.numbers.empty() &&
+            // Empty: the library's choice (zeroMeans); else not all 0.
+            return value.kind == OptionValue::Kind::List &&
                    std::all_of(value.numbers.begin(), value.numbers.end(),
                                [&](double v) { return validOptionNumber(spec, v); }) &&
-                   std::any_of(value.numbers.begin(), value.numbers.end(), [](double v) { return v > 0; });
+                   (value.numbers.empty() ||
+                    std::any_of(value.numbers.begin(), value.numbers.end(), [](double v) { return v > 0; }));
         case OptionType::Integer:
         case OptionType::Number:
             break;
@@ -300,8 +303,12 @@ void checkEveryOption(const TileWarpOptions& options, std::string_view source, b
 }
 
 std::string optionDefaultText(const OptionSpec& spec) {
-    const std::string library = valueText(spec, spec.get(TileWarpOptions{}));
-    const std::string shot = valueText(spec, spec.get(shotOptions()));
+    const auto shown = [&](const TileWarpOptions& o) {
+        const std::vector<double> v = spec.get(o);
+        return spec.type == OptionType::IntegerList && v.empty() ? std::string("empty") : valueText(spec, v);
+    };
+    const std::string library = shown(TileWarpOptions{});
+    const std::string shot = shown(shotOptions());
     std::string text = library;
     if (shot != library) text += "; in a shot: " + shot;
     return text;
@@ -337,8 +344,8 @@ std::string expectedValue(const OptionSpec& spec) {
         case OptionType::Flag:
             return "true or false";
         case OptionType::IntegerList:
-            return "a non-empty list of whole numbers from " + low + " to " + number(spec.high) +
-                   ", not all 0";
+            return "a list of whole numbers from " + number(spec.low) + " to " + number(spec.high) +
+                   ", not all 0; empty: " + std::string(spec.zeroMeans);
         case OptionType::Integer:
             if (spec.powerOfTwo) return low + " or a power of two from 2 to " + number(spec.high) + unit;
             return "a whole number from " + low + " to " + number(spec.high) + unit;

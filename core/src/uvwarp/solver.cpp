@@ -340,8 +340,7 @@ struct Solver::Impl : detail::SolverState {
     }
 
     int32_t sweepsAt(size_t level) const {
-        if (options.sweepsPerLevel.empty()) return 1;
-        return options.sweepsPerLevel[std::min(level, options.sweepsPerLevel.size() - 1)];
+        return sweeps[std::min(level, sweeps.size() - 1)];
     }
 
     // One iteration; returns the largest distance a point moved, in fine-grid uv units.
@@ -389,14 +388,17 @@ struct Solver::Impl : detail::SolverState {
         // regularisation, and the neighbours' mean (untangle) does not always repair what they fold: points
         // of triangles still folded go back to where the iteration found them (velU, velV), so every
         // iteration ends fold-free and a point the steps fight over stops moving (UV-16).
-        stats.revertedPoints += detail::revertFolds(*this, velU.data(), velV.data());
-        // Step 5: integration. The largest move is a max, the same whatever the order: bit-identical for
-        // any thread count.
+        const detail::FoldRepair repair = detail::revertFolds(*this, velU.data(), velV.data());
+        stats.revertedPoints += repair.reverted;
+        stats.shortenedSteps += repair.shortened ? 1 : 0;
+        // Step 5: integration, without velocities after a repair that spread (revertFolds). The largest move
+        // is a max, the same whatever the order: bit-identical for any thread count.
+        const float keepVelocity = repair.restart ? 0.0f : 1.0f;
         const float largest = maxOverMovable(finest, [&](int32_t i, int32_t j) {
             const size_t k = finest.index(i, j);
             const float du = grid.u[k] - velU[k], dv = grid.v[k] - velV[k];
-            velU[k] = du;
-            velV[k] = dv;
+            velU[k] = keepVelocity * du;
+            velV[k] = keepVelocity * dv;
             return du * du + dv * dv;
         });
         return std::sqrt(largest);
@@ -533,6 +535,7 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     m.source = source;
     m.options = options;
     m.cells = restGeometry.cells;
+    m.sweeps = options.sweepsPerLevel.empty() ? defaultSweeps(m.cells) : options.sweepsPerLevel;
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "a power of two, at least 2"));
@@ -610,9 +613,15 @@ std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
             {"levels", Kind::Count, static_cast<double>(s.levels)},
             {"untangled_points", Kind::Count, static_cast<double>(s.untangledPoints)},
             {"reverted_points", Kind::Count, static_cast<double>(s.revertedPoints)},
+            {"shortened_steps", Kind::Count, static_cast<double>(s.shortenedSteps)},
             {"remaining_folds", Kind::Count, static_cast<double>(s.remainingFolds)},
             {"last_move", Kind::Number, static_cast<double>(s.lastMove)},
             {"converged", Kind::Flag, s.converged ? 1.0 : 0.0}};
+}
+
+std::vector<int32_t> defaultSweeps(int32_t cells) {
+    if (cells <= 1024) return {4, 8, 16};
+    return {4, 8, 16, 32, 64};
 }
 
 SolverOptions liveOptions(int32_t cells) {
@@ -645,6 +654,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;
     m.stats.revertedPoints = 0;
+    m.stats.shortenedSteps = 0;
     m.stats.iterations = 0;
     m.stats.lastMove = 0.0f;
     m.stats.converged = false;

@@ -75,10 +75,17 @@ struct Level {
     [[nodiscard]] bool movable(size_t k) const { return rigidity[k] >= 0.0f; }
 };
 
+// A point revertFolds put back, and where it was.
+struct RevertedPoint {
+    size_t index;
+    float u, v;
+};
+
 struct SolverState {
     std::string source;
     SolverOptions options;
     int32_t cells = 0;
+    std::vector<int32_t> sweeps;  // options.sweepsPerLevel, or the grid's default schedule when that is empty
     std::vector<Level> levels;
     WarpGrid grid;
     // Velocities; between prediction and integration they hold the positions before the prediction (of the
@@ -90,8 +97,9 @@ struct SolverState {
     const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
     std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
     std::vector<int32_t> untangleNext;
-    std::vector<int32_t> rowFolds;  // per cell row of the scan: triangles at or near zero area
-    int32_t foldsLeft = 0;          // folded triangles of the finest grid after the last revertFolds
+    std::vector<RevertedPoint> revertLog;  // scratch of revertFolds()
+    std::vector<int32_t> rowFolds;         // per cell row of the scan: triangles at or near zero area
+    int32_t foldsLeft = 0;                 // folded triangles of the finest grid after the last revertFolds
     // Folded triangles of the finest grid's cells outside its cellRuns (constant: their corners may not
     // move); < 0: to be counted (after setMaps changes which points may move).
     int32_t fixedFolds = 0;
@@ -111,10 +119,19 @@ void findSetRuns(Level& level);
 // moves.
 int32_t untangle(SolverState& state, const Level& level);
 
-// Makes the finest grid fold-free whatever the steps of an iteration did (solver_folds.cpp): the corners of
-// every triangle with non-positive area that moved since (oldU, oldV), a fold-free state, go back there,
-// spreading to the neighbours until no triangle is folded. Returns the number of points put back, and sets
-// foldsLeft to the grid's folded triangles (countFolds) without another scan of the whole grid.
-int32_t revertFolds(SolverState& state, const float* oldU, const float* oldV);
+// What revertFolds did: points put back, or the whole step shortened; restart: the repair spread, and the
+// velocities are to be dropped.
+struct FoldRepair {
+    int32_t reverted = 0;
+    bool shortened = false;
+    bool restart = false;
+};
+
+// Makes the finest grid fold-free whatever the steps of an iteration did (solver_folds.cpp), from (oldU,
+// oldV), a fold-free state: the corners of every triangle with non-positive area that moved go back there,
+// spreading to the neighbours until no triangle is folded, or, when that spreads over a share of the moved
+// points, every point goes 0.9 of the way to where the first triangle would fold. Sets foldsLeft
+// to the grid's folded triangles (countFolds) without another scan of the whole grid.
+FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV);
 
 }  // namespace deformkit::uvwarp::detail

@@ -414,10 +414,7 @@ void setRedirectOption(RedirectInputs& in, const RedirectOptionAttribute& attrib
             value.numbers.push_back(x);
             i = end;
         }
-        if (value.kind == Kind::List && value.numbers.empty()) {
-            value.kind = Kind::Other;
-            value.shown = quoted(text) + ", which lists no number";
-        }
+        // No number (the default, ""): the library's choice, as an empty list anywhere.
     }
     uvwarp::setOption(in.options, *attribute.spec, value, "dkUvRedirect", attribute.spec->name);
 }

@@ -563,7 +563,8 @@ TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named
         CAPTURE(name);
         REQUIRE(a.spec == &spec);
         const std::vector<double> value = spec.get(defaults);
-        const double first = value.front();
+        const double first =
+            value.empty() ? 0.0 : value.front();  // empty: sweepsPerLevel's automatic schedule
         // A value in range other than the default, and values just outside the range.
         double inRange = 0.0, above = spec.high + 1.0, below = spec.lowOpen ? spec.low : spec.low - 1.0;
         std::string text;
@@ -587,7 +588,7 @@ TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named
                 break;
             case uvwarp::OptionType::IntegerList:
                 CHECK(a.kind == Kind::Text);
-                CHECK(a.text == "4 8 8");
+                CHECK(a.text.empty());  // sweepsPerLevel: the library's schedule by the grid's size
                 text = "2, 3 5";
                 break;
         }
@@ -613,7 +614,9 @@ TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named
             refused(0, "4 -1");
             refused(0, "0 0");
             refused(0, "4 x 8");
-            refused(0, "  ");
+            maya::RedirectInputs automatic = base;  // no number: the library's schedule, as the default
+            maya::setRedirectOption(automatic, a, 0, "  ");
+            CHECK(spec.get(automatic.options).empty());
         } else if (spec.type != uvwarp::OptionType::Flag) {
             refused(above, "");
             refused(below, "");

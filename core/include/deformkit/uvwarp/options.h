@@ -23,7 +23,7 @@ enum class OptionType {
     Integer,      // a whole number
     Number,       // a real number, kept as float32
     Flag,         // true or false
-    IntegerList,  // a non-empty list of whole numbers, not all 0
+    IntegerList,  // a list of whole numbers, not all 0; empty: the library's choice (zeroMeans)
 };
 
 struct OptionSpec {
@@ -87,7 +87,8 @@ void checkOptions(const SolverOptions& options, std::string_view source);
 
 // The library's presets: every option's value for a use, by name in every interface (`--preset live`,
 // "preset": "live", preset="live", the Maya node's preset attribute).
-//   shot  the default schedule (4 iterations of sweeps {4, 8, 8}), each frame from the identity: what a shot
+//   shot  the default schedule (4 iterations, sweeps by the grid's size), each frame from the identity: what
+//   a shot
 //         written as files runs (shotOptions()).
 //   live  one warm-started iteration a frame, for a live preview: liveOptions(cells), whose schedule depends
 //         on the grid's size.

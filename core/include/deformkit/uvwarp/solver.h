@@ -32,8 +32,9 @@ struct SolverOptions {
     // warm-started frame of a smooth animation then pays for the iterations its change needs.
     float tolerance = 0.0f;
     // Constraint-projection sweeps (all 8 parallel sets) per iteration at each level, finest first; levels
-    // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion.
-    std::vector<int32_t> sweepsPerLevel = {4, 8, 8};
+    // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion. Empty
+    // (the default): by the grid's size, defaultSweeps(cells).
+    std::vector<int32_t> sweepsPerLevel;
     // Orientation preservation in [0, 1] (§4.2): after projection a segment is turned this fraction of the
     // way back towards its canonical direction (0°, 45°, 90°, 135°). Multiplied by the optional map.
     float orientationPreservation = 0.05f;
@@ -65,6 +66,12 @@ struct SolverOptions {
     bool operator==(const SolverOptions&) const = default;
 };
 
+// The default schedule (SolverOptions::sweepsPerLevel empty) of a grid of `cells` cells per side: {4, 8, 16}
+// up to 1024 cells; from 2048, where rigid detail spans more cells and the hierarchy is deeper, the sweeps
+// double with each coarser level up to 64, {4, 8, 16, 32, 64}, so that the rigid stretch removed on a fully
+// covered tile stays within 2 points from 2048^2 to 8192^2 (docs/decisions.md UV-19).
+[[nodiscard]] std::vector<int32_t> defaultSweeps(int32_t cells);
+
 // The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the
 // coarse levels over-relaxed by 1.4, sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
 // {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 1, 10} at 1024, {1, 1, 2, 8} from 2048) and, from 1024 cells, no
@@ -86,6 +93,9 @@ struct SolveStats {
     // Points put back to where their iteration found them because a triangle around them stayed folded
     // (every iteration ends fold-free).
     int32_t revertedPoints = 0;
+    // Iterations whose whole step was shortened to the fold-free part of it instead (putting points back
+    // would have undone more of the iteration's motion: large smooth steps of a large grid).
+    int32_t shortenedSteps = 0;
     int32_t remainingFolds = 0;  // grid triangles left with non-positive area (both cell splittings)
     int32_t threads = 0;         // OpenMP threads of the last iteration
 };
@@ -139,7 +149,7 @@ class Solver {
 };
 
 // The figures of the last solve as hosts report them after the warp's (metrics.h): iterations, levels,
-// untangled_points, reverted_points, remaining_folds, last_move, converged.
+// untangled_points, reverted_points, shortened_steps, remaining_folds, last_move, converged.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const SolveStats& s);
 
 // Number of grid triangles with signed area <= 0, counting both diagonal splittings of every cell.
