@@ -201,7 +201,7 @@ struct RedirectInputs {
 
 // The attribute of one UV-warp option (uvwarp/options.h): named as declared (camelCase, the short name the
 // same), an int, double or boolean attribute with the library's default, or for a list a string of whole
-// numbers separated by spaces or commas ("4 8 8").
+// numbers separated by spaces or commas ("4 8 16"; empty: the library's choice).
 struct RedirectOptionAttribute {
     enum class Kind { Int, Double, Boolean, Text };
     const uvwarp::OptionSpec* spec = nullptr;
