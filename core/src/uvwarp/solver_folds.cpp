@@ -375,12 +375,7 @@ FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV)
     }
     // The folds left (countFolds of the grid): those of the cells that never change, and of the marked rows'
     // other cells (a triangle changes only when a corner goes back).
-    if (state.fixedFolds < 0) {
-        int32_t inRuns = 0;
-        for (int32_t j = 0; j < c; ++j)
-            inRuns += countInRuns(state, level, j, 0.0f);
-        state.fixedFolds = countFolds(state.grid) - inRuns;
-    }
+    if (state.fixedFolds < 0) state.fixedFolds = countFolds(state.grid) - foldsInRuns(state);
     int32_t left = state.fixedFolds;
     for (int32_t j = 0; j < c; ++j) {
         if (counts[j] != 0) left += countInRuns(state, level, j, 0.0f);
