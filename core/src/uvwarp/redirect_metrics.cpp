@@ -150,14 +150,23 @@ struct RedirectMetrics::Impl {
 
     // Whether r lies on a UV triangle: the same answer as locate() >= 0, quicker. The texel's own triangle
     // `own` and then r's bucket are tried with a margin (a sure yes); only a point near an edge is located.
-    [[nodiscard]] bool onChart(int32_t own, glm::dvec2 r) const {
-        if (insideWithMargin(own, r)) return true;
+    // `hint`, when given, is the entry of bucketTriangles that answered the last call: neighbouring texels'
+    // content mostly lies in the same triangle, so it is tried first when r falls in the same bucket (the
+    // same answer, since the bucket's loop would reach it).
+    [[nodiscard]] bool onChart(int32_t own, glm::dvec2 r, int32_t* hint = nullptr) const {
         const auto cell = [&](double c) {
             return std::clamp(static_cast<int32_t>(std::floor(c * buckets)), 0, buckets - 1);
         };
         const int32_t b = cell(r.y) * buckets + cell(r.x);
-        for (int32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k)
-            if (insideWithMargin(bucketTriangles[k], r)) return true;
+        if (hint && *hint >= bucketStart[b] && *hint < bucketStart[b + 1] &&
+            insideWithMargin(bucketTriangles[*hint], r))
+            return true;
+        if (insideWithMargin(own, r)) return true;
+        for (int32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k) {
+            if (!insideWithMargin(bucketTriangles[k], r)) continue;
+            if (hint) *hint = k;
+            return true;
+        }
         glm::dvec3 bary;
         return locate(r, bary) >= 0;
     }
@@ -334,12 +343,13 @@ bool RedirectMetrics::mayShow(int32_t x, int32_t y, glm::dvec2 r) const {
 void RedirectMetrics::refusedInRow(const io::Image& redirect, int32_t y,
                                    std::vector<int32_t>& refused) const {
     const Impl& m = *impl_;
+    int32_t hint = -1;
     for (int64_t run = m.rowRunBegin[y]; run < m.rowRunBegin[y + 1]; ++run) {
         const int32_t own = m.runTriangle[run];
         if (own < 0) continue;
         const int32_t end = run + 1 < m.rowRunBegin[y + 1] ? m.runStart[run + 1] : m.texels;
         for (int32_t x = m.runStart[run]; x < end; ++x)
-            if (!m.onChart(own, detail::redirectAt(redirect, x, y))) refused.push_back(x);
+            if (!m.onChart(own, detail::redirectAt(redirect, x, y), &hint)) refused.push_back(x);
     }
 }
 
