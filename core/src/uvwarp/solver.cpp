@@ -343,6 +343,29 @@ struct Solver::Impl : detail::SolverState {
         return sweeps[std::min(level, sweeps.size() - 1)];
     }
 
+    // Whether the last iteration's fold repair spread (FoldRepair::restart).
+    bool lastRepairSpread = false;
+
+    // Up to `planned` iterations (fewer once converged), counted into stats.
+    void run(int32_t planned) {
+        const int32_t allowed = omp_get_max_threads();
+        stats.converged = false;
+        for (int32_t n = 0; n < planned && !stats.converged; ++n) {
+            const int32_t team =
+                options.threads > 0 ? std::min(options.threads, allowed) : this->team.next(allowed);
+            omp_set_num_threads(team);
+            const auto start = std::chrono::steady_clock::now();
+            stats.lastMove = iterate() * static_cast<float>(cells);
+            if (options.threads == 0)
+                this->team.record(
+                    team, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+            stats.threads = team;
+            ++stats.iterations;
+            stats.converged = options.tolerance > 0.0f && stats.lastMove <= options.tolerance;
+        }
+        omp_set_num_threads(allowed);
+    }
+
     // One iteration; returns the largest distance a point moved, in fine-grid uv units.
     float iterate() {
         const float keep = 1.0f - options.damping;
@@ -391,6 +414,7 @@ struct Solver::Impl : detail::SolverState {
         const detail::FoldRepair repair = detail::revertFolds(*this, velU.data(), velV.data());
         stats.revertedPoints += repair.reverted;
         stats.shortenedSteps += repair.shortened ? 1 : 0;
+        lastRepairSpread = repair.restart;
         // Step 5: integration, without velocities after a repair that spread (revertFolds). The largest move
         // is a max, the same whatever the order: bit-identical for any thread count.
         const float keepVelocity = repair.restart ? 0.0f : 1.0f;
@@ -614,6 +638,7 @@ std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
             {"untangled_points", Kind::Count, static_cast<double>(s.untangledPoints)},
             {"reverted_points", Kind::Count, static_cast<double>(s.revertedPoints)},
             {"shortened_steps", Kind::Count, static_cast<double>(s.shortenedSteps)},
+            {"cold_restart", Kind::Flag, s.coldRestart ? 1.0 : 0.0},
             {"remaining_folds", Kind::Count, static_cast<double>(s.remainingFolds)},
             {"last_move", Kind::Number, static_cast<double>(s.lastMove)},
             {"converged", Kind::Flag, s.converged ? 1.0 : 0.0}};
@@ -655,27 +680,21 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     m.stats.untangledPoints = 0;
     m.stats.revertedPoints = 0;
     m.stats.shortenedSteps = 0;
+    m.stats.coldRestart = false;
     m.stats.iterations = 0;
     m.stats.lastMove = 0.0f;
     m.stats.converged = false;
-    const auto cells = static_cast<float>(m.cells);
-    const int32_t allowed = omp_get_max_threads();
-    const int32_t planned =
-        m.fromIdentity && m.options.coldIterations > 0 ? m.options.coldIterations : m.options.iterations;
-    while (m.stats.iterations < planned && !m.stats.converged) {
-        const int32_t team =
-            m.options.threads > 0 ? std::min(m.options.threads, allowed) : m.team.next(allowed);
-        omp_set_num_threads(team);
-        const auto start = std::chrono::steady_clock::now();
-        m.stats.lastMove = m.iterate() * cells;
-        if (m.options.threads == 0)
-            m.team.record(team,
-                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        m.stats.threads = team;
-        ++m.stats.iterations;
-        m.stats.converged = m.options.tolerance > 0.0f && m.stats.lastMove <= m.options.tolerance;
+    const int32_t cold = m.options.coldIterations > 0 ? m.options.coldIterations : m.options.iterations;
+    const bool warm = !m.fromIdentity;
+    m.run(warm ? m.options.iterations : cold);
+    // A jam (UV-34): the warm start's last iteration ended with a fold repair that spread. The last frame's
+    // warp folds under this frame's motion, and frames after it would stay jammed; the frame is solved
+    // again from the identity, as after a cut.
+    if (warm && m.stats.iterations > 0 && m.lastRepairSpread) {
+        reset();
+        m.stats.coldRestart = true;
+        m.run(cold);
     }
-    omp_set_num_threads(allowed);
     if (m.stats.iterations > 0) m.fromIdentity = false;
     // After an iteration the fold revert has counted them; otherwise the grid is scanned.
     m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);

@@ -1,4 +1,6 @@
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <catch2/catch.hpp>
 
@@ -6,6 +8,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/inversion.h"
 #include "deformkit/uvwarp/mask.h"
+#include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/tile_warp.h"
 
 using namespace deformkit;
@@ -254,4 +257,43 @@ TEST_CASE(
     CHECK(delivered.invertedTriangles == 0);
     CHECK(delivered.offChartTexels == 0);
     CHECK(delivered.removed > 0.69);
+}
+
+TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as after a cut",
+          "[uvwarp][invariants]") {
+    // The live preset (one warm-started iteration a frame) on the Fox running at 512^2: where the last
+    // frame's warp folds under the new pose, the iteration's fold repair spreads, and the frame is solved
+    // again from the identity (SolveStats::coldRestart). Such a frame's warp is, byte for byte, what a solver
+    // that never saw the frames before it gives; the others keep their warm start.
+    const geom::Mesh fox = io::readObj(DEFORMKIT_TEST_DATA "/fox/rest.obj").mesh;
+    const io::Image rigidity = foxDisks(fox, 512);
+    const uvwarp::TileWarpOptions live = uvwarp::presetOptions(uvwarp::Preset::Live, 512);
+    uvwarp::TileWarp warp(fox, 1001, rigidity, {}, live);
+    int restarts = 0;
+    for (int f = 1; f <= 24; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "/fox/anim.%04d.obj", f);
+        const io::ObjContent posed = io::readObj(std::string(DEFORMKIT_TEST_DATA) + name);
+        const std::vector<glm::vec3> points(posed.mesh.points().begin(), posed.mesh.points().end());
+        warp.solve(points);
+        CHECK(warp.stats().remainingFolds == 0);
+        if (f == 1 || !warp.stats().coldRestart) continue;
+        ++restarts;
+        INFO("frame " << f);
+        CHECK(warp.stats().iterations == live.solver.iterations + live.solver.coldIterations);
+        uvwarp::TileWarp fresh(fox, 1001, rigidity, {}, live);
+        fresh.solve(points);
+        CHECK(warp.warp().u == fresh.warp().u);
+        CHECK(warp.warp().v == fresh.warp().v);
+    }
+    CHECK(restarts > 0);
+
+    // A smooth stretch keeps its warm start on every frame.
+    const geom::Mesh plane = uvPlane(16);
+    uvwarp::TileWarp smooth(plane, 1001, diskRigidity(128), {},
+                            uvwarp::presetOptions(uvwarp::Preset::Live, 128));
+    for (int f = 0; f < 24; ++f) {
+        smooth.solve(stretched(plane, 1.0f + 0.5f * static_cast<float>(f) / 23.0f));
+        CHECK_FALSE(smooth.stats().coldRestart);
+    }
 }

@@ -56,7 +56,8 @@ struct SolverOptions {
     // another process on a core) all threads are never slower than one; n > 0 uses min(n, allowed). The
     // warp is the same, byte for byte, whatever the choice.
     int32_t threads = 0;
-    // Warm start (paper §4.1, temporal coherence): each solve starts from the last warp. false: each solve
+    // Warm start (paper §4.1, temporal coherence): each solve starts from the last warp, unless that start
+    // jams (SolveStats::coldRestart: the frame is then solved again from the identity). false: each solve
     // starts from the identity, so a frame's warp depends on that frame's inputs alone, not on the frames
     // solved before it (a farm chunk's maps are then an uninterrupted run's, byte for byte, with no warm-up
     // frames; docs/decisions.md UV-20). The default schedule reaches the same quality either way.
@@ -83,7 +84,7 @@ struct SolverOptions {
 
 // Figures from the last solve.
 struct SolveStats {
-    int32_t iterations = 0;  // iterations run by the last solve
+    int32_t iterations = 0;  // iterations run by the last solve (those before a cold restart included)
     // Largest distance a point moved in the last iteration, in grid cells, and whether it was within
     // SolverOptions::tolerance (false when the tolerance is 0).
     float lastMove = 0.0f;
@@ -96,6 +97,10 @@ struct SolveStats {
     // Iterations whose whole step was shortened to the fold-free part of it instead (putting points back
     // would have undone more of the iteration's motion: large smooth steps of a large grid).
     int32_t shortenedSteps = 0;
+    // Whether a warm-started solve jammed and was solved again from the identity: its last iteration's fold
+    // repair spread (more than 1/256 of the moved points put back, or the step shortened), which a warm start
+    // that folds under the frame's motion does frame after frame (docs/decisions.md UV-34).
+    bool coldRestart = false;
     int32_t remainingFolds = 0;  // grid triangles left with non-positive area (both cell splittings)
     int32_t threads = 0;         // OpenMP threads of the last iteration
 };
@@ -149,7 +154,7 @@ class Solver {
 };
 
 // The figures of the last solve as hosts report them after the warp's (metrics.h): iterations, levels,
-// untangled_points, reverted_points, shortened_steps, remaining_folds, last_move, converged.
+// untangled_points, reverted_points, shortened_steps, cold_restart, remaining_folds, last_move, converged.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const SolveStats& s);
 
 // Number of grid triangles with signed area <= 0, counting both diagonal splittings of every cell.
