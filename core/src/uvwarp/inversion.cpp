@@ -361,18 +361,22 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                 }
                 for (int32_t i = i0; i < i1; ++i) {
                     if (identity[i - i0]) {
-                        // Texel rows size - (j + 1) r .. size - j r - 1 (raster y runs down), within the
-                        // band.
+                        // A run of still cells i .. end - 1, drawn in its turn: texel rows size - (j + 1) r
+                        // .. size - j r - 1 (raster y runs down) within the band, columns i r .. end r - 1.
+                        int32_t end = i + 1;
+                        while (end < i1 && identity[end - i0])
+                            ++end;
                         const int32_t yFirst = std::max(y0, size - (j + 1) * ratio);
                         const int32_t yLast = std::min(y1, size - j * ratio);
                         for (int32_t y = yFirst; y < yLast; ++y) {
-                            float* texel =
-                                out + (static_cast<size_t>(y) * size + static_cast<size_t>(i) * ratio) * 2;
-                            for (int32_t x = i * ratio; x < (i + 1) * ratio; ++x, texel += 2) {
-                                texel[0] = centreU[x];
-                                texel[1] = centreV[y];
+                            float* __restrict texel = out + static_cast<size_t>(y) * size * 2;
+                            const float v = centreV[y];
+                            for (int32_t x = i * ratio; x < end * ratio; ++x) {
+                                texel[2 * x] = centreU[x];
+                                texel[2 * x + 1] = v;
                             }
                         }
+                        i = end - 1;
                         continue;
                     }
                     const RasterPoint &p00 = lowerRow[i - i0], &p10 = lowerRow[i - i0 + 1];
