@@ -96,7 +96,8 @@ geom::Mesh coveredPlane() {
 std::vector<glm::vec3> pose(const geom::Mesh& mesh, float amount = 1.0f) {
     std::vector<glm::vec3> out;
     for (const glm::vec3& p : mesh.points())
-        out.emplace_back(p.x * (1.0f + 0.4f * amount * p.x), p.y, 0.05f * amount * std::sin(6.2831853f * p.y));
+        out.emplace_back(p.x * (1.0f + 0.4f * amount * p.x), p.y,
+                         0.05f * amount * std::sin(6.2831853f * p.y));
     return out;
 }
 
@@ -207,7 +208,8 @@ void BM_UvWarpCoveredLiveFrame(benchmark::State& state) {
                 restarts += live.stats().coldRestart ? 1 : 0;
             }
             for (size_t p = 0; p < std::size(kProbes); ++p)
-                if (kProbes[p] == f) worstGap = std::max(worstGap, shot[p] - 100.0 * live.measure(map).removed);
+                if (kProbes[p] == f)
+                    worstGap = std::max(worstGap, shot[p] - 100.0 * live.measure(map).removed);
         }
     }
     const double target = texels >= 2048 ? 141.0 : 33.0;
