@@ -151,9 +151,10 @@ struct RedirectMetrics::Impl {
     // Whether r lies on a UV triangle: the same answer as locate() >= 0, quicker. The texel's own triangle
     // `own` and then r's bucket are tried with a margin (a sure yes); only a point near an edge is located.
     // `hint`, when given, is the entry of bucketTriangles that answered the last call: neighbouring texels'
-    // content mostly lies in the same triangle, so it is tried first when r falls in the same bucket (the
-    // same answer, since the bucket's loop would reach it).
+    // content mostly lies in the same triangle, so after `own` it is tried first when r falls in the same
+    // bucket (the same answer, since the bucket's loop would reach it).
     [[nodiscard]] bool onChart(int32_t own, glm::dvec2 r, int32_t* hint = nullptr) const {
+        if (insideWithMargin(own, r)) return true;
         const auto cell = [&](double c) {
             return std::clamp(static_cast<int32_t>(std::floor(c * buckets)), 0, buckets - 1);
         };
@@ -161,7 +162,6 @@ struct RedirectMetrics::Impl {
         if (hint && *hint >= bucketStart[b] && *hint < bucketStart[b + 1] &&
             insideWithMargin(bucketTriangles[*hint], r))
             return true;
-        if (insideWithMargin(own, r)) return true;
         for (int32_t k = bucketStart[b]; k < bucketStart[b + 1]; ++k) {
             if (!insideWithMargin(bucketTriangles[k], r)) continue;
             if (hint) *hint = k;
