@@ -176,7 +176,8 @@ const OptionSpec kSpecs[] = {
      .type = OptionType::Flag,
      .meaning = "Start each solve from the last frame's warp, as a live preview does (the paper's temporal "
                 "coherence), instead of from the identity. It changes only where a solve starts, not the "
-                "schedule: iterations and sweeps stay as set (a live preset sets those). Off, a frame's "
+                "schedule: iterations and sweeps stay as set (a live preset sets those); a frame whose warm "
+                "start jams (its fold repair spreads) is solved again from the identity. Off, a frame's "
                 "maps depend on that frame alone, whatever range of frames a job covers.",
      .solver = true,
      .get = SolverMember<&SolverOptions::warmStart>::get,
