@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -264,12 +265,16 @@ TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as
     // The live preset (one warm-started iteration a frame) on the Fox running at 512^2: where the last
     // frame's warp folds under the new pose, the iteration's fold repair spreads, and the frame is solved
     // again from the identity (SolveStats::coldRestart). Such a frame's warp is, byte for byte, what a solver
-    // that never saw the frames before it gives; the others keep their warm start.
+    // that never saw the frames before it gives; the others keep their warm start. The worst frame's rigid
+    // stretch removed, on the delivered map, stays above 65% (67.9% measured; 52.7% when jammed frames kept
+    // their warm start; the shot preset's worst frame 68.8%).
     const geom::Mesh fox = io::readObj(DEFORMKIT_TEST_DATA "/fox/rest.obj").mesh;
     const io::Image rigidity = foxDisks(fox, 512);
     const uvwarp::TileWarpOptions live = uvwarp::presetOptions(uvwarp::Preset::Live, 512);
     uvwarp::TileWarp warp(fox, 1001, rigidity, {}, live);
     int restarts = 0;
+    double worst = 1.0;
+    io::Image map;
     for (int f = 1; f <= 24; ++f) {
         char name[32];
         std::snprintf(name, sizeof name, "/fox/anim.%04d.obj", f);
@@ -277,16 +282,19 @@ TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as
         const std::vector<glm::vec3> points(posed.mesh.points().begin(), posed.mesh.points().end());
         warp.solve(points);
         CHECK(warp.stats().remainingFolds == 0);
+        warp.redirect(map);
+        worst = std::min(worst, warp.measure(map).removed);
         if (f == 1 || !warp.stats().coldRestart) continue;
         ++restarts;
         INFO("frame " << f);
         CHECK(warp.stats().iterations == live.solver.iterations + live.solver.coldIterations);
         uvwarp::TileWarp fresh(fox, 1001, rigidity, {}, live);
         fresh.solve(points);
-        CHECK(warp.warp().u == fresh.warp().u);
-        CHECK(warp.warp().v == fresh.warp().v);
+        const bool same = warp.warp().u == fresh.warp().u && warp.warp().v == fresh.warp().v;
+        CHECK(same);
     }
     CHECK(restarts > 0);
+    CHECK(worst > 0.65);
 
     // A smooth stretch keeps its warm start on every frame.
     const geom::Mesh plane = uvPlane(16);
