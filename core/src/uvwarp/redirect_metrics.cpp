@@ -43,8 +43,14 @@ glm::dvec3 barycentricIn(const std::array<glm::vec2, 3>& t, glm::dvec2 p) {
     return {1.0 - l1 - l2, l1, l2};
 }
 
-// Connected components of UV triangles sharing an edge, UVs welded by value: the charts.
-std::vector<int32_t> chartsOf(const detail::TileUVs& uvs) {
+// UV triangles sharing an edge, UVs welded by value: the charts (connected components), and per triangle the
+// triangle across the edge opposite each corner (-1 none; where more than two share an edge, the last two).
+struct Adjacency {
+    std::vector<int32_t> chart;
+    std::vector<std::array<int32_t, 3>> across;
+};
+
+Adjacency adjacencyOf(const detail::TileUVs& uvs) {
     const size_t n = uvs.uvs.size();
     std::vector<int32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0);
@@ -68,19 +74,29 @@ std::vector<int32_t> chartsOf(const detail::TileUVs& uvs) {
             return std::hash<uint64_t>()(e.a * 0x9E3779B97F4A7C15ULL ^ e.b);
         }
     };
-    std::unordered_map<EdgeKey, int32_t, EdgeHash> firstUse;
+    struct Use {
+        int32_t triangle, opposite;  // the triangle, and its corner opposite the edge
+    };
+    Adjacency out;
+    out.across.assign(n, {-1, -1, -1});
+    std::unordered_map<EdgeKey, Use, EdgeHash> lastUse;
     for (size_t t = 0; t < n; ++t) {
         for (int k = 0; k < 3; ++k) {
             uint64_t a = key(uvs.uvs[t][k]), b = key(uvs.uvs[t][(k + 1) % 3]);
             if (a > b) std::swap(a, b);
-            const auto [it, inserted] = firstUse.emplace(EdgeKey{a, b}, static_cast<int32_t>(t));
-            if (!inserted) parent[find(static_cast<int32_t>(t))] = find(it->second);
+            const Use use{static_cast<int32_t>(t), (k + 2) % 3};
+            const auto [it, inserted] = lastUse.emplace(EdgeKey{a, b}, use);
+            if (inserted) continue;
+            parent[find(use.triangle)] = find(it->second.triangle);
+            out.across[t][use.opposite] = it->second.triangle;
+            out.across[it->second.triangle][it->second.opposite] = use.triangle;
+            it->second = use;
         }
     }
-    std::vector<int32_t> chart(n);
+    out.chart.resize(n);
     for (size_t t = 0; t < n; ++t)
-        chart[t] = find(static_cast<int32_t>(t));
-    return chart;
+        out.chart[t] = find(static_cast<int32_t>(t));
+    return out;
 }
 
 // What a texel shows: where it sits on the deformed surface, and its content's rest position and rigidity,
@@ -107,7 +123,8 @@ struct RedirectMetrics::Impl {
     std::string source;
     int32_t texels = 0;
     detail::TileUVs uvs;
-    std::vector<int32_t> chart;  // per UV triangle
+    std::vector<int32_t> chart;                  // per UV triangle
+    std::vector<std::array<int32_t, 3>> across;  // per UV triangle, Adjacency::across
     // Per UV triangle: corner a and the rows of the inverse of (b - a, c - a), for mayShow's quick test.
     std::vector<std::array<glm::dvec2, 3>> inverse;
     // Per texel, the UV triangle its centre lies in (-1 none), run-length coded per row: row y holds runs r
@@ -138,23 +155,37 @@ struct RedirectMetrics::Impl {
         return -1;
     }
 
-    // Whether r lies in UV triangle t with a margin far beyond this test's rounding: a quick yes before
-    // locate() (most content comes from the texel's own triangle).
-    [[nodiscard]] bool insideWithMargin(int32_t t, glm::dvec2 r) const {
+    // Barycentric coordinates of r in UV triangle t (those of corners 1 and 2), for the quick tests below.
+    [[nodiscard]] glm::dvec2 quickBarycentric(int32_t t, glm::dvec2 r) const {
         const auto& [a, row0, row1] = inverse[static_cast<size_t>(t)];
         const glm::dvec2 p = r - a;
-        const double l1 = row0.x * p.x + row0.y * p.y, l2 = row1.x * p.x + row1.y * p.y;
+        return {row0.x * p.x + row0.y * p.y, row1.x * p.x + row1.y * p.y};
+    }
+    // Whether barycentric coordinates l (corners 1 and 2) lie inside their triangle with a margin far
+    // beyond this test's rounding: a sure yes before locate().
+    static bool insideWithMargin(glm::dvec2 l) {
         constexpr double kMargin = 1e-6;
-        return l1 >= kMargin && l2 >= kMargin && l1 + l2 <= 1.0 - kMargin;
+        return l.x >= kMargin && l.y >= kMargin && l.x + l.y <= 1.0 - kMargin;
+    }
+    [[nodiscard]] bool insideWithMargin(int32_t t, glm::dvec2 r) const {
+        return insideWithMargin(quickBarycentric(t, r));
     }
 
-    // Whether r lies on a UV triangle: the same answer as locate() >= 0, quicker. The texel's own triangle
-    // `own` and then r's bucket are tried with a margin (a sure yes); only a point near an edge is located.
-    // `hint`, when given, is the entry of bucketTriangles that answered the last call: neighbouring texels'
-    // content mostly lies in the same triangle, so after `own` it is tried first when r falls in the same
-    // bucket (the same answer, since the bucket's loop would reach it).
+    // Whether r lies on a UV triangle: the same answer as locate() >= 0, quicker. Each test below is a sure
+    // yes (r inside a triangle with a margin, where the bucket's loop would find it too); only a point near
+    // an edge reaches locate(). First the texel's own triangle `own`, then a short walk from it across the
+    // edge r lies furthest beyond (content moved a few texels mostly lies in a neighbour), then r's bucket.
+    // `hint`, when given, is the entry of bucketTriangles that answered the last bucket search: neighbouring
+    // texels' content mostly lies in the same triangle, so it is tried first when r falls in the same bucket.
     [[nodiscard]] bool onChart(int32_t own, glm::dvec2 r, int32_t* hint = nullptr) const {
-        if (insideWithMargin(own, r)) return true;
+        constexpr int32_t kWalkSteps = 3;
+        for (int32_t t = own, step = 0; t >= 0 && step <= kWalkSteps; ++step) {
+            const glm::dvec2 l = quickBarycentric(t, r);
+            if (insideWithMargin(l)) return true;
+            const double l0 = 1.0 - l.x - l.y;
+            const int32_t beyond = l0 <= l.x ? (l0 <= l.y ? 0 : 2) : (l.x <= l.y ? 1 : 2);
+            t = across[static_cast<size_t>(t)][beyond];
+        }
         const auto cell = [&](double c) {
             return std::clamp(static_cast<int32_t>(std::floor(c * buckets)), 0, buckets - 1);
         };
@@ -253,7 +284,9 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
     }
     m.texels = rigidity.width;
     setRigidity(rigidity);
-    m.chart = chartsOf(m.uvs);
+    Adjacency adjacency = adjacencyOf(m.uvs);
+    m.chart = std::move(adjacency.chart);
+    m.across = std::move(adjacency.across);
     m.inverse.reserve(m.uvs.uvs.size());
     for (const auto& tri : m.uvs.uvs) {
         const glm::dvec2 a(tri[0]), e0 = glm::dvec2(tri[1]) - a, e1 = glm::dvec2(tri[2]) - a;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/io/image.h"
+#include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/html_report.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
 #include "deformkit/uvwarp/shot_job.h"
@@ -226,6 +228,73 @@ TEST_CASE("delivered texels: a stretched plane's closed form, and folds and off-
             CHECK(texels.chart.at(x, y, 0) == (x < kT / 2 ? 1.0f : 0.0f));
             CHECK(texels.offChart.at(x, y, 0) == (x == 2 && y == 8 ? 1.0f : 0.0f));
         }
+}
+
+TEST_CASE(
+    "off-chart scan: refusedInRow lists the chart texels whose content lies on no UV triangle, on "
+    "Spot's charts over random maps",
+    "[uvwarp][report]") {
+    constexpr int kT = 256;
+    constexpr double kClear = 1e-5;  // barycentric margin beyond which the reference's verdict is taken
+    const geom::Mesh spot = io::readObj(DEFORMKIT_TEST_DATA "/spot/spot_quadrangulated.obj").mesh;
+    // The reference, apart from the library: each face's UV polygon fanned from its first corner, and a
+    // point's largest smallest-barycentric over every triangle (> 0 inside one, < 0 outside all).
+    std::vector<std::array<glm::dvec2, 3>> triangles;
+    for (int f = 0; f < spot.numFaces(); ++f) {
+        const auto uv = spot.faceUVIndices(f);
+        for (size_t k = 1; k + 1 < uv.size(); ++k)
+            triangles.push_back({glm::dvec2(spot.uvs()[uv[0]]), glm::dvec2(spot.uvs()[uv[k]]),
+                                 glm::dvec2(spot.uvs()[uv[k + 1]])});
+    }
+    const auto depth = [&](glm::dvec2 p) {
+        double best = -1e300;
+        for (const auto& [a, b, c] : triangles) {
+            const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+            if (area == 0.0) continue;
+            const double lb = ((p.x - a.x) * (c.y - a.y) - (p.y - a.y) * (c.x - a.x)) / area;
+            const double lc = ((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)) / area;
+            best = std::max(best, std::min({1.0 - lb - lc, lb, lc}));
+        }
+        return best;
+    };
+    const io::Image rigid(kT, kT, 1, 0.0f);
+    const uvwarp::RedirectMetrics metrics(spot, 1001, rigid);
+    std::mt19937 rng(20261205);
+    int64_t refusedTotal = 0, keptTotal = 0, compared = 0, skipped = 0;
+    // Content moved up to 0.5, 2, 8 and 40 texels in random directions: within the own triangle, a few
+    // triangles on (the walk across edges), and far off, across charts and into the empty tile.
+    for (const double reach : {0.5, 2.0, 8.0, 40.0}) {
+        std::uniform_real_distribution<double> offset(-reach / kT, reach / kT);
+        io::Image map = identityMap(kT);
+        for (int y = 0; y < kT; ++y)
+            for (int x = 0; x < kT; ++x) {
+                map.at(x, y, 0) += static_cast<float>(offset(rng));
+                map.at(x, y, 1) += static_cast<float>(offset(rng));
+            }
+        for (int y = 0; y < kT; y += 7) {  // every seventh row: the reference loops over every triangle
+            std::vector<int32_t> refused;
+            metrics.refusedInRow(map, y, refused);
+            REQUIRE(std::is_sorted(refused.begin(), refused.end()));
+            for (int x = 0; x < kT; ++x) {
+                const double own = depth({(x + 0.5) / kT, 1.0 - (y + 0.5) / kT});
+                const double content = depth({map.at(x, y, 0), map.at(x, y, 1)});
+                if (std::abs(own) < kClear || std::abs(content) < kClear) {
+                    ++skipped;  // a centre or content on a triangle's edge: either verdict is right
+                    continue;
+                }
+                const bool listed = std::binary_search(refused.begin(), refused.end(), x);
+                INFO("reach " << reach << " texel " << x << ", " << y);
+                CHECK(listed == (own > 0.0 && content < 0.0));
+                ++compared;
+                refusedTotal += listed ? 1 : 0;
+                keptTotal += own > 0.0 && !listed ? 1 : 0;
+            }
+        }
+    }
+    INFO("refused " << refusedTotal << ", kept " << keptTotal << ", skipped " << skipped);
+    CHECK(refusedTotal > 1000);  // the cases were met
+    CHECK(keptTotal > 10000);
+    CHECK(skipped * 1000 < compared);
 }
 
 TEST_CASE(
