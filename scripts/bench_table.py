@@ -14,6 +14,7 @@ REFERENCES = {
     "BM_BvhClosestPoint": ("BM_BruteForceClosestPoint", "BVH / brute-force closest point"),
     "BM_BvhRayCast": ("BM_BruteForceRayCast", "BVH / brute-force ray cast"),
     "BM_BarrEvaluateEngine": ("BM_BarrEvaluate", "generic engine / fast path"),
+    "BM_BarrDeform": ("BM_BarrEvaluate", "deform (input checked finite, as hosts and Python call it) / evaluate"),
     "BM_WiresEngineEvaluate": ("BM_WiresEvaluate", "generic engine / fast path"),
     "BM_FfdEvaluatePortable": ("BM_FfdEvaluate", "portable kernel / runtime-selected kernel"),
     "BM_FfdBSplineEvaluate": ("BM_FfdEvaluate", "B-spline / Bernstein evaluate (requirement: at most 2)"),

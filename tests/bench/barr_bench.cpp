@@ -1,6 +1,8 @@
 // Barr taper, twist and bend on a 1,001,000-vertex grid: bind and evaluate timed apart. Evaluate runs the
 // direct path with all threads and with one (the speed-up), and the generic engine path (per-point
-// transformations through evaluateWarp) as the in-run reference the direct path is measured against.
+// transformations through evaluateWarp) as the in-run reference the direct path is measured against;
+// BM_BarrDeform is the checked call a host or the Python module's bound evaluate makes
+// (scripts/bench_python.py's reference for it).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -80,6 +82,21 @@ void BM_BarrEvaluate1Thread(benchmark::State& state) {
     evaluateDirect(state, true);
 }
 
+// What a host pays for a bound warp: AxialWarp::deform, the evaluate with its check of the points
+// (finite coordinates) and the envelope; the path the Python module's bound evaluate and the hosts take.
+void BM_BarrDeform(benchmark::State& state) {
+    const int kind = static_cast<int>(state.range(0));
+    auto warp = makeWarp(kind);
+    warp->bind(grid());
+    std::vector<glm::vec3> out(grid().size());
+    for (auto _ : state) {
+        warp->deform(grid(), out, {}, 1.0f);
+        benchmark::DoNotOptimize(out.data());
+    }
+    setLabel(state, kind);
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid().size()));
+}
+
 // The generic path: per-point transformations (the paper's per-point sampling) + Eq. 3.
 void BM_BarrEvaluateEngine(benchmark::State& state) {
     const int kind = static_cast<int>(state.range(0));
@@ -101,6 +118,7 @@ void BM_BarrEvaluateEngine(benchmark::State& state) {
 
 BENCHMARK(BM_BarrBind)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3);
 BENCHMARK(BM_BarrEvaluate)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime();
+BENCHMARK(BM_BarrDeform)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime();
 BENCHMARK(BM_BarrEvaluate1Thread)
     ->DenseRange(0, 2)
     ->Unit(benchmark::kMillisecond)

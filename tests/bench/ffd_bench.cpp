@@ -1,7 +1,9 @@
 // FFD (paper §4.1) with 4x4x4 control points (divisions 3, 3, 3) on a 1,000,000-vertex grid: bind (local
 // coordinates cached) and evaluate (a new target lattice) timed apart; evaluate on all threads and on one,
 // so the table shows the speed-up; the portable kernel (no AVX2), the B-spline variant and FFD with frames
-// beside it. scripts/bench_blender.py builds the same grid and lattice in Blender.
+// beside it; BM_FfdEvaluateInto, input and output apart, is the call of the Python module's bound evaluate
+// (scripts/bench_python.py's reference for it). scripts/bench_blender.py builds the same grid and lattice in
+// Blender.
 #include <benchmark/benchmark.h>
 
 #include <omp.h>
@@ -93,6 +95,21 @@ void BM_FfdEvaluate(benchmark::State& state) {
     evaluateLoop(state, ffd, 0);
 }
 
+// The call the Python module's bound evaluate with out= makes: input and output apart (points read, the
+// caller's buffer written), no weights, envelope 1.
+void BM_FfdEvaluateInto(benchmark::State& state) {
+    const Input& in = input();
+    Ffd ffd(in.lattice);
+    ffd.setTargets(in.target);
+    ffd.bind(in.rest);
+    std::vector<glm::vec3> out(in.rest.size());
+    for (auto _ : state) {
+        ffd.evaluate(in.rest, out, {}, 1.0f);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(in.rest.size()));
+}
+
 void BM_FfdEvaluate1Thread(benchmark::State& state) {
     Ffd ffd(input().lattice);
     ffd.setTargets(input().target);
@@ -132,6 +149,7 @@ void BM_FfdSetTargets(benchmark::State& state) {
 BENCHMARK(BM_FfdBind)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdBSplineBind)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FfdEvaluateInto)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluate1Thread)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdEvaluatePortable)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FfdBSplineEvaluate)->Unit(benchmark::kMillisecond)->UseRealTime();
