@@ -2,15 +2,19 @@
 0.025 of the tile on a 0.1 lattice, kept inside the UV charts) are painted into a rigidity map and, as red dots
 on a grey grid, into a texture; `deformkit uvwarp` solves the shot (shot preset) and bakes the texture through
 each redirect map; `deformkit preview` renders the chosen frame with the texture as painted (<name>_before.png)
-and as baked (<name>_after.png). With --crop, <name>_texture.png puts a window of the texture as painted beside
-the same window baked at that frame, in texture space.
+and as baked (<name>_after.png).
 
     suzanne  Suzanne bent and twisted by keyed modifiers (tests/data/suzanne), 512^2, frame 6
     fox      the rigged Fox running (tests/data/fox), 1024^2, frame 19 (its skinning's largest area change)
+    ceiling  the model's ceiling (fox_ceiling.png): the Fox at frame 18 of its Run, 256^2, the disk its skinning
+             squashes most, as painted, through the PBD solve's map and through the map of the model's
+             optimum (bench_uvwarp_reference --maps: Levenberg-Marquardt to convergence); prints each disk's
+             area as shown over its rest area, for the three, worst disks first
 
 Usage, from the repository's root:
 
-    python3 scripts/uvwarp_pictures.py build/bin/deformkit [--python build/python] [--keep DIR] [suzanne] [fox]"""
+    python3 scripts/uvwarp_pictures.py build/bin/deformkit [--python build/python] [--keep DIR]
+        [--bench build/bin/bench_uvwarp_reference] [suzanne] [fox] [ceiling]"""
 import argparse
 import os
 import subprocess
@@ -19,7 +23,7 @@ import tempfile
 
 import numpy as np
 
-from uvwarp_rigged_figures import chart_texels
+from uvwarp_rigged_figures import chart_texels, surface_at_texels
 
 SHOTS = {
     "suzanne": dict(rest="tests/data/suzanne/suzanne.0001.obj", deformed="tests/data/suzanne/suzanne.####.obj",
@@ -69,19 +73,118 @@ def make(name, shot, deformkit, dk, images, keep):
                            check=True)
 
 
+def texel_areas(surface):
+    """(t, t): the surface area a texel spans (forward differences), 0 at chart borders and off the charts."""
+    dx, dy = np.zeros_like(surface), np.zeros_like(surface)
+    dx[:, :-1] = surface[:, 1:] - surface[:, :-1]
+    dy[:-1] = surface[1:] - surface[:-1]
+    area = np.linalg.norm(np.cross(dx, dy), axis=-1)
+    area[~np.isfinite(area)] = 0
+    return area
+
+
+def label_disks(rigid):
+    """(t, t) int: each 4-connected region of rigid texels numbered from 0, -1 elsewhere; and their count."""
+    t = rigid.shape[0]
+    label = -np.ones(rigid.shape, int)
+    count = 0
+    for y0, x0 in zip(*np.nonzero(rigid)):
+        if label[y0, x0] >= 0:
+            continue
+        label[y0, x0] = count
+        stack = [(y0, x0)]
+        while stack:
+            y, x = stack.pop()
+            for yy, xx in ((y + 1, x), (y - 1, x), (y, x + 1), (y, x - 1)):
+                if 0 <= yy < t and 0 <= xx < t and rigid[yy, xx] and label[yy, xx] < 0:
+                    label[yy, xx] = count
+                    stack.append((yy, xx))
+        count += 1
+    return label, count
+
+
+def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
+    """fox_ceiling.png and the per-disk areas (see the module's docstring)."""
+    rest = dk.read_mesh("tests/data/fox/rest.obj")
+    posed = f"tests/data/fox/anim.{frame:04d}.obj"
+    with tempfile.TemporaryDirectory() as scratch:
+        work = keep or scratch
+        os.makedirs(work, exist_ok=True)
+        subprocess.run([bench, "--maps", work, f"--benchmark_filter=BM_UvWarpReference/1/{frame}/{t}/"],
+                       check=True, stdout=subprocess.DEVNULL)
+        stem = os.path.join(work, f"reference_1_{frame}_{t}_")
+        rigid = dk.read_image(stem + "rigidity.exr")[..., 0] >= 0.5
+        maps = {name: dk.read_image(stem + name + ".exr") for name in ("pbd", "optimum")}
+        # Each disk's area as the deformed surface shows it (the texels whose content lies in it) over its area
+        # at rest: 1 is its rest size.
+        label, disks = label_disks(rigid)
+        rest_area = texel_areas(surface_at_texels(rest, rest.points, t))
+        posed_area = texel_areas(surface_at_texels(rest, dk.read_mesh(posed).points, t))
+        at_rest = np.array([rest_area[label == d].sum() for d in range(disks)])
+        ratio = {"painted": np.array([posed_area[label == d].sum() for d in range(disks)]) / at_rest}
+        for name, m in maps.items():
+            x = np.clip(np.floor(m[..., 0] * t).astype(int), 0, t - 1)
+            y = np.clip(np.floor((1 - m[..., 1]) * t).astype(int), 0, t - 1)
+            content = label[y, x]
+            ratio[name] = np.array([posed_area[content == d].sum() for d in range(disks)]) / at_rest
+        print(f"{disks} disks; area shown / rest area, worst disks (by the optimum) first:")
+        for d in np.argsort(-np.abs(np.log(ratio["optimum"])))[:6]:
+            print(f"  disk of {(label == d).sum():3d} texels: painted {ratio['painted'][d]:.2f}, "
+                  f"PBD {ratio['pbd'][d]:.2f}, optimum {ratio['optimum'][d]:.2f}")
+        # The texture at `shown`^2 (disks where the rigidity map is rigid), the maps read bilinearly between
+        # their texel centres, the texture bilinearly through them.
+        yy, xx = np.mgrid[0:shown, 0:shown]
+        u, v = (xx + 0.5) / shown, 1 - (yy + 0.5) / shown
+        centres = np.arange(0.05, 1, 0.1)
+        distance = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
+        disk = rigid[yy * t // shown, xx * t // shown] & (distance < 0.025)
+        texture = np.full((shown, shown, 3), 0.72, np.float32)
+        texture[((xx % 32) == 0) | ((yy % 32) == 0)] = 0.45
+        texture[disk] = (0.85, 0.12, 0.1)
+        texture[disk & (distance < 0.012)] = (1.0, 0.85, 0.2)
+
+        def bilinear(image, x, y):
+            x = np.clip(x, 0, image.shape[1] - 1.001)
+            y = np.clip(y, 0, image.shape[0] - 1.001)
+            x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+            fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+            return (image[y0, x0] * (1 - fx) * (1 - fy) + image[y0, x0 + 1] * fx * (1 - fy)
+                    + image[y0 + 1, x0] * (1 - fx) * fy + image[y0 + 1, x0 + 1] * fx * fy)
+
+        panels = {"painted": texture}
+        for name, m in maps.items():
+            r = bilinear(m, (xx + 0.5) * t / shown - 0.5, (yy + 0.5) * t / shown - 0.5)
+            panels[name] = bilinear(texture, r[..., 0] * shown - 0.5, (1 - r[..., 1]) * shown - 0.5).astype(np.float32)
+        views = []
+        for name, image in panels.items():
+            path = os.path.join(work, f"ceiling_{name}.png")
+            dk.write_image(path, image)
+            out = os.path.join(work, f"view_{name}.png")
+            subprocess.run([deformkit, "preview", posed, "--texture", path, "--out", out, "--width", "320",
+                            "--height", "320", "--view", "-1,-0.3,0.2", "--frame", "4,38,-42,22,60,-16"],
+                           check=True, stdout=subprocess.DEVNULL)
+            views.append(dk.read_image(out))
+        dk.write_image(os.path.join(images, "fox_ceiling.png"), np.concatenate(views, 1))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("deformkit")
     parser.add_argument("--python", default="build/python")
     parser.add_argument("--keep", help="folder to keep the maps, texture and bakes in (default: a temporary one)")
-    parser.add_argument("shots", nargs="*", default=list(SHOTS))
+    parser.add_argument("--bench", default="build/bin/bench_uvwarp_reference",
+                        help="bench_uvwarp_reference, for the ceiling picture")
+    parser.add_argument("shots", nargs="*", default=list(SHOTS) + ["ceiling"])
     args = parser.parse_intermixed_args()
     sys.path.insert(0, os.path.abspath(args.python))
     import deformkit as dk
     images = os.path.join("docs", "images", "uvwarp")
     for name in args.shots:
         keep = os.path.join(args.keep, name) if args.keep else None
-        make(name, SHOTS[name], os.path.abspath(args.deformkit), dk, images, keep)
+        if name == "ceiling":
+            ceiling(os.path.abspath(args.bench), os.path.abspath(args.deformkit), dk, images, keep)
+        else:
+            make(name, SHOTS[name], os.path.abspath(args.deformkit), dk, images, keep)
 
 
 if __name__ == "__main__":

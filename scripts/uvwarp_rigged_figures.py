@@ -15,32 +15,39 @@ import time
 import numpy as np
 
 
-def chart_texels(mesh, t):
-    """(t, t) bool: texel centres (row 0 at v = 1) inside a UV triangle of the mesh's faces (fans)."""
-    uv = mesh.uvs.astype(np.float64)
-    inside = np.zeros((t, t), bool)
+def surface_at_texels(mesh, points, t):
+    """(t, t, 3): the surface point (mesh vertices moved to `points`) under each texel centre, NaN off the charts."""
+    uv, p = mesh.uvs.astype(np.float64), points.astype(np.float64)
+    out = np.full((t, t, 3), np.nan)
     offset = 0
     for count in mesh.face_counts:
-        corners = mesh.uv_indices[offset:offset + count]
+        vertex = mesh.face_indices[offset:offset + count]
+        corner = mesh.uv_indices[offset:offset + count]
         offset += count
         for k in range(1, count - 1):
-            a, b, c = uv[corners[0]], uv[corners[k]], uv[corners[k + 1]]
+            ids = (0, k, k + 1)
+            a, b, c = (uv[corner[i]] for i in ids)
             lo = np.floor(np.minimum.reduce([a, b, c]) * t).astype(int)
             hi = np.ceil(np.maximum.reduce([a, b, c]) * t).astype(int)
             xs, ys = np.arange(max(lo[0], 0), min(hi[0], t)), np.arange(max(t - hi[1], 0), min(t - lo[1], t))
-            if not len(xs) or not len(ys):
-                continue
-            x, y = np.meshgrid(xs, ys)
-            p = np.stack([(x + 0.5) / t, 1 - (y + 0.5) / t], -1) - a
             e0, e1 = b - a, c - a
             den = e0[0] * e1[1] - e1[0] * e0[1]
-            if den == 0:
+            if not len(xs) or not len(ys) or den == 0:
                 continue
-            l1 = (p[..., 0] * e1[1] - e1[0] * p[..., 1]) / den
-            l2 = (e0[0] * p[..., 1] - p[..., 0] * e0[1]) / den
+            x, y = np.meshgrid(xs, ys)
+            q = np.stack([(x + 0.5) / t, 1 - (y + 0.5) / t], -1) - a
+            l1 = (q[..., 0] * e1[1] - e1[0] * q[..., 1]) / den
+            l2 = (e0[0] * q[..., 1] - q[..., 0] * e0[1]) / den
             ok = (l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)
-            inside[y[ok], x[ok]] = True
-    return inside
+            value = ((1 - l1 - l2)[..., None] * p[vertex[ids[0]]] + l1[..., None] * p[vertex[ids[1]]]
+                     + l2[..., None] * p[vertex[ids[2]]])
+            out[y[ok], x[ok]] = value[ok]
+    return out
+
+
+def chart_texels(mesh, t):
+    """(t, t) bool: texel centres (row 0 at v = 1) inside a UV triangle of the mesh's faces (fans)."""
+    return np.isfinite(surface_at_texels(mesh, mesh.points, t)[..., 0])
 
 
 def rigid_disks(inside, t):

@@ -12,16 +12,22 @@
 // = the rigged Fox (tests/data/fox), pose = a frame of its Run clip (18: the one that keeps least of its
 // rigid stretch removed, where skinning collapses a triangle at a front leg to 12% of its area). The default
 // schedule from the identity.
+// With --maps DIR (before the benchmark's own flags) each case also writes, for pictures
+// (scripts/uvwarp_pictures.py ceiling): reference_<model>_<pose>_<cells>_rigidity.exr (the painted disks),
+// _pbd.exr and _optimum.exr (the two redirect maps as delivered, fold-repaired).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "deformkit/geom/mesh.h"
+#include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/inversion.h"
@@ -36,6 +42,8 @@ namespace {
 
 using namespace deformkit;
 using namespace deformkit::uvwarp;
+
+std::filesystem::path mapsFolder;  // --maps: where the maps are written (empty: nowhere)
 
 // Rigid disks of radius 0.025 on a 0.1 lattice, kept where the whole disk texel's 3 x 3 lies in a chart.
 io::Image disksInCharts(const io::Image& mask, int32_t t) {
@@ -129,6 +137,13 @@ void BM_UvWarpReference(benchmark::State& state) {
         state.counters["inverted_pbd"] = static_cast<double>(pbdRepair.invertedFound);
         state.counters["inverted_optimum"] = static_cast<double>(bestRepair.invertedFound);
         state.counters["lm_iterations"] = best.iterations;
+        if (!mapsFolder.empty()) {
+            const std::string stem = "reference_" + std::to_string(model) + "_" + std::to_string(pose) + "_" +
+                                     std::to_string(n) + "_";
+            io::writeImage(mapsFolder / (stem + "rigidity.exr"), disks);
+            io::writeImage(mapsFolder / (stem + "pbd.exr"), pbdMap);
+            io::writeImage(mapsFolder / (stem + "optimum.exr"), bestMap);
+        }
     }
 }
 BENCHMARK(BM_UvWarpReference)
@@ -144,4 +159,21 @@ BENCHMARK(BM_UvWarpReference)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+    // --maps DIR, taken out before Google Benchmark reads the rest.
+    int kept = 1;
+    for (int k = 1; k < argc; ++k) {
+        if (std::strcmp(argv[k], "--maps") == 0 && k + 1 < argc) {
+            mapsFolder = argv[++k];
+            std::filesystem::create_directories(mapsFolder);
+        } else {
+            argv[kept++] = argv[k];
+        }
+    }
+    argc = kept;
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
