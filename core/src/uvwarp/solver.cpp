@@ -354,11 +354,18 @@ struct Solver::Impl : detail::SolverState {
             const int32_t team =
                 options.threads > 0 ? std::min(options.threads, allowed) : this->team.next(allowed);
             omp_set_num_threads(team);
+            const bool chosen = options.threads == 0;
+            const double cpuBefore = chosen && team > 1 ? detail::teamCpuSeconds() : 0.0;
             const auto start = std::chrono::steady_clock::now();
             stats.lastMove = iterate() * static_cast<float>(cells);
-            if (options.threads == 0)
-                this->team.record(
-                    team, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+            if (chosen) {
+                const double seconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                const double share = team > 1 && seconds > 0.0
+                                         ? (detail::teamCpuSeconds() - cpuBefore) / (seconds * team)
+                                         : 1.0;
+                this->team.record(team, seconds, share);
+            }
             stats.threads = team;
             ++stats.iterations;
             stats.converged = options.tolerance > 0.0f && stats.lastMove <= options.tolerance;

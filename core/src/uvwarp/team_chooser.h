@@ -14,6 +14,15 @@
 // most 128), and again after 8 once the choice changes. A try costs at most one run at the slower size; a
 // short job (a cold frame's few iterations) pays none on a quiet machine, where one thread is about twice as
 // slow, and at most 8 runs of all threads next to other work, where they are about 1.25 times as slow as one.
+//
+// One thread is tried only while all threads do not get their cores: their CPU time over a run
+// (teamCpuSeconds) below kQuietShare of the team's wall time, as a running mean. On a quiet machine they get
+// them (0.96 to 1.0 measured; a core another process holds: 0.5 to 0.86), one thread could only be slower,
+// and a try would cost a frame of a live preset about twice its time, now and then; so a quiet machine never
+// pays it.
+
+#include <omp.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -33,16 +42,20 @@ class TeamChooser {
         }
         if (all_ == 1) return 1;
         if (meanAll_ < 0.0) return all_;
-        if (meanOne_ < 0.0) return sinceTry_ >= tryEvery_ ? 1 : all_;  // one thread first timed after 8 runs
+        const bool quiet = meanShare_ >= kQuietShare;  // all threads get their cores: no try of one
+        if (meanOne_ < 0.0) return sinceTry_ >= tryEvery_ && !quiet ? 1 : all_;  // first timed after 8 runs
         const int32_t best = chosen();
-        if (sinceTry_ >= tryEvery_) return best == 1 ? all_ : 1;  // try the other one
+        if (sinceTry_ >= tryEvery_ && (best == 1 || !quiet))
+            return best == 1 ? all_ : 1;  // try the other one
         return best;
     }
 
-    // The time one run took with `team` threads.
-    void record(int32_t team, double seconds) {
+    // The time one run took with `team` threads, and (all threads) the share of the team's wall time they
+    // ran: their CPU time / (seconds x team), teamCpuSeconds() before and after the run.
+    void record(int32_t team, double seconds, double cpuShare) {
         if (all_ == 1) return;
         const bool one = team == 1;
+        if (!one) meanShare_ = meanShare_ < 0.0 ? cpuShare : 0.5 * meanShare_ + 0.5 * cpuShare;
         double& mean = one ? meanOne_ : meanAll_;
         const int32_t before = chosen();
         const bool trying = meanAll_ >= 0.0 && meanOne_ >= 0.0 && team != before;
@@ -70,9 +83,26 @@ class TeamChooser {
     // All threads are chosen when their mean time is below this fraction of one thread's (on a quiet
     // machine it is about 0.55 with 2 threads).
     static constexpr double kAllFaster = 0.8;
+    // All threads count as getting their cores from this share of the team's wall time on (running mean).
+    static constexpr double kQuietShare = 0.9;
     int32_t all_ = 1;
+    double meanShare_ = -1.0;                 // all threads' CPU share; < 0: not measured yet
     double meanAll_ = -1.0, meanOne_ = -1.0;  // seconds per run; < 0: not timed yet
     int32_t sinceTry_ = 0, tryEvery_ = kFirstTryEvery;
 };
+
+// The CPU time the threads of the current team (omp_get_max_threads()) have used so far, summed: the
+// difference over a run, divided by its wall time and the team size, is the share TeamChooser::record takes.
+// The pool's threads run every region of a team of that size, so they are the threads of the run.
+inline double teamCpuSeconds() {
+    double sum = 0.0;
+#pragma omp parallel reduction(+ : sum)
+    {
+        timespec now{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+        sum += static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+    }
+    return sum;
+}
 
 }  // namespace deformkit::uvwarp::detail
