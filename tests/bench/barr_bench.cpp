@@ -2,7 +2,7 @@
 // direct path with all threads and with one (the speed-up), and the generic engine path (per-point
 // transformations through evaluateWarp) as the in-run reference the direct path is measured against;
 // BM_BarrDeform is the checked call a host or the Python module's bound evaluate makes
-// (scripts/bench_python.py's reference for it).
+// (scripts/bench_python.py's reference for it), BM_BarrDeformSmall the same on 110 points.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -97,6 +97,22 @@ void BM_BarrDeform(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid().size()));
 }
 
+// The same call on a 110-point grid (10 x 9 cells), where the work is next to nothing: what a call costs
+// around it (scripts/bench_python.py sets the Python module's same call against it).
+void BM_BarrDeformSmall(benchmark::State& state) {
+    const geom::Mesh mesh = geom::makeGrid({10, 9, 4.0f, 1.0f});
+    const std::vector<glm::vec3> points(mesh.points().begin(), mesh.points().end());
+    auto warp = makeWarp(0);
+    warp->bind(points);
+    std::vector<glm::vec3> out(points.size());
+    for (auto _ : state) {
+        warp->deform(points, out, {}, 1.0f);
+        benchmark::DoNotOptimize(out.data());
+    }
+    setLabel(state, 0);
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(points.size()));
+}
+
 // The generic path: per-point transformations (the paper's per-point sampling) + Eq. 3.
 void BM_BarrEvaluateEngine(benchmark::State& state) {
     const int kind = static_cast<int>(state.range(0));
@@ -119,6 +135,7 @@ void BM_BarrEvaluateEngine(benchmark::State& state) {
 BENCHMARK(BM_BarrBind)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3);
 BENCHMARK(BM_BarrEvaluate)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime();
 BENCHMARK(BM_BarrDeform)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime();
+BENCHMARK(BM_BarrDeformSmall)->Unit(benchmark::kMicrosecond)->MinTime(0.3)->UseRealTime();
 BENCHMARK(BM_BarrEvaluate1Thread)
     ->DenseRange(0, 2)
     ->Unit(benchmark::kMillisecond)
