@@ -6,20 +6,19 @@
 // the team size (every parallel loop of the solver gives the same bytes for any thread count), so the
 // choice changes only the time.
 //
-// The job runs on all threads for its first 8 runs, then once on one thread; from then on on one thread
-// unless all threads' recent time (a running mean) is clearly lower (by a fifth: next to other work all
-// threads are about as fast as one in most runs and much slower in a few, and a choice that followed the
-// near-ties would pay for those few), the other team being tried again now and then to notice a change (a
-// core taken or given back): after 8 runs, then after twice as many each time the try confirms the choice (at
-// most 128), and again after 8 once the choice changes. A try costs at most one run at the slower size; a
-// short job (a cold frame's few iterations) pays none on a quiet machine, where one thread is about twice as
-// slow, and at most 8 runs of all threads next to other work, where they are about 1.25 times as slow as one.
+// The job runs on all threads for its first 8 runs, then once on one thread (if all threads do not get their
+// cores, below); from then on on one thread unless all threads' recent time (a running mean) is clearly lower
+// (by a fifth: next to other work all threads are about as fast as one in most runs and much slower in a
+// few, and a choice that followed the near-ties would pay for those few), the other team being tried again
+// now and then to notice a change (a core taken or given back): after 8 runs, then after twice as many each
+// time the try confirms the choice (at most 128), and again after 8 once the choice changes. A try costs at
+// most one run at the slower size; a short job (a cold frame's few iterations) pays at most 8 runs of all
+// threads next to other work, where they are about 1.25 times as slow as one.
 //
 // One thread is tried only while all threads do not get their cores: their CPU time over a run
-// (teamCpuSeconds) below kQuietShare of the team's wall time, as a running mean. On a quiet machine they get
-// them (0.96 to 1.0 measured; a core another process holds: 0.5 to 0.86), one thread could only be slower,
-// and a try would cost a frame of a live preset about twice its time, now and then; so a quiet machine never
-// pays it.
+// (teamCpuSeconds) below kQuietShare of the team's wall time, as a running mean (UV-35). On a quiet machine
+// they get them (0.96 to 1.0 measured; a core another process holds: 0.5 to 0.86) and one thread is about
+// twice as slow: a try would cost a live preset's frame about twice its time, now and then, for nothing.
 
 #include <omp.h>
 #include <time.h>
