@@ -8,7 +8,8 @@
 //   (inverted and fold-repaired, measured by RedirectMetrics); inverted_pbd, inverted_optimum: the inverted
 //   triangles the fold repair found in each map (it delivers none).
 // BM_UvWarpReference/model/pose/cells: model 0 = Spot (its own UVs, rigid disks inside its charts), pose 0 =
-// stretched 1.4x along its length, 1 = bent 0.6 rad per unit along it (about 60 degrees end to end); model 1
+// stretched 1.4x along its length, 1 = bent 0.6 rad per unit along it (about 60 degrees end to end), 2 = bent
+// about its length as tests/python/test_uvwarp_spot.py bends it (0.6 rad per unit of z, 59 degrees); model 1
 // = the rigged Fox (tests/data/fox), pose = a frame of its Run clip (18: the one that keeps least of its
 // rigid stretch removed, where skinning collapses a triangle at a front leg to 12% of its area). The default
 // schedule from the identity.
@@ -74,6 +75,10 @@ std::vector<glm::vec3> posed(const geom::Mesh& mesh, int pose) {
     for (glm::vec3& q : p) {
         if (pose == 0) {
             q.x = centre.x + 1.4f * (q.x - centre.x);
+        } else if (pose ==
+                   2) {  // bent about its length: turned about x by 0.6 rad per unit of z (59 degrees)
+            const float a = 0.6f * (q.z - centre.z), y = q.y - centre.y;
+            q = {q.x, centre.y + y * std::cos(a), q.z + y * std::sin(a)};
         } else {  // bent about z, 0.6 rad per unit along x: the axis onto a circle of radius 1 / 0.6
             const float k = 0.6f, a = k * (q.x - centre.x), r = q.y - centre.y;
             q = {centre.x + std::sin(a) * (1.0f / k - r), centre.y + 1.0f / k - std::cos(a) * (1.0f / k - r),
@@ -151,6 +156,8 @@ BENCHMARK(BM_UvWarpReference)
     ->Args({0, 1, 128})
     ->Args({0, 0, 256})
     ->Args({0, 1, 256})
+    ->Args({0, 2, 128})
+    ->Args({0, 2, 256})
     ->Args({1, 18, 128})
     ->Args({1, 18, 256})
     ->Args({1, 9, 256})

@@ -234,13 +234,21 @@ inline ReferenceResult minimiseReference(const ReferenceProblem& p, const uvwarp
                 continue;
             }
             const Eigen::VectorXd step = solver.solve(-gradient);
+            // The step, or where it would fold the grid a fraction of it (halved up to kBacktracks times):
+            // next to a nearly collapsed cell a whole step folds it for any damping that still moves.
             uvwarp::WarpGrid trial = w;
-            for (size_t k = 0; k < points; ++k) {
-                if (var[k] < 0) continue;
-                trial.u[k] = static_cast<float>(w.u[k] + step[2 * var[k]]);
-                trial.v[k] = static_cast<float>(w.v[k] + step[2 * var[k] + 1]);
+            double e = std::numeric_limits<double>::infinity();
+            for (int half = 0, kBacktracks = 10; half <= kBacktracks; ++half) {
+                const double fraction = std::ldexp(1.0, -half);
+                for (size_t k = 0; k < points; ++k) {
+                    if (var[k] < 0) continue;
+                    trial.u[k] = static_cast<float>(w.u[k] + fraction * step[2 * var[k]]);
+                    trial.v[k] = static_cast<float>(w.v[k] + fraction * step[2 * var[k] + 1]);
+                }
+                if (!foldFree(trial)) continue;
+                e = energy(trial);
+                break;
             }
-            const double e = foldFree(trial) ? energy(trial) : std::numeric_limits<double>::infinity();
             if (e < result.energy) {
                 const double gain = result.energy - e;
                 result.warp = std::move(trial);
