@@ -437,7 +437,7 @@ struct Solver::Impl : detail::SolverState {
 
     // `rigidity` becomes the finest level's map (pass it with std::move to keep one copy).
     void buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation);
-    static void findLevelRuns(Level& level);
+    static void findLevelRuns(Level& level, int32_t fineCells);
 };
 
 void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation) {
@@ -519,11 +519,12 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
     }
     markFixed(levels.back(), movable);
     for (Level& level : levels)
-        findLevelRuns(level);
+        findLevelRuns(level, cells);
 }
 
-void detail::findSetRuns(Level& level) {
+void detail::findSetRuns(Level& level, int32_t fineCells) {
     const int32_t c = level.cells;
+    const float least = detail::leastRigidity(c, fineCells);
     // Per row and set, the runs of segments it projects. A gap shorter than a pair of lanes costs a sweep
     // nothing (the pair is computed whole), so runs are merged across it.
     collectRuns(
@@ -539,15 +540,15 @@ void detail::findSetRuns(Level& level) {
                 [&](int32_t g) {
                     const int32_t i = first + g * step;
                     return detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
-                                                    level.rigidity[level.index(i + e.bi, j + e.bj)]);
+                                                    level.rigidity[level.index(i + e.bi, j + e.bj)], least);
                 },
                 out);
         },
         level.setRunBegin, level.setRuns);
 }
 
-void Solver::Impl::findLevelRuns(Level& level) {
-    detail::findSetRuns(level);
+void Solver::Impl::findLevelRuns(Level& level, int32_t fineCells) {
+    detail::findSetRuns(level, fineCells);
     const int32_t c = level.cells;
     const auto movable = [&](int32_t i, int32_t j) { return level.movable(level.index(i, j)); };
     findRuns(c + 1, c + 1, movable, level.movableBegin, level.movableRuns);

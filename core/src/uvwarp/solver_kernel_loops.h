@@ -203,6 +203,7 @@ template <class Ops, int32_t Type, bool Mapped>
     const float* orientationB = Mapped ? level.orientation + levelIndex(level, 0, jb) : nullptr;
     const float preservation = grid.orientationPreservation;
     const int32_t fineCells = grid.cells;
+    const float least = leastRigidity(c, fineCells);  // segmentProjected's, exceeded by a projected segment
     // Each lane reads a window of the warp: point rows j - 1 .. j - 1 + kRows - 1 and columns i - 1 ..
     // i - 1 + kCols - 1 around its segment's cell (i, j), which holds both ends and their 8 neighbours.
     // Windows of different segments of the set do not overlap, and a lane moves only its two ends.
@@ -296,7 +297,7 @@ template <class Ops, int32_t Type, bool Mapped>
             const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
             const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
             const bool live = liveLane[l] != 0;
-            const bool active = live & ((!fixedA & !fixedB & (rig > 0.0f)) | pinned);
+            const bool active = live & ((!fixedA & !fixedB & (rig > least)) | pinned);
             Ring ringA, ringB;  // B's slot for A is filled once A has moved
 #pragma GCC unroll 8
             for (int32_t q = 0; q < 8; ++q) {

@@ -100,10 +100,22 @@ inline void setLanes(int32_t type, int32_t first, int32_t j, int32_t cells, int3
     if (j + e.aj < 1 || j + e.bj > cells - 1) gMax = 0;
 }
 
+// Coarse levels project a segment only where the larger blurred rigidity (Eq. 7) of its movable ends exceeds
+// this (the finest level: any rigidity above 0). The blur spreads a little rigidity over the free skin around
+// rigid detail; projected there, a coarse level pulled that skin towards its rest lengths, which the finest
+// level then had to undo (UV-36).
+constexpr float kCoarseLeastRigidity = 0.3f;
+
+// The least rigidity (exceeded) of a projected segment on a level of `cells` cells of a `fineCells` grid.
+inline float leastRigidity(int32_t cells, int32_t fineCells) {
+    return cells < fineCells ? kCoarseLeastRigidity : 0.0f;
+}
+
 // Whether a segment with ends of level rigidity ra and rb is projected (§4.2): both ends movable and either
-// rigid, or one end fixed (kFixed - R) and both painted rigid (R >= 0.5: UV-15, the whole correction on the
-// free end). Written without branches or library calls (the SIMD kernels inline it).
-inline bool segmentProjected(float ra, float rb) {
+// more rigid than `least` (leastRigidity), or one end fixed (kFixed - R) and both painted rigid (R >= 0.5:
+// UV-15, the whole correction on the free end). Written without branches or library calls (the SIMD kernels
+// inline it).
+inline bool segmentProjected(float ra, float rb, float least) {
     const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
     // The painted R of an end, fixed (kFixed - R) or not (R), as a max: GCC does not vectorise the kernel's
     // loop with a select here.
@@ -111,7 +123,7 @@ inline bool segmentProjected(float ra, float rb) {
                 paintedB = rb < kFixed - rb ? kFixed - rb : rb;
     const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
     const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
-    return (!fixedA & !fixedB & (rig > 0.0f)) | pinned;
+    return (!fixedA & !fixedB & (rig > least)) | pinned;
 }
 
 // Twice the signed area of triangle (a, b, c): > 0 counter-clockwise.

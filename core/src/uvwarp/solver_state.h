@@ -111,8 +111,8 @@ struct SolverState {
     }
 };
 
-// Level::setRunBegin and setRuns from the level's rigidity map (solver.cpp).
-void findSetRuns(Level& level);
+// Level::setRunBegin and setRuns from the level's rigidity map, for a grid of fineCells cells (solver.cpp).
+void findSetRuns(Level& level, int32_t fineCells);
 
 // Repairs folds a propagation or prediction step may have made on `level` (solver_folds.cpp): a movable
 // point with a non-positive triangle around it moves to the mean of its 8 neighbours. Returns the number of

@@ -51,7 +51,9 @@ void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int
     const float paintedA = std::max(ra, kFixed - ra), paintedB = std::max(rb, kFixed - rb);
     const bool pinned = fixedA != fixedB && paintedA >= 0.5f && paintedB >= 0.5f;
     const float rig = fixedA ? rb : (fixedB ? ra : std::max(ra, rb));
-    const bool active = (!fixedA && !fixedB && rig > 0.0f) || pinned;
+    // On a coarse level a segment is projected only above rigidity 0.3 (docs/decisions.md UV-36).
+    const float least = l.cells < g.cells ? 0.3f : 0.0f;
+    const bool active = (!fixedA && !fixedB && rig > least) || pinned;
     if (!active) return;
     Ring ringA = ringOf(ia, ja), ringB = ringOf(ib, jb);
     const float pax = l.u[at(ia, ja)], pay = l.v[at(ia, ja)];
@@ -194,7 +196,7 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
             s.orientation[static_cast<size_t>(j) * side + i] = unit(rng);
         }
     }
-    findSetRuns(s.runs);
+    findSetRuns(s.runs, s.fineCells);
     s.grid = {n, s.rest.data(), s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
     s.level = {cells,
                stride,
