@@ -23,7 +23,7 @@ import tempfile
 
 import numpy as np
 
-from uvwarp_rigged_figures import chart_texels, surface_at_texels
+from uvwarp_rigged_figures import chart_texels, lattice_distance, surface_at_texels
 
 SHOTS = {
     "suzanne": dict(rest="tests/data/suzanne/suzanne.0001.obj", deformed="tests/data/suzanne/suzanne.####.obj",
@@ -37,6 +37,16 @@ SHOTS = {
 }
 
 
+def disk_texture(rigid, distance, grid):
+    """The pictures' texture: grey, grid lines every `grid` texels, rigid texels red with a yellow centre."""
+    yy, xx = np.mgrid[0:rigid.shape[0], 0:rigid.shape[1]]
+    texture = np.full(rigid.shape + (3,), 0.72, np.float32)
+    texture[((xx % grid) == 0) | ((yy % grid) == 0)] = 0.45
+    texture[rigid] = (0.85, 0.12, 0.1)
+    texture[rigid & (distance < 0.012)] = (1.0, 0.85, 0.2)
+    return texture
+
+
 def make(name, shot, deformkit, dk, images, keep):
     t = shot["texels"]
     mesh = dk.read_mesh(shot["rest"])
@@ -45,15 +55,9 @@ def make(name, shot, deformkit, dk, images, keep):
     for dy in range(-shot["margin"], shot["margin"] + 1):
         for dx in range(-shot["margin"], shot["margin"] + 1):
             interior &= np.roll(np.roll(covered, dy, 0), dx, 1)
-    yy, xx = np.mgrid[0:t, 0:t]
-    u, v = (xx + 0.5) / t, 1 - (yy + 0.5) / t
-    centres = np.arange(0.05, 1, 0.1)
-    distance = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
+    distance = lattice_distance(t)
     rigid = (distance < 0.025) & interior
-    texture = np.full((t, t, 3), 0.72, np.float32)
-    texture[((xx % shot["grid"]) == 0) | ((yy % shot["grid"]) == 0)] = 0.45
-    texture[rigid] = (0.85, 0.12, 0.1)
-    texture[rigid & (distance < 0.012)] = (1.0, 0.85, 0.2)
+    texture = disk_texture(rigid, distance, shot["grid"])
     first, last = shot["frames"]
     with tempfile.TemporaryDirectory() as scratch:
         work = keep or scratch
@@ -134,14 +138,8 @@ def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
         # The texture at `shown`^2 (disks where the rigidity map is rigid), the maps read bilinearly between
         # their texel centres, the texture bilinearly through them.
         yy, xx = np.mgrid[0:shown, 0:shown]
-        u, v = (xx + 0.5) / shown, 1 - (yy + 0.5) / shown
-        centres = np.arange(0.05, 1, 0.1)
-        distance = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
-        disk = rigid[yy * t // shown, xx * t // shown] & (distance < 0.025)
-        texture = np.full((shown, shown, 3), 0.72, np.float32)
-        texture[((xx % 32) == 0) | ((yy % 32) == 0)] = 0.45
-        texture[disk] = (0.85, 0.12, 0.1)
-        texture[disk & (distance < 0.012)] = (1.0, 0.85, 0.2)
+        distance = lattice_distance(shown)
+        texture = disk_texture(rigid[yy * t // shown, xx * t // shown] & (distance < 0.025), distance, 32)
 
         def bilinear(image, x, y):
             x = np.clip(x, 0, image.shape[1] - 1.001)

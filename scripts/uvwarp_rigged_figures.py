@@ -50,11 +50,16 @@ def chart_texels(mesh, t):
     return np.isfinite(surface_at_texels(mesh, mesh.points, t)[..., 0])
 
 
-def rigid_disks(inside, t):
+def lattice_distance(t):
+    """(t, t): each texel centre's distance (tile units) to the nearest disk centre of the 0.1 lattice."""
     y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
     u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
     centres = np.arange(0.05, 1, 0.1)
-    d = np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
+    return np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
+
+
+def rigid_disks(inside, t):
+    d = lattice_distance(t)
     interior = inside.copy()
     r = max(1, t // 256)
     for dy in range(-r, r + 1):
