@@ -44,12 +44,11 @@ def test_suzanne_shot_from_blender_keeps_rigid_disks_frame_after_frame():
 def test_suzanne_shot_solved_frame_by_frame_from_the_identity_is_as_good_and_as_smooth():
     """A shot's default (docs/decisions.md UV-20): each frame from the identity, so a frame's warp depends on
     that frame alone. On the Blender shot it removes at least as much as the warm start, frame by frame
-    (measured 68.1, 75.1, 78.9, 81.4, 83.0% against 68.1, 74.3, 78.3, 80.6, 82.2%), and the warp moves about
-    as little between frames: the largest move of a grid point between frames 2-6 measured 0.71-1.66 texels
-    against 0.95-1.46. The warm start carries the last frame's warp and the cold solve does not, so on the
-    fastest pair of frames the cold solve moves a little more (1.66 against 1.46): a fifth more is allowed.
-    (Before coarse levels left weakly rigid segments alone, UV-36, the cold solve moved 1.17-1.39 texels and
-    the warm start 1.35-1.93.)"""
+    (measured 69.8, 77.2, 81.1, 83.7, 85.1% against 69.8, 76.4, 80.4, 82.7, 84.3%), and the warp moves about
+    as little between frames: the largest move of a grid point between frames 2-6 measured 0.72-1.19 texels
+    against 1.00-1.38. The warm start carries the last frame's warp and the cold solve does not, so on a fast
+    pair of frames the cold solve may move a little more: a fifth more is allowed (with orientation
+    preservation 0.05, UV-37, it moved 0.71-1.66 texels against 0.95-1.46)."""
     frames = [dk.read_mesh(os.path.join(SHOT, "suzanne.%04d.obj" % f)) for f in range(1, 7)]
     mesh = frames[0]
     layout = Layout(mesh)
@@ -76,5 +75,5 @@ def test_suzanne_shot_solved_frame_by_frame_from_the_identity_is_as_good_and_as_
     print("largest move between frames (texels), warm:", " ".join(f"{m:.2f}" for m in moves[True]),
           "| from the identity:", " ".join(f"{m:.2f}" for m in moves[False]))
     assert all(cold >= warm - 0.002 for warm, cold in zip(removed[True], removed[False]))
-    assert removed[False][-1] > 0.77
+    assert removed[False][-1] > 0.83
     assert max(moves[False]) <= 1.2 * max(moves[True])

@@ -37,7 +37,7 @@ struct SolverOptions {
     std::vector<int32_t> sweepsPerLevel;
     // Orientation preservation in [0, 1] (§4.2): after projection a segment is turned this fraction of the
     // way back towards its canonical direction (0°, 45°, 90°, 135°). Multiplied by the optional map.
-    float orientationPreservation = 0.05f;
+    float orientationPreservation = 0.02f;
     // s in Eq. 4: how much as-rigid-as-possible points are smoothed (non-rigid points are smoothed fully).
     float smoothing = 0.1f;
     // Velocity damping in [0, 1]: the fraction of the velocity removed each iteration (§4.1 step 1).
