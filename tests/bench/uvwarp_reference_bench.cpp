@@ -75,8 +75,8 @@ std::vector<glm::vec3> posed(const geom::Mesh& mesh, int pose) {
     for (glm::vec3& q : p) {
         if (pose == 0) {
             q.x = centre.x + 1.4f * (q.x - centre.x);
-        } else if (pose ==
-                   2) {  // bent about its length: turned about x by 0.6 rad per unit of z (59 degrees)
+        } else if (pose == 2) {
+            // Bent about its length: turned about x by 0.6 rad per unit of z (59 degrees).
             const float a = 0.6f * (q.z - centre.z), y = q.y - centre.y;
             q = {q.x, centre.y + y * std::cos(a), q.z + y * std::sin(a)};
         } else {  // bent about z, 0.6 rad per unit along x: the axis onto a circle of radius 1 / 0.6

@@ -289,15 +289,12 @@ template <class Ops, int32_t Type, bool Mapped>
             // the border): nothing to do. One end fixed: the paper does not project it; here a segment rigid
             // at both ends (R >= 0.5) is projected with the whole correction on its free end (the fixed end's
             // mass is infinite), so rigid detail that a pinned chart border cuts keeps its lengths to the
-            // border instead of tearing from it (docs/decisions.md, UV-15).
+            // border instead of tearing from it (docs/decisions.md, UV-15). segmentProjected decides it;
+            // the correction uses the ends' fixedness and the larger rigidity of its movable ends.
             const bool fixedA = ra < 0.0f, fixedB = rb < 0.0f;
-            // The painted R of an end, fixed (kFixed - R) or not (R), as a max: GCC does not vectorise the
-            // loop with a select here.
-            const float paintedA = maxOf(ra, kFixed - ra), paintedB = maxOf(rb, kFixed - rb);
-            const bool pinned = (fixedA != fixedB) & (paintedA >= 0.5f) & (paintedB >= 0.5f);
             const float rig = fixedA ? rb : (fixedB ? ra : (ra > rb ? ra : rb));
             const bool live = liveLane[l] != 0;
-            const bool active = live & ((!fixedA & !fixedB & (rig > least)) | pinned);
+            const bool active = live & segmentProjected(ra, rb, least);
             Ring ringA, ringB;  // B's slot for A is filled once A has moved
 #pragma GCC unroll 8
             for (int32_t q = 0; q < 8; ++q) {
