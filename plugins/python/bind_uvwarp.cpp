@@ -703,7 +703,8 @@ void bindUvWarp(py::module_& m) {
              "figures as diagnostics (grid_rigid_stretch_error, grid_fold_overs, "
              "grid_max_masked_displacement,\n"
              "...); and the solve's iterations, levels, untangled_points, reverted_points,\n"
-             "shortened_steps, cold_restart, remaining_folds, last_move (cells) and converged.")
+             "shortened_steps, shortened_everywhere, cold_restart, remaining_folds, last_move (cells) and "
+             "converged.")
         .def("reset", &PyUvWarpSolver::reset, "Back to the identity warp (a cut in the shot).")
         .def_property_readonly("warp", &PyUvWarpSolver::warp, "The current warp grid, as solve returns it.")
         .def_property_readonly("tile", [](const PyUvWarpSolver& s) { return s.tileWarp().tile(); })

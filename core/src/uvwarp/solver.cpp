@@ -421,6 +421,7 @@ struct Solver::Impl : detail::SolverState {
         const detail::FoldRepair repair = detail::revertFolds(*this, velU.data(), velV.data());
         stats.revertedPoints += repair.reverted;
         stats.shortenedSteps += repair.shortened ? 1 : 0;
+        stats.shortenedEverywhere += repair.everywhere ? 1 : 0;
         lastRepairSpread = repair.restart;
         // Step 5: integration, without velocities after a repair that spread (revertFolds). The largest move
         // is a max, the same whatever the order: bit-identical for any thread count.
@@ -646,6 +647,7 @@ std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
             {"untangled_points", Kind::Count, static_cast<double>(s.untangledPoints)},
             {"reverted_points", Kind::Count, static_cast<double>(s.revertedPoints)},
             {"shortened_steps", Kind::Count, static_cast<double>(s.shortenedSteps)},
+            {"shortened_everywhere", Kind::Count, static_cast<double>(s.shortenedEverywhere)},
             {"cold_restart", Kind::Flag, s.coldRestart ? 1.0 : 0.0},
             {"remaining_folds", Kind::Count, static_cast<double>(s.remainingFolds)},
             {"last_move", Kind::Number, static_cast<double>(s.lastMove)},
@@ -688,6 +690,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     m.stats.untangledPoints = 0;
     m.stats.revertedPoints = 0;
     m.stats.shortenedSteps = 0;
+    m.stats.shortenedEverywhere = 0;
     m.stats.coldRestart = false;
     m.stats.iterations = 0;
     m.stats.lastMove = 0.0f;

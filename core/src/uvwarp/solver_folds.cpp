@@ -137,34 +137,47 @@ double firstZeroArea(const float* u, const float* v, const Before& before, size_
 
 // revertFolds puts back at most 1 / kShortenShare of the points an iteration moved (at least kRevertFloor),
 // and at most kRevertFloor points that had moved farther than kLargeStep grid cells, before it shortens the
-// iteration's step instead; from 1 / kRestartShare of the moved points (at least kRevertFloor) the velocities
-// are dropped. Measured on a fully covered 8192^2 tile (a spread repair there left no iteration any progress:
-// -4.9% of the rigid stretch removed, 89.7% with these) and on the Fox's shot at 1024^2 (smaller limits
-// shortened steps that a local repair serves better: up to 6 points less).
+// iteration's step instead (around the folds first, then everywhere); from 1 / kRestartShare of the moved
+// points (at least kRevertFloor) the velocities are dropped. Measured on a fully covered 8192^2 tile (a
+// spread repair there left no iteration any progress: -4.9% of the rigid stretch removed, 89.7% with these)
+// and on the Fox's shot at 1024^2 (smaller limits shortened steps that a local repair serves better: up to 6
+// points less).
 constexpr size_t kShortenShare = 16;
 constexpr size_t kRestartShare = 256;
 constexpr size_t kRevertFloor = 256;
 constexpr float kLargeStep = 16.0f;
+// shortenLocally: fold cells are gathered in blocks of kFoldBlock cells a side, at most kMaxFoldBlocks of
+// them (beyond, the step is shortened everywhere); the step scale rises from 0.9 of a block's fold-free step
+// to the full step over kRampSteps times the largest step an iteration made.
+constexpr int32_t kFoldBlock = 64;
+constexpr size_t kMaxFoldBlocks = 1024;
+constexpr double kRampSteps = 2.0;
 
-// Rows of the finest level's movable runs: fn(k) for each point k in them that may move (runs may hold
-// points that may not, closer than the runs' gap), rows in parallel; returns the sum of what fn returns.
+// fn(k) for each point k of row j of the finest level's movable runs that may move (runs may hold points
+// that may not, closer than the runs' gap).
+template <class Fn>
+void forMovableInRow(const Level& level, int32_t j, const Fn& fn) {
+    const size_t row = static_cast<size_t>(level.side());
+    const int32_t* run = level.movableRuns.data() + 2 * static_cast<size_t>(level.movableBegin[j]);
+    const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
+    for (int32_t r = 0; r < runs; ++r) {
+        for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
+            const size_t k = static_cast<size_t>(j) * row + static_cast<size_t>(i);
+            if (level.movable(k)) fn(k);
+        }
+    }
+}
+
+// fn(k) for each point k of the finest level that may move, rows in parallel; returns the sum of what fn
+// returns.
 template <class Fn>
 int64_t sumOverMovable(const SolverState& state, const Fn& fn) {
     const Level& level = state.levels[0];
     const int32_t c = level.cells;
-    const size_t row = static_cast<size_t>(level.side());
     int64_t sum = 0;
 #pragma omp parallel for schedule(dynamic, kBlockRows) reduction(+ : sum) if (kParallelRows < static_cast <int64_t>(c))
-    for (int32_t j = 0; j <= c; ++j) {
-        const int32_t* run = level.movableRuns.data() + 2 * static_cast<size_t>(level.movableBegin[j]);
-        const int32_t runs = level.movableBegin[j + 1] - level.movableBegin[j];
-        for (int32_t r = 0; r < runs; ++r) {
-            for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
-                const size_t k = static_cast<size_t>(j) * row + static_cast<size_t>(i);
-                if (level.movable(k)) sum += fn(k);
-            }
-        }
-    }
+    for (int32_t j = 0; j <= c; ++j)
+        forMovableInRow(level, j, [&](size_t k) { sum += fn(k); });
     return sum;
 }
 
@@ -229,6 +242,116 @@ void shortenStep(SolverState& state, const float* oldU, const float* oldV, float
         if (scale == 0.0f || foldsInRuns(state) == 0) return;
         step = 0.5f;
     }
+}
+
+// The largest distance a point that may move went from (oldU, oldV), in uv units: a max, the same whatever
+// the order.
+double largestStep(const SolverState& state, const float* oldU, const float* oldV) {
+    const Level& level = state.levels[0];
+    const int32_t c = level.cells;
+    const float* u = state.grid.u.data();
+    const float* v = state.grid.v.data();
+    float largest = 0.0f;
+#pragma omp parallel for schedule(dynamic, kBlockRows) \
+    reduction(max                                      \
+              : largest) if (kParallelRows < static_cast <int64_t>(c))
+    for (int32_t j = 0; j <= c; ++j) {
+        forMovableInRow(level, j, [&](size_t k) {
+            const float du = u[k] - oldU[k], dv = v[k] - oldV[k];
+            largest = std::max(largest, du * du + dv * dv);
+        });
+    }
+    return std::sqrt(static_cast<double>(largest));
+}
+
+// A block of cells with a triangle that would fold on the way, and the least step at which one does.
+struct FoldBlock {
+    int32_t i0, j0, i1, j1;  // cells [i0, i1] x [j0, j1] of the block holding such triangles
+    double step;
+};
+
+// Shortens the iteration's step only around the triangles that fold on the way (UV-16): a point at distance
+// d (cells) from a block of such triangles goes s(d) = 0.9 t + (1 - 0.9 t) min(1, d / ramp) of its step, t
+// the block's fold-free step (foldFreeStep's, over the block), the least over blocks; ramp = kRampSteps times
+// the largest step in cells, so that neighbouring points' steps differ by at most about half a cell of
+// motion. Points farther than the ramp from every block keep their step (bit for bit). The scale is
+// evaluated at the corners of a kFoldBlock grid at their distance to a block less the grid's cell diagonal,
+// and blended bilinearly: never above s(d) of the point itself. Returns false, and moves nothing, when no
+// triangle folds on the way or more than kMaxFoldBlocks blocks hold one (the caller shortens everywhere).
+bool shortenLocally(SolverState& state, const float* oldU, const float* oldV) {
+    const Level& level = state.levels[0];
+    const int32_t c = level.cells;
+    const size_t row = static_cast<size_t>(level.side());
+    float* u = state.grid.u.data();
+    float* v = state.grid.v.data();
+    const auto before = [&](size_t k) {
+        return level.movable(k) ? std::pair<double, double>(oldU[k], oldV[k])
+                                : std::pair<double, double>(u[k], v[k]);
+    };
+    // Fold-free step per block of cells, found row of blocks by row of blocks (rows in parallel, each block
+    // row's cells written by one thread: deterministic).
+    const int32_t blocks = (c + kFoldBlock - 1) / kFoldBlock;
+    std::vector<FoldBlock> grid(static_cast<size_t>(blocks) * blocks, FoldBlock{c, c, -1, -1, 2.0});
+#pragma omp parallel for schedule(dynamic, 1) if (kParallelRows < static_cast <int64_t>(c))
+    for (int32_t bj = 0; bj < blocks; ++bj) {
+        for (int32_t j = bj * kFoldBlock; j < std::min(c, (bj + 1) * kFoldBlock); ++j) {
+            const int32_t* run = level.cellRuns.data() + 2 * static_cast<size_t>(level.cellRunBegin[j]);
+            const int32_t runs = level.cellRunBegin[j + 1] - level.cellRunBegin[j];
+            for (int32_t r = 0; r < runs; ++r) {
+                for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
+                    const size_t a = static_cast<size_t>(j) * row + static_cast<size_t>(i), b = a + 1,
+                                 d = a + row, e = d + 1;
+                    const double t = std::min(
+                        {firstZeroArea(u, v, before, a, b, e), firstZeroArea(u, v, before, a, e, d),
+                         firstZeroArea(u, v, before, a, b, d), firstZeroArea(u, v, before, b, e, d)});
+                    if (t >= 1.0) continue;
+                    FoldBlock& f = grid[static_cast<size_t>(bj) * blocks + i / kFoldBlock];
+                    f = {std::min(f.i0, i), std::min(f.j0, j), std::max(f.i1, i), std::max(f.j1, j),
+                         std::min(f.step, t)};
+                }
+            }
+        }
+    }
+    std::vector<FoldBlock> folds;
+    for (const FoldBlock& f : grid) {
+        if (f.step < 1.0) folds.push_back(f);
+    }
+    if (folds.empty() || folds.size() > kMaxFoldBlocks) return false;
+    const double ramp = std::max(1.0, kRampSteps * largestStep(state, oldU, oldV) * c);
+    // The scale at the corners of the block grid (corner (I, J) at cell (I B, J B)).
+    const int32_t corners = blocks + 1;
+    const double diagonal = kFoldBlock * std::sqrt(2.0);
+    std::vector<float> scale(static_cast<size_t>(corners) * corners, 1.0f);
+    for (int32_t cj = 0; cj < corners; ++cj) {
+        for (int32_t ci = 0; ci < corners; ++ci) {
+            const double x = static_cast<double>(ci) * kFoldBlock, y = static_cast<double>(cj) * kFoldBlock;
+            double least = 1.0;
+            for (const FoldBlock& f : folds) {
+                // Distance to the block's cells [i0, i1 + 1] x [j0, j1 + 1], less the blend's reach.
+                const double dx = std::max({0.0, f.i0 - x, x - (f.i1 + 1.0)});
+                const double dy = std::max({0.0, f.j0 - y, y - (f.j1 + 1.0)});
+                const double d = std::max(0.0, std::sqrt(dx * dx + dy * dy) - diagonal);
+                const double near = 0.9 * f.step;
+                least = std::min(least, near + (1.0 - near) * std::min(1.0, d / ramp));
+            }
+            scale[static_cast<size_t>(cj) * corners + ci] = static_cast<float>(least);
+        }
+    }
+    const int64_t moved = sumOverMovable(state, [&](size_t k) {
+        const int32_t i = static_cast<int32_t>(k % row), j = static_cast<int32_t>(k / row);
+        const int32_t bi = std::min(i / kFoldBlock, blocks - 1), bj = std::min(j / kFoldBlock, blocks - 1);
+        const float* s0 = scale.data() + static_cast<size_t>(bj) * corners + bi;
+        const float* s1 = s0 + corners;
+        if (s0[0] == 1.0f && s0[1] == 1.0f && s1[0] == 1.0f && s1[1] == 1.0f) return 0;
+        const float fx = static_cast<float>(i - bi * kFoldBlock) / kFoldBlock,
+                    fy = static_cast<float>(j - bj * kFoldBlock) / kFoldBlock;
+        const float s =
+            (1.0f - fy) * ((1.0f - fx) * s0[0] + fx * s0[1]) + fy * ((1.0f - fx) * s1[0] + fx * s1[1]);
+        u[k] = oldU[k] + s * (u[k] - oldU[k]);
+        v[k] = oldV[k] + s * (v[k] - oldV[k]);
+        return 1;
+    });
+    return moved > 0;
 }
 
 }  // namespace
@@ -301,8 +424,9 @@ int32_t untangle(SolverState& state, const Level& level) {
 // goes back at most once and a triangle whose corners are all back is the old one, so this ends, at worst in
 // the old state. Where the steps are large and smooth (a coarse level's motion on a large grid), a point put
 // back folds its neighbours and the repair spreads: past kShortenShare of the moved points, or kRevertFloor
-// points put back from steps over kLargeStep cells, the points take their positions again and every point
-// goes 0.9 of the fold-free part of its step instead (shortenStep). A
+// points put back from steps over kLargeStep cells, the points take their positions again, the step is
+// shortened around the triangles that fold on the way (shortenLocally) and the repair starts again; if it
+// spreads again, every point goes 0.9 of the fold-free part of its step instead (shortenStep). A
 // repair past kRestartShare (or a shortened step) asks for the velocities to be dropped (restart): points put
 // back have none, their neighbours large ones, and the next prediction would fold between them (an adaptive
 // restart of the momentum, as O'Donoghue and Candes's). Serial, in ascending order: deterministic.
@@ -312,17 +436,21 @@ FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV)
     float* u = state.grid.u.data();
     float* v = state.grid.v.data();
     int32_t* counts = state.rowFolds.data();
-    // Cells whose corners may not move are skipped: none of their corners would go back.
+    // The corners of every folded triangle into `out`, the rows' fold counts into counts. Cells whose corners
+    // may not move are skipped: none of their corners would go back.
+    const auto scan = [&](std::vector<int32_t>& out) {
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(c))
-    for (int32_t j = 0; j < c; ++j)
-        counts[j] = countInRuns(state, level, j, 0.0f);
+        for (int32_t j = 0; j < c; ++j)
+            counts[j] = countInRuns(state, level, j, 0.0f);
+        out.clear();
+        for (int32_t j = 0; j < c; ++j) {
+            if (counts[j] == 0) continue;
+            for (int32_t i = 0; i < c; ++i)
+                collectFolded(state, level, i, j, 0.0f, out);
+        }
+    };
     std::vector<int32_t>& work = state.untangleWork;
-    work.clear();
-    for (int32_t j = 0; j < c; ++j) {
-        if (counts[j] == 0) continue;
-        for (int32_t i = 0; i < c; ++i)
-            collectFolded(state, level, i, j, 0.0f, work);
-    }
+    scan(work);
     FoldRepair repair;
     size_t budget = 0;     // points put back before the step is shortened instead
     size_t restartAt = 0;  // points put back from which the velocities are dropped
@@ -338,7 +466,8 @@ FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV)
     log.clear();
     // counts[j] != 0 from here on: cell row j may hold a folded triangle (the scan found one there, or a
     // point of the row's cells went back).
-    while (!work.empty() && !repair.shortened) {
+    bool local = false;  // the step was shortened around the folds
+    while (!work.empty() && !repair.everywhere) {
         std::sort(work.begin(), work.end());
         work.erase(std::unique(work.begin(), work.end()), work.end());
         next.clear();
@@ -354,16 +483,26 @@ FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV)
                     u[p.index] = p.u;
                     v[p.index] = p.v;
                 }
-                shortenStep(state, oldU, oldV, 0.9f * static_cast<float>(foldFreeStep(state, oldU, oldV)));
-                std::fill(counts, counts + c, 1);
+                log.clear();
                 repair = {0, true};
+                // First only around the triangles that fold on the way; if putting points back then spreads
+                // again, everywhere.
+                if (!local && shortenLocally(state, oldU, oldV)) {
+                    local = true;
+                    large = 0;
+                    scan(next);
+                    break;
+                }
+                std::fill(counts, counts + c, 1);
                 next.clear();
+                shortenStep(state, oldU, oldV, 0.9f * static_cast<float>(foldFreeStep(state, oldU, oldV)));
+                repair.everywhere = true;
                 break;
             }
             log.push_back({k, u[k], v[k]});
             u[k] = oldU[k];
             v[k] = oldV[k];
-            ++repair.reverted;
+            ++repair.reverted;  // (0 after a shortening: counts the points put back since)
             const int32_t i = id % (c + 1), j = id / (c + 1);
             for (int32_t cj = std::max(j - 1, 0); cj <= std::min(j, c - 1); ++cj) {
                 counts[cj] = 1;
@@ -381,7 +520,7 @@ FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV)
         if (counts[j] != 0) left += countInRuns(state, level, j, 0.0f);
     }
     state.foldsLeft = left;
-    repair.restart = repair.shortened || static_cast<size_t>(repair.reverted) > restartAt;
+    repair.restart = repair.everywhere || static_cast<size_t>(repair.reverted) > restartAt;
     return repair;
 }
 

@@ -119,18 +119,21 @@ void findSetRuns(Level& level, int32_t fineCells);
 // moves.
 int32_t untangle(SolverState& state, const Level& level);
 
-// What revertFolds did: points put back, or the whole step shortened; restart: the repair spread, and the
-// velocities are to be dropped.
+// What revertFolds did: points put back, the step shortened (around the folds, and perhaps everywhere);
+// restart: the repair spread, and the velocities are to be dropped.
 struct FoldRepair {
     int32_t reverted = 0;
     bool shortened = false;
+    bool everywhere = false;
     bool restart = false;
 };
 
 // Makes the finest grid fold-free whatever the steps of an iteration did (solver_folds.cpp), from (oldU,
 // oldV), a fold-free state: the corners of every triangle with non-positive area that moved go back there,
 // spreading to the neighbours until no triangle is folded, or, when that spreads over a share of the moved
-// points, every point goes 0.9 of the way to where the first triangle would fold. Sets foldsLeft
+// points, the points around the triangles that fold on the way go 0.9 of the way to where they fold, the
+// share rising to the whole step farther off, and the corners still folded go back; when that spreads
+// again, every point goes 0.9 of the way to where the first triangle would fold. Sets foldsLeft
 // to the grid's folded triangles (countFolds) without another scan of the whole grid.
 FoldRepair revertFolds(SolverState& state, const float* oldU, const float* oldV);
 

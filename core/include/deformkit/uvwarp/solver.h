@@ -94,9 +94,12 @@ struct SolveStats {
     // Points put back to where their iteration found them because a triangle around them stayed folded
     // (every iteration ends fold-free).
     int32_t revertedPoints = 0;
-    // Iterations whose whole step was shortened to the fold-free part of it instead (putting points back
-    // would have undone more of the iteration's motion: large smooth steps of a large grid).
+    // Iterations whose step was shortened towards the fold-free part of it instead (putting points back
+    // would have undone more of the iteration's motion: large smooth steps of a large grid): around the
+    // triangles that fold on the way, and of those, shortenedEverywhere: the whole step (the local
+    // shortening left folds whose repair spread again).
     int32_t shortenedSteps = 0;
+    int32_t shortenedEverywhere = 0;
     // Whether a warm-started solve jammed and was solved again from the identity: its last iteration's fold
     // repair spread (more than 1/256 of the moved points put back, or the step shortened), which a warm start
     // that folds under the frame's motion does frame after frame (docs/decisions.md UV-34).
@@ -154,7 +157,8 @@ class Solver {
 };
 
 // The figures of the last solve as hosts report them after the warp's (metrics.h): iterations, levels,
-// untangled_points, reverted_points, shortened_steps, cold_restart, remaining_folds, last_move, converged.
+// untangled_points, reverted_points, shortened_steps, shortened_everywhere, cold_restart, remaining_folds,
+// last_move, converged.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const SolveStats& s);
 
 // Number of grid triangles with signed area <= 0, counting both diagonal splittings of every cell.
