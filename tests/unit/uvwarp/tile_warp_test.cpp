@@ -218,17 +218,13 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
     }
 }
 
-TEST_CASE(
-    "uv warp: a fold repair that would spread shortens the iteration's step around the folds, and the maps "
-    "stay fold-free",
-    "[uvwarp][invariants]") {
-    // The Fox's frame 8 at 512^2 with the default schedule and orientation preservation 0.05: points put back
-    // would spread past a sixteenth of those that moved, so an iteration takes the fold-free part of its step
-    // instead, around the triangles that fold on the way only (SolveStats::shortenedSteps, none shortened
-    // everywhere). The solver's grid ends fold-free (counted here), the delivered map has no inverted
-    // triangle and no off-chart texel, and the rigid stretch removed is above what putting points back alone
-    // gave (67.6%) and what shortening the whole step gave (71.2%): 77.7%, the floor 2 points under. With the
-    // default 0.02 no step of this shot's frames needs shortening (82.2% removed at this frame).
+TEST_CASE("uv warp: where skinning folds the grid, it ends fold-free, and so do the maps",
+          "[uvwarp][invariants]") {
+    // The Fox's frame 8 at 512^2 with the default schedule and orientation preservation 0.05: the prediction
+    // and propagation fold the triangles around thousands of points (5,157 untangled; shortened steps are
+    // tested on random cases, solver_invariants_test.cpp). The solver's grid ends fold-free (counted here),
+    // the delivered map has no inverted triangle and no off-chart texel, and the rigid stretch removed is
+    // 79.3%, the floor 2 points under.
     const geom::Mesh fox = io::readObj(DEFORMKIT_TEST_DATA "/fox/rest.obj").mesh;
     const io::ObjContent posed = io::readObj(DEFORMKIT_TEST_DATA "/fox/anim.0008.obj");
     const std::vector<glm::vec3> points(posed.mesh.points().begin(), posed.mesh.points().end());
@@ -237,8 +233,6 @@ TEST_CASE(
     options.solver.orientationPreservation = 0.05f;
     uvwarp::TileWarp warp(fox, 1001, foxDisks(fox, 512), {}, options);
     const uvwarp::WarpGrid& grid = warp.solve(points);
-    CHECK(warp.stats().shortenedSteps > 0);
-    CHECK(warp.stats().shortenedEverywhere == 0);
     CHECK(warp.stats().remainingFolds == 0);
     const int32_t n = grid.cells;
     int64_t folds = 0;
@@ -262,7 +256,7 @@ TEST_CASE(
     const uvwarp::DeliveredMetrics delivered = warp.measure(map);
     CHECK(delivered.invertedTriangles == 0);
     CHECK(delivered.offChartTexels == 0);
-    CHECK(delivered.removed > 0.75);
+    CHECK(delivered.removed > 0.77);
 }
 
 TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as after a cut",
