@@ -181,37 +181,43 @@ int64_t sumOverMovable(const SolverState& state, const Fn& fn) {
     return sum;
 }
 
-// The largest t in (0, 1] such that no triangle of the finest grid (both splittings) has zero area while its
-// corners move in straight lines from (oldU, oldV) to t of the way to where they are: the flip-free step of
-// Smith and Schaefer's line search (2015). 1 when no triangle in the runs folds on the way.
-double foldFreeStep(const SolverState& state, const float* oldU, const float* oldV) {
+// fn(i, t) for each cell i of row j of the finest level's cell runs, t the least step at which one of its
+// triangles (both splittings) has zero area while its corners move in straight lines from (oldU, oldV) to
+// where they are (firstZeroArea; points that may not move keep no old position: they have not moved).
+template <class Fn>
+void forCellStepsInRow(const SolverState& state, const float* oldU, const float* oldV, int32_t j,
+                       const Fn& fn) {
     const Level& level = state.levels[0];
-    const int32_t c = level.cells;
     const size_t row = static_cast<size_t>(level.side());
     const float* u = state.grid.u.data();
     const float* v = state.grid.v.data();
-    // Points that may not move keep no old position (they have not moved).
     const auto before = [&](size_t k) {
         return level.movable(k) ? std::pair<double, double>(oldU[k], oldV[k])
                                 : std::pair<double, double>(u[k], v[k]);
     };
+    const int32_t* run = level.cellRuns.data() + 2 * static_cast<size_t>(level.cellRunBegin[j]);
+    const int32_t runs = level.cellRunBegin[j + 1] - level.cellRunBegin[j];
+    for (int32_t r = 0; r < runs; ++r) {
+        for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
+            const size_t a = static_cast<size_t>(j) * row + static_cast<size_t>(i), b = a + 1, d = a + row,
+                         e = d + 1;
+            fn(i, std::min({firstZeroArea(u, v, before, a, b, e), firstZeroArea(u, v, before, a, e, d),
+                            firstZeroArea(u, v, before, a, b, d), firstZeroArea(u, v, before, b, e, d)}));
+        }
+    }
+}
+
+// The largest t in (0, 1] such that no triangle of the finest grid (both splittings) has zero area while its
+// corners move in straight lines from (oldU, oldV) to t of the way to where they are: the flip-free step of
+// Smith and Schaefer's line search (2015). 1 when no triangle in the runs folds on the way.
+double foldFreeStep(const SolverState& state, const float* oldU, const float* oldV) {
+    const int32_t c = state.levels[0].cells;
     double largest = 1.0;
 #pragma omp parallel for schedule(dynamic, kBlockRows) \
     reduction(min                                      \
               : largest) if (kParallelRows < static_cast <int64_t>(c))
-    for (int32_t j = 0; j < c; ++j) {
-        const int32_t* run = level.cellRuns.data() + 2 * static_cast<size_t>(level.cellRunBegin[j]);
-        const int32_t runs = level.cellRunBegin[j + 1] - level.cellRunBegin[j];
-        for (int32_t r = 0; r < runs; ++r) {
-            for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
-                const size_t a = static_cast<size_t>(j) * row + static_cast<size_t>(i), b = a + 1,
-                             d = a + row, e = d + 1;
-                largest = std::min(
-                    {largest, firstZeroArea(u, v, before, a, b, e), firstZeroArea(u, v, before, a, e, d),
-                     firstZeroArea(u, v, before, a, b, d), firstZeroArea(u, v, before, b, e, d)});
-            }
-        }
-    }
+    for (int32_t j = 0; j < c; ++j)
+        forCellStepsInRow(state, oldU, oldV, j, [&](int32_t, double t) { largest = std::min(largest, t); });
     return largest;
 }
 
@@ -284,10 +290,6 @@ bool shortenLocally(SolverState& state, const float* oldU, const float* oldV) {
     const size_t row = static_cast<size_t>(level.side());
     float* u = state.grid.u.data();
     float* v = state.grid.v.data();
-    const auto before = [&](size_t k) {
-        return level.movable(k) ? std::pair<double, double>(oldU[k], oldV[k])
-                                : std::pair<double, double>(u[k], v[k]);
-    };
     // Fold-free step per block of cells, found row of blocks by row of blocks (rows in parallel, each block
     // row's cells written by one thread: deterministic).
     const int32_t blocks = (c + kFoldBlock - 1) / kFoldBlock;
@@ -295,21 +297,12 @@ bool shortenLocally(SolverState& state, const float* oldU, const float* oldV) {
 #pragma omp parallel for schedule(dynamic, 1) if (kParallelRows < static_cast <int64_t>(c))
     for (int32_t bj = 0; bj < blocks; ++bj) {
         for (int32_t j = bj * kFoldBlock; j < std::min(c, (bj + 1) * kFoldBlock); ++j) {
-            const int32_t* run = level.cellRuns.data() + 2 * static_cast<size_t>(level.cellRunBegin[j]);
-            const int32_t runs = level.cellRunBegin[j + 1] - level.cellRunBegin[j];
-            for (int32_t r = 0; r < runs; ++r) {
-                for (int32_t i = run[2 * r]; i < run[2 * r + 1]; ++i) {
-                    const size_t a = static_cast<size_t>(j) * row + static_cast<size_t>(i), b = a + 1,
-                                 d = a + row, e = d + 1;
-                    const double t = std::min(
-                        {firstZeroArea(u, v, before, a, b, e), firstZeroArea(u, v, before, a, e, d),
-                         firstZeroArea(u, v, before, a, b, d), firstZeroArea(u, v, before, b, e, d)});
-                    if (t >= 1.0) continue;
-                    FoldBlock& f = grid[static_cast<size_t>(bj) * blocks + i / kFoldBlock];
-                    f = {std::min(f.i0, i), std::min(f.j0, j), std::max(f.i1, i), std::max(f.j1, j),
-                         std::min(f.step, t)};
-                }
-            }
+            forCellStepsInRow(state, oldU, oldV, j, [&](int32_t i, double t) {
+                if (t >= 1.0) return;
+                FoldBlock& f = grid[static_cast<size_t>(bj) * blocks + i / kFoldBlock];
+                f = {std::min(f.i0, i), std::min(f.j0, j), std::max(f.i1, i), std::max(f.j1, j),
+                     std::min(f.step, t)};
+            });
         }
     }
     std::vector<FoldBlock> folds;
