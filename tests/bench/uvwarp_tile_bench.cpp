@@ -1,6 +1,7 @@
 // A fully covered UV tile at production sizes, as a farm job solves it: a plane whose UVs fill tile 1001,
 // rigid disks painted over the whole tile, the deformed pose (a stretch growing from 1x to 1.8x along u and a
-// wave across v) solved cold with the default schedule. One TileWarp per run: bind (geometry images, maps,
+// wave across v) solved cold with the shot preset (a farm job's: the default schedule, every frame from the
+// identity). One TileWarp per run: bind (geometry images, maps,
 // hierarchy), the cold solve, the redirect map with its repair, and the delivered figures a farm job logs.
 //
 // BM_UvWarpTileScale/T, T texels (= grid cells) per side. Counters: bind_s, solve_s, redirect_s, measure_s;
@@ -32,6 +33,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -135,9 +137,10 @@ void BM_UvWarpTileScale(benchmark::State& state) {
             peak = std::max(peak, bytes);
             resetPeak();
         };
-        const io::Image rigidity = rigidDisks(texels);
+        io::Image rigidity = rigidDisks(texels);
         auto start = Clock::now();
-        TileWarp warp(mesh, kTile, rigidity);
+        // The warp keeps the rigidity map (the delivered figures read it), as a farm job hands it over.
+        TileWarp warp(mesh, kTile, std::move(rigidity), {}, presetOptions(Preset::Shot, texels));
         const double bind = secondsSince(start);
         phasePeak("peak_bind");
         start = Clock::now();

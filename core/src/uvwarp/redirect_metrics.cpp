@@ -7,6 +7,7 @@
 #include <limits>
 #include <numeric>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -272,8 +273,7 @@ struct RedirectMetrics::Impl {
     }
 };
 
-RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Image& rigidity,
-                                 const std::string& source)
+RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.source = source;
@@ -283,7 +283,7 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, const io::Ima
                                        "a tile of the mesh's UVs"));
     }
     m.texels = rigidity.width;
-    setRigidity(rigidity);
+    setRigidity(std::move(rigidity));
     Adjacency adjacency = adjacencyOf(m.uvs);
     m.chart = std::move(adjacency.chart);
     m.across = std::move(adjacency.across);
@@ -394,7 +394,7 @@ const io::Image& RedirectMetrics::rigidity() const {
     return impl_->rigidity;
 }
 
-void RedirectMetrics::setRigidity(const io::Image& rigidity) {
+void RedirectMetrics::setRigidity(io::Image rigidity) {
     Impl& m = *impl_;
     if (rigidity.width < 1 || rigidity.width != rigidity.height || rigidity.channels < 1 ||
         rigidity.pixels.size() != static_cast<size_t>(rigidity.width) * rigidity.height * rigidity.channels) {
@@ -407,6 +407,10 @@ void RedirectMetrics::setRigidity(const io::Image& rigidity) {
         throw InvalidInput(formatError(m.source, "rigidity map",
                                        std::to_string(rigidity.width) + " texels per side",
                                        std::to_string(m.texels) + ", the bound map's size"));
+    }
+    if (rigidity.channels == 1) {  // channel 0 is the map: kept as it comes, without a copy
+        m.rigidity = std::move(rigidity);
+        return;
     }
     m.rigidity.width = rigidity.width;
     m.rigidity.height = rigidity.height;

@@ -449,7 +449,7 @@ bool samePixels(const io::Image& a, const io::Image& b) {
 }  // namespace
 
 void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
-    const io::Image rigidity = readMap(plan.rigidity, frame, plan.tile, "rigidity map");
+    io::Image rigidity = readMap(plan.rigidity, frame, plan.tile, "rigidity map");
     const io::Image mask = readMap(plan.mask, frame, plan.tile, "warp mask");
     const io::Image orientation = readMap(plan.orientation, frame, plan.tile, "orientation map");
     if (plan.texture.file) {
@@ -457,8 +457,9 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
     }
-    plan.warp.emplace(*job.rest, plan.tile, rigidity, mask, plan.options, orientation, job.restName);
     if (!plan.rigidity.framePattern.empty()) plan.lastRigidity = rigidity;
+    plan.warp.emplace(*job.rest, plan.tile, std::move(rigidity), mask, plan.options, orientation,
+                      job.restName);
     if (!plan.mask.framePattern.empty()) plan.lastMask = mask;
     if (!plan.orientation.framePattern.empty()) plan.lastOrientation = orientation;
 }

@@ -456,6 +456,39 @@ struct Solver::Impl : detail::SolverState {
         return std::sqrt(largest);
     }
 
+    // What an iteration works in besides the warp: the velocities (zero), the coarse levels' snapshots and
+    // the compact copy a coarse level is swept in. A warm-started solver keeps them between solves (the
+    // velocities carry over); one that solves every frame from the identity holds them only during a solve,
+    // so that the redirect map and the delivered figures made after it do not pay for them.
+    void allocateSolveState() {
+        const size_t n = grid.numPoints();
+        if (velU.size() == n) return;
+        deformkit::detail::assignLarge(velU, n, 0.0f);
+        deformkit::detail::assignLarge(velV, n, 0.0f);
+        for (size_t l = 1; l < levels.size(); ++l) {
+            Level& level = levels[l];
+            const size_t count = static_cast<size_t>(level.side()) * level.side();
+            deformkit::detail::assignLarge(level.snapshotU, count, 0.0f);
+            deformkit::detail::assignLarge(level.snapshotV, count, 0.0f);
+            if (l == 1) {  // the largest coarse level: its points fit every coarser level's
+                deformkit::detail::assignLarge(workU, count, 0.0f);
+                deformkit::detail::assignLarge(workV, count, 0.0f);
+            }
+        }
+    }
+    void releaseSolveState() {
+        const auto release = [](std::vector<float>& values) { std::vector<float>().swap(values); };
+        release(velU);
+        release(velV);
+        release(workU);
+        release(workV);
+        for (Level& level : levels) {
+            release(level.snapshotU);
+            release(level.snapshotV);
+        }
+        deformkit::detail::releaseFreedMemory();
+    }
+
     // `rigidity` becomes the finest level's map (pass it with std::move to keep one copy).
     void buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation);
     static void findLevelRuns(Level& level, int32_t fineCells);
@@ -620,15 +653,6 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
         Level& level = m.levels[l];
         level.cells = m.cells >> l;
         level.stride = 1 << l;
-        const size_t count = static_cast<size_t>(level.side()) * level.side();
-        if (l > 0) {
-            deformkit::detail::assignLarge(level.snapshotU, count, 0.0f);
-            deformkit::detail::assignLarge(level.snapshotV, count, 0.0f);
-        }
-        if (l == 1) {  // the largest coarse level: its points fit every coarser level's
-            deformkit::detail::assignLarge(m.workU, count, 0.0f);
-            deformkit::detail::assignLarge(m.workV, count, 0.0f);
-        }
     }
     m.rest = std::move(restGeometry);
     m.untangleWork.reserve(8 * static_cast<size_t>(m.cells + 1));
@@ -636,9 +660,7 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     m.rowFolds.assign(static_cast<size_t>(m.cells) + 1, 0);
     m.buildMaps(std::move(rigidity), mask, orientation);
     m.grid = WarpGrid::identity(m.cells);
-    const size_t n = m.grid.numPoints();
-    deformkit::detail::assignLarge(m.velU, n, 0.0f);
-    deformkit::detail::assignLarge(m.velV, n, 0.0f);
+    if (m.options.warmStart) m.allocateSolveState();
     m.stats.levels = levelCount;
 }
 
@@ -706,6 +728,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
     detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
     if (!m.options.warmStart) reset();
+    m.allocateSolveState();
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;
     m.stats.revertedPoints = 0;
@@ -730,6 +753,7 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     // After an iteration the fold revert has counted them; otherwise the grid is scanned.
     m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);
     m.deformed = nullptr;
+    if (!m.options.warmStart) m.releaseSolveState();
     return m.grid;
 }
 

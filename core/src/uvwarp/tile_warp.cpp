@@ -54,10 +54,13 @@ struct TileWarp::Impl {
     int32_t texels = 0;
     int32_t cells = 0;
     std::unique_ptr<GeometryImager> imager;
-    // f_D of the last solve (f_O lives in the solver; the rigidity map, in `delivered`).
+    // f_D of the last solve (f_O lives in the solver; the rigidity map, in `delivered`). Kept between solves
+    // only when they warm-start (SolverOptions::warmStart): otherwise the redirect map and the figures made
+    // after a solve, which read the deformed mesh itself, do not pay for it.
     PointField deformed;
-    // The warp mask at grid points (maskAtPoints: 0 or 1), a byte a point; boundMask is the constructor's
-    // (given or derived): setMaps' default.
+    bool keepDeformed = true;
+    // The warp mask at grid points (maskAtPoints: 0 or 1), a byte a point: boundMask the constructor's
+    // (given or derived), setMaps' default; mask the one setMaps was last given, empty when it is boundMask.
     std::vector<uint8_t> mask, boundMask;
     int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
@@ -66,7 +69,7 @@ struct TileWarp::Impl {
     std::vector<glm::vec3> lastDeformed;       // the last solve's positions (the rest ones before any)
 };
 
-TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, const io::Image& mask,
                    const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
@@ -122,15 +125,15 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigi
     m.solver =
         std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid, options.solver,
                                  orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
-    m.mask = maskBytes(maskAtGrid);
-    m.boundMask = m.mask;
-    m.delivered.emplace(rest, tile, rigidity, source);
+    m.boundMask = maskBytes(maskAtGrid);
+    m.keepDeformed = options.solver.warmStart;
+    m.delivered.emplace(rest, tile, std::move(rigidity), source);
     m.lastDeformed.assign(rest.points().begin(), rest.points().end());
 }
 
-TileWarp::TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+TileWarp::TileWarp(const geom::Mesh& rest, int tile, io::Image rigidity, const io::Image& mask,
                    const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
-    : TileWarp(Bind{}, rest, tile, rigidity, mask, options, orientation, source) {
+    : TileWarp(Bind{}, rest, tile, std::move(rigidity), mask, options, orientation, source) {
     deformkit::detail::releaseFreedMemory();  // the bind's rasters and maps at grid points
 }
 
@@ -143,7 +146,12 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.imager->sample(deformedPoints, m.deformed);
     m.lastDeformed.assign(deformedPoints.begin(), deformedPoints.end());
     m.solved = true;
-    return m.solver->solve(m.deformed);
+    const WarpGrid& warp = m.solver->solve(m.deformed);
+    if (!m.keepDeformed) {
+        m.deformed = {};
+        deformkit::detail::releaseFreedMemory();
+    }
+    return warp;
 }
 
 FoldRepair TileWarp::redirect(io::Image& out) const {
@@ -180,8 +188,11 @@ WarpMetrics TileWarp::metrics() const {
     const PointField& rest = m.solver->restGeometry();
     WarpMetrics figures;
     {
-        const PointField rigidity = rigidityAtGridPoints(), mask = maskField(m.mask, m.cells);
-        figures = measureWarp(m.solver->warp(), rest, m.solved ? m.deformed : rest, rigidity, mask, options);
+        const PointField rigidity = rigidityAtGridPoints(), mask = maskAtGridPoints();
+        PointField resampled;  // f_D of the last solve, when it was not kept
+        if (m.solved && m.deformed.values.empty()) m.imager->sample(m.lastDeformed, resampled);
+        const PointField& deformed = !m.solved ? rest : (m.deformed.values.empty() ? resampled : m.deformed);
+        figures = measureWarp(m.solver->warp(), rest, deformed, rigidity, mask, options);
     }
     deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
     return figures;
@@ -217,7 +228,11 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     }
     m.solver->setMaps(std::move(newRigidity), newMask, orientationAtPoints);
     m.delivered->setRigidity(rigidity);
-    m.mask = maskBytes(newMask);
+    if (mask.pixels.empty())
+        m.mask.clear();  // the bound mask again
+    else
+        m.mask = maskBytes(newMask);
+    m.mask.shrink_to_fit();
     newRigidity = {};
     newMask = {};
     orientationAtPoints = {};
@@ -243,7 +258,8 @@ PointField TileWarp::rigidityAtGridPoints() const {
     return rigidityAtPoints(impl_->delivered->rigidity(), impl_->cells);
 }
 PointField TileWarp::maskAtGridPoints() const {
-    return maskField(impl_->mask, impl_->cells);
+    const Impl& m = *impl_;
+    return maskField(m.mask.empty() ? m.boundMask : m.mask, m.cells);
 }
 
 }  // namespace deformkit::uvwarp

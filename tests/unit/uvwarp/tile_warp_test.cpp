@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -304,4 +306,55 @@ TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as
         smooth.solve(stretched(plane, 1.0f + 0.5f * static_cast<float>(f) / 23.0f));
         CHECK_FALSE(smooth.stats().coldRestart);
     }
+}
+
+TEST_CASE("tile warp: solved from the identity every frame, it keeps nothing between frames and gives the same "
+          "bytes",
+          "[uvwarp]") {
+    // The shot preset frees f_D, the velocities and the coarse levels' copies after each solve; a warp that
+    // keeps them (warm start) and is reset before each frame is the reference. The rigidity map handed over
+    // with 3 channels (channel 0 read) against 1.
+    const geom::Mesh mesh = uvPlane(32);
+    const io::Image disks = diskRigidity(128);
+    io::Image rgb(128, 128, 3);
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x) {
+            rgb.at(x, y, 0) = disks.at(x, y, 0);
+            rgb.at(x, y, 1) = 0.25f;
+            rgb.at(x, y, 2) = 1.0f - disks.at(x, y, 0);
+        }
+    uvwarp::TileWarp cold(mesh, 1001, std::move(rgb), {}, uvwarp::presetOptions(uvwarp::Preset::Shot, 128));
+    uvwarp::TileWarpOptions warmOptions = uvwarp::presetOptions(uvwarp::Preset::Shot, 128);
+    warmOptions.solver.warmStart = true;
+    uvwarp::TileWarp warm(mesh, 1001, disks, {}, warmOptions);
+    for (const float sx : {1.2f, 1.6f, 1.3f}) {
+        const std::vector<glm::vec3> pose = stretched(mesh, sx);
+        cold.solve(pose);
+        warm.reset();
+        warm.solve(pose);
+        INFO("stretch " << sx);
+        REQUIRE(cold.stats().iterations > 0);
+        CHECK(cold.warp().u == warm.warp().u);
+        CHECK(cold.warp().v == warm.warp().v);
+        const io::Image coldMap = cold.redirect(), warmMap = warm.redirect();
+        CHECK(coldMap.pixels == warmMap.pixels);
+        const uvwarp::DeliveredMetrics coldFigures = cold.measure(coldMap),
+                                       warmFigures = warm.measure(warmMap);
+        CHECK(coldFigures.rigidStretchError == warmFigures.rigidStretchError);
+        CHECK(coldFigures.rigidEdges == warmFigures.rigidEdges);
+        CHECK(coldFigures.removed > 0.5);
+        // The grid figures read f_D again from the deformed mesh where it was not kept.
+        const uvwarp::WarpMetrics coldGrid = cold.metrics(), warmGrid = warm.metrics();
+        CHECK(coldGrid.rigidStretchError == warmGrid.rigidStretchError);
+        CHECK(coldGrid.identityStretchError == warmGrid.identityStretchError);
+        CHECK(coldGrid.foldOvers == 0);
+    }
+    // A mask given to setMaps, then none: the bound (derived) mask again.
+    const uvwarp::PointField bound = cold.maskAtGridPoints();
+    io::Image everywhere(128, 128, 1);
+    std::fill(everywhere.pixels.begin(), everywhere.pixels.end(), 1.0f);
+    cold.setMaps(disks, everywhere);
+    CHECK(cold.maskAtGridPoints().values != bound.values);
+    cold.setMaps(disks);
+    CHECK(cold.maskAtGridPoints().values == bound.values);
 }

@@ -59,16 +59,16 @@ struct DeliveredTexels {
 // kept as runs per row.
 class RedirectMetrics {
   public:
-    // rest: the mesh with UVs; rigidity: T x T, channel 0 in [0, 1]. `source` names the inputs in errors.
-    // Throws InvalidInput for a mesh without UVs, a tile it has no face in, or a non-square or empty map.
-    RedirectMetrics(const geom::Mesh& rest, int tile, const io::Image& rigidity,
-                    const std::string& source = "tile");
+    // rest: the mesh with UVs; rigidity: T x T, channel 0 in [0, 1] (a 1-channel map passed with std::move
+    // is kept without a copy). `source` names the inputs in errors. Throws InvalidInput for a mesh without
+    // UVs, a tile it has no face in, or a non-square or empty map.
+    RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity, const std::string& source = "tile");
     ~RedirectMetrics();
     RedirectMetrics(RedirectMetrics&&) noexcept;
     RedirectMetrics& operator=(RedirectMetrics&&) noexcept;
 
-    // A new rigidity map of the same size (an animated map).
-    void setRigidity(const io::Image& rigidity);
+    // A new rigidity map of the same size (an animated map); kept as the constructor keeps it.
+    void setRigidity(io::Image rigidity);
     // deformed: #V positions of the rest mesh's vertices; redirect: T x T, channels 0 and 1 the tile-local
     // r = (u', v') (invertWarp's layout, row 0 at v = 1). `texels`, when given, receives where the figures
     // come from. Throws InvalidInput for another vertex count or map size, or a non-finite redirect texel

@@ -118,9 +118,11 @@ struct SolveStats {
 // orientation-preservation map in [0, 1] (empty: 1 everywhere). The solver keeps f_O (rest lengths are
 // measured through it) and R (its finest level's map): pass them with std::move to keep one copy.
 //
-// Memory: 16 bytes per fine grid point for positions and velocities, 12 for f_O, 5 for rigidity and
-// movability, about 4.4 more for the coarser levels (+ 4 per point with an orientation map); no allocation
-// in a solve once the fold-repair scratch has grown to the largest fold count seen.
+// Memory per fine grid point: 8 bytes for positions, 12 for f_O, 4 for rigidity and movability, 1.3 for the
+// coarser levels' (+ 4 and 1.3 with an orientation map); during a solve 8 more for velocities and 4.7 for
+// the coarser levels' working copies. With SolverOptions::warmStart (the velocities carry over) those stay
+// between solves and a solve allocates nothing once the fold-repair scratch has grown to the largest fold
+// count seen; without it they are allocated at the start of each solve and freed at its end.
 class Solver {
   public:
     Solver(PointField restGeometry, PointField rigidity, const PointField& mask,

@@ -41,8 +41,10 @@ class TileWarp {
     // (channel 0, >= 0.5 may warp) or an empty Image to derive one; orientation: T x T in [0, 1] or empty.
     // `source` names the tile's inputs in errors ("rig.1001.exr"). Throws InvalidInput for: a mesh without
     // UVs or a face straddling tiles, a non-square map or one whose size is not a power of two (when
-    // cells = 0), maps of different sizes, rigidity outside [0, 1], cells not a power of two.
-    TileWarp(const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask = {},
+    // cells = 0), maps of different sizes, rigidity outside [0, 1], cells not a power of two. The warp keeps
+    // the rigidity map (the delivered figures read it): a 1-channel map passed with std::move is kept
+    // without a copy.
+    TileWarp(const geom::Mesh& rest, int tile, io::Image rigidity, const io::Image& mask = {},
              const TileWarpOptions& options = {}, const io::Image& orientation = {},
              const std::string& source = "tile");
     ~TileWarp();
@@ -85,7 +87,7 @@ class TileWarp {
 
   private:
     struct Bind {};  // the constructor's work, before the memory it freed is given back
-    TileWarp(Bind, const geom::Mesh& rest, int tile, const io::Image& rigidity, const io::Image& mask,
+    TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, const io::Image& mask,
              const TileWarpOptions& options, const io::Image& orientation, const std::string& source);
 
     struct Impl;
