@@ -273,7 +273,8 @@ struct RedirectMetrics::Impl {
     }
 };
 
-RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity, const std::string& source)
+RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity,
+                                 const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.source = source;

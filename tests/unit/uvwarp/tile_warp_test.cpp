@@ -308,9 +308,10 @@ TEST_CASE("uv warp: a warm start that jams is solved again from the identity, as
     }
 }
 
-TEST_CASE("tile warp: solved from the identity every frame, it keeps nothing between frames and gives the same "
-          "bytes",
-          "[uvwarp]") {
+TEST_CASE(
+    "tile warp: solved from the identity every frame, it keeps nothing between frames and gives the same "
+    "bytes",
+    "[uvwarp]") {
     // The shot preset frees f_D, the velocities and the coarse levels' copies after each solve; a warp that
     // keeps them (warm start) and is reset before each frame is the reference. The rigidity map handed over
     // with 3 channels (channel 0 read) against 1.
