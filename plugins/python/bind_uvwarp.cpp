@@ -699,7 +699,7 @@ void bindUvWarp(py::module_& m) {
              "(of the map's texel-centre grid, both diagonals), off_chart_texels, chart_texels; what the "
              "fold\n"
              "repair did to the map (repair_inverted_found, repair_texels_moved, repair_passes,\n"
-             "repair_regions_scaled, repair_smallest_scale); the solver's grid\n"
+             "repair_folds_scaled_locally, repair_regions_scaled, repair_smallest_scale); the solver's grid\n"
              "figures as diagnostics (grid_rigid_stretch_error, grid_fold_overs, "
              "grid_max_masked_displacement,\n"
              "...); and the solve's iterations, levels, untangled_points, reverted_points,\n"

@@ -18,6 +18,12 @@ constexpr int32_t kPassesPerRing = 16;
 constexpr int32_t kScaleHalvings = 24;
 // Bisection steps placing a texel that shows off-chart content back on its chart.
 constexpr int32_t kOnChartSteps = 10;
+// The local scale-back: folds closer than this (in cells) are one cluster; a cluster's window reaches
+// kFirstReach texels past its box, doubling up to kLastReach; the scales tried at its core.
+constexpr int32_t kClusterGap = 2;
+constexpr int32_t kFirstReach = 4;
+constexpr int32_t kLastReach = 256;
+constexpr double kCoreScales[] = {0.5, 0.25, 0.125, 0.0};
 
 class FoldRepairer {
   public:
@@ -46,6 +52,7 @@ class FoldRepairer {
             cells = smooth(cells, pass / kPassesPerRing);
             ++report_.passes;
         }
+        if (!cells.empty()) cells = scaleLocally(cells);
         if (!cells.empty()) scaleBack(cells);
         return report_;
     }
@@ -167,6 +174,102 @@ class FoldRepairer {
         return r_.at(x, y, 0) != q.x || r_.at(x, y, 1) != q.y;
     }
 
+    // Clusters of `cells` (ascending): cells fewer than kClusterGap cells apart (Chebyshev) are in one. Each
+    // cluster ascending, clusters in the order of their first cell.
+    [[nodiscard]] std::vector<std::vector<int64_t>> clusters(const std::vector<int64_t>& cells) const {
+        std::unordered_set<int64_t> left(cells.begin(), cells.end());
+        std::vector<std::vector<int64_t>> out;
+        for (int64_t first : cells) {
+            if (left.erase(first) == 0) continue;
+            std::vector<int64_t> cluster{first};
+            for (size_t k = 0; k < cluster.size(); ++k) {
+                const int32_t x = cellX(cluster[k]), y = cellY(cluster[k]);
+                for (int32_t dy = -kClusterGap; dy <= kClusterGap; ++dy) {
+                    for (int32_t dx = -kClusterGap; dx <= kClusterGap; ++dx) {
+                        const int32_t nx = x + dx, ny = y + dy;
+                        if (nx < 0 || ny < 0 || nx >= t_ || ny >= t_) continue;
+                        if (left.erase(idOf(nx, ny)) > 0) cluster.push_back(idOf(nx, ny));
+                    }
+                }
+            }
+            std::sort(cluster.begin(), cluster.end());
+            out.push_back(std::move(cluster));
+        }
+        return out;
+    }
+
+    // Before the guarantee, the displacement is scaled back around each cluster of folds the smoothing left
+    // only: in a window `reach` texels past the cluster's box, by `core` inside the box and its first
+    // reach / 2 texels, rising linearly to 1 at the window's edge (Chebyshev distance to the box). Windows
+    // from kFirstReach texels doubling to kLastReach, core scales kCoreScales; the first that leaves no cell
+    // it touches inverted and every texel it moves showing content mayShow allows is kept. The displacement
+    // of a texel of a wide region of warp (a chart's worth) is then kept outside a neighbourhood of the fold
+    // instead of halved with the whole region. Returns the cells still inverted, for the guarantee.
+    std::vector<int64_t> scaleLocally(const std::vector<int64_t>& cells) {
+        std::vector<int64_t> left;
+        for (const std::vector<int64_t>& cluster : clusters(cells)) {
+            int32_t x0 = t_, y0 = t_, x1 = -1, y1 = -1;  // the box of the cluster's cells' corners
+            for (int64_t id : cluster) {
+                x0 = std::min(x0, cellX(id));
+                y0 = std::min(y0, cellY(id));
+                x1 = std::max(x1, cellX(id) + 1);
+                y1 = std::max(y1, cellY(id) + 1);
+            }
+            if (!scaleWindow(x0, y0, x1, y1)) {
+                for (int64_t id : cluster)
+                    if (isInverted(id)) left.push_back(id);
+            }
+        }
+        std::sort(left.begin(), left.end());
+        return left;
+    }
+
+    // scaleLocally's search for one cluster with corner box [x0, x1] x [y0, y1]; true when one window
+    // leaves it unfolded (kept), false with the map as it was.
+    bool scaleWindow(int32_t x0, int32_t y0, int32_t x1, int32_t y1) {
+        for (int32_t reach = kFirstReach; reach <= kLastReach; reach *= 2) {
+            // The window's texels (the tile's border ones too: the inversion displaces them as any other).
+            const int32_t wx0 = std::max(0, x0 - reach), wy0 = std::max(0, y0 - reach);
+            const int32_t wx1 = std::min(t_ - 1, x1 + reach), wy1 = std::min(t_ - 1, y1 + reach);
+            const int32_t width = wx1 - wx0 + 1;
+            std::vector<glm::vec2> original;
+            original.reserve(static_cast<size_t>(width) * (wy1 - wy0 + 1));
+            for (int32_t y = wy0; y <= wy1; ++y)
+                for (int32_t x = wx0; x <= wx1; ++x)
+                    original.emplace_back(r_.at(x, y, 0), r_.at(x, y, 1));
+            const double inner = 0.5 * reach;
+            for (const double core : kCoreScales) {
+                bool shown = true;
+                for (int32_t y = wy0; y <= wy1; ++y) {
+                    for (int32_t x = wx0; x <= wx1; ++x) {
+                        const int32_t distance = std::max({x0 - x, x - x1, y0 - y, y - y1, 0});
+                        const double ramp = std::clamp((distance - inner) / (reach - inner), 0.0, 1.0);
+                        const double scale = core + (1.0 - core) * ramp;
+                        const glm::dvec2 q(identityTexel(x, y));
+                        const glm::dvec2 d =
+                            glm::dvec2(original[static_cast<size_t>(y - wy0) * width + (x - wx0)]) - q;
+                        if (scale == 1.0 || (d.x == 0.0 && d.y == 0.0)) continue;
+                        set(x, y, glm::vec2(q + scale * d));
+                        if (shown) shown = mayShow_(x, y, detail::redirectAt(r_, x, y));
+                    }
+                }
+                bool unfolded = shown;  // and no cell with a corner in the window inverted
+                for (int32_t y = std::max(0, wy0 - 1); unfolded && y <= std::min(wy1, t_ - 2); ++y)
+                    for (int32_t x = std::max(0, wx0 - 1); unfolded && x <= std::min(wx1, t_ - 2); ++x)
+                        unfolded = !isInverted(idOf(x, y));
+                if (unfolded) {
+                    ++report_.regionsScaledLocally;
+                    report_.smallestScale = std::min(report_.smallestScale, core);
+                    return true;
+                }
+            }
+            for (int32_t y = wy0; y <= wy1; ++y)  // as it was
+                for (int32_t x = wx0; x <= wx1; ++x)
+                    set(x, y, original[static_cast<size_t>(y - wy0) * width + (x - wx0)]);
+        }
+        return false;
+    }
+
     // The guarantee: the 8-connected regions of displaced texels holding a corner of an inverted cell,
     // their displacement scaled back until nothing they touch is inverted or refused.
     void scaleBack(const std::vector<int64_t>& cells) {
@@ -258,6 +361,7 @@ std::vector<ReportedFigure> reportedFigures(const FoldRepair& r) {
             {"repair_texels_moved", Kind::Count, static_cast<double>(r.texelsMoved)},
             {"repair_passes", Kind::Count, static_cast<double>(r.passes)},
             {"repair_regions_scaled", Kind::Count, static_cast<double>(r.regionsScaled)},
+            {"repair_folds_scaled_locally", Kind::Count, static_cast<double>(r.regionsScaledLocally)},
             {"repair_smallest_scale", Kind::Number, r.smallestScale}};
 }
 

@@ -195,7 +195,8 @@ TEST_CASE("the repair ends every fold of random maps, near the folds, keeping co
     CHECK(worstReturn < 1.5);
 }
 
-TEST_CASE("a fold the smoothing cannot end is removed by scaling its region back", "[uvwarp][repair]") {
+TEST_CASE("a fold the smoothing cannot end is scaled back around it, or with its region",
+          "[uvwarp][repair]") {
     const int32_t t = 32;
     SECTION("no content allowed but a texel's own centre") {
         io::Image map = smoothMap(t, 0.04);
@@ -220,23 +221,49 @@ TEST_CASE("a fold the smoothing cannot end is removed by scaling its region back
             }
         }
     }
-    SECTION("a fold pinned by a texel on the tile border, which never moves") {
-        io::Image map(t, t, 2);
-        for (int32_t y = 0; y < t; ++y) {
-            for (int32_t x = 0; x < t; ++x) {
-                const glm::vec2 q(centreOf(x, y, t));
-                map.at(x, y, 0) = q.x;
-                map.at(x, y, 1) = q.y;
-            }
-        }
-        // Border texel (0, 16) pulled 6 texels inwards, past its row's interior texels.
+    SECTION("a fold pinned by a texel on the tile border, which the smoothing never moves") {
+        // The smooth map displaces every interior texel; border texel (0, 16) is pulled 6 texels inwards,
+        // past its row's interior texels. The displacement is scaled back around the fold only: texels more
+        // than a window's reach from it keep their values, where scaling the region back would have scaled
+        // the whole tile's warp.
+        io::Image map = smoothMap(t, 0.04);
         map.at(0, 16, 0) += 6.0f / t;
         REQUIRE(invertedReference(map) > 0);
+        const io::Image given = map;
         const FoldRepair r = repairFolds(map, kAnything);
         CHECK(invertedReference(map) == 0);
-        CHECK(r.regionsScaled == 1);
-        CHECK(r.smallestScale > 0.0);
+        CHECK(r.regionsScaledLocally == 1);
+        CHECK(r.regionsScaled == 0);
         CHECK(r.smallestScale < 1.0);
+        int64_t kept = 0, far = 0;
+        for (int32_t y = 0; y < t; ++y) {
+            for (int32_t x = 0; x < t; ++x) {
+                if (std::max(x, std::abs(y - 16)) <= 16) continue;
+                ++far;
+                kept += map.at(x, y, 0) == given.at(x, y, 0) && map.at(x, y, 1) == given.at(x, y, 1);
+            }
+        }
+        CHECK(kept == far);
+        CHECK(far > 0);
+    }
+    SECTION("the guarantee, where no window around the fold can end it") {
+        // Content allowed: a texel's own centre or what it was given, nothing in between; on a tile wider
+        // than twice the largest window, the windows' ramps always ask for something in between. The region
+        // is scaled back to the identity.
+        const int32_t wide = 1024;
+        io::Image map = smoothMap(wide, 0.04);
+        map.at(0, 512, 0) += 6.0f / wide;
+        const io::Image given = map;
+        const ContentCheck givenOrCentre = [&](int32_t x, int32_t y, glm::dvec2 r) {
+            const glm::vec2 stored(r), q(centreOf(x, y, wide));
+            return stored == q || (stored.x == given.at(x, y, 0) && stored.y == given.at(x, y, 1));
+        };
+        REQUIRE(invertedReference(map) > 0);
+        const FoldRepair r = repairFolds(map, givenOrCentre);
+        CHECK(invertedReference(map) == 0);
+        CHECK(r.regionsScaledLocally == 0);
+        CHECK(r.regionsScaled == 1);
+        CHECK(r.smallestScale == 0.0);
     }
 }
 

@@ -21,12 +21,13 @@ using ContentRowCheck =
 
 // What repairFolds did to a map.
 struct FoldRepair {
-    int64_t invertedFound = 0;   // inverted triangles of the map it was given
-    int64_t offChartFound = 0;   // texels of it showing content mayShow refuses
-    int64_t texelsMoved = 0;     // smoothing moves made
-    int32_t passes = 0;          // smoothing passes run
-    int32_t regionsScaled = 0;   // regions whose displacement was scaled back (the guarantee)
-    double smallestScale = 1.0;  // the smallest scale applied (1 when none)
+    int64_t invertedFound = 0;         // inverted triangles of the map it was given
+    int64_t offChartFound = 0;         // texels of it showing content mayShow refuses
+    int64_t texelsMoved = 0;           // smoothing moves made
+    int32_t passes = 0;                // smoothing passes run
+    int32_t regionsScaledLocally = 0;  // clusters of folds unfolded by scaling back around them (step 2)
+    int32_t regionsScaled = 0;         // regions whose displacement was scaled back (the guarantee, step 3)
+    double smallestScale = 1.0;        // the smallest scale applied (1 when none)
 };
 
 // Makes a redirect map (T x T x >= 2, channels 0 and 1 tile-local r, invertWarp's layout) fold-free: on
@@ -44,8 +45,13 @@ struct FoldRepair {
 //     still inverted; after every 16 passes the moved set grows by a ring. A mean `mayShow` refuses (past a
 //     chart border) gives way to the point halfway to the texel's own centre, then to the centre, then no
 //     move. This ends almost every fold within a few texels of it.
-//  2. The guarantee: if folds remain after 256 passes, each 8-connected region of texels displaced from their
-//     own centre that holds one has its displacement scaled by 1/2, 1/4, ... down to 0 until neither a fold
+//  2. Local scale-back: if folds remain after 256 passes, each cluster of them (folds fewer than 2 cells
+//     apart) has the displacement around it scaled back: in a window 4, 8, ... 256 texels past the
+//     cluster's box, by 1/2, 1/4, 1/8 or 0 within half the window's reach of the box, rising linearly to 1
+//     at its edge; the first window and scale that leave none of its cells inverted and no texel showing
+//     refused content is kept. The warp away from the fold is kept whole.
+//  3. The guarantee: if folds still remain, each 8-connected region of texels displaced from their own
+//     centre that holds one has its displacement scaled by 1/2, 1/4, ... down to 0 until neither a fold
 //     nor refused content is left in the cells it touches. At 0 the region is the identity, fold-free and on
 //     chart, so this always ends.
 // Smoothing never moves texels on the tile's border. Serial over the texels concerned after parallel scans:
@@ -55,8 +61,8 @@ FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow,
                        const ContentRowCheck& refusedInRow = {});
 
 // The figures of `r` as hosts report them (metrics.h): repair_inverted_found, repair_off_chart_found,
-// repair_texels_moved,
-// repair_passes, repair_regions_scaled, repair_smallest_scale.
+// repair_texels_moved, repair_passes, repair_regions_scaled, repair_folds_scaled_locally,
+// repair_smallest_scale.
 [[nodiscard]] std::vector<ReportedFigure> reportedFigures(const FoldRepair& r);
 
 }  // namespace deformkit::uvwarp
