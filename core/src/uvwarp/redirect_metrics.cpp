@@ -321,33 +321,38 @@ RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rig
     geom::rasterizeAttributes({t, t}, corners, indices, {}, 0, raster);
     std::vector<int32_t> texelTriangle = std::move(raster.triangle);
 
-    // Point-location buckets over the tile, each listing the triangles whose UV box overlaps it, ascending.
+    // Point-location buckets over the tile, each listing the triangles whose UV box overlaps it, ascending:
+    // counted, then filled in triangle order (one array, not a list per bucket: a 16384^2 tile has 16.8M).
     m.buckets = std::max(1, t / kBucketTexels);
     const int32_t g = m.buckets;
-    std::vector<std::vector<int32_t>> lists(static_cast<size_t>(g) * g);
-    for (size_t k = 0; k < triangles; ++k) {
-        const auto& tri = m.uvs.uvs[k];
-        const float u0 = std::min({tri[0].x, tri[1].x, tri[2].x}),
-                    u1 = std::max({tri[0].x, tri[1].x, tri[2].x});
-        const float v0 = std::min({tri[0].y, tri[1].y, tri[2].y}),
-                    v1 = std::max({tri[0].y, tri[1].y, tri[2].y});
-        const auto cell = [&](float c) {
-            return std::clamp(static_cast<int32_t>(std::floor(c * static_cast<float>(g))), 0, g - 1);
-        };
-        for (int32_t by = cell(v0); by <= cell(v1); ++by)
-            for (int32_t bx = cell(u0); bx <= cell(u1); ++bx)
-                lists[static_cast<size_t>(by) * g + bx].push_back(static_cast<int32_t>(k));
+    const auto forBuckets = [&](const auto& fn) {
+        for (size_t k = 0; k < triangles; ++k) {
+            const auto& tri = m.uvs.uvs[k];
+            const float u0 = std::min({tri[0].x, tri[1].x, tri[2].x}),
+                        u1 = std::max({tri[0].x, tri[1].x, tri[2].x});
+            const float v0 = std::min({tri[0].y, tri[1].y, tri[2].y}),
+                        v1 = std::max({tri[0].y, tri[1].y, tri[2].y});
+            const auto cell = [&](float c) {
+                return std::clamp(static_cast<int32_t>(std::floor(c * static_cast<float>(g))), 0, g - 1);
+            };
+            for (int32_t by = cell(v0); by <= cell(v1); ++by)
+                for (int32_t bx = cell(u0); bx <= cell(u1); ++bx)
+                    fn(static_cast<size_t>(by) * g + bx, static_cast<int32_t>(k));
+        }
+    };
+    m.bucketStart.assign(static_cast<size_t>(g) * g + 1, 0);
+    forBuckets([&](size_t b, int32_t) { ++m.bucketStart[b + 1]; });
+    for (size_t b = 0; b + 1 < m.bucketStart.size(); ++b)
+        m.bucketStart[b + 1] += m.bucketStart[b];
+    m.bucketTriangles.resize(static_cast<size_t>(m.bucketStart.back()));
+    {
+        std::vector<int32_t> next(m.bucketStart.begin(), m.bucketStart.end() - 1);
+        forBuckets([&](size_t b, int32_t k) { m.bucketTriangles[static_cast<size_t>(next[b]++)] = k; });
     }
-    m.bucketStart.assign(lists.size() + 1, 0);
-    for (size_t b = 0; b < lists.size(); ++b)
-        m.bucketStart[b + 1] = m.bucketStart[b] + static_cast<int32_t>(lists[b].size());
-    m.bucketTriangles.reserve(static_cast<size_t>(m.bucketStart.back()));
-    for (const auto& list : lists)
-        m.bucketTriangles.insert(m.bucketTriangles.end(), list.begin(), list.end());
 
-        // The rasteriser snaps corners to 1/256 texel: a centre it covers within that of an edge may lie just
-        // outside its triangle. A chart texel is one whose centre the point location finds, so that the
-        // identity (r = q) never counts as off-chart.
+    // The rasteriser snaps corners to 1/256 texel: a centre it covers within that of an edge may lie just
+    // outside its triangle. A chart texel is one whose centre the point location finds, so that the
+    // identity (r = q) never counts as off-chart.
 #pragma omp parallel for schedule(static)
     for (int32_t y = 0; y < t; ++y) {
         for (int32_t x = 0; x < t; ++x) {

@@ -96,12 +96,14 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
         for (int32_t t : mesh.faceUVIndices(f))
             used.push_back(t);
     }
+    // Each index once (a UV index is shared by the corners of several faces), then ordered by value.
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
     std::sort(used.begin(), used.end(), [&](int32_t a, int32_t b) {
         if (uvs[a].x != uvs[b].x) return uvs[a].x < uvs[b].x;
         if (uvs[a].y != uvs[b].y) return uvs[a].y < uvs[b].y;
         return a < b;
     });
-    used.erase(std::unique(used.begin(), used.end()), used.end());
     std::vector<int32_t> weld(static_cast<size_t>(mesh.numUVs()), -1);
     for (size_t k = 0; k < used.size(); ++k) {
         const bool same = k > 0 && uvs[used[k]] == uvs[used[k - 1]];
