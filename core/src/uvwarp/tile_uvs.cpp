@@ -77,6 +77,10 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
     }
 
     const geom::Triangulation tris = geom::triangulate(mesh);
+    // Sized once: grown by push_back, these buffers' copies and first-touched pages cost more than the rest.
+    out.vertices.reserve(static_cast<size_t>(tris.size()));
+    out.uvs.reserve(static_cast<size_t>(tris.size()));
+    out.face.reserve(static_cast<size_t>(tris.size()));
     std::vector<int32_t> firstTriangle(static_cast<size_t>(mesh.numFaces()), -1);
     for (int32_t t = 0; t < tris.size(); ++t) {
         const int32_t f = tris.face[t];
@@ -91,6 +95,7 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
 
     // Weld UV indices by value: equal coordinates get one id, the smallest index holding them.
     std::vector<int32_t> used;
+    used.reserve(mesh.faceIndices().size());
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
         if (!inTile[f]) continue;
         for (int32_t t : mesh.faceUVIndices(f))
@@ -111,6 +116,7 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
     }
 
     std::vector<EdgeUse> edges;
+    edges.reserve(mesh.faceIndices().size());
     for (int32_t f = 0; f < mesh.numFaces(); ++f) {
         if (!inTile[f]) continue;
         const auto corners = mesh.faceUVIndices(f);
