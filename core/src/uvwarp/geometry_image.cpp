@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "deformkit/error.h"
@@ -107,6 +108,14 @@ std::vector<int32_t> nearestCovered(const std::vector<int32_t>& triangle, int32_
 
 GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                                const GeometryImageOptions& options)
+    : GeometryImager(rest, tile, cells, options, nullptr) {}
+
+GeometryImager::GeometryImager(const geom::Mesh& rest, const detail::TileUVs& uvs, int32_t cells,
+                               const GeometryImageOptions& options)
+    : GeometryImager(rest, uvs.tile, cells, options, &uvs) {}
+
+GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
+                               const GeometryImageOptions& options, const detail::TileUVs* collected)
     : tile_(tile), cells_(cells), numVertices_(rest.numVertices()), label_(options.label) {
     if (!isPowerOfTwo(cells) || cells > kMaxGridCells) {
         throw InvalidInput(formatError(label_, "geometry image cells", "is " + std::to_string(cells),
@@ -117,7 +126,9 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
                                        "is " + std::to_string(options.dilationRings),
                                        "0 to " + std::to_string(kMaxRings)));
     }
-    const detail::TileUVs uvs = detail::collectTileUVs(rest, tile, label_);
+    std::optional<detail::TileUVs> own;
+    if (collected == nullptr) own = detail::collectTileUVs(rest, tile, label_);
+    const detail::TileUVs& uvs = collected != nullptr ? *collected : *own;
     if (uvs.face.empty()) {
         throw InvalidInput(formatError(detail::tileSource(label_, tile), "", "holds no UV face",
                                        "a tile with at least one face whose UV centroid lies in it"));

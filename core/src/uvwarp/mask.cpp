@@ -54,10 +54,7 @@ void texelsWithinOne(double c, int32_t size, int32_t& lo, int32_t& hi) {
     hi = std::clamp(static_cast<int32_t>(std::floor(c + 1.0)), 0, size - 1);
 }
 
-}  // namespace
-
-io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
-                         const DerivedMaskOptions& options) {
+void checkMaskOptions(int32_t texels, const DerivedMaskOptions& options) {
     if (texels < 1) {
         throw InvalidInput(
             formatError(options.label, "mask texels", "is " + std::to_string(texels), "at least 1"));
@@ -66,7 +63,9 @@ io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
         throw InvalidInput(formatError(options.label, "mask border width",
                                        "is " + std::to_string(options.borderWidth), "at least 1 texel"));
     }
-    const detail::TileUVs uvs = detail::collectTileUVs(rest, tile, options.label);
+}
+
+io::Image maskOf(const detail::TileUVs& uvs, int32_t texels, const DerivedMaskOptions& options) {
     const int32_t size = texels;
     const auto t = static_cast<float>(texels);
 
@@ -109,6 +108,19 @@ io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
         }
     }
     return mask;
+}
+
+}  // namespace
+
+io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
+                         const DerivedMaskOptions& options) {
+    checkMaskOptions(texels, options);
+    return maskOf(detail::collectTileUVs(rest, tile, options.label), texels, options);
+}
+
+io::Image deriveWarpMask(const detail::TileUVs& uvs, int32_t texels, const DerivedMaskOptions& options) {
+    checkMaskOptions(texels, options);
+    return maskOf(uvs, texels, options);
 }
 
 io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label) {

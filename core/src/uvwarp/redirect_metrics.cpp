@@ -275,12 +275,16 @@ struct RedirectMetrics::Impl {
 
 RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity,
                                  const std::string& source)
+    : RedirectMetrics(rest, detail::collectTileUVs(rest, tile, source), std::move(rigidity), source) {}
+
+RedirectMetrics::RedirectMetrics(const geom::Mesh& rest, detail::TileUVs uvs, io::Image rigidity,
+                                 const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.source = source;
-    m.uvs = detail::collectTileUVs(rest, tile, source);
+    m.uvs = std::move(uvs);
     if (m.uvs.uvs.empty()) {
-        throw InvalidInput(formatError(detail::tileSource(source, tile), "", "holds no UV face",
+        throw InvalidInput(formatError(detail::tileSource(source, m.uvs.tile), "", "holds no UV face",
                                        "a tile of the mesh's UVs"));
     }
     m.texels = rigidity.width;

@@ -13,6 +13,7 @@
 #include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
 #include "memory/large_buffers.h"
+#include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
 
@@ -96,10 +97,12 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                        "a power of two, at least 2"));
     }
 
+    // The tile's UV triangles, collected once for the imager, the derived mask and the delivered figures.
+    detail::TileUVs uvs = detail::collectTileUVs(rest, tile, source);
     GeometryImageOptions imageOptions;
     imageOptions.dilationRings = options.dilationRings;
     imageOptions.label = source;
-    m.imager = std::make_unique<GeometryImager>(rest, tile, m.cells, imageOptions);
+    m.imager = std::make_unique<GeometryImager>(rest, uvs, m.cells, imageOptions);
     PointField restImage;
     m.imager->sample(rest.points(), restImage);
 
@@ -109,7 +112,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     if (derive) {
         DerivedMaskOptions maskOptions = options.derivedMask;
         maskOptions.label = source;
-        maskAtGrid = maskAtPoints(deriveWarpMask(rest, tile, m.texels, maskOptions), m.cells,
+        maskAtGrid = maskAtPoints(deriveWarpMask(uvs, m.texels, maskOptions), m.cells,
                                   {source + " derived mask", tile});
     } else {
         maskAtGrid = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
@@ -127,7 +130,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                  orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
     m.boundMask = maskBytes(maskAtGrid);
     m.keepDeformed = options.solver.warmStart;
-    m.delivered.emplace(rest, tile, std::move(rigidity), source);
+    m.delivered.emplace(rest, std::move(uvs), std::move(rigidity), source);
     m.lastDeformed.assign(rest.points().begin(), rest.points().end());
 }
 

@@ -13,6 +13,10 @@
 
 namespace deformkit::uvwarp {
 
+namespace detail {
+struct TileUVs;  // a tile's UV triangles (uvwarp/tile_uvs.h, private to the library)
+}  // namespace detail
+
 // Geometry images f_O and f_D (paper §3): the 3D positions of a mesh sampled at the warp grid's points in
 // one UDIM tile's UV space, so that f(uv) can be looked up bilinearly anywhere in the unit square.
 //
@@ -47,6 +51,9 @@ class GeometryImager {
     // by more than 0.1 of a tile (naming the face), a tile holding no UV triangle, cells not a power of
     // two, dilationRings out of range.
     GeometryImager(const geom::Mesh& rest, int tile, int32_t cells, const GeometryImageOptions& options = {});
+    // The same from the tile's UV triangles already collected from `rest` (uvwarp/tile_uvs.h).
+    GeometryImager(const geom::Mesh& rest, const detail::TileUVs& uvs, int32_t cells,
+                   const GeometryImageOptions& options = {});
 
     [[nodiscard]] int tile() const { return tile_; }
     [[nodiscard]] int32_t cells() const { return cells_; }
@@ -69,6 +76,9 @@ class GeometryImager {
     [[nodiscard]] PointField sample(std::span<const glm::vec3> positions) const;
 
   private:
+    GeometryImager(const geom::Mesh& rest, int tile, int32_t cells, const GeometryImageOptions& options,
+                   const detail::TileUVs* collected);
+
     int tile_ = 0;
     int32_t cells_ = 0;
     int32_t numVertices_ = 0;

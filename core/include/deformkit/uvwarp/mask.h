@@ -10,6 +10,10 @@
 
 namespace deformkit::uvwarp {
 
+namespace detail {
+struct TileUVs;  // a tile's UV triangles (uvwarp/tile_uvs.h, private to the library)
+}  // namespace detail
+
 // The per-tile maps that drive the warp (paper §3): the rigidity map R (T x T texels, 0 = infinitely
 // elastic, 1 = as rigid as possible) and the warp mask M (1 = may warp, 0 = fixed), as images in the
 // conventions of grid.h (row 0 at v = 1), and their values at the warp grid's points.
@@ -36,6 +40,9 @@ struct DerivedMaskOptions {
 // InvalidInput naming the mesh label for a mesh without UVs, a bad tile number, a face of the tile
 // straddling tiles (naming the face), texels < 1 or borderWidth < 1.
 [[nodiscard]] io::Image deriveWarpMask(const geom::Mesh& rest, int tile, int32_t texels,
+                                       const DerivedMaskOptions& options = {});
+// The same from the tile's UV triangles already collected (uvwarp/tile_uvs.h).
+[[nodiscard]] io::Image deriveWarpMask(const detail::TileUVs& uvs, int32_t texels,
                                        const DerivedMaskOptions& options = {});
 
 // A user-painted warp mask made binary: channel 0 (the red channel of a colour image) thresholded at

@@ -15,6 +15,10 @@
 
 namespace deformkit::uvwarp {
 
+namespace detail {
+struct TileUVs;  // a tile's UV triangles (uvwarp/tile_uvs.h, private to the library)
+}  // namespace detail
+
 // What a redirect map delivers, measured on the map a renderer reads, not on the solver's grid. Texel q of
 // the tile (its centre, tile-local uv) shows the rest-pose content at r = R(q); f_D is the deformed mesh and
 // f_O the rest mesh as functions of UV (barycentric over the tile's UV triangles).
@@ -63,6 +67,9 @@ class RedirectMetrics {
     // is kept without a copy). `source` names the inputs in errors. Throws InvalidInput for a mesh without
     // UVs, a tile it has no face in, or a non-square or empty map.
     RedirectMetrics(const geom::Mesh& rest, int tile, io::Image rigidity, const std::string& source = "tile");
+    // The same from the tile's UV triangles already collected from `rest` (uvwarp/tile_uvs.h).
+    RedirectMetrics(const geom::Mesh& rest, detail::TileUVs uvs, io::Image rigidity,
+                    const std::string& source = "tile");
     ~RedirectMetrics();
     RedirectMetrics(RedirectMetrics&&) noexcept;
     RedirectMetrics& operator=(RedirectMetrics&&) noexcept;
