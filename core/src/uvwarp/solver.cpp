@@ -459,7 +459,8 @@ struct Solver::Impl : detail::SolverState {
     // What an iteration works in besides the warp: the velocities (zero), the coarse levels' snapshots and
     // the compact copy a coarse level is swept in. A warm-started solver keeps them between solves (the
     // velocities carry over); one that solves every frame from the identity holds them only during a solve,
-    // so that the redirect map and the delivered figures made after it do not pay for them.
+    // so that the redirect map and the delivered figures made after it do not pay for them (the caller gives
+    // the freed pages back, deformkit::detail::releaseFreedMemory, once it has freed its own: TileWarp, f_D).
     void allocateSolveState() {
         const size_t n = grid.numPoints();
         if (velU.size() == n) return;
@@ -486,7 +487,6 @@ struct Solver::Impl : detail::SolverState {
             release(level.snapshotU);
             release(level.snapshotV);
         }
-        deformkit::detail::releaseFreedMemory();
     }
 
     // `rigidity` becomes the finest level's map (pass it with std::move to keep one copy).

@@ -6,6 +6,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/triangulation.h"
+#include "memory/large_buffers.h"
 
 namespace deformkit::uvwarp::detail {
 namespace {
@@ -78,9 +79,9 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
 
     const geom::Triangulation tris = geom::triangulate(mesh);
     // Sized once: grown by push_back, these buffers' copies and first-touched pages cost more than the rest.
-    out.vertices.reserve(static_cast<size_t>(tris.size()));
-    out.uvs.reserve(static_cast<size_t>(tris.size()));
-    out.face.reserve(static_cast<size_t>(tris.size()));
+    deformkit::detail::reserveLarge(out.vertices, static_cast<size_t>(tris.size()));
+    deformkit::detail::reserveLarge(out.uvs, static_cast<size_t>(tris.size()));
+    deformkit::detail::reserveLarge(out.face, static_cast<size_t>(tris.size()));
     std::vector<int32_t> firstTriangle(static_cast<size_t>(mesh.numFaces()), -1);
     for (int32_t t = 0; t < tris.size(); ++t) {
         const int32_t f = tris.face[t];

@@ -152,7 +152,7 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     const WarpGrid& warp = m.solver->solve(m.deformed);
     if (!m.keepDeformed) {
         m.deformed = {};
-        deformkit::detail::releaseFreedMemory();
+        deformkit::detail::releaseFreedMemory();  // f_D and what the solve freed (Solver: warmStart off)
     }
     return warp;
 }

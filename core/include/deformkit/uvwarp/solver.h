@@ -122,7 +122,8 @@ struct SolveStats {
 // coarser levels' (+ 4 and 1.3 with an orientation map); during a solve 8 more for velocities and 4.7 for
 // the coarser levels' working copies. With SolverOptions::warmStart (the velocities carry over) those stay
 // between solves and a solve allocates nothing once the fold-repair scratch has grown to the largest fold
-// count seen; without it they are allocated at the start of each solve and freed at its end.
+// count seen; without it they are allocated at the start of each solve and freed at its end (the caller
+// gives the pages back: TileWarp does).
 class Solver {
   public:
     Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
