@@ -6,7 +6,9 @@ the rigid stretch removed (median and worst frame), the inverted triangles deliv
 repair unfolded, off-chart texels, the time a frame takes (solve and map). Usage, from the repository's root:
 
     python3 scripts/uvwarp_rigged_figures.py tests/data/fox [--texels 1024] [--python build/python]
-        [--first 1] [--option name=value ...]"""
+        [--first 1] [--option name=value ...] [--margin TEXELS] [--split]
+
+--split also measures the same maps over the disks whole inside a chart and over those a chart border cuts."""
 import argparse
 import os
 import sys
@@ -58,14 +60,30 @@ def lattice_distance(t):
     return np.min([np.hypot(u - cu, v - cv) for cu in centres for cv in centres], axis=0)
 
 
-def rigid_disks(inside, t):
+def rigid_disks(inside, t, margin=None):
+    """(t, t) float32: 1 at texels of the disks whose (2 margin + 1)^2 neighbourhood lies inside the charts
+    (margin: t / 256 texels, at least 1, unless given), 0 elsewhere."""
     d = lattice_distance(t)
     interior = inside.copy()
-    r = max(1, t // 256)
+    r = max(1, t // 256) if margin is None else margin
     for dy in range(-r, r + 1):
         for dx in range(-r, r + 1):
             interior &= np.roll(np.roll(inside, dy, 0), dx, 1)
     return ((d < 0.025) & interior).astype(np.float32)
+
+
+def whole_disks(rigidity, t):
+    """(t, t) float32: the texels of `rigidity` (rigid_disks) in disks that no chart border cuts (every texel of
+    the disk's circle is rigid); rigidity minus it is the disks that chart borders cut."""
+    y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
+    u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
+    whole = np.zeros_like(rigidity)
+    for cu in np.arange(0.05, 1, 0.1):
+        for cv in np.arange(0.05, 1, 0.1):
+            disk = np.hypot(u - cu, v - cv) < 0.025
+            if disk.any() and (rigidity[disk] >= 0.5).all():
+                whole[disk] = rigidity[disk]
+    return whole
 
 
 def value(text):
@@ -88,13 +106,20 @@ def main():
     parser.add_argument("--python", default="build/python")
     parser.add_argument("--first", type=int, default=1, help="first frame measured (2 skips a rest pose)")
     parser.add_argument("--option", action="append", default=[], help="a solver option, name=value")
+    parser.add_argument("--margin", type=int, help="texels between the disks and the chart borders (T / 256)")
+    parser.add_argument("--split", action="store_true",
+                        help="also the figures of the disks whole inside a chart and of those chart borders cut")
     args = parser.parse_args()
     sys.path.insert(0, os.path.abspath(args.python))
     import deformkit as dk
 
     t = args.texels
     rest = dk.read_mesh(os.path.join(args.shot, "rest.obj"))
-    rigidity = rigid_disks(chart_texels(rest, t), t)
+    rigidity = rigid_disks(chart_texels(rest, t), t, args.margin)
+    # The same maps measured over subsets of the disks: those whole inside a chart, those a chart border cuts.
+    whole = whole_disks(rigidity, t)
+    parts = {"whole": whole, "cut": rigidity - whole} if args.split else {}
+    part_removed = {name: [] for name in parts}
     options = dict(preset="shot")
     options.update({k: value(v) for k, v in (o.split("=", 1) for o in args.option)})
     solver = dk.UvWarpSolver(rest, 1001, rigidity, **options)
@@ -111,12 +136,20 @@ def main():
         inverted += m["inverted_triangles"]
         off_chart += m["off_chart_texels"]
         unfolded += solver.metrics()["repair_inverted_found"]
+        for name, part in parts.items():
+            part_removed[name].append(
+                dk.redirect_metrics(rest, 1001, part, posed.points, redirect)["rigid_stretch_removed"])
     removed = np.array(removed)
     print(f"{args.shot} at {t}^2, {int(rigidity.sum())} rigid texels, {len(removed)} frames: rigid stretch removed "
           f"{100 * np.median(removed):.1f}% median, {100 * removed.min():.1f}% worst (frame "
           f"{args.first + int(removed.argmin())}); {inverted} inverted triangles delivered ({unfolded} unfolded by "
           f"the repair), {off_chart} off-chart texels; {1e3 * np.median(seconds):.0f} ms a frame (solve and map)")
     print("per frame removed:", " ".join(f"{100 * r:.1f}" for r in removed))
+    for name, values in part_removed.items():
+        values = np.array(values)
+        print(f"disks {'whole inside a chart' if name == 'whole' else 'cut by a chart border'} "
+              f"({int(parts[name].sum())} texels): {100 * np.median(values):.1f}% median, "
+              f"{100 * values.min():.1f}% worst (frame {args.first + int(values.argmin())})")
 
 
 if __name__ == "__main__":

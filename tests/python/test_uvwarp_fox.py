@@ -16,7 +16,7 @@ import deformkit as dk
 
 # The chart coverage and the disk layout of the figures docs/uvwarp_quality.md quotes (scripts/uvwarp_rigged_figures.py).
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
-from uvwarp_rigged_figures import chart_texels, rigid_disks  # noqa: E402
+from uvwarp_rigged_figures import chart_texels, rigid_disks, whole_disks  # noqa: E402
 
 SHOT = os.path.join(os.path.dirname(__file__), "..", "data", "fox")
 T = 256
@@ -103,6 +103,32 @@ def test_the_fox_running_keeps_its_rigid_disks_through_every_frame():
           f"{sum(repaired)} inverted triangles in {sum(1 for i in repaired if i)} frames")
     # Measured 53.8% median, 46.2% worst at 256^2 (the disks are 6 texels across).
     assert np.median(removed) > 0.52 and removed.min() > 0.45
+
+
+def test_the_figures_split_the_disks_into_whole_and_cut():
+    # A square chart over [0, 0.47]^2 of the tile: the disks centred at 0.05 .. 0.35 lie inside it with their
+    # margin, those at 0.45 reach past 0.47 and are cut, the others are off the chart.
+    t = 256
+    y, x = np.meshgrid(np.arange(t), np.arange(t), indexing="ij")
+    u, v = (x + 0.5) / t, 1 - (y + 0.5) / t
+    inside = (u < 0.47) & (v < 0.47)
+    rigidity = rigid_disks(inside, t)
+    whole = whole_disks(rigidity, t)
+    cut = rigidity - whole
+    assert set(np.unique(whole)) <= {0.0, 1.0} and (cut >= 0).all()
+    for cu in np.arange(0.05, 1, 0.1):
+        for cv in np.arange(0.05, 1, 0.1):
+            disk = np.hypot(u - cu, v - cv) < 0.025
+            if max(cu, cv) < 0.4:
+                assert whole[disk].all() and not cut[disk].any(), (cu, cv)
+            elif max(cu, cv) < 0.5:
+                assert not whole[disk].any() and cut[disk].any() and not cut[disk].all(), (cu, cv)
+            else:
+                assert not rigidity[disk].any(), (cu, cv)
+    # The margin: rigid texels stay that many texels off the chart's edge (u < 0.47: texel 119 is the last inside).
+    for margin in (1, 4):
+        assert rigid_disks(inside, t, margin)[:, 119 - margin + 1:].sum() == 0
+        assert rigid_disks(inside, t, margin)[:, 119 - margin].sum() > 0
 
 
 def test_random_poses_and_rigid_layouts_give_fold_free_on_chart_maps():
