@@ -37,7 +37,8 @@ const OptionSpec kSpecs[] = {
      .unit = "grid cells",
      .zeroMeans = "the rigidity map's size",
      .meaning = "Warp grid cells per side. A finer grid follows smaller rigid detail and costs more; the "
-                "redirect map keeps the rigidity map's size.",
+                "redirect map keeps the rigidity map's size. Twice the map's size keeps 1-7 points more of "
+                "the rigid stretch removed on rigged characters, for about 4x the time.",
      .recorded = false,
      .get = TileMember<&TileWarpOptions::cells>::get,
      .put = TileMember<&TileWarpOptions::cells>::put},
