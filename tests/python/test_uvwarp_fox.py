@@ -206,3 +206,28 @@ def test_a_grid_coarser_than_the_map_delivers_no_off_chart_texel():
                 placed += m["repair_off_chart_found"]
     print(f"grids of 128 and 256 cells on 512^2 maps: {placed} texels placed back on their charts, none delivered off")
     assert placed > 100
+
+
+def test_a_grid_finer_than_the_map_delivers_fold_free_on_chart_maps():
+    """A grid twice the map's size (docs/uvwarp_quality.md): each texel's content is read from a warp of four
+    cells; what is delivered still has no fold and no texel off the charts."""
+    rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
+    triangles = uv_triangles(rest)
+    rng = np.random.default_rng(12)
+    t = 256
+    inside = chart_texels(rest, t)
+    for case in range(2):
+        rigidity = rigid_disks(inside, t) if case == 0 else (inside & (rng.random((t, t)) < 0.3)).astype(np.float32)
+        solver = dk.UvWarpSolver(rest, 1001, rigidity, resolution=2 * t, preset="shot")
+        for frame in rng.choice(24, 3, replace=False):
+            solver.solve(dk.read_mesh(os.path.join(SHOT, f"anim.{frame + 1:04d}.obj")).points)
+            m = solver.metrics()
+            redirect = solver.redirect_map()
+            label = f"case {case} frame {frame + 1}"
+            assert redirect.shape == (t, t, 2), label
+            assert np.isfinite(redirect).all(), label
+            assert m["inverted_triangles"] == 0 and inverted_triangles(redirect) == 0, label
+            assert m["off_chart_texels"] == 0 and off_chart_texels(redirect, inside, triangles, t) == 0, label
+            assert m["grid_fold_overs"] == 0, label
+            # The warp does act: 0.45-0.57 measured on the disks, 0.38-0.43 on the scattered texels.
+            assert m["rigid_stretch_removed"] > 0.3, label
