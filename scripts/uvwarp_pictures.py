@@ -10,11 +10,14 @@ and as baked (<name>_after.png).
              squashes most, as painted, through the PBD solve's map and through the map of the model's
              optimum (bench_uvwarp_reference --maps: Levenberg-Marquardt to convergence); prints each disk's
              area as shown over its rest area, for the three, worst disks first
+    residual the Fox at frame 18 of its Run, 1024^2 (fox_residual.png): each disk coloured by the rigid stretch
+             error left on it through the delivered map, with the default grid and with one twice the map's
+             size; prints the figures of the whole and the cut disks for both
 
 Usage, from the repository's root:
 
     python3 scripts/uvwarp_pictures.py build/bin/deformkit [--python build/python] [--keep DIR]
-        [--bench build/bin/bench_uvwarp_reference] [suzanne] [fox] [ceiling]"""
+        [--bench build/bin/bench_uvwarp_reference] [suzanne] [fox] [ceiling] [residual]"""
 import argparse
 import os
 import subprocess
@@ -165,6 +168,38 @@ def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
         dk.write_image(os.path.join(images, "fox_ceiling.png"), np.concatenate(views, 1))
 
 
+def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
+    """fox_residual.png: the Fox's tile at `frame` of its Run, each disk coloured by the rigid stretch error
+    the delivered map leaves on it (the mean |l_def / l_rest - 1| over its texel edges: green 0, yellow 5%,
+    red 10% or more), with the default grid and with one twice the map's size; prints each panel's whole and
+    cut figures."""
+    from uvwarp_rigged_figures import rigid_disks, whole_disks
+    rest = dk.read_mesh("tests/data/fox/rest.obj")
+    posed = dk.read_mesh(f"tests/data/fox/anim.{frame:04d}.obj")
+    inside = chart_texels(rest, t)
+    rigidity = rigid_disks(inside, t)
+    whole = whole_disks(rigidity, t)
+    label, disks = label_disks(rigidity >= 0.5)
+    panels = []
+    for cells in grids:
+        solver = dk.UvWarpSolver(rest, 1001, rigidity, resolution=cells, preset="shot")
+        solver.solve(posed.points)
+        redirect = solver.redirect_map()
+        image = np.where(inside[..., None], np.float32(0.55), np.float32(0.1)) * np.ones(3, np.float32)
+        for d in range(disks):
+            part = (label == d).astype(np.float32)
+            m = dk.redirect_metrics(rest, 1001, part, posed.points, redirect)
+            share = float(np.clip(m["rigid_stretch_error"] / 0.1, 0, 1))  # 10% or more: red
+            image[label == d] = (min(1.0, 2 * share), min(1.0, 2 * (1 - share)), 0.1)
+        figures = {name: dk.redirect_metrics(rest, 1001, r, posed.points, redirect)["rigid_stretch_removed"]
+                   for name, r in (("all", rigidity), ("whole", whole), ("cut", rigidity - whole))}
+        print(f"frame {frame}, grid {cells}: " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in figures.items()))
+        step = t // shown
+        panels.append(image[::step, ::step])
+        panels.append(np.ones((shown, 8, 3), np.float32))
+    dk.write_image(os.path.join(images, "fox_residual.png"), np.concatenate(panels[:-1], 1))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("deformkit")
@@ -172,7 +207,7 @@ def main():
     parser.add_argument("--keep", help="folder to keep the maps, texture and bakes in (default: a temporary one)")
     parser.add_argument("--bench", default="build/bin/bench_uvwarp_reference",
                         help="bench_uvwarp_reference, for the ceiling picture")
-    parser.add_argument("shots", nargs="*", default=list(SHOTS) + ["ceiling"])
+    parser.add_argument("shots", nargs="*", default=list(SHOTS) + ["ceiling", "residual"])
     args = parser.parse_intermixed_args()
     sys.path.insert(0, os.path.abspath(args.python))
     import deformkit as dk
@@ -181,6 +216,8 @@ def main():
         keep = os.path.join(args.keep, name) if args.keep else None
         if name == "ceiling":
             ceiling(os.path.abspath(args.bench), os.path.abspath(args.deformkit), dk, images, keep)
+        elif name == "residual":
+            residual(dk, images)
         else:
             make(name, SHOTS[name], os.path.abspath(args.deformkit), dk, images, keep)
 
