@@ -173,12 +173,12 @@ def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
     the delivered map leaves on it (the mean |l_def / l_rest - 1| over its texel edges: green 0, yellow 5%,
     red 10% or more), with the default grid and with one twice the map's size; prints each panel's whole and
     cut figures."""
-    from uvwarp_rigged_figures import rigid_disks, whole_disks
+    from uvwarp_rigged_figures import disk_parts, rigid_disks
     rest = dk.read_mesh("tests/data/fox/rest.obj")
     posed = dk.read_mesh(f"tests/data/fox/anim.{frame:04d}.obj")
     inside = chart_texels(rest, t)
     rigidity = rigid_disks(inside, t)
-    whole = whole_disks(rigidity, t)
+    parts = {"all": rigidity, **disk_parts(rigidity, t)}
     label, disks = label_disks(rigidity >= 0.5)
     panels = []
     for cells in grids:
@@ -192,7 +192,7 @@ def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
             share = float(np.clip(m["rigid_stretch_error"] / 0.1, 0, 1))  # 10% or more: red
             image[label == d] = (min(1.0, 2 * share), min(1.0, 2 * (1 - share)), 0.1)
         figures = {name: dk.redirect_metrics(rest, 1001, r, posed.points, redirect)["rigid_stretch_removed"]
-                   for name, r in (("all", rigidity), ("whole", whole), ("cut", rigidity - whole))}
+                   for name, r in parts.items()}
         print(f"frame {frame}, grid {cells}: " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in figures.items()))
         step = t // shown
         panels.append(image[::step, ::step])

@@ -86,6 +86,12 @@ def whole_disks(rigidity, t):
     return whole
 
 
+def disk_parts(rigidity, t):
+    """{"whole": the disks whole inside a chart, "cut": those a chart border cuts} (whole_disks)."""
+    whole = whole_disks(rigidity, t)
+    return {"whole": whole, "cut": rigidity - whole}
+
+
 def value(text):
     if text in ("true", "false"):
         return text == "true"
@@ -117,8 +123,7 @@ def main():
     rest = dk.read_mesh(os.path.join(args.shot, "rest.obj"))
     rigidity = rigid_disks(chart_texels(rest, t), t, args.margin)
     # The same maps measured over subsets of the disks: those whole inside a chart, those a chart border cuts.
-    whole = whole_disks(rigidity, t)
-    parts = {"whole": whole, "cut": rigidity - whole} if args.split else {}
+    parts = disk_parts(rigidity, t) if args.split else {}
     part_removed = {name: [] for name in parts}
     options = dict(preset="shot")
     options.update({k: value(v) for k, v in (o.split("=", 1) for o in args.option)})
