@@ -11,6 +11,7 @@ import os
 import sys
 
 import numpy as np
+import pytest
 
 import deformkit as dk
 
@@ -210,9 +211,14 @@ def test_a_grid_coarser_than_the_map_delivers_no_off_chart_texel():
     assert placed > 100
 
 
-def test_a_grid_finer_than_the_map_delivers_fold_free_on_chart_maps():
-    """A grid twice the map's size (docs/uvwarp_quality.md): each texel's content is read from a warp of four
-    cells; what is delivered still has no fold and no texel off the charts."""
+# Floors of the rigid stretch removed, under what was measured: on the disks 0.45-0.57 (grid) and 0.53-0.65
+# (refinement; the map's grid alone 0.47-0.61), on the scattered texels 0.38-0.43 and 0.25-0.28 (0.13-0.20).
+@pytest.mark.parametrize("finer, floor", [({"resolution": 512}, 0.3), ({"refinement_sweeps": 2}, 0.2)],
+                         ids=["grid", "refinement"])
+def test_a_grid_finer_than_the_map_delivers_fold_free_on_chart_maps(finer, floor):
+    """A grid twice the map's size, solved on (resolution) or refining the solve on the map's grid
+    (refinement_sweeps; docs/uvwarp_quality.md): each texel's content is read from a warp of four cells; what
+    is delivered still has no fold and no texel off the charts."""
     rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
     triangles = uv_triangles(rest)
     rng = np.random.default_rng(12)
@@ -220,7 +226,8 @@ def test_a_grid_finer_than_the_map_delivers_fold_free_on_chart_maps():
     inside = chart_texels(rest, t)
     for case in range(2):
         rigidity = rigid_disks(inside, t) if case == 0 else (inside & (rng.random((t, t)) < 0.3)).astype(np.float32)
-        solver = dk.UvWarpSolver(rest, 1001, rigidity, resolution=2 * t, preset="shot")
+        solver = dk.UvWarpSolver(rest, 1001, rigidity, preset="shot", **finer)
+        assert solver.warp.shape == (2 * t + 1, 2 * t + 1, 2)
         for frame in rng.choice(24, 3, replace=False):
             solver.solve(dk.read_mesh(os.path.join(SHOT, f"anim.{frame + 1:04d}.obj")).points)
             m = solver.metrics()
@@ -230,5 +237,4 @@ def test_a_grid_finer_than_the_map_delivers_fold_free_on_chart_maps():
             assert np.isfinite(redirect).all(), label
             assert_fold_free_on_charts(m, redirect, inside, triangles, t, label)
             assert m["grid_fold_overs"] == 0, label
-            # The warp does act: 0.45-0.57 measured on the disks, 0.38-0.43 on the scattered texels.
-            assert m["rigid_stretch_removed"] > 0.3, label
+            assert m["rigid_stretch_removed"] > floor, label  # the warp does act

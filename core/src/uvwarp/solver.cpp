@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "deformkit/error.h"
+#include "deformkit/uvwarp/inversion.h"
 #include "deformkit/uvwarp/options.h"
 #include "memory/large_buffers.h"
 #include "row_wavefront.h"
@@ -197,6 +198,7 @@ struct Solver::Impl : detail::SolverState {
     const detail::SolverKernels* kernels = &kernelsFor(simd::activeIsa());
     detail::TeamChooser team;  // SolverOptions::threads == 0
     bool fromIdentity = true;  // the next solve starts from the identity (SolverOptions::coldIterations)
+    bool started = false;      // the next solve starts from a coarser warp (startFrom): no cold restart
     // The wavefront's per-block flags (forRowBlocks), enough for any level's rows.
     std::vector<std::atomic<int32_t>> blockDone;
 
@@ -744,12 +746,13 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     // A jam (UV-34): the warm start's last iteration ended with a fold repair that spread. The last frame's
     // warp folds under this frame's motion, and frames after it would stay jammed; the frame is solved
     // again from the identity, as after a cut.
-    if (warm && m.stats.iterations > 0 && m.lastRepairSpread) {
+    if (warm && !m.started && m.stats.iterations > 0 && m.lastRepairSpread) {
         reset();
         m.stats.coldRestart = true;
         m.run(cold);
     }
     if (m.stats.iterations > 0) m.fromIdentity = false;
+    m.started = false;
     // After an iteration the fold revert has counted them; otherwise the grid is scanned.
     m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);
     m.deformed = nullptr;
@@ -764,6 +767,40 @@ void Solver::reset() {
     m.fixedFolds = 0;  // the identity has none
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);
+}
+
+void Solver::startFrom(const WarpGrid& coarser) {
+    Impl& m = *impl_;
+    if (coarser.cells * 2 != m.cells || coarser.u.size() != coarser.numPoints() ||
+        coarser.v.size() != coarser.numPoints() ||
+        coarser.numPoints() != static_cast<size_t>(coarser.side()) * coarser.side()) {
+        throw InvalidInput(formatError(m.source, "warp to start from",
+                                       "has " + std::to_string(coarser.cells) + " cells per side",
+                                       std::to_string(m.cells / 2) + ", half the solver's grid"));
+    }
+    validateWarpGrid(coarser, m.source + ": warp to start from");
+    // Point (i, j) of this grid sits at (i / 2, j / 2) of the coarser one: a coarse point, the middle of a
+    // coarse edge, or the middle of a coarse cell, which lies on the cell's (i, j)-(i + 1, j + 1) diagonal
+    // where the cell is split (grid.h): the mean of the two ends either way.
+    const int32_t side = m.grid.side(), coarseSide = coarser.side();
+    const auto at = [&](const std::vector<float>& values, int32_t i, int32_t j) {
+        return values[static_cast<size_t>(j) * coarseSide + i];
+    };
+#pragma omp parallel for schedule(static) if (side > detail::kParallelRows)
+    for (int32_t j = 0; j < side; ++j) {
+        const int32_t j0 = j / 2, j1 = (j + 1) / 2;
+        for (int32_t i = 0; i < side; ++i) {
+            const int32_t i0 = i / 2, i1 = (i + 1) / 2;
+            const size_t k = static_cast<size_t>(j) * side + i;
+            m.grid.u[k] = 0.5f * (at(coarser.u, i0, j0) + at(coarser.u, i1, j1));
+            m.grid.v[k] = 0.5f * (at(coarser.v, i0, j0) + at(coarser.v, i1, j1));
+        }
+    }
+    std::fill(m.velU.begin(), m.velU.end(), 0.0f);
+    std::fill(m.velV.begin(), m.velV.end(), 0.0f);
+    m.fromIdentity = false;
+    m.started = true;
+    m.fixedFolds = -1;  // the fixed cells moved with the map: counted again
 }
 
 const WarpGrid& Solver::warp() const {

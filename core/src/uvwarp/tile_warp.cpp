@@ -65,10 +65,57 @@ struct TileWarp::Impl {
     std::vector<uint8_t> mask, boundMask;
     int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
+    // TileWarpOptions::refinementSweeps: the grid of twice the cells the last iteration runs on, its imager,
+    // f_D (kept between solves: the refining solver keeps its state too, warm-started from each solve) and
+    // masks (as above), and the figures of a solve through both grids.
+    int32_t refinedCells = 0;
+    std::unique_ptr<GeometryImager> refinedImager;
+    std::unique_ptr<Solver> refiner;
+    PointField refinedDeformed;
+    std::vector<uint8_t> refinedMask, refinedBoundMask;
+    SolveStats stats;
     bool solved = false;
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
     std::vector<glm::vec3> lastDeformed;       // the last solve's positions (the rest ones before any)
+
+    // The orientation-preservation map at the points of a grid of `n` cells: the painted one, else the
+    // density heuristic's (TileWarpOptions::orientationDensity), else none (1 everywhere).
+    [[nodiscard]] PointField orientationAt(const io::Image& orientation, const io::Image& rigidity,
+                                           int32_t n) const {
+        if (!orientation.pixels.empty())
+            return rigidityAtPoints(orientation, n, {source + " orientation map", tile});
+        if (densityRadius > 0)
+            return rigidityAtPoints(densityOrientationMap(rigidity, densityRadius), n,
+                                    {source + " density orientation", tile});
+        return {};
+    }
+
+    // The solver whose warp is delivered, its grid's cells and its imager.
+    [[nodiscard]] const Solver& delivering() const { return refiner ? *refiner : *solver; }
+    [[nodiscard]] int32_t deliveredCells() const { return refiner ? refinedCells : cells; }
+    [[nodiscard]] const GeometryImager& deliveredImager() const { return refiner ? *refinedImager : *imager; }
+    [[nodiscard]] const std::vector<uint8_t>& deliveredMask() const {
+        if (refiner) return refinedMask.empty() ? refinedBoundMask : refinedMask;
+        return mask.empty() ? boundMask : mask;
+    }
 };
+
+namespace {
+
+// The refining solver's options: one warm iteration of `sweeps` sweeps on its finest level alone, the rest
+// as the main solver's.
+SolverOptions refinementOptions(SolverOptions options, int32_t sweeps) {
+    options.iterations = 1;
+    options.coldIterations = 1;
+    options.tolerance = 0.0f;
+    options.sweepsPerLevel = {sweeps};
+    options.levels = 1;
+    options.maxLevels = 0;
+    options.warmStart = true;
+    return options;
+}
+
+}  // namespace
 
 TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, const io::Image& mask,
                    const TileWarpOptions& options, const io::Image& orientation, const std::string& source)
@@ -96,6 +143,12 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                            (options.cells == 0 ? " (the rigidity map's size)" : ""),
                                        "a power of two, at least 2"));
     }
+    if (options.refinementSweeps > 0 && m.cells > kMaxGridCells / 2) {
+        throw InvalidInput(formatError(
+            source, "grid resolution, UDIM tile " + std::to_string(tile),
+            std::to_string(m.cells) + " cells per side with refinement sweeps",
+            "at most " + std::to_string(kMaxGridCells / 2) + " (the refinement's grid has twice the cells)"));
+    }
 
     // The tile's UV triangles, collected once for the imager, the derived mask and the delivered figures.
     detail::TileUVs uvs = detail::collectTileUVs(rest, tile, source);
@@ -108,23 +161,31 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
 
     const MapLabel rigidityLabel{source + " rigidity map", tile};
     PointField rigidityAtGrid = rigidityAtPoints(rigidity, m.cells, rigidityLabel);
-    PointField maskAtGrid;
+    io::Image derivedMask;
     if (derive) {
         DerivedMaskOptions maskOptions = options.derivedMask;
         maskOptions.label = source;
-        maskAtGrid = maskAtPoints(deriveWarpMask(uvs, m.texels, maskOptions), m.cells,
-                                  {source + " derived mask", tile});
-    } else {
-        maskAtGrid = maskAtPoints(mask, m.cells, {source + " warp mask", tile});
+        derivedMask = deriveWarpMask(uvs, m.texels, maskOptions);
     }
+    const io::Image& maskMap = derive ? derivedMask : mask;
+    const MapLabel maskLabel{source + (derive ? " derived mask" : " warp mask"), tile};
+    const PointField maskAtGrid = maskAtPoints(maskMap, m.cells, maskLabel);
     m.densityRadius = options.orientationDensity;
-    PointField orientationAtPoints;
-    if (!orientation.pixels.empty()) {
-        orientationAtPoints = rigidityAtPoints(orientation, m.cells, {source + " orientation map", tile});
-    } else if (m.densityRadius > 0) {
-        orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
-                                               {source + " density orientation", tile});
+    const PointField orientationAtPoints = m.orientationAt(orientation, rigidity, m.cells);
+    if (options.refinementSweeps > 0) {
+        m.refinedCells = 2 * m.cells;
+        m.refinedImager = std::make_unique<GeometryImager>(rest, uvs, m.refinedCells, imageOptions);
+        PointField refinedRest;
+        m.refinedImager->sample(rest.points(), refinedRest);
+        const PointField refinedMask = maskAtPoints(maskMap, m.refinedCells, maskLabel);
+        m.refiner = std::make_unique<Solver>(
+            std::move(refinedRest), rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel), refinedMask,
+            refinementOptions(options.solver, options.refinementSweeps),
+            m.orientationAt(orientation, rigidity, m.refinedCells),
+            source + ", UDIM tile " + std::to_string(tile) + ", refinement");
+        m.refinedBoundMask = maskBytes(refinedMask);
     }
+    derivedMask = {};
     m.solver =
         std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid, options.solver,
                                  orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
@@ -150,16 +211,29 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.lastDeformed.assign(deformedPoints.begin(), deformedPoints.end());
     m.solved = true;
     const WarpGrid& warp = m.solver->solve(m.deformed);
+    m.stats = m.solver->stats();
     if (!m.keepDeformed) {
         m.deformed = {};
         deformkit::detail::releaseFreedMemory();  // f_D and what the solve freed (Solver: warmStart off)
     }
-    return warp;
+    if (!m.refiner) return warp;
+    m.refiner->startFrom(warp);
+    m.refinedImager->sample(deformedPoints, m.refinedDeformed);
+    const WarpGrid& refined = m.refiner->solve(m.refinedDeformed);
+    const SolveStats& r = m.refiner->stats();
+    m.stats.iterations += r.iterations;
+    m.stats.lastMove = r.lastMove;
+    m.stats.untangledPoints += r.untangledPoints;
+    m.stats.revertedPoints += r.revertedPoints;
+    m.stats.shortenedSteps += r.shortenedSteps;
+    m.stats.shortenedEverywhere += r.shortenedEverywhere;
+    m.stats.remainingFolds = r.remainingFolds;
+    return refined;
 }
 
 FoldRepair TileWarp::redirect(io::Image& out) const {
     const Impl& m = *impl_;
-    invertWarp(m.solver->warp(), m.texels, out);
+    invertWarp(m.delivering().warp(), m.texels, out);
     return repairFolds(
         out, [&m](int32_t x, int32_t y, glm::dvec2 r) { return m.delivered->mayShow(x, y, r); },
         [&m](const io::Image& map, int32_t y, std::vector<int32_t>& refused) {
@@ -188,14 +262,17 @@ WarpMetrics TileWarp::metrics() const {
     const Impl& m = *impl_;
     MetricsOptions options;
     options.texels = m.texels;
-    const PointField& rest = m.solver->restGeometry();
+    const Solver& solver = m.delivering();
+    const PointField& rest = solver.restGeometry();
     WarpMetrics figures;
     {
-        const PointField rigidity = rigidityAtGridPoints(), mask = maskAtGridPoints();
+        const PointField rigidity = rigidityAtPoints(m.delivered->rigidity(), m.deliveredCells());
+        const PointField mask = maskField(m.deliveredMask(), m.deliveredCells());
+        const PointField& kept = m.refiner ? m.refinedDeformed : m.deformed;
         PointField resampled;  // f_D of the last solve, when it was not kept
-        if (m.solved && m.deformed.values.empty()) m.imager->sample(m.lastDeformed, resampled);
-        const PointField& deformed = !m.solved ? rest : (m.deformed.values.empty() ? resampled : m.deformed);
-        figures = measureWarp(m.solver->warp(), rest, deformed, rigidity, mask, options);
+        if (m.solved && kept.values.empty()) m.deliveredImager().sample(m.lastDeformed, resampled);
+        const PointField& deformed = !m.solved ? rest : (kept.values.empty() ? resampled : kept);
+        figures = measureWarp(solver.warp(), rest, deformed, rigidity, mask, options);
     }
     deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
     return figures;
@@ -203,6 +280,7 @@ WarpMetrics TileWarp::metrics() const {
 
 void TileWarp::reset() {
     impl_->solver->reset();
+    if (impl_->refiner) impl_->refiner->reset();
 }
 
 void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const io::Image& orientation) {
@@ -222,14 +300,21 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     PointField newRigidity = rigidityAtPoints(rigidity, m.cells, {m.source + " rigidity map", m.tile});
     PointField newMask = mask.pixels.empty() ? maskField(m.boundMask, m.cells)
                                              : maskAtPoints(mask, m.cells, {m.source + " warp mask", m.tile});
-    PointField orientationAtPoints;
-    if (!orientation.pixels.empty()) {
-        orientationAtPoints = rigidityAtPoints(orientation, m.cells, {m.source + " orientation map", m.tile});
-    } else if (m.densityRadius > 0) {
-        orientationAtPoints = rigidityAtPoints(densityOrientationMap(rigidity, m.densityRadius), m.cells,
-                                               {m.source + " density orientation", m.tile});
-    }
+    PointField orientationAtPoints = m.orientationAt(orientation, rigidity, m.cells);
     m.solver->setMaps(std::move(newRigidity), newMask, orientationAtPoints);
+    if (m.refiner) {
+        const int32_t n = m.refinedCells;
+        const PointField refinedMask = mask.pixels.empty()
+                                           ? maskField(m.refinedBoundMask, n)
+                                           : maskAtPoints(mask, n, {m.source + " warp mask", m.tile});
+        m.refiner->setMaps(rigidityAtPoints(rigidity, n, {m.source + " rigidity map", m.tile}), refinedMask,
+                           m.orientationAt(orientation, rigidity, n));
+        if (mask.pixels.empty())
+            m.refinedMask.clear();
+        else
+            m.refinedMask = maskBytes(refinedMask);
+        m.refinedMask.shrink_to_fit();
+    }
     m.delivered->setRigidity(rigidity);
     if (mask.pixels.empty())
         m.mask.clear();  // the bound mask again
@@ -252,10 +337,10 @@ int32_t TileWarp::cells() const {
     return impl_->cells;
 }
 const WarpGrid& TileWarp::warp() const {
-    return impl_->solver->warp();
+    return impl_->delivering().warp();
 }
 const SolveStats& TileWarp::stats() const {
-    return impl_->solver->stats();
+    return impl_->solved ? impl_->stats : impl_->solver->stats();
 }
 PointField TileWarp::rigidityAtGridPoints() const {
     return rigidityAtPoints(impl_->delivered->rigidity(), impl_->cells);

@@ -599,3 +599,66 @@ TEST_CASE("uv warp: the hierarchy's rigidity and masks follow Eq. 7 and 8", "[uv
     CHECK(fixedByEq8 > 0);  // points whose own finer point may move but a neighbour may not
     CHECK_THROWS_AS(solver.levelMovable(solver.levels()), InvalidInput);
 }
+
+namespace {
+
+// The piecewise-linear map of a warp grid at (u, v): the test's own barycentric look-up in the cell's
+// triangle ((i, j), (i + 1, j), (i + 1, j + 1) below its diagonal, (i, j), (i + 1, j + 1), (i, j + 1) above).
+glm::dvec2 mapAt(const WarpGrid& w, double u, double v) {
+    const int n = w.cells;
+    const double x = u * n, y = v * n;
+    const int i = std::min(static_cast<int>(x), n - 1), j = std::min(static_cast<int>(y), n - 1);
+    const double fx = x - i, fy = y - j;
+    const auto p = [&](int a, int b) {
+        const size_t k = static_cast<size_t>(b) * (n + 1) + a;
+        return glm::dvec2(w.u[k], w.v[k]);
+    };
+    if (fx >= fy) return p(i, j) + fx * (p(i + 1, j) - p(i, j)) + fy * (p(i + 1, j + 1) - p(i + 1, j));
+    return p(i, j) + fy * (p(i, j + 1) - p(i, j)) + fx * (p(i + 1, j + 1) - p(i, j + 1));
+}
+
+}  // namespace
+
+TEST_CASE("uv warp: a solve started from a coarser warp starts from its map, fold-free", "[uvwarp]") {
+    // A 32-cell warp solved under 0.5x compression (far from the identity), then a 64-cell solver of one
+    // warm iteration on its finest level started from it: each point where the coarser map takes it (the
+    // test's own look-up), no fold; its solve runs that iteration without a restart, fold-free, and takes the
+    // rigid disks nearer their rest lengths.
+    const Scene coarse = stretchedPlane(32, 0.5f);
+    uvwarp::Solver coarseSolver(coarse.rest, coarse.rigidity, coarse.mask);
+    const WarpGrid& from = coarseSolver.solve(coarse.deformed);
+    REQUIRE(uvwarp::countFolds(from) == 0);
+
+    const Scene fine = stretchedPlane(64, 0.5f);
+    uvwarp::SolverOptions refine;
+    refine.iterations = 1;
+    refine.levels = 1;
+    refine.sweepsPerLevel = {4};
+    refine.warmStart = true;
+    uvwarp::Solver solver(fine.rest, fine.rigidity, fine.mask, refine);
+    solver.startFrom(from);
+    const WarpGrid started = solver.warp();
+    double worst = 0.0;
+    for (int j = 0; j <= 64; ++j)
+        for (int i = 0; i <= 64; ++i) {
+            const glm::dvec2 expected = mapAt(from, i / 64.0, j / 64.0);
+            const size_t k = static_cast<size_t>(j) * 65 + i;
+            worst = std::max(worst, glm::length(glm::dvec2(started.u[k], started.v[k]) - expected));
+        }
+    CHECK(worst < 1e-6);
+    CHECK(uvwarp::countFolds(started) == 0);
+
+    const WarpGrid& refined = solver.solve(fine.deformed);
+    CHECK(solver.stats().iterations == 1);
+    CHECK_FALSE(solver.stats().coldRestart);
+    CHECK(uvwarp::countFolds(refined) == 0);
+    CHECK(rigidStretchError(refined, fine.rest, fine.deformed, fine.rigidity) <
+          rigidStretchError(started, fine.rest, fine.deformed, fine.rigidity));
+
+    // A warp of the wrong size, or not finite, is refused with what was expected.
+    CHECK_THROWS_WITH(solver.startFrom(WarpGrid::identity(16)),
+                      Catch::Contains("32, half the solver's grid"));
+    WarpGrid broken = WarpGrid::identity(32);
+    broken.u[40] = std::nanf("");
+    CHECK_THROWS_AS(solver.startFrom(broken), InvalidInput);
+}

@@ -29,6 +29,10 @@ struct TileWarpOptions {
     // > 0: without a painted orientation map, the paper's heuristic for severe compression
     // (densityOrientationMap of the rigidity map with this window radius, texels); 0: 1 everywhere.
     int32_t orientationDensity = 0;
+    // > 0: each solve ends with one more iteration of this many sweeps on a grid of twice the cells, started
+    // from the solved warp (Solver::startFrom) with the finest level only; that grid's warp is the one
+    // delivered. 0: none.
+    int32_t refinementSweeps = 0;
 };
 
 // The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's
