@@ -168,11 +168,12 @@ def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
         dk.write_image(os.path.join(images, "fox_ceiling.png"), np.concatenate(views, 1))
 
 
-def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
+def residual(dk, images, frame=18, t=1024, shown=512,
+             solves=({}, {"resolution": 2048}, {"refinement_sweeps": 2})):
     """fox_residual.png: the Fox's tile at `frame` of its Run, each disk coloured by the rigid stretch error
     the delivered map leaves on it (the mean |l_def / l_rest - 1| over its texel edges: green 0, yellow 5%,
-    red 10% or more), with the default grid and with one twice the map's size; prints each panel's whole and
-    cut figures."""
+    red 10% or more), a panel per solve: the default grid, one twice the map's size, 2 refinement sweeps;
+    prints each panel's whole and cut figures."""
     from uvwarp_rigged_figures import disk_parts, rigid_disks
     rest = dk.read_mesh("tests/data/fox/rest.obj")
     posed = dk.read_mesh(f"tests/data/fox/anim.{frame:04d}.obj")
@@ -181,8 +182,8 @@ def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
     parts = {"all": rigidity, **disk_parts(rigidity, t)}
     label, disks = label_disks(rigidity >= 0.5)
     panels = []
-    for cells in grids:
-        solver = dk.UvWarpSolver(rest, 1001, rigidity, resolution=cells, preset="shot")
+    for options in solves:
+        solver = dk.UvWarpSolver(rest, 1001, rigidity, preset="shot", **options)
         solver.solve(posed.points)
         redirect = solver.redirect_map()
         image = np.where(inside[..., None], np.float32(0.55), np.float32(0.1)) * np.ones(3, np.float32)
@@ -193,7 +194,7 @@ def residual(dk, images, frame=18, t=1024, grids=(1024, 2048), shown=512):
             image[label == d] = (min(1.0, 2 * share), min(1.0, 2 * (1 - share)), 0.1)
         figures = {name: dk.redirect_metrics(rest, 1001, r, posed.points, redirect)["rigid_stretch_removed"]
                    for name, r in parts.items()}
-        print(f"frame {frame}, grid {cells}: " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in figures.items()))
+        print(f"frame {frame}, {options or 'defaults'}: " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in figures.items()))
         step = t // shown
         panels.append(image[::step, ::step])
         panels.append(np.ones((shown, 8, 3), np.float32))

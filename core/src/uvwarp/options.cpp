@@ -48,7 +48,8 @@ const OptionSpec kSpecs[] = {
      .zeroMeans = "none",
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
-                "grid's points (a mesh bends at every edge), at about 1.5x the time a frame.",
+                "grid's points (a mesh bends at every edge). 2 took rigged characters at 1024^2 1.4-6 points "
+                "further (rigged Spot 79.4 to 85.4%), for 1.25-1.45x the time a frame.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},
     {.name = "iterations",

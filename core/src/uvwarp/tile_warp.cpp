@@ -47,6 +47,24 @@ PointField maskField(const std::vector<uint8_t>& bytes, int32_t cells) {
     return mask;
 }
 
+// The refining grid's mask (TileWarpOptions::refinementSweeps): a point the map fixes (`fine`, the map at the
+// refining grid's points) stays only where every point of the solved grid (`coarse`) its start is made from
+// (Solver::startFrom: itself, or the two ends of an edge or of a cell's diagonal) is fixed too: there the
+// start is the identity, as a fixed point must be. Elsewhere the solved grid has moved that start, and the
+// refinement moves it on.
+PointField refinedMask(PointField fine, const PointField& coarse) {
+    const int32_t side = fine.side(), coarseSide = coarse.side();
+    const auto fixed = [&](int32_t i, int32_t j) {
+        return coarse.values[static_cast<size_t>(j) * coarseSide + i] < 0.5f;
+    };
+    for (int32_t j = 0; j < side; ++j)
+        for (int32_t i = 0; i < side; ++i) {
+            float& value = fine.values[static_cast<size_t>(j) * side + i];
+            if (value < 0.5f && !(fixed(i / 2, j / 2) && fixed((i + 1) / 2, (j + 1) / 2))) value = 1.0f;
+        }
+    return fine;
+}
+
 }  // namespace
 
 struct TileWarp::Impl {
@@ -177,13 +195,13 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
         m.refinedImager = std::make_unique<GeometryImager>(rest, uvs, m.refinedCells, imageOptions);
         PointField refinedRest;
         m.refinedImager->sample(rest.points(), refinedRest);
-        const PointField refinedMask = maskAtPoints(maskMap, m.refinedCells, maskLabel);
+        const PointField refined = refinedMask(maskAtPoints(maskMap, m.refinedCells, maskLabel), maskAtGrid);
         m.refiner = std::make_unique<Solver>(
-            std::move(refinedRest), rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel), refinedMask,
+            std::move(refinedRest), rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel), refined,
             refinementOptions(options.solver, options.refinementSweeps),
             m.orientationAt(orientation, rigidity, m.refinedCells),
             source + ", UDIM tile " + std::to_string(tile) + ", refinement");
-        m.refinedBoundMask = maskBytes(refinedMask);
+        m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};
     m.solver =
@@ -304,15 +322,16 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     m.solver->setMaps(std::move(newRigidity), newMask, orientationAtPoints);
     if (m.refiner) {
         const int32_t n = m.refinedCells;
-        const PointField refinedMask = mask.pixels.empty()
-                                           ? maskField(m.refinedBoundMask, n)
-                                           : maskAtPoints(mask, n, {m.source + " warp mask", m.tile});
-        m.refiner->setMaps(rigidityAtPoints(rigidity, n, {m.source + " rigidity map", m.tile}), refinedMask,
+        const PointField refined =
+            mask.pixels.empty()
+                ? maskField(m.refinedBoundMask, n)
+                : refinedMask(maskAtPoints(mask, n, {m.source + " warp mask", m.tile}), newMask);
+        m.refiner->setMaps(rigidityAtPoints(rigidity, n, {m.source + " rigidity map", m.tile}), refined,
                            m.orientationAt(orientation, rigidity, n));
         if (mask.pixels.empty())
             m.refinedMask.clear();
         else
-            m.refinedMask = maskBytes(refinedMask);
+            m.refinedMask = maskBytes(refined);
         m.refinedMask.shrink_to_fit();
     }
     m.delivered->setRigidity(rigidity);
