@@ -68,8 +68,8 @@ class TileWarp {
     [[nodiscard]] DeliveredMetrics measure(const io::Image& redirect) const;
     // `repair`, when given, receives what the repair did to the map measured.
     [[nodiscard]] DeliveredMetrics deliveredMetrics(FoldRepair* repair = nullptr) const;
-    // The solver's own figures on its grid (diagnostics: identity vs. ours on grid edges, grid folds, masked
-    // and border motion).
+    // The solver's own figures on the delivered warp's grid (diagnostics: identity vs. ours on grid edges,
+    // grid folds, masked and border motion).
     [[nodiscard]] WarpMetrics metrics() const;
     // Back to the identity warp (a cut in the shot).
     void reset();
@@ -81,12 +81,14 @@ class TileWarp {
 
     [[nodiscard]] int tile() const;
     [[nodiscard]] int32_t texels() const;
-    [[nodiscard]] int32_t cells() const;
+    [[nodiscard]] int32_t cells() const;  // the solver's grid (TileWarpOptions::cells)
+    // The warp delivered: with refinementSweeps, the refining grid's (2 cells() cells), else the solver's.
     [[nodiscard]] const WarpGrid& warp() const;
+    // The last solve's figures; with refinementSweeps, its iteration and repairs added, its folds left.
     [[nodiscard]] const SolveStats& stats() const;
-    // The rigidity map at grid points (rigidityAtPoints), made on each call.
+    // The rigidity map at the solver's grid points (rigidityAtPoints), made on each call.
     [[nodiscard]] PointField rigidityAtGridPoints() const;
-    // The warp mask at grid points (0 or 1), made on each call.
+    // The warp mask at the solver's grid points (0 or 1), made on each call.
     [[nodiscard]] PointField maskAtGridPoints() const;
 
   private:
