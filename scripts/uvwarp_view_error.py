@@ -103,11 +103,15 @@ def bilinear(corner, cells, u, v):
             + (corner(i, j + 1) * (1 - fx) + corner(i + 1, j + 1) * fx) * fy)
 
 
+# The ends of a grid's 4-connected edges, as index pairs of its point arrays: along rows, then along columns.
+EDGES = (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
+         ((slice(0, -1), slice(None)), (slice(1, None), slice(None))))
+
+
 def grid_edge_errors(deformed, rest, rigid):
     """|l_def / l_org - 1| on the 4-connected edges of a grid of points (rows, columns, 3) with both ends rigid."""
     errors = []
-    for a, b in (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
-                 ((slice(0, -1), slice(None)), (slice(1, None), slice(None)))):
+    for a, b in EDGES:
         keep = rigid[a] & rigid[b]
         ratio = np.linalg.norm(deformed[b] - deformed[a], axis=-1) / np.linalg.norm(rest[b] - rest[a], axis=-1)
         errors.append(np.where(keep, np.abs(ratio - 1), np.nan))
@@ -133,10 +137,13 @@ def figures(locator, rest_points, posed_points, warp, rigidity):
     # Every figure over the same edges: those every variant measures (a point whose bilinear look-up reads an
     # image point off the charts, NaN, drops out; the solver's image is dilated there instead).
     variants = {"identity": locator.surface(posed_points, gu, gv)}
+    image = variants["identity"].reshape(cells + 1, cells + 1, 3)  # f_D at the grid's own points
     for k in (1, 2, 4):
         fine = cells * k
 
         def corner(ci, cj, fine=fine):
+            if fine == cells:
+                return image[cj, ci]
             return locator.surface(posed_points, np.clip(ci / fine, eps, 1 - eps), np.clip(cj / fine, eps, 1 - eps))
 
         variants[f"view {k}x"] = bilinear(corner, fine, wu, wv)
@@ -149,8 +156,7 @@ def figures(locator, rest_points, posed_points, warp, rigidity):
     errors = [np.where(common[d], errors["surface"][d], np.nan) for d in range(2)]
     triangle = locator.locate(gu, gv)[0].reshape(cells + 1, cells + 1)
     across, crossing = 0.0, 0
-    for e, (a, b) in zip(errors, (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
-                                  ((slice(0, -1), slice(None)), (slice(1, None), slice(None))))):
+    for e, (a, b) in zip(errors, EDGES):
         across += np.nansum(np.where(triangle[a] != triangle[b], e, 0.0))
         crossing += (np.isfinite(e) & (triangle[a] != triangle[b])).sum()
     out["across edges"] = across / sum(np.nansum(e) for e in errors)
