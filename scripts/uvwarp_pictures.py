@@ -11,8 +11,8 @@ and as baked (<name>_after.png).
              optimum (bench_uvwarp_reference --maps: Levenberg-Marquardt to convergence); prints each disk's
              area as shown over its rest area, for the three, worst disks first
     residual the Fox at frame 18 of its Run, 1024^2 (fox_residual.png): each disk coloured by the rigid stretch
-             error left on it through the delivered map, with the default grid and with one twice the map's
-             size; prints the figures of the whole and the cut disks for both
+             error left on it through the delivered map, without refinement, with a grid twice the map's size
+             and with the shot preset; prints the figures of the whole and the cut disks for each
 
 Usage, from the repository's root:
 
@@ -169,11 +169,11 @@ def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
 
 
 def residual(dk, images, frame=18, t=1024, shown=512,
-             solves=({}, {"resolution": 2048}, {"refinement_sweeps": 2})):
+             solves=({"refinement_sweeps": 0}, {"resolution": 2048}, {})):
     """fox_residual.png: the Fox's tile at `frame` of its Run, each disk coloured by the rigid stretch error
     the delivered map leaves on it (the mean |l_def / l_rest - 1| over its texel edges: green 0, yellow 5%,
-    red 10% or more), a panel per solve: the default grid, one twice the map's size, 2 refinement sweeps;
-    prints each panel's whole and cut figures."""
+    red 10% or more), a panel per solve of the shot preset: the map's grid without refinement, a grid twice
+    the map's size, the preset itself (the map's grid, refined); prints each panel's whole and cut figures."""
     from uvwarp_rigged_figures import disk_parts, rigid_disks
     rest = dk.read_mesh("tests/data/fox/rest.obj")
     posed = dk.read_mesh(f"tests/data/fox/anim.{frame:04d}.obj")

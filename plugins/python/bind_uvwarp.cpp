@@ -753,22 +753,20 @@ void bindUvWarp(py::module_& m) {
             if (cells < 1 || cells > (int64_t{1} << 15))
                 throw InvalidInput(formatError("uv_warp_live_options", "cells", "is " + std::to_string(cells),
                                                "a grid size from 1 to 32768"));
-            TileWarpOptions o;
-            o.solver = uvwarp::liveOptions(static_cast<int32_t>(cells));
+            const TileWarpOptions o =
+                uvwarp::presetOptions(uvwarp::Preset::Live, static_cast<int32_t>(cells));
             py::dict options;
             for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
-                if (spec.solver) options[py::str(uvwarp::pythonName(spec))] = optionObject(spec, o);
+                if (spec.solver || spec.name == "refinementSweeps")
+                    options[py::str(uvwarp::pythonName(spec))] = optionObject(spec, o);
             }
             return options;
         },
         py::arg("cells"),
-        "The live-preview preset for a grid of `cells` cells per side, as UvWarpSolver keyword options "
-        "(every\n"
-        "solver option): one\n"
-        "warm-started iteration a frame, the coarse levels over-relaxed by 1.4, sweeps per level by grid "
-        "size\n"
-        "(uvwarp::liveOptions; within 2 points of a converged solve on every probed frame of a smooth\n"
-        "animation).");
+        "The live-preview preset for a grid of `cells` cells per side, as UvWarpSolver keyword options\n"
+        "(every solver option and refinement_sweeps, 0): one warm-started iteration a frame, the coarse\n"
+        "levels over-relaxed by 1.4, sweeps per level by grid size, no refinement (uvwarp::presetOptions;\n"
+        "within 2 points of a converged solve on every probed frame of a smooth animation).");
 
     m.def(
         "redirect_metrics",

@@ -1,8 +1,9 @@
 // A fully covered UV tile at production sizes, as a farm job solves it: a plane whose UVs fill tile 1001,
 // rigid disks painted over the whole tile, the deformed pose (a stretch growing from 1x to 1.8x along u and a
 // wave across v) solved cold with the shot preset (a farm job's: the default schedule, every frame from the
-// identity). One TileWarp per run: bind (geometry images, maps,
-// hierarchy), the cold solve, the redirect map with its repair, and the delivered figures a farm job logs.
+// identity, refined on a grid of twice the cells up to 1024 cells). One TileWarp per run: bind (geometry
+// images, maps, hierarchy, the refining grid's), the cold solve, the redirect map with its repair, and the
+// delivered figures a farm job logs.
 //
 // BM_UvWarpTileScale/T, T texels (= grid cells) per side. Counters: bind_s, solve_s, redirect_s, measure_s;
 // bind_ratio = bind / solve (target <= 0.25); peak_bytes_per_cell = the process's peak resident memory over

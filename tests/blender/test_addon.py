@@ -392,14 +392,14 @@ def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     check_bake_report(obj, out, disk)
 
     # The same solve through the module: the mesh's own positions at each frame, the painted disk (row 0 at
-    # v = 1, so Blender's bottom-up rows flipped), each frame from the identity (a shot's default): the same
-    # bytes.
+    # v = 1, so Blender's bottom-up rows flipped), the shot preset (each frame from the identity, refined by
+    # the grid's size): the same bytes.
     counts = np.full(len(obj.data.polygons), 4, np.int32)
     indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
     uv_indices = np.arange(len(indices), dtype=np.int32)
     uvs = (rest[indices][:, :2] + 1.0) / 2.0
     solver = dk.UvWarpSolver(rest, counts, indices, uvs.astype(np.float32), uv_indices, 1001,
-                             np.ascontiguousarray(disk[::-1]), warm_start=False)
+                             np.ascontiguousarray(disk[::-1]), preset="shot")
     for frame in (1, 2, 3):
         bpy.context.scene.frame_set(frame)
         solver.solve(positions(obj))

@@ -323,7 +323,7 @@ def test_shot_writes_the_solvers_maps_frame_by_frame_with_provenance(tmp_path):
                      for k, (frame, tile) in enumerate((f, t) for f in FRAMES for t in (1001, 1002))]
     assert sorted(report) == [1001, 1002]
     for tile in (1001, 1002):
-        solver = dk.UvWarpSolver(*mesh, tile, rig[tile], **OPTIONS)
+        solver = dk.UvWarpSolver(*mesh, tile, rig[tile], preset="shot", **OPTIONS)  # a shot's, with OPTIONS
         r = report[tile]
         outs = [str(tmp_path / f"redirect.{tile}.{f:04d}.exr") for f in FRAMES]
         bakes = [str(tmp_path / f"col.{tile}.{f:04d}.exr") for f in FRAMES]
@@ -403,7 +403,7 @@ def test_shot_by_default_solves_each_frame_from_the_identity(tmp_path):
             name = f"redirect.{tile}.{frame:04d}.exr"
             whole = dk.read_image(str(tmp_path / "whole" / name))
             np.testing.assert_array_equal(dk.read_image(str(tmp_path / "last" / name)), whole)
-            alone = dk.UvWarpSolver(*mesh, tile, rig[tile], iterations=4, warm_start=False)
+            alone = dk.UvWarpSolver(*mesh, tile, rig[tile], preset="shot", iterations=4)
             alone.solve(pose(mesh[0], frame))
             np.testing.assert_array_equal(whole, alone.redirect_map())
     solver = json.loads(dk.read_image_info(str(tmp_path / "whole" / "redirect.1001.0004.exr"))["attributes"][

@@ -164,7 +164,10 @@ def test_the_live_preset_by_name_in_python_the_command_line_and_scenes(shot):
     mine = dk.UvWarpSolver(mesh, 1001, rigidity, preset="live", iterations=3, resolution=8)
     assert mine.options["iterations"] == 3 and mine.options["resolution"] == 8
     assert mine.options["sweeps_per_level"] == dk.uv_warp_live_options(8)["sweeps_per_level"]
-    assert dk.UvWarpSolver(mesh, 1001, rigidity, preset="shot").options["warm_start"] is False
+    assert live["refinement_sweeps"] == 0
+    shot_options = dk.UvWarpSolver(mesh, 1001, rigidity, preset="shot").options
+    assert shot_options["warm_start"] is False and shot_options["refinement_sweeps"] == -1  # by the grid's size
+    assert dk.UvWarpSolver(mesh, 1001, rigidity).options["refinement_sweeps"] == 0  # a library solver: none
     with pytest.raises(dk.InvalidInput, match=r"UvWarpSolver: preset: is 'fast' \(expected shot or live\)"):
         dk.UvWarpSolver(mesh, 1001, rigidity, preset="fast")
 

@@ -44,12 +44,15 @@ const OptionSpec kSpecs[] = {
      .put = TileMember<&TileWarpOptions::cells>::put},
     {.name = "refinementSweeps",
      .type = OptionType::Integer,
+     .low = kAutomaticRefinement,
      .high = 64,
      .zeroMeans = "none",
+     .lowMeans = "by the grid's size: 4 up to 1024 cells, none from 2048",
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
-                "grid's points (a mesh bends at every edge). 2 took rigged characters at 1024^2 1.4-6 points "
-                "further (rigged Spot 79.4 to 85.4%), for 1.25-1.45x the time a frame.",
+                "grid's points (a mesh bends at every edge). The shot preset's 4 took rigged characters at "
+                "1024^2 1.8-6.8 points further (rigged Spot 79.4 to 86.2% median), for 1.4-1.5x the time a "
+                "frame; the live preset has none.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},
     {.name = "iterations",
@@ -349,9 +352,15 @@ std::string pythonName(const OptionSpec& spec) {
 
 std::string expectedValue(const OptionSpec& spec) {
     const auto number = [&](double v) { return optionNumberText(spec, v); };
+    const std::string unit = spec.unit.empty() ? "" : ", " + std::string(spec.unit);
+    if (!spec.lowMeans.empty()) {  // a whole number from 0 with one special value below it
+        return "a whole number from 0" +
+               (spec.zeroMeans.empty() ? "" : " (" + std::string(spec.zeroMeans) + ")") + " to " +
+               number(spec.high) + unit + ", or " + number(spec.low) + " (" + std::string(spec.lowMeans) +
+               ")";
+    }
     std::string low = number(spec.low);
     if (spec.low == 0 && !spec.zeroMeans.empty()) low += " (" + std::string(spec.zeroMeans) + ")";
-    const std::string unit = spec.unit.empty() ? "" : ", " + std::string(spec.unit);
     switch (spec.type) {
         case OptionType::Flag:
             return "true or false";
@@ -406,7 +415,10 @@ Preset presetNamed(std::string_view name, std::string_view source, std::string_v
 
 TileWarpOptions presetOptions(Preset preset, int32_t cells) {
     TileWarpOptions options = shotOptions();
-    if (preset == Preset::Live) options.solver = liveOptions(cells);
+    if (preset == Preset::Live) {
+        options.solver = liveOptions(cells);
+        options.refinementSweeps = 0;  // a live frame's budget has no room for a grid of twice the cells
+    }
     options.cells = cells;
     return options;
 }

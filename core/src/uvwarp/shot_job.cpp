@@ -584,6 +584,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
 TileWarpOptions shotOptions() {
     TileWarpOptions options;
     options.solver.warmStart = false;
+    options.refinementSweeps = kAutomaticRefinement;
     return options;
 }
 

@@ -161,7 +161,8 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                            (options.cells == 0 ? " (the rigidity map's size)" : ""),
                                        "a power of two, at least 2"));
     }
-    if (options.refinementSweeps > 0 && m.cells > kMaxGridCells / 2) {
+    const int32_t refinementSweeps = refinementSweepsFor(options.refinementSweeps, m.cells);
+    if (refinementSweeps > 0 && m.cells > kMaxGridCells / 2) {
         throw InvalidInput(formatError(
             source, "grid resolution, UDIM tile " + std::to_string(tile),
             std::to_string(m.cells) + " cells per side with refinement sweeps",
@@ -190,17 +191,17 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     const PointField maskAtGrid = maskAtPoints(maskMap, m.cells, maskLabel);
     m.densityRadius = options.orientationDensity;
     const PointField orientationAtPoints = m.orientationAt(orientation, rigidity, m.cells);
-    if (options.refinementSweeps > 0) {
+    if (refinementSweeps > 0) {
         m.refinedCells = 2 * m.cells;
         m.refinedImager = std::make_unique<GeometryImager>(rest, uvs, m.refinedCells, imageOptions);
         PointField refinedRest;
         m.refinedImager->sample(rest.points(), refinedRest);
         const PointField refined = refinedMask(maskAtPoints(maskMap, m.refinedCells, maskLabel), maskAtGrid);
-        m.refiner = std::make_unique<Solver>(
-            std::move(refinedRest), rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel), refined,
-            refinementOptions(options.solver, options.refinementSweeps),
-            m.orientationAt(orientation, rigidity, m.refinedCells),
-            source + ", UDIM tile " + std::to_string(tile) + ", refinement");
+        m.refiner = std::make_unique<Solver>(std::move(refinedRest),
+                                             rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel),
+                                             refined, refinementOptions(options.solver, refinementSweeps),
+                                             m.orientationAt(orientation, rigidity, m.refinedCells),
+                                             source + ", UDIM tile " + std::to_string(tile) + ", refinement");
         m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};

@@ -21,6 +21,7 @@
 #include "deformkit/scene/scene.h"
 #include "deformkit/scene/uvwarp_stage.h"
 #include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/shot_job.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "eval_command.h"
 #include "farm_command.h"
@@ -52,8 +53,9 @@ TEST_CASE("scene uvwarp: eval writes per tile and frame the maps of TileWarp fed
 
     // The reference: one TileWarp per tile, solved over frames 1..3 in order with the same options,
     // fed by the stack built by hand.
-    uvwarp::TileWarpOptions options;
+    uvwarp::TileWarpOptions options = uvwarp::shotOptions();  // and the scene's params
     options.solver.iterations = 6;
+    options.solver.warmStart = true;
     const io::Image rigidity = uvwarp::readRigidityMap(shot.dir / "rig.1001.exr", 1001);
     for (int tile : {1001, 1002}) {
         uvwarp::TileWarp warp(shot.rest, tile, rigidity, {}, options);
@@ -237,8 +239,9 @@ TEST_CASE("scene uvwarp: an animated rigidity map (rig.<UDIM>.####.exr) is follo
     const harness::EvalReport report = harness::evalCommand(command);
     REQUIRE(!report.uvwarpLines.empty());
     CHECK_THAT(report.uvwarpLines[0], Contains("maps changed at 1 frame"));
-    uvwarp::TileWarpOptions options;
+    uvwarp::TileWarpOptions options = uvwarp::shotOptions();  // and the scene's params
     options.solver.iterations = 6;
+    options.solver.warmStart = true;
     for (int tile : {1001, 1002}) {
         uvwarp::TileWarp warp(shot.rest, tile, disks(), {}, options);
         for (int frame = 1; frame <= 3; ++frame) {

@@ -90,7 +90,7 @@ TEST_CASE("shot job: each tile equals a TileWarp solved frame by frame; each fra
     CHECK(shot.asked == kFrames);  // not frames x tiles
     REQUIRE(report.tiles.size() == 2);
     for (const int tile : {1001, 1002}) {
-        uvwarp::TileWarp reference(shot.rest, tile, test::twoDisks(kTexels));
+        uvwarp::TileWarp reference(shot.rest, tile, test::twoDisks(kTexels), {}, shot.job.options);
         for (int f = 1; f <= kFrames; ++f) {
             reference.solve(test::stretchedAndBent(shot.rest, f));
             const io::Image written = io::readImage(shot.out(tile, f));
@@ -159,7 +159,7 @@ TEST_CASE("shot job: animated maps are given to the warp when they change, and o
         CHECK(t.mapChanges == 1);
     CHECK_THAT(uvwarp::shotSummary(report)[0], Contains("maps changed at 1 frame"));
     for (const int tile : {1001, 1002}) {
-        uvwarp::TileWarp reference(animated.rest, tile, test::twoDisks(kTexels));
+        uvwarp::TileWarp reference(animated.rest, tile, test::twoDisks(kTexels), {}, animated.job.options);
         for (int f = 1; f <= kFrames; ++f) {
             if (f == 3) reference.setMaps(none);
             reference.solve(test::stretchedAndBent(animated.rest, f));

@@ -36,8 +36,11 @@ struct OptionSpec {
     bool powerOfTwo = false;          // a value other than 0 must be a power of two (the grid resolution)
     std::string_view unit = {};       // "grid cells", "texels", or empty for a count or a fraction
     std::string_view zeroMeans = {};  // what 0 stands for where it is special ("automatic"), or empty
-    std::string_view meaning = {};    // one or two sentences: help texts and the reference are made from it
-    bool solver = false;              // a SolverOptions member, checked by the Solver's constructor as well
+    // What `low` stands for when it is a value below the range (-1: "by the grid's size"), or empty: the
+    // range then starts at 0 and `low` is named apart from it.
+    std::string_view lowMeans = {};
+    std::string_view meaning = {};  // one or two sentences: help texts and the reference are made from it
+    bool solver = false;            // a SolverOptions member, checked by the Solver's constructor as well
     // Written to the shot header (deformkit:uvwarp:solver). False for an option that never changes a
     // result (threads) or whose value in use the header records otherwise (the resolution, as "cells").
     bool recorded = true;
@@ -87,11 +90,10 @@ void checkOptions(const SolverOptions& options, std::string_view source);
 
 // The library's presets: every option's value for a use, by name in every interface (`--preset live`,
 // "preset": "live", preset="live", the Maya node's preset attribute).
-//   shot  the default schedule (4 iterations, sweeps by the grid's size), each frame from the identity: what
-//   a shot
-//         written as files runs (shotOptions()).
-//   live  one warm-started iteration a frame, for a live preview: liveOptions(cells), whose schedule depends
-//         on the grid's size.
+//   shot  the default schedule (4 iterations, sweeps by the grid's size), each frame from the identity,
+//         refined by the grid's size: what a shot written as files runs (shotOptions()).
+//   live  one warm-started iteration a frame, for a live preview, unrefined: liveOptions(cells), whose
+//         schedule depends on the grid's size.
 enum class Preset { Shot, Live };
 [[nodiscard]] std::string_view presetName(Preset preset);
 // "shot" or "live"; InvalidInput "<source>: <element>: is '<name>' (expected shot or live)" otherwise.

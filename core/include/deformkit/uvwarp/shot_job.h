@@ -72,10 +72,12 @@ struct TileMapSource {
 };
 
 // The options a job over a shot starts from: TileWarpOptions{} but every frame solved from the identity
-// (SolverOptions::warmStart false). With the default schedule that costs what a warm-started frame does and
-// removes as much of the rigid stretch, and a frame's maps then depend on that frame alone: not on the
-// frames before it, nor on where a farm chunk or a resumed job begins (docs/decisions.md, UV-20). Hosts
-// that show a live preview, one iteration a frame, warm-start instead (TileWarpOptions{}).
+// (SolverOptions::warmStart false) and refined by the grid's size (kAutomaticRefinement: grids up to 1024
+// cells end on a grid of twice the cells, UV-39). From the identity, the default schedule costs what a
+// warm-started frame does and removes as much of the rigid stretch, and a frame's maps then depend on that
+// frame alone: not on the frames before it, nor on where a farm chunk or a resumed job begins
+// (docs/decisions.md, UV-20). Hosts that show a live preview, one iteration a frame, warm-start instead
+// (TileWarpOptions{}).
 [[nodiscard]] TileWarpOptions shotOptions();
 
 struct ShotJob {

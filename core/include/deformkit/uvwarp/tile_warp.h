@@ -31,9 +31,21 @@ struct TileWarpOptions {
     int32_t orientationDensity = 0;
     // > 0: each solve ends with one more iteration of this many sweeps on a grid of twice the cells, started
     // from the solved warp (Solver::startFrom) with the finest level only; that grid's warp is the one
-    // delivered. 0: none.
+    // delivered. 0: none. kAutomaticRefinement: by the grid's size (refinementSweepsFor), the shot preset's.
     int32_t refinementSweeps = 0;
 };
+
+// refinementSweeps chosen by the grid's size: kAutomaticRefinementSweeps on grids up to
+// kAutomaticRefinementCells cells, none on finer grids (they sample the posed surface as finely already, and
+// the refining grid would hold four times their memory).
+inline constexpr int32_t kAutomaticRefinement = -1;
+inline constexpr int32_t kAutomaticRefinementSweeps = 4;
+inline constexpr int32_t kAutomaticRefinementCells = 1024;
+// The refinement sweeps a grid of `cells` cells runs for the option's value `sweeps`.
+[[nodiscard]] constexpr int32_t refinementSweepsFor(int32_t sweeps, int32_t cells) {
+    if (sweeps != kAutomaticRefinement) return sweeps;
+    return cells <= kAutomaticRefinementCells ? kAutomaticRefinementSweeps : 0;
+}
 
 // The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's
 // UV triangles of the tile (geometry images), the rigidity map R, the warp mask M (derived from the UVs
