@@ -729,7 +729,7 @@ SolverOptions liveOptions(int32_t cells) {
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
     detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
-    if (!m.options.warmStart) reset();
+    if (!m.options.warmStart && !m.started) reset();  // startFrom says where this solve starts
     m.allocateSolveState();
     m.deformed = deformedGeometry.values.data();
     m.stats.untangledPoints = 0;

@@ -84,8 +84,8 @@ struct TileWarp::Impl {
     int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     // TileWarpOptions::refinementSweeps: the grid of twice the cells the last iteration runs on, its imager,
-    // f_D (kept between solves: the refining solver keeps its state too, warm-started from each solve) and
-    // masks (as above), and the figures of a solve through both grids.
+    // f_D (kept between solves as the solve's is: only when warm-started, as the refining solver keeps its
+    // state) and masks (as above), and the figures of a solve through both grids.
     int32_t refinedCells = 0;
     std::unique_ptr<GeometryImager> refinedImager;
     std::unique_ptr<Solver> refiner;
@@ -129,8 +129,7 @@ SolverOptions refinementOptions(SolverOptions options, int32_t sweeps) {
     options.sweepsPerLevel = {sweeps};
     options.levels = 1;
     options.maxLevels = 0;
-    options.warmStart = true;
-    return options;
+    return options;  // warmStart as the solve's: each solve starts from it (startFrom), kept only when warm
 }
 
 }  // namespace
@@ -247,6 +246,10 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats.shortenedSteps += r.shortenedSteps;
     m.stats.shortenedEverywhere += r.shortenedEverywhere;
     m.stats.remainingFolds = r.remainingFolds;
+    if (!m.keepDeformed) {
+        m.refinedDeformed = {};
+        deformkit::detail::releaseFreedMemory();  // as the solve's f_D above, and the refiner's solve state
+    }
     return refined;
 }
 

@@ -313,9 +313,9 @@ TEST_CASE(
     "tile warp: solved from the identity every frame, it keeps nothing between frames and gives the same "
     "bytes",
     "[uvwarp]") {
-    // The shot preset frees f_D, the velocities and the coarse levels' copies after each solve; a warp that
-    // keeps them (warm start) and is reset before each frame is the reference. The rigidity map handed over
-    // with 3 channels (channel 0 read) against 1.
+    // The shot preset frees f_D, the velocities and the coarse levels' copies after each solve, its refining
+    // grid's too; a warp that keeps them (warm start) and is reset before each frame is the reference. The
+    // rigidity map handed over with 3 channels (channel 0 read) against 1.
     const geom::Mesh mesh = uvPlane(32);
     const io::Image disks = diskRigidity(128);
     io::Image rgb(128, 128, 3);
@@ -336,6 +336,7 @@ TEST_CASE(
         warm.solve(pose);
         INFO("stretch " << sx);
         REQUIRE(cold.stats().iterations > 0);
+        REQUIRE(cold.warp().cells == 256);  // refined (the shot preset at 128 cells)
         CHECK(cold.warp().u == warm.warp().u);
         CHECK(cold.warp().v == warm.warp().v);
         const io::Image coldMap = cold.redirect(), warmMap = warm.redirect();

@@ -142,8 +142,9 @@ class Solver {
     void reset();
     // The next solve starts from `coarser`'s warp, a fold-free grid of half the cells: each point where that
     // piecewise-linear map takes it, so the grid is the same map (every triangle lies inside one of
-    // `coarser`'s, so none folds), with zero velocity. That solve runs `iterations` warm iterations and
-    // never restarts from the identity (a fold repair that spreads keeps the grid fold-free). Points the mask
+    // `coarser`'s, so none folds), with zero velocity. That solve runs `iterations` warm iterations, with or
+    // without warmStart (which then only says whether the solve's state is kept after it), and never
+    // restarts from the identity (a fold repair that spreads keeps the grid fold-free). Points the mask
     // fixes keep the map `coarser` gives them. Throws InvalidInput when `coarser` has not half the cells or
     // is not finite.
     void startFrom(const WarpGrid& coarser);
