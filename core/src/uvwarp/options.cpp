@@ -29,6 +29,10 @@ struct TileMember {
     }
 };
 
+// refinementSweeps' lowMeans spells the rule of refinementSweepsFor out.
+static_assert(kAutomaticRefinementSweeps == 4 && kAutomaticRefinementCells == 1024,
+              "refinementSweeps' lowMeans states 4 sweeps up to 1024 cells");
+
 const OptionSpec kSpecs[] = {
     {.name = "resolution",
      .type = OptionType::Integer,
