@@ -40,7 +40,8 @@ REFERENCES = {
     "BM_UvWarpContendedAllThreads": ("BM_UvWarpContended1Thread", "time ratio: all threads / 1, a core taken"),
     "BM_UvWarpContendedChosen": ("BM_UvWarpContended1Thread", "time ratio: chosen team / 1, a core taken"),
     "BM_UvWarpFrame": ("BM_UvWarpFrameConverged", "animated frame / converged cold solve, frames per second"),
-    # A shot frame of the rigged Fox at 1024^2 (solve, map, delivered figures) against Spot's, frames per second.
+    # A shot frame of the rigged Fox at 1024^2 (solve, map, delivered figures; the argument its refinement sweeps,
+    # -1 the shot preset's) against Spot's unrefined frame, frames per second.
     "BM_UvWarpRiggedShotFrame": ("BM_UvWarpSpotShotFrame", "rigged Fox / Spot shot frame, frames per second"),
     "BM_PtexRead": ("BM_PtexPlainRead", "Ptex read / plain read of the file's bytes, same texel bytes"),
     "BM_PtexZlibInflate": ("BM_PtexRead", "zlib inflate alone / whole Ptex read, same texel bytes"),
