@@ -44,6 +44,13 @@ contains info-ply "$work/out" "faces       1 (triangles 0, quads 1, n-gons 0)"
 echo "not a mesh" >"$work/notes.txt"
 expect info-unknown 2 "$dk" info "$work/notes.txt"
 contains info-unknown "$work/err" "is neither a mesh, a point cache nor an image (expected a mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)"
+# Images are read through DeformKit's OpenImageIO module, loaded on the first image read or write: a command
+# on meshes alone never needs it; an image command without it names the image, the module and why.
+expect image-module-unused 0 env DEFORMKIT_IMAGE_MODULE="$work/none/deformkit_image_oiio.so" "$dk" info "$work/quad.ply"
+expect image-module-missing 2 env DEFORMKIT_IMAGE_MODULE="$work/none/deformkit_image_oiio.so" "$dk" info "$work/notes.txt"
+contains image-module-missing "$work/err" "$work/notes.txt: cannot load DeformKit's image module ($work/none/deformkit_image_oiio.so: no such file) (expected deformkit_image_oiio.so installed beside the library (lib/deformkit) or named by DEFORMKIT_IMAGE_MODULE)"
+expect image-module-not-a-library 2 env DEFORMKIT_IMAGE_MODULE="$work/quad.ply" "$dk" info "$work/notes.txt"
+contains image-module-not-a-library "$work/err" "($work/quad.ply: invalid ELF header)"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n' >"$work/bad.obj"
 expect bad-index 2 "$dk" info "$work/bad.obj"
 contains bad-index "$work/err" "line 4"

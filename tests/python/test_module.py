@@ -1,5 +1,6 @@
 """The deformkit Python module: numpy views, round trips and errors, checked against numpy references."""
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -67,6 +68,21 @@ def test_image_round_trips(tmp_path):
 def _write(path, data, type):
     dk.write_image(path, data, type=type)
     return path
+
+
+def test_openimageio_is_loaded_by_the_first_image_call_only(tmp_path):
+    # A fresh interpreter: importing the module maps no OpenImageIO library; the first image written does.
+    script = (
+        "import sys, numpy as np, deformkit as dk\n"
+        "def mapped():\n"
+        "    return 'libOpenImageIO' in open('/proc/self/maps').read()\n"
+        "before = mapped()\n"
+        "dk.write_image(sys.argv[1], np.zeros((2, 2, 1), np.float32))\n"
+        "print(before, mapped(), dk.read_image(sys.argv[1]).shape)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", script, str(tmp_path / "a.exr")], check=True, capture_output=True,
+                         text=True)
+    assert out.stdout.split("\n")[0] == "False True (2, 2, 1)"
 
 
 def test_udim_tiles(tmp_path):

@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
 #include <zlib.h>
 
 #include <array>
@@ -17,6 +16,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
+#include "io/image_codec.h"
 
 namespace deformkit::io {
 namespace fs = std::filesystem;
@@ -25,8 +25,8 @@ namespace {
 
 // OpenImageIO keeps a per-thread global error and appends to it; a message left by an earlier failure
 // would otherwise be reported with the next one.
-void discardPendingOiioErrors() {
-    (void)OIIO::geterror();
+void discardPendingOiioErrors(const codec::Codec& oiio) {
+    (void)oiio.takeGlobalError();
 }
 
 // OpenImageIO messages may span lines (libpng adds its own); errors are reported on one line.
@@ -45,9 +45,9 @@ std::string oneLine(std::string message) {
     return out.empty() ? std::string("unknown OpenImageIO error") : out;
 }
 
-std::string oiioError(const std::string& objectError = {}) {
+std::string oiioError(const codec::Codec& oiio, const std::string& objectError = {}) {
     std::string message = objectError;
-    const std::string global = OIIO::geterror();
+    const std::string global = oiio.takeGlobalError();
     if (!global.empty()) message += (message.empty() ? "" : "\n") + global;
     return oneLine(message);
 }
@@ -71,24 +71,22 @@ void requireReadableFile(const fs::path& path) {
     }
 }
 
-std::unique_ptr<OIIO::ImageInput> openInput(const fs::path& path) {
+std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::path& path) {
     requireReadableFile(path);
-    discardPendingOiioErrors();
+    discardPendingOiioErrors(oiio);
     // Keep colour and alpha as stored: a 4-channel data map must not come back premultiplied.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path.string(), &config);
+    auto in = oiio.openReader(path.string(), true);
     if (!in) {
-        throw ParseError(formatError(path.string(), "", "cannot read the image: " + oiioError(),
+        throw ParseError(formatError(path.string(), "", "cannot read the image: " + oiioError(oiio),
                                      "a complete image file in a format OpenImageIO reads"));
     }
-    const OIIO::ImageSpec& spec = in->spec();
+    const codec::Spec& spec = in->spec();
     if (spec.deep) throw InvalidInput(formatError(path.string(), "", "is a deep image", "a flat image"));
-    if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) {
+    if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.channels < 1) {
         throw ParseError(formatError(path.string(), "header",
                                      "declares " + std::to_string(spec.width) + "x" +
                                          std::to_string(spec.height) + "x" + std::to_string(spec.depth) +
-                                         " pixels with " + std::to_string(spec.nchannels) + " channels",
+                                         " pixels with " + std::to_string(spec.channels) + " channels",
                                      "a 2D image with at least one pixel and one channel"));
     }
     return in;
@@ -133,32 +131,25 @@ void requireCompletePng(const fs::path& path) {
     }
 }
 
-std::string pixelTypeName(OIIO::TypeDesc type) {
-    if (type == OIIO::TypeDesc::UINT8) return "uint8";
-    if (type == OIIO::TypeDesc::UINT16) return "uint16";
-    if (type == OIIO::TypeDesc::HALF) return "half";
-    if (type == OIIO::TypeDesc::FLOAT) return "float";
-    return type.c_str();
-}
-
 std::string channelCount(int32_t n) {
     return std::to_string(n) + (n == 1 ? " channel" : " channels");
 }
 
-OIIO::TypeDesc requestedType(PixelType type, std::string_view format) {
+// The pixel type's name, as the codec takes it.
+std::string requestedType(PixelType type, std::string_view format) {
     switch (type) {
         case PixelType::UInt8:
-            return OIIO::TypeDesc::UINT8;
+            return "uint8";
         case PixelType::UInt16:
-            return OIIO::TypeDesc::UINT16;
+            return "uint16";
         case PixelType::Half:
-            return OIIO::TypeDesc::HALF;
+            return "half";
         case PixelType::Float:
-            return OIIO::TypeDesc::FLOAT;
+            return "float";
         case PixelType::Auto:
             break;
     }
-    return format == "openexr" ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8;
+    return format == "openexr" ? "half" : "uint8";
 }
 
 bool hasAttribute(const ImageWriteOptions& options, std::string_view name) {
@@ -170,15 +161,16 @@ bool hasAttribute(const ImageWriteOptions& options, std::string_view name) {
 
 // Reads the written file's header back: OpenImageIO silently drops metadata a format cannot hold
 // (TIFF keeps only its standard tags), and a map that loses how it was made must not pass as written.
-void requireAttributesStored(const fs::path& path, const fs::path& written, std::string_view format,
-                             const ImageWriteOptions& options) {
+void requireAttributesStored(const codec::Codec& oiio, const fs::path& path, const fs::path& written,
+                             std::string_view format, const ImageWriteOptions& options) {
     if (options.attributes.empty()) return;
-    discardPendingOiioErrors();
-    auto in = OIIO::ImageInput::open(written.string());
+    discardPendingOiioErrors(oiio);
+    auto in = oiio.openReader(written.string(), false);
     if (!in)
-        throw IoError(formatError(path.string(), "", "cannot read back the written header: " + oiioError()));
+        throw IoError(
+            formatError(path.string(), "", "cannot read back the written header: " + oiioError(oiio)));
     for (const auto& [name, value] : options.attributes) {
-        if (!in->spec().find_attribute(name)) {
+        if (!in->hasAttribute(name)) {
             throw InvalidInput(formatError(path.string(), "attribute '" + name + "'",
                                            std::string(format) + " files cannot store this header attribute",
                                            "a format with arbitrary metadata, such as .exr"));
@@ -192,46 +184,46 @@ void requireAttributesStored(const fs::path& path, const fs::path& written, std:
 Image readImage(const fs::path& path, const ImageReadOptions& options) {
     requireReadableFile(path);
     requireCompletePng(path);
-    auto in = openInput(path);
-    const OIIO::ImageSpec& spec = in->spec();
-    if (options.expectedChannels > 0 && spec.nchannels != options.expectedChannels) {
-        throw InvalidInput(formatError(path.string(), options.role, "has " + channelCount(spec.nchannels),
+    const codec::Codec& oiio = codec::load(path.string());
+    auto in = openInput(oiio, path);
+    const codec::Spec& spec = in->spec();
+    if (options.expectedChannels > 0 && spec.channels != options.expectedChannels) {
+        throw InvalidInput(formatError(path.string(), options.role, "has " + channelCount(spec.channels),
                                        channelCount(options.expectedChannels)));
     }
     Image image;
     try {
-        image = Image(spec.width, spec.height, spec.nchannels);
+        image = Image(spec.width, spec.height, spec.channels);
     } catch (const std::bad_alloc&) {
         throw InvalidInput(formatError(path.string(), "",
                                        "image of " + std::to_string(spec.width) + "x" +
                                            std::to_string(spec.height) + " pixels with " +
-                                           channelCount(spec.nchannels) + " is too large to load",
+                                           channelCount(spec.channels) + " is too large to load",
                                        "an image that fits in memory"));
     }
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-        throw ParseError(formatError(path.string(), "pixels", "cannot read: " + oiioError(in->geterror()),
+    if (!in->readFloats(image.pixels.data())) {
+        throw ParseError(formatError(path.string(), "pixels", "cannot read: " + oiioError(oiio, in->error()),
                                      "a complete, uncorrupted image file"));
     }
     in->close();
-    discardPendingOiioErrors();
+    discardPendingOiioErrors(oiio);
     return image;
 }
 
 ImageInfo readImageInfo(const fs::path& path) {
-    auto in = openInput(path);
-    const OIIO::ImageSpec& spec = in->spec();
+    const codec::Codec& oiio = codec::load(path.string());
+    auto in = openInput(oiio, path);
+    const codec::Spec& spec = in->spec();
     ImageInfo info;
     info.width = spec.width;
     info.height = spec.height;
-    info.channels = spec.nchannels;
-    info.format = in->format_name();
-    info.pixelType = pixelTypeName(spec.format);
-    info.channelNames = spec.channelnames;
-    for (const OIIO::ParamValue& p : spec.extra_attribs) {
-        if (p.type() == OIIO::TypeString) info.attributes.emplace_back(p.name().string(), p.get_string());
-    }
+    info.channels = spec.channels;
+    info.format = in->formatName();
+    info.pixelType = spec.pixelType;
+    info.channelNames = spec.channelNames;
+    info.attributes = spec.stringAttributes;
     in->close();
-    discardPendingOiioErrors();
+    discardPendingOiioErrors(oiio);
     return info;
 }
 
@@ -250,79 +242,86 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
                                        std::to_string(expected) + " = width * height * channels"));
     }
 
-    discardPendingOiioErrors();
+    const codec::Codec& oiio = codec::load(path.string());
+    discardPendingOiioErrors(oiio);
     // Created from the final name (nothing is opened yet): its format decides the checks below.
-    std::unique_ptr<OIIO::ImageOutput> probe = OIIO::ImageOutput::create(path.string());
+    std::unique_ptr<codec::Writer> probe = oiio.createWriter(path.string());
     if (!probe) {
         throw InvalidInput(formatError(
             path.string(), "", "no image format for the extension '" + path.extension().string() + "'",
             "an extension OpenImageIO writes, such as .exr, .png or .tif"));
     }
-    const std::string format = probe->format_name();
-    if (image.channels > 4 && !probe->supports("nchannels")) {
+    const std::string format = probe->formatName();
+    if (image.channels > 4 && !probe->supportsAnyChannelCount()) {
         throw InvalidInput(formatError(path.string(), "", "has " + channelCount(image.channels),
                                        "at most 4 channels in " + format + " files"));
     }
-    const OIIO::TypeDesc type = requestedType(options.type, format);
+    const std::string type = requestedType(options.type, format);
 
     writeAtomically(path, [&](const fs::path& tmp) {
-        const std::unique_ptr<OIIO::ImageOutput> out = std::move(probe);  // owned here: closed before rename
+        const std::unique_ptr<codec::Writer> out = std::move(probe);  // owned here: closed before rename
 
-        OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
+        codec::WriteSpec spec;
+        spec.width = image.width;
+        spec.height = image.height;
+        spec.channels = image.channels;
+        spec.pixelType = type;
         // EXR keeps channels sorted by name and OpenImageIO restores R, G, B, A but orders other names as
         // strings ("channel10" before "channel4"): zero-padded names keep channels 5 and up in place.
         const size_t digits = std::to_string(image.channels - 1).size();
         for (int32_t c = 4; c < image.channels; ++c) {
             const std::string index = std::to_string(c);
-            spec.channelnames[c] = "channel" + std::string(digits - index.size(), '0') + index;
+            spec.channelNames.emplace_back(c, "channel" + std::string(digits - index.size(), '0') + index);
         }
         // Stored as given: no unpremultiplication of 2- or 4-channel data on the way out.
-        spec.attribute("oiio:UnassociatedAlpha", 1);
+        spec.intAttributes.emplace_back("oiio:UnassociatedAlpha", 1);
         // TIFF writes float unless half is asked for explicitly.
-        if (format == "tiff" && type == OIIO::TypeDesc::HALF) spec.attribute("tiff:half", 1);
+        if (format == "tiff" && type == "half") spec.intAttributes.emplace_back("tiff:half", 1);
         // EXR and TIFF writers stamp the current time unless given one; an empty stamp keeps the same
         // image written twice byte-identical.
         if ((format == "openexr" || format == "tiff") && !hasAttribute(options, "DateTime")) {
-            spec.attribute("DateTime", "");
+            spec.stringAttributes.emplace_back("DateTime", "");
         }
-        for (const auto& [name, value] : options.attributes)
-            spec.attribute(name, value);
+        for (const auto& attribute : options.attributes)
+            spec.stringAttributes.push_back(attribute);
 
         if (!out->open(tmp.string(), spec)) {
-            throw IoError(formatError(path.string(), "", "cannot write: " + oiioError(out->geterror()),
+            throw IoError(formatError(path.string(), "", "cannot write: " + oiioError(oiio, out->error()),
                                       "a writable file"));
         }
-        if (out->spec().nchannels != image.channels) {
+        if (out->openedChannels() != image.channels) {
             throw InvalidInput(formatError(path.string(), "", "has " + channelCount(image.channels),
-                                           channelCount(out->spec().nchannels) + " in " + format + " files"));
+                                           channelCount(out->openedChannels()) + " in " + format + " files"));
         }
         std::string rejected;
-        if (options.type != PixelType::Auto && out->spec().format != type) {
-            rejected = formatError(path.string(), "pixel type",
-                                   format + " files cannot store " + pixelTypeName(type) + " pixels",
-                                   "a type the format stores, such as " + pixelTypeName(out->spec().format));
+        if (options.type != PixelType::Auto && out->openedPixelType() != type) {
+            rejected =
+                formatError(path.string(), "pixel type", format + " files cannot store " + type + " pixels",
+                            "a type the format stores, such as " + out->openedPixelType());
         }
-        if (!out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-            throw IoError(formatError(path.string(), "pixels", "cannot write: " + oiioError(out->geterror()),
+        if (!out->writeFloats(image.pixels.data())) {
+            throw IoError(formatError(path.string(), "pixels",
+                                      "cannot write: " + oiioError(oiio, out->error()),
                                       "enough space to write"));
         }
         if (!out->close()) {
             throw IoError(formatError(path.string(), "",
-                                      "cannot finish writing: " + oiioError(out->geterror()),
+                                      "cannot finish writing: " + oiioError(oiio, out->error()),
                                       "enough space to write"));
         }
         // Rejected only now: a PNG writer closed before its pixels makes libpng print to stderr.
         if (!rejected.empty()) throw InvalidInput(rejected);
-        requireAttributesStored(path, tmp, format, options);
+        requireAttributesStored(oiio, path, tmp, format, options);
     });
-    discardPendingOiioErrors();
+    discardPendingOiioErrors(oiio);
 }
 
 bool isImageFileName(const fs::path& path) {
     if (path.extension().empty()) return false;
-    discardPendingOiioErrors();
-    const bool known = OIIO::ImageInput::create(path.string(), false) != nullptr;
-    discardPendingOiioErrors();
+    const codec::Codec& oiio = codec::load(path.string());
+    discardPendingOiioErrors(oiio);
+    const bool known = oiio.hasReaderFor(path.string());
+    discardPendingOiioErrors(oiio);
     return known;
 }
 
