@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -106,6 +108,67 @@ inline void barycentric(const RasterPoint& a, const RasterPoint& b, const Raster
     const Pair quotients = numerators / area;
     bb = quotients[0];
     bc = quotients[1];
+}
+
+// A cell's two triangles as the inversion draws them: lower (i, j), (i+1, j), (i+1, j+1) and upper (i, j),
+// (i+1, j+1), (i, j+1). Where both cover a centre (a fold) the upper one, drawn later, wins.
+struct CellRaster {
+    enum Hit { kNone, kLower, kUpper };
+
+    CellRaster(const RasterPoint& p00, const RasterPoint& p10, const RasterPoint& p01, const RasterPoint& p11)
+        : p00(p00),
+          p10(p10),
+          p01(p01),
+          p11(p11),
+          lowerArea(edgeFunction(p00, p10, p11.sx, p11.sy)),
+          upperArea(edgeFunction(p00, p11, p01.sx, p01.sy)),
+          // Same orientation: the two lie on opposite sides of the diagonal, which decides a centre's
+          // triangle with one edge test (the diagonal's top-left owner).
+          split((lowerArea > 0 && upperArea > 0) || (lowerArea < 0 && upperArea < 0)),
+          diagFrom(upperArea > 0 ? p00 : p11),
+          diagTo(upperArea > 0 ? p11 : p00) {}
+
+    [[nodiscard]] Hit hit(int64_t cx, int64_t cy) const {
+        if (split) {
+            if (ownedEdge(diagFrom, diagTo, cx, cy) >= 0)
+                return covers(p00, p11, p01, upperArea, cx, cy) ? kUpper : kNone;
+            return covers(p00, p10, p11, lowerArea, cx, cy) ? kLower : kNone;
+        }
+        if (covers(p00, p11, p01, upperArea, cx, cy)) return kUpper;
+        return covers(p00, p10, p11, lowerArea, cx, cy) ? kLower : kNone;
+    }
+
+    const RasterPoint &p00, &p10, &p01, &p11;
+    const int64_t lowerArea, upperArea;
+    const bool split;
+    const RasterPoint &diagFrom, &diagTo;
+};
+
+// When a cell is 1/q texel wide (q = cells / texels, a power of two from 2 to 256), texel centres lie on grid
+// points only: (i, j) with i = j = q/2 (mod q). A cell the warp leaves where it is (a still cell) is then an
+// axis-aligned square with no centre inside or on an open edge, and the top-left rule gives each of its
+// corners to the same cell around it whatever the square's place (its snapped corners are exact multiples of
+// 256 / q): every still cell covers the centre on one corner, its `corner`, and no other. Found by drawing a
+// still cell with a centre on each corner in turn. Null when the rule would give none or several (never, for
+// a rule under which cells tiling a region cover each centre once).
+std::optional<std::pair<int32_t, int32_t>> stillCellCorner(int32_t q) {
+    const float side = 1.0f / static_cast<float>(q);
+    std::optional<std::pair<int32_t, int32_t>> found;
+    int32_t hits = 0;
+    for (int32_t b = 0; b <= 1; ++b) {
+        for (int32_t a = 0; a <= 1; ++a) {
+            // Corner (a, b) on the centre of texel (0, 0), (0.5, 0.5); raster y runs down as v rises.
+            const float x0 = 0.5f - static_cast<float>(a) * side, y0 = 0.5f + static_cast<float>(b) * side;
+            auto point = [](float x, float y) { return RasterPoint{x, y, snap(x), snap(y)}; };
+            const RasterPoint p00 = point(x0, y0), p10 = point(x0 + side, y0);
+            const RasterPoint p01 = point(x0, y0 - side), p11 = point(x0 + side, y0 - side);
+            if (CellRaster(p00, p10, p01, p11).hit(128, 128) != CellRaster::kNone) {
+                found = std::make_pair(a, b);
+                ++hits;
+            }
+        }
+    }
+    return hits == 1 ? found : std::nullopt;
 }
 
 InversionError measure(const WarpGrid& warp, const io::Image& redirect, const io::Image* region) {
@@ -303,6 +366,14 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     // (it is drawn in its turn, over what earlier cells drew).
     const int32_t ratio = size / cells;
     const bool identityRects = size >= cells && size % cells == 0 && isPowerOfTwo(ratio);
+    // A grid finer than the map (a refined solve's): a still cell draws the centre on its owned corner, if
+    // that corner is a texel centre (stillCellCorner), with the identity's value, in its turn.
+    const int32_t fineness = cells / size;
+    const std::optional<std::pair<int32_t, int32_t>> corner =
+        size < cells && cells % size == 0 && isPowerOfTwo(fineness) && fineness <= 256
+            ? stillCellCorner(fineness)
+            : std::nullopt;
+    const bool stillCells = identityRects || corner.has_value();
     std::vector<float> identityAt(static_cast<size_t>(side));
     for (int32_t i = 0; i <= cells; ++i)
         identityAt[i] = static_cast<float>(i) / static_cast<float>(cells);  // WarpGrid::identity's values
@@ -334,7 +405,7 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                 const auto j = static_cast<int32_t>(chunk / chunksPerRow);
                 const auto i0 = static_cast<int32_t>(chunk % chunksPerRow) * kChunkCells;
                 const int32_t i1 = std::min(cells, i0 + kChunkCells);
-                if (identityRects) {
+                if (stillCells) {
                     // Per point of the chunk's two rows whether it is where the identity has it, then per
                     // cell.
                     const size_t k0 = static_cast<size_t>(j) * side + i0;
@@ -360,6 +431,17 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                     upperRow[i - i0] = rasterPoint(wu[k + side], wv[k + side], t);
                 }
                 for (int32_t i = i0; i < i1; ++i) {
+                    if (identity[i - i0] && corner) {
+                        // A still cell finer than a texel: the centre on its owned corner, if there is one.
+                        const int32_t ci = i + corner->first, cj = j + corner->second, half = fineness / 2;
+                        if (ci % fineness != half || cj % fineness != half) continue;
+                        const int32_t x = ci / fineness, y = size - 1 - cj / fineness;
+                        if (y < y0 || y >= y1) continue;
+                        float* texel = out + (static_cast<size_t>(y) * size + static_cast<size_t>(x)) * 2;
+                        texel[0] = centreU[x];
+                        texel[1] = centreV[y];
+                        continue;
+                    }
                     if (identity[i - i0]) {
                         // A run of still cells i .. end - 1, drawn in its turn: texel rows size - (j + 1) r
                         // .. size - j r - 1 (raster y runs down) within the band, columns i r .. end r - 1.
@@ -396,35 +478,16 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                         y1 - 1,
                         lastCentreAtOrBelow(std::max(std::max(p00.sy, p10.sy), std::max(p01.sy, p11.sy))));
                     if (yFirst > yLast) continue;
-                    // Lower (i, j), (i+1, j), (i+1, j+1); upper (i, j), (i+1, j+1), (i, j+1). Where both
-                    // cover a texel (a fold) the upper one, drawn later, wins.
-                    const int64_t lowerArea = edgeFunction(p00, p10, p11.sx, p11.sy);
-                    const int64_t upperArea = edgeFunction(p00, p11, p01.sx, p01.sy);
-                    // Same orientation: the two lie on opposite sides of the diagonal, which decides the
-                    // candidate's triangle with one edge test (the diagonal's top-left owner).
-                    const bool split = (lowerArea > 0 && upperArea > 0) || (lowerArea < 0 && upperArea < 0);
-                    const RasterPoint& diagFrom = upperArea > 0 ? p00 : p11;
-                    const RasterPoint& diagTo = upperArea > 0 ? p11 : p00;
+                    const CellRaster cell(p00, p10, p01, p11);
                     for (int64_t y = yFirst; y <= yLast; ++y) {
                         for (int64_t x = xFirst; x <= xLast; ++x) {
-                            const int64_t cx = 256 * x + 128, cy = 256 * y + 128;
-                            bool upper = false, lower = false;
-                            if (split) {
-                                if (ownedEdge(diagFrom, diagTo, cx, cy) >= 0) {
-                                    upper = covers(p00, p11, p01, upperArea, cx, cy);
-                                } else {
-                                    lower = covers(p00, p10, p11, lowerArea, cx, cy);
-                                }
-                            } else {
-                                upper = covers(p00, p11, p01, upperArea, cx, cy);
-                                lower = !upper && covers(p00, p10, p11, lowerArea, cx, cy);
-                            }
+                            const CellRaster::Hit hit = cell.hit(256 * x + 128, 256 * y + 128);
                             double bb = 0.0, bc = 0.0, u = 0.0, v = 0.0;
-                            if (upper) {
+                            if (hit == CellRaster::kUpper) {
                                 barycentric(p00, p11, p01, x, y, bb, bc);
                                 u = i + bb;
                                 v = j + bb + bc;
-                            } else if (lower) {
+                            } else if (hit == CellRaster::kLower) {
                                 barycentric(p00, p10, p11, x, y, bb, bc);
                                 u = i + bb + bc;
                                 v = j + bc;

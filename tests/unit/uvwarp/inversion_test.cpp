@@ -214,10 +214,12 @@ TEST_CASE("inversion draws what geom::rasterizeAttributes draws", "[uvwarp][inve
     }
     SECTION("cells left at the identity beside moved and folded ones") {
         // Most of a real tile is fixed by its warp mask: those cells are drawn as rectangles of texels when
-        // a cell is a power-of-two number of texels wide, and rasterised otherwise (3 texels per cell). Moved
-        // points, some pushed across their neighbours so that moved cells fold over still ones drawn before
-        // and after them, must give the reference's coverage and winners.
-        for (const int32_t texels : {64, 128, 192, 256}) {
+        // a cell is a power-of-two number of texels wide, as the centre on one corner when a texel is a
+        // power-of-two number of cells wide (a refined grid's 1/2 texel: 32 texels; 1/4, 1/8), and rasterised
+        // otherwise (3 texels per cell). Moved points, some pushed across their neighbours so that moved
+        // cells fold over still ones drawn before and after them, must give the reference's coverage and
+        // winners.
+        for (const int32_t texels : {8, 16, 32, 64, 128, 192, 256}) {
             const int32_t cells = 64, side = cells + 1;
             std::mt19937 rng(11);
             std::uniform_real_distribution<double> jitter(-0.45, 0.45);
@@ -237,18 +239,52 @@ TEST_CASE("inversion draws what geom::rasterizeAttributes draws", "[uvwarp][inve
             warp.u[12 * side + 17] -= 2.5f / cells;
             CHECK(compare(warp, texels, covered) < 1e-6);
             CHECK(covered > texels * texels * 9 / 10);
-            if (texels % cells != 0 || texels / cells == 3) continue;
-            // Texels of the still cells (33..38, 33..38), away from the folds: the identity's values,
-            // exactly.
+            if (texels == 192) continue;
+            // Texels whose centres lie in the still cells (33..38, 33..38), away from the folds: the
+            // identity's values, exactly.
             const io::Image redirect = invertWarp(warp, texels);
-            const int32_t ratio = texels / cells;
-            for (int32_t y = texels - 39 * ratio; y < texels - 33 * ratio; ++y) {
-                for (int32_t x = 33 * ratio; x < 39 * ratio; ++x) {
+            int still = 0;
+            for (int32_t y = 0; y < texels; ++y) {
+                for (int32_t x = 0; x < texels; ++x) {
+                    const double gi = (x + 0.5) * cells / texels, gj = cells - (y + 0.5) * cells / texels;
+                    if (gi < 33 || gi >= 39 || gj < 33 || gj >= 39) continue;
+                    ++still;
                     CHECK(redirect.at(x, y, 0) ==
                           (static_cast<float>(x) + 0.5f) / static_cast<float>(texels));
                     CHECK(redirect.at(x, y, 1) ==
                           1.0f - (static_cast<float>(y) + 0.5f) / static_cast<float>(texels));
                 }
+            }
+            // Centres in [33, 39) per axis: 6 per cell at 1 cell a texel and more; 33, 35, 37 at 2 cells a
+            // texel (centres on odd points); 34, 38 at 4 (2 mod 4); 36 at 8 (4 mod 8).
+            const int32_t perAxis = texels >= cells ? 6 * (texels / cells)
+                                    : texels == 32  ? 3
+                                    : texels == 16  ? 2
+                                                    : 1;
+            CHECK(still == perAxis * perAxis);
+        }
+    }
+    SECTION("a grid finer than the map, moved cells folding over still ones on every side") {
+        // Where a fold covers a texel centre on a still point, which cell draws it last decides its value:
+        // a still cell must draw exactly the centre the rasteriser gives it, in its turn.
+        const int32_t cells = 64, side = cells + 1;
+        for (const int32_t texels : {32, 16}) {
+            for (uint32_t seed = 1; seed <= 12; ++seed) {
+                std::mt19937 rng(seed);
+                std::uniform_real_distribution<double> jitter(-1.5, 1.5);
+                std::bernoulli_distribution moved(0.15);
+                WarpGrid warp = WarpGrid::identity(cells);
+                for (int32_t j = 1; j < cells; ++j) {
+                    for (int32_t i = 1; i < cells; ++i) {
+                        if (!moved(rng)) continue;
+                        const size_t k = static_cast<size_t>(j) * side + i;
+                        warp.u[k] += static_cast<float>(jitter(rng) / cells);
+                        warp.v[k] += static_cast<float>(jitter(rng) / cells);
+                    }
+                }
+                CAPTURE(texels, seed);
+                CHECK(compare(warp, texels, covered) < 1e-6);
+                CHECK(covered == texels * texels);
             }
         }
     }
