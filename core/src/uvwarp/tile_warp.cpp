@@ -230,10 +230,7 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.solved = true;
     const WarpGrid& warp = m.solver->solve(m.deformed);
     m.stats = m.solver->stats();
-    if (!m.keepDeformed) {
-        m.deformed = {};
-        deformkit::detail::releaseFreedMemory();  // f_D and what the solve freed (Solver: warmStart off)
-    }
+    if (!m.keepDeformed) m.deformed = {};
     if (!m.refiner) return warp;
     m.refiner->startFrom(warp);
     m.refinedImager->sample(deformedPoints, m.refinedDeformed);
@@ -246,10 +243,7 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats.shortenedSteps += r.shortenedSteps;
     m.stats.shortenedEverywhere += r.shortenedEverywhere;
     m.stats.remainingFolds = r.remainingFolds;
-    if (!m.keepDeformed) {
-        m.refinedDeformed = {};
-        deformkit::detail::releaseFreedMemory();  // as the solve's f_D above, and the refiner's solve state
-    }
+    if (!m.keepDeformed) m.refinedDeformed = {};
     return refined;
 }
 
@@ -286,6 +280,8 @@ WarpMetrics TileWarp::metrics() const {
     options.texels = m.texels;
     const Solver& solver = m.delivering();
     const PointField& rest = solver.restGeometry();
+    // The maps at grid points made here are freed on return; their memory stays with the process for the next
+    // frame's solve and figures (as the solve state, Solver::Impl::allocateSolveState).
     WarpMetrics figures;
     {
         const PointField rigidity = rigidityAtPoints(m.delivered->rigidity(), m.deliveredCells());
@@ -296,7 +292,6 @@ WarpMetrics TileWarp::metrics() const {
         const PointField& deformed = !m.solved ? rest : (kept.values.empty() ? resampled : kept);
         figures = measureWarp(solver.warp(), rest, deformed, rigidity, mask, options);
     }
-    deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
     return figures;
 }
 
