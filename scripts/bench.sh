@@ -24,9 +24,11 @@ if [ "${1:-}" = "--quick" ]; then
 fi
 build=${DEFORMKIT_BUILD_DIR:-build}
 
-if ! ls "$build"/bin/bench_* >/dev/null 2>&1; then
+# The benchmarks are not part of the default build: configure (setup.sh) if needed, then build them.
+if [ ! -f "$build/CMakeCache.txt" ]; then
     ./scripts/setup.sh >/dev/null
 fi
+cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target deformkit_benchmarks >/dev/null
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for exe in "$build"/bin/bench_*; do

@@ -216,6 +216,9 @@ def main():
     for name in args.shots:
         keep = os.path.join(args.keep, name) if args.keep else None
         if name == "ceiling":
+            if not os.path.exists(args.bench):
+                raise SystemExit(f"uvwarp_pictures: {args.bench} is missing: build it "
+                                 "(cmake --build build --target bench_uvwarp_reference)")
             ceiling(os.path.abspath(args.bench), os.path.abspath(args.deformkit), dk, images, keep)
         elif name == "residual":
             residual(dk, images)

@@ -12,10 +12,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${DEFORMKIT_BUILD_DIR:-build}
 exe="$build/bin/bench_uvwarp_tile"
-if [ ! -x "$exe" ]; then
-    echo "uvwarp_tile_scale.sh: $exe is missing: build with scripts/setup.sh (benchmarks on)" >&2
+if [ ! -f "$build/CMakeCache.txt" ]; then
+    echo "uvwarp_tile_scale.sh: $build is not configured: run scripts/setup.sh first" >&2
     exit 2
 fi
+cmake --build "$build" --target bench_uvwarp_tile >/dev/null  # not part of the default build
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(1024 2048 4096 8192 16384)
 out=$(mktemp -d)
