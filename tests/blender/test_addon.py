@@ -110,6 +110,12 @@ def test_the_addon_is_registered_and_zipped():
         names = set(z.namelist())
     assert "deformkit/__init__.py" in names
     assert any(n.startswith("deformkit/deformkit.") and n.endswith(".so") for n in names), names
+    # The library's OpenImageIO module ships beside the compiled module and serves the add-on's image calls.
+    assert "deformkit/deformkit_image_oiio.so" in names, names
+    dk.write_image(os.path.join(tempfile.mkdtemp(), "probe.exr"), np.zeros((2, 2, 1), np.float32))
+    with open("/proc/self/maps") as maps:
+        loaded = {line.split()[-1] for line in maps if line.rstrip().endswith("deformkit_image_oiio.so")}
+    assert loaded == {os.path.realpath(os.path.join(STAGE, "deformkit", "deformkit_image_oiio.so"))}, loaded
 
 
 def test_slide_follows_the_end_empty():
