@@ -71,8 +71,8 @@ void requireReadableFile(const fs::path& path) {
     }
 }
 
+// The caller has checked the file is there and readable (requireReadableFile).
 std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::path& path) {
-    requireReadableFile(path);
     discardPendingOiioErrors(oiio);
     // Keep colour and alpha as stored: a 4-channel data map must not come back premultiplied.
     auto in = oiio.openReader(path.string(), true);
@@ -211,6 +211,7 @@ Image readImage(const fs::path& path, const ImageReadOptions& options) {
 }
 
 ImageInfo readImageInfo(const fs::path& path) {
+    requireReadableFile(path);
     const codec::Codec& oiio = codec::load(path.string());
     auto in = openInput(oiio, path);
     const codec::Spec& spec = in->spec();
