@@ -10,6 +10,7 @@
 
 #include "deformkit/error.h"
 #include "memory/large_buffers.h"
+#include "uvwarp/raster_points.h"
 
 namespace deformkit::uvwarp {
 namespace {
@@ -31,29 +32,9 @@ void requireRegion(const io::Image& image, int32_t size, const char* what) {
     }
 }
 
-// A warped grid point in raster coordinates (x = u T, y = (1 - v) T; raster pixels are image texels),
-// with its position snapped to 1/256 texel for exact coverage, as geom::rasterizeTriangle snaps.
-struct RasterPoint {
-    float x, y;
-    int64_t sx, sy;
-};
-
-// Rounds to the nearest 1/256, halves away from zero (llround's rule, without a library call): x * 256 and
-// x * 256 +- 0.5 are exact in double for a float |x| < 2^21.
-inline int64_t snap(float x) {
-    const double scaled = static_cast<double>(x) * 256.0;
-    return static_cast<int64_t>(scaled + (scaled >= 0.0 ? 0.5 : -0.5));
-}
-
-// Far-off points (a broken warp) are clamped to 2^20 texels, which keeps every edge function within int64.
-constexpr float kRasterLimit = 1048576.0f;
-inline float rasterY(float v, float t) {
-    return std::clamp((1.0f - v) * t, -kRasterLimit, kRasterLimit);
-}
-inline RasterPoint rasterPoint(float u, float v, float t) {
-    const float x = std::clamp(u * t, -kRasterLimit, kRasterLimit), y = rasterY(v, t);
-    return {x, y, snap(x), snap(y)};
-}
+using detail::RasterPoint;
+using detail::rasterY;
+using detail::snap;
 
 // Twice the signed area of (a, b, c) in snapped units, positive when c is left of a -> b with y up.
 inline int64_t edgeFunction(const RasterPoint& a, const RasterPoint& b, int64_t cx, int64_t cy) {
@@ -67,6 +48,38 @@ inline int64_t firstCentreAtOrAbove(int64_t s) {
 inline int64_t lastCentreAtOrBelow(int64_t s) {
     return (s - 128) >> 8;
 }
+
+using ChunkRow = detail::RasterRow<kChunkCells + 1>;
+
+// Per cell of a chunk (cell m has corners m, m + 1 of the lower and upper point rows), the texel centres in
+// its bounding box, within the band's rows [y0, y1) and the map: an empty range for a still cell (drawn
+// without edge tests). A loop the compiler vectorises.
+struct CandidateBoxes {
+    int32_t xFirst[kChunkCells], xLast[kChunkCells], yFirst[kChunkCells], yLast[kChunkCells];
+
+    void compute(const ChunkRow& lower, const ChunkRow& upper, const uint8_t* __restrict still, int32_t n,
+                 int32_t size, int32_t y0, int32_t y1) {
+        const int32_t* __restrict lx = lower.sx;
+        const int32_t* __restrict ly = lower.sy;
+        const int32_t* __restrict ux = upper.sx;
+        const int32_t* __restrict uy = upper.sy;
+        int32_t* __restrict xf = xFirst;
+        int32_t* __restrict xl = xLast;
+        int32_t* __restrict yf = yFirst;
+        int32_t* __restrict yl = yLast;
+        for (int32_t m = 0; m < n; ++m) {
+            const int32_t minX = std::min(std::min(lx[m], lx[m + 1]), std::min(ux[m], ux[m + 1]));
+            const int32_t maxX = std::max(std::max(lx[m], lx[m + 1]), std::max(ux[m], ux[m + 1]));
+            const int32_t minY = std::min(std::min(ly[m], ly[m + 1]), std::min(uy[m], uy[m + 1]));
+            const int32_t maxY = std::max(std::max(ly[m], ly[m + 1]), std::max(uy[m], uy[m + 1]));
+            // firstCentreAtOrAbove and lastCentreAtOrBelow, in int32 (snapped positions are within 2^28).
+            xf[m] = std::max(0, -((128 - minX) >> 8));
+            xl[m] = still[m] ? -1 : std::min(size - 1, (maxX - 128) >> 8);
+            yf[m] = std::max(y0, -((128 - minY) >> 8));
+            yl[m] = std::min(y1 - 1, (maxY - 128) >> 8);
+        }
+    }
+};
 
 // The edge function of from -> to at (cx, cy), minus 1 when the edge does not own the centres on it: an
 // edge of a positively oriented triangle owns them when it is a top or a left edge (geom::rasterizeTriangle's
@@ -385,10 +398,11 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
     }
 #pragma omp parallel
     {
-        // Raster points of a chunk's two point rows (those of its cells that are not the identity), and which
-        // of its cells are.
-        std::vector<RasterPoint> lowerRow(kChunkCells + 1), upperRow(kChunkCells + 1);
+        // Which cells of a chunk are still, the raster points of its two point rows and its cells' candidate
+        // texel centres (when any cell moved).
         std::vector<uint8_t> identity(kChunkCells), pointStill(kChunkCells + 1);
+        ChunkRow lowerRow, upperRow;
+        CandidateBoxes boxes;
 #pragma omp for schedule(dynamic, 1)
         for (int32_t band = 0; band < numBands; ++band) {
             const int32_t y0 = band * kBandRows, y1 = std::min(size, y0 + kBandRows);
@@ -405,10 +419,11 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                 const auto j = static_cast<int32_t>(chunk / chunksPerRow);
                 const auto i0 = static_cast<int32_t>(chunk % chunksPerRow) * kChunkCells;
                 const int32_t i1 = std::min(cells, i0 + kChunkCells);
+                const size_t k0 = static_cast<size_t>(j) * side + i0;
+                bool anyMoved = true;
                 if (stillCells) {
                     // Per point of the chunk's two rows whether it is where the identity has it, then per
                     // cell.
-                    const size_t k0 = static_cast<size_t>(j) * side + i0;
                     const float* __restrict lu = wu + k0;
                     const float* __restrict lv = wv + k0;
                     const float* __restrict at = identityAt.data() + i0;
@@ -419,16 +434,19 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                                     (lv[m + side] == upperV))
                                        ? 1
                                        : 0;
-                    for (int32_t m = 0; m < i1 - i0; ++m)
+                    uint8_t all = 1;
+                    for (int32_t m = 0; m < i1 - i0; ++m) {
                         identity[m] = still[m] & still[m + 1];
+                        all &= identity[m];
+                    }
+                    anyMoved = all == 0;
                 } else {
                     std::fill(identity.begin(), identity.end(), uint8_t{0});
                 }
-                for (int32_t i = i0; i <= i1; ++i) {
-                    if ((i == i0 || identity[i - 1 - i0]) && (i == i1 || identity[i - i0])) continue;
-                    const size_t k = static_cast<size_t>(j) * side + i;
-                    lowerRow[i - i0] = rasterPoint(wu[k], wv[k], t);
-                    upperRow[i - i0] = rasterPoint(wu[k + side], wv[k + side], t);
+                if (anyMoved) {  // every point of both rows: cheaper in vector loops than only the moved ones
+                    lowerRow.compute(wu + k0, wv + k0, i1 - i0 + 1, t);
+                    upperRow.compute(wu + k0 + side, wv + k0 + side, i1 - i0 + 1, t);
+                    boxes.compute(lowerRow, upperRow, identity.data(), i1 - i0, size, y0, y1);
                 }
                 for (int32_t i = i0; i < i1; ++i) {
                     if (identity[i - i0] && corner) {
@@ -461,23 +479,12 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
                         i = end - 1;
                         continue;
                     }
-                    const RasterPoint &p00 = lowerRow[i - i0], &p10 = lowerRow[i - i0 + 1];
-                    const RasterPoint &p01 = upperRow[i - i0], &p11 = upperRow[i - i0 + 1];
-                    // Candidate texel centres: those in the cell's bounding box within the band.
-                    const int64_t xFirst = std::max<int64_t>(
-                        0,
-                        firstCentreAtOrAbove(std::min(std::min(p00.sx, p10.sx), std::min(p01.sx, p11.sx))));
-                    const int64_t xLast = std::min<int64_t>(
-                        size - 1,
-                        lastCentreAtOrBelow(std::max(std::max(p00.sx, p10.sx), std::max(p01.sx, p11.sx))));
-                    if (xFirst > xLast) continue;
-                    const int64_t yFirst = std::max<int64_t>(
-                        y0,
-                        firstCentreAtOrAbove(std::min(std::min(p00.sy, p10.sy), std::min(p01.sy, p11.sy))));
-                    const int64_t yLast = std::min<int64_t>(
-                        y1 - 1,
-                        lastCentreAtOrBelow(std::max(std::max(p00.sy, p10.sy), std::max(p01.sy, p11.sy))));
-                    if (yFirst > yLast) continue;
+                    const int32_t m = i - i0;
+                    const int64_t xFirst = boxes.xFirst[m], xLast = boxes.xLast[m];
+                    const int64_t yFirst = boxes.yFirst[m], yLast = boxes.yLast[m];
+                    if (xFirst > xLast || yFirst > yLast) continue;
+                    const RasterPoint p00 = lowerRow.point(m), p10 = lowerRow.point(m + 1);
+                    const RasterPoint p01 = upperRow.point(m), p11 = upperRow.point(m + 1);
                     const CellRaster cell(p00, p10, p01, p11);
                     for (int64_t y = yFirst; y <= yLast; ++y) {
                         for (int64_t x = xFirst; x <= xLast; ++x) {

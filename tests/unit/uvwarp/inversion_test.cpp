@@ -1,13 +1,17 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/uvwarp/inversion.h"
+#include "uvwarp/raster_points.h"
 #include "uvwarp_test_support.h"
 
 using namespace deformkit;
@@ -149,6 +153,64 @@ TEST_CASE("inversion error of a wrong redirect, over a region", "[uvwarp][invers
     CHECK_THROWS_WITH(inversionError(identity, redirect), Catch::Contains("redirect texel (5, 7)"));
     CHECK_THROWS_AS(inversionError(identity, io::Image(texels, texels / 2, 2)), InvalidInput);
     CHECK_THROWS_AS(inversionError(identity, invertWarp(identity, texels), io::Image(8, 8, 1)), InvalidInput);
+}
+
+TEST_CASE("raster points in vector-friendly float arithmetic equal the double rounding",
+          "[uvwarp][inversion]") {
+    using detail::snap;
+    using detail::snapFloat;
+    // The float rounding against the double one: every 499th float up to the clamp (both signs), every float
+    // within 3 ulps of the halves k / 256 + 1 / 512 for |k| <= 2^16 and of the clamp itself. (All 2.5e9
+    // floats of the range agree; too slow for a unit test.)
+    const auto limitBits = std::bit_cast<uint32_t>(detail::kRasterLimit);
+    int64_t checked = 0, mismatches = 0;
+    const auto check = [&](float x) {
+        for (const float s : {x, -x}) {
+            ++checked;
+            if (snap(s) != static_cast<int64_t>(snapFloat(s))) {
+                if (++mismatches <= 5) INFO("x = " << s << ": " << snap(s) << " vs " << snapFloat(s));
+                CHECK(snap(s) == static_cast<int64_t>(snapFloat(s)));
+            }
+        }
+    };
+    for (uint32_t bits = 0; bits <= limitBits; bits += 499)
+        check(std::bit_cast<float>(bits));
+    const auto around = [&](float centre) {
+        float x = centre;
+        for (int step = 0; step < 3; ++step)
+            x = std::nextafter(x, 0.0f);
+        for (int step = 0; step < 7; ++step, x = std::nextafter(x, detail::kRasterLimit))
+            if (std::abs(x) <= detail::kRasterLimit) check(x);
+    };
+    for (int32_t k = -65536; k <= 65536; ++k)
+        around((static_cast<float>(k) + 0.5f) / 256.0f);
+    around(detail::kRasterLimit);
+    CHECK(mismatches == 0);
+    CHECK(checked > 5000000);
+
+    // A row of points, far-off and negative ones included, against the clamp and the double rounding.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> near(-0.2f, 1.2f), far(-3000.0f, 3000.0f);
+    detail::RasterRow<65> row;
+    for (int round = 0; round < 50; ++round) {
+        std::array<float, 65> u{}, v{};
+        for (size_t m = 0; m < u.size(); ++m) {
+            u[m] = m % 7 == 3 ? far(rng) : near(rng);
+            v[m] = m % 11 == 5 ? far(rng) : near(rng);
+        }
+        const float t = round % 2 == 0 ? 1024.0f : 4096.0f;
+        row.compute(u.data(), v.data(), 65, t);
+        for (int32_t m = 0; m < 65; ++m) {
+            const float limit = detail::kRasterLimit;
+            const float x = std::clamp(u[m] * t, -limit, limit),
+                        y = std::clamp((1.0f - v[m]) * t, -limit, limit);
+            const detail::RasterPoint got = row.point(m);
+            REQUIRE(got.x == x);
+            REQUIRE(got.y == y);
+            REQUIRE(got.sx == snap(x));
+            REQUIRE(got.sy == snap(y));
+        }
+    }
 }
 
 TEST_CASE("inversion draws what geom::rasterizeAttributes draws", "[uvwarp][inversion]") {
