@@ -139,19 +139,19 @@ int32_t appendRuns(int32_t from, int32_t to, int32_t gap, const In& in, std::vec
     return count;
 }
 
-// Runs per row and part (a row's runs of each of `parts` kinds): append(j, p, out) appends part p of row j's
-// runs to `out` (appendRuns) and returns how many. Afterwards runs [runs[2r], runs[2r + 1]) for r in
-// [begin[j parts + p], begin[j parts + p + 1]) are part p of row j. Rows are found in parallel, each into a
-// list of its own, then laid end to end in row order: the same arrays as one pass over the rows.
-template <class Append>
-void collectRuns(int32_t rows, int32_t parts, const Append& append, std::vector<int32_t>& begin,
+// Runs per row and part (a row's runs of each of `parts` kinds): appendRow(j, out, count) appends row j's
+// runs to `out`, part after part (appendRuns), and sets count[p] to part p's number of them. Afterwards runs
+// [runs[2r], runs[2r + 1]) for r in [begin[j parts + p], begin[j parts + p + 1]) are part p of row j. Rows
+// are found in parallel, each into a list of its own, then laid end to end in row order: the same arrays as
+// one pass over the rows.
+template <class AppendRow>
+void collectRuns(int32_t rows, int32_t parts, const AppendRow& appendRow, std::vector<int32_t>& begin,
                  std::vector<int32_t>& runs) {
     std::vector<std::vector<int32_t>> rowRuns(static_cast<size_t>(rows));
     begin.assign(static_cast<size_t>(rows) * parts + 1, 0);
 #pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(rows))
     for (int32_t j = 0; j < rows; ++j)
-        for (int32_t p = 0; p < parts; ++p)
-            begin[static_cast<size_t>(j) * parts + p + 1] = append(j, p, rowRuns[j]);
+        appendRow(j, rowRuns[j], &begin[static_cast<size_t>(j) * parts + 1]);
     for (size_t k = 1; k < begin.size(); ++k)
         begin[k] += begin[k - 1];
     runs.resize(2 * static_cast<size_t>(begin.back()));
@@ -168,8 +168,8 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
               std::vector<int32_t>& runs) {
     collectRuns(
         rows, 1,
-        [&](int32_t j, int32_t, std::vector<int32_t>& out) {
-            return appendRuns(
+        [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
+            count[0] = appendRuns(
                 0, columns, kRunGap, [&](int32_t i) { return in(i, j); }, out);
         },
         begin, runs);
@@ -582,24 +582,34 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
 void detail::findSetRuns(Level& level, int32_t fineCells) {
     const int32_t c = level.cells;
     const float least = detail::leastRigidity(c, fineCells);
+    const size_t side = static_cast<size_t>(level.side());
     // Per row and set, the runs of segments it projects. A gap shorter than a pair of lanes costs a sweep
-    // nothing (the pair is computed whole), so runs are merged across it.
+    // nothing (the pair is computed whole), so runs are merged across it. Whether the segment of each edge
+    // type at each cell of the row is projected is found first, for the whole row in loops that vectorise
+    // (a set takes every second or fourth of its type's cells).
     collectRuns(
         c, detail::kSets,
-        [&](int32_t j, int32_t set, std::vector<int32_t>& out) {
-            const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
-            const detail::EdgeType e = detail::kEdgeTypes[type];
-            const int32_t step = detail::setStep(type);
-            int32_t gMin = 0, gMax = 0;
-            detail::setLanes(type, first, j, c, gMin, gMax);
-            return appendRuns(
-                gMin, gMax, kRunGapLanes,
-                [&](int32_t g) {
-                    const int32_t i = first + g * step;
-                    return detail::segmentProjected(level.rigidity[level.index(i + e.ai, j + e.aj)],
-                                                    level.rigidity[level.index(i + e.bi, j + e.bj)], least);
-                },
-                out);
+        [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
+            std::vector<uint8_t> projected(4 * static_cast<size_t>(c));
+            for (int32_t type = 0; type < 4; ++type) {
+                const detail::EdgeType e = detail::kEdgeTypes[type];  // ends on rows j, j + 1 <= c
+                const float* __restrict a = level.rigidity.data() + (j + e.aj) * side + e.ai;
+                const float* __restrict b = level.rigidity.data() + (j + e.bj) * side + e.bi;
+                uint8_t* __restrict p = projected.data() + static_cast<size_t>(type) * c;
+                const int32_t n = c;  // locals: the byte stores could alias the captured ones
+                const float floor = least;
+                for (int32_t i = 0; i < n; ++i)
+                    p[i] = detail::segmentProjected(a[i], b[i], floor) ? 1 : 0;
+            }
+            for (int32_t set = 0; set < detail::kSets; ++set) {
+                const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
+                const int32_t step = detail::setStep(type);
+                int32_t gMin = 0, gMax = 0;
+                detail::setLanes(type, first, j, c, gMin, gMax);
+                const uint8_t* p = projected.data() + static_cast<size_t>(type) * c + first;
+                count[set] = appendRuns(
+                    gMin, gMax, kRunGapLanes, [&](int32_t g) { return p[g * step] != 0; }, out);
+            }
         },
         level.setRunBegin, level.setRuns);
 }

@@ -264,3 +264,69 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
     CHECK(cases >= 96);
     CHECK(moved > 1000);  // the sweeps did move points: the comparison is not of untouched grids
 }
+
+TEST_CASE("uv warp kernels: a row's runs of projected segments are every set's projected segments",
+          "[uvwarp][kernels]") {
+    // findSetRuns against a reference written here: per row and parallel set, each of the set's segments
+    // inside the grid (setLanes) tested on its own (segmentProjected), and runs fewer than a pair of lanes
+    // apart merged. Random maps with rigid blocks, scattered rigid points, fixed points (painted rigid or
+    // not) and a fixed border; fine levels (any rigidity above 0 projects) and coarse ones (above 0.3).
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (const int32_t cells : {8, 16, 64, 256}) {
+        for (const int32_t stride : {1, 4}) {
+            for (int round = 0; round < 3; ++round) {
+                CAPTURE(cells, stride, round);
+                Level level;
+                level.cells = cells;
+                const int32_t side = cells + 1;
+                level.rigidity.assign(static_cast<size_t>(side) * side, 0.0f);
+                for (int32_t j = 0; j <= cells; ++j) {
+                    for (int32_t i = 0; i <= cells; ++i) {
+                        float& r = level.rigidity[static_cast<size_t>(j) * side + i];
+                        const bool block = ((i / 5 + j / 3 + round) % 3) == 0;
+                        r = block ? 0.2f + 0.8f * unit(rng) : (unit(rng) < 0.05f ? unit(rng) : 0.0f);
+                        const bool border = i == 0 || j == 0 || i == cells || j == cells;
+                        if (border || unit(rng) < 0.1f) r = kFixed - r;
+                    }
+                }
+                findSetRuns(level, cells * stride);
+
+                const float least = stride > 1 ? 0.3f : 0.0f;
+                std::vector<int32_t> begin{0}, runs;
+                for (int32_t j = 0; j < cells; ++j) {
+                    for (int32_t set = 0; set < kSets; ++set) {
+                        const int32_t type = kSetType[set], first = kSetFirst[set];
+                        const EdgeType e = kEdgeTypes[type];
+                        int32_t gMin = 0, gMax = 0;
+                        setLanes(type, first, j, cells, gMin, gMax);
+                        int32_t count = 0, open = -1, last = -1;
+                        for (int32_t g = gMin; g < gMax; ++g) {
+                            const int32_t i = first + g * setStep(type);
+                            const float ra = level.rigidity[static_cast<size_t>(j + e.aj) * side + i + e.ai];
+                            const float rb = level.rigidity[static_cast<size_t>(j + e.bj) * side + i + e.bi];
+                            if (!segmentProjected(ra, rb, least)) continue;
+                            if (open >= 0 && g - last - 1 < 2) {  // fewer than 2 segments between: merged
+                                last = g;
+                                continue;
+                            }
+                            if (open >= 0) {
+                                runs.insert(runs.end(), {open, last + 1});
+                                ++count;
+                            }
+                            open = last = g;
+                        }
+                        if (open >= 0) {
+                            runs.insert(runs.end(), {open, last + 1});
+                            ++count;
+                        }
+                        begin.push_back(begin.back() + count);
+                    }
+                }
+                CHECK(runs.size() > 0);
+                CHECK(level.setRunBegin == begin);
+                CHECK(level.setRuns == runs);
+            }
+        }
+    }
+}
