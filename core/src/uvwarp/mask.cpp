@@ -75,11 +75,14 @@ io::Image maskOf(const detail::TileUVs& uvs, int32_t texels, const DerivedMaskOp
     mask.channels = 1;
     deformkit::detail::assignLarge(mask.pixels, static_cast<size_t>(size) * size, 0.0f);
     const geom::RasterGrid grid{size, size};
-    for (const auto& c : uvs.uvs) {
-        rasterizeTriangle(grid, c[0] * t, c[1] * t, c[2] * t, [&](int32_t x, int32_t r, const glm::vec3&) {
-            mask.at(x, size - 1 - r, 0) = 1.0f;
-        });
-    }
+    geom::rasterizeTrianglesInBands(
+        grid, static_cast<int32_t>(uvs.uvs.size()),
+        [&](int32_t k, glm::vec2& a, glm::vec2& b, glm::vec2& c) {
+            a = uvs.uvs[k][0] * t;
+            b = uvs.uvs[k][1] * t;
+            c = uvs.uvs[k][2] * t;
+        },
+        [&](int32_t, int32_t x, int32_t r, const glm::vec3&) { mask.at(x, size - 1 - r, 0) = 1.0f; });
 
     // Border band: texel (x, r) is fixed when the edge meets [x - g, x + 1 + g] x [r - g, r + 1 + g].
     const double g = 0.5 * (options.borderWidth - 1);

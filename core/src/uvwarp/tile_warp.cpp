@@ -32,7 +32,9 @@ void requireSquare(const io::Image& map, const std::string& source, int tile, co
 std::vector<uint8_t> maskBytes(const PointField& mask) {
     std::vector<uint8_t> bytes;
     deformkit::detail::assignLarge(bytes, mask.values.size(), uint8_t{0});
-    for (size_t k = 0; k < bytes.size(); ++k)
+    const auto count = static_cast<int64_t>(bytes.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t k = 0; k < count; ++k)
         bytes[k] = mask.values[k] >= 0.5f ? 1 : 0;
     return bytes;
 }
@@ -42,7 +44,9 @@ PointField maskField(const std::vector<uint8_t>& bytes, int32_t cells) {
     mask.cells = cells;
     mask.channels = 1;
     deformkit::detail::assignLarge(mask.values, bytes.size(), 0.0f);
-    for (size_t k = 0; k < bytes.size(); ++k)
+    const auto count = static_cast<int64_t>(bytes.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t k = 0; k < count; ++k)
         mask.values[k] = bytes[k];
     return mask;
 }
@@ -57,6 +61,7 @@ PointField refinedMask(PointField fine, const PointField& coarse) {
     const auto fixed = [&](int32_t i, int32_t j) {
         return coarse.values[static_cast<size_t>(j) * coarseSide + i] < 0.5f;
     };
+#pragma omp parallel for schedule(static)
     for (int32_t j = 0; j < side; ++j)
         for (int32_t i = 0; i < side; ++i) {
             float& value = fine.values[static_cast<size_t>(j) * side + i];
