@@ -308,12 +308,15 @@ void invertWarp(const WarpGrid& warp, int32_t texels, io::Image& redirect) {
             const int32_t i0 = c * kChunkCells, i1 = std::min(cells, i0 + kChunkCells);
             const float* ru = wu + static_cast<size_t>(j) * side;
             const float* rv = wv + static_cast<size_t>(j) * side;
-            float low = std::numeric_limits<float>::infinity(), high = -low;
-            int32_t bad = 0;
+            // The chunk's last point (its first in the next chunk) on its own: the vector loop then runs
+            // whole vectors only (64 points), with no scalar remainder.
+            constexpr float kLargest = std::numeric_limits<float>::max();
+            float low = rv[i1], high = rv[i1];
+            int32_t bad =
+                !(std::abs(ru[i1]) <= kLargest) | !(std::abs(rv[i1]) <= kLargest);  // NaN or infinite
 #pragma omp simd reduction(min : low) reduction(max : high) reduction(| : bad)
-            for (int32_t i = i0; i <= i1; ++i) {
-                constexpr float kLargest = std::numeric_limits<float>::max();
-                bad |= !(std::abs(ru[i]) <= kLargest) | !(std::abs(rv[i]) <= kLargest);  // NaN or infinite
+            for (int32_t i = i0; i < i1; ++i) {
+                bad |= !(std::abs(ru[i]) <= kLargest) | !(std::abs(rv[i]) <= kLargest);
                 low = std::min(low, rv[i]);
                 high = std::max(high, rv[i]);
             }
