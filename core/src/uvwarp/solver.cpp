@@ -175,10 +175,15 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
         begin, runs);
 }
 
-// The kernels' view of a level whose points are at u[j * row + i * step].
-detail::KernelLevel kernelLevel(const Level& level, float* u, float* v, int32_t step, ptrdiff_t row) {
+// The kernels' view of a level whose points are at u[j * row + i * step], in a grid whose f_O is `rest`.
+detail::KernelLevel kernelLevel(const Level& level, const PointField& rest, float* u, float* v, int32_t step,
+                                ptrdiff_t row) {
+    const bool compact = !level.rest.empty();
     return {level.cells,
-            level.stride,
+            compact ? level.rest.data() : rest.values.data(),
+            compact ? 3 * static_cast<ptrdiff_t>(level.side())
+                    : 3 * static_cast<ptrdiff_t>(level.stride) * (rest.cells + 1),
+            compact ? 3 : 3 * level.stride,
             u,
             v,
             step,
@@ -215,7 +220,7 @@ struct Solver::Impl : detail::SolverState {
 
     // The level's points where they are, in the warp.
     detail::KernelLevel inPlace(const Level& level) {
-        return kernelLevel(level, grid.u.data(), grid.v.data(), level.stride,
+        return kernelLevel(level, rest, grid.u.data(), grid.v.data(), level.stride,
                            static_cast<ptrdiff_t>(level.stride) * side());
     }
 
@@ -232,7 +237,7 @@ struct Solver::Impl : detail::SolverState {
                 workV[level.index(i, j)] = grid.v[k];
             }
         }
-        return kernelLevel(level, workU.data(), workV.data(), 1, n);
+        return kernelLevel(level, rest, workU.data(), workV.data(), 1, n);
     }
 
     // The copy's points back into the warp: those that may move (the sweeps move no other).
@@ -668,6 +673,17 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
         level.stride = 1 << l;
     }
     m.rest = std::move(restGeometry);
+    for (Level& level : m.levels) {
+        if (!m.options.warmStart || level.stride < detail::kCompactRestStride) continue;
+        const int32_t n = level.side();
+        level.rest.resize(3 * static_cast<size_t>(n) * n);
+        for (int32_t j = 0; j < n; ++j) {
+            for (int32_t i = 0; i < n; ++i) {
+                const float* from = &m.rest.values[3 * m.fine(level, i, j)];
+                std::copy(from, from + 3, &level.rest[3 * level.index(i, j)]);
+            }
+        }
+    }
     m.untangleWork.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.untangleNext.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.rowFolds.assign(static_cast<size_t>(m.cells) + 1, 0);

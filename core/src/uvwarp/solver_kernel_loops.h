@@ -191,11 +191,10 @@ template <class Ops, int32_t Type, bool Mapped>
     float* vA = v + centreA;
     float* uB = u + centreB;
     float* vB = v + centreB;
-    // f_O at the level's points: every stride-th fine point of every stride-th fine row.
-    const int32_t restStep = 3 * level.stride;
-    const ptrdiff_t restRow = static_cast<ptrdiff_t>(restStep) * (grid.cells + 1);
-    const float* restA = grid.rest + ja * restRow;
-    const float* restB = grid.rest + jb * restRow;
+    // f_O at the level's points.
+    const int32_t restStep = level.restStep;
+    const float* restA = level.rest + ja * level.restRow;
+    const float* restB = level.rest + jb * level.restRow;
     const float* deformedImage = grid.deformed;
     const float* rigidityA = level.rigidity + levelIndex(level, 0, ja);
     const float* rigidityB = level.rigidity + levelIndex(level, 0, jb);

@@ -16,7 +16,7 @@ namespace deformkit::uvwarp::detail {
 // between an AVX2 and a baseline object (docs/decisions.md, "SIMD kernels").
 struct KernelGrid {
     int32_t cells;                  // n, cells per side of the fine grid
-    const float* rest;              // f_O, 3 floats per fine point
+    const float* rest;              // f_O, 3 floats per fine point (a level reads it through KernelLevel)
     const float* deformed;          // f_D of the current solve, 3 floats per fine point
     float orientationPreservation;  // SolverOptions
     float smoothing;                // SolverOptions
@@ -27,7 +27,11 @@ struct KernelGrid {
 // warp (step = stride) or in a compact copy of the level's points (step 1).
 struct KernelLevel {
     int32_t cells;
-    int32_t stride;  // fine points between the level's points: where f_O is read
+    // f_O at the level's points: point (i, j) at rest[j * restRow + i * restStep] (3 floats), in the fine
+    // image (restStep 3 stride) or in a compact copy of the level's points (restStep 3).
+    const float* rest;
+    ptrdiff_t restRow;
+    int32_t restStep;
     float *u, *v;
     int32_t step;
     ptrdiff_t row;

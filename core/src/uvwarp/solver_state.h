@@ -41,6 +41,10 @@ constexpr int32_t kBlockRows = 16;
 // and barriers cost (timed on a 1024^2 grid's level 5).
 constexpr int64_t kParallelWavefrontRows = 32;
 
+// A warm-started solver's levels this many fine points apart or more read f_O from compact copies
+// (Level::rest): about 1 byte a fine cell, their sweeps 10-14% faster at 1024^2.
+constexpr int32_t kCompactRestStride = 4;
+
 // Level::rigidity of a point that may not move is kFixed - R (kFixed: solver_kernels.h).
 [[nodiscard]] inline float fixedRigidity(float r) {
     return kFixed - r;
@@ -54,7 +58,11 @@ struct Level {
     // 32-bit values, so their vector loops run 8 lanes per AVX2 iteration, not 32 (a byte map made GCC
     // choose 32 lanes, which left every run shorter than 32 segments to the scalar remainder loop).
     std::vector<float> rigidity;
-    std::vector<float> orientation;           // empty without an orientation map (1 everywhere)
+    std::vector<float> orientation;  // empty without an orientation map (1 everywhere)
+    // f_O at this level's points, 3 floats each, in a solver that keeps its solve state between solves
+    // (SolverOptions::warmStart), on levels kCompactRestStride or more fine points apart; empty otherwise
+    // (the level reads the fine image, every point of it a cache line of its own).
+    std::vector<float> rest;
     std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)
     // Per row of cells j and parallel set s (kSets, solver_kernels.h), runs [setRuns[2r], setRuns[2r + 1])
     // of the set's segment numbers g, r in [setRunBegin[j kSets + s], setRunBegin[j kSets + s + 1]), holding

@@ -65,9 +65,10 @@ void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int
     const float lDef = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
     const float dx = pbx - pax, dy = pby - pay;
     const float length = std::sqrt(dx * dx + dy * dy);
-    const size_t restRow = 3 * static_cast<size_t>(l.stride) * (static_cast<size_t>(g.cells) + 1);
-    const float* restA = g.rest + ja * restRow + 3 * static_cast<size_t>(ia) * l.stride;
-    const float* restB = g.rest + jb * restRow + 3 * static_cast<size_t>(ib) * l.stride;
+    const size_t stride = static_cast<size_t>(g.cells / l.cells);  // f_O from the fine image itself
+    const size_t restRow = 3 * stride * (static_cast<size_t>(g.cells) + 1);
+    const float* restA = g.rest + ja * restRow + 3 * static_cast<size_t>(ia) * stride;
+    const float* restB = g.rest + jb * restRow + 3 * static_cast<size_t>(ib) * stride;
     const float r0 = restB[0] - restA[0], r1 = restB[1] - restA[1], r2 = restB[2] - restA[2];
     const float lOrg = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
     if (!(lDef > 1e-12f && length > 1e-12f && lOrg > 0.0f)) return;
@@ -135,6 +136,7 @@ struct Scene {
     int32_t fineCells = 0;
     std::vector<float> rest, deformed;  // 3 floats per fine point
     std::vector<float> u, v;            // the level's points, in its layout
+    std::vector<float> restCopy;  // f_O at the level's points (compact scenes), as a warm solver keeps it
     std::vector<float> orientation;
     Level runs;  // cells, rigidity and the runs of projected segments (findSetRuns)
     KernelGrid grid{};
@@ -198,8 +200,21 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
     }
     findSetRuns(s.runs, s.fineCells);
     s.grid = {n, s.rest.data(), s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
+    // Compact scenes read f_O from a copy of the level's points (the reference reads the fine image).
+    if (compact) {
+        s.restCopy.resize(3 * static_cast<size_t>(side) * side);
+        for (int32_t j = 0; j <= cells; ++j)
+            for (int32_t i = 0; i <= cells; ++i)
+                for (int32_t c = 0; c < 3; ++c)
+                    s.restCopy[3 * (static_cast<size_t>(j) * side + i) + c] =
+                        s.rest[3 * (static_cast<size_t>(j) * stride * (n + 1) +
+                                    static_cast<size_t>(i) * stride) +
+                               c];
+    }
     s.level = {cells,
-               stride,
+               compact ? s.restCopy.data() : s.rest.data(),
+               compact ? 3 * static_cast<ptrdiff_t>(side) : 3 * static_cast<ptrdiff_t>(stride) * (n + 1),
+               compact ? 3 : 3 * stride,
                s.u.data(),
                s.v.data(),
                step,

@@ -451,3 +451,26 @@ TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 4 swee
     const uvwarp::TileWarp large(mesh, 1001, diskRigidity(128), {}, fine);
     CHECK(large.warp().cells == 2048);
 }
+
+TEST_CASE("uv warp: a warm-started solver's first solve is the cold solver's, byte for byte", "[uvwarp]") {
+    // A solver that keeps its state between solves reads f_O on its coarse levels from compact copies of
+    // their points; one that starts every solve from the identity reads the fine image. From the identity,
+    // with the same schedule, the first solves are the same arithmetic on the same values.
+    const geom::Mesh plane = uvPlane(16);
+    for (const int32_t texels : {128, 256}) {
+        CAPTURE(texels);
+        uvwarp::TileWarpOptions cold;
+        cold.solver.warmStart = false;
+        cold.refinementSweeps = 0;
+        uvwarp::TileWarpOptions warm = cold;
+        warm.solver.warmStart = true;
+        uvwarp::TileWarp a(plane, 1001, diskRigidity(texels), {}, cold);
+        uvwarp::TileWarp b(plane, 1001, diskRigidity(texels), {}, warm);
+        const std::vector<glm::vec3> pose = stretched(plane, 1.4f);
+        const uvwarp::WarpGrid& coldWarp = a.solve(pose);
+        const uvwarp::WarpGrid& warmWarp = b.solve(pose);
+        REQUIRE(a.stats().levels >= 3);  // a level 4 fine points apart or more
+        CHECK(coldWarp.u == warmWarp.u);
+        CHECK(coldWarp.v == warmWarp.v);
+    }
+}
