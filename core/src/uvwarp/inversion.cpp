@@ -41,11 +41,14 @@ inline int64_t edgeFunction(const RasterPoint& a, const RasterPoint& b, int64_t 
     return (b.sx - a.sx) * (cy - a.sy) - (b.sy - a.sy) * (cx - a.sx);
 }
 
-// Smallest pixel whose centre (256 i + 128) is >= s, largest whose centre is <= s.
-inline int64_t firstCentreAtOrAbove(int64_t s) {
+// Smallest pixel whose centre (256 i + 128) is >= s, largest whose centre is <= s; int32 in vector loops
+// (snapped positions are within 2^28), int64 elsewhere.
+template <class Int>
+inline Int firstCentreAtOrAbove(Int s) {
     return -((128 - s) >> 8);
 }
-inline int64_t lastCentreAtOrBelow(int64_t s) {
+template <class Int>
+inline Int lastCentreAtOrBelow(Int s) {
     return (s - 128) >> 8;
 }
 
@@ -72,11 +75,10 @@ struct CandidateBoxes {
             const int32_t maxX = std::max(std::max(lx[m], lx[m + 1]), std::max(ux[m], ux[m + 1]));
             const int32_t minY = std::min(std::min(ly[m], ly[m + 1]), std::min(uy[m], uy[m + 1]));
             const int32_t maxY = std::max(std::max(ly[m], ly[m + 1]), std::max(uy[m], uy[m + 1]));
-            // firstCentreAtOrAbove and lastCentreAtOrBelow, in int32 (snapped positions are within 2^28).
-            xf[m] = std::max(0, -((128 - minX) >> 8));
-            xl[m] = still[m] ? -1 : std::min(size - 1, (maxX - 128) >> 8);
-            yf[m] = std::max(y0, -((128 - minY) >> 8));
-            yl[m] = std::min(y1 - 1, (maxY - 128) >> 8);
+            xf[m] = std::max(0, firstCentreAtOrAbove(minX));
+            xl[m] = still[m] ? -1 : std::min(size - 1, lastCentreAtOrBelow(maxX));
+            yf[m] = std::max(y0, firstCentreAtOrAbove(minY));
+            yl[m] = std::min(y1 - 1, lastCentreAtOrBelow(maxY));
         }
     }
 };

@@ -208,7 +208,7 @@ struct Solver::Impl : detail::SolverState {
     std::vector<std::atomic<int32_t>> blockDone;
 
     [[nodiscard]] detail::KernelGrid kernelGrid() {
-        return {cells, rest.values.data(), deformed, options.orientationPreservation, options.smoothing};
+        return {cells, deformed, options.orientationPreservation, options.smoothing};
     }
 
     // Rows of cells j moves points on rows j and j + 1 and reads rows j - 1 .. j + 2 (the clamp and the
@@ -595,7 +595,8 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
     collectRuns(
         c, detail::kSets,
         [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
-            std::vector<uint8_t> projected(4 * static_cast<size_t>(c));
+            thread_local std::vector<uint8_t> projected;  // each thread's, kept: no allocation per row
+            projected.resize(4 * static_cast<size_t>(c));
             for (int32_t type = 0; type < 4; ++type) {
                 const detail::EdgeType e = detail::kEdgeTypes[type];  // ends on rows j, j + 1 <= c
                 const float* __restrict a = level.rigidity.data() + (j + e.aj) * side + e.ai;

@@ -16,7 +16,6 @@ namespace deformkit::uvwarp::detail {
 // between an AVX2 and a baseline object (docs/decisions.md, "SIMD kernels").
 struct KernelGrid {
     int32_t cells;                  // n, cells per side of the fine grid
-    const float* rest;              // f_O, 3 floats per fine point (a level reads it through KernelLevel)
     const float* deformed;          // f_D of the current solve, 3 floats per fine point
     float orientationPreservation;  // SolverOptions
     float smoothing;                // SolverOptions

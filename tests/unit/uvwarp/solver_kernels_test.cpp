@@ -25,8 +25,8 @@ using namespace deformkit::uvwarp::detail;
 // canonical direction, the clamped, fold-checked moves of both ends, written for one segment with scalar
 // code. The per-point helpers (f_D look-up, clamp and fold check) are the kernel's own: this reference
 // checks which segments are projected, from which state, and where the results go.
-void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int32_t i, int32_t j,
-                    float stiffness) {
+void projectSegment(const KernelGrid& g, const float* fineRest, const KernelLevel& l, int32_t type, int32_t i,
+                    int32_t j, float stiffness) {
     const EdgeType e = kEdgeTypes[type];
     const int32_t ia = i + e.ai, ja = j + e.aj, ib = i + e.bi, jb = j + e.bj;
     const auto at = [&](int32_t pi, int32_t pj) { return static_cast<ptrdiff_t>(pj) * l.row + pi * l.step; };
@@ -67,8 +67,8 @@ void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int
     const float length = std::sqrt(dx * dx + dy * dy);
     const size_t stride = static_cast<size_t>(g.cells / l.cells);  // f_O from the fine image itself
     const size_t restRow = 3 * stride * (static_cast<size_t>(g.cells) + 1);
-    const float* restA = g.rest + ja * restRow + 3 * static_cast<size_t>(ia) * stride;
-    const float* restB = g.rest + jb * restRow + 3 * static_cast<size_t>(ib) * stride;
+    const float* restA = fineRest + ja * restRow + 3 * static_cast<size_t>(ia) * stride;
+    const float* restB = fineRest + jb * restRow + 3 * static_cast<size_t>(ib) * stride;
     const float r0 = restB[0] - restA[0], r1 = restB[1] - restA[1], r2 = restB[2] - restA[2];
     const float lOrg = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
     if (!(lDef > 1e-12f && length > 1e-12f && lOrg > 0.0f)) return;
@@ -117,7 +117,8 @@ void projectSegment(const KernelGrid& g, const KernelLevel& l, int32_t type, int
 // The reference sweep of row of cells j: the 8 sets in the kernel's order (each edge type by the parity of
 // its cell column), a set's segments one after another, every one with both ends and their rings inside the
 // grid (projectSegment leaves those it does not project).
-void referenceSweepRow(const KernelGrid& g, const KernelLevel& l, int32_t j, float stiffness) {
+void referenceSweepRow(const KernelGrid& g, const float* fineRest, const KernelLevel& l, int32_t j,
+                       float stiffness) {
     const int32_t c = l.cells;
     for (int32_t type : {0, 1, 2, 3}) {
         const EdgeType e = kEdgeTypes[type];
@@ -126,7 +127,7 @@ void referenceSweepRow(const KernelGrid& g, const KernelLevel& l, int32_t j, flo
         if (j + e.aj < 1 || j + e.bj > c - 1) continue;
         for (int32_t first = 0; first < step; ++first) {
             for (int32_t i = 1; i < limit; ++i) {
-                if (i % step == first) projectSegment(g, l, type, i, j, stiffness);
+                if (i % step == first) projectSegment(g, fineRest, l, type, i, j, stiffness);
             }
         }
     }
@@ -199,7 +200,7 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
         }
     }
     findSetRuns(s.runs, s.fineCells);
-    s.grid = {n, s.rest.data(), s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
+    s.grid = {n, s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
     // Compact scenes read f_O from a copy of the level's points (the reference reads the fine image).
     if (compact) {
         s.restCopy.resize(3 * static_cast<size_t>(side) * side);
@@ -245,7 +246,6 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
                         const Scene scene = makeScene(rng, cells, stride, compact, mapped);
                         for (const SolverKernels* k : kernels) {
                             Scene kernel = scene, reference = scene;
-                            kernel.grid.rest = reference.grid.rest = scene.rest.data();
                             kernel.grid.deformed = reference.grid.deformed = scene.deformed.data();
                             kernel.level.u = kernel.u.data();
                             kernel.level.v = kernel.v.data();
@@ -260,7 +260,8 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
                             const float stiffness = 0.8f;
                             for (int32_t j = 0; j < cells; ++j) {
                                 k->sweepRow(kernel.grid, kernel.level, j, stiffness);
-                                referenceSweepRow(reference.grid, reference.level, j, stiffness);
+                                referenceSweepRow(reference.grid, scene.rest.data(), reference.level, j,
+                                                  stiffness);
                             }
                             INFO("cells " << cells << ", stride " << stride << ", compact " << compact
                                           << ", orientation map " << mapped << ", trial " << trial
