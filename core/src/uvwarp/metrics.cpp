@@ -35,8 +35,10 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
                         const PointField& rigidity, const PointField& mask, const MetricsOptions& options) {
     validateWarpGrid(warp, "warp metrics: warp grid");
     const int32_t n = warp.cells, side = n + 1;
-    detail::requireField(rest, n, 3, "warp metrics", "rest geometry image");
-    detail::requireField(deformed, n, 3, "warp metrics", "deformed geometry image");
+    // The geometry images: of the grid's cells, or of half of them (Solver: looked up between their points).
+    const int32_t imageCells = rest.cells == n / 2 && n >= 2 ? n / 2 : n;
+    detail::requireField(rest, imageCells, 3, "warp metrics", "rest geometry image");
+    detail::requireField(deformed, imageCells, 3, "warp metrics", "deformed geometry image");
     detail::requireField(rigidity, n, 1, "warp metrics", "rigidity");
     detail::requireField(mask, n, 1, "warp metrics", "mask");
     if (options.texels < 0) {
@@ -46,17 +48,19 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
     const double unit = options.texels > 0 ? options.texels : n;
     const double inverseCells = 1.0 / n;  // exact: n is a power of two
 
-    // The size of f_O, for the degenerate-edge threshold.
-    std::vector<float> rowLo(static_cast<size_t>(side) * 3), rowHi(static_cast<size_t>(side) * 3);
+    // The size of f_O, for the degenerate-edge threshold (the image's points: between them f_O is their
+    // blend).
+    const int32_t imageSide = imageCells + 1;
+    std::vector<float> rowLo(static_cast<size_t>(imageSide) * 3), rowHi(static_cast<size_t>(imageSide) * 3);
 #pragma omp parallel for schedule(static)
-    for (int32_t j = 0; j < side; ++j) {
+    for (int32_t j = 0; j < imageSide; ++j) {
         float lo[3], hi[3];
         for (int c = 0; c < 3; ++c) {
             lo[c] = std::numeric_limits<float>::infinity();
             hi[c] = -std::numeric_limits<float>::infinity();
         }
-        for (int32_t i = 0; i < side; ++i) {
-            const size_t k = static_cast<size_t>(j) * side + i;
+        for (int32_t i = 0; i < imageSide; ++i) {
+            const size_t k = static_cast<size_t>(j) * imageSide + i;
             for (int c = 0; c < 3; ++c) {
                 lo[c] = std::min(lo[c], rest.values[3 * k + c]);
                 hi[c] = std::max(hi[c], rest.values[3 * k + c]);
@@ -70,7 +74,7 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
     double extent2 = 0.0;
     for (int c = 0; c < 3; ++c) {
         float lo = rowLo[c], hi = rowHi[c];
-        for (int32_t j = 1; j < side; ++j) {
+        for (int32_t j = 1; j < imageSide; ++j) {
             lo = std::min(lo, rowLo[3 * j + c]);
             hi = std::max(hi, rowHi[3 * j + c]);
         }
@@ -82,6 +86,7 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
     const float* fo = rest.values.data();
     const float* fd = deformed.values.data();
     const float* r = rigidity.values.data();
+    const bool between = imageCells < n;
 #pragma omp parallel
     {
         // f_D(W(p)) of point rows j and j + 1; the upper row is kept for the next j of this thread.
@@ -89,11 +94,26 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
         auto lookUpRow = [&](int32_t j, std::vector<float>& out) {
             for (int32_t i = 0; i < side; ++i) {
                 const size_t k = static_cast<size_t>(j) * side + i;
-                const glm::vec3 p = detail::bilinear3(fd, n, warp.u[k], warp.v[k]);
+                const glm::vec3 p = detail::bilinear3(fd, imageCells, warp.u[k], warp.v[k]);
                 out[3 * i] = p.x;
                 out[3 * i + 1] = p.y;
                 out[3 * i + 2] = p.z;
             }
+        };
+        // f_O and f_D at the grid points of rows j and j + 1: the images' own rows, or their look-ups
+        // between the points of an image of half the cells.
+        std::vector<float> gridRows[2][2];  // [f_O, f_D][lower, upper]
+        const auto gridRow = [&](const float* image, int32_t jj, std::vector<float>& out) -> const float* {
+            if (!between) return image + 3 * static_cast<size_t>(jj) * side;
+            out.resize(static_cast<size_t>(side) * 3);
+            for (int32_t i = 0; i < side; ++i) {
+                const glm::vec3 p = detail::bilinear3(image, imageCells, static_cast<float>(i * inverseCells),
+                                                      static_cast<float>(jj * inverseCells));
+                out[3 * i] = p.x;
+                out[3 * i + 1] = p.y;
+                out[3 * i + 2] = p.z;
+            }
+            return out.data();
         };
         int32_t cached = -1;
 #pragma omp for schedule(static)
@@ -109,28 +129,36 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
             }
             const float* wLower = lowerRow.data();
             const float* wUpper = upperRow.data();
+            const int32_t jUp = std::min(j + 1, n);
+            const float* foRow[2] = {gridRow(fo, j, gridRows[0][0]), gridRow(fo, jUp, gridRows[0][1])};
+            const float* fdRow[2] = {gridRow(fd, j, gridRows[1][0]), gridRow(fd, jUp, gridRows[1][1])};
             RowSums sums;
-            // Ratios in float (relative error ~1e-7), sums in double.
-            auto edge = [&](size_t a, size_t b, const float* wa, const float* wb) {
+            // Ratios in float (relative error ~1e-7), sums in double. Ends a and b: grid points (ia, row a)
+            // and (ib, row b) of rows j (0) and j + 1 (1).
+            auto edge = [&](int32_t ia, int32_t rowA, int32_t ib, int32_t rowB, const float* wa,
+                            const float* wb) {
+                const size_t a = static_cast<size_t>(j + rowA) * side + ia,
+                             b = static_cast<size_t>(j + rowB) * side + ib;
                 if (std::max(r[a], r[b]) < options.rigidThreshold) return;
-                const float original2 = distance2(fo + 3 * a, fo + 3 * b);
+                const float original2 = distance2(foRow[rowA] + 3 * ia, foRow[rowB] + 3 * ib);
                 if (!(original2 > degenerate2)) {
                     ++sums.skipped;
                     return;
                 }
                 const float inverse = 1.0f / std::sqrt(original2);
                 sums.ours += std::abs(std::sqrt(distance2(wa, wb)) * inverse - 1.0f);
-                sums.identity += std::abs(std::sqrt(distance2(fd + 3 * a, fd + 3 * b)) * inverse - 1.0f);
+                sums.identity += std::abs(
+                    std::sqrt(distance2(fdRow[rowA] + 3 * ia, fdRow[rowB] + 3 * ib)) * inverse - 1.0f);
                 ++sums.edges;
             };
             for (int32_t i = 0; i < side; ++i) {
                 const size_t k = static_cast<size_t>(j) * side + i;
                 const float* w = wLower + 3 * i;
                 const float* wUp = wUpper + 3 * i;
-                if (i < n) edge(k, k + 1, w, w + 3);                    // horizontal
-                if (j < n) edge(k, k + side, w, wUp);                   // vertical
-                if (i < n && j < n) edge(k, k + side + 1, w, wUp + 3);  // diagonal (i, j)-(i+1, j+1)
-                if (i < n && j < n) edge(k + 1, k + side, w + 3, wUp);  // diagonal (i+1, j)-(i, j+1)
+                if (i < n) edge(i, 0, i + 1, 0, w, w + 3);             // horizontal
+                if (j < n) edge(i, 0, i, 1, w, wUp);                   // vertical
+                if (i < n && j < n) edge(i, 0, i + 1, 1, w, wUp + 3);  // diagonal (i, j)-(i+1, j+1)
+                if (i < n && j < n) edge(i + 1, 0, i, 1, w + 3, wUp);  // diagonal (i+1, j)-(i, j+1)
 
                 const bool masked = mask.values[k] < 0.5f, border = i == 0 || j == 0 || i == n || j == n;
                 if (masked || border) {

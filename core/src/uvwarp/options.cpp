@@ -33,6 +33,10 @@ struct TileMember {
 static_assert(kAutomaticRefinementSweeps == 4 && kAutomaticRefinementCells == 1024,
               "refinementSweeps' lowMeans states 4 sweeps up to 1024 cells");
 
+// geometryImageCells' zeroMeans spells the rule of geometryImageCellsFor out.
+static_assert(kFullGeometryImageCells == 8192,
+              "geometryImageCells' zeroMeans states the grid's cells up to 8192");
+
 const OptionSpec kSpecs[] = {
     {.name = "resolution",
      .type = OptionType::Integer,
@@ -190,6 +194,21 @@ const OptionSpec kSpecs[] = {
                 "near seams read plausible positions.",
      .get = TileMember<&TileWarpOptions::dilationRings>::get,
      .put = TileMember<&TileWarpOptions::dilationRings>::put},
+    {.name = "geometryImageCells",
+     .type = OptionType::Integer,
+     .high = 32768,
+     .powerOfTwo = true,
+     .unit = "cells",
+     .zeroMeans = "by the grid's size: the grid's cells up to 8192, half of them from 16384",
+     .meaning =
+         "Cells per side of the geometry images of the rest and posed surfaces: the grid's, or half of "
+         "them, which holds them in a quarter of the memory (a 16384^2 tile: 18 bytes a cell less). "
+         "The surfaces are affine inside each UV triangle, where the solver's look-ups between the "
+         "image's points are exact; the cells that straddle a triangle's edge cost the rigged Fox 2.5 "
+         "points of rigid stretch removed at 256^2 and 1.3 at 512^2, half as much each time the grid "
+         "doubles.",
+     .get = TileMember<&TileWarpOptions::geometryImageCells>::get,
+     .put = TileMember<&TileWarpOptions::geometryImageCells>::put},
     {.name = "warmStart",
      .type = OptionType::Flag,
      .meaning = "Start each solve from the last frame's warp, as a live preview does (the paper's temporal "

@@ -175,15 +175,20 @@ void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>&
         begin, runs);
 }
 
-// The kernels' view of a level whose points are at u[j * row + i * step], in a grid whose f_O is `rest`.
-detail::KernelLevel kernelLevel(const Level& level, const PointField& rest, float* u, float* v, int32_t step,
-                                ptrdiff_t row) {
+// The kernels' view of a level whose points are at u[j * row + i * step], in a grid of fineCells cells whose
+// f_O is `rest` (a geometry image of fineCells or fineCells / 2 cells).
+detail::KernelLevel kernelLevel(const Level& level, int32_t fineCells, const PointField& rest, float* u,
+                                float* v, int32_t step, ptrdiff_t row) {
     const bool compact = !level.rest.empty();
+    const int32_t shift = rest.cells < fineCells ? 1 : 0;  // fine point i is image point i >> shift
+    const bool between = !compact && level.stride < (1 << shift);
+    const int32_t imageStride = between ? 1 : level.stride >> shift;
     return {level.cells,
             compact ? level.rest.data() : rest.values.data(),
             compact ? 3 * static_cast<ptrdiff_t>(level.side())
-                    : 3 * static_cast<ptrdiff_t>(level.stride) * (rest.cells + 1),
-            compact ? 3 : 3 * level.stride,
+                    : 3 * static_cast<ptrdiff_t>(imageStride) * (rest.cells + 1),
+            compact ? 3 : 3 * imageStride,
+            between ? 1 : 0,
             u,
             v,
             step,
@@ -208,7 +213,7 @@ struct Solver::Impl : detail::SolverState {
     std::vector<std::atomic<int32_t>> blockDone;
 
     [[nodiscard]] detail::KernelGrid kernelGrid() {
-        return {cells, deformed, options.orientationPreservation, options.smoothing};
+        return {cells, deformed, rest.cells, options.orientationPreservation, options.smoothing};
     }
 
     // Rows of cells j moves points on rows j and j + 1 and reads rows j - 1 .. j + 2 (the clamp and the
@@ -220,7 +225,7 @@ struct Solver::Impl : detail::SolverState {
 
     // The level's points where they are, in the warp.
     detail::KernelLevel inPlace(const Level& level) {
-        return kernelLevel(level, rest, grid.u.data(), grid.v.data(), level.stride,
+        return kernelLevel(level, cells, rest, grid.u.data(), grid.v.data(), level.stride,
                            static_cast<ptrdiff_t>(level.stride) * side());
     }
 
@@ -237,7 +242,7 @@ struct Solver::Impl : detail::SolverState {
                 workV[level.index(i, j)] = grid.v[k];
             }
         }
-        return kernelLevel(level, rest, workU.data(), workV.data(), 1, n);
+        return kernelLevel(level, cells, rest, workU.data(), workV.data(), 1, n);
     }
 
     // The copy's points back into the warp: those that may move (the sweeps move no other).
@@ -639,7 +644,9 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     Impl& m = *impl_;
     m.source = source;
     m.options = options;
-    m.cells = restGeometry.cells;
+    // The grid is the maps' (rigidity, mask); f_O is a geometry image of the grid's cells or half of them.
+    const bool halfImage = rigidity.cells == 2 * restGeometry.cells && restGeometry.cells >= 2;
+    m.cells = halfImage ? rigidity.cells : restGeometry.cells;
     m.sweeps = options.sweepsPerLevel.empty() ? defaultSweeps(m.cells) : options.sweepsPerLevel;
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
@@ -649,7 +656,7 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
         throw InvalidInput(formatError(source, "grid", std::to_string(m.cells) + " cells per side",
                                        "at most " + std::to_string(kMaxGridCells)));
     }
-    detail::requireField(restGeometry, m.cells, 3, source, "rest geometry image");
+    detail::requireField(restGeometry, halfImage ? m.cells / 2 : m.cells, 3, source, "rest geometry image");
     m.blockDone =
         std::vector<std::atomic<int32_t>>(static_cast<size_t>(detail::mostWavefrontBlocks(m.cells)));
     checkOptions(options, source);
@@ -677,10 +684,12 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     for (Level& level : m.levels) {
         if (!m.options.warmStart || level.stride < detail::kCompactRestStride) continue;
         const int32_t n = level.side();
+        const size_t imageStride = static_cast<size_t>(halfImage ? level.stride / 2 : level.stride);
+        const size_t imageSide = static_cast<size_t>(m.rest.cells) + 1;
         level.rest.resize(3 * static_cast<size_t>(n) * n);
         for (int32_t j = 0; j < n; ++j) {
             for (int32_t i = 0; i < n; ++i) {
-                const float* from = &m.rest.values[3 * m.fine(level, i, j)];
+                const float* from = &m.rest.values[3 * imageStride * (j * imageSide + i)];
                 std::copy(from, from + 3, &level.rest[3 * level.index(i, j)]);
             }
         }
@@ -756,7 +765,7 @@ SolverOptions liveOptions(int32_t cells) {
 
 const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     Impl& m = *impl_;
-    detail::requireField(deformedGeometry, m.cells, 3, m.source, "deformed geometry image");
+    detail::requireField(deformedGeometry, m.rest.cells, 3, m.source, "deformed geometry image");
     if (!m.options.warmStart && !m.started) reset();  // startFrom says where this solve starts
     m.allocateSolveState();
     m.deformed = deformedGeometry.values.data();

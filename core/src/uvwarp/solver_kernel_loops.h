@@ -193,9 +193,10 @@ template <class Ops, int32_t Type, bool Mapped>
     float* vB = v + centreB;
     // f_O at the level's points.
     const int32_t restStep = level.restStep;
-    const float* restA = level.rest + ja * level.restRow;
-    const float* restB = level.rest + jb * level.restRow;
+    const float* restA = level.restBetween ? level.rest : level.rest + ja * level.restRow;
+    const float* restB = level.restBetween ? level.rest : level.rest + jb * level.restRow;
     const float* deformedImage = grid.deformed;
+    const int32_t imageCells = grid.imageCells;
     const float* rigidityA = level.rigidity + levelIndex(level, 0, ja);
     const float* rigidityB = level.rigidity + levelIndex(level, 0, jb);
     const float* orientationA = Mapped ? level.orientation + levelIndex(level, 0, ja) : nullptr;
@@ -250,23 +251,46 @@ template <class Ops, int32_t Type, bool Mapped>
                           fyB[kLaneBlock] = {};
 #pragma omp simd
         for (int32_t l = 0; l < lanes; ++l) {
-            imageCell(fineCells, wu[rowA][colA][l], wv[rowA][colA][l], cellA[l], fxA[l], fyA[l]);
-            imageCell(fineCells, wu[rowB][colB][l], wv[rowB][colB][l], cellB[l], fxB[l], fyB[l]);
+            imageCell(imageCells, wu[rowA][colA][l], wv[rowA][colA][l], cellA[l], fxA[l], fyA[l]);
+            imageCell(imageCells, wu[rowB][colB][l], wv[rowB][colB][l], cellB[l], fxB[l], fyB[l]);
         }
         alignas(32) float xa0[kLaneBlock], xa1[kLaneBlock], xa2[kLaneBlock];
         alignas(32) float xb0[kLaneBlock], xb1[kLaneBlock], xb2[kLaneBlock];
-        Ops::blendCells(deformedImage, fineCells, cellA, fxA, fyA, xa0, xa1, xa2);
-        Ops::blendCells(deformedImage, fineCells, cellB, fxB, fyB, xb0, xb1, xb2);
+        Ops::blendCells(deformedImage, imageCells, cellA, fxA, fyA, xa0, xa1, xa2);
+        Ops::blendCells(deformedImage, imageCells, cellB, fxB, fyB, xb0, xb1, xb2);
         // f_O at both ends (l_org, Eq. 1, through f_O at the rest grid points, Eq. 6).
         alignas(32) uint32_t restAt[2][kLaneBlock] = {};  // 0: lanes past `lanes`
-        for (int32_t l = 0; l < lanes; ++l) {
-            restAt[0][l] = static_cast<uint32_t>((cell[l] + e.ai) * restStep);
-            restAt[1][l] = static_cast<uint32_t>((cell[l] + e.bi) * restStep);
-        }
         alignas(32) float ra0[kLaneBlock], ra1[kLaneBlock], ra2[kLaneBlock];
         alignas(32) float rb0[kLaneBlock], rb1[kLaneBlock], rb2[kLaneBlock];
-        Ops::loadPoints(restA, restAt[0], ra0, ra1, ra2);
-        Ops::loadPoints(restB, restAt[1], rb0, rb1, rb2);
+        if (level.restBetween) {
+            // Ends at image point (i / 2, j / 2) and fractions 0 or 1/2: the image's cell inside the grid,
+            // since segment ends are (i, j < n).
+            alignas(32) float fxRest[2][kLaneBlock] = {};
+            alignas(32) float fyRest[2][kLaneBlock];
+            const uint32_t imageRow = 3u * static_cast<uint32_t>(imageCells + 1);
+            for (int32_t l = 0; l < lanes; ++l) {
+                const int32_t ia = cell[l] + e.ai, ib = cell[l] + e.bi;
+                restAt[0][l] =
+                    static_cast<uint32_t>(ja >> 1) * imageRow + 3u * static_cast<uint32_t>(ia >> 1);
+                restAt[1][l] =
+                    static_cast<uint32_t>(jb >> 1) * imageRow + 3u * static_cast<uint32_t>(ib >> 1);
+                fxRest[0][l] = 0.5f * static_cast<float>(ia & 1);
+                fxRest[1][l] = 0.5f * static_cast<float>(ib & 1);
+            }
+            for (int32_t l = 0; l < kLaneBlock; ++l) {
+                fyRest[0][l] = 0.5f * static_cast<float>(ja & 1);
+                fyRest[1][l] = 0.5f * static_cast<float>(jb & 1);
+            }
+            Ops::blendCells(level.rest, imageCells, restAt[0], fxRest[0], fyRest[0], ra0, ra1, ra2);
+            Ops::blendCells(level.rest, imageCells, restAt[1], fxRest[1], fyRest[1], rb0, rb1, rb2);
+        } else {
+            for (int32_t l = 0; l < lanes; ++l) {
+                restAt[0][l] = static_cast<uint32_t>((cell[l] + e.ai) * restStep);
+                restAt[1][l] = static_cast<uint32_t>((cell[l] + e.bi) * restStep);
+            }
+            Ops::loadPoints(restA, restAt[0], ra0, ra1, ra2);
+            Ops::loadPoints(restB, restAt[1], rb0, rb1, rb2);
+        }
         // The per-level maps at both ends, copied into lane arrays, so that the main loop reads lane arrays
         // only.
         alignas(32) float rigA[kLaneBlock], rigB[kLaneBlock], oriA[kLaneBlock] = {}, oriB[kLaneBlock] = {};

@@ -16,7 +16,8 @@ namespace deformkit::uvwarp::detail {
 // between an AVX2 and a baseline object (docs/decisions.md, "SIMD kernels").
 struct KernelGrid {
     int32_t cells;                  // n, cells per side of the fine grid
-    const float* deformed;          // f_D of the current solve, 3 floats per fine point
+    const float* deformed;          // f_D of the current solve, 3 floats per point of its geometry image
+    int32_t imageCells;             // the geometry images' cells per side: n, or n / 2 (Solver)
     float orientationPreservation;  // SolverOptions
     float smoothing;                // SolverOptions
 };
@@ -26,11 +27,15 @@ struct KernelGrid {
 // warp (step = stride) or in a compact copy of the level's points (step 1).
 struct KernelLevel {
     int32_t cells;
-    // f_O at the level's points: point (i, j) at rest[j * restRow + i * restStep] (3 floats), in the fine
-    // image (restStep 3 stride) or in a compact copy of the level's points (restStep 3).
+    // f_O at the level's points: point (i, j) at rest[j * restRow + i * restStep] (3 floats), in the rest
+    // geometry image (restStep 3 stride, or 3 stride / 2 in an image of half the fine grid's cells) or in a
+    // compact copy of the level's points (restStep 3). restBetween: the finest level over an image of half
+    // its cells; rest is that image (restRow 3 (imageCells + 1)), and f_O at a point between the image's is
+    // its bilinear look-up (the mean of 2 or 4 image points).
     const float* rest;
     ptrdiff_t restRow;
     int32_t restStep;
+    int32_t restBetween;
     float *u, *v;
     int32_t step;
     ptrdiff_t row;

@@ -173,12 +173,20 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
             "at most " + std::to_string(kMaxGridCells / 2) + " (the refinement's grid has twice the cells)"));
     }
 
+    const int32_t imageCells = geometryImageCellsFor(options.geometryImageCells, m.cells);
+    if (imageCells != m.cells && (imageCells * 2 != m.cells || imageCells < 1)) {
+        throw InvalidInput(formatError(source, "geometry images, UDIM tile " + std::to_string(tile),
+                                       std::to_string(imageCells) + " cells per side",
+                                       std::to_string(m.cells) + " (the grid's cells) or " +
+                                           std::to_string(m.cells / 2) + " (half of them)"));
+    }
+
     // The tile's UV triangles, collected once for the imager, the derived mask and the delivered figures.
     detail::TileUVs uvs = detail::collectTileUVs(rest, tile, source);
     GeometryImageOptions imageOptions;
     imageOptions.dilationRings = options.dilationRings;
     imageOptions.label = source;
-    m.imager = std::make_unique<GeometryImager>(rest, uvs, m.cells, imageOptions);
+    m.imager = std::make_unique<GeometryImager>(rest, uvs, imageCells, imageOptions);
     PointField restImage;
     m.imager->sample(rest.points(), restImage);
 

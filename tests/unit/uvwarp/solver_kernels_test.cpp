@@ -24,9 +24,11 @@ using namespace deformkit::uvwarp::detail;
 // One segment of the set of edge type `type`, anchored at level cell (i, j): Eq. 1-3, the turn towards the
 // canonical direction, the clamped, fold-checked moves of both ends, written for one segment with scalar
 // code. The per-point helpers (f_D look-up, clamp and fold check) are the kernel's own: this reference
-// checks which segments are projected, from which state, and where the results go.
-void projectSegment(const KernelGrid& g, const float* fineRest, const KernelLevel& l, int32_t type, int32_t i,
-                    int32_t j, float stiffness) {
+// checks which segments are projected, from which state, and where the results go. f_O is read from the rest
+// image itself (g.imageCells cells): at a fine point between the points of an image of half the fine grid's
+// cells, the mean of the 2 or 4 around it.
+void projectSegment(const KernelGrid& g, const float* restImage, const KernelLevel& l, int32_t type,
+                    int32_t i, int32_t j, float stiffness) {
     const EdgeType e = kEdgeTypes[type];
     const int32_t ia = i + e.ai, ja = j + e.aj, ib = i + e.bi, jb = j + e.bj;
     const auto at = [&](int32_t pi, int32_t pj) { return static_cast<ptrdiff_t>(pj) * l.row + pi * l.step; };
@@ -41,8 +43,8 @@ void projectSegment(const KernelGrid& g, const float* fineRest, const KernelLeve
     const auto fD = [&](float u, float v, float& x0, float& x1, float& x2) {
         uint32_t p00 = 0;
         float fx = 0.0f, fy = 0.0f;
-        imageCell(g.cells, u, v, p00, fx, fy);
-        blendCell(g.deformed, g.cells, p00, fx, fy, x0, x1, x2);
+        imageCell(g.imageCells, u, v, p00, fx, fy);
+        blendCell(g.deformed, g.imageCells, p00, fx, fy, x0, x1, x2);
     };
     const size_t side = static_cast<size_t>(l.cells) + 1;
     const float ra = l.rigidity[static_cast<size_t>(ja) * side + ia];
@@ -65,10 +67,22 @@ void projectSegment(const KernelGrid& g, const float* fineRest, const KernelLeve
     const float lDef = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
     const float dx = pbx - pax, dy = pby - pay;
     const float length = std::sqrt(dx * dx + dy * dy);
-    const size_t stride = static_cast<size_t>(g.cells / l.cells);  // f_O from the fine image itself
-    const size_t restRow = 3 * stride * (static_cast<size_t>(g.cells) + 1);
-    const float* restA = fineRest + ja * restRow + 3 * static_cast<size_t>(ia) * stride;
-    const float* restB = fineRest + jb * restRow + 3 * static_cast<size_t>(ib) * stride;
+    const int32_t stride = g.cells / l.cells;
+    const auto fO = [&](int32_t fi, int32_t fj, int32_t c) {  // f_O at fine point (fi, fj), channel c
+        const size_t side = static_cast<size_t>(g.imageCells) + 1;
+        const auto at = [&](int32_t x, int32_t y) { return restImage[3 * (y * side + x) + c]; };
+        if (g.imageCells == g.cells) return at(fi, fj);
+        const int32_t x = fi / 2, y = fj / 2;
+        if (fi % 2 == 0 && fj % 2 == 0) return at(x, y);
+        if (fj % 2 == 0) return (at(x, y) + at(x + 1, y)) * 0.5f;
+        if (fi % 2 == 0) return (at(x, y) + at(x, y + 1)) * 0.5f;
+        return (((at(x, y) + at(x + 1, y)) + at(x, y + 1)) + at(x + 1, y + 1)) * 0.25f;
+    };
+    float restA[3], restB[3];
+    for (int32_t c = 0; c < 3; ++c) {
+        restA[c] = fO(ia * stride, ja * stride, c);
+        restB[c] = fO(ib * stride, jb * stride, c);
+    }
     const float r0 = restB[0] - restA[0], r1 = restB[1] - restA[1], r2 = restB[2] - restA[2];
     const float lOrg = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
     if (!(lDef > 1e-12f && length > 1e-12f && lOrg > 0.0f)) return;
@@ -117,7 +131,7 @@ void projectSegment(const KernelGrid& g, const float* fineRest, const KernelLeve
 // The reference sweep of row of cells j: the 8 sets in the kernel's order (each edge type by the parity of
 // its cell column), a set's segments one after another, every one with both ends and their rings inside the
 // grid (projectSegment leaves those it does not project).
-void referenceSweepRow(const KernelGrid& g, const float* fineRest, const KernelLevel& l, int32_t j,
+void referenceSweepRow(const KernelGrid& g, const float* restImage, const KernelLevel& l, int32_t j,
                        float stiffness) {
     const int32_t c = l.cells;
     for (int32_t type : {0, 1, 2, 3}) {
@@ -127,7 +141,7 @@ void referenceSweepRow(const KernelGrid& g, const float* fineRest, const KernelL
         if (j + e.aj < 1 || j + e.bj > c - 1) continue;
         for (int32_t first = 0; first < step; ++first) {
             for (int32_t i = 1; i < limit; ++i) {
-                if (i % step == first) projectSegment(g, fineRest, l, type, i, j, stiffness);
+                if (i % step == first) projectSegment(g, restImage, l, type, i, j, stiffness);
             }
         }
     }
@@ -135,8 +149,9 @@ void referenceSweepRow(const KernelGrid& g, const float* fineRest, const KernelL
 
 struct Scene {
     int32_t fineCells = 0;
-    std::vector<float> rest, deformed;  // 3 floats per fine point
-    std::vector<float> u, v;            // the level's points, in its layout
+    std::vector<float> rest, deformed;  // 3 floats per point of the geometry images (imageCells)
+    int32_t imageCells = 0;
+    std::vector<float> u, v;      // the level's points, in its layout
     std::vector<float> restCopy;  // f_O at the level's points (compact scenes), as a warm solver keeps it
     std::vector<float> orientation;
     Level runs;  // cells, rigidity and the runs of projected segments (findSetRuns)
@@ -147,17 +162,18 @@ struct Scene {
 // A level of `cells` cells (level stride `stride` in a fine grid of cells * stride cells), its points
 // jittered about the identity (compact: a copy of its own; otherwise in place in a fine warp), rigidity
 // in random blocks on a free background, with fixed points and a fixed border.
-Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, bool mapped) {
+Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, bool mapped, bool halfImage) {
     Scene s;
     s.fineCells = cells * stride;
-    const int32_t n = s.fineCells, side = cells + 1;
+    s.imageCells = halfImage ? s.fineCells / 2 : s.fineCells;
+    const int32_t n = s.fineCells, side = cells + 1, m = s.imageCells;
     std::uniform_real_distribution<float> unit(0.0f, 1.0f), jitter(-0.3f, 0.3f);
-    s.rest.resize(3 * static_cast<size_t>(n + 1) * (n + 1));
+    s.rest.resize(3 * static_cast<size_t>(m + 1) * (m + 1));
     s.deformed.resize(s.rest.size());
-    for (int32_t y = 0; y <= n; ++y) {
-        for (int32_t x = 0; x <= n; ++x) {
-            const size_t k = 3 * (static_cast<size_t>(y) * (n + 1) + x);
-            const float fu = static_cast<float>(x) / n, fv = static_cast<float>(y) / n;
+    for (int32_t y = 0; y <= m; ++y) {
+        for (int32_t x = 0; x <= m; ++x) {
+            const size_t k = 3 * (static_cast<size_t>(y) * (m + 1) + x);
+            const float fu = static_cast<float>(x) / m, fv = static_cast<float>(y) / m;
             s.rest[k] = fu + 0.01f * unit(rng);
             s.rest[k + 1] = fv + 0.01f * unit(rng);
             s.rest[k + 2] = 0.1f * fu * fv;
@@ -200,22 +216,28 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
         }
     }
     findSetRuns(s.runs, s.fineCells);
-    s.grid = {n, s.deformed.data(), mapped ? 0.6f : 0.3f, 0.0f};
-    // Compact scenes read f_O from a copy of the level's points (the reference reads the fine image).
+    s.grid = {n, s.deformed.data(), m, mapped ? 0.6f : 0.3f, 0.0f};
+    // Compact scenes read f_O from a copy of the level's points (the reference reads the image), taken from
+    // an image of half the cells at every (stride / 2)-th point (stride >= 2).
+    const int32_t imageStride = halfImage ? stride / 2 : stride;
     if (compact) {
         s.restCopy.resize(3 * static_cast<size_t>(side) * side);
         for (int32_t j = 0; j <= cells; ++j)
             for (int32_t i = 0; i <= cells; ++i)
                 for (int32_t c = 0; c < 3; ++c)
                     s.restCopy[3 * (static_cast<size_t>(j) * side + i) + c] =
-                        s.rest[3 * (static_cast<size_t>(j) * stride * (n + 1) +
-                                    static_cast<size_t>(i) * stride) +
+                        s.rest[3 * (static_cast<size_t>(j) * imageStride * (m + 1) +
+                                    static_cast<size_t>(i) * imageStride) +
                                c];
     }
+    // The finest level over an image of half its cells reads f_O between the image's points.
+    const bool between = !compact && imageStride == 0;
+    const int32_t restStride = between ? 1 : imageStride;
     s.level = {cells,
                compact ? s.restCopy.data() : s.rest.data(),
-               compact ? 3 * static_cast<ptrdiff_t>(side) : 3 * static_cast<ptrdiff_t>(stride) * (n + 1),
-               compact ? 3 : 3 * stride,
+               compact ? 3 * static_cast<ptrdiff_t>(side) : 3 * static_cast<ptrdiff_t>(restStride) * (m + 1),
+               compact ? 3 : 3 * restStride,
+               between ? 1 : 0,
                s.u.data(),
                s.v.data(),
                step,
@@ -236,14 +258,18 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
 #ifdef DEFORMKIT_SIMD_X86
     if (deformkit::simd::activeIsa() == deformkit::simd::Isa::Avx2) kernels.push_back(&kAvx2Kernels);
 #endif
+    // Scenes with geometry images of the fine grid's cells and of half of them (the finest level then reads
+    // f_O between the image's points; a level with a compact copy is at least 4 fine points apart).
     std::mt19937 rng(2026);
-    int cases = 0, moved = 0;
+    int cases = 0, moved = 0, movedOverHalfImages = 0;
     for (const int32_t cells : {8, 16, 32, 64}) {
         for (const int32_t stride : {1, 2}) {
             for (const bool compact : {true, false}) {
                 for (const bool mapped : {false, true}) {
-                    for (int trial = 0; trial < 3; ++trial) {
-                        const Scene scene = makeScene(rng, cells, stride, compact, mapped);
+                    for (int trial = 0; trial < 4; ++trial) {
+                        const bool half = trial == 3;
+                        if (half && compact && stride == 1) continue;
+                        const Scene scene = makeScene(rng, cells, stride, compact, mapped, half);
                         for (const SolverKernels* k : kernels) {
                             Scene kernel = scene, reference = scene;
                             kernel.grid.deformed = reference.grid.deformed = scene.deformed.data();
@@ -265,11 +291,15 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
                             }
                             INFO("cells " << cells << ", stride " << stride << ", compact " << compact
                                           << ", orientation map " << mapped << ", trial " << trial
+                                          << ", images of " << scene.imageCells << " cells"
                                           << (k == &kBaselineKernels ? ", baseline" : ", AVX2"));
                             CHECK(std::memcmp(kernel.u.data(), reference.u.data(), 4 * kernel.u.size()) == 0);
                             CHECK(std::memcmp(kernel.v.data(), reference.v.data(), 4 * kernel.v.size()) == 0);
-                            for (size_t q = 0; q < scene.u.size(); ++q)
-                                moved += kernel.u[q] != scene.u[q] || kernel.v[q] != scene.v[q];
+                            for (size_t q = 0; q < scene.u.size(); ++q) {
+                                const bool m = kernel.u[q] != scene.u[q] || kernel.v[q] != scene.v[q];
+                                moved += m;
+                                movedOverHalfImages += m && half;
+                            }
                             ++cases;
                         }
                     }
@@ -279,6 +309,7 @@ TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another m
     }
     CHECK(cases >= 96);
     CHECK(moved > 1000);  // the sweeps did move points: the comparison is not of untouched grids
+    CHECK(movedOverHalfImages > 200);
 }
 
 TEST_CASE("uv warp kernels: a row's runs of projected segments are every set's projected segments",

@@ -37,8 +37,9 @@ struct WarpMetrics {
     int64_t pointsOutside = 0;  // warped points outside the closed unit square
 };
 
-// Measures `warp` given the geometry images `rest` (f_O) and `deformed` (f_D), 3 channels, and the
-// `rigidity` and `mask` point fields, 1 channel, all on the warp's grid. OpenMP over rows, sums per row
+// Measures `warp` given the geometry images `rest` (f_O) and `deformed` (f_D), 3 channels, on the warp's
+// grid or of half its cells (looked up between their points, as the Solver does), and the `rigidity` and
+// `mask` point fields, 1 channel, on the warp's grid. OpenMP over rows, sums per row
 // in a fixed order: bit-identical for any thread count. Throws InvalidInput for an invalid warp
 // (validateWarpGrid) or a field of another grid or channel count, naming the field.
 [[nodiscard]] WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest,

@@ -113,12 +113,16 @@ struct SolveStats {
 // State (positions, velocities) persists between solves: each solve warm-starts from the last warp, so a
 // static pose converges to a static warp and an animation changes smoothly.
 //
-// Inputs are fields on the (n + 1)^2 grid points (grid.h): restGeometry f_O (3 channels), rigidity R in
-// [0, 1], mask M (0 or 1; tile-border points never move whatever the mask says), and optionally an
-// orientation-preservation map in [0, 1] (empty: 1 everywhere). The solver keeps f_O (rest lengths are
-// measured through it) and R (its finest level's map): pass them with std::move to keep one copy.
+// Inputs are fields on the (n + 1)^2 grid points (grid.h): rigidity R in [0, 1], mask M (0 or 1;
+// tile-border points never move whatever the mask says), and optionally an orientation-preservation map in
+// [0, 1] (empty: 1 everywhere); restGeometry f_O (3 channels) on the grid's points, or a geometry image of
+// n / 2 cells (f_O at a grid point between the image's points is the mean of the 2 or 4 around it, their
+// bilinear look-up: exact where f_O is affine, as inside a UV triangle; TileWarpOptions::geometryImageCells).
+// The solver keeps f_O (rest lengths are measured through it) and R (its finest level's map): pass them
+// with std::move to keep one copy.
 //
-// Memory per fine grid point: 8 bytes for positions, 12 for f_O, 4 for rigidity and movability, 1.3 for the
+// Memory per fine grid point: 8 bytes for positions, 12 for f_O (3 on an image of half the cells), 4 for
+// rigidity and movability, 1.3 for the
 // coarser levels' (+ 4 and 1.3 with an orientation map); during a solve 8 more for velocities and 4.7 for
 // the coarser levels' working copies. With SolverOptions::warmStart (the velocities carry over) those stay
 // between solves and a solve allocates nothing once the fold-repair scratch has grown to the largest fold
@@ -136,7 +140,8 @@ class Solver {
     // New rigidity / mask / orientation maps (a painter's edit): rebuilds the per-level hierarchies (Eq.
     // 7-8). The warp is kept; a point the new mask fixes stays where it is (its velocity is dropped).
     void setMaps(PointField rigidity, const PointField& mask, const PointField& orientation = {});
-    // One frame: deformedGeometry f_D (3 channels, same grid). Returns the warp W.
+    // One frame: deformedGeometry f_D (3 channels, a geometry image of restGeometry's cells). Returns the
+    // warp W.
     const WarpGrid& solve(const PointField& deformedGeometry);
     // Back to the identity warp with zero velocity (a cut in the shot).
     void reset();

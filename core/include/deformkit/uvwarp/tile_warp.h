@@ -33,7 +33,20 @@ struct TileWarpOptions {
     // from the solved warp (Solver::startFrom) with the finest level only; that grid's warp is the one
     // delivered. 0: none. kAutomaticRefinement: by the grid's size (refinementSweepsFor), the shot preset's.
     int32_t refinementSweeps = 0;
+    // Cells per side of the geometry images f_O and f_D: the grid's, or half of them (a quarter of their
+    // memory; f_O and f_D are affine inside each UV triangle, where the solver's bilinear look-ups between
+    // the image's points are then exact). 0: geometryImageCellsFor.
+    int32_t geometryImageCells = 0;
 };
+
+// The geometry images of grids up to this many cells have the grid's cells; finer grids' have half of them
+// (a 16384^2 tile: 18 bytes a cell less, so that it solves in 40 bytes a cell; docs/decisions.md UV-22).
+inline constexpr int32_t kFullGeometryImageCells = 8192;
+// The geometry images' cells of a grid of `cells` cells for the option's value `imageCells`.
+[[nodiscard]] constexpr int32_t geometryImageCellsFor(int32_t imageCells, int32_t cells) {
+    if (imageCells != 0) return imageCells;
+    return cells <= kFullGeometryImageCells ? cells : cells / 2;
+}
 
 // refinementSweeps chosen by the grid's size: kAutomaticRefinementSweeps on grids up to
 // kAutomaticRefinementCells cells, none on finer grids (they sample the posed surface as finely already, and
