@@ -59,21 +59,33 @@ const detail::SolverKernels& kernelsFor(simd::Isa isa) {
 // not on the tile border) to the nearest point that may not: the half-width of the widest chart. The exact
 // chessboard distance transform of Meijster, Roerdink and Hesselink (2000), separable: per column the
 // distance to the nearest fixed point of the column, then per row the lower envelope of
-// max(|x - i|, g(i)); columns, then rows, in parallel.
+// max(|x - i|, g(i)); columns (in blocks walked row by row, so that each row's stretch is read whole),
+// then rows, in parallel.
 int32_t widestChartRadius(const PointField& mask) {
     const int32_t side = mask.side();
     std::vector<int32_t> g;  // per point: the distance to the nearest fixed point of its column
     deformkit::detail::assignLarge(g, static_cast<size_t>(side) * side, 0);
+    constexpr int32_t kBlockColumns = 64;
+    const int32_t blocks = (side + kBlockColumns - 1) / kBlockColumns;
 #pragma omp parallel for schedule(static) if (kParallelRows < static_cast <int64_t>(side))
-    for (int32_t i = 0; i < side; ++i) {
-        const bool borderColumn = i == 0 || i == side - 1;
-        const auto at = [&](int32_t j) -> int32_t& { return g[static_cast<size_t>(j) * side + i]; };
+    for (int32_t b = 0; b < blocks; ++b) {
+        const int32_t i0 = b * kBlockColumns, i1 = std::min(side, i0 + kBlockColumns);
+        const auto row = [&](int32_t j) { return g.data() + static_cast<size_t>(j) * side; };
         for (int32_t j = 1; j < side; ++j) {
-            const bool fixed = borderColumn || j == side - 1 || mask.values[mask.index(i, j)] < 0.5f;
-            at(j) = fixed ? 0 : at(j - 1) + 1;
+            int32_t* here = row(j);
+            const int32_t* below = row(j - 1);
+            const float* m = &mask.values[mask.index(0, j)];
+            for (int32_t i = i0; i < i1; ++i) {
+                const bool fixed = i == 0 || i == side - 1 || j == side - 1 || m[i] < 0.5f;
+                here[i] = fixed ? 0 : below[i] + 1;
+            }
         }
-        for (int32_t j = side - 2; j >= 0; --j)
-            at(j) = std::min(at(j), at(j + 1) + 1);
+        for (int32_t j = side - 2; j >= 0; --j) {
+            int32_t* here = row(j);
+            const int32_t* above = row(j + 1);
+            for (int32_t i = i0; i < i1; ++i)
+                here[i] = std::min(here[i], above[i] + 1);
+        }
     }
     int32_t widest = 0;
 #pragma omp parallel reduction(max : widest) if (kParallelRows < static_cast <int64_t>(side))
