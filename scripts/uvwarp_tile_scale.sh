@@ -7,7 +7,7 @@
 #   ./scripts/uvwarp_tile_scale.sh 1024 2048        the sizes given
 #   DEFORMKIT_BUILD_DIR=build-perf ./scripts/uvwarp_tile_scale.sh
 #
-# 16384^2 needs about 15 GB of memory and several minutes on 2 cores.
+# 16384^2 needs about 11 GB of memory and several minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${DEFORMKIT_BUILD_DIR:-build}

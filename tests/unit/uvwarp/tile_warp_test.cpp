@@ -481,32 +481,39 @@ TEST_CASE(
     "[uvwarp][options]") {
     // f_O and f_D are affine inside each UV triangle, and the solver looks the images up bilinearly between
     // their points: on a plane stretched by an affine map (a shear and a stretch), an image of half the
-    // grid's cells holds the same surface, and the warp is the full image's up to float rounding.
+    // grid's cells holds the same surface, and the warp is the full image's up to float rounding. From the
+    // identity, and warm-started (whose coarse levels read f_O from compact copies of the image's points).
     const geom::Mesh plane = uvPlane(8);
     std::vector<glm::vec3> sheared(plane.points().begin(), plane.points().end());
     for (glm::vec3& p : sheared)
         p = {1.6f * p.x + 0.3f * p.y, 0.9f * p.y, 0.2f * p.x};
     uvwarp::TileWarpOptions full;
-    full.solver.warmStart = false;
     uvwarp::TileWarpOptions half = full;
     half.geometryImageCells = 64;
-    uvwarp::TileWarp a(plane, 1001, diskRigidity(128), {}, full);
-    uvwarp::TileWarp b(plane, 1001, diskRigidity(128), {}, half);
-    const uvwarp::WarpGrid& wa = a.solve(sheared);
-    const uvwarp::WarpGrid& wb = b.solve(sheared);
-    double gap = 0.0, moved = 0.0;
-    for (size_t k = 0; k < wa.u.size(); ++k) {
-        gap = std::max<double>(gap, std::hypot(wa.u[k] - wb.u[k], wa.v[k] - wb.v[k]));
-        moved = std::max<double>(moved, std::abs(wa.u[k] - (k % 129) / 128.0));
+    for (const bool warm : {false, true}) {
+        full.solver.warmStart = half.solver.warmStart = warm;
+        uvwarp::TileWarp a(plane, 1001, diskRigidity(128), {}, full);
+        uvwarp::TileWarp b(plane, 1001, diskRigidity(128), {}, half);
+        for (int frame = 0; frame < (warm ? 2 : 1); ++frame) {
+            const uvwarp::WarpGrid& wa = a.solve(sheared);
+            const uvwarp::WarpGrid& wb = b.solve(sheared);
+            double gap = 0.0, moved = 0.0;
+            for (size_t k = 0; k < wa.u.size(); ++k) {
+                gap = std::max<double>(gap, std::hypot(wa.u[k] - wb.u[k], wa.v[k] - wb.v[k]));
+                moved = std::max<double>(moved, std::abs(wa.u[k] - (k % 129) / 128.0));
+            }
+            INFO("warm start " << warm << ", frame " << frame << ": largest gap " << gap * 128
+                               << " cells; largest move " << moved * 128 << " cells");
+            CHECK(moved * 128 > 1.0);
+            CHECK(gap * 128 < 1e-3);
+        }
+        CHECK(a.stats().levels >= 3);  // level 2's points are 4 fine points apart
+        // The solver-grid figures look the images up between their points too.
+        const uvwarp::WarpMetrics ma = a.metrics(), mb = b.metrics();
+        CHECK(mb.rigidEdges == ma.rigidEdges);
+        CHECK(mb.identityStretchError == Approx(ma.identityStretchError).epsilon(1e-5));
+        CHECK(mb.rigidStretchError == Approx(ma.rigidStretchError).epsilon(1e-3));
     }
-    INFO("largest gap " << gap * 128 << " cells; largest move " << moved * 128 << " cells");
-    CHECK(moved * 128 > 1.0);
-    CHECK(gap * 128 < 1e-3);
-    // The solver-grid figures look the images up between their points too.
-    const uvwarp::WarpMetrics ma = a.metrics(), mb = b.metrics();
-    CHECK(mb.rigidEdges == ma.rigidEdges);
-    CHECK(mb.identityStretchError == Approx(ma.identityStretchError).epsilon(1e-5));
-    CHECK(mb.rigidStretchError == Approx(ma.rigidStretchError).epsilon(1e-3));
 
     // By default the grid's cells up to kFullGeometryImageCells, half of them on finer grids; any other size
     // is refused.

@@ -122,12 +122,11 @@ struct SolveStats {
 // with std::move to keep one copy.
 //
 // Memory per fine grid point: 8 bytes for positions, 12 for f_O (3 on an image of half the cells), 4 for
-// rigidity and movability, 1.3 for the
-// coarser levels' (+ 4 and 1.3 with an orientation map); during a solve 8 more for velocities and 4.7 for
-// the coarser levels' working copies. With SolverOptions::warmStart (the velocities carry over) those stay
-// between solves and a solve allocates nothing once the fold-repair scratch has grown to the largest fold
-// count seen; without it they are allocated at the start of each solve and freed at its end (the caller
-// gives the pages back: TileWarp does).
+// rigidity and movability, 1.3 for the coarser levels' (+ 4 and 1.3 with an orientation map); during a
+// solve 8 more for velocities and 4.7 for the coarser levels' working copies. With SolverOptions::warmStart
+// (the velocities carry over) those stay between solves and a solve allocates nothing once the fold-repair
+// scratch has grown to the largest fold count seen; without it they are allocated at the start of each solve
+// and freed at its end (the caller gives the pages back: TileWarp does).
 class Solver {
   public:
     Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
