@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -601,37 +602,97 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
         findLevelRuns(level, cells);
 }
 
+namespace {
+
+// Appends to `runs` the runs [runs[2r], runs[2r + 1]) of the bytes p[0, n) that are 1 (all others 0),
+// unmerged: eight bytes at a time across stretches of zeros or ones.
+void appendByteRuns(const uint8_t* p, int32_t n, std::vector<int32_t>& runs) {
+    constexpr uint64_t kOnes = 0x0101010101010101ull;
+    const auto word = [p](int32_t i) {
+        uint64_t w = 0;
+        std::memcpy(&w, p + i, sizeof w);
+        return w;
+    };
+    int32_t i = 0;
+    while (i < n) {
+        while (i + 8 <= n && word(i) == 0)
+            i += 8;
+        while (i < n && p[i] == 0)
+            ++i;
+        if (i == n) break;
+        const int32_t start = i;
+        while (i + 8 <= n && word(i) == kOnes)
+            i += 8;
+        while (i < n && p[i] != 0)
+            ++i;
+        runs.push_back(start);
+        runs.push_back(i);
+    }
+}
+
+}  // namespace
+
 void detail::findSetRuns(Level& level, int32_t fineCells) {
     const int32_t c = level.cells;
     const float least = detail::leastRigidity(c, fineCells);
     const size_t side = static_cast<size_t>(level.side());
     // Per row and set, the runs of segments it projects. A gap shorter than a pair of lanes costs a sweep
     // nothing (the pair is computed whole), so runs are merged across it. Whether the segment of each edge
-    // type at each cell of the row is projected is found first, for the whole row in loops that vectorise
-    // (a set takes every second or fourth of its type's cells).
+    // type at each cell of the row is projected is found first, for the whole row in loops that vectorise,
+    // then the runs of cells of each type; a set takes the cells i = first + g step of its type's runs (every
+    // second or fourth cell), merged as appendRuns merges them: the same runs as testing each of its
+    // segments.
     collectRuns(
         c, detail::kSets,
         [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
             thread_local std::vector<uint8_t> projected;  // each thread's, kept: no allocation per row
-            projected.resize(4 * static_cast<size_t>(c));
+            thread_local std::vector<int32_t> typeRuns[4];
+            projected.resize(static_cast<size_t>(c));
             for (int32_t type = 0; type < 4; ++type) {
                 const detail::EdgeType e = detail::kEdgeTypes[type];  // ends on rows j, j + 1 <= c
                 const float* __restrict a = level.rigidity.data() + (j + e.aj) * side + e.ai;
                 const float* __restrict b = level.rigidity.data() + (j + e.bj) * side + e.bi;
-                uint8_t* __restrict p = projected.data() + static_cast<size_t>(type) * c;
+                uint8_t* __restrict p = projected.data();
                 const int32_t n = c;  // locals: the byte stores could alias the captured ones
                 const float floor = least;
                 for (int32_t i = 0; i < n; ++i)
                     p[i] = detail::segmentProjected(a[i], b[i], floor) ? 1 : 0;
+                typeRuns[type].clear();
+                appendByteRuns(p, n, typeRuns[type]);
             }
             for (int32_t set = 0; set < detail::kSets; ++set) {
                 const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
                 const int32_t step = detail::setStep(type);
                 int32_t gMin = 0, gMax = 0;
                 detail::setLanes(type, first, j, c, gMin, gMax);
-                const uint8_t* p = projected.data() + static_cast<size_t>(type) * c + first;
-                count[set] = appendRuns(
-                    gMin, gMax, kRunGapLanes, [&](int32_t g) { return p[g * step] != 0; }, out);
+                // The first g with first + g step >= i.
+                const auto firstAtOrAfter = [&](int32_t i) {
+                    return i <= first ? 0 : (i - first + step - 1) / step;
+                };
+                int32_t runs = 0, open = -1, end = -1;  // the run [open, end) being built
+                const std::vector<int32_t>& cellRuns = typeRuns[type];
+                for (size_t r = 0; r < cellRuns.size(); r += 2) {
+                    const int32_t ga = std::max(gMin, firstAtOrAfter(cellRuns[r]));
+                    const int32_t gb = std::min(gMax, firstAtOrAfter(cellRuns[r + 1]));
+                    if (ga >= gb) continue;
+                    if (open >= 0 && ga - end < kRunGapLanes) {
+                        end = gb;
+                        continue;
+                    }
+                    if (open >= 0) {
+                        out.push_back(open);
+                        out.push_back(end);
+                        ++runs;
+                    }
+                    open = ga;
+                    end = gb;
+                }
+                if (open >= 0) {
+                    out.push_back(open);
+                    out.push_back(end);
+                    ++runs;
+                }
+                count[set] = runs;
             }
         },
         level.setRunBegin, level.setRuns);
