@@ -125,28 +125,44 @@ int32_t widestChartRadius(const PointField& mask) {
     return widest;
 }
 
-// Appends to `runs` the runs [runs[2r], runs[2r + 1]) of i in [from, to) where in(i) holds, runs fewer than
-// `gap` apart merged; returns how many.
-template <class In>
-int32_t appendRuns(int32_t from, int32_t to, int32_t gap, const In& in, std::vector<int32_t>& runs) {
-    int32_t count = 0;
-    int32_t open = -1, last = -1;  // current run [open, last + 1)
-    for (int32_t i = from; i < to; ++i) {
-        if (!in(i)) continue;
-        if (open >= 0 && i - (last + 1) < gap) {
-            last = i;
+// Appends to `runs` the runs [runs[2r], runs[2r + 1]) of the bytes p[0, n) that are 1 (all others 0), runs
+// fewer than `gap` apart merged (0: none); returns how many. Eight bytes at a time across stretches of zeros
+// or ones.
+int32_t appendByteRuns(const uint8_t* p, int32_t n, int32_t gap, std::vector<int32_t>& runs) {
+    constexpr uint64_t kOnes = 0x0101010101010101ull;
+    const auto word = [p](int32_t i) {
+        uint64_t w = 0;
+        std::memcpy(&w, p + i, sizeof w);
+        return w;
+    };
+    int32_t count = 0, open = -1, end = -1;  // the run [open, end) being built
+    int32_t i = 0;
+    while (i < n) {
+        while (i + 8 <= n && word(i) == 0)
+            i += 8;
+        while (i < n && p[i] == 0)
+            ++i;
+        if (i == n) break;
+        const int32_t start = i;
+        while (i + 8 <= n && word(i) == kOnes)
+            i += 8;
+        while (i < n && p[i] != 0)
+            ++i;
+        if (open >= 0 && start - end < gap) {
+            end = i;
             continue;
         }
         if (open >= 0) {
             runs.push_back(open);
-            runs.push_back(last + 1);
+            runs.push_back(end);
             ++count;
         }
-        open = last = i;
+        open = start;
+        end = i;
     }
     if (open >= 0) {
         runs.push_back(open);
-        runs.push_back(last + 1);
+        runs.push_back(end);
         ++count;
     }
     return count;
@@ -174,16 +190,18 @@ void collectRuns(int32_t rows, int32_t parts, const AppendRow& appendRow, std::v
                   runs.begin() + 2 * static_cast<ptrdiff_t>(begin[static_cast<size_t>(j) * parts]));
 }
 
-// Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) where in(i, j) holds, r in
-// [begin[j], begin[j + 1]); runs closer than kRunGap are merged.
-template <class In>
-void findRuns(int32_t columns, int32_t rows, const In& in, std::vector<int32_t>& begin,
+// Per row j of `rows`, the runs [runs[2r], runs[2r + 1]) of i in [0, columns) whose byte fillRow(j, bytes)
+// sets to 1 (the others 0), r in [begin[j], begin[j + 1]); runs closer than kRunGap are merged.
+template <class FillRow>
+void findRuns(int32_t columns, int32_t rows, const FillRow& fillRow, std::vector<int32_t>& begin,
               std::vector<int32_t>& runs) {
     collectRuns(
         rows, 1,
         [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
-            count[0] = appendRuns(
-                0, columns, kRunGap, [&](int32_t i) { return in(i, j); }, out);
+            thread_local std::vector<uint8_t> bytes;  // each thread's, kept: no allocation per row
+            bytes.resize(static_cast<size_t>(columns));
+            fillRow(j, bytes.data());
+            count[0] = appendByteRuns(bytes.data(), columns, kRunGap, out);
         },
         begin, runs);
 }
@@ -524,12 +542,18 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
     detail::requireField(rigidity, cells, 1, source, "rigidity");
     detail::requireField(mask, cells, 1, source, "mask");
     if (!orientation.values.empty()) detail::requireField(orientation, cells, 1, source, "orientation map");
-    for (size_t k = 0; k < rigidity.values.size(); ++k) {
+    // The first value outside [0, 1], found in parallel (the least index over the threads').
+    const auto values = static_cast<int64_t>(rigidity.values.size());
+    int64_t firstBad = values;
+#pragma omp parallel for schedule(static) reduction(min \
+                                                    : firstBad) if (kParallelRows * kParallelRows < values)
+    for (int64_t k = 0; k < values; ++k) {
         const float r = rigidity.values[k];
-        if (!(r >= 0.0f && r <= 1.0f)) {
-            throw InvalidInput(formatError(source, "rigidity at grid point " + std::to_string(k),
-                                           std::to_string(r), "a value in [0, 1]"));
-        }
+        if (!(r >= 0.0f && r <= 1.0f)) firstBad = std::min(firstBad, k);
+    }
+    if (firstBad < values) {
+        throw InvalidInput(formatError(source, "rigidity at grid point " + std::to_string(firstBad),
+                                       std::to_string(rigidity.values[firstBad]), "a value in [0, 1]"));
     }
     for (Level& level : levels) {
         const size_t count = static_cast<size_t>(level.side()) * level.side();
@@ -602,36 +626,6 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
         findLevelRuns(level, cells);
 }
 
-namespace {
-
-// Appends to `runs` the runs [runs[2r], runs[2r + 1]) of the bytes p[0, n) that are 1 (all others 0),
-// unmerged: eight bytes at a time across stretches of zeros or ones.
-void appendByteRuns(const uint8_t* p, int32_t n, std::vector<int32_t>& runs) {
-    constexpr uint64_t kOnes = 0x0101010101010101ull;
-    const auto word = [p](int32_t i) {
-        uint64_t w = 0;
-        std::memcpy(&w, p + i, sizeof w);
-        return w;
-    };
-    int32_t i = 0;
-    while (i < n) {
-        while (i + 8 <= n && word(i) == 0)
-            i += 8;
-        while (i < n && p[i] == 0)
-            ++i;
-        if (i == n) break;
-        const int32_t start = i;
-        while (i + 8 <= n && word(i) == kOnes)
-            i += 8;
-        while (i < n && p[i] != 0)
-            ++i;
-        runs.push_back(start);
-        runs.push_back(i);
-    }
-}
-
-}  // namespace
-
 void detail::findSetRuns(Level& level, int32_t fineCells) {
     const int32_t c = level.cells;
     const float least = detail::leastRigidity(c, fineCells);
@@ -658,7 +652,7 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
                 for (int32_t i = 0; i < n; ++i)
                     p[i] = detail::segmentProjected(a[i], b[i], floor) ? 1 : 0;
                 typeRuns[type].clear();
-                appendByteRuns(p, n, typeRuns[type]);
+                appendByteRuns(p, n, 0, typeRuns[type]);
             }
             for (int32_t set = 0; set < detail::kSets; ++set) {
                 const int32_t type = detail::kSetType[set], first = detail::kSetFirst[set];
@@ -700,13 +694,31 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
 
 void Solver::Impl::findLevelRuns(Level& level, int32_t fineCells) {
     detail::findSetRuns(level, fineCells);
+    detail::findMovableRuns(level);
+}
+
+void detail::findMovableRuns(Level& level) {
     const int32_t c = level.cells;
-    const auto movable = [&](int32_t i, int32_t j) { return level.movable(level.index(i, j)); };
-    findRuns(c + 1, c + 1, movable, level.movableBegin, level.movableRuns);
+    const size_t side = static_cast<size_t>(level.side());
+    const float* rigidity = level.rigidity.data();  // movable: >= 0 (Level::movable)
+    findRuns(
+        c + 1, c + 1,
+        [&](int32_t j, uint8_t* __restrict out) {
+            const float* __restrict r = rigidity + j * side;
+            const int32_t n = c + 1;
+            for (int32_t i = 0; i < n; ++i)
+                out[i] = r[i] >= 0.0f ? 1 : 0;
+        },
+        level.movableBegin, level.movableRuns);
     findRuns(
         c, c,
-        [&](int32_t i, int32_t j) {
-            return movable(i, j) || movable(i + 1, j) || movable(i, j + 1) || movable(i + 1, j + 1);
+        [&](int32_t j, uint8_t* __restrict out) {
+            const float* __restrict r0 = rigidity + j * side;
+            const float* __restrict r1 = r0 + side;
+            const int32_t n = c;
+            for (int32_t i = 0; i < n; ++i)
+                out[i] =
+                    (r0[i] >= 0.0f) | (r0[i + 1] >= 0.0f) | (r1[i] >= 0.0f) | (r1[i + 1] >= 0.0f) ? 1 : 0;
         },
         level.cellRunBegin, level.cellRuns);
 }

@@ -121,6 +121,8 @@ struct SolverState {
 
 // Level::setRunBegin and setRuns from the level's rigidity map, for a grid of fineCells cells (solver.cpp).
 void findSetRuns(Level& level, int32_t fineCells);
+// Level::movableBegin, movableRuns, cellRunBegin and cellRuns from the level's rigidity map (solver.cpp).
+void findMovableRuns(Level& level);
 
 // Repairs folds a propagation or prediction step may have made on `level` (solver_folds.cpp): a movable
 // point with a non-positive triangle around it moves to the mean of its 8 neighbours. Returns the number of

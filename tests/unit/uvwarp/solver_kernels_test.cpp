@@ -377,3 +377,76 @@ TEST_CASE("uv warp kernels: a row's runs of projected segments are every set's p
         }
     }
 }
+
+TEST_CASE(
+    "uv warp kernels: a level's runs of movable points and cells are its points and cells that may move",
+    "[uvwarp][kernels]") {
+    // findMovableRuns against a reference written here: per row, each point that may move (level rigidity
+    // >= 0) and each cell with such a corner, tested on its own, runs fewer than 8 apart merged. Random maps:
+    // fixed blocks, scattered fixed points and a fixed border, some rows all fixed, some all movable.
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const auto reference = [](int32_t columns, int32_t rows, const auto& in, std::vector<int32_t>& begin,
+                              std::vector<int32_t>& runs) {
+        begin = {0};
+        runs.clear();
+        for (int32_t j = 0; j < rows; ++j) {
+            int32_t count = 0, open = -1, last = -1;
+            for (int32_t i = 0; i < columns; ++i) {
+                if (!in(i, j)) continue;
+                if (open >= 0 && i - (last + 1) < 8) {
+                    last = i;
+                    continue;
+                }
+                if (open >= 0) {
+                    runs.insert(runs.end(), {open, last + 1});
+                    ++count;
+                }
+                open = last = i;
+            }
+            if (open >= 0) {
+                runs.insert(runs.end(), {open, last + 1});
+                ++count;
+            }
+            begin.push_back(begin.back() + count);
+        }
+    };
+    for (const int32_t cells : {8, 16, 64, 256}) {
+        for (int round = 0; round < 3; ++round) {
+            CAPTURE(cells, round);
+            Level level;
+            level.cells = cells;
+            const int32_t side = cells + 1;
+            level.rigidity.assign(static_cast<size_t>(side) * side, 0.0f);
+            for (int32_t j = 0; j <= cells; ++j) {
+                const int rowKind = j % 7;  // 0: all fixed, 1: all movable, else mixed
+                for (int32_t i = 0; i <= cells; ++i) {
+                    float& r = level.rigidity[static_cast<size_t>(j) * side + i];
+                    r = unit(rng);
+                    const bool block = ((i / (3 + round) + j / 5) % 4) == 0;
+                    const bool border = i == 0 || j == 0 || i == cells || j == cells;
+                    const bool fixed =
+                        rowKind == 0 || (rowKind != 1 && (block || unit(rng) < 0.15f)) || border;
+                    if (fixed) r = kFixed - r;
+                }
+            }
+            findMovableRuns(level);
+            const auto movable = [&](int32_t i, int32_t j) {
+                return level.rigidity[static_cast<size_t>(j) * side + i] >= 0.0f;
+            };
+            std::vector<int32_t> begin, runs;
+            reference(side, side, movable, begin, runs);
+            CHECK(runs.size() > 0);
+            CHECK(level.movableBegin == begin);
+            CHECK(level.movableRuns == runs);
+            reference(
+                cells, cells,
+                [&](int32_t i, int32_t j) {
+                    return movable(i, j) || movable(i + 1, j) || movable(i, j + 1) || movable(i + 1, j + 1);
+                },
+                begin, runs);
+            CHECK(level.cellRunBegin == begin);
+            CHECK(level.cellRuns == runs);
+        }
+    }
+}

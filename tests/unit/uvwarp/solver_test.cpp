@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <functional>
 #include <vector>
@@ -267,6 +268,11 @@ TEST_CASE("uv warp: bad solver input names what is wrong", "[uvwarp]") {
     PointField outOfRange = s.rigidity;
     outOfRange.values[100] = 1.5f;
     CHECK_THROWS_WITH(uvwarp::Solver(s.rest, outOfRange, s.mask), Catch::Contains("grid point 100"));
+    outOfRange = s.rigidity;  // two bad values, in different threads' halves: the first one is named
+    outOfRange.values[4000] = -0.5f;
+    outOfRange.values[2500] = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THROWS_WITH(uvwarp::Solver(s.rest, outOfRange, s.mask),
+                      Catch::Contains("rigidity at grid point 2500") && Catch::Contains("nan"));
     uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
     CHECK_THROWS_WITH(solver.solve(bad.deformed), Catch::Contains("deformed geometry image"));
     uvwarp::SolverOptions options;
