@@ -1,7 +1,7 @@
 #include <cmath>
-#include <limits>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include <omp.h>
