@@ -168,8 +168,16 @@ int32_t appendByteRuns(const uint8_t* p, int32_t n, int32_t gap, std::vector<int
     return count;
 }
 
-// Runs per row and part (a row's runs of each of `parts` kinds): appendRow(j, out, count) appends row j's
-// runs to `out`, part after part (appendRuns), and sets count[p] to part p's number of them. Afterwards runs
+// A thread's scratch while it finds rows' runs: a row's byte map, and runs before they are merged (per edge
+// type). Made once per thread and call (not thread_local: LeakSanitizer's exit scan crashed on the OpenMP
+// threads' thread-local vectors).
+struct RowScratch {
+    std::vector<uint8_t> bytes;
+    std::vector<int32_t> typeRuns[4];
+};
+
+// Runs per row and part (a row's runs of each of `parts` kinds): appendRow(j, out, count, scratch) appends
+// row j's runs to `out`, part after part, and sets count[p] to part p's number of them. Afterwards runs
 // [runs[2r], runs[2r + 1]) for r in [begin[j parts + p], begin[j parts + p + 1]) are part p of row j. Rows
 // are found in parallel, each into a list of its own, then laid end to end in row order: the same arrays as
 // one pass over the rows.
@@ -178,9 +186,13 @@ void collectRuns(int32_t rows, int32_t parts, const AppendRow& appendRow, std::v
                  std::vector<int32_t>& runs) {
     std::vector<std::vector<int32_t>> rowRuns(static_cast<size_t>(rows));
     begin.assign(static_cast<size_t>(rows) * parts + 1, 0);
-#pragma omp parallel for schedule(dynamic, kBlockRows) if (kParallelRows < static_cast <int64_t>(rows))
-    for (int32_t j = 0; j < rows; ++j)
-        appendRow(j, rowRuns[j], &begin[static_cast<size_t>(j) * parts + 1]);
+#pragma omp parallel if (kParallelRows < static_cast <int64_t>(rows))
+    {
+        RowScratch scratch;
+#pragma omp for schedule(dynamic, kBlockRows)
+        for (int32_t j = 0; j < rows; ++j)
+            appendRow(j, rowRuns[j], &begin[static_cast<size_t>(j) * parts + 1], scratch);
+    }
     for (size_t k = 1; k < begin.size(); ++k)
         begin[k] += begin[k - 1];
     runs.resize(2 * static_cast<size_t>(begin.back()));
@@ -197,11 +209,10 @@ void findRuns(int32_t columns, int32_t rows, const FillRow& fillRow, std::vector
               std::vector<int32_t>& runs) {
     collectRuns(
         rows, 1,
-        [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
-            thread_local std::vector<uint8_t> bytes;  // each thread's, kept: no allocation per row
-            bytes.resize(static_cast<size_t>(columns));
-            fillRow(j, bytes.data());
-            count[0] = appendByteRuns(bytes.data(), columns, kRunGap, out);
+        [&](int32_t j, std::vector<int32_t>& out, int32_t* count, RowScratch& scratch) {
+            scratch.bytes.resize(static_cast<size_t>(columns));
+            fillRow(j, scratch.bytes.data());
+            count[0] = appendByteRuns(scratch.bytes.data(), columns, kRunGap, out);
         },
         begin, runs);
 }
@@ -638,9 +649,9 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
     // segments.
     collectRuns(
         c, detail::kSets,
-        [&](int32_t j, std::vector<int32_t>& out, int32_t* count) {
-            thread_local std::vector<uint8_t> projected;  // each thread's, kept: no allocation per row
-            thread_local std::vector<int32_t> typeRuns[4];
+        [&](int32_t j, std::vector<int32_t>& out, int32_t* count, RowScratch& scratch) {
+            std::vector<uint8_t>& projected = scratch.bytes;
+            std::vector<int32_t>(&typeRuns)[4] = scratch.typeRuns;
             projected.resize(static_cast<size_t>(c));
             for (int32_t type = 0; type < 4; ++type) {
                 const detail::EdgeType e = detail::kEdgeTypes[type];  // ends on rows j, j + 1 <= c
