@@ -115,7 +115,7 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
             }
             return out.data();
         };
-        int32_t cached = -1;
+        int32_t cached = -1, cachedGrid = -1;
 #pragma omp for schedule(static)
         for (int32_t j = 0; j < side; ++j) {
             if (cached == j) {
@@ -129,9 +129,19 @@ WarpMetrics measureWarp(const WarpGrid& warp, const PointField& rest, const Poin
             }
             const float* wLower = lowerRow.data();
             const float* wUpper = upperRow.data();
+            // Between an image's points, row j's look-ups are the last j's upper row when this thread made
+            // it.
             const int32_t jUp = std::min(j + 1, n);
-            const float* foRow[2] = {gridRow(fo, j, gridRows[0][0]), gridRow(fo, jUp, gridRows[0][1])};
-            const float* fdRow[2] = {gridRow(fd, j, gridRows[1][0]), gridRow(fd, jUp, gridRows[1][1])};
+            const bool reuse = between && cachedGrid == j;
+            if (reuse) {
+                gridRows[0][0].swap(gridRows[0][1]);
+                gridRows[1][0].swap(gridRows[1][1]);
+            }
+            const float* foRow[2] = {reuse ? gridRows[0][0].data() : gridRow(fo, j, gridRows[0][0]),
+                                     gridRow(fo, jUp, gridRows[0][1])};
+            const float* fdRow[2] = {reuse ? gridRows[1][0].data() : gridRow(fd, j, gridRows[1][0]),
+                                     gridRow(fd, jUp, gridRows[1][1])};
+            cachedGrid = jUp;
             RowSums sums;
             // Ratios in float (relative error ~1e-7), sums in double. Ends a and b: grid points (ia, row a)
             // and (ib, row b) of rows j (0) and j + 1 (1).

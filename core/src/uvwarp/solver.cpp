@@ -169,8 +169,8 @@ int32_t appendByteRuns(const uint8_t* p, int32_t n, int32_t gap, std::vector<int
 }
 
 // A thread's scratch while it finds rows' runs: a row's byte map, and runs before they are merged (per edge
-// type). Made once per thread and call (not thread_local: LeakSanitizer's exit scan crashed on the OpenMP
-// threads' thread-local vectors).
+// type). Made once per thread and call: thread_local vectors on OpenMP's threads crash LeakSanitizer's exit
+// scan.
 struct RowScratch {
     std::vector<uint8_t> bytes;
     std::vector<int32_t> typeRuns[4];
@@ -645,8 +645,8 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
     // nothing (the pair is computed whole), so runs are merged across it. Whether the segment of each edge
     // type at each cell of the row is projected is found first, for the whole row in loops that vectorise,
     // then the runs of cells of each type; a set takes the cells i = first + g step of its type's runs (every
-    // second or fourth cell), merged as appendRuns merges them: the same runs as testing each of its
-    // segments.
+    // second or fourth cell), merged as appendByteRuns merges runs: the same runs as testing each of its
+    // segments on its own.
     collectRuns(
         c, detail::kSets,
         [&](int32_t j, std::vector<int32_t>& out, int32_t* count, RowScratch& scratch) {

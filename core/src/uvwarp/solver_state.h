@@ -102,7 +102,7 @@ struct SolverState {
     // A compact copy of the points of the coarse level being swept (level 1's size: the largest).
     std::vector<float> workU, workV;
     PointField rest;                    // f_O: rest lengths (Eq. 1) are measured through it when needed
-    const float* deformed = nullptr;    // f_D of the current solve, 3 floats per fine point
+    const float* deformed = nullptr;    // f_D of the current solve, 3 floats per point of its image (rest's)
     std::vector<int32_t> untangleWork;  // scratch of untangle(), sized at construction, kept between calls
     std::vector<int32_t> untangleNext;
     std::vector<RevertedPoint> revertLog;  // scratch of revertFolds()

@@ -174,7 +174,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     }
 
     const int32_t imageCells = geometryImageCellsFor(options.geometryImageCells, m.cells);
-    if (imageCells != m.cells && (imageCells * 2 != m.cells || imageCells < 1)) {
+    if (imageCells != m.cells && (imageCells * 2 != m.cells || imageCells < 2)) {
         throw InvalidInput(formatError(source, "geometry images, UDIM tile " + std::to_string(tile),
                                        std::to_string(imageCells) + " cells per side",
                                        std::to_string(m.cells) + " (the grid's cells) or " +

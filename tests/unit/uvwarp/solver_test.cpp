@@ -268,11 +268,13 @@ TEST_CASE("uv warp: bad solver input names what is wrong", "[uvwarp]") {
     PointField outOfRange = s.rigidity;
     outOfRange.values[100] = 1.5f;
     CHECK_THROWS_WITH(uvwarp::Solver(s.rest, outOfRange, s.mask), Catch::Contains("grid point 100"));
-    outOfRange = s.rigidity;  // two bad values, in different threads' halves: the first one is named
-    outOfRange.values[4000] = -0.5f;
-    outOfRange.values[2500] = std::numeric_limits<float>::quiet_NaN();
+    // Two bad values, one in each half of the 4,225 points (each of two threads finds one): the first is
+    // named.
+    outOfRange = s.rigidity;
+    outOfRange.values[3000] = -0.5f;
+    outOfRange.values[1500] = std::numeric_limits<float>::quiet_NaN();
     CHECK_THROWS_WITH(uvwarp::Solver(s.rest, outOfRange, s.mask),
-                      Catch::Contains("rigidity at grid point 2500") && Catch::Contains("nan"));
+                      Catch::Contains("rigidity at grid point 1500") && Catch::Contains("nan"));
     uvwarp::Solver solver(s.rest, s.rigidity, s.mask);
     CHECK_THROWS_WITH(solver.solve(bad.deformed), Catch::Contains("deformed geometry image"));
     uvwarp::SolverOptions options;

