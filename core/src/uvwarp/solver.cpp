@@ -125,6 +125,38 @@ int32_t widestChartRadius(const PointField& mask) {
     return widest;
 }
 
+// Runs [start, end), given in ascending order, appended to `out` as [out[2r], out[2r + 1]), those fewer than
+// `gap` apart merged (0: none).
+struct RunMerger {
+    std::vector<int32_t>& out;
+    int32_t gap;
+    int32_t count = 0, open = -1, end = -1;  // the run [open, end) being built
+
+    void add(int32_t start, int32_t stop) {
+        if (open >= 0 && start - end < gap) {
+            end = stop;
+            return;
+        }
+        emit();
+        open = start;
+        end = stop;
+    }
+    // Appends the last run; returns how many were appended.
+    int32_t finish() {
+        emit();
+        open = -1;
+        return count;
+    }
+
+  private:
+    void emit() {
+        if (open < 0) return;
+        out.push_back(open);
+        out.push_back(end);
+        ++count;
+    }
+};
+
 // Appends to `runs` the runs [runs[2r], runs[2r + 1]) of the bytes p[0, n) that are 1 (all others 0), runs
 // fewer than `gap` apart merged (0: none); returns how many. Eight bytes at a time across stretches of zeros
 // or ones.
@@ -135,7 +167,7 @@ int32_t appendByteRuns(const uint8_t* p, int32_t n, int32_t gap, std::vector<int
         std::memcpy(&w, p + i, sizeof w);
         return w;
     };
-    int32_t count = 0, open = -1, end = -1;  // the run [open, end) being built
+    RunMerger merger{runs, gap};
     int32_t i = 0;
     while (i < n) {
         while (i + 8 <= n && word(i) == 0)
@@ -148,24 +180,9 @@ int32_t appendByteRuns(const uint8_t* p, int32_t n, int32_t gap, std::vector<int
             i += 8;
         while (i < n && p[i] != 0)
             ++i;
-        if (open >= 0 && start - end < gap) {
-            end = i;
-            continue;
-        }
-        if (open >= 0) {
-            runs.push_back(open);
-            runs.push_back(end);
-            ++count;
-        }
-        open = start;
-        end = i;
+        merger.add(start, i);
     }
-    if (open >= 0) {
-        runs.push_back(open);
-        runs.push_back(end);
-        ++count;
-    }
-    return count;
+    return merger.finish();
 }
 
 // A thread's scratch while it finds rows' runs: a row's byte map, and runs before they are merged (per edge
@@ -217,14 +234,21 @@ void findRuns(int32_t columns, int32_t rows, const FillRow& fillRow, std::vector
         begin, runs);
 }
 
+// Image points between neighbouring points of `level` in a geometry image of imageCells cells over a grid of
+// fineCells (imageCells = fineCells or fineCells / 2); 0: the finest level over an image of half its cells,
+// whose points lie between the image's.
+int32_t imagePointsApart(const Level& level, int32_t fineCells, int32_t imageCells) {
+    return imageCells < fineCells ? level.stride / 2 : level.stride;
+}
+
 // The kernels' view of a level whose points are at u[j * row + i * step], in a grid of fineCells cells whose
 // f_O is `rest` (a geometry image of fineCells or fineCells / 2 cells).
 detail::KernelLevel kernelLevel(const Level& level, int32_t fineCells, const PointField& rest, float* u,
                                 float* v, int32_t step, ptrdiff_t row) {
     const bool compact = !level.rest.empty();
-    const int32_t shift = rest.cells < fineCells ? 1 : 0;  // fine point i is image point i >> shift
-    const bool between = !compact && level.stride < (1 << shift);
-    const int32_t imageStride = between ? 1 : level.stride >> shift;
+    const int32_t apart = imagePointsApart(level, fineCells, rest.cells);
+    const bool between = !compact && apart == 0;
+    const int32_t imageStride = between ? 1 : apart;
     return {level.cells,
             compact ? level.rest.data() : rest.values.data(),
             compact ? 3 * static_cast<ptrdiff_t>(level.side())
@@ -645,8 +669,8 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
     // nothing (the pair is computed whole), so runs are merged across it. Whether the segment of each edge
     // type at each cell of the row is projected is found first, for the whole row in loops that vectorise,
     // then the runs of cells of each type; a set takes the cells i = first + g step of its type's runs (every
-    // second or fourth cell), merged as appendByteRuns merges runs: the same runs as testing each of its
-    // segments on its own.
+    // second or fourth cell), merged by RunMerger as every kind of run is: the same runs as testing each of
+    // its segments on its own.
     collectRuns(
         c, detail::kSets,
         [&](int32_t j, std::vector<int32_t>& out, int32_t* count, RowScratch& scratch) {
@@ -674,30 +698,14 @@ void detail::findSetRuns(Level& level, int32_t fineCells) {
                 const auto firstAtOrAfter = [&](int32_t i) {
                     return i <= first ? 0 : (i - first + step - 1) / step;
                 };
-                int32_t runs = 0, open = -1, end = -1;  // the run [open, end) being built
+                RunMerger merger{out, kRunGapLanes};
                 const std::vector<int32_t>& cellRuns = typeRuns[type];
                 for (size_t r = 0; r < cellRuns.size(); r += 2) {
                     const int32_t ga = std::max(gMin, firstAtOrAfter(cellRuns[r]));
                     const int32_t gb = std::min(gMax, firstAtOrAfter(cellRuns[r + 1]));
-                    if (ga >= gb) continue;
-                    if (open >= 0 && ga - end < kRunGapLanes) {
-                        end = gb;
-                        continue;
-                    }
-                    if (open >= 0) {
-                        out.push_back(open);
-                        out.push_back(end);
-                        ++runs;
-                    }
-                    open = ga;
-                    end = gb;
+                    if (ga < gb) merger.add(ga, gb);
                 }
-                if (open >= 0) {
-                    out.push_back(open);
-                    out.push_back(end);
-                    ++runs;
-                }
-                count[set] = runs;
+                count[set] = merger.finish();
             }
         },
         level.setRunBegin, level.setRuns);
@@ -780,7 +788,7 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     for (Level& level : m.levels) {
         if (!m.options.warmStart || level.stride < detail::kCompactRestStride) continue;
         const int32_t n = level.side();
-        const size_t imageStride = static_cast<size_t>(halfImage ? level.stride / 2 : level.stride);
+        const auto imageStride = static_cast<size_t>(imagePointsApart(level, m.cells, m.rest.cells));
         const size_t imageSide = static_cast<size_t>(m.rest.cells) + 1;
         level.rest.resize(3 * static_cast<size_t>(n) * n);
         for (int32_t j = 0; j < n; ++j) {

@@ -251,6 +251,30 @@ Scene makeScene(std::mt19937& rng, int32_t cells, int32_t stride, bool compact, 
     return s;
 }
 
+// The runs [runs[2r], runs[2r + 1]) of i in [from, to) where in(i) holds, one value after another, runs fewer
+// than `gap` apart merged; appended to `runs`, returns how many.
+template <class In>
+int32_t referenceRuns(int32_t from, int32_t to, int32_t gap, const In& in, std::vector<int32_t>& runs) {
+    int32_t count = 0, open = -1, last = -1;
+    for (int32_t i = from; i < to; ++i) {
+        if (!in(i)) continue;
+        if (open >= 0 && i - (last + 1) < gap) {
+            last = i;
+            continue;
+        }
+        if (open >= 0) {
+            runs.insert(runs.end(), {open, last + 1});
+            ++count;
+        }
+        open = last = i;
+    }
+    if (open >= 0) {
+        runs.insert(runs.end(), {open, last + 1});
+        ++count;
+    }
+    return count;
+}
+
 }  // namespace
 
 TEST_CASE("uv warp kernels: a row's sweep moves what one segment after another moves", "[uvwarp][kernels]") {
@@ -347,27 +371,14 @@ TEST_CASE("uv warp kernels: a row's runs of projected segments are every set's p
                         const EdgeType e = kEdgeTypes[type];
                         int32_t gMin = 0, gMax = 0;
                         setLanes(type, first, j, cells, gMin, gMax);
-                        int32_t count = 0, open = -1, last = -1;
-                        for (int32_t g = gMin; g < gMax; ++g) {
+                        const auto projected = [&](int32_t g) {
                             const int32_t i = first + g * setStep(type);
                             const float ra = level.rigidity[static_cast<size_t>(j + e.aj) * side + i + e.ai];
                             const float rb = level.rigidity[static_cast<size_t>(j + e.bj) * side + i + e.bi];
-                            if (!segmentProjected(ra, rb, least)) continue;
-                            if (open >= 0 && g - last - 1 < 2) {  // fewer than 2 segments between: merged
-                                last = g;
-                                continue;
-                            }
-                            if (open >= 0) {
-                                runs.insert(runs.end(), {open, last + 1});
-                                ++count;
-                            }
-                            open = last = g;
-                        }
-                        if (open >= 0) {
-                            runs.insert(runs.end(), {open, last + 1});
-                            ++count;
-                        }
-                        begin.push_back(begin.back() + count);
+                            return segmentProjected(ra, rb, least);
+                        };
+                        // Fewer than 2 segments between: merged.
+                        begin.push_back(begin.back() + referenceRuns(gMin, gMax, 2, projected, runs));
                     }
                 }
                 CHECK(runs.size() > 0);
@@ -391,23 +402,8 @@ TEST_CASE(
         begin = {0};
         runs.clear();
         for (int32_t j = 0; j < rows; ++j) {
-            int32_t count = 0, open = -1, last = -1;
-            for (int32_t i = 0; i < columns; ++i) {
-                if (!in(i, j)) continue;
-                if (open >= 0 && i - (last + 1) < 8) {
-                    last = i;
-                    continue;
-                }
-                if (open >= 0) {
-                    runs.insert(runs.end(), {open, last + 1});
-                    ++count;
-                }
-                open = last = i;
-            }
-            if (open >= 0) {
-                runs.insert(runs.end(), {open, last + 1});
-                ++count;
-            }
+            const int32_t count = referenceRuns(
+                0, columns, 8, [&](int32_t i) { return in(i, j); }, runs);
             begin.push_back(begin.back() + count);
         }
     };
