@@ -275,6 +275,7 @@ struct Solver::Impl : detail::SolverState {
     detail::TeamChooser team;  // SolverOptions::threads == 0
     bool fromIdentity = true;  // the next solve starts from the identity (SolverOptions::coldIterations)
     bool started = false;      // the next solve starts from a coarser warp (startFrom): no cold restart
+    bool keepState = false;    // keepSolveState(): the solve state's memory stays between cold solves
     // The wavefront's per-block flags (forRowBlocks), enough for any level's rows.
     std::vector<std::atomic<int32_t>> blockDone;
 
@@ -538,8 +539,8 @@ struct Solver::Impl : detail::SolverState {
     // the compact copy a coarse level is swept in. A warm-started solver keeps them between solves (the
     // velocities carry over); one that solves every frame from the identity holds them only during a solve,
     // so that the redirect map and the delivered figures made after it (and the next tile of a shot) reuse
-    // their memory. The freed pages stay with the process: given back to the system, they would be faulted
-    // in again by every frame's solve (about 25 ms a 1024² frame).
+    // their memory, or keeps them (keepSolveState): reset() and startFrom() zero the velocities, and the
+    // snapshots and working copies are written before they are read.
     void allocateSolveState() {
         const size_t n = grid.numPoints();
         if (velU.size() == n) return;
@@ -897,8 +898,14 @@ const WarpGrid& Solver::solve(const PointField& deformedGeometry) {
     // After an iteration the fold revert has counted them; otherwise the grid is scanned.
     m.stats.remainingFolds = m.stats.iterations > 0 ? m.foldsLeft : countFolds(m.grid);
     m.deformed = nullptr;
-    if (!m.options.warmStart) m.releaseSolveState();
+    if (!m.options.warmStart && !m.keepState) m.releaseSolveState();
     return m.grid;
+}
+
+void Solver::keepSolveState(bool keep) {
+    Impl& m = *impl_;
+    m.keepState = keep;
+    if (!keep && !m.options.warmStart) m.releaseSolveState();
 }
 
 void Solver::reset() {

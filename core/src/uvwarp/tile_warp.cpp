@@ -89,8 +89,10 @@ struct TileWarp::Impl {
     int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     // TileWarpOptions::refinementSweeps: the grid of twice the cells the last iteration runs on, its imager,
-    // f_D (kept between solves as the solve's is: only when warm-started, as the refining solver keeps its
-    // state) and masks (as above), and the figures of a solve through both grids.
+    // f_D and masks (as above), and the figures of a solve through both grids. Refinement runs on grids of
+    // at most 1024 cells, so its f_D (at most 50 MB) and its solver's state (Solver::keepSolveState, 34 MB)
+    // keep their memory between solves: above glibc's mmap threshold, freed, they would go back to the
+    // system and be faulted in again by every frame (about 25 ms a 1024² frame).
     int32_t refinedCells = 0;
     std::unique_ptr<GeometryImager> refinedImager;
     std::unique_ptr<Solver> refiner;
@@ -214,6 +216,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                              refined, refinementOptions(options.solver, refinementSweeps),
                                              m.orientationAt(orientation, rigidity, m.refinedCells),
                                              source + ", UDIM tile " + std::to_string(tile) + ", refinement");
+        m.refiner->keepSolveState(true);
         m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};
@@ -256,7 +259,6 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats.shortenedSteps += r.shortenedSteps;
     m.stats.shortenedEverywhere += r.shortenedEverywhere;
     m.stats.remainingFolds = r.remainingFolds;
-    if (!m.keepDeformed) m.refinedDeformed = {};
     return refined;
 }
 

@@ -195,6 +195,49 @@ TEST_CASE("uv warp: without warm start a solve depends on its own frame alone", 
     CHECK(maxMove(warm.solve(b.deformed), alone) > 0.01 / 64.0);
 }
 
+TEST_CASE("uv warp: a solver that keeps its solve state's memory gives the same bytes", "[uvwarp]") {
+    // Without warm start, keepSolveState only keeps the memory: each solve starts from zero velocities (reset
+    // or startFrom), as with fresh buffers. Frames a, a, b against a solver that has seen b alone,
+    // and a refining solver (one level, started from a coarser warp each frame) against one that frees its
+    // state: bit for bit.
+    const Scene a = stretchedPlane(64, 1.5f), b = stretchedPlane(64, 1.3f);
+    uvwarp::SolverOptions options;
+    options.warmStart = false;
+    uvwarp::Solver keeping(a.rest, a.rigidity, a.mask, options);
+    keeping.keepSolveState(true);
+    keeping.solve(a.deformed);
+    keeping.solve(a.deformed);
+    const WarpGrid afterHistory = keeping.solve(b.deformed);
+    uvwarp::Solver fresh(b.rest, b.rigidity, b.mask, options);
+    const WarpGrid& alone = fresh.solve(b.deformed);
+    CHECK(std::memcmp(afterHistory.u.data(), alone.u.data(), alone.u.size() * sizeof(float)) == 0);
+    CHECK(std::memcmp(afterHistory.v.data(), alone.v.data(), alone.v.size() * sizeof(float)) == 0);
+
+    const Scene coarseA = stretchedPlane(32, 1.5f), coarseB = stretchedPlane(32, 1.3f);
+    uvwarp::Solver coarse(coarseA.rest, coarseA.rigidity, coarseA.mask, options);
+    uvwarp::SolverOptions refine = options;
+    refine.iterations = 1;
+    refine.levels = 1;
+    refine.sweepsPerLevel = {4};
+    uvwarp::Solver kept(a.rest, a.rigidity, a.mask, refine), freed(a.rest, a.rigidity, a.mask, refine);
+    kept.keepSolveState(true);
+    for (const auto& [coarseScene, scene] : {std::pair{&coarseA, &a}, {&coarseA, &a}, {&coarseB, &b}}) {
+        const WarpGrid& from = coarse.solve(coarseScene->deformed);
+        kept.startFrom(from);
+        freed.startFrom(from);
+        const WarpGrid& x = kept.solve(scene->deformed);
+        const WarpGrid& y = freed.solve(scene->deformed);
+        CHECK(std::memcmp(x.u.data(), y.u.data(), y.u.size() * sizeof(float)) == 0);
+        CHECK(std::memcmp(x.v.data(), y.v.data(), y.v.size() * sizeof(float)) == 0);
+    }
+    kept.keepSolveState(false);  // frees it again; the next solve allocates afresh
+    kept.startFrom(coarse.solve(coarseB.deformed));
+    freed.startFrom(coarse.warp());
+    const WarpGrid& x = kept.solve(b.deformed);
+    const WarpGrid& y = freed.solve(b.deformed);
+    CHECK(std::memcmp(x.u.data(), y.u.data(), y.u.size() * sizeof(float)) == 0);
+}
+
 TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]") {
     // Stretch ramps 1.30, 1.31, ... : the per-frame warp change stays bounded by a small multiple of the
     // change a 1-frame step causes at a settled state, and never jumps.

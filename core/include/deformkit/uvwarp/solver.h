@@ -126,7 +126,7 @@ struct SolveStats {
 // solve 8 more for velocities and 4.7 for the coarser levels' working copies. With SolverOptions::warmStart
 // (the velocities carry over) those stay between solves and a solve allocates nothing once the fold-repair
 // scratch has grown to the largest fold count seen; without it they are allocated at the start of each solve
-// and freed at its end (the caller gives the pages back: TileWarp does).
+// and freed at its end, unless keepSolveState() says to keep their memory.
 class Solver {
   public:
     Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
@@ -152,6 +152,13 @@ class Solver {
     // fixes keep the map `coarser` gives them. Throws InvalidInput when `coarser` has not half the cells or
     // is not finite.
     void startFrom(const WarpGrid& coarser);
+    // Without warmStart: whether the solve's state (velocities, the coarser levels' working copies) keeps its
+    // memory between solves instead of being allocated and freed by each solve. The same bytes either way:
+    // each solve starts from zero velocities (reset or startFrom), and the copies are written before use.
+    // Keeping it holds that memory between frames and spares each frame the first touches of fresh pages:
+    // glibc hands buffers above its mmap threshold (32 MiB at most) back to the system when they are freed.
+    // Off by default; TileWarp keeps its refining solver's (UV-22).
+    void keepSolveState(bool keep);
 
     [[nodiscard]] const WarpGrid& warp() const;
     [[nodiscard]] const PointField& restGeometry() const;
