@@ -30,8 +30,8 @@ struct TileMember {
 };
 
 // refinementSweeps' lowMeans spells the rule of refinementSweepsFor out.
-static_assert(kAutomaticRefinementSweeps == 4 && kAutomaticRefinementCells == 1024,
-              "refinementSweeps' lowMeans states 4 sweeps up to 1024 cells");
+static_assert(kAutomaticRefinementSweeps == 6 && kAutomaticRefinementCells == 1024,
+              "refinementSweeps' lowMeans states 6 sweeps up to 1024 cells");
 
 // geometryImageCells' zeroMeans spells the rule of geometryImageCellsFor out.
 static_assert(kFullGeometryImageCells == 8192,
@@ -55,11 +55,11 @@ const OptionSpec kSpecs[] = {
      .low = kAutomaticRefinement,
      .high = 64,
      .zeroMeans = "none",
-     .lowMeans = "by the grid's size: 4 up to 1024 cells, none from 2048",
+     .lowMeans = "by the grid's size: 6 up to 1024 cells, none from 2048",
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
-                "grid's points (a mesh bends at every edge). The shot preset's 4 took rigged characters at "
-                "1024^2 1.8-6.8 points further (rigged Spot 79.4 to 86.2% median), for 1.4-1.5x the time a "
+                "grid's points (a mesh bends at every edge). The shot preset's 6 took rigged characters at "
+                "1024^2 2.0-7.1 points further (rigged Spot 79.4 to 86.5% median), for about 1.5x the time a "
                 "frame; the live preset has none.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},

@@ -420,11 +420,11 @@ TEST_CASE("tile warp: refinement sweeps end each solve on a grid of twice the ce
                       Catch::Contains("at most 16384"));
 }
 
-TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 4 sweeps, finer grids not",
+TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 6 sweeps, finer grids not",
           "[uvwarp][options]") {
     // refinementSweeps -1 (the shot preset's, by the grid's size), as the option's reference states it.
     for (const int32_t cells : {2, 64, 256, 1024})
-        CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 4);
+        CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 6);
     for (const int32_t cells : {2048, 4096, 16384})
         CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 0);
     CHECK(uvwarp::refinementSweepsFor(0, 64) == 0);
@@ -433,15 +433,15 @@ TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 4 swee
     CHECK(uvwarp::presetOptions(uvwarp::Preset::Live, 1024).refinementSweeps == 0);
     CHECK(uvwarp::TileWarpOptions{}.refinementSweeps == 0);  // the library's warm-started solvers: none
 
-    // A shot on the plane's 128-cell grid delivers the 256-cell grid of 4 explicit sweeps, bit for bit.
+    // A shot on the plane's 128-cell grid delivers the 256-cell grid of 6 explicit sweeps, bit for bit.
     const geom::Mesh mesh = uvPlane(32);
     const std::vector<glm::vec3> pose = stretched(mesh, 1.5f);
     uvwarp::TileWarp shot(mesh, 1001, diskRigidity(128), {}, uvwarp::shotOptions());
     uvwarp::TileWarpOptions explicitSweeps = uvwarp::shotOptions();
-    explicitSweeps.refinementSweeps = 4;
-    uvwarp::TileWarp four(mesh, 1001, diskRigidity(128), {}, explicitSweeps);
+    explicitSweeps.refinementSweeps = 6;
+    uvwarp::TileWarp six(mesh, 1001, diskRigidity(128), {}, explicitSweeps);
     const uvwarp::WarpGrid& delivered = shot.solve(pose);
-    const uvwarp::WarpGrid& reference = four.solve(pose);
+    const uvwarp::WarpGrid& reference = six.solve(pose);
     CHECK(delivered.cells == 256);
     CHECK(delivered.u == reference.u);
     CHECK(delivered.v == reference.v);
