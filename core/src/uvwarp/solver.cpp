@@ -275,7 +275,7 @@ struct Solver::Impl : detail::SolverState {
     detail::TeamChooser team;  // SolverOptions::threads == 0
     bool fromIdentity = true;  // the next solve starts from the identity (SolverOptions::coldIterations)
     bool started = false;      // the next solve starts from a coarser warp (startFrom): no cold restart
-    bool keepState = false;    // keepSolveState(): the solve state's memory stays between cold solves
+    bool keepState = false;    // keepSolveState(): without warmStart, the solve state stays between solves
     // The wavefront's per-block flags (forRowBlocks), enough for any level's rows.
     std::vector<std::atomic<int32_t>> blockDone;
 

@@ -59,8 +59,8 @@ struct Level {
     // choose 32 lanes, which left every run shorter than 32 segments to the scalar remainder loop).
     std::vector<float> rigidity;
     std::vector<float> orientation;  // empty without an orientation map (1 everywhere)
-    // f_O at this level's points, 3 floats each, in a solver that keeps its solve state between solves
-    // (SolverOptions::warmStart), on levels kCompactRestStride or more fine points apart; empty otherwise
+    // f_O at this level's points, 3 floats each, in a warm-started solver (SolverOptions::warmStart), on
+    // levels kCompactRestStride or more fine points apart; empty otherwise
     // (the level reads the fine image, every point of it a cache line of its own).
     std::vector<float> rest;
     std::vector<float> snapshotU, snapshotV;  // positions before this level's sweeps (for propagation)

@@ -89,15 +89,17 @@ struct TileWarp::Impl {
     int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
     std::unique_ptr<Solver> solver;
     // TileWarpOptions::refinementSweeps: the grid of twice the cells the last iteration runs on, its imager,
-    // f_D and masks (as above), and the figures of a solve through both grids. Refinement runs on grids of
-    // at most 1024 cells, so its f_D (at most 50 MB) and its solver's state (Solver::keepSolveState, 34 MB)
-    // keep their memory between solves: above glibc's mmap threshold, freed, they would go back to the
-    // system and be faulted in again by every frame (about 25 ms a 1024² frame).
+    // f_D and masks (as above), and the figures of a solve through both grids. A refining grid of at most
+    // kKeptRefinementCells (the shot preset's, on grids up to 1024 cells) keeps its f_D (at most 50 MB) and
+    // its solver's state (Solver::keepSolveState, 34 MB) between solves: above glibc's mmap threshold,
+    // freed, they would go back to the system and be faulted in again by every frame (about 12% of a refined
+    // 1024² frame). A finer one, asked for explicitly, frees them after each solve as the solve does.
     int32_t refinedCells = 0;
     std::unique_ptr<GeometryImager> refinedImager;
     std::unique_ptr<Solver> refiner;
     PointField refinedDeformed;
     std::vector<uint8_t> refinedMask, refinedBoundMask;
+    bool keepRefined = false;  // the refinement keeps its f_D and solve state between solves
     SolveStats stats;
     bool solved = false;
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
@@ -127,6 +129,10 @@ struct TileWarp::Impl {
 
 namespace {
 
+// The finest refining grid that keeps its f_D and solve state between solves (Impl::keepRefined): the shot
+// preset's, twice kAutomaticRefinementCells.
+constexpr int32_t kKeptRefinementCells = 2 * kAutomaticRefinementCells;
+
 // The refining solver's options: one warm iteration of `sweeps` sweeps on its finest level alone, the rest
 // as the main solver's.
 SolverOptions refinementOptions(SolverOptions options, int32_t sweeps) {
@@ -136,7 +142,7 @@ SolverOptions refinementOptions(SolverOptions options, int32_t sweeps) {
     options.sweepsPerLevel = {sweeps};
     options.levels = 1;
     options.maxLevels = 0;
-    return options;  // warmStart as the solve's: each solve starts from it (startFrom), kept only when warm
+    return options;  // warmStart as the solve's: each solve starts from it (startFrom)
 }
 
 }  // namespace
@@ -216,7 +222,8 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                              refined, refinementOptions(options.solver, refinementSweeps),
                                              m.orientationAt(orientation, rigidity, m.refinedCells),
                                              source + ", UDIM tile " + std::to_string(tile) + ", refinement");
-        m.refiner->keepSolveState(true);
+        m.keepRefined = m.refinedCells <= kKeptRefinementCells;
+        m.refiner->keepSolveState(m.keepRefined);
         m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};
@@ -248,8 +255,8 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats = m.solver->stats();
     if (!m.keepDeformed) m.deformed = {};
     if (!m.refiner) return warp;
-    m.refiner->startFrom(warp);
     m.refinedImager->sample(deformedPoints, m.refinedDeformed);
+    m.refiner->startFrom(warp);
     const WarpGrid& refined = m.refiner->solve(m.refinedDeformed);
     const SolveStats& r = m.refiner->stats();
     m.stats.iterations += r.iterations;
@@ -259,6 +266,7 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats.shortenedSteps += r.shortenedSteps;
     m.stats.shortenedEverywhere += r.shortenedEverywhere;
     m.stats.remainingFolds = r.remainingFolds;
+    if (!m.keepDeformed && !m.keepRefined) m.refinedDeformed = {};
     return refined;
 }
 

@@ -236,6 +236,7 @@ TEST_CASE("uv warp: a solver that keeps its solve state's memory gives the same 
     const WarpGrid& x = kept.solve(b.deformed);
     const WarpGrid& y = freed.solve(b.deformed);
     CHECK(std::memcmp(x.u.data(), y.u.data(), y.u.size() * sizeof(float)) == 0);
+    CHECK(std::memcmp(x.v.data(), y.v.data(), y.v.size() * sizeof(float)) == 0);
 }
 
 TEST_CASE("uv warp: a slow animation changes the warp in proportion", "[uvwarp]") {
