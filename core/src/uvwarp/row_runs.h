@@ -17,28 +17,31 @@ namespace deformkit::uvwarp::detail {
 inline void encodeRowRuns(const std::vector<int32_t>& values, int32_t columns, int32_t rows,
                           std::vector<int64_t>& rowBegin, std::vector<int32_t>& start,
                           std::vector<int32_t>& value) {
-    std::vector<std::vector<int32_t>> perRow(static_cast<size_t>(rows));  // start, value pairs
+    // Two passes over the rows, in parallel: each row's run count (a run starts at column 0 and wherever the
+    // value changes), then, from the counts' prefix sums, its runs in place. No per-row buffers: a bind of a
+    // 2048-cell grid would otherwise grow thousands of small vectors on every thread.
+    rowBegin.assign(static_cast<size_t>(rows) + 1, 0);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int32_t y = 0; y < rows; ++y) {
         const int32_t* row = values.data() + static_cast<size_t>(y) * columns;
-        std::vector<int32_t>& runs = perRow[static_cast<size_t>(y)];
-        for (int32_t x = 0; x < columns; ++x) {
-            if (x > 0 && row[x] == row[x - 1]) continue;
-            runs.push_back(x);
-            runs.push_back(row[x]);
-        }
+        int64_t runs = columns > 0 ? 1 : 0;
+        for (int32_t x = 1; x < columns; ++x)
+            runs += row[x] != row[x - 1] ? 1 : 0;
+        rowBegin[static_cast<size_t>(y) + 1] = runs;
     }
-    rowBegin.assign(static_cast<size_t>(rows) + 1, 0);
     for (int32_t y = 0; y < rows; ++y)
-        rowBegin[y + 1] = rowBegin[y] + static_cast<int64_t>(perRow[static_cast<size_t>(y)].size() / 2);
-    start.resize(static_cast<size_t>(rowBegin[rows]));
+        rowBegin[static_cast<size_t>(y) + 1] += rowBegin[static_cast<size_t>(y)];
+    start.resize(static_cast<size_t>(rowBegin[static_cast<size_t>(rows)]));
     value.resize(start.size());
 #pragma omp parallel for schedule(dynamic, 16)
     for (int32_t y = 0; y < rows; ++y) {
-        const std::vector<int32_t>& runs = perRow[static_cast<size_t>(y)];
-        for (size_t r = 0; r < runs.size() / 2; ++r) {
-            start[static_cast<size_t>(rowBegin[y]) + r] = runs[2 * r];
-            value[static_cast<size_t>(rowBegin[y]) + r] = runs[2 * r + 1];
+        const int32_t* row = values.data() + static_cast<size_t>(y) * columns;
+        auto r = static_cast<size_t>(rowBegin[static_cast<size_t>(y)]);
+        for (int32_t x = 0; x < columns; ++x) {
+            if (x > 0 && row[x] == row[x - 1]) continue;
+            start[r] = x;
+            value[r] = row[x];
+            ++r;
         }
     }
 }
