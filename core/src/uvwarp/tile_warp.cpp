@@ -142,7 +142,7 @@ SolverOptions refinementOptions(SolverOptions options, int32_t sweeps) {
     options.sweepsPerLevel = {sweeps};
     options.levels = 1;
     options.maxLevels = 0;
-    return options;  // warmStart as the solve's: each solve starts from it (startFrom)
+    return options;  // warmStart as the solve's: each solve starts from the solved warp (startFrom)
 }
 
 }  // namespace

@@ -157,7 +157,7 @@ class Solver {
     // each solve starts from zero velocities (reset or startFrom), and the copies are written before use.
     // Keeping it holds that memory between frames and spares each frame the first touches of fresh pages:
     // glibc hands buffers above its mmap threshold (32 MiB at most) back to the system when they are freed.
-    // Off by default; TileWarp keeps its refining solver's (UV-22).
+    // Off by default; TileWarp keeps its refining solver's on the shot preset's grids (UV-22).
     void keepSolveState(bool keep);
 
     [[nodiscard]] const WarpGrid& warp() const;
