@@ -70,6 +70,10 @@ PointField refinedMask(PointField fine, const PointField& coarse) {
     return fine;
 }
 
+// The finest refining grid that keeps its f_D and solve state between solves (Impl::refinementKept): the
+// shot preset's, twice kAutomaticRefinementCells.
+constexpr int32_t kKeptRefinementCells = 2 * kAutomaticRefinementCells;
+
 }  // namespace
 
 struct TileWarp::Impl {
@@ -99,7 +103,7 @@ struct TileWarp::Impl {
     std::unique_ptr<Solver> refiner;
     PointField refinedDeformed;
     std::vector<uint8_t> refinedMask, refinedBoundMask;
-    bool keepRefined = false;  // the refinement keeps its f_D and solve state between solves
+    [[nodiscard]] bool refinementKept() const { return refinedCells <= kKeptRefinementCells; }
     SolveStats stats;
     bool solved = false;
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
@@ -128,10 +132,6 @@ struct TileWarp::Impl {
 };
 
 namespace {
-
-// The finest refining grid that keeps its f_D and solve state between solves (Impl::keepRefined): the shot
-// preset's, twice kAutomaticRefinementCells.
-constexpr int32_t kKeptRefinementCells = 2 * kAutomaticRefinementCells;
 
 // The refining solver's options: one warm iteration of `sweeps` sweeps on its finest level alone, the rest
 // as the main solver's.
@@ -222,8 +222,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                              refined, refinementOptions(options.solver, refinementSweeps),
                                              m.orientationAt(orientation, rigidity, m.refinedCells),
                                              source + ", UDIM tile " + std::to_string(tile) + ", refinement");
-        m.keepRefined = m.refinedCells <= kKeptRefinementCells;
-        m.refiner->keepSolveState(m.keepRefined);
+        m.refiner->keepSolveState(m.refinementKept());
         m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};
@@ -266,7 +265,7 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.stats.shortenedSteps += r.shortenedSteps;
     m.stats.shortenedEverywhere += r.shortenedEverywhere;
     m.stats.remainingFolds = r.remainingFolds;
-    if (!m.keepDeformed && !m.keepRefined) m.refinedDeformed = {};
+    if (!m.keepDeformed && !m.refinementKept()) m.refinedDeformed = {};
     return refined;
 }
 
