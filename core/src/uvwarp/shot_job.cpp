@@ -585,6 +585,7 @@ TileWarpOptions shotOptions() {
     TileWarpOptions options;
     options.solver.warmStart = false;
     options.refinementSweeps = kAutomaticRefinement;
+    options.orientationDensity = kAutomaticDensity;
     return options;
 }
 

@@ -570,11 +570,11 @@ struct Solver::Impl : detail::SolverState {
     }
 
     // `rigidity` becomes the finest level's map (pass it with std::move to keep one copy).
-    void buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation);
+    void buildMaps(PointField rigidity, const PointField& mask, PointField orientation);
     static void findLevelRuns(Level& level, int32_t fineCells);
 };
 
-void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const PointField& orientation) {
+void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, PointField orientation) {
     detail::requireField(rigidity, cells, 1, source, "rigidity");
     detail::requireField(mask, cells, 1, source, "mask");
     if (!orientation.values.empty()) detail::requireField(orientation, cells, 1, source, "orientation map");
@@ -591,15 +591,18 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
         throw InvalidInput(formatError(source, "rigidity at grid point " + std::to_string(firstBad),
                                        std::to_string(rigidity.values[firstBad]), "a value in [0, 1]"));
     }
+    const bool oriented = !orientation.values.empty();
     for (Level& level : levels) {
         const size_t count = static_cast<size_t>(level.side()) * level.side();
         if (&level == &levels.front())
             level.rigidity = std::move(rigidity.values);  // R of the finest level: the map itself
         else
             deformkit::detail::assignLarge(level.rigidity, count, 0.0f);
-        if (orientation.values.empty()) {
+        if (!oriented) {
             level.orientation.clear();
             level.orientation.shrink_to_fit();
+        } else if (&level == &levels.front()) {
+            level.orientation = std::move(orientation.values);  // the map itself, clamped below
         } else {
             deformkit::detail::assignLarge(level.orientation, count, 1.0f);
         }
@@ -622,7 +625,7 @@ void Solver::Impl::buildMaps(PointField rigidity, const PointField& mask, const 
             const bool border = i == 0 || j == 0 || i == cells || j == cells;
             movable[k] = (!border && mask.values[k] >= 0.5f) ? 1 : 0;
             if (!finest.orientation.empty())
-                finest.orientation[k] = std::clamp(orientation.values[k], 0.0f, 1.0f);
+                finest.orientation[k] = std::clamp(finest.orientation[k], 0.0f, 1.0f);
         }
     }
     // Eq. 7 (rigidity and orientation blurred by K_G) and Eq. 8 (mask min over 3x3), then subsampled.
@@ -744,7 +747,7 @@ void detail::findMovableRuns(Level& level) {
 }
 
 Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
-               const SolverOptions& options, const PointField& orientation, const std::string& source)
+               const SolverOptions& options, PointField orientation, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.source = source;
@@ -802,7 +805,7 @@ Solver::Solver(PointField restGeometry, PointField rigidity, const PointField& m
     m.untangleWork.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.untangleNext.reserve(8 * static_cast<size_t>(m.cells + 1));
     m.rowFolds.assign(static_cast<size_t>(m.cells) + 1, 0);
-    m.buildMaps(std::move(rigidity), mask, orientation);
+    m.buildMaps(std::move(rigidity), mask, std::move(orientation));
     m.grid = WarpGrid::identity(m.cells);
     if (m.options.warmStart) m.allocateSolveState();
     m.stats.levels = levelCount;
@@ -812,9 +815,9 @@ Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
-void Solver::setMaps(PointField rigidity, const PointField& mask, const PointField& orientation) {
+void Solver::setMaps(PointField rigidity, const PointField& mask, PointField orientation) {
     Impl& m = *impl_;
-    m.buildMaps(std::move(rigidity), mask, orientation);
+    m.buildMaps(std::move(rigidity), mask, std::move(orientation));
     // A point the new maps fix stays where it is: without its velocity, prediction would carry it on.
     const detail::Level& finest = m.levels[0];
     for (size_t k = 0; k < m.velU.size(); ++k) {

@@ -109,15 +109,20 @@ struct TileWarp::Impl {
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
     std::vector<glm::vec3> lastDeformed;       // the last solve's positions (the rest ones before any)
 
+    // The density heuristic's orientation-preservation map (TileWarpOptions::orientationDensity) where no
+    // map is painted and the heuristic is on; else empty.
+    [[nodiscard]] io::Image densityMap(const io::Image& orientation, const io::Image& rigidity) const {
+        if (!orientation.pixels.empty() || densityRadius <= 0) return {};
+        return densityOrientationMap(rigidity, densityRadius);
+    }
     // The orientation-preservation map at the points of a grid of `n` cells: the painted one, else the
-    // density heuristic's (TileWarpOptions::orientationDensity), else none (1 everywhere).
-    [[nodiscard]] PointField orientationAt(const io::Image& orientation, const io::Image& rigidity,
+    // density heuristic's (densityMap), else none (1 everywhere).
+    [[nodiscard]] PointField orientationAt(const io::Image& orientation, const io::Image& density,
                                            int32_t n) const {
         if (!orientation.pixels.empty())
             return rigidityAtPoints(orientation, n, {source + " orientation map", tile});
-        if (densityRadius > 0)
-            return rigidityAtPoints(densityOrientationMap(rigidity, densityRadius), n,
-                                    {source + " density orientation", tile});
+        if (!density.pixels.empty())
+            return rigidityAtPoints(density, n, {source + " density orientation", tile});
         return {};
     }
 
@@ -209,8 +214,9 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     const io::Image& maskMap = derive ? derivedMask : mask;
     const MapLabel maskLabel{source + (derive ? " derived mask" : " warp mask"), tile};
     const PointField maskAtGrid = maskAtPoints(maskMap, m.cells, maskLabel);
-    m.densityRadius = options.orientationDensity;
-    const PointField orientationAtPoints = m.orientationAt(orientation, rigidity, m.cells);
+    m.densityRadius = orientationDensityFor(options.orientationDensity, m.texels);
+    io::Image density = m.densityMap(orientation, rigidity);
+    PointField orientationAtPoints = m.orientationAt(orientation, density, m.cells);
     if (refinementSweeps > 0) {
         m.refinedCells = 2 * m.cells;
         m.refinedImager = std::make_unique<GeometryImager>(rest, uvs, m.refinedCells, imageOptions);
@@ -220,15 +226,16 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
         m.refiner = std::make_unique<Solver>(std::move(refinedRest),
                                              rigidityAtPoints(rigidity, m.refinedCells, rigidityLabel),
                                              refined, refinementOptions(options.solver, refinementSweeps),
-                                             m.orientationAt(orientation, rigidity, m.refinedCells),
+                                             m.orientationAt(orientation, density, m.refinedCells),
                                              source + ", UDIM tile " + std::to_string(tile) + ", refinement");
         m.refiner->keepSolveState(m.refinementKept());
         m.refinedBoundMask = maskBytes(refined);
     }
     derivedMask = {};
-    m.solver =
-        std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid, options.solver,
-                                 orientationAtPoints, source + ", UDIM tile " + std::to_string(tile));
+    density = {};
+    m.solver = std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid,
+                                        options.solver, std::move(orientationAtPoints),
+                                        source + ", UDIM tile " + std::to_string(tile));
     m.boundMask = maskBytes(maskAtGrid);
     m.keepDeformed = options.solver.warmStart;
     m.delivered.emplace(rest, std::move(uvs), std::move(rigidity), source);
@@ -339,8 +346,8 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     PointField newRigidity = rigidityAtPoints(rigidity, m.cells, {m.source + " rigidity map", m.tile});
     PointField newMask = mask.pixels.empty() ? maskField(m.boundMask, m.cells)
                                              : maskAtPoints(mask, m.cells, {m.source + " warp mask", m.tile});
-    PointField orientationAtPoints = m.orientationAt(orientation, rigidity, m.cells);
-    m.solver->setMaps(std::move(newRigidity), newMask, orientationAtPoints);
+    io::Image density = m.densityMap(orientation, rigidity);
+    m.solver->setMaps(std::move(newRigidity), newMask, m.orientationAt(orientation, density, m.cells));
     if (m.refiner) {
         const int32_t n = m.refinedCells;
         const PointField refined =
@@ -348,7 +355,7 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
                 ? maskField(m.refinedBoundMask, n)
                 : refinedMask(maskAtPoints(mask, n, {m.source + " warp mask", m.tile}), newMask);
         m.refiner->setMaps(rigidityAtPoints(rigidity, n, {m.source + " rigidity map", m.tile}), refined,
-                           m.orientationAt(orientation, rigidity, n));
+                           m.orientationAt(orientation, density, n));
         if (mask.pixels.empty())
             m.refinedMask.clear();
         else
@@ -363,7 +370,7 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
     m.mask.shrink_to_fit();
     newRigidity = {};
     newMask = {};
-    orientationAtPoints = {};
+    density = {};
     deformkit::detail::releaseFreedMemory();  // the maps at grid points just made
 }
 

@@ -1,6 +1,9 @@
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -163,6 +166,76 @@ TEST_CASE("tile warp: the density heuristic for orientation preservation", "[uvw
     const std::vector<float> c = uniform.solve(squeezed).u;
     CHECK(a == b);
     CHECK(a != c);
+}
+
+TEST_CASE("tile warp: the density map over several column blocks, any thread count", "[uvwarp][options]") {
+    // Random rigidity in [0, 1] on a map wider than the implementation's blocks of 64 columns (the last one
+    // partial), against the window mean brute-forced here, and the same bytes on 1 and 2 threads.
+    const int w = 150, h = 97, r = 7;
+    io::Image rigidity(w, h, 1);
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> value(0.0f, 1.0f);
+    for (float& p : rigidity.pixels)
+        p = value(random) < 0.3f ? value(random) : 0.0f;
+    std::vector<double> mean(static_cast<size_t>(w) * h);
+    double largest = 0.0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double sum = 0.0;
+            int count = 0;
+            for (int wy = std::max(0, y - r); wy <= std::min(h - 1, y + r); ++wy)
+                for (int wx = std::max(0, x - r); wx <= std::min(w - 1, x + r); ++wx) {
+                    sum += rigidity.at(wx, wy, 0);
+                    ++count;
+                }
+            mean[static_cast<size_t>(y) * w + x] = sum / count;
+            largest = std::max(largest, sum / count);
+        }
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const io::Image one = uvwarp::densityOrientationMap(rigidity, r);
+    omp_set_num_threads(2);
+    const io::Image two = uvwarp::densityOrientationMap(rigidity, r);
+    omp_set_num_threads(threads);
+    CHECK(one.pixels == two.pixels);
+    double worst = 0.0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            worst =
+                std::max(worst, std::abs(two.at(x, y, 0) - mean[static_cast<size_t>(y) * w + x] / largest));
+    CHECK(worst < 1e-6);
+    CHECK(*std::max_element(two.pixels.begin(), two.pixels.end()) == 1.0f);
+}
+
+TEST_CASE("tile warp: the presets' density window by the map's size", "[uvwarp][options]") {
+    // 1/16 of the map's texels, at least 1, off past 8192^2; an explicit radius is kept.
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 1024) == 64);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8192) == 512);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 16384) == 0);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8) == 1);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(5, 1024) == 5);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(0, 1024) == 0);
+    CHECK(uvwarp::shotOptions().orientationDensity == uvwarp::kAutomaticDensity);
+    CHECK(uvwarp::presetOptions(uvwarp::Preset::Live, 256).orientationDensity == uvwarp::kAutomaticDensity);
+    CHECK(uvwarp::TileWarpOptions{}.orientationDensity == 0);
+
+    // The automatic window is that radius, bit for bit, and differs from none on a squeezed plane.
+    const int t = 64;
+    io::Image rigidity(t, t, 1);
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x)
+            rigidity.at(x, y, 0) =
+                std::hypot(x - 20.0, y - 30.0) < 6.0 || std::hypot(x - 44.0, y - 30.0) < 3.0 ? 1.0f : 0.0f;
+    const geom::Mesh plane = uvPlane(8);
+    const std::vector<glm::vec3> squeezed = stretched(plane, 0.5f);
+    const auto solved = [&](int32_t radius) {
+        uvwarp::TileWarpOptions options;
+        options.orientationDensity = radius;
+        uvwarp::TileWarp tile(plane, 1001, rigidity, {}, options);
+        return tile.solve(squeezed).u;
+    };
+    CHECK(solved(uvwarp::kAutomaticDensity) == solved(t / 16));
+    CHECK(solved(uvwarp::kAutomaticDensity) != solved(0));
 }
 
 namespace {

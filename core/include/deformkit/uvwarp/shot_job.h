@@ -73,8 +73,9 @@ struct TileMapSource {
 
 // The options a job over a shot starts from: TileWarpOptions{} but every frame solved from the identity
 // (SolverOptions::warmStart false) and refined by the grid's size (kAutomaticRefinement: grids up to 1024
-// cells end on a grid of twice the cells, UV-39). From the identity, the default schedule costs what a
-// warm-started frame does and removes as much of the rigid stretch, and a frame's maps then depend on that
+// cells end on a grid of twice the cells, UV-39) with the density heuristic's orientation preservation
+// (kAutomaticDensity: a window of 1/16 of the map, UV-40). From the identity, the default schedule costs what
+// a warm-started frame does and removes as much of the rigid stretch, and a frame's maps then depend on that
 // frame alone: not on the frames before it, nor on where a farm chunk or a resumed job begins
 // (docs/decisions.md, UV-20). Hosts that show a live preview, one iteration a frame, warm-start instead
 // (TileWarpOptions{}).

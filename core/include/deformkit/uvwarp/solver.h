@@ -129,8 +129,9 @@ struct SolveStats {
 // and freed at its end, unless keepSolveState() says to keep their memory.
 class Solver {
   public:
+    // The rigidity and orientation fields become the finest level's own (passed as rvalues, no copy).
     Solver(PointField restGeometry, PointField rigidity, const PointField& mask,
-           const SolverOptions& options = {}, const PointField& orientation = {},
+           const SolverOptions& options = {}, PointField orientation = {},
            const std::string& source = "tile");
     ~Solver();
     Solver(Solver&&) noexcept;
@@ -138,7 +139,7 @@ class Solver {
 
     // New rigidity / mask / orientation maps (a painter's edit): rebuilds the per-level hierarchies (Eq.
     // 7-8). The warp is kept; a point the new mask fixes stays where it is (its velocity is dropped).
-    void setMaps(PointField rigidity, const PointField& mask, const PointField& orientation = {});
+    void setMaps(PointField rigidity, const PointField& mask, PointField orientation = {});
     // One frame: deformedGeometry f_D (3 channels, a geometry image of restGeometry's cells). Returns the
     // warp W.
     const WarpGrid& solve(const PointField& deformedGeometry);

@@ -27,7 +27,8 @@ struct TileWarpOptions {
     DerivedMaskOptions derivedMask;  // used when no mask map is given
     int32_t dilationRings = 4;       // geometry-image dilation past chart borders
     // > 0: without a painted orientation map, the paper's heuristic for severe compression
-    // (densityOrientationMap of the rigidity map with this window radius, texels); 0: 1 everywhere.
+    // (densityOrientationMap of the rigidity map with this window radius, texels); 0: 1 everywhere;
+    // kAutomaticDensity: by the map's size (orientationDensityFor), the presets'.
     int32_t orientationDensity = 0;
     // > 0: each solve ends with one more iteration of this many sweeps on a grid of twice the cells, started
     // from the solved warp (Solver::startFrom) with the finest level only; that grid's warp is the one
@@ -58,6 +59,19 @@ inline constexpr int32_t kAutomaticRefinementCells = 1024;
 [[nodiscard]] constexpr int32_t refinementSweepsFor(int32_t sweeps, int32_t cells) {
     if (sweeps != kAutomaticRefinement) return sweeps;
     return cells <= kAutomaticRefinementCells ? kAutomaticRefinementSweeps : 0;
+}
+
+// orientationDensity chosen by the map's size: a window radius of 1/kAutomaticDensityShare of the map's
+// texels (64 at 1024^2) on maps up to kAutomaticDensityTexels; none on larger ones, whose grid's orientation
+// field (4 bytes a cell and its levels) would take a 16384^2 tile past 40 bytes a cell (UV-22, UV-40).
+inline constexpr int32_t kAutomaticDensity = -1;
+inline constexpr int32_t kAutomaticDensityShare = 16;
+inline constexpr int32_t kAutomaticDensityTexels = 8192;
+// The window radius, texels, a map of `texels` per side gets for the option's value `radius`.
+[[nodiscard]] constexpr int32_t orientationDensityFor(int32_t radius, int32_t texels) {
+    if (radius != kAutomaticDensity) return radius;
+    if (texels > kAutomaticDensityTexels) return 0;
+    return texels / kAutomaticDensityShare > 1 ? texels / kAutomaticDensityShare : 1;
 }
 
 // The content-aware UV warp of one UDIM tile, from maps and meshes to redirect maps: binds the rest mesh's
