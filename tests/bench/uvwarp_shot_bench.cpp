@@ -8,12 +8,11 @@
 // against). BM_UvWarpRiggedShotFrame: the rigged Fox running (tests/data/fox: 24 frames of its Run clip
 // skinned in Blender), the shot preset, the argument its refinement sweeps: 0 (none, the reference of the
 // others), -1 (the shot preset: 6 at 1024²), 8, 16. Rigid disks of radius 0.025 on a 0.1 lattice inside the
-// charts. Counters (medians over the frames): frame_ms, solve_ms, redirect_ms, measure_ms; removed_pct (median rigid stretch removed, delivered), inverted
-// (delivered inverted triangles, all frames), repaired (inverted triangles the fold repair unfolded, all
-// frames); on the Fox, ratio_to_spot = its frame_ms over Spot's and, refined, ratio_to_plain = its frame_ms
-// over the unrefined Fox's, in the same run.
-// Requirement: a rigged character's shot frame at most 1.5x the 0.31-0.37 s it cost before the fold repair,
-// on 2 cores.
+// charts. Counters (medians over the frames): frame_ms, solve_ms, redirect_ms, measure_ms; removed_pct
+// (median rigid stretch removed, delivered), inverted (delivered inverted triangles, all frames), repaired
+// (inverted triangles the fold repair unfolded, all frames); on the Fox, ratio_to_spot = its frame_ms over
+// Spot's and, refined, ratio_to_plain = its frame_ms over the unrefined Fox's, in the same run. Requirement:
+// a rigged character's shot frame at most 1.5x the 0.31-0.37 s it cost before the fold repair, on 2 cores.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
