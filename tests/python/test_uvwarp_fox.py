@@ -108,8 +108,7 @@ def test_the_fox_running_keeps_its_rigid_disks_through_every_frame():
     print(f"Fox Run at {T}^2, shot preset: {100 * np.median(removed):.1f}% of the rigid stretch removed (median), "
           f"worst {100 * removed.min():.1f}% (frame {removed.argmin() + 1}); the fold repair unfolded "
           f"{sum(repaired)} inverted triangles in {sum(1 for i in repaired if i)} frames")
-    # Measured 64.3% median, 57.2% worst at 256^2 (the disks are 6 texels across; 53.8% and 46.2% without the
-    # preset's refinement).
+    # Measured 64.9% median, 58.3% worst at 256^2 (the disks are 6 texels across).
     assert np.median(removed) > 0.62 and removed.min() > 0.55
 
 

@@ -63,7 +63,7 @@ const OptionSpec kSpecs[] = {
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
                 "grid's points (a mesh bends at every edge). The shot preset's 6 took rigged characters at "
-                "1024^2 2.0-7.1 points further (rigged Spot 79.4 to 86.5% median), for about 1.5x the time a "
+                "1024^2 1.9-7.4 points further (rigged Spot 80.9 to 88.3% median), for about 1.5x the time a "
                 "frame; the live preset has none.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},
