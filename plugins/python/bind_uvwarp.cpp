@@ -607,7 +607,8 @@ constexpr const char* kSolverDoc =
     "tile: the UDIM tile (1001, ...). Maps are (T, T) or (T, T, 1) float32 images, row 0 at v = 1:\n"
     "rigidity in [0, 1] (1 = as rigid as possible); mask (>= 0.5 may warp; None derives one from the UVs:\n"
     "texels outside every UV triangle and on chart borders stay fixed); orientation in [0, 1] scales\n"
-    "orientation_preservation (None: 1). resolution: grid cells per side n, a power of two (None: T).\n";
+    "orientation_preservation (None: 1, or the density heuristic's map where orientation_density turns it\n"
+    "on, as the shot preset does). resolution: grid cells per side n, a power of two (None: T).\n";
 
 constexpr const char* kSolveDoc =
     "Solve one frame: deformed_points (N, 3) float32, the rest mesh's vertices moved (scene units).\n"
@@ -757,16 +758,19 @@ void bindUvWarp(py::module_& m) {
                 uvwarp::presetOptions(uvwarp::Preset::Live, static_cast<int32_t>(cells));
             py::dict options;
             for (const uvwarp::OptionSpec& spec : uvwarp::optionSpecs()) {
-                if (spec.solver || spec.name == "refinementSweeps")
+                if (spec.solver || spec.name == "refinementSweeps" || spec.name == "orientationDensity")
                     options[py::str(uvwarp::pythonName(spec))] = optionObject(spec, o);
             }
             return options;
         },
         py::arg("cells"),
         "The live-preview preset for a grid of `cells` cells per side, as UvWarpSolver keyword options\n"
-        "(every solver option and refinement_sweeps, 0): one warm-started iteration a frame, the coarse\n"
-        "levels over-relaxed by 1.4, sweeps per level by grid size, no refinement (uvwarp::presetOptions;\n"
-        "within 2 points of a converged solve on every probed frame of a smooth animation).");
+        "(every solver option, refinement_sweeps and orientation_density, both 0): one warm-started "
+        "iteration\n"
+        "a frame, the coarse levels over-relaxed by 1.4, sweeps per level by grid size, no refinement, a\n"
+        "uniform orientation turn (uvwarp::presetOptions; within 2 points of a converged solve on every "
+        "probed\n"
+        "frame of a smooth animation).");
 
     m.def(
         "redirect_metrics",

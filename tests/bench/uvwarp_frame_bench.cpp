@@ -22,8 +22,7 @@
 // r = 2: the live preset's first frame (uvwarp::liveOptions: its cold iterations of its own sweeps; k
 // unused). BM_UvWarpFrameConverged/T, the in-run reference: the last frame solved cold, from the identity,
 // for kColdRounds default solves (a settled warp), plus its redirect map; items/s of the two give the ratio
-// bench_table.py prints (frames per second animated / converged cold). Every row, the reference included,
-// runs the presets' orientation preservation (the density heuristic over 1/16 of the map, UV-40).
+// bench_table.py prints (frames per second animated / converged cold).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -120,13 +119,6 @@ const Inputs& inputs(int32_t texels) {
     return in;
 }
 
-// The library's options with the presets' orientation preservation: what every row starts from.
-TileWarpOptions model() {
-    TileWarpOptions options;
-    options.orientationDensity = kAutomaticDensity;
-    return options;
-}
-
 double reduction(const WarpMetrics& m) {
     return m.identityStretchError > 0.0 ? 100.0 * (1.0 - m.rigidStretchError / m.identityStretchError) : 0.0;
 }
@@ -151,7 +143,7 @@ void BM_UvWarpFrameConverged(benchmark::State& state) {
     io::Image redirect;
     double figure = 0.0;
     for (auto _ : state) {
-        TileWarp cold(spot(), kTile, in.rigidity, {}, model());
+        TileWarp cold(spot(), kTile, in.rigidity);
         for (int round = 0; round < kColdRounds; ++round)
             cold.solve(in.frames.back());
         cold.redirect(redirect);
@@ -162,7 +154,7 @@ void BM_UvWarpFrameConverged(benchmark::State& state) {
     probes[kFrames - 1] = figure;
     for (const int f : kProbeFrames) {  // untimed: the probe frames' references, for worst_gap_pts
         if (probes.contains(f)) continue;
-        TileWarp cold(spot(), kTile, in.rigidity, {}, model());
+        TileWarp cold(spot(), kTile, in.rigidity);
         for (int round = 0; round < kColdRounds; ++round)
             cold.solve(in.frames[f]);
         probes[f] = reduction(cold.metrics());
@@ -177,7 +169,7 @@ void BM_UvWarpFrame(benchmark::State& state) {
     const int64_t schedule = state.range(1);
     const double targetMs = texels >= 2048 ? 141.0 : 33.0;
     const Inputs& in = inputs(texels);
-    TileWarpOptions options = model();
+    TileWarpOptions options;
     if (schedule > 0) options.solver = liveOptions(schedule == 1 ? 1024 : 2048);
     std::vector<double> frameMs, solveMs, redirectMs;
     double animated = 0.0;
@@ -232,7 +224,7 @@ void BM_UvWarpFrame(benchmark::State& state) {
 void BM_UvWarpColdFrame(benchmark::State& state) {
     const auto texels = static_cast<int32_t>(state.range(0));
     const Inputs& in = inputs(texels);
-    TileWarpOptions options = model();
+    TileWarpOptions options;
     options.solver.iterations = static_cast<int32_t>(state.range(1));
     if (state.range(2) == 1) options.solver.coarseRelaxation = 1.4f;
     if (state.range(2) == 2) options.solver = liveOptions(texels);  // its coldIterations, not k

@@ -1,5 +1,7 @@
 #include "deformkit/uvwarp/mask.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -282,7 +284,8 @@ io::Image densityOrientationMap(const io::Image& rigidity, int32_t radius) {
     constexpr int32_t kColumns = 64;
     const int32_t blocks = (w + kColumns - 1) / kColumns;
     double largest = 0.0;
-#pragma omp parallel reduction(max : largest)
+    // A team no larger than the blocks: each thread's prefix sums are (h + 1) x 64 doubles.
+#pragma omp parallel reduction(max : largest) num_threads(std::min(blocks, omp_get_max_threads()))
     {
         std::vector<double> prefix((static_cast<size_t>(h) + 1) * kColumns, 0.0);
 #pragma omp for schedule(static)
@@ -308,7 +311,10 @@ io::Image densityOrientationMap(const io::Image& rigidity, int32_t radius) {
             }
         }
     }
-    if (largest <= 0.0) return out;  // no rigidity: 0 everywhere
+    if (largest <= 0.0) {  // no rigidity: 0 everywhere
+        std::fill(out.pixels.begin(), out.pixels.end(), 0.0f);
+        return out;
+    }
     const auto count = static_cast<int64_t>(w) * h;
 #pragma omp parallel for schedule(static)
     for (int64_t k = 0; k < count; ++k)

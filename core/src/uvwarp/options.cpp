@@ -34,8 +34,8 @@ static_assert(kAutomaticRefinementSweeps == 6 && kAutomaticRefinementCells == 10
               "refinementSweeps' lowMeans states 6 sweeps up to 1024 cells");
 
 // orientationDensity's lowMeans spells the rule of orientationDensityFor out.
-static_assert(kAutomaticDensityShare == 16 && kAutomaticDensityTexels == 8192,
-              "orientationDensity's lowMeans states 1/16 of the map's texels up to 8192^2");
+static_assert(kAutomaticDensityShare == 16 && kAutomaticDensityCells == 8192,
+              "orientationDensity's lowMeans states 1/16 of the map's texels on grids up to 8192 cells");
 
 // geometryImageCells' zeroMeans spells the rule of geometryImageCellsFor out.
 static_assert(kFullGeometryImageCells == 8192,
@@ -187,12 +187,13 @@ const OptionSpec kSpecs[] = {
      .high = 4096,
      .unit = "texels",
      .zeroMeans = "off",
-     .lowMeans = "by the map's size: 1/16 of its texels up to 8192^2, off on larger maps",
-     .meaning = "Without an orientation map: orientation preservation scaled by the rigidity's local "
-                "density over a window of this radius, high where rigid detail is dense and low where it is "
-                "sparse (the paper's heuristic for severe compression, §6). The presets' window of 1/16 of "
-                "the map took rigged characters at 1024^2 further where skinning squashes rigid detail (the "
-                "Fox's Survey 74.3 to 77.3% worst frame, Spot bent 83.6 to 85.6%).",
+     .lowMeans = "by the map's size: 1/16 of its texels, on grids up to 8192 cells, off on finer ones",
+     .meaning =
+         "Without an orientation map: orientation preservation scaled by the rigidity's local "
+         "density over a window of this radius, high where rigid detail is dense and low where it is "
+         "sparse (the paper's heuristic for severe compression, §6). The shot preset's window of 1/16 "
+         "of the map took rigged characters at 1024^2 further where skinning squashes rigid detail (the "
+         "Fox's Survey 74.3 to 77.3% worst frame, Spot bent 83.6 to 85.6%); the live preset has none.",
      .get = TileMember<&TileWarpOptions::orientationDensity>::get,
      .put = TileMember<&TileWarpOptions::orientationDensity>::put},
     {.name = "dilationRings",
@@ -448,7 +449,8 @@ TileWarpOptions presetOptions(Preset preset, int32_t cells) {
     TileWarpOptions options = shotOptions();
     if (preset == Preset::Live) {
         options.solver = liveOptions(cells);
-        options.refinementSweeps = 0;  // a live frame's budget has no room for a grid of twice the cells
+        options.refinementSweeps = 0;    // a live frame's budget has no room for a grid of twice the cells
+        options.orientationDensity = 0;  // nor its memory for the orientation fields (UV-40)
     }
     options.cells = cells;
     return options;

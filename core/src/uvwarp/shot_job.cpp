@@ -353,8 +353,12 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                 sameSize(plan.orientation, "orientation map");
                 noteChannels(plan.orientation, "orientation map");
             } else {
-                plan.report.notes.push_back("no orientation map '" + plan.orientation.name +
-                                            "': orientation preservation as given everywhere");
+                const int32_t cells = plan.options.cells != 0 ? plan.options.cells : r.width;
+                const bool density =
+                    orientationDensityFor(plan.options.orientationDensity, r.width, cells) > 0;
+                plan.report.notes.push_back("no orientation map '" + plan.orientation.name + "': " +
+                                            (density ? "the density heuristic's (orientationDensity)"
+                                                     : "orientation preservation as given everywhere"));
             }
         }
         if (wantBake) {

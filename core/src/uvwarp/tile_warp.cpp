@@ -90,7 +90,7 @@ struct TileWarp::Impl {
     // The warp mask at grid points (maskAtPoints: 0 or 1), a byte a point: boundMask the constructor's
     // (given or derived), setMaps' default; mask the one setMaps was last given, empty when it is boundMask.
     std::vector<uint8_t> mask, boundMask;
-    int32_t densityRadius = 0;  // TileWarpOptions::orientationDensity
+    int32_t densityRadius = 0;  // the density heuristic's window, texels (orientationDensityFor); 0: none
     std::unique_ptr<Solver> solver;
     // TileWarpOptions::refinementSweeps: the grid of twice the cells the last iteration runs on, its imager,
     // f_D and masks (as above), and the figures of a solve through both grids. A refining grid of at most
@@ -214,7 +214,7 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     const io::Image& maskMap = derive ? derivedMask : mask;
     const MapLabel maskLabel{source + (derive ? " derived mask" : " warp mask"), tile};
     const PointField maskAtGrid = maskAtPoints(maskMap, m.cells, maskLabel);
-    m.densityRadius = orientationDensityFor(options.orientationDensity, m.texels);
+    m.densityRadius = orientationDensityFor(options.orientationDensity, m.texels, m.cells);
     io::Image density = m.densityMap(orientation, rigidity);
     PointField orientationAtPoints = m.orientationAt(orientation, density, m.cells);
     if (refinementSweeps > 0) {

@@ -407,8 +407,8 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     // And the amount matters on this scene: 0.5 everywhere differs from 0.
     CHECK(none.pixels != run(nullptr, 0.0f).pixels);
 
-    // A missing tile is reported and means 1 everywhere; a wrong size or a value outside [0, 1] is an error
-    // naming the file.
+    // A missing tile is reported (and means the density heuristic's map, a shot's default); a wrong size or a
+    // value outside [0, 1] is an error naming the file.
     Scene missing;
     missing.command.orientation = missing.dir / "orient.<UDIM>.exr";
     const uvwarp::ShotReport report = harness::uvwarpCommand(missing.command, nullptr);

@@ -196,8 +196,11 @@ TEST_CASE("tile warp: the density map over several column blocks, any thread cou
     const io::Image one = uvwarp::densityOrientationMap(rigidity, r);
     omp_set_num_threads(2);
     const io::Image two = uvwarp::densityOrientationMap(rigidity, r);
+    omp_set_num_threads(3);  // three blocks of columns, one a thread (where three are granted)
+    const io::Image three = uvwarp::densityOrientationMap(rigidity, r);
     omp_set_num_threads(threads);
     CHECK(one.pixels == two.pixels);
+    CHECK(one.pixels == three.pixels);
     double worst = 0.0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
@@ -207,16 +210,20 @@ TEST_CASE("tile warp: the density map over several column blocks, any thread cou
     CHECK(*std::max_element(two.pixels.begin(), two.pixels.end()) == 1.0f);
 }
 
-TEST_CASE("tile warp: the presets' density window by the map's size", "[uvwarp][options]") {
-    // 1/16 of the map's texels, at least 1, off past 8192^2; an explicit radius is kept.
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 1024) == 64);
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8192) == 512);
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 16384) == 0);
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8) == 1);
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(5, 1024) == 5);
-    STATIC_REQUIRE(uvwarp::orientationDensityFor(0, 1024) == 0);
+TEST_CASE("tile warp: the shot preset's density window by the map's size", "[uvwarp][options]") {
+    // 1/16 of the map's texels, at least 1, none on grids of more than 8192 cells (whatever the map's size);
+    // an explicit radius is kept.
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 1024, 1024) == 64);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8192, 8192) == 512);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 16384, 16384) == 0);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8192, 16384) == 0);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 16384, 8192) == 1024);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(uvwarp::kAutomaticDensity, 8, 8) == 1);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(5, 1024, 16384) == 5);
+    STATIC_REQUIRE(uvwarp::orientationDensityFor(0, 1024, 1024) == 0);
     CHECK(uvwarp::shotOptions().orientationDensity == uvwarp::kAutomaticDensity);
-    CHECK(uvwarp::presetOptions(uvwarp::Preset::Live, 256).orientationDensity == uvwarp::kAutomaticDensity);
+    CHECK(uvwarp::presetOptions(uvwarp::Preset::Shot, 256).orientationDensity == uvwarp::kAutomaticDensity);
+    CHECK(uvwarp::presetOptions(uvwarp::Preset::Live, 256).orientationDensity == 0);
     CHECK(uvwarp::TileWarpOptions{}.orientationDensity == 0);
 
     // The automatic window is that radius, bit for bit, and differs from none on a squeezed plane.
@@ -236,6 +243,30 @@ TEST_CASE("tile warp: the presets' density window by the map's size", "[uvwarp][
     };
     CHECK(solved(uvwarp::kAutomaticDensity) == solved(t / 16));
     CHECK(solved(uvwarp::kAutomaticDensity) != solved(0));
+
+    // A refined tile (the shot preset's grid of twice the cells): the heuristic gives both grids the map a
+    // painter would paint, at bind and after setMaps.
+    const io::Image density = uvwarp::densityOrientationMap(rigidity, t / 16);
+    uvwarp::TileWarpOptions refined;
+    refined.refinementSweeps = 2;
+    uvwarp::TileWarpOptions heuristic = refined;
+    heuristic.orientationDensity = uvwarp::kAutomaticDensity;
+    uvwarp::TileWarp byHeuristic(plane, 1001, rigidity, {}, heuristic);
+    uvwarp::TileWarp painted(plane, 1001, rigidity, {}, refined, density);
+    uvwarp::TileWarp uniform(plane, 1001, rigidity, {}, refined);
+    const std::vector<float> a = byHeuristic.solve(squeezed).u;
+    CHECK(a == painted.solve(squeezed).u);
+    CHECK(a != uniform.solve(squeezed).u);
+    io::Image moved(t, t, 1);  // the disks moved: a new density map
+    for (int y = 0; y < t; ++y)
+        for (int x = 0; x < t; ++x)
+            moved.at(x, y, 0) = std::hypot(x - 30.0, y - 20.0) < 6.0 ? 1.0f : 0.0f;
+    byHeuristic.setMaps(moved);
+    painted.setMaps(moved, {}, uvwarp::densityOrientationMap(moved, t / 16));
+    uniform.setMaps(moved);
+    const std::vector<float> b = byHeuristic.solve(squeezed).u;
+    CHECK(b == painted.solve(squeezed).u);
+    CHECK(b != uniform.solve(squeezed).u);
 }
 
 namespace {

@@ -52,8 +52,9 @@ namespace deformkit::uvwarp {
 // - Checks before anything is written: map patterns have a UDIM token; output folders exist; per tile the
 //   maps' sizes (square, equal, a power of two when the grid takes the map's size). A tile without a rigidity
 //   map is left unwarped (no outputs) and reported, unless no tile has one (an error). A missing mask tile is
-//   derived from the UVs, a missing orientation tile means 1 everywhere, a missing texture tile is not baked;
-//   each is reported.
+//   derived from the UVs, a missing orientation tile means the density heuristic's map where
+//   orientationDensity turns it on (the shot's default) and 1 everywhere otherwise, a missing texture tile is
+//   not baked; each is reported.
 // - Animated maps: a rigidity, mask, orientation or texture pattern with a frame token in its file name as
 //   well ("rig.<UDIM>.####.exr", io::ObjSequence tokens) has one file per frame, each checked to exist with
 //   the first one's size before anything is written. The warp gets a frame's maps only when they differ
@@ -78,7 +79,7 @@ struct TileMapSource {
 // a warm-started frame does and removes as much of the rigid stretch, and a frame's maps then depend on that
 // frame alone: not on the frames before it, nor on where a farm chunk or a resumed job begins
 // (docs/decisions.md, UV-20). Hosts that show a live preview, one iteration a frame, warm-start instead
-// (TileWarpOptions{}).
+// (the live preset, presetOptions).
 [[nodiscard]] TileWarpOptions shotOptions();
 
 struct ShotJob {

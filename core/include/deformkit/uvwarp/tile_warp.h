@@ -62,15 +62,16 @@ inline constexpr int32_t kAutomaticRefinementCells = 1024;
 }
 
 // orientationDensity chosen by the map's size: a window radius of 1/kAutomaticDensityShare of the map's
-// texels (64 at 1024^2) on maps up to kAutomaticDensityTexels; none on larger ones, whose grid's orientation
-// field (4 bytes a cell and its levels) would take a 16384^2 tile past 40 bytes a cell (UV-22, UV-40).
+// texels (64 at 1024^2), on grids up to kAutomaticDensityCells cells; none on finer grids, whose orientation
+// field (4 bytes a cell and its levels) would take a 16384-cell tile past 40 bytes a cell (UV-22, UV-40).
 inline constexpr int32_t kAutomaticDensity = -1;
 inline constexpr int32_t kAutomaticDensityShare = 16;
-inline constexpr int32_t kAutomaticDensityTexels = 8192;
-// The window radius, texels, a map of `texels` per side gets for the option's value `radius`.
-[[nodiscard]] constexpr int32_t orientationDensityFor(int32_t radius, int32_t texels) {
+inline constexpr int32_t kAutomaticDensityCells = 8192;
+// The window radius, texels, a map of `texels` per side on a grid of `cells` gets for the option's value
+// `radius` (0: none).
+[[nodiscard]] constexpr int32_t orientationDensityFor(int32_t radius, int32_t texels, int32_t cells) {
     if (radius != kAutomaticDensity) return radius;
-    if (texels > kAutomaticDensityTexels) return 0;
+    if (cells > kAutomaticDensityCells) return 0;
     return texels / kAutomaticDensityShare > 1 ? texels / kAutomaticDensityShare : 1;
 }
 
@@ -114,8 +115,9 @@ class TileWarp {
     void reset();
     // New maps for the next frames (animated maps, a painter's edit): the same size as the bound rigidity
     // map; an empty mask keeps the mask derived from the UVs (or the bound one), an empty orientation means
-    // 1 everywhere. Rebuilds the solver's hierarchy (Eq. 7-8) and keeps the warp, so the next solve warm-
-    // starts from it. Throws InvalidInput as the constructor does for a map of the wrong size or values.
+    // the density heuristic's map where orientationDensity turns it on, else 1 everywhere. Rebuilds the
+    // solver's hierarchy (Eq. 7-8) and keeps the warp, so the next solve warm- starts from it. Throws
+    // InvalidInput as the constructor does for a map of the wrong size or values.
     void setMaps(const io::Image& rigidity, const io::Image& mask = {}, const io::Image& orientation = {});
 
     [[nodiscard]] int tile() const;
