@@ -97,7 +97,8 @@ const OptionSpec kSpecs[] = {
     {.name = "sweepsPerLevel",
      .type = OptionType::IntegerList,
      .high = 1000,
-     .zeroMeans = "by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048",
+     .zeroMeans = "by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; the finest level 2 "
+                  "from 1024 cells where a refinement follows",
      .meaning = "Constraint-projection sweeps (all 8 parallel sets) per iteration at each hierarchy level, "
                 "finest first; levels beyond the list use its last value.",
      .solver = true,

@@ -843,9 +843,10 @@ std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
             {"converged", Kind::Flag, s.converged ? 1.0 : 0.0}};
 }
 
-std::vector<int32_t> defaultSweeps(int32_t cells) {
-    if (cells <= 1024) return {4, 8, 16};
-    return {4, 8, 16, 32, 64};
+std::vector<int32_t> defaultSweeps(int32_t cells, bool refined) {
+    const int32_t finest = refined && cells >= kHalvedFinestCells ? 2 : 4;
+    if (cells <= 1024) return {finest, 8, 16};
+    return {finest, 8, 16, 32, 64};
 }
 
 SolverOptions liveOptions(int32_t cells) {

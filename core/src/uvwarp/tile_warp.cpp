@@ -233,8 +233,11 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     }
     derivedMask = {};
     density = {};
+    SolverOptions solverOptions = options.solver;
+    if (refinementSweeps > 0 && solverOptions.sweepsPerLevel.empty())
+        solverOptions.sweepsPerLevel = defaultSweeps(m.cells, true);  // a refinement follows each solve
     m.solver = std::make_unique<Solver>(std::move(restImage), std::move(rigidityAtGrid), maskAtGrid,
-                                        options.solver, std::move(orientationAtPoints),
+                                        solverOptions, std::move(orientationAtPoints),
                                         source + ", UDIM tile " + std::to_string(tile));
     m.boundMask = maskBytes(maskAtGrid);
     m.keepDeformed = options.solver.warmStart;

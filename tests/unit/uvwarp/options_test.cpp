@@ -199,7 +199,8 @@ TEST_CASE("uv warp options: the presets and defaults are valid; zero iterations 
     CHECK_THROWS_WITH(
         uvwarp::checkOptions(idle, "tile 1001"),
         "tile 1001: option sweepsPerLevel: is [0, 0] (expected a list of whole numbers from 0 to 1000, not "
-        "all 0; empty: by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048)");
+        "all 0; empty: by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; the finest level "
+        "2 from 1024 cells where a refinement follows)");
 }
 
 TEST_CASE("uv warp options: the solver and the tile warp refuse each option out of range by its name",

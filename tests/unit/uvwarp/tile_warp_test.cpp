@@ -291,6 +291,9 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
     CHECK(uvwarp::defaultSweeps(1024) == std::vector<int32_t>{4, 8, 16});
     CHECK(uvwarp::defaultSweeps(2048) == std::vector<int32_t>{4, 8, 16, 32, 64});
     CHECK(uvwarp::defaultSweeps(16384) == std::vector<int32_t>{4, 8, 16, 32, 64});
+    CHECK(uvwarp::defaultSweeps(512, true) == std::vector<int32_t>{4, 8, 16});
+    CHECK(uvwarp::defaultSweeps(uvwarp::kHalvedFinestCells, true) == std::vector<int32_t>{2, 8, 16});
+    CHECK(uvwarp::defaultSweeps(2048, true) == std::vector<int32_t>{2, 8, 16, 32, 64});
     CHECK(uvwarp::SolverOptions{}.sweepsPerLevel.empty());
     const geom::Mesh plane = uvPlane(8);
     std::vector<glm::vec3> stretched(plane.points().begin(), plane.points().end());
@@ -311,6 +314,40 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
         uvwarp::TileWarp b(plane, 1001, rigidity, {}, spelled);
         CHECK(a.solve(stretched).u == b.solve(stretched).u);
         CHECK(a.warp().v == b.warp().v);
+    }
+}
+
+TEST_CASE("uv warp: a refined grid's empty schedule halves its finest sweeps from 1024 cells, byte for byte",
+          "[uvwarp][options][slow]") {
+    // With refinement sweeps, the solved grid's default schedule is defaultSweeps(cells, true): on a grid of
+    // kHalvedFinestCells the same warp as {2, 8, 16} spelled out and not the unrefined default's {4, 8, 16};
+    // on a coarser grid the unrefined default's.
+    const geom::Mesh plane = uvPlane(8);
+    std::vector<glm::vec3> stretched(plane.points().begin(), plane.points().end());
+    for (glm::vec3& p : stretched)
+        p.x *= 1.0f + 0.5f * p.x;
+    for (const int32_t texels : {512, uvwarp::kHalvedFinestCells}) {
+        CAPTURE(texels);
+        io::Image rigidity(texels, texels, 1);
+        for (int32_t y = 0; y < texels; ++y)
+            for (int32_t x = 0; x < texels; ++x)
+                rigidity.at(x, y, 0) =
+                    std::hypot(x + 0.5 - texels / 2.0, y + 0.5 - texels / 2.0) < texels / 6.0;
+        uvwarp::TileWarpOptions automatic;
+        automatic.solver.iterations = 1;
+        automatic.refinementSweeps = 2;
+        uvwarp::TileWarpOptions halved = automatic, full = automatic;
+        halved.solver.sweepsPerLevel = {2, 8, 16};
+        full.solver.sweepsPerLevel = {4, 8, 16};
+        const bool halves = texels >= uvwarp::kHalvedFinestCells;
+        uvwarp::TileWarp a(plane, 1001, rigidity, {}, automatic);
+        uvwarp::TileWarp b(plane, 1001, rigidity, {}, halves ? halved : full);
+        uvwarp::TileWarp c(plane, 1001, rigidity, {}, halves ? full : halved);
+        const uvwarp::WarpGrid warp = a.solve(stretched);
+        CHECK(warp.cells == 2 * texels);  // the refined grid's warp is the one delivered
+        CHECK(warp.u == b.solve(stretched).u);
+        CHECK(warp.v == b.warp().v);
+        CHECK(warp.u != c.solve(stretched).u);
     }
 }
 

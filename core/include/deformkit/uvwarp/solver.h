@@ -70,8 +70,12 @@ struct SolverOptions {
 // The default schedule (SolverOptions::sweepsPerLevel empty) of a grid of `cells` cells per side: {4, 8, 16}
 // up to 1024 cells; from 2048, where rigid detail spans more cells and the hierarchy is deeper, the sweeps
 // double with each coarser level up to 64, {4, 8, 16, 32, 64}, so that the rigid stretch removed on a fully
-// covered tile stays within 2 points from 2048^2 to 8192^2 (docs/decisions.md UV-19).
-[[nodiscard]] std::vector<int32_t> defaultSweeps(int32_t cells);
+// covered tile stays within 2 points from 2048^2 to 8192^2 (docs/decisions.md UV-19). `refined`: a grid of
+// at least kHalvedFinestCells cells whose solve a refinement follows (TileWarpOptions::refinementSweeps)
+// sweeps its finest level half as often, 2 instead of 4: the refining grid's sweeps take the finest detail
+// over from there. Coarser grids keep 4: their finest level carries more of the detail (UV-41).
+inline constexpr int32_t kHalvedFinestCells = 1024;
+[[nodiscard]] std::vector<int32_t> defaultSweeps(int32_t cells, bool refined = false);
 
 // The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the
 // coarse levels over-relaxed by 1.4, sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
