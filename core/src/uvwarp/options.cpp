@@ -33,6 +33,10 @@ struct TileMember {
 static_assert(kAutomaticRefinementSweeps == 6 && kAutomaticRefinementCells == 1024,
               "refinementSweeps' lowMeans states 6 sweeps up to 1024 cells");
 
+// sweepsPerLevel's zeroMeans spells the rule of defaultSweeps out.
+static_assert(kHalvedFinestCells == 1024,
+              "sweepsPerLevel's zeroMeans states the finest level 2 from 1024 cells");
+
 // orientationDensity's lowMeans spells the rule of orientationDensityFor out.
 static_assert(kAutomaticDensityShare == 16 && kAutomaticDensityCells == 8192,
               "orientationDensity's lowMeans states 1/16 of the map's texels on grids up to 8192 cells");
@@ -63,8 +67,8 @@ const OptionSpec kSpecs[] = {
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
                 "grid's points (a mesh bends at every edge). The shot preset's 6 took rigged characters at "
-                "1024^2 1.9-7.4 points further (rigged Spot 80.9 to 88.3% median), for about 1.5x the time a "
-                "frame; the live preset has none.",
+                "1024^2 1.8-7.3 points further (rigged Spot 80.9 to 88.2% median), for 1.16-1.39x the time "
+                "a frame; the live preset has none.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},
     {.name = "iterations",
@@ -194,7 +198,7 @@ const OptionSpec kSpecs[] = {
          "density over a window of this radius, high where rigid detail is dense and low where it is "
          "sparse (the paper's heuristic for severe compression, §6). The shot preset's window of 1/16 "
          "of the map took rigged characters at 1024^2 further where skinning squashes rigid detail (the "
-         "Fox's Survey 74.3 to 77.3% worst frame, Spot bent 83.6 to 85.6%); the live preset has none.",
+         "Fox's Survey 73.3 to 79.0% worst frame, Spot bent 83.5 to 85.7%); the live preset has none.",
      .get = TileMember<&TileWarpOptions::orientationDensity>::get,
      .put = TileMember<&TileWarpOptions::orientationDensity>::put},
     {.name = "dilationRings",

@@ -33,7 +33,8 @@ struct SolverOptions {
     float tolerance = 0.0f;
     // Constraint-projection sweeps (all 8 parallel sets) per iteration at each level, finest first; levels
     // beyond the list use its last value. Coarse levels are cheap and carry the large-scale motion. Empty
-    // (the default): by the grid's size, defaultSweeps(cells).
+    // (the default): by the grid's size, defaultSweeps(cells); a refined TileWarp's solved grid:
+    // defaultSweeps(cells, true).
     std::vector<int32_t> sweepsPerLevel;
     // Orientation preservation in [0, 1] (§4.2): after projection a segment is turned this fraction of the
     // way back towards its canonical direction (0°, 45°, 90°, 135°). Multiplied by the optional map.
