@@ -54,6 +54,23 @@ io::Image diskRigidity(int texels) {
     return map;
 }
 
+// One rigid disk of radius T / 6 texels at the tile's centre, elastic elsewhere; T x T texels.
+io::Image centreDisk(int32_t texels) {
+    io::Image map(texels, texels, 1);
+    for (int32_t y = 0; y < texels; ++y)
+        for (int32_t x = 0; x < texels; ++x)
+            map.at(x, y, 0) = std::hypot(x + 0.5 - texels / 2.0, y + 0.5 - texels / 2.0) < texels / 6.0;
+    return map;
+}
+
+// The mesh stretched along x by 1 + 0.5 x: 1x at x = 0 growing to 1.5x at x = 1.
+std::vector<glm::vec3> widening(const geom::Mesh& mesh) {
+    std::vector<glm::vec3> out(mesh.points().begin(), mesh.points().end());
+    for (glm::vec3& p : out)
+        p.x *= 1.0f + 0.5f * p.x;
+    return out;
+}
+
 std::vector<glm::vec3> stretched(const geom::Mesh& mesh, float sx) {
     std::vector<glm::vec3> out(mesh.points().begin(), mesh.points().end());
     for (auto& p : out)
@@ -296,16 +313,10 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
     CHECK(uvwarp::defaultSweeps(2048, true) == std::vector<int32_t>{2, 8, 16, 32, 64});
     CHECK(uvwarp::SolverOptions{}.sweepsPerLevel.empty());
     const geom::Mesh plane = uvPlane(8);
-    std::vector<glm::vec3> stretched(plane.points().begin(), plane.points().end());
-    for (glm::vec3& p : stretched)
-        p.x *= 1.0f + 0.5f * p.x;
+    const std::vector<glm::vec3> stretched = widening(plane);
     for (const int32_t texels : {64, 2048}) {
         CAPTURE(texels);
-        io::Image rigidity(texels, texels, 1);
-        for (int32_t y = 0; y < texels; ++y)
-            for (int32_t x = 0; x < texels; ++x)
-                rigidity.at(x, y, 0) =
-                    std::hypot(x + 0.5 - texels / 2.0, y + 0.5 - texels / 2.0) < texels / 6.0;
+        const io::Image rigidity = centreDisk(texels);
         uvwarp::TileWarpOptions automatic;
         automatic.solver.iterations = 1;
         uvwarp::TileWarpOptions spelled = automatic;
@@ -323,16 +334,10 @@ TEST_CASE("uv warp: a refined grid's empty schedule halves its finest sweeps fro
     // kHalvedFinestCells the same warp as {2, 8, 16} spelled out and not the unrefined default's {4, 8, 16};
     // on a coarser grid the unrefined default's.
     const geom::Mesh plane = uvPlane(8);
-    std::vector<glm::vec3> stretched(plane.points().begin(), plane.points().end());
-    for (glm::vec3& p : stretched)
-        p.x *= 1.0f + 0.5f * p.x;
+    const std::vector<glm::vec3> stretched = widening(plane);
     for (const int32_t texels : {512, uvwarp::kHalvedFinestCells}) {
         CAPTURE(texels);
-        io::Image rigidity(texels, texels, 1);
-        for (int32_t y = 0; y < texels; ++y)
-            for (int32_t x = 0; x < texels; ++x)
-                rigidity.at(x, y, 0) =
-                    std::hypot(x + 0.5 - texels / 2.0, y + 0.5 - texels / 2.0) < texels / 6.0;
+        const io::Image rigidity = centreDisk(texels);
         uvwarp::TileWarpOptions automatic;
         automatic.solver.iterations = 1;
         automatic.refinementSweeps = 2;
