@@ -277,7 +277,9 @@ void addUvWarpCommand(CommandLine& cli) {
         const std::string help = std::string(spec.meaning) + " (" + uvwarp::expectedValue(spec) + ")";
         switch (spec.type) {
             case uvwarp::OptionType::Flag:
-                o->given.push_back(uvwarp.flag(names, o->flags[i], std::string(spec.meaning)));
+                o->given.push_back(uvwarp.flag(
+                    names, o->flags[i],
+                    std::string(spec.meaning) + " (" + uvwarp::cliName(spec) + "=false turns it off)"));
                 break;
             case uvwarp::OptionType::IntegerList:
                 o->given.push_back(

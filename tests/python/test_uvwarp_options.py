@@ -109,7 +109,10 @@ def test_the_command_line_takes_every_option_by_its_name_and_range(shot):
     (folder / "cli").mkdir()
     for o in OPTIONS:
         value = in_range(o)
-        args += [o["cli"]] if o["type"] == "flag" else [o["cli"], cli_text(value)]
+        if o["type"] == "flag":  # a flag on in a shot is turned off as --name=false
+            args += [o["cli"] if value else o["cli"] + "=false"]
+        else:
+            args += [o["cli"], cli_text(value)]
     done = run(*args)
     assert done.returncode == 0, done.stderr
     header = dk.read_image_info(str(folder / "cli" / "redirect.1001.0001.exr"))["attributes"]

@@ -590,6 +590,7 @@ TileWarpOptions shotOptions() {
     options.solver.warmStart = false;
     options.refinementSweeps = kAutomaticRefinement;
     options.orientationDensity = kAutomaticDensity;
+    options.seamSlide = true;
     return options;
 }
 

@@ -429,6 +429,19 @@ struct Solver::Impl : detail::SolverState {
         return sweeps[std::min(level, sweeps.size() - 1)];
     }
 
+    // Points placed off their rest positions (placePoints), whether each is fixed, and placing them: the
+    // fixed ones, and with movableToo the others (a solve from the identity starts there).
+    std::vector<int64_t> placedIndex;
+    std::vector<float> placedU, placedV;
+    std::vector<uint8_t> placedFixed;
+    void placeListed(bool movableToo) {
+        for (size_t k = 0; k < placedIndex.size(); ++k) {
+            if (!placedFixed[k] && !movableToo) continue;
+            grid.u[placedIndex[k]] = placedU[k];
+            grid.v[placedIndex[k]] = placedV[k];
+        }
+    }
+
     // Whether the last iteration's fold repair spread (FoldRepair::restart).
     bool lastRepairSpread = false;
 
@@ -826,6 +839,8 @@ void Solver::setMaps(PointField rigidity, const PointField& mask, PointField ori
             m.velV[k] = 0.0f;
         }
     }
+    for (size_t k = 0; k < m.placedIndex.size(); ++k)  // placed points the new mask fixes, or frees
+        m.placedFixed[k] = finest.movable(static_cast<size_t>(m.placedIndex[k])) ? 0 : 1;
     m.fixedFolds = -1;  // other cells may change now: their folds are counted again
 }
 
@@ -912,11 +927,58 @@ void Solver::keepSolveState(bool keep) {
     if (!keep && !m.options.warmStart) m.releaseSolveState();
 }
 
+void Solver::placePoints(std::span<const int64_t> index, std::span<const float> u, std::span<const float> v) {
+    Impl& m = *impl_;
+    if (u.size() != index.size() || v.size() != index.size()) {
+        throw InvalidInput(formatError(m.source, "placed points",
+                                       std::to_string(index.size()) + " indices, " +
+                                           std::to_string(u.size()) + " u and " + std::to_string(v.size()) +
+                                           " v",
+                                       "as many positions as indices"));
+    }
+    const auto points = static_cast<int64_t>(m.grid.numPoints());
+    for (size_t k = 0; k < index.size(); ++k) {
+        if (index[k] < 0 || index[k] >= points || (k > 0 && index[k] <= index[k - 1]) ||
+            !std::isfinite(u[k]) || !std::isfinite(v[k])) {
+            throw InvalidInput(formatError(m.source, "placed point " + std::to_string(k),
+                                           "is point " + std::to_string(index[k]) + " at (" +
+                                               std::to_string(u[k]) + ", " + std::to_string(v[k]) + ")",
+                                           "a grid point below " + std::to_string(points) +
+                                               ", after the one before, at a finite position"));
+        }
+    }
+    // The points listed before go back to rest where they are fixed, then the new ones are placed.
+    const int32_t side = m.grid.side();
+    const auto n = static_cast<float>(m.cells);
+    for (size_t k = 0; k < m.placedIndex.size(); ++k) {
+        if (!m.placedFixed[k]) continue;
+        const int64_t p = m.placedIndex[k];
+        m.grid.u[p] = static_cast<float>(p % side) / n;
+        m.grid.v[p] = static_cast<float>(p / side) / n;
+    }
+    m.placedIndex.clear();
+    m.placedU.clear();
+    m.placedV.clear();
+    m.placedFixed.clear();
+    const Level& finest = m.levels[0];
+    for (size_t k = 0; k < index.size(); ++k) {
+        const auto i = static_cast<int32_t>(index[k] % side), j = static_cast<int32_t>(index[k] / side);
+        if (i == 0 || j == 0 || i == m.cells || j == m.cells) continue;
+        m.placedIndex.push_back(index[k]);
+        m.placedU.push_back(u[k]);
+        m.placedV.push_back(v[k]);
+        m.placedFixed.push_back(finest.rigidity[finest.index(i, j)] < 0.0f ? 1 : 0);  // kFixed < 0
+    }
+    m.placeListed(m.fromIdentity);
+    m.fixedFolds = -1;  // fixed points moved: their cells' folds are counted again
+}
+
 void Solver::reset() {
     Impl& m = *impl_;
     m.grid.setIdentity(m.cells);
     m.fromIdentity = true;
-    m.fixedFolds = 0;  // the identity has none
+    m.placeListed(true);
+    m.fixedFolds = m.placedIndex.empty() ? 0 : -1;  // the identity has none; placed points are counted
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);
 }
@@ -950,6 +1012,7 @@ void Solver::startFrom(const WarpGrid& coarser) {
     }
     std::fill(m.velU.begin(), m.velU.end(), 0.0f);
     std::fill(m.velV.begin(), m.velV.end(), 0.0f);
+    m.placeListed(false);
     m.fromIdentity = false;
     m.started = true;
     m.fixedFolds = -1;  // the fixed cells moved with the map: counted again

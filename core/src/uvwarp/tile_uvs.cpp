@@ -152,6 +152,8 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
             out.borderEdges.push_back(
                 {uvs[corners[use.corner]] - out.origin, uvs[corners[(use.corner + 1) % n]] - out.origin});
             out.borderTriangle.push_back(firstTriangle[use.face] + m);
+            const auto points = mesh.face(use.face);
+            out.borderPoints.push_back({points[use.corner], points[(use.corner + 1) % n]});
         }
         begin = end;
     }

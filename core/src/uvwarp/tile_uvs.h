@@ -34,6 +34,7 @@ struct TileUVs {
     // inside stacked copies of a shell stays interior while their outlines stay borders).
     std::vector<std::array<glm::vec2, 2>> borderEdges;  // tile-local UV segments
     std::vector<int32_t> borderTriangle;                // #borderEdges: the triangle holding each edge
+    std::vector<std::array<int32_t, 2>> borderPoints;   // #borderEdges: the mesh points at its two ends
 };
 
 // "mesh 'x'" style label for errors about tile `tile` of input `label`.

@@ -13,6 +13,7 @@
 #include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/redirect_metrics.h"
 #include "memory/large_buffers.h"
+#include "seam_slide.h"
 #include "tile_uvs.h"
 
 namespace deformkit::uvwarp {
@@ -104,6 +105,10 @@ struct TileWarp::Impl {
     PointField refinedDeformed;
     std::vector<uint8_t> refinedMask, refinedBoundMask;
     [[nodiscard]] bool refinementKept() const { return refinedCells <= kKeptRefinementCells; }
+    // TileWarpOptions::seamSlide with a derived mask and seams in the tile: where the solved grid's points
+    // next to seams are placed each frame (the refining grid's fixed points follow the solved warp).
+    std::unique_ptr<detail::SeamSlide> slide;
+    int slideGrid = -1;
     SolveStats stats;
     bool solved = false;
     std::optional<RedirectMetrics> delivered;  // the figures of the redirect map a renderer reads
@@ -240,6 +245,13 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
                                         solverOptions, std::move(orientationAtPoints),
                                         source + ", UDIM tile " + std::to_string(tile));
     m.boundMask = maskBytes(maskAtGrid);
+    if (options.seamSlide && derive) {
+        m.slide = std::make_unique<detail::SeamSlide>(rest, uvs, rigidity);
+        if (m.slide->chains() > 0)
+            m.slideGrid = m.slide->addGrid(m.cells);
+        else
+            m.slide.reset();
+    }
     m.keepDeformed = options.solver.warmStart;
     m.delivered.emplace(rest, std::move(uvs), std::move(rigidity), source);
     m.lastDeformed.assign(rest.points().begin(), rest.points().end());
@@ -260,6 +272,11 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
     m.imager->sample(deformedPoints, m.deformed);
     m.lastDeformed.assign(deformedPoints.begin(), deformedPoints.end());
     m.solved = true;
+    if (m.slide && m.mask.empty()) {  // the derived mask (setMaps given none)
+        m.slide->update(deformedPoints);
+        const detail::SlidPoints& p = m.slide->points(m.slideGrid);
+        m.solver->placePoints(p.index, p.u, p.v);
+    }
     const WarpGrid& warp = m.solver->solve(m.deformed);
     m.stats = m.solver->stats();
     if (!m.keepDeformed) m.deformed = {};
@@ -366,6 +383,10 @@ void TileWarp::setMaps(const io::Image& rigidity, const io::Image& mask, const i
         m.refinedMask.shrink_to_fit();
     }
     m.delivered->setRigidity(rigidity);
+    if (m.slide) {
+        m.slide->setRigidity(rigidity);
+        if (!mask.pixels.empty()) m.solver->placePoints({}, {}, {});  // a painted mask: its borders stay
+    }
     if (mask.pixels.empty())
         m.mask.clear();  // the bound mask again
     else

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -158,6 +159,13 @@ class Solver {
     // fixes keep the map `coarser` gives them. Throws InvalidInput when `coarser` has not half the cells or
     // is not finite.
     void startFrom(const WarpGrid& coarser);
+    // Points placed off their rest positions (TileWarpOptions::seamSlide: content slid along seams): point
+    // index[k] (j * (n + 1) + i, ascending) at (u[k], v[k]). A listed point the mask fixes sits there from
+    // now on, and after every reset() and startFrom(); a listed point that may move starts there when a solve
+    // starts from the identity (the next one, if it does, and every one after a reset()). Points on the tile
+    // border are left out; an empty list puts the points listed before back at rest. Throws InvalidInput for
+    // lists of different lengths, an index out of the grid or not ascending, or a position not finite.
+    void placePoints(std::span<const int64_t> index, std::span<const float> u, std::span<const float> v);
     // Without warmStart: whether the solve's state (velocities, the coarser levels' working copies) keeps its
     // memory between solves instead of being allocated and freed by each solve. The same bytes either way:
     // each solve starts from zero velocities (reset or startFrom), and the copies are written before use.

@@ -38,6 +38,10 @@ struct TileWarpOptions {
     // memory; f_O and f_D are affine inside each UV triangle, where the solver's bilinear look-ups between
     // the image's points are then exact). 0: geometryImageCellsFor.
     int32_t geometryImageCells = 0;
+    // With a derived mask: content next to a seam (a chart border whose mesh edges have their other UV copy
+    // in the tile) slides along it, the same way in both charts, so that rigid detail a seam cuts is undone
+    // along the seam as well (docs/decisions.md UV-42). Off: chart borders are fixed. The shot preset's.
+    bool seamSlide = false;
 };
 
 // The geometry images of grids up to this many cells have the grid's cells; finer grids' have half of them
