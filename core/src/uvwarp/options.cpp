@@ -207,7 +207,8 @@ const OptionSpec kSpecs[] = {
          "density over a window of this radius, high where rigid detail is dense and low where it is "
          "sparse (the paper's heuristic for severe compression, §6). The shot preset's window of 1/16 "
          "of the map took rigged characters at 1024^2 further where skinning squashes rigid detail (the "
-         "Fox's Survey 73.3 to 79.0% worst frame, Spot bent 83.5 to 85.7%); the live preset has none.",
+         "Fox's Survey 73.3 to 79.0% worst frame, Spot bent 83.5 to 85.7%, seams fixed); the live preset has "
+         "none.",
      .get = TileMember<&TileWarpOptions::orientationDensity>::get,
      .put = TileMember<&TileWarpOptions::orientationDensity>::put},
     {.name = "dilationRings",

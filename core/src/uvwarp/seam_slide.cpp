@@ -8,6 +8,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "deformkit/io/sampling.h"
+
 namespace deformkit::uvwarp::detail {
 
 namespace {
@@ -27,20 +29,6 @@ uint64_t edgeKey(int32_t a, int32_t b) {
     const auto lo = static_cast<uint64_t>(static_cast<uint32_t>(std::min(a, b)));
     const auto hi = static_cast<uint64_t>(static_cast<uint32_t>(std::max(a, b)));
     return (lo << 32) | hi;
-}
-
-// Channel 0 of `map` (row 0 at v = 1) at tile-local uv, bilinear between texel centres, clamped.
-float sampleMap(const io::Image& map, glm::vec2 uv) {
-    const int32_t t = map.width;
-    const float x = std::clamp(uv.x * static_cast<float>(t) - 0.5f, 0.0f, static_cast<float>(t - 1));
-    const float y = std::clamp((1.0f - uv.y) * static_cast<float>(t) - 0.5f, 0.0f, static_cast<float>(t - 1));
-    const int32_t x0 = static_cast<int32_t>(x), y0 = static_cast<int32_t>(y);
-    const int32_t x1 = std::min(x0 + 1, t - 1), y1 = std::min(y0 + 1, t - 1);
-    const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
-    const auto at = [&](int32_t xx, int32_t yy) { return map.at(xx, yy, 0); };
-    const float top = at(x0, y0) + fx * (at(x1, y0) - at(x0, y0));
-    const float bottom = at(x0, y1) + fx * (at(x1, y1) - at(x0, y1));
-    return top + fy * (bottom - top);
 }
 
 // Distance from p to segment ab, and the fraction along it of p's nearest point.
@@ -140,9 +128,9 @@ SeamSlide::SeamSlide(const geom::Mesh& rest, const TileUVs& uvs, const io::Image
             const auto lo = static_cast<int32_t>(key >> 32), hi = static_cast<int32_t>(key & 0xffffffffu);
             const int32_t next = point == lo ? hi : lo;
             // Each copy goes on through the edge's copy that shares its UV at `point`.
-            const size_t first = uvAt(key, 0, point) == chain.uv[0].back() ? 0 : 1;
-            chain.uv[0].push_back(uvAt(key, first, next));
-            chain.uv[1].push_back(uvAt(key, 1 - first, next));
+            const size_t same = uvAt(key, 0, point) == chain.uv[0].back() ? 0 : 1;
+            chain.uv[0].push_back(uvAt(key, same, next));
+            chain.uv[1].push_back(uvAt(key, 1 - same, next));
             chain.points.push_back(next);
             point = next;
             if (point == start || !inside(point)) break;
@@ -188,8 +176,16 @@ SeamSlide::SeamSlide(const geom::Mesh& rest, const TileUVs& uvs, const io::Image
 }
 
 void SeamSlide::sampleRigidity(Chain& chain, const io::Image& rigidity) {
-    const int32_t near = std::max(1, rigidity.width / kNearShare);
+    const int32_t near = std::max(kLeastNear, rigidity.width / kNearShare);
     const float texel = 1.0f / static_cast<float>(rigidity.width);
+    std::vector<float> sample(static_cast<size_t>(rigidity.channels));
+    const auto at = [&](glm::vec2 uv) {  // channel 0 at tile-local uv (image row 0 at v = 1), bilinear
+        io::sampleImage(
+            rigidity,
+            {uv.x * static_cast<float>(rigidity.width), (1.0f - uv.y) * static_cast<float>(rigidity.height)},
+            io::SampleFilter::Bilinear, sample);
+        return sample[0];
+    };
     chain.rigidity.assign(chain.restLength.size(), 0.0f);
     for (int32_t e = 0; e < chain.edges(); ++e) {
         const int32_t subs = chain.firstSub[e + 1] - chain.firstSub[e];
@@ -203,8 +199,7 @@ void SeamSlide::sampleRigidity(Chain& chain, const io::Image& rigidity) {
                 const glm::vec2 across =
                     length > 0.0f ? glm::vec2(-along.y, along.x) / length : glm::vec2(0.0f);
                 for (int32_t k = -near; k <= near; ++k)
-                    r = std::max(
-                        r, sampleMap(rigidity, chain.at(c, t) + static_cast<float>(k) * texel * across));
+                    r = std::max(r, at(chain.at(c, t) + static_cast<float>(k) * texel * across));
             }
             chain.rigidity[static_cast<size_t>(chain.firstSub[e] + s)] = std::clamp(r, 0.0f, 1.0f);
         }
@@ -244,12 +239,25 @@ int SeamSlide::addGrid(int32_t cells) {
         const int32_t i1 = std::min(cells - 1, pointOf(std::max(s.a.x, s.b.x) + radius) + 1);
         const int32_t j0 = std::max(1, pointOf(std::min(s.a.y, s.b.y) - radius));
         const int32_t j1 = std::min(cells - 1, pointOf(std::max(s.a.y, s.b.y) + radius) + 1);
-        for (int32_t j = j0; j <= j1; ++j)
-            for (int32_t i = i0; i <= i1; ++i) {
+        for (int32_t j = j0; j <= j1; ++j) {
+            // The columns of row j within `radius` of the segment: those near its part within `radius` of
+            // the row (so a long diagonal border costs its length, not its bounding box's area).
+            const float y = static_cast<float>(j) * cell;
+            float lo = std::min(s.a.x, s.b.x), hi = std::max(s.a.x, s.b.x);
+            if (s.b.y != s.a.y) {
+                const float f0 = std::clamp((y - radius - s.a.y) / (s.b.y - s.a.y), 0.0f, 1.0f);
+                const float f1 = std::clamp((y + radius - s.a.y) / (s.b.y - s.a.y), 0.0f, 1.0f);
+                lo = std::min(s.a.x + f0 * (s.b.x - s.a.x), s.a.x + f1 * (s.b.x - s.a.x));
+                hi = std::max(s.a.x + f0 * (s.b.x - s.a.x), s.a.x + f1 * (s.b.x - s.a.x));
+            }
+            const int32_t first = std::max(i0, pointOf(lo - radius)),
+                          last = std::min(i1, pointOf(hi + radius) + 1);
+            for (int32_t i = first; i <= last; ++i) {
                 const glm::vec2 p{static_cast<float>(i) * cell, static_cast<float>(j) * cell};
                 if (toSegment(p, s.a, s.b).first < radius)
                     near.emplace_back(static_cast<int64_t>(j) * (cells + 1) + i, static_cast<int32_t>(k));
             }
+        }
     }
     std::sort(near.begin(), near.end());
     Grid grid;
@@ -306,9 +314,14 @@ int SeamSlide::addGrid(int32_t cells) {
     return static_cast<int>(grids_.size()) - 1;
 }
 
-void SeamSlide::solveChain(Chain& chain, std::span<const glm::vec3> deformed) const {
+void SeamSlide::solveChain(Chain& chain, std::span<const glm::vec3> deformed) {
     const auto n = chain.restLength.size();
-    std::vector<double> length(static_cast<size_t>(chain.edges())), delta(n), w(n), c(n);
+    Scratch& work = scratch_;  // grown once, kept between frames: a frame allocates nothing
+    std::vector<double>&length = work.length, &delta = work.delta, &w = work.w, &c = work.c;
+    length.resize(static_cast<size_t>(chain.edges()));
+    delta.resize(n);
+    w.resize(n);
+    c.resize(n);
     double total = 0.0;
     for (int32_t e = 0; e < chain.edges(); ++e) {
         length[e] = glm::length(deformed[chain.points[e + 1]] - deformed[chain.points[e]]);
@@ -329,7 +342,10 @@ void SeamSlide::solveChain(Chain& chain, std::span<const glm::vec3> deformed) co
     // (w_{b-1} + w_b + mu) y_b - w_{b-1} y_{b-1} - w_b y_{b+1} = w_{b-1} c_{b-1} - w_b c_b, tridiagonal
     // (Thomas).
     const double mu = kElasticWeight / (kReach * kReach);
-    std::vector<double> y(n + 1, 0.0), upper(n + 1, 0.0), rhs(n + 1, 0.0);
+    std::vector<double>&y = work.y, &upper = work.upper, &rhs = work.rhs;
+    y.assign(n + 1, 0.0);
+    upper.assign(n + 1, 0.0);
+    rhs.assign(n + 1, 0.0);
     for (size_t b = 1; b < n; ++b) {
         const double d = w[b - 1] + w[b] + mu - (b > 1 ? w[b - 1] * upper[b - 1] : 0.0);
         upper[b] = w[b] / d;
@@ -338,7 +354,8 @@ void SeamSlide::solveChain(Chain& chain, std::span<const glm::vec3> deformed) co
     for (size_t b = n - 1; b >= 1; --b)
         y[b] = rhs[b] + upper[b] * y[b + 1];
     // Where each end is shown in deformed arc length, in order (kLeastShare), ending at the chain's end...
-    std::vector<double> shown(n + 1, 0.0);
+    std::vector<double>& shown = work.shown;
+    shown.assign(n + 1, 0.0);
     double identity = 0.0;
     for (size_t j = 0; j < n; ++j) {
         identity += delta[j];
@@ -376,18 +393,22 @@ int32_t SeamSlide::Chain::subOf(float t) const {
                       subs - 1);
 }
 
-void SeamSlide::place(Grid& grid) const {
+void SeamSlide::place(Grid& grid) {
     const size_t count = grid.anchors.size();
     const int32_t n = grid.cells, side = n + 1;
     const float cell = 1.0f / static_cast<float>(n);
     // Each chain's slide may be scaled down per sub-segment, for both copies at once (the repair below).
-    std::vector<std::vector<float>> scale(chains_.size());
-    std::vector<std::vector<uint8_t>> halvings(chains_.size());
+    Scratch& work = scratch_;  // grown once, kept between frames: a frame allocates nothing
+    auto& scale = work.scale;
+    auto& halvings = work.halvings;
+    scale.resize(chains_.size());
+    halvings.resize(chains_.size());
     for (size_t c = 0; c < chains_.size(); ++c) {
         scale[c].assign(chains_[c].restLength.size(), 1.0f);
         halvings[c].assign(chains_[c].restLength.size(), 0);
     }
-    std::vector<glm::vec2> shift(count);
+    std::vector<glm::vec2>& shift = work.shift;
+    shift.resize(count);
     const auto slide = [&](size_t a) {
         const Anchor& anchor = grid.anchors[a];
         const Chain& chain = chains_[static_cast<size_t>(anchor.chain)];
@@ -427,9 +448,13 @@ void SeamSlide::place(Grid& grid) const {
     };
     // The first check, a row of cells at a time: its two rows of points in two rows of slots, so that a
     // check looks each corner up directly.
-    std::vector<int64_t> folded;
-    std::vector<int32_t> lower(static_cast<size_t>(side), -1), upper(static_cast<size_t>(side), -1);
-    std::vector<uint8_t> checked(static_cast<size_t>(n), 0);
+    std::vector<int64_t>& folded = work.folded;
+    std::vector<int32_t>&lower = work.lowerRow, &upper = work.upperRow;
+    std::vector<uint8_t>& checked = work.checked;
+    folded.clear();
+    lower.assign(static_cast<size_t>(side), -1);
+    upper.assign(static_cast<size_t>(side), -1);
+    checked.assign(static_cast<size_t>(n), 0);
     const auto rowOf = [&](int32_t j) {
         return std::pair{grid.rowBegin[static_cast<size_t>(j)], grid.rowBegin[static_cast<size_t>(j) + 1]};
     };
@@ -471,7 +496,8 @@ void SeamSlide::place(Grid& grid) const {
     }
     while (!folded.empty()) {
         // The chains' sub-segments to halve: around each slid corner of a folded cell.
-        std::vector<std::pair<int32_t, int32_t>> subs;  // (chain, sub-segment)
+        std::vector<std::pair<int32_t, int32_t>>& subs = work.subs;  // (chain, sub-segment)
+        subs.clear();
         for (int64_t c : folded) {
             const auto i = static_cast<int32_t>(c % n), j = static_cast<int32_t>(c / n);
             for (int32_t dj = 0; dj <= 1; ++dj)
@@ -488,7 +514,8 @@ void SeamSlide::place(Grid& grid) const {
         }
         std::sort(subs.begin(), subs.end());
         subs.erase(std::unique(subs.begin(), subs.end()), subs.end());
-        std::vector<int64_t> around;
+        std::vector<int64_t>& around = work.around;
+        around.clear();
         for (size_t b = 0; b < subs.size();) {  // runs of sub-segments of one chain
             size_t e = b;
             while (e + 1 < subs.size() && subs[e + 1].first == subs[b].first &&

@@ -13,19 +13,22 @@
 // few texels across the seam) asks for its rest 3D length with weight rho, elastic content for its deformed
 // length with a small weight, and mu keeps a slide local. Chains end, fixed, where charts meet (a mesh point
 // on three or more border copies, or where the copies change) and at borders that are not seams of the tile
-// (open borders, seams into another UDIM tile).
+// (open borders, seams into another UDIM tile); a closed loop of seam is held at its lowest-numbered point.
 //
 // A grid's points nearest to a chain copy then sit where the content they hold is shown: point p, nearest to
-// the copy at parameter t, moves along the copy from uv(t) to uv(t + w (phi(t) - t)), w its share: 1 within a
-// band as wide as the mask's, fading to 0 further into the chart and half-way to another border. Fixed
+// the copy at parameter t, moves along the copy from uv(t) to uv(t + w (phi(t) - t)), w its share: 1 within
+// kBand cells of it (the derived mask's default band of one texel fixes points within about 1.5), fading to
+// 0 over kFade more cells into the chart and half-way to another border. Fixed
 // points stay there; the others start there when a solve starts from the identity (Solver::placePoints).
 // Where that folds a grid cell, the chains of its slid corners slide half as far around them, on both copies
-// at once, until no cell folds: the placement is fold-free by construction and the same on both sides of a
-// seam.
+// at once, until no cell folds: the placement is fold-free by construction. phi and the repair are shared by
+// a seam's two copies; a point's share w depends on its own side's distances, so where a seam's UV outline
+// turns near another border its two sides may differ by a few texels (docs/uvwarp.md, limits).
 
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -51,8 +54,10 @@ class SeamSlide {
     // Sub-segments (about a texel each) over which a slide fades in elastic content: mu = kElasticWeight /
     // kReach^2.
     static constexpr double kReach = 16.0;
-    // Texels across a seam whose rigidity its content takes: the map's texels / kNearShare (6 at 1024^2).
+    // Texels across a seam whose rigidity its content takes: the map's texels / kNearShare (6 at 1024^2), at
+    // least kLeastNear.
     static constexpr int32_t kNearShare = 170;
+    static constexpr int32_t kLeastNear = 2;
     // Grid cells into a chart over which a point's share of the slide fades from 1 to 0, past the band.
     static constexpr float kFade = 6.0f;
     static constexpr float kBand = 2.0f;
@@ -105,12 +110,23 @@ class SeamSlide {
     };
 
     static void sampleRigidity(Chain& chain, const io::Image& rigidity);
-    void solveChain(Chain& chain, std::span<const glm::vec3> deformed) const;
-    void place(Grid& grid) const;
+    void solveChain(Chain& chain, std::span<const glm::vec3> deformed);
+    void place(Grid& grid);
 
     std::vector<Chain> chains_;
     std::vector<std::array<glm::vec2, 2>> still_;  // border copies that do not slide
     std::vector<Grid> grids_;
+    // A frame's working buffers (solveChain, place), kept between frames.
+    struct Scratch {
+        std::vector<double> length, delta, w, c, y, upper, rhs, shown;
+        std::vector<std::vector<float>> scale;
+        std::vector<std::vector<uint8_t>> halvings;
+        std::vector<glm::vec2> shift;
+        std::vector<int32_t> lowerRow, upperRow;
+        std::vector<uint8_t> checked;
+        std::vector<int64_t> folded, around;
+        std::vector<std::pair<int32_t, int32_t>> subs;
+    } scratch_;
 };
 
 }  // namespace deformkit::uvwarp::detail

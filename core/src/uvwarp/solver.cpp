@@ -841,7 +841,8 @@ void Solver::setMaps(PointField rigidity, const PointField& mask, PointField ori
     }
     for (size_t k = 0; k < m.placedIndex.size(); ++k)  // placed points the new mask fixes, or frees
         m.placedFixed[k] = finest.movable(static_cast<size_t>(m.placedIndex[k])) ? 0 : 1;
-    m.fixedFolds = -1;  // other cells may change now: their folds are counted again
+    m.placeListed(false);  // those it fixes sit where they are placed from now on
+    m.fixedFolds = -1;     // other cells may change now: their folds are counted again
 }
 
 std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
@@ -947,11 +948,12 @@ void Solver::placePoints(std::span<const int64_t> index, std::span<const float> 
                                                ", after the one before, at a finite position"));
         }
     }
-    // The points listed before go back to rest where they are fixed, then the new ones are placed.
+    // The points listed before go back to rest where they are fixed, or all of them while the next solve
+    // starts from the identity; then the new ones are placed.
     const int32_t side = m.grid.side();
     const auto n = static_cast<float>(m.cells);
     for (size_t k = 0; k < m.placedIndex.size(); ++k) {
-        if (!m.placedFixed[k]) continue;
+        if (!m.placedFixed[k] && !m.fromIdentity) continue;
         const int64_t p = m.placedIndex[k];
         m.grid.u[p] = static_cast<float>(p % side) / n;
         m.grid.v[p] = static_cast<float>(p / side) / n;
@@ -967,7 +969,7 @@ void Solver::placePoints(std::span<const int64_t> index, std::span<const float> 
         m.placedIndex.push_back(index[k]);
         m.placedU.push_back(u[k]);
         m.placedV.push_back(v[k]);
-        m.placedFixed.push_back(finest.rigidity[finest.index(i, j)] < 0.0f ? 1 : 0);  // kFixed < 0
+        m.placedFixed.push_back(finest.movable(finest.index(i, j)) ? 0 : 1);
     }
     m.placeListed(m.fromIdentity);
     m.fixedFolds = -1;  // fixed points moved: their cells' folds are counted again

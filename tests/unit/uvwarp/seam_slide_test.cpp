@@ -289,3 +289,65 @@ TEST_CASE("Solver::placePoints: fixed points stay placed, movable ones start the
     const std::vector<float> nan{std::nanf("")};
     CHECK_THROWS_AS(solver.placePoints(std::vector<int64_t>{fixedPoint}, nan, one), InvalidInput);
 }
+
+TEST_CASE("seam slide: the Fox's delivered maps, any thread count; a painted mask keeps seams fixed",
+          "[uvwarp][seam]") {
+    // The Fox's frame 18 at 256² (its skinning's hip squash), 2 refinement sweeps, each solve from the
+    // identity: with the slide, points the derived mask fixes move (along seams) but none on the tile border,
+    // the delivered grid and map fold nowhere and show nothing off the charts, and the warp is the same bytes
+    // on 1 and 2 threads. Given the derived mask as a painted one, the slide stops: the warp is the one of a
+    // tile bound without the slide.
+    const geom::Mesh fox = io::readObj(DEFORMKIT_TEST_DATA "/fox/rest.obj").mesh;
+    const geom::Mesh posed = io::readObj(DEFORMKIT_TEST_DATA "/fox/anim.0018.obj").mesh;
+    const std::vector<glm::vec3> points(posed.points().begin(), posed.points().end());
+    constexpr int32_t t = 256;
+    io::Image rigidity(t, t, 1);  // disks of radius 0.025 on a 0.1 lattice, a texel inside the derived mask
+    const io::Image derived = uvwarp::deriveWarpMask(fox, 1001, t);
+    for (int32_t y = 0; y < t; ++y)
+        for (int32_t x = 0; x < t; ++x) {
+            const double u = (x + 0.5) / t, v = 1.0 - (y + 0.5) / t;
+            bool rigid = std::hypot(u - (std::floor(u * 10.0) + 0.5) / 10.0,
+                                    v - (std::floor(v * 10.0) + 0.5) / 10.0) < 0.025;
+            for (int32_t dy = -1; dy <= 1 && rigid; ++dy)
+                for (int32_t dx = -1; dx <= 1 && rigid; ++dx)
+                    rigid = derived.at(std::clamp(x + dx, 0, t - 1), std::clamp(y + dy, 0, t - 1), 0) >= 0.5f;
+            rigidity.at(x, y, 0) = rigid ? 1.0f : 0.0f;
+        }
+    uvwarp::TileWarpOptions options;
+    options.solver.warmStart = false;
+    options.refinementSweeps = 2;
+    options.seamSlide = true;
+    const auto run = [&] {
+        uvwarp::TileWarp warp(fox, 1001, rigidity, {}, options);
+        const uvwarp::WarpGrid grid = warp.solve(points);
+        const uvwarp::DeliveredMetrics delivered = warp.deliveredMetrics();
+        CHECK(delivered.invertedTriangles == 0);
+        CHECK(delivered.offChartTexels == 0);
+        CHECK(uvwarp::countFolds(grid) == 0);
+        const uvwarp::WarpMetrics figures = warp.metrics();
+        CHECK(figures.maxMaskedDisplacement > 0.5);  // texels: border content slid along its seam
+        CHECK(figures.maxBorderDisplacement == 0.0);
+        return grid;
+    };
+    const uvwarp::WarpGrid one = test::withThreads(1, run), two = test::withThreads(2, run);
+    CHECK(one.u == two.u);
+    CHECK(one.v == two.v);
+
+    // The same tile given the derived mask as a painted one after a solve with the slide, then its derived
+    // mask again.
+    uvwarp::TileWarp painted(fox, 1001, rigidity, {}, options);
+    painted.solve(points);
+    painted.setMaps(rigidity, derived);
+    const uvwarp::WarpGrid still = painted.solve(points);
+    uvwarp::TileWarpOptions fixed = options;
+    fixed.seamSlide = false;
+    uvwarp::TileWarp reference(fox, 1001, rigidity, derived, fixed);
+    const uvwarp::WarpGrid expected = reference.solve(points);
+    CHECK(still.u == expected.u);
+    CHECK(still.v == expected.v);
+    CHECK(still.u != one.u);
+    painted.setMaps(rigidity);
+    const uvwarp::WarpGrid again = painted.solve(points);
+    CHECK(again.u == one.u);
+    CHECK(again.v == one.v);
+}

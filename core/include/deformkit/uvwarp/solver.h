@@ -163,7 +163,8 @@ class Solver {
     // index[k] (j * (n + 1) + i, ascending) at (u[k], v[k]). A listed point the mask fixes sits there from
     // now on, and after every reset() and startFrom(); a listed point that may move starts there when a solve
     // starts from the identity (the next one, if it does, and every one after a reset()). Points on the tile
-    // border are left out; an empty list puts the points listed before back at rest. Throws InvalidInput for
+    // border are left out. The points listed before go back to rest where they are fixed, and all of them
+    // when the next solve starts from the identity (an empty list: none placed). Throws InvalidInput for
     // lists of different lengths, an index out of the grid or not ascending, or a position not finite.
     void placePoints(std::span<const int64_t> index, std::span<const float> u, std::span<const float> v);
     // Without warmStart: whether the solve's state (velocities, the coarser levels' working copies) keeps its
