@@ -429,14 +429,13 @@ struct Solver::Impl : detail::SolverState {
         return sweeps[std::min(level, sweeps.size() - 1)];
     }
 
-    // Points placed off their rest positions (placePoints), whether each is fixed, and placing them: the
-    // fixed ones, and with movableToo the others (a solve from the identity starts there).
+    // Points placed off their rest positions (placePoints), and placing them: the fixed ones (by the current
+    // mask), and with movableToo the others (a solve from the identity starts there).
     std::vector<int64_t> placedIndex;
     std::vector<float> placedU, placedV;
-    std::vector<uint8_t> placedFixed;
     void placeListed(bool movableToo) {
         for (size_t k = 0; k < placedIndex.size(); ++k) {
-            if (!placedFixed[k] && !movableToo) continue;
+            if (!movableToo && levels[0].movable(static_cast<size_t>(placedIndex[k]))) continue;
             grid.u[placedIndex[k]] = placedU[k];
             grid.v[placedIndex[k]] = placedV[k];
         }
@@ -839,9 +838,7 @@ void Solver::setMaps(PointField rigidity, const PointField& mask, PointField ori
             m.velV[k] = 0.0f;
         }
     }
-    for (size_t k = 0; k < m.placedIndex.size(); ++k)  // placed points the new mask fixes, or frees
-        m.placedFixed[k] = finest.movable(static_cast<size_t>(m.placedIndex[k])) ? 0 : 1;
-    m.placeListed(false);  // those it fixes sit where they are placed from now on
+    m.placeListed(false);  // placed points the new mask fixes sit where they are placed from now on
     m.fixedFolds = -1;     // other cells may change now: their folds are counted again
 }
 
@@ -952,8 +949,9 @@ void Solver::placePoints(std::span<const int64_t> index, std::span<const float> 
     // starts from the identity; then the new ones are placed.
     const int32_t side = m.grid.side();
     const auto n = static_cast<float>(m.cells);
+    const Level& finest = m.levels[0];
     for (size_t k = 0; k < m.placedIndex.size(); ++k) {
-        if (!m.placedFixed[k] && !m.fromIdentity) continue;
+        if (!m.fromIdentity && finest.movable(static_cast<size_t>(m.placedIndex[k]))) continue;
         const int64_t p = m.placedIndex[k];
         m.grid.u[p] = static_cast<float>(p % side) / n;
         m.grid.v[p] = static_cast<float>(p / side) / n;
@@ -961,15 +959,12 @@ void Solver::placePoints(std::span<const int64_t> index, std::span<const float> 
     m.placedIndex.clear();
     m.placedU.clear();
     m.placedV.clear();
-    m.placedFixed.clear();
-    const Level& finest = m.levels[0];
     for (size_t k = 0; k < index.size(); ++k) {
         const auto i = static_cast<int32_t>(index[k] % side), j = static_cast<int32_t>(index[k] / side);
         if (i == 0 || j == 0 || i == m.cells || j == m.cells) continue;
         m.placedIndex.push_back(index[k]);
         m.placedU.push_back(u[k]);
         m.placedV.push_back(v[k]);
-        m.placedFixed.push_back(finest.movable(finest.index(i, j)) ? 0 : 1);
     }
     m.placeListed(m.fromIdentity);
     m.fixedFolds = -1;  // fixed points moved: their cells' folds are counted again
