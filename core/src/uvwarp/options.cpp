@@ -30,12 +30,12 @@ struct TileMember {
 };
 
 // refinementSweeps' lowMeans spells the rule of refinementSweepsFor out.
-static_assert(kAutomaticRefinementSweeps == 6 && kAutomaticRefinementCells == 1024,
-              "refinementSweeps' lowMeans states 6 sweeps up to 1024 cells");
+static_assert(kAutomaticRefinementSweeps == 4 && kAutomaticRefinementCells == 1024,
+              "refinementSweeps' lowMeans states 4 sweeps up to 1024 cells");
 
 // sweepsPerLevel's zeroMeans spells the rule of defaultSweeps out.
-static_assert(kHalvedFinestCells == 1024,
-              "sweepsPerLevel's zeroMeans states the finest level 2 from 1024 cells");
+static_assert(kHalvedFinestCells == 1024 && kRefinedThirdLevelSweeps == 64,
+              "sweepsPerLevel's zeroMeans states the finest level 2 from 1024 cells, 2 8 64 16 at 1024");
 
 // orientationDensity's lowMeans spells the rule of orientationDensityFor out.
 static_assert(kAutomaticDensityShare == 16 && kAutomaticDensityCells == 8192,
@@ -63,11 +63,11 @@ const OptionSpec kSpecs[] = {
      .low = kAutomaticRefinement,
      .high = 64,
      .zeroMeans = "none",
-     .lowMeans = "by the grid's size: 6 up to 1024 cells, none from 2048",
+     .lowMeans = "by the grid's size: 4 up to 1024 cells, none from 2048",
      .meaning = "Sweeps of one last iteration on a grid of twice the cells, started from the solved warp, "
                 "whose warp is delivered: its points follow the posed surface where it bends between the "
-                "grid's points (a mesh bends at every edge). The shot preset's 6 took rigged characters at "
-                "1024^2 1.8-7.3 points further (rigged Spot 80.9 to 88.2% median), for 1.16-1.39x the time "
+                "grid's points (a mesh bends at every edge). The shot preset's 4 took rigged characters at "
+                "1024^2 1.5-7.0 points further (rigged Spot 80.9 to 87.9% median), for about 1.3x the time "
                 "a frame; the live preset has none.",
      .get = TileMember<&TileWarpOptions::refinementSweeps>::get,
      .put = TileMember<&TileWarpOptions::refinementSweeps>::put},
@@ -101,8 +101,8 @@ const OptionSpec kSpecs[] = {
     {.name = "sweepsPerLevel",
      .type = OptionType::IntegerList,
      .high = 1000,
-     .zeroMeans = "by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; the finest level 2 "
-                  "from 1024 cells where a refinement follows",
+     .zeroMeans = "by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; where a refinement "
+                  "follows, the finest level 2 from 1024 cells, and 2 8 64 16 at 1024",
      .meaning = "Constraint-projection sweeps (all 8 parallel sets) per iteration at each hierarchy level, "
                 "finest first; levels beyond the list use its last value.",
      .solver = true,

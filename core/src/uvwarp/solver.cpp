@@ -857,9 +857,11 @@ std::vector<ReportedFigure> reportedFigures(const SolveStats& s) {
 }
 
 std::vector<int32_t> defaultSweeps(int32_t cells, bool refined) {
-    const int32_t finest = refined && cells >= kHalvedFinestCells ? 2 : 4;
-    if (cells <= 1024) return {finest, 8, 16};
-    return {finest, 8, 16, 32, 64};
+    const bool halved = refined && cells >= kHalvedFinestCells;
+    if (cells <= 1024)
+        return halved ? std::vector<int32_t>{2, 8, kRefinedThirdLevelSweeps, 16}
+                      : std::vector<int32_t>{4, 8, 16};
+    return {halved ? 2 : 4, 8, 16, 32, 64};
 }
 
 SolverOptions liveOptions(int32_t cells) {

@@ -99,8 +99,8 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
         {"tubes.obj",
          R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"sweepsPerLevel": [0, 0]}}])",
          ": objects[0].stack[0].params.sweepsPerLevel: is [0,0] (expected a list of whole numbers from 0 to "
-         "1000, not all 0; empty: by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; the "
-         "finest level 2 from 1024 cells where a refinement follows)"},
+         "1000, not all 0; empty: by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; where "
+         "a refinement follows, the finest level 2 from 1024 cells, and 2 8 64 16 at 1024)"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "params": {"warmStart": 0}}])",
          ": objects[0].stack[0].params.warmStart: is 0 (expected true or false)"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "filter": "lanczos"}])",

@@ -309,7 +309,7 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
     CHECK(uvwarp::defaultSweeps(2048) == std::vector<int32_t>{4, 8, 16, 32, 64});
     CHECK(uvwarp::defaultSweeps(16384) == std::vector<int32_t>{4, 8, 16, 32, 64});
     CHECK(uvwarp::defaultSweeps(512, true) == std::vector<int32_t>{4, 8, 16});
-    CHECK(uvwarp::defaultSweeps(uvwarp::kHalvedFinestCells, true) == std::vector<int32_t>{2, 8, 16});
+    CHECK(uvwarp::defaultSweeps(uvwarp::kHalvedFinestCells, true) == std::vector<int32_t>{2, 8, 64, 16});
     CHECK(uvwarp::defaultSweeps(2048, true) == std::vector<int32_t>{2, 8, 16, 32, 64});
     CHECK(uvwarp::SolverOptions{}.sweepsPerLevel.empty());
     const geom::Mesh plane = uvPlane(8);
@@ -328,11 +328,13 @@ TEST_CASE("uv warp: an empty schedule is the grid's default schedule, byte for b
     }
 }
 
-TEST_CASE("uv warp: a refined grid's empty schedule halves its finest sweeps from 1024 cells, byte for byte",
-          "[uvwarp][options][slow]") {
+TEST_CASE(
+    "uv warp: a refined grid's empty schedule halves its finest sweeps from 1024 cells and sweeps its third "
+    "level 64 times at 1024, byte for byte",
+    "[uvwarp][options][slow]") {
     // With refinement sweeps, the solved grid's default schedule is defaultSweeps(cells, true): on a grid of
-    // kHalvedFinestCells the same warp as {2, 8, 16} spelled out and not the unrefined default's {4, 8, 16};
-    // on a coarser grid the unrefined default's.
+    // kHalvedFinestCells the same warp as {2, 8, 64, 16} spelled out and not the unrefined default's
+    // {4, 8, 16}; on a coarser grid the unrefined default's.
     const geom::Mesh plane = uvPlane(8);
     const std::vector<glm::vec3> stretched = widening(plane);
     for (const int32_t texels : {512, uvwarp::kHalvedFinestCells}) {
@@ -342,7 +344,7 @@ TEST_CASE("uv warp: a refined grid's empty schedule halves its finest sweeps fro
         automatic.solver.iterations = 1;
         automatic.refinementSweeps = 2;
         uvwarp::TileWarpOptions halved = automatic, full = automatic;
-        halved.solver.sweepsPerLevel = {2, 8, 16};
+        halved.solver.sweepsPerLevel = {2, 8, 64, 16};
         full.solver.sweepsPerLevel = {4, 8, 16};
         const bool halves = texels >= uvwarp::kHalvedFinestCells;
         uvwarp::TileWarp a(plane, 1001, rigidity, {}, automatic);
@@ -558,7 +560,7 @@ TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 6 swee
           "[uvwarp][options]") {
     // refinementSweeps -1 (the shot preset's, by the grid's size), as the option's reference states it.
     for (const int32_t cells : {2, 64, 256, 1024})
-        CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 6);
+        CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 4);
     for (const int32_t cells : {2048, 4096, 16384})
         CHECK(uvwarp::refinementSweepsFor(uvwarp::kAutomaticRefinement, cells) == 0);
     CHECK(uvwarp::refinementSweepsFor(0, 64) == 0);
@@ -567,15 +569,15 @@ TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 6 swee
     CHECK(uvwarp::presetOptions(uvwarp::Preset::Live, 1024).refinementSweeps == 0);
     CHECK(uvwarp::TileWarpOptions{}.refinementSweeps == 0);  // the library's warm-started solvers: none
 
-    // A shot on the plane's 128-cell grid delivers the 256-cell grid of 6 explicit sweeps, bit for bit.
+    // A shot on the plane's 128-cell grid delivers the 256-cell grid of 4 explicit sweeps, bit for bit.
     const geom::Mesh mesh = uvPlane(32);
     const std::vector<glm::vec3> pose = stretched(mesh, 1.5f);
     uvwarp::TileWarp shot(mesh, 1001, diskRigidity(128), {}, uvwarp::shotOptions());
     uvwarp::TileWarpOptions explicitSweeps = uvwarp::shotOptions();
-    explicitSweeps.refinementSweeps = 6;
-    uvwarp::TileWarp six(mesh, 1001, diskRigidity(128), {}, explicitSweeps);
+    explicitSweeps.refinementSweeps = 4;
+    uvwarp::TileWarp four(mesh, 1001, diskRigidity(128), {}, explicitSweeps);
     const uvwarp::WarpGrid& delivered = shot.solve(pose);
-    const uvwarp::WarpGrid& reference = six.solve(pose);
+    const uvwarp::WarpGrid& reference = four.solve(pose);
     CHECK(delivered.cells == 256);
     CHECK(delivered.u == reference.u);
     CHECK(delivered.v == reference.v);

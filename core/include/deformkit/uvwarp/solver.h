@@ -75,8 +75,11 @@ struct SolverOptions {
 // covered tile stays within 2 points from 2048^2 to 8192^2 (docs/decisions.md UV-19). `refined`: a grid of
 // at least kHalvedFinestCells cells whose solve a refinement follows (TileWarpOptions::refinementSweeps)
 // sweeps its finest level half as often, 2 instead of 4: the refining grid's sweeps take the finest detail
-// over from there. Coarser grids keep 4: their finest level carries more of the detail (UV-41).
+// over from there (UV-41). Coarser grids keep 4: their finest level carries more of the detail. A refined
+// grid of 1024 cells sweeps its third level (points 4 cells apart) kRefinedThirdLevelSweeps times: what
+// rigid detail 5-25 texels inside a chart border keeps is the mid-scale's convergence (UV-43).
 inline constexpr int32_t kHalvedFinestCells = 1024;
+inline constexpr int32_t kRefinedThirdLevelSweeps = 64;
 [[nodiscard]] std::vector<int32_t> defaultSweeps(int32_t cells, bool refined = false);
 
 // The live-preview preset for a grid of `cells` cells per side: one warm-started iteration a frame, the

@@ -57,7 +57,7 @@ inline constexpr int32_t kFullGeometryImageCells = 8192;
 // kAutomaticRefinementCells cells, none on finer grids (they sample the posed surface as finely already, and
 // the refining grid would hold four times their memory).
 inline constexpr int32_t kAutomaticRefinement = -1;
-inline constexpr int32_t kAutomaticRefinementSweeps = 6;
+inline constexpr int32_t kAutomaticRefinementSweeps = 4;
 inline constexpr int32_t kAutomaticRefinementCells = 1024;
 // The refinement sweeps a grid of `cells` cells runs for the option's value `sweeps`.
 [[nodiscard]] constexpr int32_t refinementSweepsFor(int32_t sweeps, int32_t cells) {
