@@ -112,6 +112,26 @@ def test_the_fox_running_keeps_its_rigid_disks_through_every_frame():
     assert np.median(removed) > 0.62 and removed.min() > 0.55
 
 
+
+def test_the_fox_running_meets_the_goal_at_1024():
+    """The goal docs/uvwarp_quality.md measures against: with the shot preset at 1024^2, at least 85% of the
+    rigid stretch removed on the median frame and 75% on the worst, through the delivered maps (the metric is
+    checked against a second implementation in test_redirect_metrics.py), no inverted triangle."""
+    t = 1024
+    rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
+    solver = dk.UvWarpSolver(rest, 1001, rigid_disks(chart_texels(rest, t), t), preset="shot")
+    removed = []
+    for frame in range(1, 25):
+        solver.solve(dk.read_mesh(os.path.join(SHOT, f"anim.{frame:04d}.obj")).points)
+        m = solver.metrics()
+        assert m["inverted_triangles"] == 0 and inverted_triangles(solver.redirect_map()) == 0, frame
+        assert m["off_chart_texels"] == 0, frame
+        removed.append(m["rigid_stretch_removed"])
+    removed = np.array(removed)
+    print(f"Fox Run at {t}^2, shot preset: {100 * np.median(removed):.1f}% median, worst {100 * removed.min():.1f}%")
+    # Measured 85.1% median, 77.7% worst (frame 19).
+    assert np.median(removed) >= 0.85 and removed.min() >= 0.75
+
 def test_the_figures_split_the_disks_into_whole_and_cut():
     # A square chart over [0, 0.47]^2 of the tile: the disks centred at 0.05 .. 0.35 lie inside it with their
     # margin, those at 0.45 reach past 0.47 and are cut, the others are off the chart.
