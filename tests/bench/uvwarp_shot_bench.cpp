@@ -7,7 +7,7 @@
 // 24 frames, without refinement and without the density heuristic (the frame the requirement below was set
 // against). BM_UvWarpRiggedShotFrame: the rigged Fox running (tests/data/fox: 24 frames of its Run clip
 // skinned in Blender), the shot preset, the argument its refinement sweeps: 0 (none, the reference of the
-// others), -1 (the shot preset: 6 at 1024²), 8, 16. Rigid disks of radius 0.025 on a 0.1 lattice inside the
+// others), -1 (the shot preset: 4 at 1024²), 8, 16. Rigid disks of radius 0.025 on a 0.1 lattice inside the
 // charts. Counters (medians over the frames): frame_ms, solve_ms, redirect_ms, measure_ms; removed_pct
 // (median rigid stretch removed, delivered), inverted (delivered inverted triangles, all frames), repaired
 // (inverted triangles the fold repair unfolded, all frames); on the Fox, ratio_to_spot = its frame_ms over
