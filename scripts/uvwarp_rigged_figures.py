@@ -6,9 +6,13 @@ the rigid stretch removed (median and worst frame), the inverted triangles deliv
 repair unfolded, off-chart texels, the time a frame takes (solve and map). Usage, from the repository's root:
 
     python3 scripts/uvwarp_rigged_figures.py tests/data/fox [--texels 1024] [--python build/python]
-        [--first 1] [--option name=value ...] [--margin TEXELS] [--split]
+        [--first 1] [--option name=value ...] [--margin TEXELS] [--split] [--gap-to-shot]
 
---split also measures the same maps over the disks whole inside a chart and over those a chart border cuts."""
+--split also measures the same maps over the disks whole inside a chart and over those a chart border cuts.
+--gap-to-shot also solves every frame with the shot preset from the identity and prints, per frame, how many
+points of rigid stretch removed the solve asked for (--option preset=live: the live preset, warm-started
+frame after frame as a preview plays the shot) leaves behind it: the live preset's requirement is a gap of
+at most 3 points on every frame."""
 import argparse
 import os
 import sys
@@ -115,6 +119,8 @@ def main():
     parser.add_argument("--margin", type=int, help="texels between the disks and the chart borders (T / 256)")
     parser.add_argument("--split", action="store_true",
                         help="also the figures of the disks whole inside a chart and of those chart borders cut")
+    parser.add_argument("--gap-to-shot", action="store_true",
+                        help="also each frame's gap to the shot preset solved from the identity, in points")
     args = parser.parse_args()
     sys.path.insert(0, os.path.abspath(args.python))
     import deformkit as dk
@@ -128,6 +134,8 @@ def main():
     options = dict(preset="shot")
     options.update({k: value(v) for k, v in (o.split("=", 1) for o in args.option)})
     solver = dk.UvWarpSolver(rest, 1001, rigidity, **options)
+    shot = dk.UvWarpSolver(rest, 1001, rigidity, preset="shot") if args.gap_to_shot else None
+    shot_removed = []
     frames = sorted(int(name[5:9]) for name in os.listdir(args.shot) if name.startswith("anim."))
     removed, inverted, unfolded, off_chart, seconds = [], 0, 0, 0, []
     for frame in (f for f in frames if f >= args.first):
@@ -141,6 +149,10 @@ def main():
         inverted += m["inverted_triangles"]
         off_chart += m["off_chart_texels"]
         unfolded += solver.metrics()["repair_inverted_found"]
+        if shot is not None:  # untimed
+            shot.solve(posed.points)
+            shot_removed.append(dk.redirect_metrics(rest, 1001, rigidity, posed.points,
+                                                    shot.redirect_map())["rigid_stretch_removed"])
         for name, part in parts.items():
             part_removed[name].append(
                 dk.redirect_metrics(rest, 1001, part, posed.points, redirect)["rigid_stretch_removed"])
@@ -150,6 +162,11 @@ def main():
           f"{args.first + int(removed.argmin())}); {inverted} inverted triangles delivered ({unfolded} unfolded by "
           f"the repair), {off_chart} off-chart texels; {1e3 * np.median(seconds):.0f} ms a frame (solve and map)")
     print("per frame removed:", " ".join(f"{100 * r:.1f}" for r in removed))
+    if shot is not None:
+        gap = 100 * (np.array(shot_removed) - removed)
+        print(f"gap to the shot preset: {np.median(gap):.1f} points median, {gap.max():.1f} worst (frame "
+              f"{args.first + int(gap.argmax())}); within 3 points on {int((gap <= 3).sum())} of {len(gap)} frames")
+        print("per frame gap:", " ".join(f"{g:.1f}" for g in gap))
     for name, values in part_removed.items():
         values = np.array(values)
         print(f"disks {'whole inside a chart' if name == 'whole' else 'cut by a chart border'} "

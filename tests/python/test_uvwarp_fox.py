@@ -132,6 +132,32 @@ def test_the_fox_running_meets_the_goal_at_1024():
     # Measured 85.1% median, 77.7% worst (frame 19).
     assert np.median(removed) >= 0.85 and removed.min() >= 0.75
 
+def test_the_figures_gap_to_the_shot_preset_is_each_frames_difference():
+    # The script's --gap-to-shot against a second computation here: the live preset warm-started over frames
+    # 20-24 in order, the shot preset from the identity on each, both measured on their delivered maps.
+    import subprocess
+    script = os.path.join(os.path.dirname(__file__), "..", "..", "scripts", "uvwarp_rigged_figures.py")
+    out = subprocess.run([sys.executable, script, SHOT, "--texels", str(T), "--first", "20", "--python",
+                          os.path.dirname(dk.__file__), "--option", "preset=live", "--gap-to-shot"],
+                         capture_output=True, text=True, check=True).stdout
+    printed = [float(g) for g in out.split("per frame gap:")[1].split("\n")[0].split()]
+    rest = dk.read_mesh(os.path.join(SHOT, "rest.obj"))
+    rigidity = rigid_disks(chart_texels(rest, T), T)
+    live = dk.UvWarpSolver(rest, 1001, rigidity, preset="live")
+    expected = []
+    for frame in range(20, 25):
+        posed = dk.read_mesh(os.path.join(SHOT, f"anim.{frame:04d}.obj"))
+        removed = []
+        for solver in (dk.UvWarpSolver(rest, 1001, rigidity, preset="shot"), live):
+            solver.solve(posed.points)
+            removed.append(dk.redirect_metrics(rest, 1001, rigidity, posed.points,
+                                               solver.redirect_map())["rigid_stretch_removed"])
+        expected.append(100 * (removed[0] - removed[1]))
+    print("gap per frame, printed:", printed, "expected:", np.round(expected, 2))
+    assert len(printed) == 5 and np.allclose(printed, expected, atol=0.051)
+    assert f"within 3 points on {sum(g <= 3 for g in expected)} of 5 frames" in out
+
+
 def test_the_figures_split_the_disks_into_whole_and_cut():
     # A square chart over [0, 0.47]^2 of the tile: the disks centred at 0.05 .. 0.35 lie inside it with their
     # margin, those at 0.45 reach past 0.47 and are cut, the others are off the chart.
