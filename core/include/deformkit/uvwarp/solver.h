@@ -86,9 +86,10 @@ inline constexpr int32_t kRefinedThirdLevelSweeps = 64;
 // coarse levels over-relaxed by 1.4, sweeps per level by the grid's size ({8, 16, 32} up to 128 cells,
 // {3, 8, 12} at 256, {2, 2, 10} at 512, {1, 1, 10} at 1024, {1, 1, 2, 8} from 2048) and, from 1024 cells, no
 // level coarser than 128 cells (maxLevels): the cheapest settings measured within 2 points of a converged
-// default solve on every probed frame of a smooth animation, on two real models; a solve from the identity
-// (the first frame, or after a cut) runs 2 iterations (3 at 512 cells) to be within 2 points as well
-// (docs/decisions.md UV-28, UV-30). The other options are the defaults.
+// default solve on every probed frame of a smooth animation, on two real models, on the solver's grid; a
+// solve from the identity (the first frame, or after a cut) runs 2 iterations (3 at 512 cells) to be within
+// 2 points as well (docs/decisions.md UV-28, UV-30). On the delivered maps, against the shot preset, the
+// gap is larger (docs/uvwarp.md, Performance and limits). The other options are the defaults.
 [[nodiscard]] SolverOptions liveOptions(int32_t cells);
 
 // Figures from the last solve.
