@@ -13,11 +13,13 @@ and as baked (<name>_after.png).
     residual the Fox at frame 18 of its Run, 1024^2 (fox_residual.png): each disk coloured by the rigid stretch
              error left on it through the delivered map, without refinement, with a grid twice the map's size
              and with the shot preset; prints the figures of the whole and the cut disks for each
+    live     the same at frame 18 (fox_live.png): the live preset played from frame 1 (a preview's warm starts)
+             beside the shot preset
 
 Usage, from the repository's root:
 
     python3 scripts/uvwarp_pictures.py build/bin/deformkit [--python build/python] [--keep DIR]
-        [--bench build/bin/bench_uvwarp_reference] [suzanne] [fox] [ceiling] [residual]"""
+        [--bench build/bin/bench_uvwarp_reference] [suzanne] [fox] [ceiling] [residual] [live]"""
 import argparse
 import os
 import subprocess
@@ -168,12 +170,28 @@ def ceiling(bench, deformkit, dk, images, keep, frame=18, t=256, shown=1024):
         dk.write_image(os.path.join(images, "fox_ceiling.png"), np.concatenate(views, 1))
 
 
-def residual(dk, images, frame=18, t=1024, shown=512,
+def residual_panel(dk, rest, posed, inside, label, disks, redirect, shown):
+    """A residual picture's panel: the tile grey on the charts, each disk coloured by the rigid stretch error
+    the redirect map leaves on it (green 0, yellow 5%, red 10% or more), `shown` texels a side."""
+    t = inside.shape[0]
+    image = np.where(inside[..., None], np.float32(0.55), np.float32(0.1)) * np.ones(3, np.float32)
+    for d in range(disks):
+        part = (label == d).astype(np.float32)
+        m = dk.redirect_metrics(rest, 1001, part, posed.points, redirect)
+        share = float(np.clip(m["rigid_stretch_error"] / 0.1, 0, 1))  # 10% or more: red
+        image[label == d] = (min(1.0, 2 * share), min(1.0, 2 * (1 - share)), 0.1)
+    step = t // shown
+    return image[::step, ::step]
+
+
+def residual(dk, images, frame=18, t=1024, shown=512, live=False,
              solves=({"refinement_sweeps": 0}, {"resolution": 2048}, {})):
     """fox_residual.png: the Fox's tile at `frame` of its Run, each disk coloured by the rigid stretch error
     the delivered map leaves on it (the mean |l_def / l_rest - 1| over its texel edges: green 0, yellow 5%,
     red 10% or more), a panel per solve of the shot preset: the map's grid without refinement, a grid twice
-    the map's size, the preset itself (the map's grid, refined); prints each panel's whole and cut figures."""
+    the map's size, the preset itself (the map's grid, refined); prints each panel's whole and cut figures.
+    live: fox_live.png instead, the live preset played from frame 1 to `frame` (warm-started, as a preview
+    plays the shot) beside the shot preset on `frame`."""
     from uvwarp_rigged_figures import disk_parts, rigid_disks
     rest = dk.read_mesh("tests/data/fox/rest.obj")
     posed = dk.read_mesh(f"tests/data/fox/anim.{frame:04d}.obj")
@@ -182,23 +200,18 @@ def residual(dk, images, frame=18, t=1024, shown=512,
     parts = {"all": rigidity, **disk_parts(rigidity, t)}
     label, disks = label_disks(rigidity >= 0.5)
     panels = []
-    for options in solves:
-        solver = dk.UvWarpSolver(rest, 1001, rigidity, preset="shot", **options)
-        solver.solve(posed.points)
+    for options in ({"preset": "live"}, {}) if live else solves:
+        solver = dk.UvWarpSolver(rest, 1001, rigidity, **{"preset": "shot", **options})
+        for f in range(1 if options.get("preset") == "live" else frame, frame + 1):
+            solver.solve(dk.read_mesh(f"tests/data/fox/anim.{f:04d}.obj").points)
         redirect = solver.redirect_map()
-        image = np.where(inside[..., None], np.float32(0.55), np.float32(0.1)) * np.ones(3, np.float32)
-        for d in range(disks):
-            part = (label == d).astype(np.float32)
-            m = dk.redirect_metrics(rest, 1001, part, posed.points, redirect)
-            share = float(np.clip(m["rigid_stretch_error"] / 0.1, 0, 1))  # 10% or more: red
-            image[label == d] = (min(1.0, 2 * share), min(1.0, 2 * (1 - share)), 0.1)
         figures = {name: dk.redirect_metrics(rest, 1001, r, posed.points, redirect)["rigid_stretch_removed"]
                    for name, r in parts.items()}
         print(f"frame {frame}, {options or 'defaults'}: " + ", ".join(f"{k} {100 * v:.1f}%" for k, v in figures.items()))
-        step = t // shown
-        panels.append(image[::step, ::step])
+        panels.append(residual_panel(dk, rest, posed, inside, label, disks, redirect, shown))
         panels.append(np.ones((shown, 8, 3), np.float32))
-    dk.write_image(os.path.join(images, "fox_residual.png"), np.concatenate(panels[:-1], 1))
+    name = "fox_live.png" if live else "fox_residual.png"
+    dk.write_image(os.path.join(images, name), np.concatenate(panels[:-1], 1))
 
 
 def main():
@@ -208,7 +221,7 @@ def main():
     parser.add_argument("--keep", help="folder to keep the maps, texture and bakes in (default: a temporary one)")
     parser.add_argument("--bench", default="build/bin/bench_uvwarp_reference",
                         help="bench_uvwarp_reference, for the ceiling picture")
-    parser.add_argument("shots", nargs="*", default=list(SHOTS) + ["ceiling", "residual"])
+    parser.add_argument("shots", nargs="*", default=list(SHOTS) + ["ceiling", "residual", "live"])
     args = parser.parse_intermixed_args()
     sys.path.insert(0, os.path.abspath(args.python))
     import deformkit as dk
@@ -220,8 +233,8 @@ def main():
                 raise SystemExit(f"uvwarp_pictures: {args.bench} is missing: build it "
                                  "(cmake --build build --target bench_uvwarp_reference)")
             ceiling(os.path.abspath(args.bench), os.path.abspath(args.deformkit), dk, images, keep)
-        elif name == "residual":
-            residual(dk, images)
+        elif name in ("residual", "live"):
+            residual(dk, images, live=name == "live")
         else:
             make(name, SHOTS[name], os.path.abspath(args.deformkit), dk, images, keep)
 
