@@ -768,9 +768,8 @@ void bindUvWarp(py::module_& m) {
         "(every solver option, refinement_sweeps and orientation_density, both 0): one warm-started "
         "iteration\n"
         "a frame, the coarse levels over-relaxed by 1.4, sweeps per level by grid size, no refinement, a\n"
-        "uniform orientation turn (uvwarp::presetOptions; within 2 points of a converged solve on every "
-        "probed\n"
-        "frame of a smooth animation).");
+        "uniform orientation turn (uvwarp::presetOptions; on its delivered maps up to 4.2 points behind the\n"
+        "shot preset on a smooth animation at 1024^2, more on rigged characters: docs/uvwarp.md).");
 
     m.def(
         "redirect_metrics",
