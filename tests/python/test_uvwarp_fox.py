@@ -8,6 +8,7 @@ texel-centre grid, no chart texel showing content off the charts, finite maps. T
 printed and held to floors just under what is measured, at 256^2 to stay quick (docs/uvwarp_quality.md gives the
 1024^2 figures against the targets)."""
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -112,7 +113,6 @@ def test_the_fox_running_keeps_its_rigid_disks_through_every_frame():
     assert np.median(removed) > 0.62 and removed.min() > 0.55
 
 
-
 def test_the_fox_running_meets_the_goal_at_1024():
     """The goal docs/uvwarp_quality.md measures against: with the shot preset at 1024^2, at least 85% of the
     rigid stretch removed on the median frame and 75% on the worst, through the delivered maps (the metric is
@@ -132,10 +132,10 @@ def test_the_fox_running_meets_the_goal_at_1024():
     # Measured 85.1% median, 77.7% worst (frame 19).
     assert np.median(removed) >= 0.85 and removed.min() >= 0.75
 
+
 def test_the_figures_gap_to_the_shot_preset_is_each_frames_difference():
     # The script's --gap-to-shot against a second computation here: the live preset warm-started over frames
     # 20-24 in order, the shot preset from the identity on each, both measured on their delivered maps.
-    import subprocess
     script = os.path.join(os.path.dirname(__file__), "..", "..", "scripts", "uvwarp_rigged_figures.py")
     out = subprocess.run([sys.executable, script, SHOT, "--texels", str(T), "--first", "20", "--python",
                           os.path.dirname(dk.__file__), "--option", "preset=live", "--gap-to-shot"],
