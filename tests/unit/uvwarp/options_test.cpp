@@ -200,8 +200,7 @@ TEST_CASE("uv warp options: the presets and defaults are valid; zero iterations 
         uvwarp::checkOptions(idle, "tile 1001"),
         "tile 1001: option sweepsPerLevel: is [0, 0] (expected a list of whole numbers from 0 to 1000, not "
         "all 0; empty: by the grid's size, 4 8 16 up to 1024 cells, 4 8 16 32 64 from 2048; where a "
-        "refinement "
-        "follows, the finest level 2 from 1024 cells, and 2 8 64 16 at 1024)");
+        "refinement follows, the finest level 2 from 1024 cells, and 2 8 64 16 at 1024)");
 }
 
 TEST_CASE("uv warp options: the solver and the tile warp refuse each option out of range by its name",

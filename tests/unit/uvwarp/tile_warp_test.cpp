@@ -556,7 +556,7 @@ TEST_CASE("tile warp: refinement sweeps end each solve on a grid of twice the ce
                       Catch::Contains("at most 16384"));
 }
 
-TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 6 sweeps, finer grids not",
+TEST_CASE("tile warp: the shot preset refines grids up to 1024 cells with 4 sweeps, finer grids not",
           "[uvwarp][options]") {
     // refinementSweeps -1 (the shot preset's, by the grid's size), as the option's reference states it.
     for (const int32_t cells : {2, 64, 256, 1024})
