@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cctype>
@@ -172,21 +173,26 @@ PointCache::PointCache(fs::path path, std::optional<double> firstFrame) : path_(
         }
         first_ = *firstFrame;
     }
+    // The frames' bytes, counted without overflow: 2^31 vertices by 2^31 samples pass 2^64, and a product
+    // wrapped around it could equal a small file's size.
     const std::uintmax_t frameBytes = static_cast<std::uintmax_t>(vertices_) * kBytesPerVertex;
-    const std::uintmax_t expected = dataOffset_ + frameBytes * static_cast<std::uintmax_t>(samples_);
-    if (size < expected) {
-        const auto whole = static_cast<int32_t>((size - dataOffset_) / frameBytes);
-        throw InvalidInput(formatError(name, frameText(sampleFrame(whole)),
+    const auto samples = static_cast<std::uintmax_t>(samples_);
+    const std::uintmax_t whole = (size - dataOffset_) / frameBytes;  // size >= dataOffset_: the header read
+    const bool countable =
+        samples == 0 || frameBytes <= (std::numeric_limits<std::uintmax_t>::max() - dataOffset_) / samples;
+    const std::string expected =
+        (countable ? std::to_string(dataOffset_ + frameBytes * samples) : std::string("more than 2^64")) +
+        " bytes for " + std::to_string(samples_) + " frames of " + std::to_string(vertices_) + " vertices";
+    if (whole < samples) {
+        throw InvalidInput(formatError(name, frameText(sampleFrame(static_cast<int32_t>(whole))),
                                        "is cut short: the file has " + std::to_string(size) + " bytes, " +
                                            std::to_string(whole) + " whole frames",
-                                       std::to_string(expected) + " bytes for " + std::to_string(samples_) +
-                                           " frames of " + std::to_string(vertices_) + " vertices"));
+                                       expected));
     }
-    if (size > expected) {
+    const std::uintmax_t extra = size - dataOffset_ - frameBytes * samples;  // whole >= samples: no overflow
+    if (extra > 0) {
         throw InvalidInput(
-            formatError(name, "", "has " + std::to_string(size - expected) + " bytes after its last frame",
-                        std::to_string(expected) + " bytes for " + std::to_string(samples_) + " frames of " +
-                            std::to_string(vertices_) + " vertices"));
+            formatError(name, "", "has " + std::to_string(extra) + " bytes after its last frame", expected));
     }
 }
 
@@ -195,18 +201,23 @@ std::vector<int> PointCache::frames() const {
     for (int32_t i = 0; i < samples_; ++i) {
         const double f = sampleFrame(i);
         const double whole = std::round(f);
-        if (std::abs(f - whole) <= kFrameTolerance && std::abs(whole) < 1.0e9)
+        // Samples closer together than the tolerance can share a whole frame (they come in order): listed
+        // once, sampleOf picks the nearest.
+        if (std::abs(f - whole) <= kFrameTolerance && std::abs(whole) < 1.0e9 &&
+            (out.empty() || out.back() != static_cast<int>(whole)))
             out.push_back(static_cast<int>(whole));
     }
     return out;
 }
 
 std::optional<int32_t> PointCache::sampleOf(int frame) const {
-    const double index = (frame - first_) / sampling_;
-    const double whole = std::round(index);
-    if (whole < 0.0 || whole >= samples_) return std::nullopt;
-    if (std::abs(sampleFrame(static_cast<int32_t>(whole)) - frame) > kFrameTolerance) return std::nullopt;
-    return static_cast<int32_t>(whole);
+    if (samples_ == 0) return std::nullopt;
+    // The nearest sample inside the cache: with samples closer than the tolerance, the nearest one counted
+    // from the start can lie past either end while an end sample is within the tolerance (frames()).
+    const double index = std::clamp(std::round((frame - first_) / sampling_), 0.0, samples_ - 1.0);
+    const auto sample = static_cast<int32_t>(index);
+    if (std::abs(sampleFrame(sample) - frame) > kFrameTolerance) return std::nullopt;
+    return sample;
 }
 
 std::string PointCache::frameName(int frame) const {

@@ -72,6 +72,24 @@ TEST_CASE("point cache: PC2 and MDD written by hand read back bit for bit, frame
         CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 2); }),
                    Contains("expected one of its frames -1 to 1 every 0.5"));
     }
+    SECTION(
+        "PC2 sampled closer than a frame's tolerance: each whole frame listed once, read from its nearest "
+        "sample") {
+        test::writeText(dir / "a.pc2",
+                        test::pc2Bytes(1.99998f, 1.0e-5f, frames));  // samples 1.99998 to 2.00002
+        io::PointCache cache(dir / "a.pc2");
+        CHECK(cache.frames() == std::vector<int>{2});
+        CHECK(cache.sampleOf(2) == 2);
+        CHECK(test::sameBits(read(cache, 2), frames[2]));
+        // All three samples (-5e-5, -4e-5, -3e-5) within the tolerance of frame 0, the nearest the last: the
+        // nearest sample to a frame lies past the cache's end when counted from its start.
+        const std::vector<std::vector<glm::vec3>> three(frames.begin(), frames.begin() + 3);
+        test::writeText(dir / "b.pc2", test::pc2Bytes(-5.0e-5f, 1.0e-5f, three));
+        io::PointCache before(dir / "b.pc2");
+        CHECK(before.frames() == std::vector<int>{0});
+        CHECK(before.sampleOf(0) == 2);
+        CHECK(test::sameBits(read(before, 0), frames[2]));
+    }
     SECTION("PC2 with the first frame set by the reader") {
         test::writeText(dir / "a.pc2", test::pc2Bytes(10.0f, 1.0f, frames));
         io::PointCache cache(dir / "a.pc2", 1.0);
@@ -181,6 +199,25 @@ TEST_CASE("point cache: bad caches are refused naming the file, the frame and th
         CHECK_THAT(
             test::errorOf<InvalidInput>([&] { open(mdd); }),
             Contains("bad.mdd: frame time 2: is 1 after 2 (expected finite times in seconds, increasing)"));
+    }
+    SECTION("a header whose frames' bytes pass 2^64 is cut short, not read") {
+        // 2147380029 vertices x 715862424 samples x 12 bytes = 2^64 + 11936: in 64-bit arithmetic the 32-byte
+        // header and 11936 bytes of data look like the whole file, while the first frame alone is 25 GB.
+        constexpr int32_t vertices = 2147380029, samples = 715862424;
+        static_assert(static_cast<uint64_t>(vertices) * 12u * static_cast<uint64_t>(samples) ==
+                      static_cast<uint64_t>(11936));  // unsigned arithmetic wraps around 2^64
+        std::string bytes("POINTCACHE2", 11);
+        bytes.push_back('\0');
+        test::appendWord(bytes, int32_t{1}, false);
+        test::appendWord(bytes, vertices, false);
+        test::appendWord(bytes, 1.0f, false);
+        test::appendWord(bytes, 1.0f, false);
+        test::appendWord(bytes, samples, false);
+        bytes.append(11936, '\0');
+        test::writeText(pc2, bytes);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("bad.pc2: frame 1: is cut short: the file has 11968 bytes, 0 whole frames") &&
+                       Contains("for 715862424 frames of 2147380029 vertices"));
     }
     SECTION("a NaN or an infinity names the frame and the vertex when the frame is read") {
         auto nan = frames;

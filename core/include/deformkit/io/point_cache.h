@@ -49,7 +49,7 @@ class PointCache {
     // MDD's times in seconds (empty for PC2).
     [[nodiscard]] const std::vector<float>& times() const { return times_; }
 
-    // The whole frames that are samples, ascending.
+    // The whole frames that are samples, ascending, each once.
     [[nodiscard]] std::vector<int> frames() const;
     // The sample of a whole frame; nullopt when the frame is none of the cache's samples.
     [[nodiscard]] std::optional<int32_t> sampleOf(int frame) const;
