@@ -5,6 +5,7 @@
 
 #include <assimp/Importer.hpp>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <string>
 #include <system_error>
@@ -48,12 +49,22 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     std::map<PositionKey, int32_t> welded;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& mesh = *scene->mMeshes[m];
+        const std::string meshName =
+            mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
         const bool uvs = mesh.HasTextureCoords(0);
         // Vertex k of this mesh is point pointOf[k]; its UV is uv base + k.
         std::vector<int32_t> pointOf(mesh.mNumVertices);
         for (unsigned k = 0; k < mesh.mNumVertices; ++k) {
             const aiVector3D& p = mesh.mVertices[k];
             const glm::vec3 point(p.x, p.y, p.z);
+            // Checked here, before welding: a NaN compares equal to every position and would be welded
+            // onto another point, and the faces around it dropped as slivers.
+            if (!std::isfinite(point.x) || !std::isfinite(point.y) || !std::isfinite(point.z)) {
+                throw InvalidInput(formatError(name, "mesh '" + meshName + "': vertex " + std::to_string(k),
+                                               "is (" + numberText(point.x) + ", " + numberText(point.y) +
+                                                   ", " + numberText(point.z) + ")",
+                                               "finite coordinates"));
+            }
             if (weld) {
                 const auto [it, added] =
                     welded.try_emplace({point.x, point.y, point.z}, static_cast<int32_t>(data.points.size()));
@@ -70,7 +81,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                 data.uvs.emplace_back(mesh.mTextureCoords[0][k].x, mesh.mTextureCoords[0][k].y);
         }
         FaceGroup group;
-        group.name = mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
+        group.name = meshName;
         for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
             const aiFace& face = mesh.mFaces[f];
             // Corners in order; a corner welded onto the one before it is dropped (a sliver of coincident

@@ -54,6 +54,26 @@ end_header
 3 3 2 4
 )";
 
+// A Collada quad (two triangles over four positions), its third position (1, 1, 0).
+const char* kCollada = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="quad" name="quad"><mesh>
+      <source id="p"><float_array id="pa" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+        <technique_common><accessor source="#pa" count="4" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+      <triangles count="2"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2 0 2 3</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node id="n" name="n">
+    <instance_geometry url="#quad"/></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)";
+
 std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
     return {m.points().begin(), m.points().end()};
 }
@@ -123,6 +143,16 @@ TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and
     CHECK_THAT(
         test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "cloud.ply"); }),
         Contains("cloud.ply: ") && (Contains("has no polygon") || Contains("cannot be read as a mesh")));
+    // A NaN position in a format whose corners are welded by position (Collada, FBX): named, not welded
+    // onto another point (NaN compares equal to every key), which dropped the faces around it.
+    std::string dae = kCollada;
+    dae.replace(dae.find("1 1 0"), 5, "nan 1 0");
+    test::writeText(dir / "nan.dae", dae);
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "nan.dae"); }),
+        Contains("nan.dae: mesh 'quad': vertex 2: is (nan, ") && Contains("(expected finite coordinates)"));
+    test::writeText(dir / "quad.dae", kCollada);
+    CHECK(io::readMesh(dir / "quad.dae").mesh.numFaces() == 2);
     CHECK(io::meshFormat("a.GLTF") == io::MeshFormat::Gltf);
     CHECK(io::meshFormat("a.Dae") == io::MeshFormat::Collada);
     CHECK_FALSE(io::meshFormat("a.exr"));
