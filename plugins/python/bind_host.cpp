@@ -87,7 +87,7 @@ std::optional<std::vector<float>> weightValuesOf(py::handle weights, std::string
             return std::nullopt;
         }
     }
-    problem = "is a " + typeName(weights);
+    problem = "is " + aTypeName(weights);
     return std::nullopt;
 }
 
@@ -108,7 +108,7 @@ std::span<glm::vec3> inplacePoints(py::handle points) {
     const char* source = "DeformerStack.evaluate_inplace";
     const char* expected = "a writeable C-contiguous (n, 3) float32 numpy array (evaluate() takes any other)";
     if (!py::isinstance<py::array>(points)) {
-        throw InvalidInput(formatError(source, "points", "is a " + typeName(points), expected));
+        throw InvalidInput(formatError(source, "points", "is " + aTypeName(points), expected));
     }
     auto a = py::reinterpret_borrow<py::array>(points);
     if (!py::isinstance<py::array_t<float>>(a)) {
@@ -279,7 +279,7 @@ void bindHost(py::module_& m) {
             "set",
             [](PyStack& s, size_t index, const std::string& name, py::handle value) {
                 const std::optional<std::vector<double>> values = valuesOf(value);
-                const std::string found = values ? std::string() : "is a " + typeName(value);
+                const std::string found = values ? std::string() : "is " + aTypeName(value);
                 Lock lock(s.mutex);
                 if (!values) {
                     throw InvalidInput(formatError(s.stack.entryName(index), "parameter '" + name + "'",

@@ -181,7 +181,7 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
     if (!d.contains("data")) {
         throw InvalidInput(formatError(source, "ptex", "has no 'data'", "a list of (vres, ures, C) arrays"));
     }
-    const py::list data = d["data"].cast<py::list>();
+    const auto data = castArgument<py::list>(d["data"], source, "data", "a list of (vres, ures[, C]) arrays");
     ptex::PtexFile file;
     file.faces.resize(data.size());
     file.texels.resize(data.size());
@@ -208,7 +208,9 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
                               static_cast<const uint8_t*>(c.data()) + c.nbytes());
     }
     file.constData.assign(file.faces.size() * file.pixelSize(), 0);
-    if (d.contains("alpha_channel")) file.alphaChannel = d["alpha_channel"].cast<int32_t>();
+    if (d.contains("alpha_channel"))
+        file.alphaChannel =
+            castArgument<int32_t>(d["alpha_channel"], source, "alpha_channel", "an int (-1: none)");
     const std::array<const char*, 2> meshTypes{"triangle", "quad"};
     file.meshType = static_cast<ptex::MeshType>(nameIndex(d, "mesh_type", meshTypes, 1, source));
     file.uBorderMode = static_cast<ptex::BorderMode>(nameIndex(d, "u_border_mode", kBorderModes, 0, source));
@@ -229,23 +231,39 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
             file.faces[f].subface = infos[f].subface;
         }
     } else if (d.contains("faces")) {
-        const py::list faces = d["faces"].cast<py::list>();
+        const auto faces = castArgument<py::list>(d["faces"], source, "faces", "a list of dicts");
         for (size_t f = 0; f < std::min(faces.size(), file.faces.size()); ++f) {
-            const py::dict face = faces[f].cast<py::dict>();
+            const std::string element = "faces[" + std::to_string(f) + "]";
+            if (!py::isinstance<py::dict>(faces[f]))
+                throw InvalidInput(formatError(source, element, "is " + aTypeName(faces[f]), "a dict"));
+            const auto face = py::reinterpret_borrow<py::dict>(faces[f]);
             if (face.contains("adj_faces")) {
-                const auto adj = face["adj_faces"].cast<std::vector<int32_t>>();
-                const auto edges = face["adj_edges"].cast<std::vector<int32_t>>();
+                const auto adj = castArgument<std::vector<int32_t>>(face["adj_faces"], source,
+                                                                    element + "['adj_faces']", "4 ints");
+                if (!face.contains("adj_edges")) {
+                    throw InvalidInput(
+                        formatError(source, element, "has adj_faces but no adj_edges", "both or neither"));
+                }
+                const auto edges = castArgument<std::vector<int32_t>>(face["adj_edges"], source,
+                                                                      element + "['adj_edges']", "4 ints");
                 for (size_t e = 0; e < 4 && e < adj.size() && e < edges.size(); ++e) {
                     file.faces[f].adjFaces[e] = adj[e];
                     file.faces[f].adjEdges[e] = static_cast<uint8_t>(edges[e]);
                 }
             }
-            if (face.contains("subface")) file.faces[f].subface = face["subface"].cast<bool>();
+            if (face.contains("subface"))
+                file.faces[f].subface =
+                    castArgument<bool>(face["subface"], source, element + "['subface']", "a bool");
         }
     }
     if (d.contains("metadata")) {
-        for (const auto& [key, value] : d["metadata"].cast<py::dict>()) {
-            const std::string k = key.cast<std::string>();
+        if (!py::isinstance<py::dict>(d["metadata"])) {
+            throw InvalidInput(formatError(source, "metadata", "is " + aTypeName(d["metadata"]),
+                                           "a dict of str -> str or array"));
+        }
+        for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(d["metadata"])) {
+            const auto k =
+                castArgument<std::string>(key, source, "metadata key " + std::string(py::repr(key)), "a str");
             if (mesh && (k == "PtexFaceVertCounts" || k == "PtexFaceVertIndices" || k == "PtexVertPositions"))
                 continue;  // written from the mesh
             file.metadata.push_back(metaFrom(k, value, source));
@@ -256,13 +274,16 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
 
 // How a mesh argument is named in messages: its OBJ path, or its size when it is a Mesh or arrays.
 std::string meshName(py::handle mesh, const geom::Mesh& m) {
-    if (!py::isinstance<geom::Mesh>(mesh)) return mesh.cast<std::filesystem::path>().string();
+    if (!py::isinstance<geom::Mesh>(mesh))
+        return mesh.cast<std::filesystem::path>().string();  // meshFrom read it
     return meshLabel(m);
 }
 
-geom::Mesh meshFrom(py::handle mesh) {
+geom::Mesh meshFrom(py::handle mesh, const std::string& source) {
     if (py::isinstance<geom::Mesh>(mesh)) return mesh.cast<geom::Mesh>();
-    return io::readMesh(mesh.cast<std::filesystem::path>()).mesh;
+    return io::readMesh(castArgument<std::filesystem::path>(mesh, source, "mesh",
+                                                            "a deformkit.Mesh or a mesh file path"))
+        .mesh;
 }
 
 }  // namespace
@@ -293,7 +314,7 @@ void bindPtex(py::module_& m) {
         [](const std::filesystem::path& path, const py::dict& ptex, py::object mesh, int compression,
            bool reductions) {
             std::optional<geom::Mesh> m;
-            if (!mesh.is_none()) m = meshFrom(mesh);
+            if (!mesh.is_none()) m = meshFrom(mesh, "write_ptex");
             const ptex::PtexFile file = fromDict(ptex, m, "write_ptex");
             ptex::WriteOptions options;
             options.compressionLevel = compression;
@@ -314,14 +335,16 @@ void bindPtex(py::module_& m) {
     m.def(
         "ptex_vertex_values",
         [](py::object mesh, py::object ptex) {
-            const geom::Mesh m = meshFrom(mesh);
+            constexpr const char* kFunction = "ptex_vertex_values";
+            const geom::Mesh m = meshFrom(mesh, kFunction);
+            const bool dict = py::isinstance<py::dict>(ptex);
+            const std::filesystem::path path =
+                dict ? std::filesystem::path()
+                     : castArgument<std::filesystem::path>(ptex, kFunction, "ptex",
+                                                           "a Ptex file path or read_ptex's dict");
             const ptex::PtexFile file =
-                py::isinstance<py::dict>(ptex)
-                    ? fromDict(ptex.cast<py::dict>(), std::nullopt, "ptex_vertex_values")
-                    : ptex::readPtex(ptex.cast<std::filesystem::path>());
-            const std::string source = py::isinstance<py::dict>(ptex)
-                                           ? std::string("ptex")
-                                           : ptex.cast<std::filesystem::path>().string();
+                dict ? fromDict(ptex.cast<py::dict>(), std::nullopt, kFunction) : ptex::readPtex(path);
+            const std::string source = dict ? std::string("ptex") : path.string();
             const std::string name = meshName(mesh, m);
             std::vector<float> values;
             {

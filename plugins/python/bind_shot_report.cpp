@@ -25,7 +25,7 @@ std::map<int, io::Image> tileImages(const py::object& value, const std::string& 
     if (value.is_none()) return out;
     if (!py::isinstance<py::dict>(value)) {
         throw InvalidInput(
-            formatError(kReport, name, "is a " + typeName(value), "None or {tile: float32 array}"));
+            formatError(kReport, name, "is " + aTypeName(value), "None or {tile: float32 array}"));
     }
     for (const auto& [key, array] : py::reinterpret_borrow<py::dict>(value)) {
         const std::string element = name + "[" + std::string(py::repr(key)) + "]";
@@ -36,7 +36,7 @@ std::map<int, io::Image> tileImages(const py::object& value, const std::string& 
         if (!image) {
             PyErr_Clear();
             throw InvalidInput(
-                formatError(kReport, element, "is a " + typeName(array), "(T, T) or (T, T, C) float32"));
+                formatError(kReport, element, "is " + aTypeName(array), "(T, T) or (T, T, C) float32"));
         }
         out.emplace(key.cast<int>(), imageOf(image, kReport, element, "(T, T) or (T, T, C) float32"));
     }
@@ -50,7 +50,8 @@ py::dict shotReport(const py::object& logs, const std::filesystem::path& page, c
     if (py::isinstance<py::str>(logs) || py::hasattr(logs, "__fspath__")) {
         files.push_back(logs.cast<std::filesystem::path>());
     } else {
-        files = logs.cast<std::vector<std::filesystem::path>>();
+        files = castArgument<std::vector<std::filesystem::path>>(logs, kReport, "logs",
+                                                                 "a JSON-lines log path or a list of them");
     }
     if (rest.has_value() != !deformed.is_none()) {
         throw InvalidInput(formatError(kReport, rest ? "deformed" : "rest",
@@ -58,7 +59,7 @@ py::dict shotReport(const py::object& logs, const std::filesystem::path& page, c
                                        "rest and deformed together, or neither"));
     }
     if (!deformed.is_none() && !PyCallable_Check(deformed.ptr())) {
-        throw InvalidInput(formatError(kReport, "deformed", "is a " + typeName(deformed),
+        throw InvalidInput(formatError(kReport, "deformed", "is " + aTypeName(deformed),
                                        "a callable frame -> (N, 3) float32 (or (positions, name))"));
     }
     uvwarp::HtmlReportOptions options;

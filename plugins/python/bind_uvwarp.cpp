@@ -99,14 +99,14 @@ uvwarp::OptionValue optionValueOf(py::handle value) {
         for (py::handle item : py::reinterpret_borrow<py::sequence>(value)) {
             if (!number(item, x)) {
                 v.kind = Kind::Other;
-                v.shown = "a " + typeName(value) + " holding a " + typeName(item);
+                v.shown = aTypeName(value) + " holding " + aTypeName(item);
                 break;
             }
             v.numbers.push_back(x);
         }
     } else {
         v.kind = Kind::Other;
-        v.shown = "a " + typeName(value);
+        v.shown = aTypeName(value);
     }
     if (v.kind != Kind::Other) v.shown = py::repr(value);  // as the caller wrote it: 2.0, [0, 0], True
     return v;
@@ -149,7 +149,7 @@ CallOptions optionsOf(const std::optional<int64_t>& resolution, const py::kwargs
         const std::string k = py::str(key);
         if (k == "preset") {
             if (!py::isinstance<py::str>(value))
-                throw InvalidInput(formatError(source, k, "is a " + typeName(value), "'shot' or 'live'"));
+                throw InvalidInput(formatError(source, k, "is " + aTypeName(value), "'shot' or 'live'"));
             o.preset = uvwarp::presetNamed(value.cast<std::string>(), source, k);
             continue;
         }
@@ -407,7 +407,7 @@ uvwarp::TileMapSource mapSourceOf(const py::object& value, const std::string& na
         images = pair[1];
     }
     if (!py::isinstance<py::dict>(images))
-        throw InvalidInput(formatError(kShot, name, "is a " + typeName(value), expected));
+        throw InvalidInput(formatError(kShot, name, "is " + aTypeName(value), expected));
     for (const auto& [key, array] : py::reinterpret_borrow<py::dict>(images)) {
         const std::string keyText = py::repr(key);
         const int32_t tile = intOption(key, kShot, name + " key " + keyText, 1001, "a UDIM tile, 1001..9999");
@@ -420,7 +420,7 @@ uvwarp::TileMapSource mapSourceOf(const py::object& value, const std::string& na
         if (!image) {
             PyErr_Clear();
             throw InvalidInput(
-                formatError(kShot, element, "is a " + typeName(array), "(T, T) or (T, T, C) float32"));
+                formatError(kShot, element, "is " + aTypeName(array), "(T, T) or (T, T, C) float32"));
         }
         map.images.emplace(tile, imageOf(image, kShot, element, "(T, T) or (T, T, C) float32"));
     }
@@ -499,7 +499,7 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
     }
     for (const auto& [value, name] : {std::pair{&out, "out"}, std::pair{&bake, "bake"}}) {
         if (!value->is_none() && !isPath(*value)) {
-            throw InvalidInput(formatError(kShot, name, "is a " + typeName(*value),
+            throw InvalidInput(formatError(kShot, name, "is " + aTypeName(*value),
                                            "a path pattern such as 'out/redirect.<UDIM>.####.exr'"));
         }
     }
@@ -517,7 +517,7 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                                           std::string(kShot) + ": deformed", rest, restName, cacheStart);
     } else if (!PyCallable_Check(deformed.ptr())) {
         throw InvalidInput(
-            formatError(kShot, "deformed", "is a " + typeName(deformed),
+            formatError(kShot, "deformed", "is " + aTypeName(deformed),
                         "a callable frame -> (N, 3) float32, an OBJ sequence pattern or a point "
                         "cache (.pc2, .mdd)"));
     } else if (cacheStart) {
@@ -525,14 +525,14 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
                                        "cache_start only with a point cache (.pc2, .mdd)"));
     }
     if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
-        throw InvalidInput(formatError(kShot, "progress", "is a " + typeName(progress),
+        throw InvalidInput(formatError(kShot, "progress", "is " + aTypeName(progress),
                                        "None or a callable (done, total, unit) -> bool"));
     }
     std::ofstream logFile;
     std::filesystem::path logPath;
     if (!log.is_none()) {
         if (!isPath(log)) {
-            throw InvalidInput(formatError(kShot, "log", "is a " + typeName(log), "None or a file path"));
+            throw InvalidInput(formatError(kShot, "log", "is " + aTypeName(log), "None or a file path"));
         }
         logPath = log.cast<std::filesystem::path>();
         logFile.open(logPath, std::ios::app | std::ios::binary);
@@ -565,11 +565,10 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
         const auto array = FloatArray::ensure(result);
         if (!array) {
             PyErr_Clear();
-            throw InvalidInput(formatError(kShot, element, "returned a " + typeName(result), expected));
+            throw InvalidInput(formatError(kShot, element, "returned " + aTypeName(result), expected));
         }
         if (array.ndim() != 2 || array.shape(1) != 3 || array.shape(0) != vertices) {
-            const std::string what =
-                py::isinstance<py::array>(result) ? "" : "a " + typeName(result) + " of ";
+            const std::string what = py::isinstance<py::array>(result) ? "" : aTypeName(result) + " of ";
             throw InvalidInput(formatError(kShot, element, "returned " + what + "shape " + shapeOf(array),
                                            "(" + std::to_string(vertices) + ", 3), one row per rest vertex"));
         }

@@ -10,6 +10,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -97,6 +98,28 @@ inline geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const
 // The Python type of a value ("list", "ndarray"), for messages.
 inline std::string typeName(pybind11::handle value) {
     return pybind11::str(pybind11::type::of(value).attr("__name__"));
+}
+
+// The same with its article: "a list", "an int".
+inline std::string aTypeName(pybind11::handle value) {
+    const std::string name = typeName(value);
+    const bool vowel =
+        !name.empty() && std::string_view("aeiouAEIOU").find(name[0]) != std::string_view::npos;
+    return (vowel ? "an " : "a ") + name;
+}
+
+// `value` as T, or InvalidInput naming the function (`source`) and the element when it is not one
+// ("write_ptex: faces: is an int (expected a list of dicts)"), instead of pybind11's "Unable to cast".
+template <class T>
+T castArgument(pybind11::handle value, const std::string& source, const std::string& element,
+               const std::string& expected) {
+    try {
+        return value.cast<T>();
+    } catch (const pybind11::cast_error&) {
+    } catch (const pybind11::error_already_set& e) {  // a Python type's constructor refused it
+        if (!e.matches(PyExc_TypeError)) throw;
+    }
+    throw InvalidInput(formatError(source, element, "is " + aTypeName(value), expected));
 }
 
 // Painted weights: None (all 1, returned empty) or one value per point.

@@ -112,6 +112,33 @@ def test_bad_input_names_the_problem(tmp_path):
         dk.read_ptex(tmp_path / "bad.ptx")
 
 
+def test_arguments_of_the_wrong_type_name_the_argument_and_what_was_expected(tmp_path):
+    face = np.zeros((4, 4, 1), np.float32)
+    grid = dk.make_grid(2, 2)
+    cases = [
+        (lambda: dk.ptex_vertex_values(grid, 0.5), r"^ptex_vertex_values: ptex: is a float \(expected a Ptex file "
+         r"path or read_ptex's dict\)"),
+        (lambda: dk.ptex_vertex_values(1.5, tmp_path / "w.ptx"), r"^ptex_vertex_values: mesh: is a float \(expected "
+         r"a deformkit.Mesh or a mesh file path\)"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face]}, 5), r"^write_ptex: mesh: is an int"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": 3}), r"^write_ptex: data: is an int \(expected a list of"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "alpha_channel": "x"}),
+         r"^write_ptex: alpha_channel: is a str \(expected an int"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": 3}), r"^write_ptex: faces: is an int"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [3]}), r"^write_ptex: faces\[0\]: is an int"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adj_faces": 1, "adj_edges": 2}]}),
+         r"^write_ptex: faces\[0\]\['adj_faces'\]: is an int \(expected 4 ints"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "metadata": 3}), r"^write_ptex: metadata: is an int"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adj_faces": [0, 0, 0, 0]}]}),
+         r"^write_ptex: faces\[0\]: has adj_faces but no adj_edges"),
+        (lambda: dk.shot_report(3, tmp_path / "p.html"), r"^shot_report: logs: is an int \(expected a JSON-lines"),
+    ]
+    for call, message in cases:
+        with pytest.raises(dk.InvalidInput, match=message):
+            call()
+    assert not (tmp_path / "x.ptx").exists()
+
+
 REFERENCE_FILES = os.path.join(os.path.dirname(__file__), "..", "data", "ptex")
 
 

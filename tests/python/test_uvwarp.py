@@ -503,12 +503,12 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(frames=[]), dk.InvalidInput, "frames: is empty"),
             (dict(frames=[2, 1]), dk.InvalidInput, "frames: are not ascending"),
             (dict(tiles=[1005]), dk.InvalidInput, "tile 1005: the rest mesh 'rest mesh' has no UV face in it"),
-            (dict(deformed=7), dk.InvalidInput, "deformed: is a int"),
+            (dict(deformed=7), dk.InvalidInput, "deformed: is an int"),
             (dict(deformed="anim.obj"), dk.InvalidInput, "uvwarp_shot: deformed: anim.obj: has no frame token"),
             (dict(deformed=str(tmp_path / "anim.####.obj")), dk.IoError, "anim.0001.obj: frame 1: is missing"),
             (dict(deformed=lambda f: mesh[0][:5]), dk.InvalidInput, r"deformed\(1\): returned shape \(5, 3\)"),
             (dict(deformed=lambda f: None), dk.InvalidInput, r"deformed\(1\): returned a NoneType of shape \(\)"),
-            (dict(progress=3), dk.InvalidInput, "progress: is a int"),
+            (dict(progress=3), dk.InvalidInput, "progress: is an int"),
             (dict(smoothing=2.0), dk.InvalidInput, "uvwarp_shot: smoothing: is 2.0"),
             (dict(filter="nearest"), dk.InvalidInput, "filter: is 'nearest'")):
         with pytest.raises(error, match=text):
