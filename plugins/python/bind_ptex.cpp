@@ -234,9 +234,7 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
         const auto faces = castArgument<py::list>(d["faces"], source, "faces", "a list of dicts");
         for (size_t f = 0; f < std::min(faces.size(), file.faces.size()); ++f) {
             const std::string element = "faces[" + std::to_string(f) + "]";
-            if (!py::isinstance<py::dict>(faces[f]))
-                throw InvalidInput(formatError(source, element, "is " + aTypeName(faces[f]), "a dict"));
-            const auto face = py::reinterpret_borrow<py::dict>(faces[f]);
+            const auto face = castArgument<py::dict>(faces[f], source, element, "a dict");
             if (face.contains("adj_faces")) {
                 const auto adj = castArgument<std::vector<int32_t>>(face["adj_faces"], source,
                                                                     element + "['adj_faces']", "4 ints");
@@ -257,11 +255,9 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
         }
     }
     if (d.contains("metadata")) {
-        if (!py::isinstance<py::dict>(d["metadata"])) {
-            throw InvalidInput(formatError(source, "metadata", "is " + aTypeName(d["metadata"]),
-                                           "a dict of str -> str or array"));
-        }
-        for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(d["metadata"])) {
+        const auto metadata =
+            castArgument<py::dict>(d["metadata"], source, "metadata", "a dict of str -> str or array");
+        for (const auto& [key, value] : metadata) {
             const auto k =
                 castArgument<std::string>(key, source, "metadata key " + std::string(py::repr(key)), "a str");
             if (mesh && (k == "PtexFaceVertCounts" || k == "PtexFaceVertIndices" || k == "PtexVertPositions"))
