@@ -321,7 +321,7 @@ void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> o
 // ---- taper ----
 
 TaperWarp::TaperWarp(const AxisFrame& frame, ProfileCurve profile)
-    : AxialWarp(frame, false, "taper"), profile_(std::move(profile)) {}
+    : ProfiledAxialWarp(frame, "taper", std::move(profile)) {}
 
 Affine TaperWarp::transformationAt(float z) const {
     const double f = profile_(z);
@@ -358,10 +358,10 @@ int64_t TaperWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> o
 // ---- twist ----
 
 TwistWarp::TwistWarp(const AxisFrame& frame, ProfileCurve angle)
-    : AxialWarp(frame, false, "twist"), angle_(std::move(angle)) {}
+    : ProfiledAxialWarp(frame, "twist", std::move(angle)) {}
 
 Affine TwistWarp::transformationAt(float z) const {
-    const double t = angle_(z), c = std::cos(t), s = std::sin(t);
+    const double t = profile_(z), c = std::cos(t), s = std::sin(t);
     return fromLocal(frame_, glm::dmat3(glm::dvec3(c, s, 0), glm::dvec3(-s, c, 0), glm::dvec3(0, 0, 1)));
 }
 
@@ -376,7 +376,7 @@ int64_t TwistWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<g
 int64_t TwistWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
-    const InlineProfile angle(angle_);
+    const InlineProfile angle(profile_);
     const float* z = restZ_.data();
     const auto n = static_cast<int64_t>(points.size());
     return forEachAngleBlock(

@@ -97,38 +97,29 @@ class AxialWarp : public Warp {
     bool bound_ = false;
 };
 
-// Barr's taper (paper §4.3.1): T(z) = scale by (f(z), f(z), 1) about the axis, i.e. the two coordinates
-// across the axis are multiplied by f(z). f = the profile (1 = unchanged; 0 collapses onto the axis;
-// negative values mirror through it).
-class TaperWarp final : public AxialWarp {
+// An axial warp driven by one curve of the axis coordinate z (taper's scale, twist's angle): the curve is
+// held here, so that a host updates either the same way.
+class ProfiledAxialWarp : public AxialWarp {
   public:
-    explicit TaperWarp(const AxisFrame& frame, ProfileCurve profile = ProfileCurve::constant(1.0f));
     void setProfile(ProfileCurve profile) { profile_ = std::move(profile); }
-    // New samples in place (ProfileCurve::assign): an animated profile updated without allocating.
+    // New samples in place (ProfileCurve::assign): an animated curve updated without allocating.
     void setProfile(std::span<const float> z, std::span<const float> values, std::string_view name) {
         profile_.assign(z, values, name);
     }
     [[nodiscard]] const ProfileCurve& profile() const { return profile_; }
-    void evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const override;
-    [[nodiscard]] Affine transformationAt(float z) const override;
 
-  private:
-    [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
-                                         std::span<glm::vec3> out) const override;
-    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
+  protected:
+    ProfiledAxialWarp(const AxisFrame& frame, std::string name, ProfileCurve profile)
+        : AxialWarp(frame, false, std::move(name)), profile_(std::move(profile)) {}
     ProfileCurve profile_;
 };
 
-// Barr's twist: T(z) = rotation by theta(z) radians about the axis, right-handed about the axis direction.
-class TwistWarp final : public AxialWarp {
+// Barr's taper (paper §4.3.1): T(z) = scale by (f(z), f(z), 1) about the axis, i.e. the two coordinates
+// across the axis are multiplied by f(z). f = the profile (1 = unchanged; 0 collapses onto the axis;
+// negative values mirror through it).
+class TaperWarp final : public ProfiledAxialWarp {
   public:
-    explicit TwistWarp(const AxisFrame& frame, ProfileCurve angle = ProfileCurve::constant(0.0f));
-    void setProfile(ProfileCurve angle) { angle_ = std::move(angle); }
-    // New samples in place (ProfileCurve::assign): an animated angle updated without allocating.
-    void setProfile(std::span<const float> z, std::span<const float> values, std::string_view name) {
-        angle_.assign(z, values, name);
-    }
-    [[nodiscard]] const ProfileCurve& profile() const { return angle_; }
+    explicit TaperWarp(const AxisFrame& frame, ProfileCurve profile = ProfileCurve::constant(1.0f));
     void evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const override;
     [[nodiscard]] Affine transformationAt(float z) const override;
 
@@ -136,7 +127,20 @@ class TwistWarp final : public AxialWarp {
     [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
                                          std::span<glm::vec3> out) const override;
     int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
-    ProfileCurve angle_;
+};
+
+// Barr's twist: T(z) = rotation by theta(z) radians about the axis, right-handed about the axis direction.
+// theta = the profile.
+class TwistWarp final : public ProfiledAxialWarp {
+  public:
+    explicit TwistWarp(const AxisFrame& frame, ProfileCurve angle = ProfileCurve::constant(0.0f));
+    void evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const override;
+    [[nodiscard]] Affine transformationAt(float z) const override;
+
+  private:
+    [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
+                                         std::span<glm::vec3> out) const override;
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
 };
 
 // Barr's (1984) global bend, in the plane of the axis and the up direction.
