@@ -217,7 +217,7 @@ TEST_CASE("point cache: bad caches are refused naming the file, the frame and th
         test::writeText(pc2, bytes);
         CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
                    Contains("bad.pc2: frame 1: is cut short: the file has 11968 bytes, 0 whole frames") &&
-                       Contains("for 715862424 frames of 2147380029 vertices"));
+                       Contains("expected more than 2^64 bytes for 715862424 frames of 2147380029 vertices"));
     }
     SECTION("a NaN or an infinity names the frame and the vertex when the frame is read") {
         auto nan = frames;
