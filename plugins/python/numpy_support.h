@@ -95,14 +95,9 @@ inline geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const
     return geom::Mesh(std::move(d), meshName);
 }
 
-// The Python type of a value ("list", "ndarray"), for messages.
-inline std::string typeName(pybind11::handle value) {
-    return pybind11::str(pybind11::type::of(value).attr("__name__"));
-}
-
-// The same with its article: "a list", "an int".
+// The Python type of a value with its article ("a list", "an int"), for messages.
 inline std::string aTypeName(pybind11::handle value) {
-    const std::string name = typeName(value);
+    const std::string name = pybind11::str(pybind11::type::of(value).attr("__name__"));
     const bool vowel =
         !name.empty() && std::string_view("aeiouAEIOU").find(name[0]) != std::string_view::npos;
     return (vowel ? "an " : "a ") + name;
