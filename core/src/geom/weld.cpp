@@ -186,7 +186,7 @@ Welding weldVertices(const Mesh& mesh, double tolerance, const std::string& sour
         std::sort(sorted.begin(), sorted.end());
         if (kept < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) continue;
         w.fileFaceOf.push_back(static_cast<int32_t>(f));
-        data.faceCounts.push_back(static_cast<int32_t>(n));
+        data.faceCounts.push_back(static_cast<int32_t>(kept));
         data.faceIndices.insert(data.faceIndices.end(), corners.begin(), corners.end());
         if (uvs) data.uvIndices.insert(data.uvIndices.end(), uvCorners.begin(), uvCorners.end());
     }

@@ -165,3 +165,43 @@ TEST_CASE("slide on split vertices: without welding the split mesh tears", "[sli
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)geom::weldVertices(apart, -1.0, "apart.obj"); }),
                Contains("apart.obj: weld tolerance: is -1"));
 }
+
+TEST_CASE("weld: a face whose corners weld keeps the corners left, with their UVs", "[slide][weld]") {
+    // Quads on coincident points, joined through an unused copy: (a) corners 3 and 4 weld onto each other
+    // (consecutive), (b) the last corner welds onto the first (cyclically). Each becomes the triangle of its
+    // distinct corners; the welded mesh's counts and indices agree, and every kept corner keeps its own UV.
+    const auto check = [](std::vector<glm::vec3> points, std::vector<int32_t> quad,
+                          std::vector<int32_t> triangle) {
+        geom::Mesh::Data data;
+        data.points = std::move(points);
+        data.faceCounts = {4};
+        data.faceIndices = quad;
+        data.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        data.uvIndices = {0, 1, 2, 3};
+        const geom::Mesh mesh(std::move(data), "quad.obj");
+        const geom::Welding weld = geom::weldVertices(mesh, 0.0, "quad.obj");
+        REQUIRE(weld.merged() >= 1);
+        REQUIRE(weld.mesh.numFaces() == 1);
+        CHECK(weld.mesh.faceCounts()[0] == 3);
+        std::vector<int32_t> corners, uvCorners;
+        for (size_t k = 0; k < 3; ++k) {
+            corners.push_back(weld.firstOf[static_cast<size_t>(weld.mesh.faceIndices()[k])]);
+            uvCorners.push_back(weld.mesh.uvIndices()[k]);
+        }
+        CHECK(corners == triangle);
+        CHECK(weld.fileFaceOf == std::vector<int32_t>{0});
+        return uvCorners;
+    };
+    // (a) file vertex 0 is an unused copy of vertices 3 and 4: the quad 1 2 3 4 welds to 1 2 0 0.
+    CHECK(check({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}, {0, 0, 0}}, {1, 2, 3, 4}, {1, 2, 0}) ==
+          std::vector<int32_t>{0, 1, 2});
+    // (b) vertex 4, unused, is a copy of vertices 0 and 3: the quad 0 1 2 3 welds to 0 1 2 0.
+    CHECK(check({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}, {0, 0, 0}}, {0, 1, 2, 3}, {0, 1, 2}) ==
+          std::vector<int32_t>{0, 1, 2});
+    // Corners of one face never weld onto each other directly (a collapsed edge, not a split copy).
+    geom::Mesh::Data data;
+    data.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}};
+    data.faceCounts = {4};
+    data.faceIndices = {0, 1, 2, 3};
+    CHECK(geom::weldVertices(geom::Mesh(std::move(data), "quad.obj")).merged() == 0);
+}
