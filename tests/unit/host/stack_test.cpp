@@ -552,5 +552,20 @@ TEST_CASE("ffd after a twist: lattice coordinates at rest, or at the incoming po
         direct.evaluate(expected);
         INFO("evaluateAt " << at);
         CHECK(test::sameBits(points, expected));
+        // Switched to the other setting (as an animated evaluateAt does between frames), the stack gives
+        // what the other setting gives from the start: a frame's result does not depend on the frames before.
+        stack.set(1, "evaluateAt", 1.0 - at);
+        std::vector<glm::vec3> switched = restOf(scene.rest);
+        stack.evaluate(switched);
+        expected = twisted;
+        warp::Ffd other(scene.lattice);
+        other.setTargets(scene.targets);
+        if (at == 1.0) {
+            other.bind(scene.rest.points());
+        } else {
+            other.bind(twisted);
+        }
+        other.evaluate(expected);
+        CHECK(test::sameBits(switched, expected));
     }
 }

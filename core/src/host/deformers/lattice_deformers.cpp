@@ -41,7 +41,9 @@ class LatticeDeformer : public Deformer {
                                  "extrapolation of the end controls, 1 the end controls repeated "
                                  "(Blender's Lattice modifier; with outside 1 it deforms as Blender does)"},
                          {0.0});
+        // Rebinds: back at 0, the lattice coordinates are the rest points' again, not the last input's.
         evaluateAt_ = addParameter({.name = "evaluateAt",
+                                    .rebinds = true,
                                     .doc = "where each point's lattice coordinates are taken: 0 at its rest "
                                            "position, once at bind; 1 at its incoming position, every "
                                            "evaluation (as Maya's and Blender's lattices do after other "
