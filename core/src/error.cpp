@@ -30,4 +30,10 @@ std::string numberText(double x) {
     return std::string(buffer, result.ptr);
 }
 
+std::string numberText(float x) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+    return std::string(buffer, result.ptr);
+}
+
 }  // namespace deformkit

@@ -47,5 +47,8 @@ class TopologyError : public InvalidInput {
 
 // The shortest text that reads back as `x` ("10", "0.1", "nan", "inf"), for numbers in messages.
 [[nodiscard]] std::string numberText(double x);
+// The same for a float: the shortest text that reads back as the float ("0.1" for 0.1f, not
+// "0.10000000149011612").
+[[nodiscard]] std::string numberText(float x);
 
 }  // namespace deformkit

@@ -249,8 +249,21 @@ void MeshWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& fields)
         }
     }
     std::vector<float> radii(rest_.size());
-    for (size_t i = 0; i < rest_.size(); ++i)
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (size_t i = 0; i < rest_.size(); ++i) {
         radii[i] = options_.beta * longest_[i];
+        lo = glm::min(lo, rest_[i] - radii[i]);
+        hi = glm::max(hi, rest_[i] + radii[i]);
+    }
+    // The supports' bounding box must have a finite size for the grid over it (a beta near float's largest
+    // value makes it infinite).
+    if (!geom::isFinite(hi - lo)) {
+        throw InvalidInput(formatError(source_, "beta",
+                                       "is " + numberText(options_.beta) +
+                                           ": the control vertices' supports (beta times "
+                                           "their longest edges) span no finite box",
+                                       "beta times the longest cage edge well within float range"));
+    }
     const SupportGrid grid = buildGrid(rest_, radii);
 
     // Points in fixed blocks: each block gathers its points' entries (in candidate order) into its own

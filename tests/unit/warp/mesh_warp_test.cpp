@@ -482,6 +482,13 @@ TEST_CASE("mesh warp: bad input names the element", "[mesh_warp][errors]") {
     const std::vector<glm::vec3> nanRest{{0, 0, 0}, {NAN, 0, 0}};
     SparseFields f;
     CHECK_THROWS_WITH(warp.bind(nanRest, f), Catch::Contains("rest point 1"));
+    // A beta whose supports overflow float: refused at bind (it once grew the support grid's cell forever).
+    o = {};
+    o.beta = 2e38f;
+    MeshWarp huge(cage, o);
+    const std::vector<glm::vec3> rest{{0, 0, 0}, {0.1f, 0, 0}};
+    CHECK_THROWS_WITH(huge.bind(rest, f),
+                      Catch::Contains("beta: is 2e+38") && Catch::Contains("no finite box"));
 }
 
 TEST_CASE("mesh warp: a cage with split vertices warps as the shared-vertex cage, bit for bit",
