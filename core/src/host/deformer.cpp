@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/warp/envelope.h"
 
 namespace deformkit::host {
@@ -177,6 +178,33 @@ void Deformer::prepare(size_t in, size_t out) {
     }
 }
 
+namespace {
+
+std::string pointText(const glm::vec3& p) {
+    std::string text = "(";
+    text += numberText(p.x);
+    text += ", ";
+    text += numberText(p.y);
+    text += ", ";
+    text += numberText(p.z);
+    text += ")";
+    return text;
+}
+
+// Parameters within float range can still take a point beyond it (an envelope of 1e38, a bend of
+// 3e38 radians a unit): refused here, naming the point, rather than handed on as NaN or infinity.
+void requireFiniteOutput(const std::string& context, std::span<const glm::vec3> in,
+                         std::span<const glm::vec3> out) {
+    const size_t u = geom::firstNonFinite(out);
+    if (u == out.size()) return;
+    throw InvalidInput(formatError(context, "point " + std::to_string(u),
+                                   "is deformed from " + pointText(in[u]) + " to " + pointText(out[u]),
+                                   "finite positions: parameters that keep the deformation within float "
+                                   "range"));
+}
+
+}  // namespace
+
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out) {
     prepare(in.size(), out.size());
     try {
@@ -184,6 +212,7 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out)
     } catch (const Error&) {
         rethrowWithContext(context_);
     }
+    requireFiniteOutput(context_, in, out);
 }
 
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
@@ -209,6 +238,7 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
     } catch (const Error&) {
         rethrowWithContext(context_);
     }
+    requireFiniteOutput(context_, in, out);
 }
 
 }  // namespace deformkit::host

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 
 namespace deformkit::host {
 namespace {
@@ -207,18 +208,10 @@ void DeformerStack::prepare(std::span<const glm::vec3> in, size_t outSize) {
     // The rest mesh's own positions are finite (geom::Mesh checks them); anything else is scanned, in one
     // branch-free pass (vectorised) before looking for the first bad point.
     if (in.data() != mesh.points().data()) {
-        const float* f = &in.data()->x;
-        bool finite = true;
-        for (size_t i = 0; i < 3 * n; ++i)
-            finite &= std::abs(f[i]) <= std::numeric_limits<float>::max();
-        if (!finite) {
-            for (size_t u = 0; u < n; ++u) {
-                const glm::vec3& p = in[u];
-                if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-                    throw InvalidInput(formatError("stack", "point " + std::to_string(u), "is not finite",
-                                                   "finite coordinates"));
-                }
-            }
+        const size_t u = geom::firstNonFinite(in);
+        if (u < n) {
+            throw InvalidInput(
+                formatError("stack", "point " + std::to_string(u), "is not finite", "finite coordinates"));
         }
     }
     active_.clear();

@@ -510,6 +510,38 @@ TEST_CASE("evaluate(in, out) gives the in-place result for 0 to 3 active entries
     CHECK_THROWS_WITH(stack.evaluate(bad), Contains("point 5: is not finite"));
 }
 
+TEST_CASE("a deformation beyond float range is refused, naming the entry and the point", "[host][stack]") {
+    // Every parameter within float range, the result not: a taper tripling the width, applied with an
+    // envelope of 1e38 (out = in + envelope (deformed - in): 2 x 1e38 x for the plane's x up to 2), and a
+    // bend of 3e38 radians a unit over 2 units of its axis (an infinite angle).
+    const Scene scene;
+    const std::vector<glm::vec3> input = restOf(scene.rest);
+    {
+        DeformerStack stack;
+        stack.setRest(scene.rest);
+        stack.add(makeDeformer("taper", "taper1"));
+        stack.set(0, "startScale", 3.0);
+        stack.set(0, "endScale", 3.0);
+        stack.setEnvelope(0, 1e38);
+        std::vector<glm::vec3> points = input;
+        CHECK_THROWS_WITH(stack.evaluate(points), Contains("stack entry 0 (taper 'taper1'): point ") &&
+                                                      Contains("expected finite positions"));
+        CHECK(test::sameBits(points, input));  // in place: untouched when an entry throws
+        stack.setEnvelope(0, 1.0);
+        CHECK_NOTHROW(stack.evaluate(points));
+    }
+    {
+        DeformerStack stack;
+        stack.setRest(scene.rest);
+        stack.add(makeDeformer("bend", "bend1"));
+        stack.set(0, "curvature", 3e38);
+        stack.set(0, "highBound", 2.0);
+        std::vector<glm::vec3> out(input.size());
+        CHECK_THROWS_WITH(stack.evaluate(input, out),
+                          Contains("stack entry 0 (bend 'bend1'): point ") && Contains("nan"));
+    }
+}
+
 TEST_CASE("ffd after a twist: lattice coordinates at rest, or at the incoming points (evaluateAt)",
           "[host][stack][ffd]") {
     // Maya's and Blender's lattices take each point where the deformers above left it; DeformKit's FFD binds

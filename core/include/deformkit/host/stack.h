@@ -29,7 +29,9 @@ namespace deformkit::host {
 //   bound). Otherwise weights and envelope apply as the deformer's weightMode() says: Maya's
 //   out = in + envelope w (deformed - in) (warp::applyEnvelope) or the deformer's own (the slide).
 // - Errors are InvalidInput (or a subclass) naming the entry, "stack entry 2 (ffd 'lattice1')" (entries
-//   count from 0), and the parameter or input; evaluate() writes nothing to `points` when it throws.
+//   count from 0), and the parameter or input; evaluate() writes nothing to `points` when it throws. An
+//   entry whose result is not finite (parameters in float range that take a point beyond it) throws,
+//   naming the point.
 //
 // Not thread-safe: one thread drives a stack; each entry runs in parallel inside (OpenMP), with results
 // bit-identical for any thread count.
