@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -113,6 +114,18 @@ void validateSegmentPairs(std::span<const SegmentPair> pairs, const std::string&
         if (!std::isfinite(s.p) || s.p < 0.0f) {
             throw InvalidInput(
                 formatError(source, element, "has p = " + std::to_string(s.p), "finite p >= 0"));
+        }
+        // The weight peaks on the segment itself (distance 0), in float as every path computes it; the
+        // sum of every pair's must stay finite, or a point on a segment gets inf / inf.
+        const double peak = weightOf(weightTerms(s), s.dstP);
+        if (!(peak * static_cast<double>(pairs.size()) <= std::numeric_limits<float>::max())) {
+            throw InvalidInput(formatError(source, element,
+                                           "has a weight of " + numberText(static_cast<float>(peak)) +
+                                               " on its segment ((length^p / a)^b, p = " + numberText(s.p) +
+                                               ", a = " + numberText(s.a) + ", b = " + numberText(s.b) + ")",
+                                           "a weight within float range over " +
+                                               std::to_string(pairs.size()) +
+                                               " pairs: a larger a, or a smaller p or b"));
         }
     }
 }

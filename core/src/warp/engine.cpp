@@ -8,6 +8,7 @@
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
 #include "warp/checks.h"
+#include "warp/weighted_mean.h"
 
 namespace deformkit::warp {
 namespace {
@@ -44,24 +45,23 @@ void evaluateWarp(std::span<const glm::vec3> points, const SparseFields& fields,
                                            "an index in [0, " + std::to_string(numTransforms) + ")"));
         }
     }
-    const float m = options.displacementWeightExponent;
+    const auto m = static_cast<double>(options.displacementWeightExponent);
 
 #pragma omp parallel for schedule(static)
     for (int64_t u = 0; u < static_cast<int64_t>(n); ++u) {
         const glm::vec3 p = points[u];
         // Eq. (3) with the weighted sum taken over displacements (matrix addition, §3.3), in double so
-        // the result does not depend on how many entries a point has.
-        glm::dvec3 displacement(0.0);
-        double weightSum = 0.0;
-        for (int32_t e = fields.offsets[u]; e < fields.offsets[u + 1]; ++e) {
-            const glm::vec3 d = applyScaled(transforms, fields.transform[e], fields.strength[e], p) - p;
-            double w = fields.weight[e];
-            if (m != 0.0f) w *= std::pow(static_cast<double>(glm::length(d)), static_cast<double>(m));
-            displacement += w * glm::dvec3(d);
-            weightSum += w;
-        }
-        // All-zero weights: the identity (paper footnote 6).
-        out[u] = weightSum > 0.0 ? p + glm::vec3(displacement / weightSum) : p;
+        // the result does not depend on how many entries a point has. All-zero weights: the identity
+        // (paper footnote 6).
+        glm::dvec3 mean;
+        const bool moved = detail::weightedMeanDisplacement(
+            fields.offsets[u], fields.offsets[u + 1], m,
+            [&](int32_t e) {
+                return applyScaled(transforms, fields.transform[e], fields.strength[e], p) - p;
+            },
+            [&](int32_t e) { return static_cast<double>(fields.weight[e]); },
+            [](double x, double y) { return std::pow(x, y); }, mean);
+        out[u] = moved ? p + glm::vec3(mean) : p;
     }
 }
 

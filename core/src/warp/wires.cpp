@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "warp/weighted_mean.h"
 
 namespace deformkit::warp {
 namespace {
@@ -537,21 +538,19 @@ void Wires::evaluate(std::span<glm::vec3> points, std::span<const float> weights
         if (begin == end) continue;
         const glm::vec3 p = points[u];
         // Eq. (3) as in evaluateWarp: displacements accumulated in double, weights times |d|^m.
-        glm::dvec3 displacement(0.0);
-        double weightSum = 0.0;
-        for (int32_t e = begin; e < end; ++e) {
-            const float s = fields_.strength[e];
-            const glm::vec3 d =
-                (smooth ? applyComposition(scratch_[fields_.transform[e]], s, p)
-                        : applyComposition(toSample(transformAt(entryWire_[e], entryPlace_[e])), s, p)) -
-                p;
-            double w = fields_.weight[e];
-            if (m != 0.0) w *= powAbs(static_cast<double>(glm::length(d)), m);
-            displacement += w * glm::dvec3(d);
-            weightSum += w;
-        }
-        if (!(weightSum > 0.0)) continue;
-        const glm::vec3 moved = p + glm::vec3(displacement / weightSum);
+        glm::dvec3 mean;
+        const bool any = detail::weightedMeanDisplacement(
+            begin, end, m,
+            [&](int32_t e) {
+                const float s = fields_.strength[e];
+                return (smooth
+                            ? applyComposition(scratch_[fields_.transform[e]], s, p)
+                            : applyComposition(toSample(transformAt(entryWire_[e], entryPlace_[e])), s, p)) -
+                       p;
+            },
+            [&](int32_t e) { return static_cast<double>(fields_.weight[e]); }, powAbs, mean);
+        if (!any) continue;
+        const glm::vec3 moved = p + glm::vec3(mean);
         const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
         points[u] = p + k * (moved - p);
     }

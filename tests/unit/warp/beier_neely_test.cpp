@@ -360,6 +360,24 @@ TEST_CASE("Beier-Neely: bad input names the segment pair", "[warp][beier_neely][
     CHECK_THROWS_WITH(beierNeelyTransformations(withSecond(badP)),
                       Catch::Contains("segment pair 1") && Catch::Contains("p >= 0"));
     CHECK_THROWS_AS(beierNeelyTransformations(withSecond(badP)), InvalidInput);
+    // A weight that overflows float on its segment: (10^0 / 0.001)^40 = 1e120. A point on the segment got
+    // inf / inf (NaN). At the edge: three pairs' peaks of (1 / 1e-19)^2 = 1e38 sum to 3e38, within float
+    // range (3.4e38); four would not.
+    SegmentPair steep = good;
+    steep.p = 0.0f;
+    steep.a = 0.001f;
+    steep.b = 40.0f;
+    CHECK_THROWS_WITH(beierNeelyTransformations(withSecond(steep)),
+                      Catch::Contains("segment pair 1") &&
+                          Catch::Contains("has a weight of inf on its segment") &&
+                          Catch::Contains("over 2 pairs"));
+    SegmentPair edge = good;
+    edge.p = 0.0f;
+    edge.a = 1e-19f;
+    edge.b = 2.0f;
+    CHECK_NOTHROW(beierNeelyTransformations(std::vector<SegmentPair>{edge, edge, edge}));
+    CHECK_THROWS_WITH(beierNeelyTransformations(std::vector<SegmentPair>{edge, edge, edge, edge}),
+                      Catch::Contains("segment pair 0") && Catch::Contains("over 4 pairs"));
 
     const BeierNeelyWarp warp({good});
     std::vector<glm::vec2> small(10);

@@ -114,6 +114,34 @@ TEST_CASE("engine: displacement-weight exponent (Wires weighting)", "[warp][engi
     CHECK(out[0].x == Approx(2.8f));
 }
 
+TEST_CASE("engine: a displacement-weight exponent beyond double's range gives the same mean",
+          "[warp][engine]") {
+    // Two translations along x and y, lengths L and 1.002 L, weights 1 and 1, exponent 400: the weights
+    // (L)^400 and (1.002 L)^400 overflow double for L = 10 and underflow it for L = 0.1, but their ratio
+    // r = 1.002^400 does not. The mean: (d1 + r d2) / (1 + r), r computed here in log space.
+    const double r = std::exp(400.0 * std::log(1.002));
+    for (const float length : {10.0f, 0.1f, 1.0f}) {
+        const std::vector<glm::vec3> points{{0, 0, 0}};
+        Transformations t;
+        t.affine = {Affine::translate({length, 0, 0}), Affine::translate({0, 1.002f * length, 0})};
+        SparseFields f;
+        f.add(0, 1.0f, 1.0f);
+        f.add(1, 1.0f, 1.0f);
+        f.endPoint();
+        std::vector<glm::vec3> out(1);
+        evaluateWarp(points, f, t, out, {400.0f});
+        // The lengths as float holds them, in the ratio's place.
+        const double l1 = length, l2 = static_cast<double>(1.002f * length);
+        const double ratio = std::exp(400.0 * std::log(l2 / l1));
+        CHECK(ratio == Approx(r).epsilon(1e-3));
+        CAPTURE(length);
+        CHECK(std::isfinite(out[0].x));
+        CHECK(out[0].x == Approx(l1 / (1.0 + ratio)).epsilon(1e-5));
+        CHECK(out[0].y == Approx(ratio * l2 / (1.0 + ratio)).epsilon(1e-5));
+        CHECK(out[0].z == 0.0f);
+    }
+}
+
 TEST_CASE("engine: bit-identical for 1 and 2 threads", "[warp][engine][determinism]") {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> uni(-1.0f, 1.0f);

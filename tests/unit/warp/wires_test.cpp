@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -10,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/warp/curve.h"
 #include "deformkit/warp/engine.h"
@@ -466,6 +468,39 @@ TEST_CASE("wires: fast path equals the generic engine and WarpDeformer", "[wires
         evaluateWarp(rest, wires.fields(), t, engine, wires.engineOptions());
         CHECK(maxDistance(again, engine) <= 1e-5f);
         CHECK(maxDistance(again, fast) > 0.05f);
+    }
+}
+
+TEST_CASE("wires: an exponent whose weights leave double's range still moves every point it reaches",
+          "[wires]") {
+    // |d|^400 overflows double for displacements over ~6.3 and underflows for those under ~0.17: the
+    // fast path and the engine take such weights relative to the longest displacement, so points move
+    // (finite, every point the plain exponent moves) and both paths agree.
+    const auto rest = randomPoints(2000, -0.5f, 2.5f, 11);
+    for (const float lift : {0.05f, 20.0f}) {
+        Wire first = bentWire(0.6f, 1.3f), second;
+        second.reference = line({0, 1, 0}, {2, 1.5f, 0.5f}, 5);
+        second.wire = line({0, 1, lift}, {2, 1.5f, 0.5f + 1.5f * lift}, 5);
+        second.radius = 0.7f;
+        for (auto& p : first.wire)
+            p.z += lift;
+        for (auto variant : {WiresVariant::Original, WiresVariant::Smooth}) {
+            CAPTURE(lift, static_cast<int>(variant));
+            Wires plain({first, second}, {variant, 1.0f, 0}), steep({first, second}, {variant, 400.0f, 0});
+            const auto moved = evaluateFast(plain, rest);
+            const auto fast = evaluateFast(steep, rest);
+            const auto generic = evaluateGeneric(steep, rest);
+            CHECK(maxDistance(fast, generic) <= 1e-5f * std::max(1.0f, lift));
+            size_t movedPlain = 0, movedSteep = 0, bad = 0;
+            for (size_t i = 0; i < rest.size(); ++i) {
+                bad += geom::isFinite(fast[i]) ? 0 : 1;
+                movedPlain += moved[i] != rest[i] ? 1 : 0;
+                movedSteep += fast[i] != rest[i] ? 1 : 0;
+            }
+            CHECK(bad == 0);
+            CHECK(movedPlain > 100);
+            CHECK(movedSteep == movedPlain);
+        }
     }
 }
 
