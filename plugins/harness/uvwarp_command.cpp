@@ -24,6 +24,7 @@
 #include "deformkit/uvwarp/html_report.h"
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/options.h"
+#include "deformkit/uvwarp/shot_log.h"
 #include "deformkit/version.h"
 
 namespace deformkit::harness {
@@ -143,11 +144,7 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     std::ofstream logFile;
     std::ostringstream logLines;  // for the page when there is no log file
     if (command.log) {
-        logFile.open(*command.log, std::ios::app | std::ios::binary);
-        if (!logFile) {
-            throw IoError(formatError(command.log->string(), "", "cannot open the log for appending",
-                                      "a writable file in an existing folder"));
-        }
+        uvwarp::openShotLog(*command.log, logFile);
         job.log = &logFile;
     } else if (command.report) {
         job.log = &logLines;

@@ -30,6 +30,7 @@
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/options.h"
 #include "deformkit/uvwarp/shot_job.h"
+#include "deformkit/uvwarp/shot_log.h"
 #include "deformkit/uvwarp/tile_warp.h"
 #include "numpy_support.h"
 
@@ -535,11 +536,7 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
             throw InvalidInput(formatError(kShot, "log", "is " + aTypeName(log), "None or a file path"));
         }
         logPath = log.cast<std::filesystem::path>();
-        logFile.open(logPath, std::ios::app | std::ios::binary);
-        if (!logFile) {
-            throw IoError(formatError(logPath.string(), "", "cannot open the log for appending",
-                                      "a writable file in an existing folder"));
-        }
+        uvwarp::openShotLog(logPath, logFile);
         job.log = &logFile;
     }
 

@@ -289,15 +289,15 @@ expect slide-bad-painted 2 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0
 contains slide-bad-painted "$work/err" "--painted-weights"
 
 # UV warp over a 2-frame shot of the grid (UVs in tile 1001) with the demo's 64 x 64 rigidity map: frame 1 is the
-# rest pose, frame 2 stretches 1.5x along x.
+# rest pose, frame 2 stretches 1.5x along x. The log's folder does not exist yet: it is made, as the outputs' are.
 mkdir -p "$work/uv/out" "$work/uv/cold" "$work/uv/coldalone" "$work/uv/warm"
 cp "$work/grid.obj" "$work/uv/anim.0001.obj"
 awk '/^v / { printf "v %.9g %s %s\n", $2 * 1.5, $3, $4; next } { print }' "$work/grid.obj" >"$work/uv/anim.0002.obj"
 uvwarp() { "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/uv/anim.####.obj" --rigidity "$work/demo/rigidity.<UDIM>.exr" "$@"; }
 expect uvwarp 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr" --texture "$work/demo/albedo.<UDIM>.png" \
-    --bake "$work/uv/out/albedo.<UDIM>.####.png" --log "$work/uv/log.jsonl"
+    --bake "$work/uv/out/albedo.<UDIM>.####.png" --log "$work/uv/logs/log.jsonl"
 contains uvwarp "$work/out" "uvwarp: tile 1001: 2 frames written (2 baked), 0 replayed, 0 skipped"
-[ "$(wc -l <"$work/uv/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
+[ "$(wc -l <"$work/uv/logs/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
 [ -s "$work/uv/out/albedo.1001.0002.png" ] || { echo "FAIL uvwarp: bake missing"; failures=$((failures + 1)); }
 # The shot's page: from the run (--report), and from logs merged with a broken one (its file and line in the
 # page, exit 0); no log at all is exit 2.
@@ -306,7 +306,7 @@ contains uvwarp-report "$work/out" "uvwarp: report $work/uv/rep/report.html"
 contains uvwarp-report "$work/uv/rep/report.html" "measured again from its files: the same"
 contains uvwarp-report "$work/uv/rep/report.html" 'data-tile="1001" data-written="2"'
 printf '{"tile":1001,"frame":3,"status":"written"}\n{"tile":1001,"frame":4,"sta' >"$work/uv/broken.jsonl"
-expect report 0 "$dk" report "$work/uv/log.jsonl" "$work/uv/broken.jsonl" --out "$work/uv/report.html"
+expect report 0 "$dk" report "$work/uv/logs/log.jsonl" "$work/uv/broken.jsonl" --out "$work/uv/report.html"
 contains report "$work/out" "report: wrote $work/uv/report.html (2 log lines, 8 pictures beside it; 2 problems)"
 contains report "$work/uv/report.html" "broken.jsonl:1: is a written frame without metrics.rigid_stretch_removed"
 contains report "$work/uv/report.html" "broken.jsonl:2: is not JSON"

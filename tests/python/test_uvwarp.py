@@ -385,6 +385,16 @@ def test_shot_maps_in_memory_equal_maps_from_files(tmp_path):
         "rigidity tile 1001", "painted mask tile 1001", "frame 2")
 
 
+def test_shot_makes_the_folders_of_its_outputs_and_its_log(tmp_path):
+    mesh = two_tiles()
+    rig, _ = shot_maps()
+    out, log = tmp_path / "maps" / "v1" / OUT, tmp_path / "logs" / "shot.jsonl"
+    dk.uvwarp_shot(*mesh, FRAMES[:2], lambda f: pose(mesh[0], f), rig, str(out), log=str(log), **OPTIONS)
+    assert sorted(os.listdir(tmp_path / "maps" / "v1")) == [
+        f"redirect.{tile}.{frame:04d}.exr" for tile in (1001, 1002) for frame in FRAMES[:2]]
+    assert len(log.read_text().splitlines()) == 4  # a line per tile and frame
+
+
 def test_shot_by_default_solves_each_frame_from_the_identity(tmp_path):
     mesh = two_tiles()
     rig, _ = shot_maps()

@@ -10,6 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "deformkit/error.h"
+#include "deformkit/io/atomic_file.h"
+
 namespace deformkit::uvwarp {
 namespace {
 
@@ -177,6 +180,14 @@ std::vector<ShotTileSeries> shotSeries(const ShotLog& log) {
         }
     }
     return out;
+}
+
+void openShotLog(const std::filesystem::path& path, std::ofstream& file) {
+    if (path.has_parent_path()) io::createFolder(path.parent_path());
+    file.open(path, std::ios::app | std::ios::binary);
+    if (!file) {
+        throw IoError(formatError(path.string(), "", "cannot open the log for appending", "a writable file"));
+    }
 }
 
 }  // namespace deformkit::uvwarp

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <istream>
 #include <limits>
 #include <map>
@@ -46,6 +47,10 @@ struct ShotLog {
 void readShotLog(std::istream& in, const std::string& file, ShotLog& log);
 // Reads a log file; a missing or unreadable one is a problem.
 void readShotLogFile(const std::filesystem::path& path, ShotLog& log);
+
+// Opens `path` for appending a shot's log lines (`deformkit uvwarp --log`, Python's log=), its folder made
+// when missing, as the shot's outputs' are. Throws IoError naming the file when it cannot be opened.
+void openShotLog(const std::filesystem::path& path, std::ofstream& file);
 
 // One frame of an object's tile as the logs tell it.
 struct ShotFrame {
