@@ -2,6 +2,9 @@
 
 #include <exception>
 #include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -152,13 +155,35 @@ Command CommandLine::group(const std::string& name, const std::string& descripti
     return Command(group);
 }
 
+namespace {
+
+// "'nosuch' is not a command (expected one of: info, preview, ...)" when a word that names no subcommand
+// stands where one is required (CLI11 says only "A subcommand is required"); the deepest command that
+// was parsed names its own subcommands ("deformkit farm nosuch").
+std::optional<std::string> unknownCommand(const CLI::App& app) {
+    for (const CLI::App* sub : app.get_subcommands({})) {
+        if (sub->parsed()) return unknownCommand(*sub);
+    }
+    const std::vector<std::string> left = app.remaining();
+    const std::vector<const CLI::App*> subs = app.get_subcommands({});
+    if (left.empty() || subs.empty() || left.front().starts_with("-")) return std::nullopt;
+    std::string names;
+    for (const CLI::App* sub : subs)
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+    const std::string where = app.get_parent() ? "a " + app.get_name() + " command" : "a command";
+    return "'" + left.front() + "' is not " + where + " (expected one of: " + names + ")";
+}
+
+}  // namespace
+
 int CommandLine::run(int argc, char** argv) {
     try {
         app_->parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // Help and version print and exit 0; a usage error is one line on stderr and exit code 2.
         if (e.get_exit_code() == 0) return app_->exit(e);
-        std::cerr << "deformkit: usage error: " << e.what() << " (see deformkit --help)\n";
+        std::cerr << "deformkit: usage error: " << unknownCommand(*app_).value_or(e.what())
+                  << " (see deformkit --help)\n";
         return 2;
     } catch (const Error& e) {  // from an option that acts as it is parsed (listing)
         std::cerr << "deformkit: error: " << e.what() << "\n";

@@ -222,8 +222,10 @@ void addFarmCommands(CommandLine& cli) {
     plan.option("--tiles-per-task", p->command.tilesPerTask,
                 "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")
         .showDefault();
-    plan.option("--warm-up", p->command.warmUp,
-                "frames a UV-warp task solves before its range, so its maps hardly depend on the chunking")
+    plan.option(
+            "--warm-up", p->command.warmUp,
+            "with a scene's \"warmStart\": true, frames a UV-warp task solves before its range, so its maps "
+            "hardly depend on the chunking (without it, none: each frame is solved from the identity)")
         .showDefault();
     plan.option("--out", p->out, "output folder of the tasks: <object>.<frame 4 digits>.obj").required();
     plan.option("--plan", p->plan, "plan file to write; default: <out>/farm_plan.json");

@@ -90,9 +90,10 @@ void addPreviewCommand(CommandLine& cli) {
             std::cout << "wrote " << o->out << "\n";
             return 0;
         });
-    preview.option("MESH", o->mesh, "mesh (.obj)").required();
+    preview.option("MESH", o->mesh, "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     preview.option("--texture", o->texture, "image, or UDIM pattern such as albedo.<UDIM>.png");
-    preview.option("--out", o->out, "output image (.png)").required();
+    preview.option("--out", o->out, "output image (.png, .jpg, .exr: any format OpenImageIO writes)")
+        .required();
     preview.option("--width", o->command.options.width, "pixels").showDefault();
     preview.option("--height", o->command.options.height, "pixels").showDefault();
     preview.option("--view", o->view, "camera direction x,y,z (y up); default -0.55,-0.45,-1");

@@ -219,7 +219,7 @@ void addPtexCommands(CommandLine& cli) {
             return 0;
         });
     toVertex.option("FILE", tv->ptex, "Ptex file painted on MESH").required();
-    toVertex.option("MESH", tv->mesh, "mesh (.obj)").required();
+    toVertex.option("MESH", tv->mesh, "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     toVertex.option("--out", tv->out, "weights file (.json)").required();
     toVertex.option("--channel", tv->channel, "channel").showDefault();
 
@@ -236,7 +236,7 @@ void addPtexCommands(CommandLine& cli) {
             return 0;
         });
     toUdim.option("FILE", tu->command.ptex, "Ptex file painted on MESH").required();
-    toUdim.option("MESH", tu->command.mesh, "mesh (.obj) with UVs").required();
+    toUdim.option("MESH", tu->command.mesh, "mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
     toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
     toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
@@ -255,7 +255,7 @@ void addPtexCommands(CommandLine& cli) {
             return 0;
         });
     fromUdim.option("PATTERN", fu->pattern, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
-    fromUdim.option("MESH", fu->mesh, "mesh (.obj) with UVs").required();
+    fromUdim.option("MESH", fu->mesh, "mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     fromUdim.option("--out", fu->out, "Ptex file (.ptx)").required();
     addPtexOutputOptions(fromUdim, fu->faceLog2, fu->type, "auto",
                          "texels per face side: auto or a power of two");
@@ -268,7 +268,7 @@ void addPtexCommands(CommandLine& cli) {
             return 0;
         });
     fromVertex.option("WEIGHTS", fv->weights, "weights file (.json), one per vertex").required();
-    fromVertex.option("MESH", fv->mesh, "mesh (.obj)").required();
+    fromVertex.option("MESH", fv->mesh, "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     fromVertex.option("--out", fv->out, "Ptex file (.ptx)").required();
     addPtexOutputOptions(fromVertex, fv->faceLog2, fv->type, "16", "texels per face side, a power of two");
 }

@@ -231,7 +231,7 @@ void addUvWarpCommand(CommandLine& cli) {
             if (c.report) std::cout << "uvwarp: report " << c.report->string() << "\n";
             return 0;
         });
-    uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj)").required();
+    uvwarp.option("--rest", o->rest, "rest mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     uvwarp
         .option("--deformed", o->deformed,
                 "deformed frames: an OBJ sequence 'anim.####.obj' (# per digit) or %04d, or a point cache "

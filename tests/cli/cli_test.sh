@@ -33,6 +33,10 @@ contains version "$work/out" "deformkit 0."
 expect help 0 "$dk" preview --help
 contains help "$work/out" "--texture"
 expect no-subcommand 2 "$dk"
+expect unknown-command 2 "$dk" nosuch
+contains unknown-command "$work/err" "'nosuch' is not a command (expected one of: info, preview,"
+expect unknown-farm-command 2 "$dk" farm nosuch
+contains unknown-farm-command "$work/err" "'nosuch' is not a farm command (expected one of: plan, run, submit, report)"
 expect unknown-option 2 "$dk" info --bogus x
 expect missing-mesh 2 "$dk" info "$work/nope.obj"
 contains missing-mesh "$work/err" "nope.obj"
