@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include <glm/geometric.hpp>
@@ -362,6 +363,14 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
         if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z)) {
             throw InvalidInput(formatError(m.source, "handle " + std::to_string(h) + " displacement",
                                            "not finite", "finite x, y, z"));
+        }
+        // Within float range, as every position is (the walk squares lengths in double).
+        constexpr float kLargest = std::numeric_limits<float>::max();
+        const double length = std::hypot(d.x, d.y, d.z);  // without squaring past double's range
+        if (!(length <= kLargest)) {
+            throw InvalidInput(formatError(
+                m.source, "handle " + std::to_string(h) + " displacement", "has length " + numberText(length),
+                "a length within float range (at most " + numberText(kLargest) + " scene units)"));
         }
     }
     m.requireCounts(nv, points.size(), weights.size());

@@ -347,6 +347,30 @@ TEST_CASE("slide: a non-finite incoming point it reads is an error naming the ve
     CHECK(points[handle].x > plane.points()[handle].x);
 }
 
+TEST_CASE("slide: a drag beyond float range is an error; one within it stays on the surface",
+          "[slide][errors]") {
+    // A drag of 1e155 once squared to infinity in the walk and wrote NaN positions.
+    const geom::Mesh plane = test::planeGrid(10, 10, 0.1f);
+    const int32_t handle = 5 * 11 + 5;
+    slide::Slider slider(plane, {{handle, 0.3}});
+    std::vector<glm::vec3> points(plane.points().begin(), plane.points().end());
+    const std::vector<glm::vec3> before = points;
+    const SlideDrive huge{glm::dvec3(1e155, 0.0, 0.0), Falloff::smooth()};
+    CHECK_THROWS_WITH(
+        slider.evaluate({&huge, 1}, points),
+        Catch::Contains("handle 0 displacement: has length 1e+155") && Catch::Contains("within float range"));
+    CHECK(std::memcmp(points.data(), before.data(), points.size() * sizeof(glm::vec3)) == 0);
+    // 3e38: every vertex it moves lands on the plane (z = 0, inside its square), none NaN.
+    const SlideDrive far{glm::dvec3(3e38, 1e38, 0.0), Falloff::smooth()};
+    slider.evaluate({&far, 1}, points);
+    for (const glm::vec3& p : points) {
+        REQUIRE(std::isfinite(p.x + p.y + p.z));
+        CHECK(p.z == 0.0f);
+        CHECK((p.x >= -1e-6f && p.x <= 1.0f + 1e-6f && p.y >= -1e-6f && p.y <= 1.0f + 1e-6f));
+    }
+    CHECK(points[handle].x > plane.points()[handle].x);
+}
+
 TEST_CASE("slide over a stretched plane: the handle follows the locator", "[slide]") {
     // The rest plane under an affine map A (stretch 1.5 along x, 0.8 along y, a shear, a turn, a move) is
     // still a plane: each vertex lands at A(P + f F^-1 d) = A(P) + f d, with f the falloff of its rest
