@@ -104,7 +104,7 @@ size_t ptexToVertexCommand(const PtexToVertexCommand& command) {
     const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     const std::vector<float> weights =
         ptex::weightsFromPtex(mesh, command.mesh.string(), command.ptex, command.channel, "");
-    io::writeFileAtomically(command.out, scene::formatWeightsFile(weights));
+    io::writeFileAtomically(command.out, scene::formatWeightsFile(weights, command.out.string()));
     return weights.size();
 }
 

@@ -1,6 +1,7 @@
 #include "deformkit/ptex/ptex_vertex_values.h"
 
 #include <cmath>
+#include <string>
 
 #include "deformkit/error.h"
 #include "deformkit/ptex/ptex_mesh.h"
@@ -13,8 +14,8 @@ namespace {
 // Sums of the corner texels at each vertex and their counts, for one data type (read without a per-value
 // switch).
 template <DataType Type>
-void sumCorners(const PtexMesh& mesh, const PtexFile& file, std::vector<double>& sum,
-                std::vector<int32_t>& count) {
+void sumCorners(const PtexMesh& mesh, const PtexFile& file, const std::string& fileSource,
+                std::vector<double>& sum, std::vector<int32_t>& count) {
     const int32_t channels = file.channels;
     const size_t bytes = bytesPerChannel(Type), pixel = file.pixelSize();
     const auto add = [&](int32_t vertex, int32_t p, int32_t i, int32_t j) {
@@ -23,8 +24,19 @@ void sumCorners(const PtexMesh& mesh, const PtexFile& file, std::vector<double>&
                 ? file.constData.data() + static_cast<size_t>(p) * pixel
                 : file.texels[p].data() + ((static_cast<size_t>(j) << file.faces[p].ulog2) + i) * pixel;
         double* out = sum.data() + static_cast<size_t>(vertex) * channels;
-        for (int32_t c = 0; c < channels; ++c)
-            out[c] += detail::loadValue(texel + c * bytes, Type);
+        for (int32_t c = 0; c < channels; ++c) {
+            const double value = detail::loadValue(texel + c * bytes, Type);
+            if constexpr (Type == DataType::Half || Type == DataType::Float) {
+                if (!std::isfinite(value)) {
+                    throw InvalidInput(formatError(
+                        fileSource,
+                        "face " + std::to_string(p) + " texel (" + std::to_string(i) + ", " +
+                            std::to_string(j) + ") channel " + std::to_string(c),
+                        "is " + numberText(value), "finite values at the faces' corners (a vertex's value)"));
+                }
+            }
+            out[c] += value;
+        }
         ++count[static_cast<size_t>(vertex)];
     };
     for (int32_t f = 0; f < mesh.numMeshFaces(); ++f) {
@@ -54,16 +66,16 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
     std::vector<int32_t> count(static_cast<size_t>(mesh.numVertices()), 0);
     switch (file.dataType) {
         case DataType::UInt8:
-            sumCorners<DataType::UInt8>(mesh, file, sum, count);
+            sumCorners<DataType::UInt8>(mesh, file, fileSource, sum, count);
             break;
         case DataType::UInt16:
-            sumCorners<DataType::UInt16>(mesh, file, sum, count);
+            sumCorners<DataType::UInt16>(mesh, file, fileSource, sum, count);
             break;
         case DataType::Half:
-            sumCorners<DataType::Half>(mesh, file, sum, count);
+            sumCorners<DataType::Half>(mesh, file, fileSource, sum, count);
             break;
         case DataType::Float:
-            sumCorners<DataType::Float>(mesh, file, sum, count);
+            sumCorners<DataType::Float>(mesh, file, fileSource, sum, count);
             break;
     }
     std::vector<float> values(sum.size(), 0.0f);

@@ -48,10 +48,15 @@ std::vector<float> readWeightsFile(const std::filesystem::path& path, size_t cou
     return parseWeightsFile(io::readFile(path, "JSON weights file"), count, path.string());
 }
 
-std::string formatWeightsFile(std::span<const float> weights) {
+std::string formatWeightsFile(std::span<const float> weights, const std::string& source) {
     std::string text = "[";
     char number[32];
     for (size_t v = 0; v < weights.size(); ++v) {
+        if (!std::isfinite(weights[v])) {
+            throw InvalidInput(formatError(source, "[" + std::to_string(v) + "]",
+                                           "is " + numberText(weights[v]),
+                                           "a finite number (JSON has no NaN or infinity)"));
+        }
         if (v > 0) text += ", ";
         if (weights[v] == 0.0f && std::signbit(weights[v])) {
             text += "-0.0";  // "-0" would read back as the integer 0, losing the sign

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -367,6 +368,16 @@ TEST_CASE("ptex mesh: per-vertex values average the corner texels of the inciden
         CHECK(v[3] == 200.0f + 3.0f);
         CHECK(v[7] == Approx(0.5 * ((200 + 33) + 100 * (pm.firstPtexFace(5) + 2))));
         CHECK(v[10] == Approx(100.0 * (pm.firstPtexFace(5) + 3)));
+
+        // A NaN at a corner texel is refused, naming the file, the face, the texel and the channel (it
+        // averaged into a NaN weight, written to JSON as "nan"); one inside the face is not read.
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        ptex::PtexFile inside = one;
+        std::memcpy(inside.texels[2].data() + 4 * (1 * 4 + 1), &nan, 4);  // texel (1, 1): not a corner
+        CHECK(ptex::vertexValues(pm, inside, "inside.ptx") == v);
+        std::memcpy(one.texels[2].data() + 4 * (0 * 4 + 3), &nan, 4);  // texel (3, 0): Q2's corner 1
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::vertexValues(pm, one, "codes.ptx"); }),
+                   Catch::Contains("codes.ptx: face 2 texel (3, 0) channel 0: is nan"));
     }
 }
 

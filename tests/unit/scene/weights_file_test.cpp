@@ -45,6 +45,12 @@ TEST_CASE("weights file: written weights read back bit for bit", "[scene][weight
     test::writeText(dir / "w.json", scene::formatWeightsFile(weights));
     CHECK(test::sameBits(scene::readWeightsFile(dir / "w.json", weights.size()), weights));
     CHECK(scene::formatWeightsFile(std::vector<float>{0.5f, 0.1f}) == "[0.5, 0.1]\n");
+    // JSON has no NaN or infinity: refused, naming the index, rather than written as text no reader takes.
+    CHECK_THROWS_WITH(scene::formatWeightsFile(std::vector<float>{0.5f, std::nanf("")}, "w.json"),
+                      Catch::Contains("w.json: [1]: is nan"));
+    CHECK_THROWS_WITH(
+        scene::formatWeightsFile(std::vector<float>{std::numeric_limits<float>::infinity()}, "w.json"),
+        Catch::Contains("w.json: [0]: is inf"));
     CHECK_THROWS_AS(scene::readWeightsFile(dir / "none.json", 1), IoError);
 }
 

@@ -20,6 +20,8 @@ namespace deformkit::scene {
 // The same from a file; IoError when it cannot be read.
 [[nodiscard]] std::vector<float> readWeightsFile(const std::filesystem::path& path, size_t count);
 // The file's text: an array of the weights, each the shortest decimal that reads back as the float.
-[[nodiscard]] std::string formatWeightsFile(std::span<const float> weights);
+// InvalidInput naming `source` and the index for a NaN or infinite weight (JSON has no such number).
+[[nodiscard]] std::string formatWeightsFile(std::span<const float> weights,
+                                            const std::string& source = "weights file");
 
 }  // namespace deformkit::scene
