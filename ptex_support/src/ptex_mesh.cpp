@@ -9,6 +9,7 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/limit_surface.h"
 #include "texel_access.h"
 
 namespace deformkit::ptex {
@@ -30,6 +31,7 @@ PtexMesh::PtexMesh(const geom::Mesh& mesh, const std::string& source)
     if (mesh.numFaces() == 0) {
         throw InvalidInput(formatError(source, "", "has no faces", "a polygon mesh for Ptex faces"));
     }
+    geom::requireSubdivisionLimits(mesh, source);  // named here, not printed by OpenSubdiv
     faceCounts_.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
     faceOffsets_.assign(mesh.faceOffsets().begin(), mesh.faceOffsets().end());
     faceIndices_.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());

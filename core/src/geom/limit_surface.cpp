@@ -247,22 +247,9 @@ void LimitSurface::Impl::setControlPoints(const Far::TopologyRefiner& topology,
     }
 }
 
-LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options, const std::string& source) {
-    auto impl = std::make_shared<Impl>();
-    impl->source = source;
-    if (options.isolationLevel < 1 || options.isolationLevel > 10) {
-        throw InvalidInput(
-            formatError(source, "limit surface options",
-                        "isolation level " + std::to_string(options.isolationLevel) + " is out of range",
-                        "an integer in [1, 10]"));
-    }
-    if (rest.numFaces() == 0) {
-        throw InvalidInput(formatError(source, "", "has no faces", "at least one face for a limit surface"));
-    }
+void requireSubdivisionLimits(const Mesh& rest, const std::string& source) {
     const auto counts = rest.faceCounts();
     const auto indices = rest.faceIndices();
-    // OpenSubdiv rejects faces and vertices beyond its valence limit (it reports on stdout and returns no
-    // refiner); name them here instead.
     for (int32_t f = 0; f < rest.numFaces(); ++f) {
         if (counts[f] > kValenceLimit) {
             throw TopologyError(formatError(source, "face " + std::to_string(f),
@@ -304,6 +291,23 @@ LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options,
             }
         }
     }
+}
+
+LimitSurface::LimitSurface(const Mesh& rest, const LimitSurfaceOptions& options, const std::string& source) {
+    auto impl = std::make_shared<Impl>();
+    impl->source = source;
+    if (options.isolationLevel < 1 || options.isolationLevel > 10) {
+        throw InvalidInput(
+            formatError(source, "limit surface options",
+                        "isolation level " + std::to_string(options.isolationLevel) + " is out of range",
+                        "an integer in [1, 10]"));
+    }
+    if (rest.numFaces() == 0) {
+        throw InvalidInput(formatError(source, "", "has no faces", "at least one face for a limit surface"));
+    }
+    const auto counts = rest.faceCounts();
+    const auto indices = rest.faceIndices();
+    requireSubdivisionLimits(rest, source);
 
     impl->numVertices = rest.numVertices();
     impl->faceCounts.assign(counts.begin(), counts.end());

@@ -381,6 +381,24 @@ TEST_CASE("ptex mesh: per-vertex values average the corner texels of the inciden
     }
 }
 
+TEST_CASE("ptex mesh: a face beyond OpenSubdiv's limit is named, not printed by OpenSubdiv", "[ptex][mesh]") {
+    // A 65536-gon: OpenSubdiv's limit is 65535 corners (it printed its own error on stdout and the message
+    // named no face).
+    const int32_t n = 65536;
+    geom::Mesh::Data data;
+    for (int32_t k = 0; k < n; ++k) {
+        const double a = 2.0 * 3.14159265358979323846 * k / n;
+        data.points.emplace_back(static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f);
+    }
+    data.faceCounts = {n};
+    for (int32_t k = 0; k < n; ++k)
+        data.faceIndices.push_back(k);
+    const geom::Mesh disc(std::move(data), "disc.obj");
+    CHECK_THROWS_AS(PtexMesh(disc, "disc.obj"), TopologyError);
+    CHECK_THROWS_WITH(PtexMesh(disc, "disc.obj"),
+                      Catch::Contains("disc.obj: face 0: has 65536 corners (expected at most 65535"));
+}
+
 TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and both counts", "[ptex][mesh]") {
     const geom::Mesh mesh = mixedMesh();
     const PtexMesh pm(mesh, "mixed.obj");

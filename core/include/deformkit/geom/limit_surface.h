@@ -45,6 +45,11 @@ struct LimitSample {
     glm::dvec3 normal{0.0};
 };
 
+// OpenSubdiv refuses a face with more corners, or a vertex of higher valence (the larger of its face and
+// edge counts), than its limit of 65535: it prints to stdout and builds nothing. Throws TopologyError
+// naming `source` and the first such face or vertex, before OpenSubdiv is asked.
+void requireSubdivisionLimits(const Mesh& rest, const std::string& source);
+
 // The Catmull-Clark limit surface of a polygon cage (OpenSubdiv feature-adaptive patches), evaluated at
 // points given the way a projection onto the cage finds them: a face and weights over its corners.
 //
