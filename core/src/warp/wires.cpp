@@ -417,25 +417,29 @@ void Wires::bind(std::span<const glm::vec3> restPoints) {
     };
 
     // Two passes: count each point's entries, then fill them at its offset. The original variant keeps
-    // pass 1's nearest points (at most one per wire) so the search runs once; the smooth variant's test
-    // is a distance to a sample, cheaper to repeat than to store.
+    // pass 1's nearest points (at most one per wire) so the search runs once, in one list per block of
+    // points (each point's entries depend on the point alone, so the lists are the same for any thread
+    // count; their size is the entries', not points x wires); the smooth variant's test is a distance to
+    // a sample, cheaper to repeat than to store.
+    struct Found {
+        CurvePlace place;
+        float strength = 0.0f;
+        int32_t wire = 0;
+    };
+    constexpr int64_t kBlock = 4096;
+    const int64_t numBlocks = (n + kBlock - 1) / kBlock;
     std::vector<int32_t> counts(static_cast<size_t>(n) + 1, 0);
-    const size_t slots = smooth ? 0 : static_cast<size_t>(n) * static_cast<size_t>(numWires);
-    std::vector<CurvePlace> firstPlace(slots);
-    std::vector<float> firstStrength(slots);
-    std::vector<int32_t> firstWire(slots);
-#pragma omp parallel for schedule(dynamic, 4096)
-    for (int64_t u = 0; u < n; ++u) {
-        int32_t c = 0;
-        visit(restPoints[u], [&](int32_t w, const CurvePlace& place, float s, float) {
-            if (!smooth) {
-                firstPlace[static_cast<size_t>(u) * numWires + c] = place;
-                firstStrength[static_cast<size_t>(u) * numWires + c] = s;
-                firstWire[static_cast<size_t>(u) * numWires + c] = w;
-            }
-            ++c;
-        });
-        counts[u + 1] = c;
+    std::vector<std::vector<Found>> found(smooth ? 0 : static_cast<size_t>(numBlocks));
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t b = 0; b < numBlocks; ++b) {
+        for (int64_t u = b * kBlock; u < std::min(n, (b + 1) * kBlock); ++u) {
+            int32_t c = 0;
+            visit(restPoints[u], [&](int32_t w, const CurvePlace& place, float s, float) {
+                if (!smooth) found[static_cast<size_t>(b)].push_back({place, s, w});
+                ++c;
+            });
+            counts[u + 1] = c;
+        }
     }
     fields_.offsets.resize(static_cast<size_t>(n) + 1);
     fields_.offsets[0] = 0;
@@ -455,15 +459,18 @@ void Wires::bind(std::span<const glm::vec3> restPoints) {
     entryPlace_.resize(smooth ? 0 : entries);
     if (!smooth) {
 #pragma omp parallel for schedule(static)
-        for (int64_t u = 0; u < n; ++u) {
-            for (int32_t e = fields_.offsets[u], c = 0; e < fields_.offsets[u + 1]; ++e, ++c) {
-                const size_t slot = static_cast<size_t>(u) * numWires + c;
+        for (int64_t b = 0; b < numBlocks; ++b) {
+            // The block's entries lie at its first point's offset, in the order they were found.
+            const std::vector<Found>& list = found[static_cast<size_t>(b)];
+            const int32_t first = fields_.offsets[b * kBlock];
+            for (size_t k = 0; k < list.size(); ++k) {
+                const auto e = static_cast<size_t>(first) + k;
                 // T_i is sampled once per entry (W9), so transformation e belongs to entry e.
-                fields_.transform[e] = e;
-                fields_.strength[e] = firstStrength[slot];
+                fields_.transform[e] = static_cast<int32_t>(e);
+                fields_.strength[e] = list[k].strength;
                 fields_.weight[e] = 1.0f;
-                entryWire_[e] = firstWire[slot];
-                entryPlace_[e] = firstPlace[slot];
+                entryWire_[e] = list[k].wire;
+                entryPlace_[e] = list[k].place;
             }
         }
     } else {
