@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -196,6 +197,12 @@ int CommandLine::run(int argc, char** argv) {
     } catch (const Error& e) {
         std::cerr << "deformkit: error: " << e.what() << "\n";
         return 2;
+    } catch (const std::bad_alloc&) {
+        // Exit 1, as for anything a retry on a larger machine may cure (docs/farm.md, Exit codes).
+        std::cerr
+            << "deformkit: error: out of memory (expected a task this machine's memory holds: fewer frames, "
+               "vertices or texels at a time)\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "deformkit: internal error: " << e.what() << "\n";
         return 1;
