@@ -120,6 +120,7 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
     options.resolution = command.resolution;
     options.tiles = command.tiles;
     options.padding = command.padding;
+    options.coverageChannel = command.coverage;
     std::vector<fs::path> written;
     for (const ptex::UdimTile& tile :
          ptex::ptexToUdim(ptexMesh, mesh, file, command.ptex.string(), options)) {
@@ -242,6 +243,8 @@ void addPtexCommands(CommandLine& cli) {
     toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
     toUdim.option("--padding", tu->command.padding, "texels of edge padding around the UV charts")
         .showDefault();
+    toUdim.flag("--coverage", tu->command.coverage,
+                "add a last channel: 1 on the UV charts, 0 in the padding and outside them");
 
     auto fu = std::make_shared<PtexFromUdimCommand>();
     Command fromUdim =

@@ -35,6 +35,7 @@ struct PtexToUdimCommand {
     int32_t resolution = 1024;
     std::vector<int> tiles;  // empty: every tile of the mesh
     int32_t padding = 8;     // texels of edge padding around the charts
+    bool coverage = false;   // a last channel: 1 on the UV charts, 0 in the padding and outside
 };
 std::vector<std::filesystem::path> ptexToUdimCommand(const PtexToUdimCommand& command);
 

@@ -154,6 +154,10 @@ expect ptex-to-udim 0 "$dk" ptex to-udim "$work/albedo.ptx" "$work/demo/tube.obj
     --resolution 64
 [ -s "$work/back.1001.png" ] && [ -s "$work/back.1002.png" ] ||
     { echo "FAIL ptex-to-udim: tiles missing"; failures=$((failures + 1)); }
+expect ptex-to-udim-coverage 0 "$dk" ptex to-udim "$work/albedo.ptx" "$work/demo/tube.obj" \
+    --out "$work/cov.<UDIM>.exr" --resolution 64 --tiles 1001 --coverage
+expect ptex-to-udim-coverage-info 0 "$dk" info "$work/cov.1001.exr"
+contains ptex-to-udim-coverage-info "$work/out" "channels    4"  # the albedo's 3, and coverage
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >"$work/quad.obj"
 expect ptex-wrong-mesh 2 "$dk" ptex to-vertex "$work/demo/ptex/falloff.ptx" "$work/quad.obj" --out "$work/x.json"
 contains ptex-wrong-mesh "$work/err" "has 23040 faces"
