@@ -367,6 +367,112 @@ def test_errors_reach_the_user_as_reports():
     assert "no handle Empty set" in obj.deformkit.status, obj.deformkit.status
 
 
+def test_adding_from_edit_mode_keeps_the_rest_shape_and_the_selected_handle():
+    # The rest shape is read from the mesh, which Edit Mode holds apart: added from there, it was all zeros
+    # (the attribute had no elements) and a later twist collapsed the mesh onto the origin.
+    fresh()
+    obj = grid_object()
+    before = positions(obj).copy()
+    bpy.ops.object.mode_set(mode='EDIT')
+    bpy.ops.mesh.select_all(action='DESELECT')
+    bpy.ops.object.mode_set(mode='OBJECT')
+    obj.data.vertices[CENTRE + 3].select = True
+    bpy.ops.object.mode_set(mode='EDIT')
+    entry = add("slide")
+    assert obj.mode == 'EDIT'  # the user stays where they were
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert entry.vertex == CENTRE + 3, entry.vertex  # the selected vertex, not the one nearest the cursor
+    assert_same(addon.evaluate.rest_points(obj), before, "rest shape captured in Edit Mode")
+    twist = add("twist")
+    twist.start_value = twist.end_value = 0.0
+    bpy.ops.deformkit.evaluate()
+    assert obj.deformkit.status == "", obj.deformkit.status
+    assert_same(positions(obj), before, "mesh after an identity twist")
+
+
+def test_a_frame_changed_in_edit_mode_is_evaluated_on_leaving_it():
+    fresh()
+    obj = grid_object()
+    entry = add("twist")
+    entry.start_value = 0.0
+    key(entry, "end_value", {1: 0.0, 10: 1.0})
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    at_one = positions(obj).copy()
+    scene.frame_set(10)
+    at_ten = positions(obj).copy()
+    assert np.abs(at_ten - at_one).max() > 0.1
+    scene.frame_set(1)
+    bpy.ops.object.mode_set(mode='EDIT')
+    scene.frame_set(10)  # written now, Blender would drop it on leaving Edit Mode
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), at_ten, "frame 10 after leaving Edit Mode")
+
+
+def test_objects_renamed_or_given_another_mesh_are_not_confused():
+    # The stacks were cached by object name and checked by vertex count only.
+    fresh()
+    a, b = grid_object("A"), grid_object("B")
+    for obj, x in ((a, 0.0), (b, 5.0)):
+        obj.data.vertices.foreach_set("co", (positions(obj) + np.array([x, 0.0, 0.0], np.float32)).ravel())
+        bpy.context.view_layer.objects.active = obj
+        add("twist")
+    expected = {obj.as_pointer(): positions(obj).copy() for obj in (a, b)}
+    a.name, b.name = "tmp", "A"
+    a.name = "B"
+    bpy.context.scene.frame_set(2)
+    for obj in (a, b):
+        addon.evaluate.evaluate_object(obj, force=True)
+        assert_same(positions(obj), expected[obj.as_pointer()], f"object {obj.name} after the names were swapped")
+    # Another mesh of the same vertex count, without a rest shape: said, and nothing written into it.
+    other = grid_object("other").data
+    other.vertices.foreach_set("co", (positions(bpy.data.objects["other"]) * 2.0).ravel())
+    b.data = other
+    message = addon.evaluate.evaluate_safely(b, force=True)
+    assert "no rest shape" in message, message
+    assert float(positions(bpy.data.objects["other"])[:, 0].max()) == 2.0
+
+
+def test_shape_keys_an_empty_mesh_and_an_unsaved_output_are_refused_with_reports():
+    fresh()
+    obj = grid_object()
+    obj.shape_key_add(name="Basis")
+    bpy.ops.deformkit.add(type="twist")  # added, with the reason it cannot show in the status
+    assert "shape keys" in obj.deformkit.status, obj.deformkit.status
+    obj.data.uv_layers.new(name="UVMap")
+    obj.deformkit.uv_output = tempfile.mkdtemp()
+    obj.deformkit.uv_rigidity = bpy.data.images.new("rig", 8, 8)
+    try:
+        bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=1)
+        raise AssertionError("a bake of a pose the deformers could not write did not report")
+    except RuntimeError as e:
+        assert "frame 1" in str(e) and "shape keys" in str(e), str(e)
+
+    fresh()
+    empty = bpy.data.objects.new("empty", bpy.data.meshes.new("empty"))
+    bpy.context.scene.collection.objects.link(empty)
+    bpy.context.view_layer.objects.active = empty
+    try:
+        bpy.ops.deformkit.add(type="twist")
+        raise AssertionError("adding to an empty mesh did not report")
+    except RuntimeError as e:
+        assert "no vertices" in str(e), str(e)
+    assert len(empty.deformkit.entries) == 0  # no half-made entry left behind
+
+    fresh()
+    obj = grid_object()
+    obj.data.uv_layers.new(name="UVMap")
+    add("twist")
+    obj.deformkit.uv_rigidity = bpy.data.images.new("rig", 8, 8)
+    assert not bpy.data.filepath and obj.deformkit.uv_output.startswith("//")
+    try:
+        bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=1)
+        raise AssertionError("a bake to a path relative to an unsaved file did not report")
+    except RuntimeError as e:
+        assert "not saved yet" in str(e), str(e)
+
+
 def test_uv_warp_bake_writes_the_solvers_maps_and_the_redirect_nodes():
     fresh()
     obj = grid_object()
@@ -509,6 +615,7 @@ def test_bake_errors_are_reports():
     fresh()
     obj = grid_object()
     add("slide")
+    obj.deformkit.uv_output = tempfile.mkdtemp()
     try:
         bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=2)
         raise AssertionError("a bake without UVs did not report")

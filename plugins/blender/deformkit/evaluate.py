@@ -17,6 +17,7 @@ REST_ATTRIBUTE = "deformkit_rest"
 
 # Per object name: the stack, the entry signature it was built for, and the last weights set per entry.
 _cache = {}
+_pending = set()  # objects whose evaluation Edit Mode put off
 
 
 class DeformKitError(Exception):
@@ -25,6 +26,7 @@ class DeformKitError(Exception):
 
 def clear_cache():
     _cache.clear()
+    _pending.clear()
 
 
 # ---- mesh data ----------------------------------------------------------------------------------------
@@ -234,12 +236,32 @@ def controls(obj):
 
 # ---- evaluation ---------------------------------------------------------------------------------------
 
+def _key(obj):
+    # The object itself, not its name: names are swapped and reused while objects live on.
+    return obj.as_pointer()
+
+
+def _shape(obj):
+    # The mesh datablock (an object can be given another) and its counts: a change rebuilds the stack.
+    mesh = obj.data
+    return (mesh.as_pointer(), len(mesh.vertices), len(mesh.polygons), len(mesh.loops))
+
+
+def take_pending(obj):
+    """True once after an evaluation of `obj` was put off because it was in Edit Mode."""
+    if _key(obj) in _pending:
+        _pending.discard(_key(obj))
+        return True
+    return False
+
+
 def _stack_for(obj):
-    """The object's DeformerStack, built again only when its entries' types or labels or the vertex count
-    change; the rest shape is read from the mesh once, with it (Reset Rest and undo clear the cache)."""
+    """The object's DeformerStack, built again only when its entries' types or labels, its mesh or the
+    mesh's counts change; the rest shape is read from the mesh once, with it (Reset Rest and undo clear
+    the cache)."""
     signature = tuple((e.type, e.name) for e in obj.deformkit.entries)
-    cached = _cache.get(obj.name)
-    if cached is None or cached["signature"] != signature or cached["vertices"] != len(obj.data.vertices):
+    cached = _cache.get(_key(obj))
+    if cached is None or cached["signature"] != signature or cached["shape"] != _shape(obj):
         stack = dk.DeformerStack()
         counts, indices, _ = topology(obj)
         rest = rest_points(obj)  # kept: reading the attribute again every frame costs 14 ms at 1M vertices
@@ -247,14 +269,14 @@ def _stack_for(obj):
         for entry in obj.deformkit.entries:
             stack.add(entry.type, entry.name)
         cached = {"signature": signature, "stack": stack, "weights": {}, "group_weights": {}, "stale_weights": {},
-                  "vertices": len(obj.data.vertices), "rest": rest}
-        _cache[obj.name] = cached
+                  "shape": _shape(obj), "rest": rest}
+        _cache[_key(obj)] = cached
     return cached
 
 
 def mark_weights_changed(obj):
     """Vertex-group weights are read again at the next evaluation (after weight painting)."""
-    cached = _cache.get(obj.name)
+    cached = _cache.get(_key(obj))
     if cached is not None:
         cached["stale_weights"] = dict(cached["group_weights"])
         cached["group_weights"].clear()
@@ -297,6 +319,14 @@ def evaluate_object(obj, depsgraph=None, force=False):
     kind) for bad parameter values, each naming the entry."""
     if len(obj.deformkit.entries) == 0:
         return
+    if obj.mode == 'EDIT':
+        # Blender keeps an Edit Mode mesh apart and writes it back on leaving: positions written now
+        # would be lost. The evaluation waits for Object Mode (take_pending).
+        _pending.add(_key(obj))
+        return
+    if obj.data.shape_keys is not None:
+        raise DeformKitError(f"{obj.name}: the mesh has shape keys, which Blender shows in place of the vertex "
+                             "positions DeformKit writes (apply or remove them, or deform a copy without them)")
     entries = evaluated_entries(obj, depsgraph)
     cached = _stack_for(obj)
     stack = cached["stack"]

@@ -52,6 +52,10 @@ def on_depsgraph_update(scene, depsgraph):
     _busy = True
     try:
         for obj in _stacked_objects(scene):
+            if obj.mode != 'EDIT' and evaluate.take_pending(obj):
+                # Back from Edit Mode, which wrote its own positions: the current frame, evaluated again.
+                evaluate.evaluate_safely(obj, depsgraph, force=True)
+                continue
             if obj.mode == 'WEIGHT_PAINT' and obj.name in objects:
                 evaluate.mark_weights_changed(obj)
                 evaluate.evaluate_safely(obj, depsgraph)

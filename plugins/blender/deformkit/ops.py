@@ -53,28 +53,27 @@ def _world(obj, local):
     return tuple(m[:3, :3] @ np.asarray(local, np.float64) + m[:3, 3])
 
 
-def _handle_vertex(context, obj, rest):
-    """The active vertex in edit mode, else the vertex nearest the 3D cursor."""
+def _handle_vertex(context, obj, rest, from_edit_mode):
+    """The selected vertex when the deformer is added from Edit Mode, else the vertex nearest the 3D
+    cursor."""
     mesh = obj.data
-    if obj.mode == 'EDIT':
-        obj.update_from_editmode()
     selected = np.zeros(len(mesh.vertices), bool)
     mesh.vertices.foreach_get("select", selected)
-    if obj.mode == 'EDIT' and selected.any():
+    if from_edit_mode and selected.any():
         return int(np.flatnonzero(selected)[0])
     m = np.array(obj.matrix_world, np.float64)
     cursor = np.linalg.inv(m) @ np.append(np.array(context.scene.cursor.location, np.float64), 1.0)
     return int(np.argmin(((rest - cursor[:3]) ** 2).sum(axis=1)))
 
 
-def setup_controls(context, obj, entry):
+def setup_controls(context, obj, entry, from_edit_mode=False):
     """Creates the controls a new entry of entry.type needs, placed around the object's rest shape."""
     rest = evaluate.rest_points(obj).astype(np.float64)
     lo, hi, size = _bounds(rest)
     centre = 0.5 * (lo + hi)
     t = entry.type
     if t == "slide":
-        entry.vertex = _handle_vertex(context, obj, rest)
+        entry.vertex = _handle_vertex(context, obj, rest, from_edit_mode)
         at = _world(obj, rest[entry.vertex])
         entry.radius = float(0.25 * size.max())
         entry.start = _new_empty(context, obj, f"{obj.name}_{entry.name}_start", at, 'SPHERE', 0.05 * size.max())
@@ -144,6 +143,16 @@ def setup_controls(context, obj, entry):
         entry.cage, entry.rest_cage = cage, rest_cage
 
 
+def _output_folder(settings):
+    """The UV warp's Output folder as an absolute path. A '//' path is relative to the .blend file; in a
+    file never saved Blender would resolve it against its working directory, wherever that is."""
+    if settings.uv_output.startswith("//") and not bpy.data.filepath:
+        raise evaluate.DeformKitError(
+            f"Output '{settings.uv_output}' is relative to the .blend file, which is not saved yet: save it, "
+            "or choose an absolute folder")
+    return bpy.path.abspath(settings.uv_output)
+
+
 class DEFORMKIT_OT_add(bpy.types.Operator):
     """Add a DeformKit deformer to the active mesh, with its controls"""
     bl_idname = "deformkit.add"
@@ -159,21 +168,38 @@ class DEFORMKIT_OT_add(bpy.types.Operator):
     def execute(self, context):
         obj = _mesh_object(context)
         settings = obj.deformkit
+        if len(obj.data.vertices) == 0 and obj.mode != 'EDIT':
+            self.report({'ERROR'}, f"{obj.name}: the mesh has no vertices to deform")
+            return {'CANCELLED'}
+        # The rest shape and the handle's selection are read from the mesh, which Blender keeps apart in
+        # Edit Mode: added from there, the deformer is set up in Object Mode and Edit Mode entered again.
+        from_edit_mode = obj.mode == 'EDIT'
+        if from_edit_mode:
+            bpy.ops.object.mode_set(mode='OBJECT')
         try:
+            if len(obj.data.vertices) == 0:
+                raise evaluate.DeformKitError(f"{obj.name}: the mesh has no vertices to deform")
             if not evaluate.has_rest(obj):
                 evaluate.capture_rest(obj)
             entry = settings.entries.add()
-            # Set the label and type before anything triggers an evaluation of a half-made entry.
-            entry["name"] = _unique_label(settings, self.type)
-            entry["type"] = [t[0] for t in DEFORMER_TYPES].index(self.type)
-            entry["envelope"] = 0.0
-            setup_controls(context, obj, entry)
-            entry.envelope = 1.0
+            try:
+                # Set the label and type before anything triggers an evaluation of a half-made entry.
+                entry["name"] = _unique_label(settings, self.type)
+                entry["type"] = [t[0] for t in DEFORMER_TYPES].index(self.type)
+                entry["envelope"] = 0.0
+                setup_controls(context, obj, entry, from_edit_mode)
+                entry.envelope = 1.0
+            except Exception:
+                settings.entries.remove(len(settings.entries) - 1)  # no half-made entry stays behind
+                raise
             settings.active_index = len(settings.entries) - 1
+            message = evaluate.evaluate_safely(obj)
         except Exception as e:  # noqa: BLE001 - reported to the user
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
-        message = evaluate.evaluate_safely(obj)
+        finally:
+            if from_edit_mode:
+                bpy.ops.object.mode_set(mode='EDIT')
         if message:
             self.report({'WARNING'}, message)
         return {'FINISHED'}
@@ -301,12 +327,17 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         if self.frame_end < self.frame_start:
             self.report({'ERROR'}, f"frame range {self.frame_start}-{self.frame_end} is empty")
             return {'CANCELLED'}
+        try:
+            folder = _output_folder(settings)
+        except evaluate.DeformKitError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
         wm = context.window_manager
         frames = range(self.frame_start, self.frame_end + 1)
         wm.progress_begin(0.0, 1.0)
         try:
             report = uvwarp.bake_redirect_maps(context, obj, settings.uv_rigidity, settings.uv_mask, frames,
-                                               bpy.path.abspath(settings.uv_output), settings.uv_resolution,
+                                               folder, settings.uv_resolution,
                                                self.resume, lambda done, total, _: wm.progress_update(done / total),
                                                preset=settings.uv_preset)
         except Exception as e:  # noqa: BLE001 - reported to the user
@@ -328,7 +359,7 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         kept = sum(t["replayed"] + t["skipped"] for t in report.values())
         page = next((t["report"] for t in report.values() if "report" in t), "")
         settings.uv_report = page
-        self.report({'INFO'}, f"wrote {written} redirect map{'' if written == 1 else 's'} to {settings.uv_output}"
+        self.report({'INFO'}, f"wrote {written} redirect map{'' if written == 1 else 's'} to {folder}"
                               + (f", kept {kept} that exist" if kept else "")
                               + (f"; shot report {page} (Open Report in the UV Warp panel)" if page else ""))
         return {'FINISHED'}
@@ -374,7 +405,11 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        first = os.path.join(bpy.path.abspath(obj.deformkit.uv_output), uvwarp.redirect_name(1001, self.frame_start))
+        try:
+            first = os.path.join(_output_folder(obj.deformkit), uvwarp.redirect_name(1001, self.frame_start))
+        except evaluate.DeformKitError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
         if not os.path.exists(first):
             self.report({'ERROR'}, f"no redirect map {first}; bake the redirect maps first")
             return {'CANCELLED'}

@@ -108,6 +108,9 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
 
     def deformed(frame):
         scene.frame_set(frame)
+        if len(obj.deformkit.entries) > 0 and obj.deformkit.status:
+            # The deformers failed at this frame: the mesh does not hold the pose the maps would be of.
+            raise UvWarpError(f"frame {frame}: {obj.deformkit.status}")
         points = evaluated_points(obj, context.evaluated_depsgraph_get(), len(rest))
         return points, f"{name} evaluated at frame {frame}"
 
