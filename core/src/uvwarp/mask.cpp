@@ -49,11 +49,11 @@ void requireCells(int32_t cells, const MapLabel& label) {
     }
 }
 
-// The range of texel indices whose centre lies within one texel of continuous texel coordinate c
+// The range of texel indices whose centre lies within `reach` texels of continuous texel coordinate c
 // (texel k centred at k), clamped to [0, size - 1].
-void texelsWithinOne(double c, int32_t size, int32_t& lo, int32_t& hi) {
-    lo = std::clamp(static_cast<int32_t>(std::ceil(c - 1.0)), 0, size - 1);
-    hi = std::clamp(static_cast<int32_t>(std::floor(c + 1.0)), 0, size - 1);
+void texelsWithin(double c, double reach, int32_t size, int32_t& lo, int32_t& hi) {
+    lo = std::clamp(static_cast<int32_t>(std::ceil(c - reach)), 0, size - 1);
+    hi = std::clamp(static_cast<int32_t>(std::floor(c + reach)), 0, size - 1);
 }
 
 void checkMaskOptions(int32_t texels, const DerivedMaskOptions& options) {
@@ -221,10 +221,12 @@ PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& la
     const int32_t size = mask.width;
     const int32_t side = cells + 1;
     const double scale = static_cast<double>(size) / cells;
+    // One texel, or one cell on a map finer than the grid: the texels of the cells around the point.
+    const double reach = std::max(1.0, scale);
     std::vector<int32_t> columnLo(side), columnHi(side), rowLo(side), rowHi(side);
     for (int32_t k = 0; k < side; ++k) {
-        texelsWithinOne(k * scale - 0.5, size, columnLo[k], columnHi[k]);
-        texelsWithinOne((cells - k) * scale - 0.5, size, rowLo[k], rowHi[k]);
+        texelsWithin(k * scale - 0.5, reach, size, columnLo[k], columnHi[k]);
+        texelsWithin((cells - k) * scale - 0.5, reach, size, rowLo[k], rowHi[k]);
     }
     // Separable minimum: over each point column's texel columns per image row, then over texel rows.
     std::vector<uint8_t> rowMin;

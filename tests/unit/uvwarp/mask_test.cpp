@@ -282,7 +282,8 @@ TEST_CASE("rigidity at grid points samples a linear ramp bilinearly", "[uvwarp][
     CHECK_THROWS_WITH(rigidityAtPoints(ramp, 12, {"ramp", 1001}), Catch::Contains("power of two"));
 }
 
-TEST_CASE("mask at grid points: one fixed texel fixes the points within one texel", "[uvwarp][mask]") {
+TEST_CASE("mask at grid points: one fixed texel fixes the points within one texel or one cell",
+          "[uvwarp][mask]") {
     // An 8 x 8 mask with texel (3, 2) fixed (image row 2 from the top: v between 5/8 and 6/8).
     io::Image mask(8, 8, 1, 1.0f);
     mask.at(3, 2, 0) = 0.0f;
@@ -300,9 +301,14 @@ TEST_CASE("mask at grid points: one fixed texel fixes the points within one texe
     // n = T: point (i, j) sits on the corner shared by texel columns i - 1, i and rows 7 - j, 8 - j, so the
     // four corners of texel (3, 2) are fixed: i in {3, 4}, j in {5, 6}.
     CHECK(zeros(maskAtPoints(mask, 8)) == std::vector<std::pair<int, int>>{{3, 5}, {4, 5}, {3, 6}, {4, 6}});
-    // n = T / 2: point (i, j) is at texel coordinate (2i - 0.5, 2(4 - j) - 0.5); texel column 3 is within
-    // one texel only of i = 2, row 2 only of j = 3.
-    CHECK(zeros(maskAtPoints(mask, 4)) == std::vector<std::pair<int, int>>{{2, 3}});
+    // n = T / 2: point (i, j) is at texel coordinate (2i - 0.5, 2(4 - j) - 0.5), and the reach is one cell
+    // (2 texels): texel column 3 is within it of i = 1 and 2, row 2 of j = 2 and 3. The four corners of
+    // the cell holding the texel are fixed (within one texel, only (2, 3) was: on a map finer than the
+    // grid, the chart-border band of fixed points was thinner than a cell and the solve fell apart).
+    CHECK(zeros(maskAtPoints(mask, 4)) == std::vector<std::pair<int, int>>{{1, 2}, {2, 2}, {1, 3}, {2, 3}});
+    // n = T / 4: one cell is 4 texels; texel (3, 2) lies in cell (0, 1) (texels 0-3, rows 0-3 from the top
+    // are v in [1/2, 1]): its corners i in {0, 1}, j in {1, 2}.
+    CHECK(zeros(maskAtPoints(mask, 2)) == std::vector<std::pair<int, int>>{{0, 1}, {1, 1}, {0, 2}, {1, 2}});
     // n = 2T: point (i, j) at texel coordinate (i / 2 - 0.5, (16 - j) / 2 - 0.5); |i / 2 - 3.5| <= 1 gives
     // i in 5..9, |(16 - j) / 2 - 2.5| <= 1 gives j in 9..13.
     std::vector<std::pair<int, int>> expected;
