@@ -156,8 +156,7 @@ void validateRigidityMap(const io::Image& rigidity, const MapLabel& label) {
         for (int32_t x = 0; x < rigidity.width; ++x) {
             const float value = rigidity.at(x, y, 0);
             if (!(value >= 0.0f && value <= 1.0f)) {
-                throw InvalidInput(formatError(sourceOf(label), texelName(x, y),
-                                               "rigidity is " + std::to_string(value),
+                throw InvalidInput(formatError(sourceOf(label), texelName(x, y), "is " + numberText(value),
                                                "a finite value in [0, 1]"));
             }
         }

@@ -228,7 +228,8 @@ const OptionSpec kSpecs[] = {
      .zeroMeans = "by the grid's size: the grid's cells up to 8192, half of them from 16384",
      .meaning =
          "Cells per side of the geometry images of the rest and posed surfaces: the grid's, or half of "
-         "them, which holds them in a quarter of the memory (a 16384^2 tile: 18 bytes a cell less). "
+         "them (any other value is refused when the grid's size is known), which holds them in a quarter of "
+         "the memory (a 16384^2 tile: 18 bytes a cell less). "
          "The surfaces are affine inside each UV triangle, where the solver's look-ups between the "
          "image's points are exact; the cells that straddle a triangle's edge cost the rigged Fox (shot "
          "preset without refinement) 3.9 points of rigid stretch removed at 512^2, 2.4 at 1024^2 and 0.8 "

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/io/animated_positions.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
@@ -611,6 +612,12 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
         throw InvalidInput(formatError(
             inputName, "", "has " + std::to_string(deformed.size()) + " vertices",
             std::to_string(vertices) + ", the vertex count of the rest mesh '" + s.job.restName + "'"));
+    }
+    // Named here, by the frame's own input: the imager's own check names the rest mesh it was bound to.
+    if (const size_t v = geom::firstNonFinite(deformed); v < deformed.size()) {
+        throw InvalidInput(formatError(inputName,
+                                       "frame " + std::to_string(frame) + ": vertex " + std::to_string(v),
+                                       "is not finite", "finite coordinates"));
     }
     const size_t k = s.nextFrame++;
     for (TilePlan& plan : s.plans) {

@@ -193,10 +193,11 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
 
     const int32_t imageCells = geometryImageCellsFor(options.geometryImageCells, m.cells);
     if (imageCells != m.cells && (imageCells * 2 != m.cells || imageCells < 2)) {
-        throw InvalidInput(formatError(source, "geometry images, UDIM tile " + std::to_string(tile),
-                                       std::to_string(imageCells) + " cells per side",
-                                       std::to_string(m.cells) + " (the grid's cells) or " +
-                                           std::to_string(m.cells / 2) + " (half of them)"));
+        throw InvalidInput(
+            formatError(source, "UDIM tile " + std::to_string(tile) + ": option geometryImageCells",
+                        "is " + std::to_string(imageCells),
+                        "0 (automatic), " + std::to_string(m.cells) + " (the grid's cells) or " +
+                            std::to_string(m.cells / 2) + " (half of them)"));
     }
 
     // The tile's UV triangles, collected once for the imager, the derived mask and the delivered figures.
