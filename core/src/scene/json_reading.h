@@ -4,8 +4,10 @@
 // plans), over nlohmann/json, which stays private to the library.
 
 #include <initializer_list>
+#include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -44,9 +46,37 @@ inline void requireKnownKeys(const json& object, const std::string& source, cons
 }
 
 // Parses `text`; ParseError naming `source`, the line and column and what the file should be (`expected`).
+// A key given twice in one object is a ParseError naming it and the keys around it: JSON readers keep one of
+// the two silently (nlohmann the last), so a value the user wrote would be ignored.
 inline json parseJson(std::string_view text, const std::string& source, const std::string& expected) {
+    std::vector<std::set<std::string>> keys;  // per open object, its keys so far
+    std::vector<std::string> path;            // per open object, the key being read (empty in arrays)
+    std::string duplicate;
+    const json::parser_callback_t check = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) {
+            keys.emplace_back();
+        } else if (event == json::parse_event_t::object_end && !keys.empty()) {
+            keys.pop_back();
+            if (!path.empty()) path.pop_back();
+        } else if (event == json::parse_event_t::key && !keys.empty()) {
+            const std::string key = parsed.get<std::string>();
+            if (!keys.back().insert(key).second && duplicate.empty()) {
+                std::string where;
+                for (size_t d = 0; d + 1 < keys.size() && d < path.size(); ++d)
+                    where += (where.empty() ? "" : ".") + path[d];
+                duplicate = where.empty() ? key : where + "." + key;
+            }
+            path.resize(keys.size());
+            path.back() = key;
+        }
+        return true;
+    };
     try {
-        return json::parse(text.begin(), text.end());
+        json root = json::parse(text.begin(), text.end(), check);
+        if (!duplicate.empty()) {
+            throw ParseError(formatError(source, duplicate, "is given twice in one object", "each key once"));
+        }
+        return root;
     } catch (const json::exception& e) {
         // nlohmann reports "[json.exception.parse_error.101] parse error at line L, column C: ..." (or
         // out_of_range for a number too large): keep the part after the bracketed id.

@@ -88,6 +88,17 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
     CHECK_THAT(
         f.error(R"({"deformkit_scene": 1, "frame": [1, 5], "frames": [1, 5], "objects": []})"),
         Contains(file + ": frame: is not a known key") && Contains("deformkit_scene, frames, objects"));
+    // A key given twice (a ParseError): JSON readers keep one silently, so the other value the user wrote
+    // was ignored. The same keys in sibling objects are fine.
+    const auto parseError = [&](const std::string& text) {
+        return test::errorOf<ParseError>([&] { (void)f.parse(text); });
+    };
+    CHECK_THAT(parseError(R"({"deformkit_scene": 1, "frames": [1, 2], "objects": [], "frames": [5, 9]})"),
+               Contains(file + ": frames: is given twice in one object (expected each key once)"));
+    CHECK_THAT(parseError(withEntry(twist + R"({"endAngle": 1.5, "endAngle": 0}})")),
+               Contains(file + ": objects.stack.params.endAngle: is given twice in one object"));
+    CHECK(f.error(withEntry(twist + R"({"endAngle": 1.5}}, )" + twist +
+                            R"({"endAngle": 1}, "label": "b"})")) == "no error");
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": "1-5", "objects": []})"),
                Contains("frames: is a string") && Contains("[first, last]"));
     CHECK_THAT(
