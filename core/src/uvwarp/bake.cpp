@@ -26,8 +26,9 @@ void bakeTexture(const io::Image& texture, const io::Image& redirect, io::Image&
     }
     if (redirect.width < 1 || redirect.height != redirect.width || redirect.channels < 2 ||
         redirect.pixels.size() != static_cast<size_t>(redirect.width) * redirect.height * redirect.channels) {
-        throw InvalidInput(formatError("bake", "redirect map", "is " + sizeText(redirect),
-                                       "a square map with 2 channels (u', v')"));
+        throw InvalidInput(
+            formatError("bake", "redirect map", "is " + sizeText(redirect),
+                        "a square map with 2 channels (u', v'), or more: the first two are read"));
     }
     if (options.width < 0 || options.height < 0) {
         throw InvalidInput(
