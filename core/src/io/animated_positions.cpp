@@ -48,11 +48,8 @@ void AnimatedPositions::requireFrames(std::span<const int> frames) const {
     for (const int frame : frames) {
         if (cache_) {
             if (!cache_->sampleOf(frame)) {
-                const std::vector<int> have = cache_->frames();
-                std::string range = have.empty() ? "none" : std::to_string(have.front());
-                if (have.size() > 1) range += "-" + std::to_string(have.back());
                 throw InvalidInput(formatError(path_.string(), "frame " + std::to_string(frame),
-                                               "is not in the cache", "one of its frames (" + range + ")"));
+                                               "is not in the cache", "one of its " + cache_->rangeText()));
             }
             continue;
         }

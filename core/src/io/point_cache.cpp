@@ -50,15 +50,6 @@ std::string frameText(double frame) {
     return "frame " + numberText(frame);
 }
 
-std::string rangeText(const PointCache& cache) {
-    if (cache.sampleCount() == 0) return "no frames";
-    const std::string first = numberText(cache.sampleFrame(0));
-    if (cache.sampleCount() == 1) return "frame " + first;
-    std::string text = "frames " + first + " to " + numberText(cache.sampleFrame(cache.sampleCount() - 1));
-    if (cache.sampling() != 1.0) text += " every " + numberText(cache.sampling());
-    return text;
-}
-
 }  // namespace
 
 std::optional<PointCacheFormat> pointCacheFormat(const fs::path& path) {
@@ -220,6 +211,15 @@ std::optional<int32_t> PointCache::sampleOf(int frame) const {
     return sample;
 }
 
+std::string PointCache::rangeText() const {
+    if (sampleCount() == 0) return "no frames";
+    const std::string first = numberText(sampleFrame(0));
+    if (sampleCount() == 1) return "frame " + first;
+    std::string text = "frames " + first + " to " + numberText(sampleFrame(sampleCount() - 1));
+    if (sampling() != 1.0) text += " every " + numberText(sampling());
+    return text;
+}
+
 std::string PointCache::frameName(int frame) const {
     return path_.string() + " frame " + std::to_string(frame);
 }
@@ -228,7 +228,7 @@ void PointCache::read(int frame, std::vector<glm::vec3>& points) {
     const std::optional<int32_t> sample = sampleOf(frame);
     if (!sample) {
         throw InvalidInput(formatError(path_.string(), frameText(frame), "is not in the cache",
-                                       "one of its " + rangeText(*this)));
+                                       "one of its " + rangeText()));
     }
     const size_t bytes = static_cast<size_t>(vertices_) * kBytesPerVertex;
     buffer_.resize(bytes);

@@ -764,8 +764,8 @@ std::vector<std::string> shotSummary(const ShotReport& report) {
                 line << "; frame " << t.lastWrittenFrame << ": rigid stretch removed " << 100.0 * d.removed
                      << "% (error " << d.rigidStretchError << ", identity " << d.identityStretchError << "), "
                      << d.invertedTriangles << " inverted triangles, " << d.offChartTexels
-                     << " off-chart texels in the redirect map (fold repair smoothed "
-                     << t.lastRepair.texelsMoved << (t.lastRepair.texelsMoved == 1 ? " texel)" : " texels)");
+                     << " off-chart texels in the redirect map (fold repair: " << t.lastRepair.texelsMoved
+                     << (t.lastRepair.texelsMoved == 1 ? " smoothing move)" : " smoothing moves)");
             }
             if (t.scaledBack > 0) {
                 line << "; " << t.scaledBack << (t.scaledBack == 1 ? " frame" : " frames")

@@ -553,12 +553,12 @@ TEST_CASE("uvwarp command: a PC2 or MDD cache of the shot writes the maps and ba
     bad.command.deformed = s.dir / "anim.pc2";
     bad.command.frames = {2, 3, 4};
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(bad.command); }),
-               Catch::Contains("anim.pc2: frame 4: is not in the cache (expected one of its frames (1-3))"));
+               Catch::Contains("anim.pc2: frame 4: is not in the cache (expected one of its frames 1 to 3)"));
     bad.command.frames = {1, 2, 3};
     bad.command.deformed = s.dir / "anim.mdd";  // frames 1-3 by default
     bad.command.cacheStart = 5.0;
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(bad.command); }),
-               Catch::Contains("anim.mdd: frame 1: is not in the cache (expected one of its frames (5-7))"));
+               Catch::Contains("anim.mdd: frame 1: is not in the cache (expected one of its frames 5 to 7)"));
     std::vector<std::vector<glm::vec3>> fewer = positions;
     for (auto& frame : fewer)
         frame.pop_back();

@@ -72,6 +72,14 @@ TEST_CASE("point cache: PC2 and MDD written by hand read back bit for bit, frame
         CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)read(cache, 2); }),
                    Contains("expected one of its frames -1 to 1 every 0.5"));
     }
+    SECTION("PC2 sampled every other frame: a job's frame between samples is named with the step") {
+        test::writeText(dir / "a.pc2", test::pc2Bytes(1.0f, 2.0f, frames));  // frames 1, 3, 5, 7, 9
+        io::AnimatedPositions positions(dir / "a.pc2", "--deformed");
+        const std::vector<int> wanted{1, 2};
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { positions.requireFrames(wanted); }),
+            Contains("a.pc2: frame 2: is not in the cache (expected one of its frames 1 to 9 every 2)"));
+    }
     SECTION(
         "PC2 sampled closer than a frame's tolerance: each whole frame listed once, read from its nearest "
         "sample") {
@@ -245,7 +253,7 @@ TEST_CASE("point cache: bad caches are refused naming the file, the frame and th
                      "'rest.obj')"));
         const std::vector<int> wanted{2, 3, 4};
         CHECK_THAT(test::errorOf<InvalidInput>([&] { positions.requireFrames(wanted); }),
-                   Contains("bad.pc2: frame 4: is not in the cache (expected one of its frames (1-3))"));
+                   Contains("bad.pc2: frame 4: is not in the cache (expected one of its frames 1 to 3)"));
         CHECK(positions.frameName(2) == pc2.string() + " frame 2");
     }
     SECTION("missing file, and a path that is neither a sequence nor a cache") {

@@ -55,6 +55,8 @@ class PointCache {
     [[nodiscard]] std::optional<int32_t> sampleOf(int frame) const;
     // "anim.pc2 frame 7", for messages and logs.
     [[nodiscard]] std::string frameName(int frame) const;
+    // The frames it holds, for messages: "frames 1 to 9 every 2", "frame 3", "no frames".
+    [[nodiscard]] std::string rangeText() const;
 
     // Reads the positions of a whole frame into `points` (resized to vertexCount()), seeking to that
     // frame only. Throws InvalidInput naming the file and frame when the frame is none of the cache's
