@@ -34,12 +34,13 @@ def texel_centres(t=T):
     return np.stack([(x + 0.5) / t, 1.0 - (y + 0.5) / t], axis=2)
 
 
-def disks(t=T):
-    """Rigidity 1 in disks of radius 0.07 on a 3 x 3 lattice, 0 elsewhere, painted at texel centres."""
+def disks(t=T, at=(0.25, 0.5, 0.75)):
+    """Rigidity 1 in disks of radius 0.07 on a 3 x 3 lattice (u and v in `at`), 0 elsewhere, painted at texel
+    centres."""
     c = texel_centres(t)
     rig = np.zeros((t, t), dtype=np.float32)
-    for cu in (0.25, 0.5, 0.75):
-        for cv in (0.25, 0.5, 0.75):
+    for cu in at:
+        for cv in at:
             rig[np.hypot(c[..., 0] - cu, c[..., 1] - cv) < 0.07] = 1.0
     return rig
 
@@ -113,18 +114,11 @@ def test_a_grid_coarser_than_the_maps_removes_as_much_as_maps_of_its_size():
     # solve removes as much of the stretch. The warp mask's band of fixed points along the border is a cell
     # wide for both; at one texel of the finer map it was a quarter of a cell, and the solve made the
     # stretch worse than no warp (-72% removed under a 1.5x stretch).
-    def edge_disks(t):
-        c = texel_centres(t)
-        rig = np.zeros((t, t), dtype=np.float32)
-        for cu in (0.06, 0.5, 0.94):
-            for cv in (0.06, 0.5, 0.94):
-                rig[np.hypot(c[..., 0] - cu, c[..., 1] - cv) < 0.07] = 1.0
-        return rig
-
     pts, counts, idx, uvs, uv_idx = plane()
     removed = {}
     for t in (T, 4 * T):
-        solver = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, edge_disks(t), resolution=T)
+        rig = disks(t, at=(0.06, 0.5, 0.94))
+        solver = dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, resolution=T)
         assert (solver.texels, solver.cells) == (t, T)
         solver.solve(stretched(pts))
         removed[t] = solver.metrics()["rigid_stretch_removed"]
