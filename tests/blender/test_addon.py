@@ -450,6 +450,20 @@ def test_shape_keys_an_empty_mesh_and_an_unsaved_output_are_refused_with_reports
         assert "frame 1" in str(e) and "shape keys" in str(e), str(e)
 
     fresh()
+    obj = grid_object()
+    obj.data.uv_layers.new(name="UVMap")
+    add("twist")
+    obj.deformkit.uv_output = tempfile.mkdtemp()
+    obj.deformkit.uv_rigidity = bpy.data.images.new("rig", 8, 8)
+    bpy.ops.object.mode_set(mode='EDIT')
+    try:
+        bpy.ops.deformkit.bake_redirect(frame_start=1, frame_end=1)
+        raise AssertionError("a bake in Edit Mode did not report")
+    except RuntimeError as e:
+        assert "Edit Mode" in str(e), str(e)
+    bpy.ops.object.mode_set(mode='OBJECT')
+
+    fresh()
     empty = bpy.data.objects.new("empty", bpy.data.meshes.new("empty"))
     bpy.context.scene.collection.objects.link(empty)
     bpy.context.view_layer.objects.active = empty

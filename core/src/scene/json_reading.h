@@ -3,6 +3,7 @@
 // The one set of JSON reading helpers of the library (scenes, weights files, feature-line files, farm
 // plans), over nlohmann/json, which stays private to the library.
 
+#include <algorithm>
 #include <initializer_list>
 #include <set>
 #include <string>
@@ -57,7 +58,7 @@ inline json parseJson(std::string_view text, const std::string& source, const st
             keys.emplace_back();
         } else if (event == json::parse_event_t::object_end && !keys.empty()) {
             keys.pop_back();
-            if (!path.empty()) path.pop_back();
+            path.resize(std::min(path.size(), keys.size()));
         } else if (event == json::parse_event_t::key && !keys.empty()) {
             const std::string key = parsed.get<std::string>();
             if (!keys.back().insert(key).second && duplicate.empty()) {

@@ -28,12 +28,14 @@ bool weightedMeanDisplacement(int32_t begin, int32_t end, double m, Displacement
     glm::dvec3 sum(0.0);
     double weightSum = 0.0, plainSum = 0.0, longest = 0.0;
     for (int32_t e = begin; e < end; ++e) {
-        const glm::vec3 d = displacement(e);
         double w = weight(e);
+        // An entry of weight 0 adds nothing (+0 to sums that start at +0), and 0 |d|^m could be 0 inf.
+        if (w == 0.0) continue;
+        const glm::vec3 d = displacement(e);
         if (m != 0.0) {
             const double length = static_cast<double>(glm::length(d));
             plainSum += w;
-            if (w > 0.0) longest = std::max(longest, length);
+            longest = std::max(longest, length);
             w *= power(length, m);
         }
         sum += w * glm::dvec3(d);
@@ -46,6 +48,7 @@ bool weightedMeanDisplacement(int32_t begin, int32_t end, double m, Displacement
         sum = glm::dvec3(0.0);
         weightSum = 0.0;
         for (int32_t e = begin; e < end; ++e) {
+            if (weight(e) == 0.0) continue;
             const glm::vec3 d = displacement(e);
             const double w = weight(e) * power(static_cast<double>(glm::length(d)) / longest, m);
             sum += w * glm::dvec3(d);

@@ -242,9 +242,16 @@ def _key(obj):
 
 
 def _shape(obj):
-    # The mesh datablock (an object can be given another) and its counts: a change rebuilds the stack.
+    # The mesh datablock (an object can be given another), its counts and three of its rest points (an
+    # object made where a deleted one was may have its address, and its mesh too): a change rebuilds the
+    # stack. Reading three points costs nothing; the whole rest shape is read only then.
     mesh = obj.data
-    return (mesh.as_pointer(), len(mesh.vertices), len(mesh.polygons), len(mesh.loops))
+    n = len(mesh.vertices)
+    attribute = mesh.attributes.get(REST_ATTRIBUTE)
+    samples = ()
+    if attribute is not None and n > 0 and len(attribute.data) == n:
+        samples = tuple(tuple(attribute.data[i].vector) for i in (0, n // 2, n - 1))
+    return (mesh.as_pointer(), n, len(mesh.polygons), len(mesh.loops), samples)
 
 
 def take_pending(obj):

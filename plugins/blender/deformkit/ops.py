@@ -190,7 +190,8 @@ class DEFORMKIT_OT_add(bpy.types.Operator):
                 setup_controls(context, obj, entry, from_edit_mode)
                 entry.envelope = 1.0
             except Exception:
-                settings.entries.remove(len(settings.entries) - 1)  # no half-made entry stays behind
+                # No half-made entry stays behind (controls made before the failure stay in the scene).
+                settings.entries.remove(len(settings.entries) - 1)
                 raise
             settings.active_index = len(settings.entries) - 1
             message = evaluate.evaluate_safely(obj)

@@ -93,6 +93,8 @@ def bake_redirect_maps(context, obj, rigidity, mask, frames, out_dir, resolution
     library's ('shot' or 'live'). progress(done, total, unit) is uvwarp_shot's. Also writes the shot's log
     (LOG_NAME) and its HTML page (REPORT_NAME) into out_dir. Returns the job's report, {tile: dict}, each with
     'report': the page's path."""
+    if obj.mode == 'EDIT':
+        raise UvWarpError(f"{obj.name}: is in Edit Mode, whose mesh Blender keeps apart; bake in Object Mode")
     scene = context.scene
     if evaluate.has_rest(obj):
         rest = evaluate.rest_points(obj)

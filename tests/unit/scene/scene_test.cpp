@@ -97,6 +97,8 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
                Contains(file + ": frames: is given twice in one object (expected each key once)"));
     CHECK_THAT(parseError(withEntry(twist + R"({"endAngle": 1.5, "endAngle": 0}})")),
                Contains(file + ": objects.stack.params.endAngle: is given twice in one object"));
+    CHECK_THAT(parseError(R"({"a": {"list": [{}, {"b": 1}], "z": 1, "z": 2}})"),
+               Contains(file + ": a.z: is given twice"));  // objects closed inside keep the path right
     CHECK(f.error(withEntry(twist + R"({"endAngle": 1.5}}, )" + twist +
                             R"({"endAngle": 1}, "label": "b"})")) == "no error");
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": "1-5", "objects": []})"),

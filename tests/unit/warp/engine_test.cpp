@@ -139,6 +139,20 @@ TEST_CASE("engine: a displacement-weight exponent beyond double's range gives th
         CHECK(out[0].x == Approx(l1 / (1.0 + ratio)).epsilon(1e-5));
         CHECK(out[0].y == Approx(ratio * l2 / (1.0 + ratio)).epsilon(1e-5));
         CHECK(out[0].z == 0.0f);
+        // An entry of weight 0 changes nothing, even one whose |d|^400 overflows (0 inf was NaN).
+        t.affine.push_back(Affine::translate({0, 0, 100.0f}));
+        SparseFields g = f;
+        g.offsets = {0};
+        g.transform.clear();
+        g.strength.clear();
+        g.weight.clear();
+        g.add(0, 1.0f, 1.0f);
+        g.add(2, 1.0f, 0.0f);
+        g.add(1, 1.0f, 1.0f);
+        g.endPoint();
+        std::vector<glm::vec3> with(1);
+        evaluateWarp(points, g, t, with, {400.0f});
+        CHECK(with[0] == out[0]);
     }
 }
 
