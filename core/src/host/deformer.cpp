@@ -195,16 +195,6 @@ std::string pointText(const glm::vec3& p) {
 // 3e38 radians a unit): refused here, naming the point, rather than handed on as NaN or infinity.
 void requireFiniteOutput(const std::string& context, std::span<const glm::vec3> in,
                          std::span<const glm::vec3> out) {
-    // On every thread, as the deformers run: one thread's pass over a million points would cost a cheap
-    // deformer (a twist) a good share of its time. The answer (all finite or not) is the same for any
-    // thread count; the first bad point is then found in order.
-    const auto n = static_cast<int64_t>(3 * out.size());
-    const float* f = out.empty() ? nullptr : &out.data()->x;
-    int finite = 1;
-#pragma omp parallel for schedule(static) reduction(& : finite) if (n > (1 << 16))
-    for (int64_t i = 0; i < n; ++i)
-        finite &= std::abs(f[i]) <= std::numeric_limits<float>::max() ? 1 : 0;
-    if (finite) return;
     const size_t u = geom::firstNonFinite(out);
     if (u == out.size()) return;
     throw InvalidInput(formatError(context, "point " + std::to_string(u),

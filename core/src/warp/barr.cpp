@@ -38,9 +38,7 @@ inline int finiteBits(const glm::vec3& p) {
 
 // The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
 int64_t firstNonFinite(std::span<const glm::vec3> points) {
-    for (size_t u = 0; u < points.size(); ++u)
-        if (!geom::isFinite(points[u])) return static_cast<int64_t>(u);
-    return static_cast<int64_t>(points.size());
+    return static_cast<int64_t>(geom::firstNonFinite(points));
 }
 
 // sin(t)/t and (1 - cos t)/t, stable at and near t = 0.

@@ -29,6 +29,21 @@ bool near(const glm::vec3& a, const glm::vec3& b, float tol) {
     return glm::length(a - b) <= tol;
 }
 
+// The engine's result at the origin for two translations by `a` and `b`, weights 1 and 1, with the
+// displacement-weight exponent `m`.
+glm::vec3 meanOfTwo(const glm::vec3& a, const glm::vec3& b, float m) {
+    const std::vector<glm::vec3> points{{0, 0, 0}};
+    Transformations t;
+    t.affine = {Affine::translate(a), Affine::translate(b)};
+    SparseFields f;
+    f.add(0, 1.0f, 1.0f);
+    f.add(1, 1.0f, 1.0f);
+    f.endPoint();
+    std::vector<glm::vec3> out(1);
+    evaluateWarp(points, f, t, out, {m});
+    return out[0];
+}
+
 }  // namespace
 
 TEST_CASE("transform components recompose and decompose", "[warp][transform]") {
@@ -101,17 +116,8 @@ TEST_CASE("engine: Eq. 3 weighted average of scaled transformations", "[warp][en
 }
 
 TEST_CASE("engine: displacement-weight exponent (Wires weighting)", "[warp][engine]") {
-    const std::vector<glm::vec3> points{{0, 0, 0}};
-    Transformations t;
-    t.affine = {Affine::translate({1, 0, 0}), Affine::translate({3, 0, 0})};
-    SparseFields f;
-    f.add(0, 1.0f, 1.0f);
-    f.add(1, 1.0f, 1.0f);
-    f.endPoint();
-    std::vector<glm::vec3> out(1);
-    evaluateWarp(points, f, t, out, {2.0f});
     // Weights 1^2 and 3^2: (1 * 1 + 9 * 3) / 10.
-    CHECK(out[0].x == Approx(2.8f));
+    CHECK(meanOfTwo({1, 0, 0}, {3, 0, 0}, 2.0f).x == Approx(2.8f));
 }
 
 TEST_CASE("engine: a displacement-weight exponent beyond double's range gives the same mean",
@@ -121,38 +127,29 @@ TEST_CASE("engine: a displacement-weight exponent beyond double's range gives th
     // r = 1.002^400 does not. The mean: (d1 + r d2) / (1 + r), r computed here in log space.
     const double r = std::exp(400.0 * std::log(1.002));
     for (const float length : {10.0f, 0.1f, 1.0f}) {
-        const std::vector<glm::vec3> points{{0, 0, 0}};
-        Transformations t;
-        t.affine = {Affine::translate({length, 0, 0}), Affine::translate({0, 1.002f * length, 0})};
-        SparseFields f;
-        f.add(0, 1.0f, 1.0f);
-        f.add(1, 1.0f, 1.0f);
-        f.endPoint();
-        std::vector<glm::vec3> out(1);
-        evaluateWarp(points, f, t, out, {400.0f});
+        const glm::vec3 a(length, 0, 0), b(0, 1.002f * length, 0);
+        const glm::vec3 out = meanOfTwo(a, b, 400.0f);
         // The lengths as float holds them, in the ratio's place.
         const double l1 = length, l2 = static_cast<double>(1.002f * length);
         const double ratio = std::exp(400.0 * std::log(l2 / l1));
         CHECK(ratio == Approx(r).epsilon(1e-3));
         CAPTURE(length);
-        CHECK(std::isfinite(out[0].x));
-        CHECK(out[0].x == Approx(l1 / (1.0 + ratio)).epsilon(1e-5));
-        CHECK(out[0].y == Approx(ratio * l2 / (1.0 + ratio)).epsilon(1e-5));
-        CHECK(out[0].z == 0.0f);
+        CHECK(std::isfinite(out.x));
+        CHECK(out.x == Approx(l1 / (1.0 + ratio)).epsilon(1e-5));
+        CHECK(out.y == Approx(ratio * l2 / (1.0 + ratio)).epsilon(1e-5));
+        CHECK(out.z == 0.0f);
         // An entry of weight 0 changes nothing, even one whose |d|^400 overflows (0 inf was NaN).
-        t.affine.push_back(Affine::translate({0, 0, 100.0f}));
-        SparseFields g = f;
-        g.offsets = {0};
-        g.transform.clear();
-        g.strength.clear();
-        g.weight.clear();
+        const std::vector<glm::vec3> points{{0, 0, 0}};
+        Transformations t;
+        t.affine = {Affine::translate(a), Affine::translate(b), Affine::translate({0, 0, 100.0f})};
+        SparseFields g;
         g.add(0, 1.0f, 1.0f);
         g.add(2, 1.0f, 0.0f);
         g.add(1, 1.0f, 1.0f);
         g.endPoint();
         std::vector<glm::vec3> with(1);
         evaluateWarp(points, g, t, with, {400.0f});
-        CHECK(with[0] == out[0]);
+        CHECK(with[0] == out);
     }
 }
 

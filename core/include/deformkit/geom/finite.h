@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <span>
 
 #include <glm/vec2.hpp>
@@ -19,17 +18,8 @@ namespace deformkit::geom {
 }
 
 // The index of the first point of `points` that is not finite, or points.size() when every one is: one
-// branch-free pass over the coordinates (vectorised), then a search only when one is bad.
-[[nodiscard]] inline size_t firstNonFinite(std::span<const glm::vec3> points) {
-    if (points.empty()) return 0;
-    const float* f = &points.data()->x;
-    bool finite = true;
-    for (size_t i = 0; i < 3 * points.size(); ++i)
-        finite &= std::abs(f[i]) <= std::numeric_limits<float>::max();
-    if (finite) return points.size();
-    for (size_t u = 0; u < points.size(); ++u)
-        if (!isFinite(points[u])) return u;
-    return points.size();
-}
+// branch-free pass over the coordinates (vectorised, on every thread for large spans: the answer is the
+// same for any thread count), then a search in order only when one is bad.
+[[nodiscard]] size_t firstNonFinite(std::span<const glm::vec3> points);
 
 }  // namespace deformkit::geom
