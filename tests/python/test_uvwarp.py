@@ -247,6 +247,8 @@ def test_bad_input_names_what_is_wrong():
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig[:, :32])
     with pytest.raises(dk.InvalidInput, match="warp mask.*32 texels per side"):
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, mask=np.ones((32, 32), np.float32))
+    with pytest.raises(dk.InvalidInput, match="orientation map, UDIM tile 1001: 32 texels per side"):
+        dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, orientation=np.ones((32, 32), np.float32))
     with pytest.raises(dk.InvalidInput, match="resolution: is 48"):
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, resolution=48)
     with pytest.raises(dk.InvalidInput, match="UDIM tile 1002: holds no UV face"):

@@ -166,16 +166,17 @@ TileWarp::TileWarp(Bind, const geom::Mesh& rest, int tile, io::Image rigidity, c
     checkOptions(options, source);
     requireSquare(rigidity, source, tile, "rigidity map");
     m.texels = rigidity.width;
-    const bool derive = mask.pixels.empty();
-    if (!derive) {
-        requireSquare(mask, source, tile, "warp mask");
-        if (mask.width != m.texels) {
-            throw InvalidInput(formatError(source, "warp mask, UDIM tile " + std::to_string(tile),
-                                           std::to_string(mask.width) + " texels per side",
+    const auto rigiditySized = [&](const io::Image& map, const char* what) {
+        requireSquare(map, source, tile, what);
+        if (map.width != m.texels) {
+            throw InvalidInput(formatError(source, std::string(what) + ", UDIM tile " + std::to_string(tile),
+                                           std::to_string(map.width) + " texels per side",
                                            std::to_string(m.texels) + ", the rigidity map's size"));
         }
-    }
-    if (!orientation.pixels.empty()) requireSquare(orientation, source, tile, "orientation map");
+    };
+    const bool derive = mask.pixels.empty();
+    if (!derive) rigiditySized(mask, "warp mask");
+    if (!orientation.pixels.empty()) rigiditySized(orientation, "orientation map");
     m.cells = options.cells == 0 ? m.texels : options.cells;
     if (!isPowerOfTwo(m.cells) || m.cells < 2) {
         throw InvalidInput(formatError(source, "grid resolution, UDIM tile " + std::to_string(tile),

@@ -154,6 +154,11 @@ TEST_CASE("tile warp: bad maps name the tile and what was expected", "[uvwarp]")
     CHECK_THROWS_WITH(uvwarp::TileWarp(mesh, 1001, io::Image(64, 32, 1)), Catch::Contains("square map"));
     CHECK_THROWS_WITH(uvwarp::TileWarp(mesh, 1001, io::Image(64, 64, 1), io::Image(32, 32, 1)),
                       Catch::Contains("the rigidity map's size"));
+    // An orientation map is read texel for texel beside the rigidity, as in setMaps and a shot.
+    CHECK_THROWS_WITH(uvwarp::TileWarp(mesh, 1001, io::Image(64, 64, 1), {}, {}, io::Image(128, 128, 1)),
+                      Catch::Contains("orientation map, UDIM tile 1001") &&
+                          Catch::Contains("128 texels per side") &&
+                          Catch::Contains("the rigidity map's size"));
     io::Image bad(64, 64, 1);
     bad.at(3, 4, 0) = 2.0f;
     CHECK_THROWS_AS(uvwarp::TileWarp(mesh, 1001, bad), InvalidInput);
