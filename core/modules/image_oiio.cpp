@@ -76,6 +76,9 @@ class OiioWriter final : public codec::Writer {
     bool writeFloats(const float* pixels) override {
         return out_->write_image(OIIO::TypeDesc::FLOAT, pixels);
     }
+    bool writeRows(int32_t yBegin, int32_t yEnd, const float* pixels) override {
+        return out_->write_scanlines(yBegin, yEnd, 0, OIIO::TypeDesc::FLOAT, pixels);
+    }
     bool close() override { return out_->close(); }
     std::string error() override { return out_->geterror(); }
 

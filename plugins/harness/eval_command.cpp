@@ -73,12 +73,12 @@ uint32_t toByte(float v) {
     return static_cast<uint32_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
 }
 
-// Pastes `preview` (8-bit values as read from its PNG) shrunk by layout.factor into cell `cell` of `sheet`.
-void pasteTile(io::Image& sheet, const io::Image& preview, const ContactSheetLayout& layout, int32_t cell) {
+// Pastes `preview` (8-bit values as read from its PNG) shrunk by layout.factor into column `column` of
+// `band`, one row of the contact sheet's tiles.
+void pasteTile(io::Image& band, const io::Image& preview, const ContactSheetLayout& layout, int32_t column) {
     const int32_t k = layout.factor;
     const uint32_t area = static_cast<uint32_t>(k) * k;
-    const int32_t x0 = (cell % layout.columns) * layout.tileWidth;
-    const int32_t y0 = (cell / layout.columns) * layout.tileHeight;
+    const int32_t x0 = column * layout.tileWidth;
     for (int32_t y = 0; y < layout.tileHeight; ++y) {
         for (int32_t x = 0; x < layout.tileWidth; ++x) {
             for (int32_t c = 0; c < 3; ++c) {
@@ -86,10 +86,32 @@ void pasteTile(io::Image& sheet, const io::Image& preview, const ContactSheetLay
                 for (int32_t j = 0; j < k; ++j)
                     for (int32_t i = 0; i < k; ++i)
                         sum += toByte(preview.at(x * k + i, y * k + j, c));
-                sheet.at(x0 + x, y0 + y, c) = static_cast<float>((sum + area / 2) / area) / 255.0f;
+                band.at(x0 + x, y, c) = static_cast<float>((sum + area / 2) / area) / 255.0f;
             }
         }
     }
+}
+
+// The contact sheet of an object's previews, written a row of tiles at a time: only one row is in memory,
+// whatever the frame count. Tiles are made from the files as written (8-bit), so a tile is reproducible
+// from its preview.
+void writeContactSheet(const fs::path& sheet, const std::vector<fs::path>& previews,
+                       const ContactSheetLayout& layout, const io::PreviewOptions& view) {
+    const glm::vec3 background(static_cast<float>(toByte(view.background[0])) / 255.0f,
+                               static_cast<float>(toByte(view.background[1])) / 255.0f,
+                               static_cast<float>(toByte(view.background[2])) / 255.0f);
+    io::writeImageInBands(
+        sheet, layout.columns * layout.tileWidth, layout.rows * layout.tileHeight, 3, layout.tileHeight,
+        [&](int32_t y0, io::Image& band) {
+            for (int32_t i = 0; i < band.width * band.height; ++i)
+                for (int32_t c = 0; c < 3; ++c)
+                    band.pixels[3 * static_cast<size_t>(i) + c] = background[c];
+            const size_t first = static_cast<size_t>(y0 / layout.tileHeight) * layout.columns;
+            for (int32_t column = 0; column < layout.columns; ++column) {
+                if (first + column >= previews.size()) break;
+                pasteTile(band, io::readImage(previews[first + column], {3, "preview"}), layout, column);
+            }
+        });
 }
 
 // Removes a folder and its contents when leaving scope, on success or error.
@@ -274,18 +296,10 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     }
 
     std::vector<geom::Box3> restBounds;       // per object
-    std::vector<io::Image> sheets;            // per object
     std::vector<std::vector<fs::path>> pngs;  // per object, frame by frame
     if (previews) {
-        io::Image blank(layout.columns * layout.tileWidth, layout.rows * layout.tileHeight, 3);
-        for (int32_t i = 0; i < blank.width * blank.height; ++i) {
-            for (int32_t c = 0; c < 3; ++c)
-                blank.pixels[3 * i + c] = static_cast<float>(toByte(view.background[c])) / 255.0f;
-        }
-        for (const scene::SceneObject& object : scene.objects) {
+        for (const scene::SceneObject& object : scene.objects)
             restBounds.push_back(object.rest.bounds());
-            sheets.push_back(blank);
-        }
         pngs.resize(numObjects);
     }
 
@@ -321,9 +335,6 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
                 io::writeImage(png, io::renderPreview(mesh, frameView));
                 report.files.push_back(png);
                 pngs[o].push_back(png);
-                // The sheet is made from the file as written (8-bit), so a tile is reproducible from the
-                // preview.
-                pasteTile(sheets[o], io::readImage(png, {3, "preview"}), layout, static_cast<int32_t>(i));
             }
             if (stages[o]) scene::solveStageFrame(*stages[o], scene, o, frame, mesh.points());
         }
@@ -357,7 +368,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
 
     for (size_t o = 0; o < numObjects; ++o) {
         const fs::path sheet = command.outDir / (scene.objects[o].name + ".contact.png");
-        io::writeImage(sheet, sheets[o]);
+        writeContactSheet(sheet, pngs[o], layout, view);
         report.files.push_back(sheet);
     }
     if (command.movie) {

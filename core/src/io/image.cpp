@@ -4,9 +4,11 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <new>
@@ -228,21 +230,19 @@ ImageInfo readImageInfo(const fs::path& path) {
     return info;
 }
 
-void writeImage(const fs::path& path, const Image& image, const ImageWriteOptions& options) {
-    if (image.width < 1 || image.height < 1 || image.channels < 1) {
+namespace {
+
+// Checks the size and format, opens the file under a temporary name, lets `writePixels` write every pixel
+// (false: OpenImageIO failed, its error is reported), closes it and moves it into place.
+void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t channels,
+                  const ImageWriteOptions& options, const std::function<bool(codec::Writer&)>& writePixels) {
+    if (width < 1 || height < 1 || channels < 1) {
         throw InvalidInput(formatError(path.string(), "",
-                                       "cannot write an empty image (" + std::to_string(image.width) + "x" +
-                                           std::to_string(image.height) + " pixels, " +
-                                           channelCount(image.channels) + ")",
+                                       "cannot write an empty image (" + std::to_string(width) + "x" +
+                                           std::to_string(height) + " pixels, " + channelCount(channels) +
+                                           ")",
                                        "at least 1x1 pixels and 1 channel"));
     }
-    const size_t expected = static_cast<size_t>(image.width) * image.height * image.channels;
-    if (image.pixels.size() != expected) {
-        throw InvalidInput(formatError(path.string(), "pixels",
-                                       "has " + std::to_string(image.pixels.size()) + " values",
-                                       std::to_string(expected) + " = width * height * channels"));
-    }
-
     const codec::Codec& oiio = codec::load(path.string());
     discardPendingOiioErrors(oiio);
     // Created from the final name (nothing is opened yet): its format decides the checks below.
@@ -253,8 +253,8 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
             "an extension OpenImageIO writes, such as .exr, .png or .tif"));
     }
     const std::string format = probe->formatName();
-    if (image.channels > 4 && !probe->supportsAnyChannelCount()) {
-        throw InvalidInput(formatError(path.string(), "", "has " + channelCount(image.channels),
+    if (channels > 4 && !probe->supportsAnyChannelCount()) {
+        throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
                                        "at most 4 channels in " + format + " files"));
     }
     const std::string type = requestedType(options.type, format);
@@ -263,14 +263,14 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
         const std::unique_ptr<codec::Writer> out = std::move(probe);  // owned here: closed before rename
 
         codec::WriteSpec spec;
-        spec.width = image.width;
-        spec.height = image.height;
-        spec.channels = image.channels;
+        spec.width = width;
+        spec.height = height;
+        spec.channels = channels;
         spec.pixelType = type;
         // EXR keeps channels sorted by name and OpenImageIO restores R, G, B, A but orders other names as
         // strings ("channel10" before "channel4"): zero-padded names keep channels 5 and up in place.
-        const size_t digits = std::to_string(image.channels - 1).size();
-        for (int32_t c = 4; c < image.channels; ++c) {
+        const size_t digits = std::to_string(channels - 1).size();
+        for (int32_t c = 4; c < channels; ++c) {
             const std::string index = std::to_string(c);
             spec.channelNames.emplace_back(c, "channel" + std::string(digits - index.size(), '0') + index);
         }
@@ -290,8 +290,8 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
             throw IoError(formatError(path.string(), "", "cannot write: " + oiioError(oiio, out->error()),
                                       "a writable file"));
         }
-        if (out->openedChannels() != image.channels) {
-            throw InvalidInput(formatError(path.string(), "", "has " + channelCount(image.channels),
+        if (out->openedChannels() != channels) {
+            throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
                                            channelCount(out->openedChannels()) + " in " + format + " files"));
         }
         std::string rejected;
@@ -300,7 +300,7 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
                 formatError(path.string(), "pixel type", format + " files cannot store " + type + " pixels",
                             "a type the format stores, such as " + out->openedPixelType());
         }
-        if (!out->writeFloats(image.pixels.data())) {
+        if (!writePixels(*out)) {
             throw IoError(formatError(path.string(), "pixels",
                                       "cannot write: " + oiioError(oiio, out->error()),
                                       "enough space to write"));
@@ -315,6 +315,58 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
         requireAttributesStored(oiio, path, tmp, format, options);
     });
     discardPendingOiioErrors(oiio);
+}
+
+}  // namespace
+
+void writeImage(const fs::path& path, const Image& image, const ImageWriteOptions& options) {
+    const size_t expected = static_cast<size_t>(std::max(image.width, 0)) * std::max(image.height, 0) *
+                            std::max(image.channels, 0);
+    if (image.width >= 1 && image.height >= 1 && image.channels >= 1 && image.pixels.size() != expected) {
+        throw InvalidInput(formatError(path.string(), "pixels",
+                                       "has " + std::to_string(image.pixels.size()) + " values",
+                                       std::to_string(expected) + " = width * height * channels"));
+    }
+    writeChecked(path, image.width, image.height, image.channels, options,
+                 [&](codec::Writer& out) { return out.writeFloats(image.pixels.data()); });
+}
+
+void writeImageInBands(const fs::path& path, int32_t width, int32_t height, int32_t channels,
+                       int32_t bandRows, const ImageBand& fill, const ImageWriteOptions& options) {
+    if (bandRows < 1) {
+        throw InvalidInput(formatError(path.string(), "band", "has " + std::to_string(bandRows) + " rows",
+                                       "at least 1 row"));
+    }
+    writeChecked(path, width, height, channels, options, [&](codec::Writer& out) {
+        Image band;
+        int32_t written = 0;  // rows in the file
+        try {
+            for (; written < height; written += bandRows) {
+                const int32_t rows = std::min(bandRows, height - written);
+                if (band.height != rows) band = Image(width, rows, channels);
+                std::fill(band.pixels.begin(), band.pixels.end(), 0.0f);
+                fill(written, band);
+                if (band.width != width || band.height != rows || band.channels != channels ||
+                    band.pixels.size() != static_cast<size_t>(width) * rows * channels) {
+                    throw InvalidInput(formatError(path.string(), "band at row " + std::to_string(written),
+                                                   "was resized to " + std::to_string(band.width) + "x" +
+                                                       std::to_string(band.height) + " pixels, " +
+                                                       channelCount(band.channels),
+                                                   std::to_string(width) + "x" + std::to_string(rows) +
+                                                       " pixels, " + channelCount(channels)));
+                }
+                if (!out.writeRows(written, written + rows, band.pixels.data())) return false;
+            }
+        } catch (...) {
+            // The temporary file is dropped, but a PNG writer closed short of its rows makes libpng print
+            // to stderr: the rest is written as zeros first, one row at a time.
+            const std::vector<float> zeros(static_cast<size_t>(width) * channels, 0.0f);
+            for (int32_t y = written; y < height; ++y)
+                if (!out.writeRows(y, y + 1, zeros.data())) break;
+            throw;
+        }
+        return true;
+    });
 }
 
 bool isImageFileName(const fs::path& path) {

@@ -18,7 +18,7 @@
 
 namespace deformkit::io::codec {
 
-inline constexpr int kAbiVersion = 1;
+inline constexpr int kAbiVersion = 2;
 
 // Pixel types by name: "uint8", "uint16", "half", "float", or OpenImageIO's name of any other type.
 struct Spec {
@@ -67,6 +67,8 @@ class Writer {
     [[nodiscard]] virtual int32_t openedChannels() const = 0;
     [[nodiscard]] virtual std::string openedPixelType() const = 0;
     [[nodiscard]] virtual bool writeFloats(const float* pixels) = 0;
+    // Rows [yBegin, yEnd) as float32, (H, W, C); rows are given in order, top to bottom.
+    [[nodiscard]] virtual bool writeRows(int32_t yBegin, int32_t yEnd, const float* pixels) = 0;
     [[nodiscard]] virtual bool close() = 0;
     [[nodiscard]] virtual std::string error() = 0;
 };

@@ -509,3 +509,71 @@ TEST_CASE("writeImage replaces a file atomically and fails on a missing or unwri
     CHECK(readText(target) == before);
     CHECK(folderEntries(dir.path()) == std::set<std::string>{"map.exr"});
 }
+
+TEST_CASE("writeImageInBands writes the bytes writeImage writes, a band at a time", "[io][image]") {
+    // The whole image written at once is the reference; bands of 1 row, of a count that does not divide
+    // the height (a short last band), and of more rows than the image must give the same file, for an 8-bit
+    // PNG and a float EXR. Each band is filled from the reference at the rows it is told.
+    TempDir dir;
+    const Image img = patternImage(7, 10, 3);
+    for (const char* name : {"a.png", "a.exr"}) {
+        const ImageWriteOptions options{std::string(name) == "a.exr" ? PixelType::Float : PixelType::Auto,
+                                        {}};
+        writeImage(dir / (std::string("whole_") + name), img, options);
+        const std::string whole = readText(dir / (std::string("whole_") + name));
+        for (const int32_t bandRows : {1, 3, 4, 10, 64}) {
+            std::vector<int32_t> starts;
+            writeImageInBands(
+                dir / name, img.width, img.height, img.channels, bandRows,
+                [&](int32_t y0, Image& band) {
+                    starts.push_back(y0);
+                    REQUIRE(band.width == img.width);
+                    REQUIRE(band.height == std::min(bandRows, img.height - y0));
+                    for (float v : band.pixels)
+                        REQUIRE(v == 0.0f);
+                    for (int32_t y = 0; y < band.height; ++y)
+                        for (int32_t x = 0; x < band.width; ++x)
+                            for (int32_t c = 0; c < 3; ++c)
+                                band.at(x, y, c) = img.at(x, y0 + y, c);
+                },
+                options);
+            CAPTURE(name, bandRows);
+            CHECK(readText(dir / name) == whole);
+            std::vector<int32_t> expected;
+            for (int32_t y = 0; y < img.height; y += bandRows)
+                expected.push_back(y);
+            CHECK(starts == expected);
+        }
+    }
+}
+
+TEST_CASE("writeImageInBands refuses bad bands and leaves no file when a band fails", "[io][image]") {
+    TempDir dir;
+    using deformkit::InvalidInput;
+    const auto fillNothing = [](int32_t, Image&) {};
+    CHECK_THROWS_WITH(writeImageInBands(dir / "a.png", 4, 4, 3, 0, fillNothing),
+                      Catch::Contains("a.png") && Catch::Contains("at least 1 row"));
+    CHECK_THROWS_WITH(writeImageInBands(dir / "a.png", 0, 4, 3, 2, fillNothing),
+                      Catch::Contains("empty image"));
+    CHECK_THROWS_WITH(
+        writeImageInBands(dir / "a.png", 4, 4, 3, 2, [](int32_t, Image& band) { band = Image(3, 2, 3); }),
+        Catch::Contains("band at row 0") && Catch::Contains("was resized to 3x2 pixels") &&
+            Catch::Contains("4x2 pixels, 3 channels"));
+    // A band that fails half way (a preview that cannot be read) leaves neither the file nor a temporary.
+    CHECK_THROWS_WITH(writeImageInBands(dir / "a.png", 4, 4, 3, 2,
+                                        [](int32_t y0, Image&) {
+                                            if (y0 > 0) throw deformkit::IoError("preview.png: no such file");
+                                        }),
+                      Catch::Contains("no such file"));
+    CHECK(folderEntries(dir.path()).empty());
+    // Over an existing file, the old file stays.
+    writeImage(dir / "keep.png", patternImage(4, 4, 3));
+    const std::string before = readText(dir / "keep.png");
+    CHECK_THROWS_AS(writeImageInBands(dir / "keep.png", 4, 4, 3, 2,
+                                      [](int32_t y0, Image&) {
+                                          if (y0 > 0) throw deformkit::IoError("stop");
+                                      }),
+                    deformkit::IoError);
+    CHECK(readText(dir / "keep.png") == before);
+    CHECK(folderEntries(dir.path()) == std::set<std::string>{"keep.png"});
+}

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,5 +69,16 @@ struct ImageInfo {
 // empty image, a pixel count that does not match width * height * channels, or a pixel type the format
 // cannot store (PNG has no half or float); IoError when the folder is missing or not writable.
 void writeImage(const std::filesystem::path& path, const Image& image, const ImageWriteOptions& options = {});
+
+// Fills `band`, rows [y0, y0 + band.height) of an image being written (all zero on entry; its size is
+// fixed).
+using ImageBand = std::function<void(int32_t y0, Image& band)>;
+
+// Writes a width x height image made `bandRows` rows at a time, top to bottom, so that only one band is in
+// memory (a contact sheet of thousands of frames). Atomic and checked as writeImage; a format whose writer
+// cannot take rows in order (none of the scanline formats) fails with IoError. An exception thrown by `fill`
+// leaves no file.
+void writeImageInBands(const std::filesystem::path& path, int32_t width, int32_t height, int32_t channels,
+                       int32_t bandRows, const ImageBand& fill, const ImageWriteOptions& options = {});
 
 }  // namespace deformkit::io
