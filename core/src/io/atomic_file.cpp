@@ -6,9 +6,11 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <random>
 #include <string>
 
 #include "deformkit/error.h"
@@ -19,12 +21,9 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temporaryPathFor(const fs::path& path) {
-    static std::atomic<unsigned> counter{0};
-    // ".name.tmp-<pid>-<n>.ext": hidden, unique per process and call, extension kept for OpenImageIO.
-    const std::string stem = path.stem().string();
-    const std::string name = "." + stem + ".tmp-" + std::to_string(::getpid()) + "-" +
-                             std::to_string(counter.fetch_add(1)) + path.extension().string();
-    return path.parent_path() / name;
+    // ".name.tmp-<token>.ext": hidden, extension kept for OpenImageIO.
+    return path.parent_path() /
+           ("." + path.stem().string() + ".tmp-" + uniqueToken() + path.extension().string());
 }
 
 void flushToDisk(const fs::path& file) {
@@ -82,6 +81,20 @@ fs::path fileInTheWay(const fs::path& folder) {
 }
 
 }  // namespace
+
+std::string uniqueToken() {
+    // The process id alone repeats across hosts and containers that share a folder (two farm runs of one
+    // task): a random number drawn once per process tells them apart, the counter tells calls apart.
+    static const std::string process = [] {
+        std::random_device device;
+        const uint64_t bits = (static_cast<uint64_t>(device()) << 32) ^ device();
+        char hex[17];
+        std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(bits));
+        return std::to_string(::getpid()) + "-" + hex;
+    }();
+    static std::atomic<unsigned> counter{0};
+    return process + "-" + std::to_string(counter.fetch_add(1));
+}
 
 void writeAtomically(const fs::path& requested, const std::function<void(const fs::path& tmp)>& write) {
     // Through a symbolic link the link's target is written (atomically, in the target's folder) and the link

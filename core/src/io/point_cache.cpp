@@ -1,9 +1,6 @@
 #include "deformkit/io/point_cache.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cctype>
 #include <cmath>
@@ -231,6 +228,7 @@ void PointCache::read(int frame, std::vector<glm::vec3>& points) {
                                        "one of its " + rangeText()));
     }
     const size_t bytes = static_cast<size_t>(vertices_) * kBytesPerVertex;
+    const std::lock_guard<std::mutex> lock(readMutex_);
     buffer_.resize(bytes);
     in_.clear();
     in_.seekg(static_cast<std::streamoff>(dataOffset_ + static_cast<std::uintmax_t>(*sample) * bytes));
@@ -271,10 +269,14 @@ PointCacheWriter::PointCacheWriter(fs::path path, int32_t vertices, int32_t fram
         throw InvalidInput(
             formatError(path_.string(), "frame rate", "is " + numberText(fps), "frames per second > 0"));
     }
-    static std::atomic<unsigned> counter{0};
+    // A PC2 stores its start frame as a 32-bit float: whole numbers are exact up to 2^24.
+    constexpr int kMaxExactStart = 1 << 24;
+    if (format_ == PointCacheFormat::Pc2 && (firstFrame > kMaxExactStart || firstFrame < -kMaxExactStart)) {
+        throw InvalidInput(formatError(path_.string(), "first frame", "is " + std::to_string(firstFrame),
+                                       "a frame from -16777216 to 16777216 (a PC2 stores it as a float)"));
+    }
     const fs::path folder = path_.parent_path().empty() ? fs::path(".") : path_.parent_path();
-    staging_ = folder / ("." + path_.filename().string() + ".partial-" + std::to_string(::getpid()) + "-" +
-                         std::to_string(counter.fetch_add(1)));
+    staging_ = folder / ("." + path_.filename().string() + ".partial-" + uniqueToken());
     out_.open(staging_, std::ios::binary | std::ios::trunc);
     if (!out_) {
         throw IoError(formatError(path_.string(), "",

@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
 
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <regex>
+#include <string>
 
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
@@ -165,4 +169,17 @@ TEST_CASE("writers refuse a file name of another format", "[io][atomic][errors]"
     const geom::Mesh mesh = geom::makeGrid({2, 2});
     CHECK_THROWS_WITH(io::writeObj(dir / "o.png", mesh), Catch::Contains("ending in .obj"));
     CHECK(countEntries(dir.path()) == 0);
+}
+
+TEST_CASE("temporary names carry the process, a random number drawn once and a call count", "[io][atomic]") {
+    // Two processes with one process id (containers, two hosts) must still not share a temporary: the
+    // token's middle part is 64 random bits drawn once per process; the last part counts calls.
+    const std::string a = io::uniqueToken(), b = io::uniqueToken();
+    const std::regex form(std::to_string(::getpid()) + "-([0-9a-f]{16})-([0-9]+)");
+    std::smatch ma, mb;
+    REQUIRE(std::regex_match(a, ma, form));
+    REQUIRE(std::regex_match(b, mb, form));
+    CHECK(ma[1] == mb[1]);
+    CHECK(std::stoul(mb[2]) == std::stoul(ma[2]) + 1);
+    CHECK(ma[1] != std::string(16, '0'));
 }

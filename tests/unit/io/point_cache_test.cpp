@@ -1,10 +1,12 @@
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -164,6 +166,70 @@ TEST_CASE("point cache: a writer that does not finish leaves the earlier file an
                Contains("c.abc") && Contains(".pc2 or .mdd"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] { io::PointCacheWriter(dir / "c.pc2", 3, 0, 1); }),
                Contains("at least one frame and one vertex"));
+    // A PC2's start frame is a float: 2^24 + 1 would read back as 2^24.
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { io::PointCacheWriter(dir / "c.pc2", 3, 2, (1 << 24) + 1); }),
+               Contains("c.pc2: first frame: is 16777217") && Contains("-16777216 to 16777216"));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { io::PointCacheWriter(dir / "c.pc2", 3, 2, -(1 << 24) - 1); }),
+        Contains("first frame: is -16777217"));
+    CHECK(test::filesIn(dir.path()) == std::vector<fs::path>{"c.pc2"});
+}
+
+TEST_CASE("point cache: start frames at the PC2 limit and MDD's far frames read back", "[io][point_cache]") {
+    const test::TempDir dir;
+    const auto frames = randomFrames(2, 3, 9);
+    for (const int first : {1 << 24, -(1 << 24), (1 << 24) + 1}) {
+        for (const char* name : {"l.pc2", "l.mdd"}) {
+            if (first == (1 << 24) + 1 && std::string(name) == "l.pc2") continue;  // refused above
+            {
+                io::PointCacheWriter writer(dir / name, 3, 2, first);
+                writer.append(frames[0]);
+                writer.append(frames[1]);
+                writer.finish();
+            }
+            io::PointCache cache(dir / name,
+                                 std::string(name) == "l.mdd" ? std::optional<double>(first) : std::nullopt);
+            CAPTURE(name, first);
+            CHECK(cache.frames() == std::vector<int>{first, first + 1});
+            std::vector<glm::vec3> got;
+            cache.read(first + 1, got);
+            CHECK(got == frames[1]);
+        }
+    }
+}
+
+TEST_CASE("point cache: one cache read from several threads at once gives each its frame",
+          "[io][point_cache]") {
+    // Frame f of the cache holds the value f at every coordinate; 4 threads read 200 frames in turn from
+    // one PointCache, each checking what it got against the frame it asked for.
+    const test::TempDir dir;
+    const int32_t vertices = 20000, count = 8;
+    {
+        io::PointCacheWriter writer(dir / "t.pc2", vertices, count, 1);
+        for (int f = 1; f <= count; ++f)
+            writer.append(std::vector<glm::vec3>(vertices, glm::vec3(static_cast<float>(f))));
+        writer.finish();
+    }
+    io::PointCache cache(dir / "t.pc2");
+    std::atomic<int> wrong{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t) {
+        threads.emplace_back([&, t] {
+            std::vector<glm::vec3> points;
+            for (int k = 0; k < 50; ++k) {
+                const int frame = 1 + (k + t) % count;
+                cache.read(frame, points);
+                for (const glm::vec3& p : points)
+                    if (p != glm::vec3(static_cast<float>(frame))) {
+                        ++wrong;
+                        break;
+                    }
+            }
+        });
+    }
+    for (std::thread& thread : threads)
+        thread.join();
+    CHECK(wrong == 0);
 }
 
 TEST_CASE("point cache: bad caches are refused naming the file, the frame and the vertex",

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
+#include <string>
 #include <string_view>
 
 namespace deformkit::io {
@@ -23,6 +24,10 @@ void createFolder(const std::filesystem::path& path);
 // (".obj"): a writer refuses to put one format behind another's name. `format` names it ("an OBJ mesh").
 void requireExtension(const std::filesystem::path& path, std::initializer_list<std::string_view> extensions,
                       std::string_view format);
+
+// A token no other call in any process uses ("<pid>-<random>-<n>"), for temporary names beside outputs
+// that several processes, on one host or several, may write at once.
+[[nodiscard]] std::string uniqueToken();
 
 // Writes `bytes` to `path` atomically.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);

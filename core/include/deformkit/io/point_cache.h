@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -61,7 +62,7 @@ class PointCache {
     // Reads the positions of a whole frame into `points` (resized to vertexCount()), seeking to that
     // frame only. Throws InvalidInput naming the file and frame when the frame is none of the cache's
     // (saying which it has), and naming the vertex when a coordinate is not finite; IoError when the read
-    // fails.
+    // fails. Calls from several threads at once run one at a time (they share the file's stream).
     void read(int frame, std::vector<glm::vec3>& points);
 
   private:
@@ -73,6 +74,7 @@ class PointCache {
     double sampling_ = 1.0;
     std::vector<float> times_;
     std::uintmax_t dataOffset_ = 0;  // bytes before sample 0
+    std::mutex readMutex_;           // over in_ and buffer_
     std::ifstream in_;
     std::vector<char> buffer_;
 };
