@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "deformkit/warp/barr.h"
 #include "deformkit/warp/barr_dcc.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -44,8 +46,9 @@ ProfileCurve profileOf(const FloatArray& z, const FloatArray& v, const char* sou
 
 // Deforms `points` with a bound warp into a new (n, 3) float32 array: the input is read in place and the
 // warp writes the output directly (no other copy).
-py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::optional<FloatArray>& weights,
-                       float envelope, const char* source, const py::object& outArg = py::none()) {
+py::array_t<float> run(AxialWarp& warp, std::mutex* mutex, const FloatArray& points,
+                       const std::optional<FloatArray>& weights, float envelope, const char* source,
+                       const py::object& outArg = py::none()) {
     const std::span<const glm::vec3> in = pointsView(points, source, "points");
     std::span<const float> w;
     if (weights) {
@@ -62,6 +65,9 @@ py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::opt
     auto [out, pts] = outputArray(outArg, in.size(), source);
     {
         py::gil_scoped_release release;
+        std::unique_lock<std::mutex> lock;
+        if (mutex) lock = std::unique_lock<std::mutex>(*mutex);
+        requireSameOrApart(in, pts, source);
         if (pts.data() == in.data()) {
             warp.deform(pts, w, envelope);  // out is the input: in place
         } else {
@@ -71,7 +77,8 @@ py::array_t<float> run(AxialWarp& warp, const FloatArray& points, const std::opt
     return out;
 }
 
-// The direct path's bind (no engine fields), reading the rest points in place.
+// The direct path's bind (no engine fields), reading the rest points in place (at construction: no other
+// thread has the object yet).
 template <class W>
 void bindRest(W& warp, const FloatArray& rest, const char* source) {
     const std::span<const glm::vec3> pts = pointsView(rest, source, "rest_points");
@@ -110,7 +117,7 @@ void defineProfileWarpFunction(py::module_& m, const char* name, const char* doc
                float envelope) {
             W w({vec3Of(origin, name, "axis_origin"), vec3Of(axis, name, "axis_dir")}, profileOf(z, v, name));
             bindRest(w, points, name);
-            return run(w, points, weights, envelope, name);
+            return run(w, nullptr, points, weights, envelope, name);
         },
         "points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a, "weights"_a = py::none(),
         "envelope"_a = 1.0f, doc);
@@ -120,24 +127,30 @@ void defineProfileWarpFunction(py::module_& m, const char* name, const char* doc
 template <class W>
 void bindProfileWarpClass(py::module_& m, const char* name, const char* doc) {
     using namespace pybind11::literals;
-    py::class_<W>(m, name, doc)
+    py::class_<Locked<W>>(m, name, doc)
         .def(py::init([name](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
                              const FloatArray& z, const FloatArray& v) {
-                 auto w = std::make_unique<W>(
+                 auto w = std::make_unique<Locked<W>>(
                      AxisFrame{vec3Of(origin, name, "axis_origin"), vec3Of(axis, name, "axis_dir")},
                      profileOf(z, v, name));
-                 bindRest(*w, rest, name);
+                 bindRest(w->object, rest, name);
                  return w;
              }),
              "rest_points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a)
         .def(
             "set_profile",
-            [name](W& w, const FloatArray& z, const FloatArray& v) { w.setProfile(profileOf(z, v, name)); },
+            [name](Locked<W>& w, const FloatArray& z, const FloatArray& v) {
+                ProfileCurve profile = profileOf(z, v, name);
+                const Lock lock(w.mutex);
+                w.object.setProfile(std::move(profile));
+            },
             "z_samples"_a, "value_samples"_a)
         .def(
             "evaluate",
-            [name](W& w, const FloatArray& points, const std::optional<FloatArray>& weights, float envelope,
-                   const py::object& out) { return run(w, points, weights, envelope, name, out); },
+            [name](Locked<W>& w, const FloatArray& points, const std::optional<FloatArray>& weights,
+                   float envelope, const py::object& out) {
+                return run(w.object, &w.mutex, points, weights, envelope, name, out);
+            },
             "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f, "out"_a = py::none(),
             "Deform points (N, 3) into a new array, or into out: a writable (N, 3) float32 array reused from "
             "call to call (no allocation; it may be points itself).");
@@ -165,7 +178,7 @@ void bindBarr(py::module_& m) {
                               vec3Of(up, "bend", "up_dir")},
                              {rate, centre, lo, hi});
             bindRest(w, points, "bend");
-            return run(w, points, weights, envelope, "bend");
+            return run(w, nullptr, points, weights, envelope, "bend");
         },
         "points"_a, "axis_origin"_a, "axis_dir"_a, "up_dir"_a, "rate"_a, "centre"_a, "lo"_a, "hi"_a,
         "weights"_a = py::none(), "envelope"_a = 1.0f,
@@ -178,28 +191,31 @@ void bindBarr(py::module_& m) {
     bindProfileWarpClass<warp::TwistWarp>(m, "Twist",
                                           "Barr twist bound to rest points; set_profile, then evaluate.");
 
-    py::class_<warp::BendWarp>(m, "Bend", "Barr bend bound to rest points; set_params, then evaluate.")
+    py::class_<Locked<warp::BendWarp>>(m, "Bend",
+                                       "Barr bend bound to rest points; set_params, then evaluate.")
         .def(py::init([](const FloatArray& rest, const FloatArray& origin, const FloatArray& axis,
                          const FloatArray& up, float rate, float centre, float lo, float hi) {
-                 auto w = std::make_unique<warp::BendWarp>(
+                 auto w = std::make_unique<Locked<warp::BendWarp>>(
                      AxisFrame{vec3Of(origin, "Bend", "axis_origin"), vec3Of(axis, "Bend", "axis_dir"),
                                vec3Of(up, "Bend", "up_dir")},
                      warp::BendParams{rate, centre, lo, hi});
-                 bindRest(*w, rest, "Bend");
+                 bindRest(w->object, rest, "Bend");
                  return w;
              }),
              "rest_points"_a, "axis_origin"_a, "axis_dir"_a, "up_dir"_a, "rate"_a, "centre"_a, "lo"_a, "hi"_a)
         .def(
             "set_params",
-            [](warp::BendWarp& w, float rate, float centre, float lo, float hi) {
-                w.setParams({rate, centre, lo, hi});
+            [](Locked<warp::BendWarp>& w, float rate, float centre, float lo, float hi) {
+                const Lock lock(w.mutex);
+                w.object.setParams({rate, centre, lo, hi});
             },
             "rate"_a, "centre"_a, "lo"_a, "hi"_a)
         .def(
             "evaluate",
-            [](warp::BendWarp& w, const FloatArray& points, const std::optional<FloatArray>& weights,
-               float envelope,
-               const py::object& out) { return run(w, points, weights, envelope, "Bend", out); },
+            [](Locked<warp::BendWarp>& w, const FloatArray& points, const std::optional<FloatArray>& weights,
+               float envelope, const py::object& out) {
+                return run(w.object, &w.mutex, points, weights, envelope, "Bend", out);
+            },
             "points"_a, "weights"_a = py::none(), "envelope"_a = 1.0f, "out"_a = py::none(),
             "Deform points (N, 3) into a new array, or into out: a writable (N, 3) float32 array reused from "
             "call to call (no allocation; it may be points itself).");

@@ -18,6 +18,7 @@
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/image_warp.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -82,7 +83,8 @@ py::array mapToNumpy(std::vector<glm::vec2>&& map, int32_t width, int32_t height
         reinterpret_cast<const float*>(data->data()), owner);
 }
 
-// Holds the warp; the deformer (generic engine path for 3-D points) is created on bind().
+// Holds the warp; the deformer (generic engine path for 3-D points) is created on bind(). Calls are
+// serialised (object_lock.h).
 class PyBeierNeely {
   public:
     PyBeierNeely(const FloatArray& src, const FloatArray& dst, float a, float b, float p,
@@ -90,26 +92,34 @@ class PyBeierNeely {
         : warp_(std::make_unique<warp::BeierNeelyWarp>(
               pairsOf(src, dst, a, b, p), warp::BeierNeelyOptions{beierNeelyVariantOf(variant)})) {}
 
-    void setSrcLines(const FloatArray& src) { warp_->setSourceSegments(linesOf(src, "src_lines")); }
+    void setSrcLines(const FloatArray& src) {
+        const auto lines = linesOf(src, "src_lines");
+        const Lock lock(mutex_);
+        warp_->setSourceSegments(lines);
+    }
 
-    py::array map(int32_t width, int32_t height) const {
+    py::array map(int32_t width, int32_t height) {
         checkSize(width, height);
         std::vector<glm::vec2> out(static_cast<size_t>(width) * height);
         {
             py::gil_scoped_release release;
+            const Lock lock(mutex_);
             warp_->mapPixelCentres(width, height, out);
         }
         return mapToNumpy(std::move(out), width, height);
     }
 
-    py::array warpImage(const FloatArray& image, const std::string& interp) const {
+    py::array warpImage(const FloatArray& image, const std::string& interp) {
         io::Image src = imageOf(image, kBeierNeely, "image");
         const io::SampleFilter interpolation = interpOf(interp);
         io::Image out;
         {
             py::gil_scoped_release release;
             std::vector<glm::vec2> map(static_cast<size_t>(src.width) * src.height);
-            warp_->mapPixelCentres(src.width, src.height, map);
+            {
+                const Lock lock(mutex_);
+                warp_->mapPixelCentres(src.width, src.height, map);
+            }
             out = warp::resampleImage(src, map, src.width, src.height, interpolation);
         }
         return imageArray(std::move(out), image.ndim() == 2);
@@ -117,32 +127,26 @@ class PyBeierNeely {
 
     void bind(const FloatArray& rest) {
         std::vector<glm::vec3> points = points3(rest, "rest_points");
-        deformer_ = std::make_unique<warp::WarpDeformer>(*warp_);
         py::gil_scoped_release release;
-        deformer_->bind(points);
+        const Lock lock(mutex_);
+        auto deformer = std::make_unique<warp::WarpDeformer>(*warp_);
+        deformer->bind(points);
+        deformer_ = std::move(deformer);
     }
 
     py::array evaluate(const FloatArray& points, const std::optional<FloatArray>& weights, float envelope) {
-        if (!deformer_ || !deformer_->isBound()) {
-            throw InvalidInput(
-                formatError(kBeierNeely, "evaluate", "called before bind", "bind(rest_points) first"));
-        }
         std::vector<glm::vec3> p = points3(points, "points");
-        std::vector<float> w;
-        if (weights) {
-            if (weights->ndim() != 1) {
-                throw InvalidInput(
-                    formatError(kBeierNeely, "weights", "has shape " + shapeOf(*weights), "(n,)"));
-            }
-            w.assign(weights->data(), weights->data() + weights->shape(0));
-        }
+        const std::vector<float> w = weightsOf(weights, p.size(), kBeierNeely);
         {
             py::gil_scoped_release release;
+            const Lock lock(mutex_);
+            if (!deformer_ || !deformer_->isBound()) {
+                throw InvalidInput(
+                    formatError(kBeierNeely, "evaluate", "called before bind", "bind(rest_points) first"));
+            }
             deformer_->evaluate(p, w, envelope);
         }
-        py::array_t<float> out({static_cast<py::ssize_t>(p.size()), py::ssize_t{3}});
-        std::memcpy(out.mutable_data(), p.data(), p.size() * sizeof(glm::vec3));
-        return out;
+        return toArray(p);
     }
 
   private:
@@ -164,6 +168,7 @@ class PyBeierNeely {
 
     std::unique_ptr<warp::BeierNeelyWarp> warp_;
     std::unique_ptr<warp::WarpDeformer> deformer_;
+    std::mutex mutex_;
 };
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -16,6 +18,7 @@
 #include "deformkit/warp/ffd.h"
 #include "deformkit/warp/ffd_frames.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -174,33 +177,64 @@ py::array_t<float> bindAndRun(W& warp, const FloatArray& points, const std::opti
     return out;
 }
 
-// Evaluates a bound warp on a copy of `points` (the rest points when None).
+// Evaluates a bound warp on a copy of `points` (the rest points when None) under the object's mutex.
 template <class W>
-py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& rest,
+py::array_t<float> evaluateBound(const W& warp, const std::vector<glm::vec3>& rest, std::mutex& mutex,
                                  const std::optional<FloatArray>& points,
                                  const std::optional<FloatArray>& weights, float envelope, const char* source,
                                  const py::object& outArg) {
-    const std::span<const glm::vec3> in =
-        points ? pointsView(*points, source, "points") : std::span<const glm::vec3>(rest);
-    const std::span<const float> w = weightsView(weights, in.size(), source);
-    auto [out, pts] = outputArray(outArg, in.size(), source);
+    const std::optional<std::span<const glm::vec3>> given =
+        points ? std::optional(pointsView(*points, source, "points")) : std::nullopt;
+    size_t count = 0;
+    if (given) {
+        count = given->size();
+    } else {
+        const Lock lock(mutex);
+        count = rest.size();
+    }
+    const std::span<const float> w = weightsView(weights, count, source);
+    auto [out, pts] = outputArray(outArg, count, source);
     {
         py::gil_scoped_release release;
+        const Lock lock(mutex);
+        const std::span<const glm::vec3> in = given ? *given : std::span<const glm::vec3>(rest);
+        if (in.size() != count) {
+            throw InvalidInput(formatError(source, "points",
+                                           "were bound again by another thread during the call",
+                                           "bind and evaluate of one object in the same thread"));
+        }
+        requireSameOrApart(in, pts, source);
         warp.evaluate(in, pts, w, envelope);  // into out, or in place when out is the input
     }
     return out;
 }
 
-// The bound classes keep their rest points so evaluate() without points deforms the rest shape.
+// The bound classes keep their rest points so evaluate() without points deforms the rest shape. Calls are
+// serialised (object_lock.h).
 struct PyFfd {
+    explicit PyFfd(Ffd f) : ffd(std::move(f)) {}
     Ffd ffd;
     std::vector<glm::vec3> rest;
+    std::mutex mutex;
 };
 
 struct PyFfdFrames {
+    explicit PyFfdFrames(FfdFrames f) : frames(std::move(f)) {}
     FfdFrames frames;
     std::vector<glm::vec3> rest;
+    std::mutex mutex;
 };
+
+// A copy of lattice points taken under the object's mutex, as an array.
+py::array_t<float> latticeCopy(std::mutex& mutex, const Lattice& lattice,
+                               const std::function<std::vector<glm::vec3>()>& copy) {
+    std::vector<glm::vec3> points;
+    {
+        const Lock lock(mutex);
+        points = copy();
+    }
+    return latticeArray(points, lattice);
+}
 
 }  // namespace
 
@@ -274,39 +308,51 @@ void bindFfd(py::module_& m) {
         .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
                          const std::string& basis, const std::string& outside, const std::string& ends) {
                  const Lattice l = latticeOf(origin, axes, divisions, "Ffd");
-                 return PyFfd{Ffd(l, optionsOf(basis, outside, ends, "Ffd")), {}};
+                 return std::make_unique<PyFfd>(Ffd(l, optionsOf(basis, outside, ends, "Ffd")));
              }),
              py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
              py::arg("outside") = "none", py::arg("ends") = "extrapolate")
         .def(
             "bind",
             [](PyFfd& self, const FloatArray& points) {
-                self.rest = pointsOf(points, "Ffd.bind", "points");
+                std::vector<glm::vec3> rest = pointsOf(points, "Ffd.bind", "points");
                 py::gil_scoped_release release;
-                self.ffd.bind(self.rest);
+                const Lock lock(self.mutex);
+                self.ffd.bind(rest);
+                self.rest = std::move(rest);
             },
             py::arg("points"), "Cache each rest point's lattice coordinates (N, 3).")
         .def(
             "set_target",
             [](PyFfd& self, const FloatArray& target) {
-                self.ffd.setTargets(
-                    latticePointsOf(target, self.ffd.lattice().lattice(), "Ffd.set_target", "target"));
+                const std::vector<glm::vec3> targets =
+                    latticePointsOf(target, self.ffd.lattice().lattice(), "Ffd.set_target", "target");
+                const Lock lock(self.mutex);
+                self.ffd.setTargets(targets);
             },
             py::arg("target"), "Move the controls: target (l+1, m+1, n+1, 3). Does no bind work.")
         .def_property_readonly(
             "source_points",
-            [](const PyFfd& self) {
-                return latticeArray(self.ffd.sourcePoints(), self.ffd.lattice().lattice());
+            [](PyFfd& self) {
+                return latticeCopy(self.mutex, self.ffd.lattice().lattice(), [&] {
+                    return std::vector<glm::vec3>(self.ffd.sourcePoints().begin(),
+                                                  self.ffd.sourcePoints().end());
+                });
             },
             "(l+1, m+1, n+1, 3) undeformed control points P_ijk")
-        .def_property_readonly(
-            "target",
-            [](const PyFfd& self) { return latticeArray(self.ffd.targets(), self.ffd.lattice().lattice()); })
+        .def_property_readonly("target",
+                               [](PyFfd& self) {
+                                   return latticeCopy(self.mutex, self.ffd.lattice().lattice(), [&] {
+                                       return std::vector<glm::vec3>(self.ffd.targets().begin(),
+                                                                     self.ffd.targets().end());
+                                   });
+                               })
         .def(
             "evaluate",
-            [](const PyFfd& self, const std::optional<FloatArray>& points,
-               const std::optional<FloatArray>& weights, float envelope, const py::object& out) {
-                return evaluateBound(self.ffd, self.rest, points, weights, envelope, "Ffd.evaluate", out);
+            [](PyFfd& self, const std::optional<FloatArray>& points, const std::optional<FloatArray>& weights,
+               float envelope, const py::object& out) {
+                return evaluateBound(self.ffd, self.rest, self.mutex, points, weights, envelope,
+                                     "Ffd.evaluate", out);
             },
             py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
             py::arg("out") = py::none(),
@@ -319,39 +365,46 @@ void bindFfd(py::module_& m) {
         .def(py::init([](const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
                          const std::string& basis, const std::string& outside, const std::string& ends) {
                  const Lattice l = latticeOf(origin, axes, divisions, "FfdFrames");
-                 return PyFfdFrames{FfdFrames(l, optionsOf(basis, outside, ends, "FfdFrames")), {}};
+                 return std::make_unique<PyFfdFrames>(
+                     FfdFrames(l, optionsOf(basis, outside, ends, "FfdFrames")));
              }),
              py::arg("origin"), py::arg("axes"), py::arg("divisions"), py::arg("basis") = "bernstein",
              py::arg("outside") = "none", py::arg("ends") = "extrapolate")
         .def(
             "bind",
             [](PyFfdFrames& self, const FloatArray& points) {
-                self.rest = pointsOf(points, "FfdFrames.bind", "points");
+                std::vector<glm::vec3> rest = pointsOf(points, "FfdFrames.bind", "points");
                 py::gil_scoped_release release;
-                self.frames.bind(self.rest);
+                const Lock lock(self.mutex);
+                self.frames.bind(rest);
+                self.rest = std::move(rest);
             },
             py::arg("points"))
         .def(
             "set_source_frames",
             [](PyFfdFrames& self, const FloatArray& origins, const FloatArray& bases) {
-                self.frames.setSourceFrames(framesOf(origins, bases, self.frames.lattice().lattice(),
-                                                     "FfdFrames.set_source_frames", "origins", "bases"));
+                const auto frames = framesOf(origins, bases, self.frames.lattice().lattice(),
+                                             "FfdFrames.set_source_frames", "origins", "bases");
+                const Lock lock(self.mutex);
+                self.frames.setSourceFrames(frames);
             },
             py::arg("origins"), py::arg("bases"))
         .def(
             "set_target_frames",
             [](PyFfdFrames& self, const FloatArray& origins, const FloatArray& bases) {
-                self.frames.setTargetFrames(framesOf(origins, bases, self.frames.lattice().lattice(),
-                                                     "FfdFrames.set_target_frames", "origins", "bases"));
+                const auto frames = framesOf(origins, bases, self.frames.lattice().lattice(),
+                                             "FfdFrames.set_target_frames", "origins", "bases");
+                const Lock lock(self.mutex);
+                self.frames.setTargetFrames(frames);
             },
             py::arg("origins"), py::arg("bases"),
             "origins (l+1, m+1, n+1, 3), bases (l+1, m+1, n+1, 3, 3) rows.")
         .def(
             "evaluate",
-            [](const PyFfdFrames& self, const std::optional<FloatArray>& points,
+            [](PyFfdFrames& self, const std::optional<FloatArray>& points,
                const std::optional<FloatArray>& weights, float envelope, const py::object& out) {
-                return evaluateBound(self.frames, self.rest, points, weights, envelope, "FfdFrames.evaluate",
-                                     out);
+                return evaluateBound(self.frames, self.rest, self.mutex, points, weights, envelope,
+                                     "FfdFrames.evaluate", out);
             },
             py::arg("points") = py::none(), py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
             py::arg("out") = py::none(), "As Ffd.evaluate.");

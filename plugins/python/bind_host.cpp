@@ -3,10 +3,8 @@
 // scenes (readScene) and SceneEvaluator. A plugin host (the Blender add-on) drives the same code as the
 // standalone host through these. Positions are numpy float32 (n, 3); parameter values are doubles.
 //
-// The stack and the evaluator are not thread-safe and run without the GIL during bind and evaluation, so
-// each Python object carries a mutex that every method takes: two Python threads sharing one object are
-// serialised instead of racing. Nothing runs Python code while the mutex is held (arguments are converted
-// before, results after), so a thread holding the mutex never waits for the GIL and the two cannot deadlock.
+// The stack and the evaluator run without the GIL during bind and evaluation: each carries its Python
+// object's mutex (object_lock.h).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -30,6 +28,7 @@
 #include "deformkit/scene/scene.h"
 #include "deformkit/uvwarp/options.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -57,8 +56,6 @@ struct PyEvaluator {
     SceneEvaluator evaluator;
     std::mutex mutex;
 };
-
-using Lock = std::lock_guard<std::mutex>;
 
 // A parameter value from Python: a number, or any sequence or array of numbers (flattened in C order, so
 // an (n, 3) array of points gives x, y, z of each point in turn). nullopt for anything else.

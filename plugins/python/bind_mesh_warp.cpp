@@ -16,6 +16,7 @@
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/mesh_warp.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -37,7 +38,7 @@ warp::MeshWarpOptions optionsOf(float alpha, float beta, float gamma, float mu) 
     return o;
 }
 
-// Bind once to a rest surface, evaluate for many target cages.
+// Bind once to a rest surface, evaluate for many target cages. Calls are serialised (object_lock.h).
 class PyMeshWarp {
   public:
     PyMeshWarp(const FloatArray& cagePoints, const IntArray& counts, const IntArray& indices, float alpha,
@@ -47,30 +48,47 @@ class PyMeshWarp {
           deformer_(std::make_unique<warp::WarpDeformer>(*warp_)) {}
 
     void bind(const FloatArray& restPoints) {
-        rest_ = pointsOf(restPoints, kMeshWarp, "rest_points");
+        std::vector<glm::vec3> rest = pointsOf(restPoints, kMeshWarp, "rest_points");
         py::gil_scoped_release release;
-        deformer_->bind(rest_);
+        const Lock lock(mutex_);
+        deformer_->bind(rest);
+        rest_ = std::move(rest);
     }
 
     py::array_t<float> evaluate(const FloatArray& targetCage, const std::optional<FloatArray>& points,
                                 const std::optional<FloatArray>& weights, float envelope) {
-        if (!deformer_->isBound()) {
-            throw InvalidInput(
-                formatError(kMeshWarp, "evaluate", "called before bind", "bind(rest_points) first"));
+        std::vector<glm::vec3> target = pointsOf(targetCage, kMeshWarp, "target_cage_points");
+        std::vector<glm::vec3> pts;
+        if (points) {
+            pts = pointsOf(*points, kMeshWarp, "points");
+        } else {
+            const Lock lock(mutex_);
+            pts = rest_;
         }
-        warp_->setTarget(pointsOf(targetCage, kMeshWarp, "target_cage_points"));
-        std::vector<glm::vec3> pts = points ? pointsOf(*points, kMeshWarp, "points") : rest_;
         const std::vector<float> w = weightsOf(weights, pts.size(), kMeshWarp);
         {
             py::gil_scoped_release release;
+            const Lock lock(mutex_);
+            if (!deformer_->isBound()) {
+                throw InvalidInput(
+                    formatError(kMeshWarp, "evaluate", "called before bind", "bind(rest_points) first"));
+            }
+            warp_->setTarget(std::move(target));
             deformer_->evaluate(pts, w, envelope);
         }
         return toArray(pts);
     }
 
-    [[nodiscard]] int32_t numControlVertices() const { return warp_->numControlVertices(); }
-    [[nodiscard]] bool isBound() const { return deformer_->isBound(); }
-    [[nodiscard]] int64_t numFieldEntries() const {
+    [[nodiscard]] int32_t numControlVertices() {
+        const Lock lock(mutex_);
+        return warp_->numControlVertices();
+    }
+    [[nodiscard]] bool isBound() {
+        const Lock lock(mutex_);
+        return deformer_->isBound();
+    }
+    [[nodiscard]] int64_t numFieldEntries() {
+        const Lock lock(mutex_);
         return static_cast<int64_t>(deformer_->fields().weight.size());
     }
 
@@ -78,6 +96,7 @@ class PyMeshWarp {
     std::unique_ptr<warp::MeshWarp> warp_;
     std::unique_ptr<warp::WarpDeformer> deformer_;
     std::vector<glm::vec3> rest_;
+    std::mutex mutex_;
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <variant>
@@ -14,6 +15,7 @@
 #include "deformkit/warp/curve.h"
 #include "deformkit/warp/wires.h"
 #include "numpy_support.h"
+#include "object_lock.h"
 
 namespace py = pybind11;
 
@@ -83,7 +85,7 @@ std::vector<warp::Wire> makeWires(const std::vector<FloatArray>& references,
     return wires;
 }
 
-// Bind once to rest points, then evaluate for new wire curves.
+// Bind once to rest points, then evaluate for new wire curves. Calls are serialised (object_lock.h).
 class PyWires {
   public:
     PyWires(const std::vector<FloatArray>& references, const PerWire& radius, const PerWire& scale, float m,
@@ -96,49 +98,94 @@ class PyWires {
     void bind(const FloatArray& points) {
         const std::vector<glm::vec3> rest = pointsOf(points, "wires", "points");
         py::gil_scoped_release release;
+        const Lock lock(mutex_);
         wires_.bind(rest);
     }
 
     void setWireCurves(const std::vector<FloatArray>& curves) {
+        const std::vector<std::vector<glm::vec3>> sampled = sampledCurves(curves);
+        py::gil_scoped_release release;
+        const Lock lock(mutex_);
+        setAll(sampled);
+    }
+
+    // With wire_curves, the curves are set for this call and kept; a rejected call (bad points, weights,
+    // envelope or curves) leaves the wires as they were.
+    py::array_t<float> evaluate(const FloatArray& points,
+                                const std::optional<std::vector<FloatArray>>& wireCurves,
+                                const std::optional<FloatArray>& weights, float envelope) {
+        const std::vector<std::vector<glm::vec3>> sampled =
+            wireCurves ? sampledCurves(*wireCurves) : std::vector<std::vector<glm::vec3>>{};
+        std::vector<glm::vec3> p = pointsOf(points, "wires", "points");
+        const std::vector<float> w = weightsOf(weights, p.size(), "wires");
+        {
+            py::gil_scoped_release release;
+            const Lock lock(mutex_);
+            const std::vector<std::vector<glm::vec3>> before = wireCurves ? current() : decltype(before){};
+            if (wireCurves) setAll(sampled);
+            try {
+                wires_.evaluate(p, w, envelope);
+            } catch (...) {
+                if (wireCurves) setAll(before);
+                throw;
+            }
+        }
+        return toArray(p);
+    }
+
+    template <class F>
+    auto read(F&& f) {
+        const Lock lock(mutex_);
+        return f(static_cast<const warp::Wires&>(wires_));
+    }
+
+  private:
+    // The curves as the wires take them, checked against every wire before any is set.
+    std::vector<std::vector<glm::vec3>> sampledCurves(const std::vector<FloatArray>& curves) {
+        const Lock lock(mutex_);
         if (static_cast<int32_t>(curves.size()) != wires_.numWires()) {
             throw InvalidInput(formatError("wires", "wire_curves",
                                            "has " + std::to_string(curves.size()) + " curves",
                                            std::to_string(wires_.numWires()) + " curves, one per wire"));
         }
-        // Validate all before changing any, so a rejected call leaves the wires as they were.
         std::vector<std::vector<glm::vec3>> sampled;
         for (size_t i = 0; i < curves.size(); ++i) {
             sampled.push_back(sampling_(curves[i], "wire_curves[" + std::to_string(i) + "]"));
-            if (sampled.back().size() != wires_.wire(static_cast<int32_t>(i)).reference.size()) {
+            const size_t want = wires_.wire(static_cast<int32_t>(i)).reference.size();
+            if (sampled.back().size() != want) {
                 throw InvalidInput(
                     formatError("wires", "wire " + std::to_string(i) + " wire curve",
                                 "has " + std::to_string(sampled.back().size()) + " points",
-                                std::to_string(wires_.wire(static_cast<int32_t>(i)).reference.size()) +
-                                    " points, as many as its reference curve"));
+                                std::to_string(want) + " points, as many as its reference curve"));
             }
         }
-        for (size_t i = 0; i < sampled.size(); ++i)
-            wires_.setWire(static_cast<int32_t>(i), sampled[i]);
+        return sampled;
     }
 
-    py::array_t<float> evaluate(const FloatArray& points,
-                                const std::optional<std::vector<FloatArray>>& wireCurves,
-                                const std::optional<FloatArray>& weights, float envelope) {
-        if (wireCurves) setWireCurves(*wireCurves);
-        std::vector<glm::vec3> p = pointsOf(points, "wires", "points");
-        const std::vector<float> w = weightsOf(weights, p.size(), "wires");
-        {
-            py::gil_scoped_release release;
-            wires_.evaluate(p, w, envelope);
+    [[nodiscard]] std::vector<std::vector<glm::vec3>> current() const {
+        std::vector<std::vector<glm::vec3>> curves;
+        for (int32_t i = 0; i < wires_.numWires(); ++i)
+            curves.push_back(wires_.wire(i).wire);
+        return curves;
+    }
+
+    // Sets every wire curve or none: a curve the wires refuse (a non-finite point) puts back those before it.
+    void setAll(const std::vector<std::vector<glm::vec3>>& curves) {
+        const std::vector<std::vector<glm::vec3>> before = current();
+        size_t i = 0;
+        try {
+            for (; i < curves.size(); ++i)
+                wires_.setWire(static_cast<int32_t>(i), curves[i]);
+        } catch (...) {
+            for (size_t j = 0; j < i; ++j)
+                wires_.setWire(static_cast<int32_t>(j), before[j]);
+            throw;
         }
-        return toArray(p);
     }
 
-    warp::Wires& wires() { return wires_; }
-
-  private:
     CurveSampling sampling_;
     warp::Wires wires_;
+    std::mutex mutex_;
 };
 
 }  // namespace
@@ -189,13 +236,21 @@ void bindWires(py::module_& m) {
         .def("evaluate", &PyWires::evaluate, py::arg("points"), py::arg("wire_curves") = py::none(),
              py::arg("weights") = py::none(), py::arg("envelope") = 1.0f,
              "Deformed copy of points (the bound rest points or upstream points of the same count).")
-        .def_property_readonly("num_wires", [](PyWires& w) { return w.wires().numWires(); })
-        .def_property_readonly("is_bound", [](PyWires& w) { return w.wires().isBound(); })
         .def_property_readonly(
-            "num_field_entries",
-            [](PyWires& w) { return w.wires().isBound() ? w.wires().fields().offsets.back() : 0; })
+            "num_wires", [](PyWires& w) { return w.read([](const warp::Wires& x) { return x.numWires(); }); })
+        .def_property_readonly(
+            "is_bound", [](PyWires& w) { return w.read([](const warp::Wires& x) { return x.isBound(); }); })
+        .def_property_readonly("num_field_entries",
+                               [](PyWires& w) {
+                                   return w.read([](const warp::Wires& x) {
+                                       return x.isBound() ? x.fields().offsets.back() : 0;
+                                   });
+                               })
         .def(
-            "smooth_samples", [](PyWires& w, int32_t i) { return w.wires().smoothSamples(i); },
+            "smooth_samples",
+            [](PyWires& w, int32_t i) {
+                return w.read([i](const warp::Wires& x) { return x.smoothSamples(i); });
+            },
             py::arg("wire"));
 }
 

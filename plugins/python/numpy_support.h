@@ -163,6 +163,20 @@ inline std::pair<pybind11::array_t<float>, std::span<glm::vec3>> outputArray(con
     return {a, {reinterpret_cast<glm::vec3*>(a.mutable_data()), count}};
 }
 
+// A deformer's output `out` must be its input `in` (in place) or lie apart from it: an output that overlaps
+// its input elsewhere would be read after it is written.
+inline void requireSameOrApart(std::span<const glm::vec3> in, std::span<const glm::vec3> out,
+                               const std::string& source) {
+    if (in.empty() || out.empty() || in.data() == out.data()) return;
+    const auto* inBegin = reinterpret_cast<const char*>(in.data());
+    const auto* outBegin = reinterpret_cast<const char*>(out.data());
+    const bool apart = outBegin >= inBegin + in.size_bytes() || inBegin >= outBegin + out.size_bytes();
+    if (!apart) {
+        throw InvalidInput(formatError(source, "out", "overlaps points without being the same array",
+                                       "points itself (in place) or an array apart from it"));
+    }
+}
+
 // An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.
 inline io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
                          const std::string& expected = "(H, W) or (H, W, C) float32") {

@@ -298,11 +298,16 @@ void Wires::updateWireTangents(int32_t w) {
     wireTangents_[w] = vertexTangents(wires_[w].wire);
 }
 
-void Wires::setWire(int32_t i, std::span<const glm::vec3> wireCurve) {
+size_t Wires::checkedIndex(int32_t i) const {
     if (i < 0 || i >= numWires()) {
         throw InvalidInput(formatError("wires", "wire index " + std::to_string(i), "does not exist",
                                        "an index in [0, " + std::to_string(numWires()) + ")"));
     }
+    return static_cast<size_t>(i);
+}
+
+void Wires::setWire(int32_t i, std::span<const glm::vec3> wireCurve) {
+    (void)checkedIndex(i);
     const std::string label = wireLabel(static_cast<size_t>(i)) + " wire curve";
     if (wireCurve.size() != wires_[i].reference.size()) {
         throw InvalidInput(formatError(

@@ -79,10 +79,11 @@ class Wires : public Warp {
     explicit Wires(std::vector<Wire> wires, const WiresOptions& options = {});
 
     [[nodiscard]] int32_t numWires() const { return static_cast<int32_t>(wires_.size()); }
-    [[nodiscard]] const Wire& wire(int32_t i) const { return wires_.at(static_cast<size_t>(i)); }
+    // Wire i; InvalidInput naming the index for one out of range (as smoothSamples and setWire).
+    [[nodiscard]] const Wire& wire(int32_t i) const { return wires_[checkedIndex(i)]; }
     [[nodiscard]] const WiresOptions& options() const { return options_; }
     // K of wire i for the smooth variant (also set for the original variant, unused there).
-    [[nodiscard]] int32_t smoothSamples(int32_t i) const { return sampleCount_.at(static_cast<size_t>(i)); }
+    [[nodiscard]] int32_t smoothSamples(int32_t i) const { return sampleCount_[checkedIndex(i)]; }
 
     // New wire curve C*_i (same point count as the reference). Throws on a bad index, count or NaN.
     void setWire(int32_t i, std::span<const glm::vec3> wireCurve);
@@ -109,6 +110,7 @@ class Wires : public Warp {
     };
 
   private:
+    [[nodiscard]] size_t checkedIndex(int32_t i) const;
     // A place on a polyline: segment j and t in [0, 1] along it.
     struct CurvePlace {
         int32_t segment = 0;
