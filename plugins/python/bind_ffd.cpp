@@ -39,6 +39,7 @@ Lattice latticeOf(const FloatArray& origin, const FloatArray& axes, const IntArr
         throw InvalidInput(
             formatError(source, "axes", "has shape " + shapeOf(axes), "(3, 3), one axis X, Y, Z per row"));
     }
+    requireInts(divisions, source, "divisions");
     if (divisions.ndim() != 1 || divisions.shape(0) != 3) {
         throw InvalidInput(
             formatError(source, "divisions", "has shape " + shapeOf(divisions), "(3,) integers l, m, n"));

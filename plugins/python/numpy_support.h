@@ -6,6 +6,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <climits>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <optional>
 #include <span>
@@ -24,7 +27,20 @@
 namespace deformkit::python {
 
 using FloatArray = pybind11::array_t<float, pybind11::array::c_style | pybind11::array::forcecast>;
-using IntArray = pybind11::array_t<int32_t, pybind11::array::c_style | pybind11::array::forcecast>;
+
+// Whole numbers from Python (a list, a numpy array of any integer or float type) as int32, converted
+// exactly: numpy's own cast would truncate 1.9 to 1 and wrap 2^32 + 2 to 2. The conversion never fails
+// when the argument is taken; `problem` says why the values are not int32 whole numbers ("holds 1.9 at
+// index 1"), and intsOf, which names the argument, refuses them.
+struct IntArray {
+    pybind11::array_t<int32_t, pybind11::array::c_style> values;
+    std::string problem;
+
+    [[nodiscard]] pybind11::ssize_t ndim() const { return values.ndim(); }
+    [[nodiscard]] pybind11::ssize_t shape(pybind11::ssize_t i) const { return values.shape(i); }
+    [[nodiscard]] const int32_t* data() const { return values.data(); }
+    [[nodiscard]] operator const pybind11::array&() const { return values; }  // NOLINT: for shapeOf
+};
 
 // "(4, 3)" or "(7,)".
 inline std::string shapeOf(const pybind11::array& a) {
@@ -61,8 +77,16 @@ inline std::span<const glm::vec3> pointsView(const FloatArray& a, const std::str
     return {reinterpret_cast<const glm::vec3*>(a.data()), static_cast<size_t>(a.shape(0))};
 }
 
+// InvalidInput naming the argument when its values are not int32 whole numbers.
+inline void requireInts(const IntArray& a, const std::string& source, const std::string& name) {
+    if (!a.problem.empty()) {
+        throw InvalidInput(formatError(source, name, a.problem, "whole numbers from -2^31 to 2^31 - 1"));
+    }
+}
+
 // A 1-D int array as indices or counts.
 inline std::vector<int32_t> intsOf(const IntArray& a, const std::string& source, const std::string& name) {
+    requireInts(a, source, name);
     if (a.ndim() != 1)
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D int array"));
     return std::vector<int32_t>(a.data(), a.data() + a.shape(0));
@@ -206,3 +230,70 @@ inline pybind11::array_t<float> toArray(std::span<const glm::vec3> points) {
 }
 
 }  // namespace deformkit::python
+
+namespace pybind11::detail {
+
+// Takes anything numpy reads as an array (None is no IntArray: an optional one is then absent).
+template <>
+struct type_caster<deformkit::python::IntArray> {
+    PYBIND11_TYPE_CASTER(deformkit::python::IntArray, const_name("numpy.ndarray[int32]"));
+
+    bool load(handle src, bool) {
+        if (src.is_none()) return false;
+        array a = array::ensure(src);
+        if (!a) return false;
+        std::vector<ssize_t> shape(a.shape(), a.shape() + a.ndim());
+        value.values = array_t<int32_t, array::c_style>(shape);
+        value.problem.clear();
+        int32_t* out = value.values.mutable_data();
+        const ssize_t n = a.size();
+        const char kind = a.dtype().kind();
+        const auto fail = [&](const std::string& what, ssize_t i) {
+            value.problem = what + (a.ndim() == 1 ? " at index " + std::to_string(i)
+                                                  : " at flat index " + std::to_string(i));
+        };
+        if (kind == 'i' || kind == 'u') {
+            if (kind == 'u' && a.itemsize() == 8) {
+                const auto u = array_t<uint64_t, array::c_style | array::forcecast>::ensure(a);
+                for (ssize_t i = 0; i < n; ++i) {
+                    if (u.data()[i] > static_cast<uint64_t>(INT32_MAX)) {
+                        fail("holds " + std::to_string(u.data()[i]), i);
+                        return true;
+                    }
+                    out[i] = static_cast<int32_t>(u.data()[i]);
+                }
+                return true;
+            }
+            const auto v = array_t<int64_t, array::c_style | array::forcecast>::ensure(a);
+            for (ssize_t i = 0; i < n; ++i) {
+                const int64_t x = v.data()[i];
+                if (x < INT32_MIN || x > INT32_MAX) {
+                    fail("holds " + std::to_string(x), i);
+                    return true;
+                }
+                out[i] = static_cast<int32_t>(x);
+            }
+            return true;
+        }
+        if (kind == 'f') {
+            const auto v = array_t<double, array::c_style | array::forcecast>::ensure(a);
+            for (ssize_t i = 0; i < n; ++i) {
+                const double x = v.data()[i];
+                if (!(x >= INT32_MIN && x <= INT32_MAX) || x != std::floor(x)) {
+                    fail("holds " + deformkit::numberText(x), i);
+                    return true;
+                }
+                out[i] = static_cast<int32_t>(x);
+            }
+            return true;
+        }
+        value.problem = "is an array of " + std::string(str(a.dtype())) + " values";
+        return true;
+    }
+
+    static handle cast(const deformkit::python::IntArray& src, return_value_policy, handle) {
+        return src.values.inc_ref();
+    }
+};
+
+}  // namespace pybind11::detail

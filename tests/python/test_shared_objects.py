@@ -140,3 +140,43 @@ def test_a_wire_index_out_of_range_is_named():
     for index in (1, -1):
         with pytest.raises(dk.InvalidInput, match=rf"wires: wire index {index}: does not exist \(expected an index in \[0, 1\)\)"):
             wires.smooth_samples(index)
+
+
+def test_whole_numbers_are_taken_exactly_or_refused_naming_the_argument():
+    tri = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    for indices, text in (([0, 1.9, 2.7], "face_indices: holds 1.9 at index 1"),
+                          (np.array([0, 1, 2**32 + 2], np.int64), "face_indices: holds 4294967298 at index 2"),
+                          (np.array([0, 1, 2**63], np.uint64), "face_indices: holds 9223372036854775808 at index 2"),
+                          (["0", "1", "2"], "face_indices: is an array of <U1 values"),
+                          ([True, False, True], "face_indices: is an array of bool values")):
+        with pytest.raises(dk.InvalidInput, match=rf"Mesh: {text} \(expected whole numbers"):
+            dk.Mesh(tri, [3], indices)
+    with pytest.raises(dk.InvalidInput, match="face_counts: holds 4294967299 at index 0"):
+        dk.Mesh(tri, np.array([2**32 + 3], np.int64), [0, 1, 2])
+    with pytest.raises(dk.InvalidInput, match="Ffd: divisions: holds 1.5 at index 0"):
+        dk.Ffd([0, 0, 0], np.eye(3), [1.5, 1, 1])
+    # Whole numbers of any numeric type give the same mesh as int32.
+    want = dk.Mesh(tri, np.array([3], np.int32), np.array([0, 1, 2], np.int32))
+    for dtype in (np.int8, np.uint16, np.int64, np.uint64, np.float32, np.float64):
+        mesh = dk.Mesh(tri, np.array([3], dtype), np.array([0, 1, 2], dtype))
+        assert np.array_equal(mesh.face_indices, want.face_indices) and np.array_equal(mesh.face_counts, want.face_counts)
+    assert dk.Ffd([0, 0, 0], np.eye(3), np.array([2.0, 1, 1])).source_points.shape == (3, 2, 2, 3)
+
+
+def test_a_non_finite_envelope_or_weight_is_refused_by_every_deformer():
+    nan_weights = np.full(len(P), np.nan, np.float32)
+    ffd = dk.Ffd(ORIGIN, AXES, [2, 2, 1])
+    ffd.bind(P)
+    beier_neely = dk.BeierNeely(np.array([[[10, 10], [50, 10]]], np.float32), np.array([[[12, 12], [52, 12]]], np.float32))
+    beier_neely.bind(P)
+    calls = {
+        "FFD evaluate: envelope": lambda: ffd.evaluate(P, envelope=float("inf")),
+        "FFD evaluate: painted weight of point 0": lambda: ffd.evaluate(P, weights=nan_weights),
+        "wires: envelope": lambda: dk.wires(P, [REF], [REF + np.float32(0.2)], envelope=float("nan")),
+        "wires: painted weight of point 0": lambda: dk.wires(P, [REF], [REF + np.float32(0.2)], weights=nan_weights),
+        "warp evaluate: envelope": lambda: beier_neely.evaluate(P, envelope=float("nan")),
+        "twist: painted weight of point 0": lambda: dk.twist(P, [0, 0, 0], [0, 1, 0], [-1, 1], [0, 1.5], weights=nan_weights),
+    }
+    for text, call in calls.items():
+        with pytest.raises(dk.InvalidInput, match=text):
+            call()

@@ -290,9 +290,7 @@ void AxialWarp::requireBound(std::span<const glm::vec3> points, std::span<glm::v
 void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
     requireBound(points.size(), "points");
     requireFinitePoints(points, name_, "point");
-    if (!std::isfinite(envelope)) {
-        throw InvalidInput(formatError(name_, "envelope", "is not finite", "a number, usually in [0, 1]"));
-    }
+    requireFiniteEnvelope(name_, weights, envelope);
     if (envelope == 1.0f && weights.empty()) {
         evaluate(points, points);  // what the envelope gives for k = 1, without the copy
         return;
@@ -305,9 +303,7 @@ void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weigh
 void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> out,
                        std::span<const float> weights, float envelope) {
     requireBound(points.size(), "points");
-    if (!std::isfinite(envelope)) {
-        throw InvalidInput(formatError(name_, "envelope", "is not finite", "a number, usually in [0, 1]"));
-    }
+    requireFiniteEnvelope(name_, weights, envelope);
     const int64_t bad = evaluateFinite(points, out);
     if (bad < static_cast<int64_t>(points.size())) {
         throw InvalidInput(formatError(name_, "point " + std::to_string(bad),

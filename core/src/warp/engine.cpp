@@ -97,6 +97,7 @@ void WarpDeformer::apply(std::span<const glm::vec3> in, std::span<glm::vec3> out
 
 void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
     requireBound(points.size());
+    requireFiniteEnvelope("warp evaluate", weights, envelope);
     update();
     evaluateWarp(points, fields_, transforms_, deformed_, warp_.engineOptions());
     applyEnvelope(points, deformed_, weights, envelope, points);

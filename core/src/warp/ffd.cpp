@@ -10,6 +10,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 #include "ffd_kernels.h"
 #include "simd/cpu.h"
 #include "warp/point_text.h"
@@ -445,6 +446,7 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
                                        "has " + std::to_string(weights.size()) + " entries",
                                        std::to_string(n) + " entries, one per point, or none"));
     }
+    requireFiniteEnvelope("FFD evaluate", weights, envelope);
     if ((stride != 3 && stride != 12) || deltas.size() != static_cast<size_t>(numControls()) * stride) {
         throw InvalidInput(formatError("FFD evaluate", "control transformations",
                                        "has " + std::to_string(deltas.size()) + " floats",
@@ -686,6 +688,7 @@ void Ffd::transformations(Transformations& out) const {
 
 void Ffd::bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
                           std::span<glm::vec3> out, std::span<const float> weights, float envelope) {
+    requireFiniteEnvelope("FFD evaluate", weights, envelope);
     if (lattice_.deformUnbound(restPoints, in, out, reinterpret_cast<const float*>(translation_.data()),
                                weights, envelope)) {
         return;

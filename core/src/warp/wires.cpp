@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/warp/envelope.h"
 #include "warp/weighted_mean.h"
 
 namespace deformkit::warp {
@@ -535,6 +536,7 @@ void Wires::evaluate(std::span<glm::vec3> points, std::span<const float> weights
                                        "has " + std::to_string(weights.size()) + " entries",
                                        std::to_string(n) + " entries, or none"));
     }
+    requireFiniteEnvelope("wires", weights, envelope);
     const bool smooth = options_.variant == WiresVariant::Smooth;
     if (smooth) {
         for (int32_t w = 0; w < numWires(); ++w) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <span>
+#include <string_view>
 
 #include <glm/vec3.hpp>
 
@@ -14,5 +15,9 @@ namespace deformkit::warp {
 // over points, bit-identical for any thread count. Throws InvalidInput when a size differs.
 void applyEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed,
                    std::span<const float> weights, double envelope, std::span<glm::vec3> out);
+
+// Throws InvalidInput naming `source` and the envelope, or the first painted weight, that is not finite
+// (NaN or infinite would make every point it scales NaN). Every deformer's evaluate checks its inputs so.
+void requireFiniteEnvelope(std::string_view source, std::span<const float> weights, double envelope);
 
 }  // namespace deformkit::warp
