@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <sstream>
 #include <system_error>
 #include <utility>
@@ -171,6 +172,23 @@ std::vector<std::string> farmTaskOutputs(const Scene& scene, int first, int last
     return outputs;
 }
 
+namespace {
+
+// The last `count` frames of the plan's tasks before `frame`, ascending.
+std::vector<int> plannedFramesBefore(const FarmPlan& plan, int frame, int count) {
+    std::set<int> before;
+    for (const FarmTask& task : plan.tasks) {
+        const int64_t last = std::min<int64_t>(task.lastFrame, int64_t{frame} - 1);
+        for (int64_t f = std::max<int64_t>(task.firstFrame, last - count + 1); f <= last; ++f)
+            before.insert(static_cast<int>(f));
+    }
+    std::vector<int> frames(before.begin(), before.end());
+    if (frames.size() > static_cast<size_t>(count)) frames.erase(frames.begin(), frames.end() - count);
+    return frames;
+}
+
+}  // namespace
+
 FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path& outDir,
                   const FarmPlanOptions& options) {
     if (options.chunk < 1) {
@@ -318,11 +336,9 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
             (all ? report.skipped : report.written).push_back(frame);
         }
         UvWarpStageRun run;
-        // Up to plan.warmUp frames before the range, within the scene's frames, warm-start the task as the
-        // frames before it warm-start an uninterrupted run.
-        for (int frame = std::max(scene.firstFrame, t.firstFrame - plan.warmUp); frame < t.firstFrame;
-             ++frame)
-            run.frames.push_back(frame);
+        // Up to plan.warmUp of the planned frames before the range warm-start the task, as they warm-start
+        // an uninterrupted run of the plan's frames (which may have gaps).
+        run.frames = plannedFramesBefore(plan, t.firstFrame, plan.warmUp);
         run.warmUpFrames = static_cast<int32_t>(run.frames.size());
         for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame)
             run.frames.push_back(frame);

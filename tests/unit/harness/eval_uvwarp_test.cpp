@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <set>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -416,4 +418,51 @@ TEST_CASE("scene uvwarp: frames solved from the identity make chunked maps the u
     }
     CHECK(differing[0] > 0);
     CHECK(differing[1] == 0);
+}
+
+// A plan of frames with a gap (1-6 and 13-20, a shot cut out in between): the frames before a task that warm
+// it up are the planned ones, as in an uninterrupted eval of those frames, never the frames of the gap (an
+// animated input may have no file there). With the warm-up reaching the plan's first frame the farm writes
+// eval's bytes, and the task's log says which frames warmed it up.
+TEST_CASE("scene uvwarp: a task after a gap in the planned frames warms up on planned frames only",
+          "[harness][uvwarp][farm]") {
+    Shot shot;
+    test::writeText(shot.scene, chunkShot(true));
+    std::vector<int> frames;
+    for (int f = 1; f <= 20; ++f)
+        if (f <= 6 || f >= 13) frames.push_back(f);
+    harness::EvalCommand eval;
+    eval.scene = shot.scene;
+    eval.outDir = shot.dir / "eval";
+    eval.previews = false;
+    eval.frames = frames;
+    (void)harness::evalCommand(eval);
+
+    harness::FarmPlanCommand plan;
+    plan.scene = shot.scene;
+    plan.frames = frames;
+    plan.chunk = 8;
+    plan.warmUp = 24;
+    plan.outDir = shot.dir / "farm";
+    const scene::FarmPlan made = harness::farmPlanCommand(plan);
+    int checked = 0;
+    for (size_t k = 0; k < made.tasks.size(); ++k) {
+        std::ostringstream log;
+        (void)harness::farmRunCommand({harness::farmPlanPath(plan), static_cast<int>(k)}, &log);
+        if (made.tasks[k].tiles.empty() || made.tasks[k].firstFrame != 13) continue;
+        std::set<int> warmUp;
+        std::istringstream lines(log.str());
+        for (std::string line; std::getline(lines, line);) {
+            const nlohmann::json j = nlohmann::json::parse(line);
+            if (j["status"] == "warm-up") warmUp.insert(j["frame"].get<int>());
+        }
+        CHECK(warmUp == std::set<int>{1, 2, 3, 4, 5, 6});
+        ++checked;
+    }
+    CHECK(checked > 0);
+    for (const int frame : frames)
+        for (const int tile : {1001, 1002}) {
+            CAPTURE(frame, tile);
+            CHECK(redirectIn(plan.outDir, tile, frame).pixels == redirectIn(eval.outDir, tile, frame).pixels);
+        }
 }
