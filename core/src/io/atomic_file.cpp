@@ -146,9 +146,10 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
 }
 
 void createFolder(const fs::path& path) {
-    std::error_code ec;
+    std::error_code ec;  // the reason creating failed (permission denied, a read-only file system)
     fs::create_directories(path, ec);
-    if (!fs::is_directory(fs::status(path, ec))) {
+    std::error_code statusError;
+    if (!fs::is_directory(fs::status(path, statusError))) {
         const fs::path blocker = fileInTheWay(path);
         if (!blocker.empty()) {
             throw IoError(formatError(path.string(), "",

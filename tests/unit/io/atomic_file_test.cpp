@@ -95,6 +95,20 @@ TEST_CASE("createFolder makes missing parents and names a path it cannot make", 
                             Catch::Contains("file' is a file, not a folder"));
     CHECK_THAT(test::errorOf<IoError>([&] { io::createFolder(dir / "file"); }),
                Catch::Contains("cannot be created") && Catch::Contains("is a file, not a folder"));
+
+    // A folder it may not write in: the system's reason, not that of the status check after it.
+    fs::create_directory(dir / "locked");
+    fs::permissions(dir / "locked", fs::perms::owner_read | fs::perms::owner_exec);
+    const bool named = test::runUnprivileged([&] {
+        try {
+            io::createFolder(dir / "locked" / "sub");
+        } catch (const IoError& e) {
+            return std::string(e.what()).find("cannot be created: Permission denied") != std::string::npos;
+        }
+        return false;
+    });
+    fs::permissions(dir / "locked", fs::perms::owner_all);
+    CHECK(named);
 }
 
 TEST_CASE("a write through a symbolic link replaces the link's target and keeps the link", "[io][atomic]") {
