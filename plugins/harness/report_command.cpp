@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <utility>
 
 #include "cli.h"
 #include "commands.h"
 #include "deformkit/error.h"
 #include "deformkit/scene/evaluator.h"
 #include "deformkit/scene/farm_plan.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "deformkit/uvwarp/shot_log.h"
 
 namespace deformkit::harness {
@@ -68,10 +71,23 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
         const scene::FarmPlan plan = scene::readFarmPlan(*command.plan);
         const fs::path planFile = fs::absolute(*command.plan);
         if (command.logs.empty()) logs = logsIn(planFile.parent_path(), planFile.stem().string() + ".");
+        // Which objects write maps of which tiles, so that a task killed after one object's maps and
+        // before another's is missing; without the scene, any object's line counts for its tile.
+        std::optional<scene::Scene> planned;
+        try {
+            planned = readScene(plan.scene);
+        } catch (const Error&) {
+        }
         for (size_t k = 0; k < plan.tasks.size(); ++k) {
             const scene::FarmTask& task = plan.tasks[k];
+            std::vector<std::pair<std::string, int>> objectTiles;
+            for (const scene::SceneObject& object :
+                 planned ? planned->objects : std::vector<scene::SceneObject>{})
+                for (const int tile : task.tiles)
+                    if (!scene::uvwarpOutputs(object, tile, task.firstFrame).empty())
+                        objectTiles.emplace_back(object.name, tile);
             options.tasks.push_back(
-                {static_cast<int>(k), task.firstFrame, task.lastFrame, task.tiles,
+                {static_cast<int>(k), task.firstFrame, task.lastFrame, task.tiles, std::move(objectTiles),
                  "deformkit farm run " + planFile.string() + " --task " + std::to_string(k)});
         }
         options.searchFolders.push_back(plan.outDir);

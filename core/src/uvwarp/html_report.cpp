@@ -11,6 +11,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -352,21 +353,31 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
     };
     std::vector<Missing> missing;
     {
-        std::set<std::pair<int, int>> done;  // (tile, frame)
+        std::set<std::pair<int, int>> done;                        // (tile, frame), any object
+        std::set<std::tuple<std::string, int, int>> doneByObject;  // (object, tile, frame)
         std::set<int> logged;
         for (const ShotLogLine& line : log.lines) {
             if (line.task) logged.insert(*line.task);
-            if (line.tile && (line.status == "written" || line.status == "skipped"))
+            if (line.tile && (line.status == "written" || line.status == "skipped")) {
                 done.insert({*line.tile, line.frame});
+                doneByObject.insert({line.object, *line.tile, line.frame});
+            }
         }
         for (const HtmlReportOptions::Task& task : options.tasks) {
             if (task.tiles.empty()) continue;
             Missing m{&task, {}, logged.contains(task.index)};
-            for (int frame = task.first; frame <= task.last; ++frame)
-                if (std::any_of(task.tiles.begin(), task.tiles.end(), [&](int tile) {
-                        return !done.contains({tile, frame});
-                    }))
-                    m.frames.push_back(frame);
+            for (int frame = task.first; frame <= task.last; ++frame) {
+                const bool all =
+                    task.objectTiles.empty()
+                        ? std::all_of(task.tiles.begin(), task.tiles.end(),
+                                      [&](int tile) {
+                                          return done.contains({tile, frame});
+                                      })
+                        : std::all_of(task.objectTiles.begin(), task.objectTiles.end(), [&](const auto& ot) {
+                              return doneByObject.contains({ot.first, ot.second, frame});
+                          });
+                if (!all) m.frames.push_back(frame);
+            }
             if (!m.frames.empty()) missing.push_back(std::move(m));
         }
     }

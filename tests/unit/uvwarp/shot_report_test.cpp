@@ -337,12 +337,18 @@ TEST_CASE(
     options.rigidity = [&](const std::string&, int tile) -> std::optional<io::Image> {
         return job.rigidity.images.at(tile);
     };
-    // Task 1 (frames 6-7 of tile 1002) never ran.
-    options.tasks = {{0, 1, 5, {1001, 1002}, "rerun 0"}, {1, 6, 7, {1002}, "rerun 1"}, {2, 1, 7, {}, ""}};
+    // Task 1 (frames 6-7 of tile 1002) never ran. Task 3's tile 1001 has maps of two objects, of which the
+    // log shows one (the shot's, named ""): a task killed between two objects' maps is missing too. Task 4
+    // expects only that object's.
+    options.tasks = {{0, 1, 5, {1001, 1002}, {}, "rerun 0"},
+                     {1, 6, 7, {1002}, {}, "rerun 1"},
+                     {2, 1, 7, {}, {}, ""},
+                     {3, 1, 5, {1001}, {{"", 1001}, {"other", 1001}}, "rerun 3"},
+                     {4, 1, 5, {1001}, {{"", 1001}}, "rerun 4"}};
     const fs::path page = dir / "shot.html";
     const uvwarp::HtmlReportResult result = uvwarp::writeHtmlReport(log, page, options);
     CHECK(result.notes.empty());
-    CHECK(result.problems == 2);                    // the broken line and the missing task
+    CHECK(result.problems == 3);                    // the broken line and the missing tasks 1 and 3
     REQUIRE(result.files.size() == 1 + 2 * 4 * 2);  // per tile 4 pictures and their thumbnails
     for (const fs::path& f : result.files)
         CHECK(fs::file_size(f) > 0);
@@ -355,6 +361,8 @@ TEST_CASE(
     CHECK_THAT(html, Contains("data-task=\"1\">task 1 (frames 6–7, tiles 1002): no log line"));
     CHECK_THAT(html, Contains("rerun 1"));
     CHECK(html.find("data-task=\"0\"") == std::string::npos);
+    CHECK_THAT(html, Contains("data-task=\"3\">task 3 (frames 1–5, tiles 1001)"));
+    CHECK(html.find("data-task=\"4\"") == std::string::npos);
     const std::string tag = "id=\"deformkit-shot\">";
     const size_t begin = html.find(tag) + tag.size();
     REQUIRE(begin > tag.size());

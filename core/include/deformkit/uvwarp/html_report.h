@@ -53,6 +53,8 @@ struct HtmlReportOptions {
         int index = 0;
         int first = 0, last = 0;  // frames, inclusive
         std::vector<int> tiles;   // empty: a mesh task (not checked)
+        // The (object, tile) pairs the task writes maps for; empty: any object's line counts for a tile.
+        std::vector<std::pair<std::string, int>> objectTiles;
         std::string rerun;
     };
     std::vector<Task> tasks;
