@@ -235,6 +235,8 @@ void addFarmCommands(CommandLine& cli) {
         try {
             work();
             return 0;
+        } catch (const std::bad_alloc&) {
+            throw;  // the CLI's own message and exit code (1)
         } catch (const std::exception& e) {
             std::cerr << "deformkit: error: " << e.what() << "\n";
             return farmExitCode(e);

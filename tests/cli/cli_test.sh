@@ -493,6 +493,12 @@ expect farm-run-warm 0 "$dk" farm run "$work/farm-uv-warm/farm_plan.json" --task
 cmp -s "$work/farm-uv-warm/grid.redirect.1001.0002.exr" "$work/eval-uv-warm/grid.redirect.1001.0002.exr" &&
     { echo "FAIL farm-run-warm: a cold start at frame 2 should differ from eval's warm start"; failures=$((failures + 1)); }
 [ -s "$work/farm-uv-warm/grid.redirect.1001.0002.exr" ] || { echo "FAIL farm-run-warm: output missing"; failures=$((failures + 1)); }
+# Out of memory in a task (a 16384-cell grid under a 1.5 GB address-space limit): the CLI's message, exit 1.
+sed 's/"params": {"iterations": 4}/"resolution": 16384, "params": {"iterations": 4}/' "$work/uvshot.json" >"$work/uvshot_huge.json"
+expect farm-plan-huge 0 "$dk" farm plan "$work/uvshot_huge.json" --chunk 1 --frames 1 --warm-up 0 --out "$work/farm-uv-huge"
+expect farm-run-out-of-memory 1 bash -c 'ulimit -v 1500000; exec "$0" farm run "$1" --task 1' \
+    "$dk" "$work/farm-uv-huge/farm_plan.json"
+contains farm-run-out-of-memory "$work/err" "deformkit: error: out of memory"
 expect farm-plan-bad-warm-up 2 "$dk" farm plan "$work/uvshot.json" --warm-up -1 --out "$work/farm-uv3"
 contains farm-plan-bad-warm-up "$work/err" "--warm-up: is -1"
 expect farm-plan-bad-tiles 2 "$dk" farm plan "$work/uvshot.json" --tiles-per-task 0 --out "$work/farm-uv2"

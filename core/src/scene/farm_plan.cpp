@@ -71,6 +71,9 @@ class PlanReader {
     }
 
   private:
+    // As many frames as the CLI takes in one --frames list: a task of more is a hand-edited plan.
+    static constexpr int64_t kMaxTaskFrames = 1000000;
+
     FarmTask task(const json& j, const std::string& at, int chunk) const {
         requireObject(j, at, {"frames", "tiles", "outputs"});
         FarmTask task;
@@ -80,9 +83,10 @@ class PlanReader {
         task.firstFrame = integer(frames[0], at + ".frames[0]");
         task.lastFrame = integer(frames[1], at + ".frames[1]");
         const int64_t count = int64_t{task.lastFrame} - task.firstFrame + 1;
-        if (count < 1 || count > chunk) {
+        if (count < 1 || count > chunk || count > kMaxTaskFrames) {
             fail(at + ".frames", "is " + frames.dump() + ", " + std::to_string(count) + " frames",
-                 "first <= last and at most chunk (" + std::to_string(chunk) + ") frames");
+                 "first <= last and at most chunk (" + std::to_string(chunk) + ") frames, at most " +
+                     std::to_string(kMaxTaskFrames));
         }
         const json& tiles = member(j, at, "tiles");
         if (!tiles.is_array()) fail(at + ".tiles", "is " + describe(tiles), "an array of UDIM tiles");

@@ -287,6 +287,11 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
             {"\"tiles\":[]", "\"tiles\":1001", ": tasks[0].tiles: is 1001 (expected an array of UDIM tiles)"},
             {"\"deformkit_farm_plan\": 1", "\"deformkit_farm_plan\": 2", ": deformkit_farm_plan: is 2"},
             {"\"chunk\": 3", "\"chunk\": 3, \"chunks\": 3", ": chunks: is not a plan key"},
+            // A hand-edited chunk lets a task claim more frames than any command line gives.
+            {"\"chunk\": 3,\n  \"warmUp\": 6,\n  \"tasks\": [\n    {\"frames\":[1,3]",
+             "\"chunk\": 1000000000,\n  \"warmUp\": 6,\n  \"tasks\": [\n    {\"frames\":[1,1000001]",
+             ": tasks[0].frames: is [1,1000001], 1000001 frames (expected first <= last and at most chunk "
+             "(1000000000) frames, at most 1000000)"},
             {"\"tube.0004.obj\"", "\"../tube.0004.obj\"", ": tasks[1].outputs[0]: is \"../tube.0004.obj\""},
             {"\"tube.0004.obj\"", "\"tube.4.obj\"",
              ": tasks[1].outputs[0]: is \"tube.4.obj\", the scene makes "
