@@ -336,7 +336,7 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
         for (int frame = t.firstFrame; frame <= t.lastFrame; ++frame) {
             bool all = true;
             for (const std::string& name : farmTaskOutputs(scene, frame, frame, t.tiles))
-                all = all && fs::exists(plan.outDir / name, ec);
+                all = all && fs::is_regular_file(plan.outDir / name, ec);
             (all ? report.skipped : report.written).push_back(frame);
         }
         UvWarpStageRun run;
@@ -366,8 +366,9 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
         bool wrote = false;
         for (size_t o = 0; o < numObjects; ++o) {
             const fs::path file = plan.outDir / frameFileName(scene.objects[o].name, frame);
-            // An output that exists is complete: every write is atomic.
-            if (fs::exists(file, ec)) continue;
+            // An output that exists is complete: every write is atomic. (A folder in its place is not one:
+            // writing there then names it.)
+            if (fs::is_regular_file(file, ec)) continue;
             io::writeObj(file, evaluator.evaluate(o, frame), scene.objects[o].groups);
             report.files.push_back(file);
             wrote = true;

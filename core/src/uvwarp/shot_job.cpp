@@ -73,9 +73,10 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// A file (or a link to one): a folder with an output's name is not a written output.
 bool fileExists(const fs::path& path) {
     std::error_code ec;
-    return fs::exists(path, ec);
+    return fs::is_regular_file(path, ec);
 }
 
 // A float option as JSON: the shortest decimal that reads back as the float (0.05, not 0.0500000007).

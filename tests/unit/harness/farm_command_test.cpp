@@ -299,6 +299,12 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
         };
         test::checkPlanEdits(good, planFile, cases);
     }
+    SECTION("a folder with an output's name is not a finished output: the run names it") {
+        fs::create_directories(shot.dir / "farm" / "tube.0001.obj");
+        const std::string what = test::errorOf<Error>([&] { (void)harness::farmRunCommand({planFile, 0}); });
+        CHECK_THAT(what, Contains("tube.0001.obj") && Contains("folder"));
+        fs::remove(shot.dir / "farm" / "tube.0001.obj");
+    }
     SECTION("a missing plan is bad input; an unwritable output folder is worth a retry") {
         const fs::path missing = shot.dir / "nope.json";
         CHECK_THAT(test::errorOf<InvalidInput>([&] {
