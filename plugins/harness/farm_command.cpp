@@ -3,6 +3,9 @@
 #include <cctype>
 #include <cstdlib>
 #include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cli.h"
 #include "commands.h"
@@ -91,6 +94,45 @@ std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const 
     return args;
 }
 
+namespace {
+
+// The task array's own sbatch options in `extra`, which the report job must not take: --array (the report
+// would run once per element), --output and --error (its output would land among the task logs), and
+// --job-name. Each as "--name=value", "--name value", "-x value" or "-xvalue".
+struct ArrayOptions {
+    std::vector<std::string> rest;  // every other argument, in order
+    std::string output;             // the value of the array's --output, if given
+};
+
+ArrayOptions splitArrayOptions(const std::vector<std::string>& extra) {
+    static const std::pair<const char*, const char*> kOptions[] = {
+        {"--array", "-a"}, {"--output", "-o"}, {"--error", "-e"}, {"--job-name", "-J"}};
+    ArrayOptions split;
+    for (size_t i = 0; i < extra.size(); ++i) {
+        const std::string& a = extra[i];
+        bool taken = false;
+        for (const auto& [name, letter] : kOptions) {
+            std::string value;
+            if (a == name || a == letter) {
+                if (i + 1 < extra.size()) value = extra[++i];
+            } else if (a.rfind(std::string(name) + "=", 0) == 0) {
+                value = a.substr(std::string(name).size() + 1);
+            } else if (a.size() > 2 && a.rfind(letter, 0) == 0) {
+                value = a.substr(2);
+            } else {
+                continue;
+            }
+            if (std::string(name) == "--output") split.output = value;
+            taken = true;
+            break;
+        }
+        if (!taken) split.rest.push_back(a);
+    }
+    return split;
+}
+
+}  // namespace
+
 std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, const fs::path& planFile,
                                                    const fs::path& deformkit,
                                                    const std::vector<std::string>& extra,
@@ -102,9 +144,14 @@ std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, 
         "--job-name=deformkit-report-" + plan.scene.stem().string(),
         "--output=" + (planAbs.parent_path() / (planAbs.stem().string() + "-report.%j.out")).string(),
     };
-    args.insert(args.end(), extra.begin(), extra.end());
-    args.push_back("--wrap=exec " + shellQuote(absolutePath(deformkit).string()) + " report --plan " +
-                   shellQuote(planAbs.string()));
+    const ArrayOptions split = splitArrayOptions(extra);
+    args.insert(args.end(), split.rest.begin(), split.rest.end());
+    std::string wrap = "exec " + shellQuote(absolutePath(deformkit).string()) + " report --plan " +
+                       shellQuote(planAbs.string());
+    // Task logs moved by the array's --output are read from that folder.
+    if (!split.output.empty())
+        wrap += " " + shellQuote(absolutePath(fs::path(split.output)).parent_path().string());
+    args.push_back("--wrap=" + wrap);
     return args;
 }
 

@@ -66,7 +66,8 @@ struct FarmSubmitCommand {
 
 // The sbatch arguments of the report job after job array `arrayJob`: --parsable, --dependency=afterany,
 // --job-name, --output beside the plan (<plan name>-report.%j.out, not read as a task's log), the extra
-// arguments, and --wrap running "exec DEFORMKIT report --plan PLAN".
+// arguments but the array's own (--array, --output, --error, --job-name), and --wrap running "exec DEFORMKIT
+// report --plan PLAN", with the folder of the array's --output when the extra arguments moved the logs.
 [[nodiscard]] std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan,
                                                                  const std::filesystem::path& planFile,
                                                                  const std::filesystem::path& deformkit,

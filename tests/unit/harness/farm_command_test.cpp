@@ -382,6 +382,21 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
                             "--wrap=exec '/opt/dk/bin/deformkit' report --plan '" + planAbs.string() + "'"});
     for (const std::string& a : reportArgs)
         recorded += a + "\n";
+    // The array's own options stay with the array (a report array of 9 jobs, the report's output among the
+    // task logs); logs the array's --output moved are read from that folder.
+    for (const std::vector<std::string>& arrayOptions :
+         {std::vector<std::string>{"--array=0-8%2", "--output=/logs/x/%A_%a.log", "-Jname", "--error",
+                                   "/e/%a"},
+          std::vector<std::string>{"-a", "0-8", "-o", "/logs/x/%A_%a.log", "--job-name=n", "-e/e/%a"}}) {
+        std::vector<std::string> extra = arrayOptions;
+        extra.insert(extra.begin(), "--partition=batch");
+        CHECK(harness::farmReportSbatchArguments(plan, planFile, "/opt/dk/bin/deformkit", extra, "4242") ==
+              std::vector<std::string>{
+                  "--parsable", "--dependency=afterany:4242", "--job-name=deformkit-report-shot",
+                  "--output=" + (planAbs.parent_path() / "farm_plan-report.%j.out").string(),
+                  "--partition=batch",
+                  "--wrap=exec '/opt/dk/bin/deformkit' report --plan '" + planAbs.string() + "' '/logs/x'"});
+    }
     CHECK(test::readText(shot.dir / "sbatch.args") == recorded);
     submit.report = false;
 
