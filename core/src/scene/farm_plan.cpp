@@ -325,6 +325,22 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
                                        "is " + listed + ", the scene makes " + made,
                                        "the outputs of the scene as planned (plan again after changing it)"));
     }
+    // A UV-warp stage added to the scene after planning has no task: every task checks the plan still
+    // covers the tiles the scene warps (at the plan's first frame, as planned).
+    std::set<int> planned;
+    int firstFrame = t.firstFrame;
+    for (const FarmTask& other : plan.tasks) {
+        planned.insert(other.tiles.begin(), other.tiles.end());
+        firstFrame = std::min(firstFrame, other.firstFrame);
+    }
+    for (const int tile : warpedTiles(scene, firstFrame)) {
+        if (!planned.contains(tile)) {
+            throw InvalidInput(
+                formatError(planName, "tasks",
+                            "have no task for UDIM tile " + std::to_string(tile) + ", which the scene warps",
+                            "a task per tile the scene warps (plan again after changing it)"));
+        }
+    }
     io::createFolder(plan.outDir);
 
     FarmTaskReport report;

@@ -466,3 +466,28 @@ TEST_CASE("scene uvwarp: a task after a gap in the planned frames warms up on pl
             CHECK(redirectIn(plan.outDir, tile, frame).pixels == redirectIn(eval.outDir, tile, frame).pixels);
         }
 }
+
+// A UV-warp stage added to a scene after planning has no task: a mesh task of the old plan says so instead of
+// writing the OBJs alone and leaving the maps unmade.
+TEST_CASE("scene uvwarp: a plan made before a UV-warp stage was added is stale", "[harness][uvwarp][farm]") {
+    Shot shot;
+    std::string meshOnly = kScene;
+    const std::string stage = R"(,
+    {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr",
+     "params": {"iterations": 6, "warmStart": true}})";
+    REQUIRE(meshOnly.find(stage) != std::string::npos);
+    meshOnly.erase(meshOnly.find(stage), stage.size());
+    test::writeText(shot.scene, meshOnly);
+    harness::FarmPlanCommand plan;
+    plan.scene = shot.scene;
+    plan.outDir = shot.dir / "farm";
+    const scene::FarmPlan made = harness::farmPlanCommand(plan);
+    REQUIRE(made.tasks.size() == 1);
+    test::writeText(shot.scene, kScene);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)harness::farmRunCommand({harness::farmPlanPath(plan), 0});
+               }),
+               Contains("farm_plan.json: tasks: have no task for UDIM tile 1001, which the scene warps") &&
+                   Contains("plan again after changing it"));
+    CHECK(test::filesIn(plan.outDir) == std::vector<fs::path>{"farm_plan.json"});
+}
