@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -189,6 +190,18 @@ class ObjParser {
         endStatement();
     }
 
+    // "1.#QNAN", "-1.#IND00", "1.#INF": how old Microsoft runtimes print NaN and infinity. Read as a number,
+    // the '#' would start a comment and leave 1 (`after` is where the digits "1." end).
+    bool isMicrosoftNonFinite(const char* after) const {
+        if (after == p_ || after[-1] != '.' || after >= end_ || *after != '#') return false;
+        std::string word;
+        for (const char* q = after + 1;
+             q < end_ && std::isalpha(static_cast<unsigned char>(*q)) && word.size() < 4; ++q)
+            word.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(*q))));
+        return word == "QNAN" || word == "SNAN" || word == "IND" || word == "INF" ||
+               word.rfind("IND", 0) == 0 || word.rfind("INF", 0) == 0;
+    }
+
     // Reads a number into `value`; false at the end of the statement. `finite` rejects NaN and inf.
     bool readFloat(float& value, std::string_view expected, bool finite = true) {
         skipBlanks();
@@ -210,6 +223,16 @@ class ObjParser {
             value = narrowed;
             ptr = r.ptr;
             ec = std::errc();
+        }
+        if (ec == std::errc() && isMicrosoftNonFinite(ptr)) {
+            const char* last = ptr;
+            while (last < end_ && !isBlank(*last) && *last != '\n')
+                ++last;
+            const std::string_view token(p_, static_cast<size_t>(last - p_));
+            if (finite)
+                fail<InvalidInput>(line_, "coordinate " + printable(token) + " is NaN or infinite",
+                                   "finite coordinates");
+            fail<ParseError>(line_, "malformed number " + printable(token), expected);
         }
         if (ec != std::errc() || !atSeparator(ptr)) {
             fail<ParseError>(line_, "malformed number " + printable(tokenAt(p_)), expected);
@@ -590,6 +613,9 @@ ObjContent parseObj(std::string_view text, const std::string& source) {
         throw ParseError(formatError(source, "", "is UTF-16 text, which is not supported",
                                      "UTF-8 or ASCII text: save the file as UTF-8"));
     }
+    // UTF-8 with a byte order mark (what Windows editors write as "UTF-8") is UTF-8: the mark is skipped,
+    // line numbers stay.
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
     return ObjParser(text, source).parse();
 }
 

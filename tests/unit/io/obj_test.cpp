@@ -320,6 +320,23 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
                           Catch::Contains("box_UTF16BE.obj: is UTF-16 text, which is not supported") &&
                               Catch::Contains("save the file as UTF-8"));
     }
+    SECTION("UTF-8 with a byte order mark reads as without it") {
+        const ObjContent plain = parseObj(quad + "f 1 2 3\n", "plain.obj");
+        const ObjContent marked = parseObj("\xEF\xBB\xBF" + quad + "f 1 2 3\n", "bom.obj");
+        CHECK(marked.mesh.points().size() == plain.mesh.points().size());
+        CHECK(std::ranges::equal(marked.mesh.faceIndices(), plain.mesh.faceIndices()));
+        CHECK_THROWS_WITH(parseObj("\xEF\xBB\xBFv 0 0\nx\n", "bom.obj"), Catch::Contains("bom.obj: line 1"));
+    }
+    SECTION("NaN and infinity as old Microsoft runtimes print them; a comment right after a number") {
+        for (const char* text : {"1.#QNAN", "-1.#IND00", "1.#INF", "1.#SNAN", "-1.#INF0"}) {
+            CHECK_THROWS_WITH(parseObj("v 0 0 0\nv 0 " + std::string(text) + " 0\n", "msvc.obj"),
+                              Catch::Contains("msvc.obj: line 2: coordinate '" + std::string(text) +
+                                              "' is NaN or infinite"));
+        }
+        const ObjContent commented = parseObj("v 0 0 1#top\nv 1 0 0.5# edge\nv 0 1 0\nf 1 2 3\n", "c.obj");
+        CHECK(commented.mesh.points()[0] == glm::vec3(0, 0, 1));
+        CHECK(commented.mesh.points()[1] == glm::vec3(1, 0, 0.5f));
+    }
     SECTION("NaN and infinite coordinates") {
         CHECK_THROWS_AS(parseObj("v 0 nan 0\n", "nan.obj"), InvalidInput);
         CHECK_THROWS_WITH(parseObj("v 0 0 0\nv 0 nan 0\n", "nan.obj"),
