@@ -6,6 +6,7 @@
 #include <mutex>
 #include <set>
 #include <span>
+#include <unordered_set>
 
 #include <glm/common.hpp>
 #include <glm/vec2.hpp>
@@ -64,8 +65,11 @@ Mesh::Mesh(Data data, const std::string& source)
                                        "one vertex index per face corner"));
     }
     const int32_t nv = numVertices();
+    std::unordered_set<int32_t> used;  // a long polygon's corners: checked in one pass, not pair by pair
     for (int32_t f = 0; f < numFaces(); ++f) {
         const auto corners = face(f);
+        const bool longFace = corners.size() > 16;
+        if (longFace) used.clear();
         for (size_t k = 0; k < corners.size(); ++k) {
             const int32_t v = corners[k];
             if (v < 0 || v >= nv) {
@@ -74,12 +78,13 @@ Mesh::Mesh(Data data, const std::string& source)
                                                "vertex index " + std::to_string(v) + " is out of range",
                                                "an index in [0, " + std::to_string(nv) + ")"));
             }
-            for (size_t j = 0; j < k; ++j) {
-                if (corners[j] == v) {
-                    throw InvalidInput(formatError(source, "face " + std::to_string(f),
-                                                   "uses vertex " + std::to_string(v) + " twice",
-                                                   "distinct vertices per face"));
-                }
+            const bool twice =
+                longFace ? !used.insert(v).second
+                         : std::find(corners.begin(), corners.begin() + k, v) != corners.begin() + k;
+            if (twice) {
+                throw InvalidInput(formatError(source, "face " + std::to_string(f),
+                                               "uses vertex " + std::to_string(v) + " twice",
+                                               "distinct vertices per face"));
             }
         }
     }

@@ -423,14 +423,16 @@ class ObjParser {
         while (!pending.empty()) {
             auto [pv, pt] = std::move(pending.back());
             pending.pop_back();
+            // The first corner that revisits a vertex (`again`) and that vertex's first corner (`first`), in
+            // one pass: a long polygon must not cost the square of its corners.
             size_t first = 0, again = 0;
-            for (size_t j = 1; j < pv.size() && again == 0; ++j) {
-                for (size_t i = 0; i < j; ++i) {
-                    if (pv[i] == pv[j]) {
-                        first = i;
-                        again = j;
-                        break;
-                    }
+            std::unordered_map<int32_t, size_t> seen;
+            for (size_t j = 0; j < pv.size(); ++j) {
+                const auto [at, inserted] = seen.try_emplace(pv[j], j);
+                if (!inserted) {
+                    first = at->second;
+                    again = j;
+                    break;
                 }
             }
             if (again == 0) {

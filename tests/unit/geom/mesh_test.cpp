@@ -61,6 +61,20 @@ TEST_CASE("mesh rejects bad connectivity and values, naming the element", "[geom
         d.faceIndices[6] = 1;
         CHECK_THROWS_WITH(Mesh(d), Catch::Contains("face 1: uses vertex 1 twice"));
     }
+    SECTION("repeated vertex in a long polygon: the first corner that comes back, as pair by pair") {
+        // 40 corners around a circle, corner 30 repeating corner 12's vertex and corner 35 corner 3's: the
+        // error names vertex 12, the first repeat in corner order (the small faces' rule).
+        Mesh::Data d;
+        for (int i = 0; i < 40; ++i)
+            d.points.emplace_back(std::cos(i * 0.157f), std::sin(i * 0.157f), 0.0f);
+        d.faceCounts = {40};
+        for (int i = 0; i < 40; ++i)
+            d.faceIndices.push_back(i);
+        CHECK_NOTHROW(Mesh(d));
+        d.faceIndices[30] = 12;
+        d.faceIndices[35] = 3;
+        CHECK_THROWS_WITH(Mesh(d), Catch::Contains("face 0: uses vertex 12 twice"));
+    }
     SECTION("NaN and infinite coordinates") {
         auto d = quadAndTriangle();
         d.points[3].y = std::numeric_limits<float>::quiet_NaN();

@@ -603,6 +603,29 @@ TEST_CASE("obj: polygons that visit a vertex twice are repaired, as exporters wr
     CHECK(c.repairedFaces == 1);
     // A file without repeats reports none.
     CHECK(parseObj(points + "f 1 2 3 4\n", "plain.obj").repairedFaces == 0);
+    // A long polygon (past the pair-by-pair check) visiting a vertex twice splits into its two loops.
+    std::string ring;
+    for (int i = 0; i < 40; ++i)
+        ring +=
+            "v " + std::to_string(std::cos(i * 0.157)) + " " + std::to_string(std::sin(i * 0.157)) + " 0\n";
+    std::string face = "f";
+    for (int i = 1; i <= 40; ++i)
+        face += " " + std::to_string(i);
+    c = parseObj(ring + face + " 20\n", "ring.obj");  // back to vertex 20 at the end: loops 20..40 and 1..20
+    got = faces(c);
+    std::sort(got.begin(), got.end());
+    Faces want(2);
+    for (int i = 0; i < 20; ++i)
+        want[0].push_back(i);
+    for (int i = 19; i < 40; ++i)
+        want[1].push_back(i);
+    std::sort(want.begin(), want.end());
+    CHECK(c.repairedFaces == 1);
+    REQUIRE(got.size() == 2);
+    // Each loop as a cyclic sequence: rotated to start at its least vertex.
+    for (auto& loop : got)
+        std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+    CHECK(got == want);
 }
 
 TEST_CASE("obj: the OBJ files of another library's test suite (assimp-testmodels), when installed",
