@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <tuple>
@@ -22,6 +23,91 @@ namespace {
 // Exact position key for welding assimp's per-corner vertices.
 using PositionKey = std::tuple<float, float, float>;
 
+// A glTF mesh's rest positions where pre-transforming its vertices by its node is wrong: a mesh skinned to
+// joints, or with morph targets at non-zero default weights. glTF places a skinned mesh by its joints alone
+// (the mesh node's own transform is ignored), so the rest pose is
+//   p = sum_j w_j (G(joint_j) * offset_j) (v + sum_k m_k (target_k - v)),
+// G the joint nodes' global transforms as the file poses them, offset_j their inverse bind matrices, m_k the
+// default morph weights: what Blender's importer shows at rest.
+class RestPose {
+  public:
+    // Whether `scene` has such a mesh; only then is the file read without assimp's pre-transform.
+    static bool needed(const aiScene& scene) {
+        for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+            const aiMesh& mesh = *scene.mMeshes[m];
+            if (mesh.HasBones()) return true;
+            for (unsigned k = 0; k < mesh.mNumAnimMeshes; ++k)
+                if (mesh.mAnimMeshes[k]->mWeight != 0.0f) return true;
+        }
+        return false;
+    }
+
+    explicit RestPose(const aiScene& scene) : scene_(scene) { visit(*scene.mRootNode, aiMatrix4x4()); }
+
+    // False when a mesh is placed by no node or by several (instances): the caller keeps assimp's
+    // pre-transform then.
+    [[nodiscard]] bool placesEveryMeshOnce() const {
+        for (unsigned m = 0; m < scene_.mNumMeshes; ++m)
+            if (placements_.count(m) != 1) return false;
+        return true;
+    }
+
+    // The rest positions of mesh m, in world space.
+    [[nodiscard]] std::vector<aiVector3D> positions(unsigned m) const {
+        const aiMesh& mesh = *scene_.mMeshes[m];
+        std::vector<aiVector3D> v(mesh.mVertices, mesh.mVertices + mesh.mNumVertices);
+        for (unsigned k = 0; k < mesh.mNumAnimMeshes; ++k) {
+            const aiAnimMesh& target = *mesh.mAnimMeshes[k];
+            if (target.mWeight == 0.0f || !target.HasPositions() || target.mNumVertices != mesh.mNumVertices)
+                continue;
+            for (unsigned i = 0; i < mesh.mNumVertices; ++i)
+                v[i] += target.mWeight * (target.mVertices[i] - mesh.mVertices[i]);
+        }
+        const aiMatrix4x4 node = placements_.find(m)->second;
+        if (!mesh.HasBones()) {
+            for (aiVector3D& p : v)
+                p = node * p;
+            return v;
+        }
+        std::vector<aiVector3D> skinned(v.size(), aiVector3D(0, 0, 0));
+        std::vector<double> weight(v.size(), 0.0);
+        for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+            const aiBone& bone = *mesh.mBones[b];
+            const aiNode* joint = scene_.mRootNode->FindNode(bone.mName);
+            const aiMatrix4x4 toWorld = (joint ? global(*joint) : node) * bone.mOffsetMatrix;
+            for (unsigned i = 0; i < bone.mNumWeights; ++i) {
+                const aiVertexWeight& w = bone.mWeights[i];
+                if (w.mVertexId >= v.size()) continue;
+                skinned[w.mVertexId] += w.mWeight * (toWorld * v[w.mVertexId]);
+                weight[w.mVertexId] += w.mWeight;
+            }
+        }
+        // Weights that do not sum to 1 are normalised; a vertex no joint moves stays with the mesh's node.
+        for (size_t i = 0; i < v.size(); ++i)
+            v[i] = weight[i] > 0.0 ? skinned[i] / static_cast<float>(weight[i]) : node * v[i];
+        return v;
+    }
+
+  private:
+    void visit(const aiNode& n, const aiMatrix4x4& parent) {
+        const aiMatrix4x4 g = parent * n.mTransformation;
+        for (unsigned i = 0; i < n.mNumMeshes; ++i)
+            placements_.emplace(n.mMeshes[i], g);
+        for (unsigned c = 0; c < n.mNumChildren; ++c)
+            visit(*n.mChildren[c], g);
+    }
+
+    static aiMatrix4x4 global(const aiNode& n) {
+        aiMatrix4x4 g = n.mTransformation;
+        for (const aiNode* p = n.mParent; p; p = p->mParent)
+            g = p->mTransformation * g;
+        return g;
+    }
+
+    const aiScene& scene_;
+    std::multimap<unsigned, aiMatrix4x4> placements_;
+};
+
 ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     const std::string name = path.string();
     std::error_code ec;
@@ -31,15 +117,24 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         throw IoError(formatError(name, "", "is not a regular file", "a mesh file"));
 
     Assimp::Importer importer;
-    // Meshes stay apart (one group each) while their vertices move to world space.
+    const auto check = [&](const aiScene* scene) {
+        if (!scene) {
+            throw InvalidInput(
+                formatError(name, "", std::string("cannot be read as a mesh: ") + importer.GetErrorString(),
+                            "a valid glTF, FBX, PLY or Collada file"));
+        }
+        return scene;
+    };
+    // Meshes stay apart (one group each) while their vertices move to world space: by assimp's
+    // pre-transform, or for skinned and morphed glTF meshes by their rest pose (RestPose).
     importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
-    const aiScene* scene =
-        importer.ReadFile(path.string(), aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
-    if (!scene) {
-        throw InvalidInput(formatError(name, "",
-                                       std::string("cannot be read as a mesh: ") + importer.GetErrorString(),
-                                       "a valid glTF, FBX, PLY or Collada file"));
+    const aiScene* scene = check(importer.ReadFile(path.string(), aiProcess_ValidateDataStructure));
+    std::optional<RestPose> rest;
+    if (format == MeshFormat::Gltf && RestPose::needed(*scene)) {
+        rest.emplace(*scene);
+        if (!rest->placesEveryMeshOnce()) rest.reset();
     }
+    if (!rest) scene = check(importer.ApplyPostProcessing(aiProcess_PreTransformVertices));
     const bool weld = format == MeshFormat::Fbx || format == MeshFormat::Collada;
     geom::Mesh::Data data;
     std::vector<FaceGroup> groups;
@@ -52,10 +147,12 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         const std::string meshName =
             mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
         const bool uvs = mesh.HasTextureCoords(0);
+        const std::vector<aiVector3D> posed = rest ? rest->positions(m) : std::vector<aiVector3D>{};
+        const aiVector3D* vertices = rest ? posed.data() : mesh.mVertices;
         // Vertex k of this mesh is point pointOf[k]; its UV is uv base + k.
         std::vector<int32_t> pointOf(mesh.mNumVertices);
         for (unsigned k = 0; k < mesh.mNumVertices; ++k) {
-            const aiVector3D& p = mesh.mVertices[k];
+            const aiVector3D& p = vertices[k];
             const glm::vec3 point(p.x, p.y, p.z);
             // Checked here, before welding: a NaN compares equal to every position and would be welded
             // onto another point, and the faces around it dropped as slivers.

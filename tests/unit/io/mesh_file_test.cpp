@@ -74,6 +74,30 @@ const char* kCollada = R"(<?xml version="1.0" encoding="utf-8"?>
 </COLLADA>
 )";
 
+// A triangle (0,0,0) (1,0,0) (0,1,0) skinned to joints "root" (global (5, 0, 2): the armature's (0, 0, 2) and
+// its own (5, 0, 0); inverse bind matrix the identity) and "tip" (global (5, 3, 2), inverse bind matrix
+// translate(-5, -3, -2)): vertex 0 follows root, vertex 1 tip, vertex 2 half each. A morph target moves every
+// vertex by (0, 0, 1) at default weight WEIGHT. The mesh's own node is translated by (100, 0, 0), which glTF
+// ignores for a skinned mesh. Made by hand (Python's struct and base64), not by an exporter.
+const char* kSkinnedGltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 3]}],
+ "nodes": [{"name": "armature", "translation": [0, 0, 2], "children": [1]},
+           {"name": "root", "translation": [5, 0, 0], "children": [2]},
+           {"name": "tip", "translation": [0, 3, 0]},
+           {"name": "skinned", "mesh": 0, "skin": 0, "translation": [100, 0, 0]}],
+ "skins": [{"joints": [1, 2], "inverseBindMatrices": 4}],
+ "meshes": [{"name": "tri", "weights": [WEIGHT], "primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 2,
+   "WEIGHTS_0": 3}, "indices": 1, "targets": [{"POSITION": 5}]}]}],
+ "buffers": [{"byteLength": 268, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAAAAAAAAQAAAAABAAAAAIA/AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAD8AAAA/AAAAAAAAAAAAAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIA/AACAPwAAAAAAAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAACgwAAAQMAAAADAAACAPwAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAAAAAAAAAAACAPw=="}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+                 {"buffer": 0, "byteOffset": 44, "byteLength": 12}, {"buffer": 0, "byteOffset": 56, "byteLength": 48},
+                 {"buffer": 0, "byteOffset": 104, "byteLength": 128}, {"buffer": 0, "byteOffset": 232, "byteLength": 36}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+               {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+               {"bufferView": 2, "componentType": 5121, "count": 3, "type": "VEC4"},
+               {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC4"},
+               {"bufferView": 4, "componentType": 5126, "count": 2, "type": "MAT4"},
+               {"bufferView": 5, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 1], "max": [0, 0, 1]}]})";
+
 std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
     return {m.points().begin(), m.points().end()};
 }
@@ -106,6 +130,27 @@ TEST_CASE("mesh files: a glTF's nodes place its meshes, one group each, vertices
     CHECK(content.groups[0].faces == std::vector<int32_t>{0, 1});
     CHECK(content.groups[1].name == "bare");
     CHECK(content.groups[1].faces == std::vector<int32_t>{2, 3});
+}
+
+TEST_CASE("mesh files: a skinned, morphed glTF mesh rests where its joints and default weights put it",
+          "[io][mesh_file]") {
+    // The glTF rest pose written out by hand: p = sum_j w_j G_j IBM_j (v + m (0, 0, 1)), the mesh node's
+    // own translation ignored (what Blender's importer shows).
+    const test::TempDir dir;
+    for (const float m : {0.0f, 0.5f, 1.0f}) {
+        std::string text = kSkinnedGltf;
+        const std::string weight = m == 0.0f ? "0.0" : m == 0.5f ? "0.5" : "1.0";
+        text.replace(text.find("WEIGHT"), 6, weight);
+        test::writeText(dir / "skinned.gltf", text);
+        const std::vector<glm::vec3> got = pointsOf(io::readMesh(dir / "skinned.gltf").mesh);
+        const std::vector<glm::vec3> want{{5.0f, 0.0f, 2.0f + m}, {1.0f, 0.0f, m}, {2.5f, 1.0f, 1.0f + m}};
+        CAPTURE(m);
+        REQUIRE(got.size() == 3);
+        for (size_t i = 0; i < 3; ++i) {
+            CAPTURE(i, got[i].x, got[i].y, got[i].z);
+            CHECK(glm::length(got[i] - want[i]) < 1e-6f);
+        }
+    }
 }
 
 TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_file]") {
