@@ -29,7 +29,8 @@ std::map<int, io::Image> tileImages(const py::object& value, const std::string& 
     }
     for (const auto& [key, array] : py::reinterpret_borrow<py::dict>(value)) {
         const std::string element = name + "[" + std::string(py::repr(key)) + "]";
-        if (!py::isinstance<py::int_>(key) || key.cast<int64_t>() < 1001 || key.cast<int64_t>() > 9999) {
+        const std::optional<int64_t> tile = wholeNumber(key);
+        if (!tile || *tile < 1001 || *tile > 9999) {
             throw InvalidInput(formatError(kReport, element, "is not a UDIM tile", "1001..9999"));
         }
         const auto image = FloatArray::ensure(array);
@@ -38,7 +39,7 @@ std::map<int, io::Image> tileImages(const py::object& value, const std::string& 
             throw InvalidInput(
                 formatError(kReport, element, "is " + aTypeName(array), "(T, T) or (T, T, C) float32"));
         }
-        out.emplace(key.cast<int>(), imageOf(image, kReport, element, "(T, T) or (T, T, C) float32"));
+        out.emplace(static_cast<int>(*tile), imageOf(image, kReport, element, "(T, T) or (T, T, C) float32"));
     }
     return out;
 }
@@ -66,10 +67,15 @@ py::dict shotReport(const py::object& logs, const std::filesystem::path& page, c
     if (!title.empty()) options.title = title;
     options.rerun = rerun;
     if (rest) {
-        // Called from the report with the GIL released by no one: the call runs on this thread.
+        // Called from the report, which runs without the GIL (other Python threads, a DCC's interface, go
+        // on): the callable runs with it, on this thread.
         options.geometry = [&](const std::string&, int frame) -> std::optional<uvwarp::ReportGeometry> {
+            const py::gil_scoped_acquire gil;
             py::object result = deformed(frame);
-            if (py::isinstance<py::tuple>(result)) result = py::reinterpret_borrow<py::tuple>(result)[0];
+            if (py::isinstance<py::tuple>(result)) {
+                const auto pair = py::reinterpret_borrow<py::tuple>(result);
+                result = pair.empty() ? py::none() : py::object(pair[0]);
+            }
             const auto array = FloatArray::ensure(result);
             const std::string element = "deformed(" + std::to_string(frame) + ")";
             if (!array || array.ndim() != 2 || array.shape(1) != 3 ||
@@ -94,9 +100,13 @@ py::dict shotReport(const py::object& logs, const std::filesystem::path& page, c
     if (!textures.empty()) options.texture = lookup(textures);
 
     uvwarp::ShotLog log;
-    for (const std::filesystem::path& file : files)
-        uvwarp::readShotLogFile(file, log);
-    const uvwarp::HtmlReportResult result = uvwarp::writeHtmlReport(log, page, options);
+    uvwarp::HtmlReportResult result;
+    {
+        const py::gil_scoped_release release;
+        for (const std::filesystem::path& file : files)
+            uvwarp::readShotLogFile(file, log);
+        result = uvwarp::writeHtmlReport(log, page, options);
+    }
     py::list written;
     for (const std::filesystem::path& f : result.files)
         written.append(f.string());

@@ -78,7 +78,7 @@ int32_t intOption(py::handle value, const std::string& source, const std::string
 uvwarp::OptionValue optionValueOf(py::handle value) {
     using Kind = uvwarp::OptionValue::Kind;
     const auto number = [](py::handle x, double& out) {
-        if (py::isinstance<py::bool_>(x) || py::isinstance<py::str>(x) || py::isinstance<py::bytes>(x) ||
+        if (isBool(x) || py::isinstance<py::str>(x) || py::isinstance<py::bytes>(x) ||
             py::isinstance<py::sequence>(x))
             return false;
         try {
@@ -90,9 +90,9 @@ uvwarp::OptionValue optionValueOf(py::handle value) {
     };
     uvwarp::OptionValue v;
     double x = 0.0;
-    if (py::isinstance<py::bool_>(value)) {
+    if (isBool(value)) {
         v.kind = Kind::Boolean;
-        v.numbers = {value.cast<bool>() ? 1.0 : 0.0};
+        v.numbers = {py::bool_(value.cast<py::object>()) ? 1.0 : 0.0};
     } else if (number(value, x)) {
         v.numbers = {x};
     } else if (py::isinstance<py::sequence>(value) && !py::isinstance<py::str>(value)) {
@@ -497,6 +497,10 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
         throw InvalidInput(formatError(kShot, texture.is_none() ? "bake" : "texture",
                                        texture.is_none() ? "given without texture" : "given without bake",
                                        "texture and bake together"));
+    }
+    if (out.is_none()) {
+        throw InvalidInput(
+            formatError(kShot, "out", "is None", "a path pattern such as 'out/redirect.<UDIM>.####.exr'"));
     }
     for (const auto& [value, name] : {std::pair{&out, "out"}, std::pair{&bake, "bake"}}) {
         if (!value->is_none() && !isPath(*value)) {

@@ -118,7 +118,11 @@ PYBIND11_MODULE(deformkit, m) {
         .def_property_readonly("num_vertices", &geom::Mesh::numVertices)
         .def_property_readonly("num_faces", &geom::Mesh::numFaces)
         .def("udim_tiles", &geom::Mesh::udimTiles, "UDIM tiles the UV faces touch")
-        .def("is_manifold", [](const geom::Mesh& mesh) { return mesh.halfEdges().report().isManifold(); })
+        .def("is_manifold",
+             [](const geom::Mesh& mesh) {
+                 const py::gil_scoped_release release;  // a large mesh's half-edges take seconds
+                 return mesh.halfEdges().report().isManifold();
+             })
         .def("__repr__", [](const geom::Mesh& mesh) {
             return "<deformkit.Mesh " + std::to_string(mesh.numVertices()) + " vertices, " +
                    std::to_string(mesh.numFaces()) + " faces" + (mesh.hasUVs() ? ", uvs>" : ">");

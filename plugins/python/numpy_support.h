@@ -119,6 +119,26 @@ inline geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const
     return geom::Mesh(std::move(d), meshName);
 }
 
+// Python's bool or numpy's (np.bool_, what comparisons of arrays give).
+inline bool isBool(pybind11::handle value) {
+    if (pybind11::isinstance<pybind11::bool_>(value)) return true;
+    const pybind11::handle type = pybind11::type::of(value);
+    return pybind11::str(type.attr("__module__")).cast<std::string>() == "numpy" &&
+           pybind11::str(type.attr("__name__")).cast<std::string>() == "bool_";
+}
+
+// A whole number from Python: an int or numpy's integer scalars (not a bool); nullopt otherwise.
+inline std::optional<int64_t> wholeNumber(pybind11::handle value) {
+    if (isBool(value) || !PyIndex_Check(value.ptr())) return std::nullopt;
+    try {
+        return pybind11::int_(pybind11::reinterpret_borrow<pybind11::object>(value)).cast<int64_t>();
+    } catch (const pybind11::error_already_set&) {
+        return std::nullopt;
+    } catch (const pybind11::cast_error&) {
+        return std::nullopt;
+    }
+}
+
 // The Python type of a value with its article ("a list", "an int"), for messages.
 inline std::string aTypeName(pybind11::handle value) {
     const std::string name = pybind11::str(pybind11::type::of(value).attr("__name__"));

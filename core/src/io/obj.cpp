@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/read_file.h"
 
@@ -648,6 +649,24 @@ std::string formatObjText(const geom::Mesh& mesh, const std::vector<FaceGroup>& 
     if (options.precision < 1 || options.precision > 17) {
         throw InvalidInput(formatError(target, "precision", "is " + std::to_string(options.precision),
                                        "1 to 17 significant digits"));
+    }
+    // The reader refuses NaN and infinite coordinates: a mesh whose points were changed after it was made
+    // (Python's writable Mesh.points) must not write them.
+    const std::span<const glm::vec3> points = mesh.points();
+    if (const size_t bad = geom::firstNonFinite(points); bad < points.size()) {
+        const glm::vec3& p = points[bad];
+        throw InvalidInput(
+            formatError(target, "vertex " + std::to_string(bad),
+                        "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")",
+                        "finite coordinates"));
+    }
+    for (size_t t = 0; t < mesh.uvs().size(); ++t) {
+        const glm::vec2& uv = mesh.uvs()[t];
+        if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
+            throw InvalidInput(formatError(target, "texture coordinate " + std::to_string(t),
+                                           "is (" + numberText(uv.x) + ", " + numberText(uv.y) + ")",
+                                           "finite coordinates"));
+        }
     }
     const int32_t numFaces = mesh.numFaces();
     // Each face's groups, as offsets into `members` (a face may belong to several groups).
