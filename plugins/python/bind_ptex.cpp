@@ -5,10 +5,14 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "bindings.h"
@@ -91,9 +95,11 @@ py::object metaValue(const ptex::MetaValue& m) {
 ptex::MetaValue metaFrom(const std::string& key, py::handle value, const std::string& source) {
     if (py::isinstance<py::str>(value)) return ptex::MetaValue::ofString(key, value.cast<std::string>());
     const py::array a = py::array::ensure(value);
-    if (!a) {
-        throw InvalidInput(formatError(source, "metadata '" + key + "'", "is not a string or an array",
-                                       "a string or a 1-D int8/int16/int32/float32/float64 array"));
+    if (!a || a.ndim() != 1) {
+        throw InvalidInput(formatError(
+            source, "metadata '" + key + "'",
+            a ? "is an array of " + std::to_string(a.ndim()) + " dimensions" : "is not a string or an array",
+            "a string or a 1-D int8/int16/int32/float32/float64 array"));
     }
     const py::dtype dt = a.dtype();
     const auto values = [&](auto tag) {
@@ -177,7 +183,26 @@ int8_t log2Of(py::ssize_t n, const std::string& source, const std::string& eleme
 
 // A PtexFile from read_ptex's dict (data required; faces, metadata, alpha_channel optional). With a mesh,
 // the faces' adjacency and sub-face flags are the mesh's and its standard metadata is written.
+// A key of `d` that is none of `known`: refused naming it (a typo such as 'adjfaces' must not be ignored).
+void requireKnownKeys(const py::dict& d, std::initializer_list<std::string_view> known,
+                      const std::string& source, const std::string& where) {
+    for (const auto& [key, value] : d) {
+        const std::string k = py::isinstance<py::str>(key) ? key.cast<std::string>() : std::string();
+        if (std::find(known.begin(), known.end(), k) != known.end()) continue;
+        std::string list;
+        for (const std::string_view name : known)
+            list += (list.empty() ? "" : ", ") + std::string(name);
+        throw InvalidInput(formatError(source, where + std::string(py::repr(key)), "is not a key it takes",
+                                       "one of " + list));
+    }
+}
+
 ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh, const std::string& source) {
+    // What read_ptex returns, so that its dict writes back; data_type and channels follow from data.
+    requireKnownKeys(d,
+                     {"data", "alpha_channel", "mesh_type", "u_border_mode", "v_border_mode",
+                      "edge_filter_mode", "faces", "metadata", "data_type", "channels"},
+                     source, "ptex key ");
     if (!d.contains("data")) {
         throw InvalidInput(formatError(source, "ptex", "has no 'data'", "a list of (vres, ures, C) arrays"));
     }
@@ -232,9 +257,16 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
         }
     } else if (d.contains("faces")) {
         const auto faces = castArgument<py::list>(d["faces"], source, "faces", "a list of dicts");
-        for (size_t f = 0; f < std::min(faces.size(), file.faces.size()); ++f) {
+        if (faces.size() != file.faces.size()) {
+            throw InvalidInput(formatError(source, "faces",
+                                           "has " + std::to_string(faces.size()) + " entries",
+                                           std::to_string(file.faces.size()) + ", one per face of data"));
+        }
+        for (size_t f = 0; f < faces.size(); ++f) {
             const std::string element = "faces[" + std::to_string(f) + "]";
             const auto face = castArgument<py::dict>(faces[f], source, element, "a dict");
+            requireKnownKeys(face, {"adj_faces", "adj_edges", "subface", "res", "constant"}, source,
+                             element + " key ");
             if (face.contains("adj_faces")) {
                 const auto adj = castArgument<std::vector<int32_t>>(face["adj_faces"], source,
                                                                     element + "['adj_faces']", "4 ints");
@@ -244,7 +276,20 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
                 }
                 const auto edges = castArgument<std::vector<int32_t>>(face["adj_edges"], source,
                                                                       element + "['adj_edges']", "4 ints");
-                for (size_t e = 0; e < 4 && e < adj.size() && e < edges.size(); ++e) {
+                for (const auto& [values, name] :
+                     {std::pair{&adj, "adj_faces"}, std::pair{&edges, "adj_edges"}}) {
+                    if (values->size() != 4) {
+                        throw InvalidInput(formatError(source, element + "['" + name + "']",
+                                                       "has " + std::to_string(values->size()) + " entries",
+                                                       "4, one per edge"));
+                    }
+                }
+                for (size_t e = 0; e < 4; ++e) {
+                    if (edges[e] < 0 || edges[e] > 3) {
+                        throw InvalidInput(formatError(source,
+                                                       element + "['adj_edges'][" + std::to_string(e) + "]",
+                                                       "is " + std::to_string(edges[e]), "an edge 0 to 3"));
+                    }
                     file.faces[f].adjFaces[e] = adj[e];
                     file.faces[f].adjEdges[e] = static_cast<uint8_t>(edges[e]);
                 }

@@ -132,6 +132,20 @@ def test_arguments_of_the_wrong_type_name_the_argument_and_what_was_expected(tmp
         (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adj_faces": [0, 0, 0, 0]}]}),
          r"^write_ptex: faces\[0\]: has adj_faces but no adj_edges"),
         (lambda: dk.shot_report(3, tmp_path / "p.html"), r"^shot_report: logs: is an int \(expected a JSON-lines"),
+        # Typos and malformed entries are named, not ignored or cut.
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "meta_data": {}}),
+         r"^write_ptex: ptex key 'meta_data': is not a key it takes \(expected one of data, "),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adjfaces": [0, 0, 0, 0]}]}),
+         r"^write_ptex: faces\[0\] key 'adjfaces': is not a key it takes"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{}, {}]}),
+         r"^write_ptex: faces: has 2 entries \(expected 1, one per face of data\)"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adj_faces": [0, 0], "adj_edges": [0, 0]}]}),
+         r"^write_ptex: faces\[0\]\['adj_faces'\]: has 2 entries \(expected 4, one per edge\)"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "faces": [{"adj_faces": [0, 0, 0, 0],
+                                                                              "adj_edges": [0, 300, 0, 0]}]}),
+         r"^write_ptex: faces\[0\]\['adj_edges'\]\[1\]: is 300 \(expected an edge 0 to 3\)"),
+        (lambda: dk.write_ptex(tmp_path / "x.ptx", {"data": [face], "metadata": {"m": np.zeros((2, 2), np.float32)}}),
+         r"^write_ptex: metadata 'm': is an array of 2 dimensions"),
     ]
     for call, message in cases:
         with pytest.raises(dk.InvalidInput, match=message):
