@@ -59,20 +59,16 @@ class PyMeshWarp {
                                 const std::optional<FloatArray>& weights, float envelope) {
         std::vector<glm::vec3> target = pointsOf(targetCage, kMeshWarp, "target_cage_points");
         std::vector<glm::vec3> pts;
-        if (points) {
-            pts = pointsOf(*points, kMeshWarp, "points");
-        } else {
+        {
             const Lock lock(mutex_);
-            pts = rest_;
+            requireBound();
+            if (!points) pts = rest_;
         }
+        if (points) pts = pointsOf(*points, kMeshWarp, "points");
         const std::vector<float> w = weightsOf(weights, pts.size(), kMeshWarp);
         {
             py::gil_scoped_release release;
             const Lock lock(mutex_);
-            if (!deformer_->isBound()) {
-                throw InvalidInput(
-                    formatError(kMeshWarp, "evaluate", "called before bind", "bind(rest_points) first"));
-            }
             warp_->setTarget(std::move(target));
             deformer_->evaluate(pts, w, envelope);
         }
@@ -93,6 +89,13 @@ class PyMeshWarp {
     }
 
   private:
+    void requireBound() const {
+        if (!deformer_->isBound()) {
+            throw InvalidInput(
+                formatError(kMeshWarp, "evaluate", "called before bind", "bind(rest_points) first"));
+        }
+    }
+
     std::unique_ptr<warp::MeshWarp> warp_;
     std::unique_ptr<warp::WarpDeformer> deformer_;
     std::vector<glm::vec3> rest_;
