@@ -164,6 +164,24 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
     REQUIRE(m.hasUVs());
     CHECK(m.uvs()[m.uvIndices()[6]] == glm::vec2(0.5f, 1.0f));
     CHECK(m.uvs()[m.uvIndices()[2]] == glm::vec2(1.0f, 0.5f));
+
+    // A header claiming more elements than the file has lines (assimp would make up the rest from the
+    // last lines): refused, naming the counts; with CRLF line ends and blank lines it still reads.
+    for (const auto& [from, to] : {std::pair{"element vertex 5", "element vertex 1000"},
+                                   std::pair{"element face 2", "element face 1000000"}}) {
+        std::string liar = kPly;
+        liar.replace(liar.find(from), std::string(from).size(), to);
+        test::writeText(dir / "liar.ply", liar);
+        CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
+                          Contains("liar.ply: declares ") && Contains("elements but holds 7 data lines"));
+    }
+    std::string crlf;
+    for (const char c : std::string(kPly)) {
+        if (c == '\n') crlf += "\r";
+        crlf += c;
+    }
+    test::writeText(dir / "crlf.ply", crlf + "\r\n\r\n");
+    CHECK(pointsOf(io::readMesh(dir / "crlf.ply").mesh) == pointsOf(m));
 }
 
 TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and the formats",
