@@ -34,13 +34,12 @@ std::vector<fs::path> logsIn(const fs::path& folder, const std::string& prefix =
     return out;
 }
 
-}  // namespace
-
-std::function<std::optional<uvwarp::ReportGeometry>(const std::string&, int)> sceneGeometry(
-    const fs::path& scene) {
-    return [scene, evaluator = std::shared_ptr<scene::SceneEvaluator>()](
+// The geometry callback over the scene `read` gives when first asked for (called once).
+std::function<std::optional<uvwarp::ReportGeometry>(const std::string&, int)> sceneGeometryOf(
+    std::function<scene::Scene()> read) {
+    return [read = std::move(read), evaluator = std::shared_ptr<scene::SceneEvaluator>()](
                const std::string& object, int frame) mutable -> std::optional<uvwarp::ReportGeometry> {
-        if (!evaluator) evaluator = std::make_shared<scene::SceneEvaluator>(readScene(scene));
+        if (!evaluator) evaluator = std::make_shared<scene::SceneEvaluator>(read());
         const scene::Scene& s = evaluator->scene();
         for (size_t o = 0; o < s.objects.size(); ++o) {
             if (s.objects[o].name != object) continue;
@@ -50,6 +49,13 @@ std::function<std::optional<uvwarp::ReportGeometry>(const std::string&, int)> sc
         }
         return std::nullopt;
     };
+}
+
+}  // namespace
+
+std::function<std::optional<uvwarp::ReportGeometry>(const std::string&, int)> sceneGeometry(
+    const fs::path& scene) {
+    return sceneGeometryOf([scene] { return readScene(scene); });
 }
 
 ReportCommandResult reportCommand(const ReportCommand& command) {
@@ -81,18 +87,25 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
         for (size_t k = 0; k < plan.tasks.size(); ++k) {
             const scene::FarmTask& task = plan.tasks[k];
             std::vector<std::pair<std::string, int>> objectTiles;
-            for (const scene::SceneObject& object :
-                 planned ? planned->objects : std::vector<scene::SceneObject>{})
-                for (const int tile : task.tiles)
-                    if (!scene::uvwarpOutputs(object, tile, task.firstFrame).empty())
-                        objectTiles.emplace_back(object.name, tile);
+            if (planned) {
+                for (const scene::SceneObject& object : planned->objects)
+                    for (const int tile : task.tiles)
+                        if (!scene::uvwarpOutputs(object, tile, task.firstFrame).empty())
+                            objectTiles.emplace_back(object.name, tile);
+            }
             options.tasks.push_back(
                 {static_cast<int>(k), task.firstFrame, task.lastFrame, task.tiles, std::move(objectTiles),
                  "deformkit farm run " + planFile.string() + " --task " + std::to_string(k)});
         }
         options.searchFolders.push_back(plan.outDir);
-        // The heatmaps' geometry as the tasks made it (the mesh tasks' OBJs may not be there).
-        options.geometry = sceneGeometry(plan.scene);
+        // The heatmaps' geometry as the tasks made it (the mesh tasks' OBJs may not be there), from the
+        // scene read above when it could be.
+        if (planned) {
+            auto read = std::make_shared<scene::Scene>(std::move(*planned));
+            options.geometry = sceneGeometryOf([read] { return std::move(*read); });
+        } else {
+            options.geometry = sceneGeometry(plan.scene);
+        }
         options.rerun.push_back("deformkit farm submit --slurm " + planFile.string() +
                                 "   # every task: finished frames are skipped");
         if (page.empty()) page = plan.outDir / "report.html";

@@ -262,12 +262,16 @@ struct type_caster<deformkit::python::IntArray> {
         if (src.is_none()) return false;
         array a = array::ensure(src);
         if (!a) return false;
+        value.problem.clear();
+        const char kind = a.dtype().kind();
+        if (kind == 'i' && a.itemsize() == 4) {  // int32 already: a view, or one contiguous copy
+            value.values = array_t<int32_t, array::c_style | array::forcecast>::ensure(a);
+            return static_cast<bool>(value.values);
+        }
         std::vector<ssize_t> shape(a.shape(), a.shape() + a.ndim());
         value.values = array_t<int32_t, array::c_style>(shape);
-        value.problem.clear();
         int32_t* out = value.values.mutable_data();
         const ssize_t n = a.size();
-        const char kind = a.dtype().kind();
         const auto fail = [&](const std::string& what, ssize_t i) {
             value.problem = what + (a.ndim() == 1 ? " at index " + std::to_string(i)
                                                   : " at flat index " + std::to_string(i));

@@ -199,8 +199,7 @@ class ObjParser {
         for (const char* q = after + 1;
              q < end_ && std::isalpha(static_cast<unsigned char>(*q)) && word.size() < 4; ++q)
             word.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(*q))));
-        return word == "QNAN" || word == "SNAN" || word == "IND" || word == "INF" ||
-               word.rfind("IND", 0) == 0 || word.rfind("INF", 0) == 0;
+        return word == "QNAN" || word == "SNAN" || word.starts_with("IND") || word.starts_with("INF");
     }
 
     // Reads a number into `value`; false at the end of the statement. `finite` rejects NaN and inf.

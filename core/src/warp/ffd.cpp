@@ -319,8 +319,9 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
     if (options_.kernel == FfdKernel::PerPoint || !(bernstein || bspline) ||
         lattice_.divisions != glm::ivec3(3) || restPoints.size() != points.size() ||
         out.size() != points.size()) {
-        return false;
+        return false;  // evaluate() checks the envelope and weights
     }
+    requireFiniteEnvelope("FFD evaluate", weights, envelope);
     const auto n = static_cast<int64_t>(restPoints.size());
     int64_t bad = n;  // bind's check, naming the first non-finite point whatever the schedule
 #pragma omp parallel for schedule(static) reduction(min : bad) if (n >= 65536)
@@ -688,7 +689,6 @@ void Ffd::transformations(Transformations& out) const {
 
 void Ffd::bindAndEvaluate(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
                           std::span<glm::vec3> out, std::span<const float> weights, float envelope) {
-    requireFiniteEnvelope("FFD evaluate", weights, envelope);
     if (lattice_.deformUnbound(restPoints, in, out, reinterpret_cast<const float*>(translation_.data()),
                                weights, envelope)) {
         return;
