@@ -7,9 +7,12 @@ frames 1-6. Blender's own exporters write the shot as PC2 (io_export_pc2) and MD
 reads each frame and must find the positions Blender evaluates, bit for bit. Then DeformKit writes caches of
 another motion and Blender's Mesh Cache modifier, on a copy of the mesh, must show those positions, bit for
 bit. Blender's Mesh Cache modifier numbers a cache's samples from its own Frame Start (the PC2 header's start
-frame is not used in its Frame mode), so it is set to the caches' first frame, 1.
+frame is not used in its Frame mode), so it is set to the caches' first frame, 1. Last, a rigged tube's PC2
+against its own OBJ and FBX exports: the OBJ keeps Blender's vertex order and reads the cache, the FBX is
+welded and renumbered on reading, as many vertices in another order, and the cache is refused.
 """
 
+import json
 import os
 import sys
 
@@ -40,10 +43,26 @@ def positions(obj):
     return out.reshape(-1, 3)
 
 
-def rigged_suzanne():
+def add_suzanne():
+    bpy.ops.mesh.primitive_monkey_add(location=(0.0, 0.0, 0.0))
+
+
+def add_tube():
+    """A 12-sided cylinder (height 2 about the origin) cut into 16 rings by subdivision: no two vertices in
+    one place, so a welded reading keeps Blender's vertex count."""
+    bpy.ops.mesh.primitive_cylinder_add(vertices=12, depth=2.0, radius=0.4, location=(0.0, 0.0, 0.0))
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="SELECT")
+    bpy.ops.mesh.subdivide(number_cuts=3)
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def rigged_suzanne(add_mesh=add_suzanne):
+    """The mesh `add_mesh` adds at the origin, rigged by a two-bone armature (automatic weights) whose tip
+    bone turns over frames 1-6 (frame 1: the rest pose)."""
     for block in list(bpy.data.objects):
         bpy.data.objects.remove(block)
-    bpy.ops.mesh.primitive_monkey_add(location=(0.0, 0.0, 0.0))
+    add_mesh()
     suzanne = bpy.context.object
     bpy.ops.object.armature_add(location=(0.0, 0.0, -1.0))
     rig = bpy.context.object
@@ -122,10 +141,49 @@ def test_deformkit_caches_shown_by_blender(folder):
     print("DeformKit's PC2 and MDD shown by Blender's Mesh Cache modifier: the written positions, bit for bit")
 
 
+def test_a_cache_against_a_renumbered_rest_mesh_is_refused(folder):
+    tube = rigged_suzanne(add_tube)
+    paths = {ext: os.path.join(folder, "tube." + ext) for ext in ("obj", "fbx", "pc2")}
+    bpy.context.scene.frame_set(1)  # the rest pose: the rest meshes below
+    bpy.ops.export_scene.obj(filepath=paths["obj"], use_selection=True, use_materials=False,
+                             use_triangles=False)
+    bpy.ops.export_scene.fbx(filepath=paths["fbx"], use_selection=True, apply_scale_options="FBX_SCALE_UNITS")
+    result = bpy.ops.export_shape.pc2(filepath=paths["pc2"], range_start=1, range_end=6, sampling="1",
+                                      world_space=True, rot_x90=False, apply_modifiers=True)
+    assert result == {"FINISHED"}, result
+    count = len(tube.data.vertices)
+    obj, fbx = dk.read_mesh(paths["obj"]), dk.read_mesh(paths["fbx"])
+    assert obj.num_vertices == fbx.num_vertices == count, (obj.num_vertices, fbx.num_vertices, count)
+    moved = int(np.count_nonzero(np.abs(fbx.points - obj.points).max(axis=1) > 1e-4))
+    assert moved > count // 2, f"the FBX reading keeps most of Blender's order ({moved} of {count} moved)"
+    cache = dk.PointCache(paths["pc2"])
+    for rest in ("obj", "fbx"):
+        scene = os.path.join(folder, "tube_" + rest + ".json")
+        with open(scene, "w") as out:
+            json.dump({"deformkit_scene": 1, "frames": [1, 6], "objects": [
+                {"name": "tube", "mesh": paths[rest], "deformed": paths["pc2"], "stack": []}]}, out)
+        evaluator = dk.SceneEvaluator(scene)
+        for frame in FRAMES:
+            if rest == "obj":
+                assert np.array_equal(evaluator.evaluate(0, frame), cache.read(frame)), frame
+                continue
+            try:
+                evaluator.evaluate(0, frame)
+            except dk.InvalidInput as error:
+                message = str(error)
+            else:
+                raise AssertionError(f"frame {frame} of the cache read against the FBX's vertex order")
+            assert f"tube.pc2: frame {frame}: stretches" in message, message
+            assert "not in the rest mesh's order" in message and "tube.fbx" in message, message
+    print(f"A rigged tube's PC2 ({count} vertices, frames 1-6) read against Blender's OBJ of the tube, refused "
+          f"against its FBX ({moved} of its vertices renumbered): {message}")
+
+
 def main():
     addon_utils.enable("io_export_pc2")
     addon_utils.enable("io_shape_mdd")
-    blender_tests.run((test_blender_exports_read_by_deformkit, test_deformkit_caches_shown_by_blender))
+    blender_tests.run((test_blender_exports_read_by_deformkit, test_deformkit_caches_shown_by_blender,
+                       test_a_cache_against_a_renumbered_rest_mesh_is_refused))
 
 
 main()

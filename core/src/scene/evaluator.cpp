@@ -136,7 +136,8 @@ void SceneEvaluator::check(std::span<const int> frames) {
         }
         if (!ob.sequence) continue;
         for (const int frame : frames) {
-            namedBy(scene_.source, so.sequenceElement, frameText(frame) + ": ",
+            // The input's errors name the frame (a cache's "frame 4", a sequence's file of frame 4).
+            namedBy(scene_.source, so.sequenceElement, "",
                     [&] { ob.sequence->requireFrames(std::span<const int>(&frame, 1)); });
         }
     }
@@ -153,7 +154,7 @@ void SceneEvaluator::readInput(size_t object, double frame) {
     }
     const int whole = static_cast<int>(frame);
     namedBy(
-        scene_.source, element, frameText(frame) + ": ", [&] { ob.sequence->read(whole, ob.input); }, false);
+        scene_.source, element, "", [&] { ob.sequence->read(whole, ob.input); }, false);
 }
 
 host::DeformerStack& SceneEvaluator::stack(size_t object) {

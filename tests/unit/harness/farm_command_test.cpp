@@ -242,11 +242,11 @@ TEST_CASE(
     CHECK(test::readText(shot.dir / "farm" / "tube.0004.obj") !=
           test::readText(shot.dir / "sway" / "tube.0004.obj"));
     // The task holding frame 1 stops there, naming the scene, the object's input, the cache and the vertex.
-    CHECK_THAT(test::errorOf<InvalidInput>([&] {
-                   (void)harness::farmRunCommand({harness::farmPlanPath(planCommand), 0});
-               }),
-               Contains("cached.json: objects[0].deformed: frame 1: ") &&
-                   Contains("sway.pc2: frame 1: vertex 0: is ("));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] {
+            (void)harness::farmRunCommand({harness::farmPlanPath(planCommand), 0});
+        }),
+        Contains("cached.json: objects[0].deformed: ") && Contains("sway.pc2: frame 1: vertex 0: is ("));
 }
 
 TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file and the JSON path or index",

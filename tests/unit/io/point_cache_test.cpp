@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -333,4 +334,141 @@ TEST_CASE("point cache: bad caches are refused naming the file, the frame and th
                        [&] { io::AnimatedPositions(dir / "a.####.obj", "--deformed", 1.0); }),
                    Contains("is an OBJ sequence, given a cache's first frame 1"));
     }
+}
+
+namespace {
+
+// The test's own measure of a frame against its rest mesh: every corner edge of every face (a shared edge
+// counted once per face) with a rest length, torn when longer than 4 times its rest length scaled by the
+// growth of the RMS distance from the centroid (mean |p|^2 - |mean p|^2, in long double).
+struct OwnTear {
+    int torn = 0, edges = 0;
+};
+OwnTear ownTear(const geom::Mesh& rest, const std::vector<glm::vec3>& frame) {
+    const auto spread = [](std::span<const glm::vec3> p) {
+        long double sx = 0, sy = 0, sz = 0, square = 0;
+        for (const glm::vec3& q : p) {
+            sx += q.x;
+            sy += q.y;
+            sz += q.z;
+            square += static_cast<long double>(q.x) * q.x + static_cast<long double>(q.y) * q.y +
+                      static_cast<long double>(q.z) * q.z;
+        }
+        const long double n = p.size();
+        return std::sqrt(square / n - (sx * sx + sy * sy + sz * sz) / (n * n));
+    };
+    const long double scale = spread(frame) / spread(rest.points());
+    const auto length = [](const glm::vec3& a, const glm::vec3& b) {
+        return std::sqrt(static_cast<long double>(b.x - a.x) * (b.x - a.x) +
+                         static_cast<long double>(b.y - a.y) * (b.y - a.y) +
+                         static_cast<long double>(b.z - a.z) * (b.z - a.z));
+    };
+    OwnTear out;
+    for (int32_t f = 0; f < rest.numFaces(); ++f) {
+        const auto face = rest.face(f);
+        for (size_t c = 0; c < face.size(); ++c) {
+            const int32_t a = face[c], b = face[(c + 1) % face.size()];
+            const long double r = length(rest.points()[a], rest.points()[b]);
+            if (r <= 0) continue;
+            ++out.edges;
+            if (length(frame[a], frame[b]) > 4 * scale * r) ++out.torn;
+        }
+    }
+    return out;
+}
+
+// A smooth motion of `rest`: a bend about the y axis, a twist about z, then a rotation, a uniform scale and a
+// translation, all random (a cache in other units, moved or turned, as well as deformed).
+std::vector<glm::vec3> moved(const geom::Mesh& rest, std::mt19937& rng) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    const float bend = unit(rng), twist = 2.0f * unit(rng), scale = std::pow(10.0f, 2.0f * unit(rng));
+    const glm::vec3 axis = glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng)) + glm::vec3(0, 0, 2.5f));
+    const float angle = 3.0f * unit(rng);
+    const glm::vec3 offset(10 * unit(rng), 10 * unit(rng), 10 * unit(rng));
+    std::vector<glm::vec3> out;
+    for (glm::vec3 p : rest.points()) {
+        const float t = twist * p.z, c = std::cos(t), s = std::sin(t);
+        p = {c * p.x - s * p.y, s * p.x + c * p.y, p.z + bend * p.x * p.x};
+        // Rodrigues' rotation about `axis`.
+        const float ca = std::cos(angle), sa = std::sin(angle);
+        p = p * ca + glm::cross(axis, p) * sa + axis * glm::dot(axis, p) * (1.0f - ca);
+        out.push_back(scale * p + offset);
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "vertex order: frames of the rest mesh's motion pass, frames in another order are torn (random cases)",
+    "[io][point_cache]") {
+    const geom::Mesh grid = geom::makeGrid({24, 24, 1.0f, 1.0f});
+    const geom::Mesh sphere = geom::makeSphere({1.0f, 32, 16});
+    std::mt19937 rng(2026);
+    for (const geom::Mesh* rest : {&grid, &sphere}) {
+        // Both meshes have fewer corners than the check samples: it judges every corner edge, as the test.
+        REQUIRE(rest->faceIndices().size() <= static_cast<size_t>(io::VertexOrderCheck::kSampledEdges));
+        const io::VertexOrderCheck check(*rest);
+        for (int trial = 0; trial < 50; ++trial) {
+            INFO((rest == &grid ? "grid" : "sphere") << ", trial " << trial);
+            std::vector<glm::vec3> frame = moved(*rest, rng);
+            const OwnTear own = ownTear(*rest, frame);
+            CHECK(own.torn == 0);
+            CHECK_FALSE(check.tear(frame).has_value());
+            // A quarter of the points collapsed onto one of them (a part scaled to nothing by its bone).
+            for (size_t k = 1; k < frame.size() / 4; ++k)
+                frame[k] = frame[0];
+            CHECK(4 * ownTear(*rest, frame).torn <= ownTear(*rest, frame).edges);
+            CHECK_FALSE(check.tear(frame).has_value());
+            // The same motion, its vertices shuffled.
+            std::vector<glm::vec3> shuffled = moved(*rest, rng);
+            std::shuffle(shuffled.begin(), shuffled.end(), rng);
+            const OwnTear mixed = ownTear(*rest, shuffled);
+            REQUIRE(4 * mixed.torn > mixed.edges);
+            const std::optional<io::VertexOrderCheck::Tear> tear = check.tear(shuffled);
+            REQUIRE(tear.has_value());
+            CHECK(tear->edges == mixed.edges);
+            // The same edges and rule, computed in double against long double: an edge within rounding of
+            // the threshold may fall either side.
+            CHECK(std::abs(tear->torn - mixed.torn) <= 1);
+        }
+    }
+    // Nothing judged: too few edges, or the frame all in one point.
+    const geom::Mesh quad = geom::makeGrid({1, 1, 1.0f, 1.0f});
+    std::vector<glm::vec3> reversed(quad.points().rbegin(), quad.points().rend());
+    CHECK_FALSE(io::VertexOrderCheck(quad).tear(reversed).has_value());
+    const std::vector<glm::vec3> point(grid.points().size(), glm::vec3(1.0f));
+    CHECK_FALSE(io::VertexOrderCheck(grid).tear(point).has_value());
+}
+
+TEST_CASE(
+    "vertex order: a cache frame in another vertex order is refused naming the cache, frame and rest mesh",
+    "[io][point_cache]") {
+    const test::TempDir dir;
+    const geom::Mesh rest = geom::makeGrid({12, 12, 1.0f, 1.0f});
+    std::vector<std::vector<glm::vec3>> frames(
+        3, std::vector<glm::vec3>(rest.points().begin(), rest.points().end()));
+    for (glm::vec3& p : frames[1])
+        p.z = 0.2f * std::sin(3.0f * p.x);  // a wave: the order kept
+    std::mt19937 rng(7);
+    std::shuffle(frames[2].begin(), frames[2].end(), rng);
+    const fs::path pc2 = dir / "anim.pc2";
+    test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, frames));
+    io::AnimatedPositions positions(pc2, "--deformed");
+    positions.setReference(rest, "rest.fbx");
+    std::vector<glm::vec3> points;
+    positions.read(1, points);
+    CHECK(test::sameBits(points, frames[0]));
+    positions.read(2, points);
+    CHECK(test::sameBits(points, frames[1]));
+    const OwnTear own = ownTear(rest, frames[2]);
+    const std::string percent = std::to_string(static_cast<int>(std::lround(100.0 * own.torn / own.edges)));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { positions.read(3, points); }),
+               Contains("anim.pc2: frame 3: stretches " + percent + "% of " + std::to_string(own.edges) +
+                        " edges of the rest mesh 'rest.fbx' beyond 4 times their rest length") &&
+                   Contains("its vertices are not in the rest mesh's order (expected the rest mesh's vertex "
+                            "order; an FBX or Collada rest mesh is welded and renumbered on reading"));
+    // Without a reference (PointCache alone, `deformkit info`) the frame is read as it is.
+    io::PointCache cache(pc2);
+    CHECK(test::sameBits(read(cache, 3), frames[2]));
 }
