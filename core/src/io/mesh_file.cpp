@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -156,6 +157,36 @@ void requireCompleteAsciiPly(const fs::path& path) {
     }
 }
 
+// A mesh's name in messages and groups: its own, or "mesh<m>" without one.
+std::string meshNameOf(const aiMesh& mesh, unsigned m) {
+    return mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
+}
+
+// The group name of each mesh: its name, unless meshes share it (assimp splits an FBX or Collada mesh per
+// material, each part named as the mesh); then "<mesh>_<material>", as Blender's OBJ names an object's
+// material groups, and ".2", ".3", ... after any name still taken. Groups written back keep their parts.
+std::vector<std::string> meshGroupNames(const aiScene& scene) {
+    std::map<std::string, int> uses;
+    for (unsigned m = 0; m < scene.mNumMeshes; ++m)
+        ++uses[meshNameOf(*scene.mMeshes[m], m)];
+    std::vector<std::string> names;
+    std::set<std::string> taken;
+    for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+        const aiMesh& mesh = *scene.mMeshes[m];
+        std::string base = meshNameOf(mesh, m);
+        if (uses[base] > 1 && mesh.mMaterialIndex < scene.mNumMaterials) {
+            const aiString material = scene.mMaterials[mesh.mMaterialIndex]->GetName();
+            if (material.length > 0) base += "_" + std::string(material.C_Str());
+        }
+        std::string name = base;
+        for (int n = 2; taken.count(name) > 0; ++n)
+            name = base + "." + std::to_string(n);
+        taken.insert(name);
+        names.push_back(std::move(name));
+    }
+    return names;
+}
+
 ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     const std::string name = path.string();
     std::error_code ec;
@@ -191,10 +222,10 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     for (unsigned m = 0; m < scene->mNumMeshes; ++m)
         anyUVs = anyUVs || scene->mMeshes[m]->HasTextureCoords(0);
     std::map<PositionKey, int32_t> welded;
+    const std::vector<std::string> groupNames = meshGroupNames(*scene);
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& mesh = *scene->mMeshes[m];
-        const std::string meshName =
-            mesh.mName.length > 0 ? std::string(mesh.mName.C_Str()) : "mesh" + std::to_string(m);
+        const std::string meshName = meshNameOf(mesh, m);
         const bool uvs = mesh.HasTextureCoords(0);
         const std::vector<aiVector3D> posed = rest ? rest->positions(m) : std::vector<aiVector3D>{};
         const aiVector3D* vertices = rest ? posed.data() : mesh.mVertices;
@@ -227,7 +258,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                 data.uvs.emplace_back(mesh.mTextureCoords[0][k].x, mesh.mTextureCoords[0][k].y);
         }
         FaceGroup group;
-        group.name = meshName;
+        group.name = groupNames[m];
         for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
             const aiFace& face = mesh.mFaces[f];
             // Corners in order; a corner welded onto the one before it is dropped (a sliver of coincident

@@ -98,6 +98,40 @@ const char* kSkinnedGltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes"
                {"bufferView": 4, "componentType": 5126, "count": 2, "type": "MAT4"},
                {"bufferView": 5, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 1], "max": [0, 0, 1]}]})";
 
+// kCollada's quad with one triangle in material "Red" and one in "Blue", instanced by two nodes (the second
+// moved by (0, 0, 1)): assimp gives four meshes, each named "quad".
+const char* kTwoMaterialCollada = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_effects><effect id="e"><profile_COMMON><technique sid="t"><lambert/></technique></profile_COMMON>
+  </effect></library_effects>
+  <library_materials>
+    <material id="red-material" name="Red"><instance_effect url="#e"/></material>
+    <material id="blue-material" name="Blue"><instance_effect url="#e"/></material>
+  </library_materials>
+  <library_geometries>
+    <geometry id="quad" name="quad"><mesh>
+      <source id="p"><float_array id="pa" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+        <technique_common><accessor source="#pa" count="4" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+      <triangles count="1" material="red"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>
+      <triangles count="1" material="blue"><input semantic="VERTEX" source="#v" offset="0"/><p>0 2 3</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="s">
+    <node id="n" name="n"><instance_geometry url="#quad"><bind_material><technique_common>
+      <instance_material symbol="red" target="#red-material"/><instance_material symbol="blue" target="#blue-material"/>
+    </technique_common></bind_material></instance_geometry></node>
+    <node id="m" name="m"><translate>0 0 1</translate><instance_geometry url="#quad"><bind_material><technique_common>
+      <instance_material symbol="red" target="#red-material"/><instance_material symbol="blue" target="#blue-material"/>
+    </technique_common></bind_material></instance_geometry></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)";
+
 std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
     return {m.points().begin(), m.points().end()};
 }
@@ -219,4 +253,30 @@ TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and
     CHECK(io::meshFormat("a.GLTF") == io::MeshFormat::Gltf);
     CHECK(io::meshFormat("a.Dae") == io::MeshFormat::Collada);
     CHECK_FALSE(io::meshFormat("a.exr"));
+}
+
+TEST_CASE("mesh files: meshes split per material keep apart as groups named by mesh and material",
+          "[io][mesh_file]") {
+    const test::TempDir dir;
+    test::writeText(dir / "two.dae", kTwoMaterialCollada);
+    const io::ObjContent content = io::readMesh(dir / "two.dae");
+    std::vector<std::string> names;
+    for (const io::FaceGroup& group : content.groups)
+        names.push_back(group.name);
+    // Each part named by its mesh and material; the second instance's parts numbered.
+    CHECK(names == std::vector<std::string>{"quad_Red", "quad_Blue", "quad_Red.2", "quad_Blue.2"});
+    for (size_t g = 0; g < content.groups.size(); ++g) {
+        REQUIRE(content.groups[g].faces.size() == 1);
+        const auto face = content.mesh.face(content.groups[g].faces[0]);
+        // The red triangle holds the quad's second corner (1, 0, z); the blue one its fourth (0, 1, z).
+        const float z = g < 2 ? 0.0f : 1.0f;
+        const glm::vec3 own = g % 2 == 0 ? glm::vec3(1, 0, z) : glm::vec3(0, 1, z);
+        bool found = false;
+        for (const int32_t v : face)
+            found = found || content.mesh.points()[v] == own;
+        CHECK(found);
+    }
+    // Written back as OBJ and read again, the four groups stay four.
+    io::writeObj(dir / "two.obj", content.mesh, content.groups);
+    CHECK(io::readObj(dir / "two.obj").groups.size() == 4);
 }
