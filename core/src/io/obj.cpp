@@ -314,19 +314,19 @@ class ObjParser {
 
     [[noreturn]] void failIndex(const Index& index, int64_t count, const Kind& kind) const {
         const std::string range =
-            count == 0 ? std::string("none defined yet")
-                       : "1.." + std::to_string(count) + " or -" + std::to_string(count) + "..-1";
+            count == 0 ? "a " + std::string(kind.one) + " defined before it (none is yet)"
+                       : "an index in 1.." + std::to_string(count) + " or -" + std::to_string(count) + "..-1";
         const std::string written = std::string(index.text.substr(0, 40));
         if (index.value == 0) {
             fail<InvalidInput>(
                 line_, std::string(kind.one) + " index " + written + " is not valid (OBJ indices start at 1)",
-                "an index in " + range);
+                range);
         }
         fail<InvalidInput>(line_,
                            std::string(kind.one) + " index " + written +
                                " is out of range: " + std::to_string(count) + " " +
                                std::string(count == 1 ? kind.one : kind.many) + " defined so far",
-                           "an index in " + range);
+                           range);
     }
 
     void readFace() {
@@ -618,6 +618,13 @@ ObjContent parseObj(std::string_view text, const std::string& source) {
     // UTF-8 with a byte order mark (what Windows editors write as "UTF-8") is UTF-8: the mark is skipped,
     // line numbers stay.
     if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+    // Lines ended by CR alone (classic Mac OS editors and exporters) would read as one line: such a file,
+    // with a CR and no LF anywhere, is read with its CRs as line ends.
+    if (text.find('\n') == std::string_view::npos && text.find('\r') != std::string_view::npos) {
+        std::string lines(text);
+        std::replace(lines.begin(), lines.end(), '\r', '\n');
+        return ObjParser(lines, source).parse();
+    }
     return ObjParser(text, source).parse();
 }
 

@@ -102,8 +102,15 @@ PointCache::PointCache(fs::path path, std::optional<double> firstFrame) : path_(
         }
         const int32_t version = loadInt(header + 12, false);
         if (version != 1) {
-            throw InvalidInput(
-                formatError(name, "header", "has version " + std::to_string(version), "PC2 version 1"));
+            // Version 1 read in the other byte order: a big-endian writer's file.
+            const bool swapped = loadInt(header + 12, true) == 1;
+            throw InvalidInput(formatError(
+                name, "header",
+                "has version " + std::to_string(version) +
+                    (swapped ? ", which is version 1 in big-endian byte order" : ""),
+                swapped
+                    ? "PC2 version 1 in little-endian byte order, as Blender, 3ds Max and Houdini write it"
+                    : "PC2 version 1"));
         }
         vertices_ = loadInt(header + 16, false);
         const float start = loadFloat(header + 20, false);
@@ -126,12 +133,30 @@ PointCache::PointCache(fs::path path, std::optional<double> firstFrame) : path_(
         samples_ = loadInt(header, true);
         vertices_ = loadInt(header + 4, true);
         first_ = 1.0;
+        // A header whose counts give the file's size only when read little-endian: a little-endian writer's
+        // file, which would otherwise be reported as cut short by billions of frames.
+        const auto fits = [size](int32_t frames, int32_t vertices) {
+            if (frames <= 0 || vertices <= 0) return false;
+            const auto f = static_cast<std::uintmax_t>(frames), v = static_cast<std::uintmax_t>(vertices);
+            if (size < 8 + 4 * f) return false;
+            const std::uintmax_t data =
+                size - 8 - 4 * f;  // f * v * 12 without overflow: compared by division
+            return data % (12 * v) == 0 && data / (12 * v) == f;
+        };
+        const int32_t littleSamples = loadInt(header, false), littleVertices = loadInt(header + 4, false);
+        if (!fits(samples_, vertices_) && fits(littleSamples, littleVertices)) {
+            throw InvalidInput(formatError(
+                name, "header",
+                "reads as " + std::to_string(littleSamples) + " frames of " + std::to_string(littleVertices) +
+                    " vertices, as the file's size says, only in little-endian byte order",
+                "MDD's big-endian byte order, as LightWave, Blender and Houdini write it"));
+        }
     }
-    if (vertices_ <= 0 || samples_ < 0) {
+    if (vertices_ <= 0 || samples_ <= 0) {
         throw InvalidInput(formatError(
             name, "header",
             "has " + std::to_string(vertices_) + " vertices and " + std::to_string(samples_) + " frames",
-            "at least one vertex and no negative frame count"));
+            "at least one vertex and one frame"));
     }
     if (format_ == PointCacheFormat::Mdd) {
         if (size < 8 + 4 * static_cast<std::uintmax_t>(samples_)) {

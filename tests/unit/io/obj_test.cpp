@@ -300,7 +300,10 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
                               Catch::Contains("expected an index in 1..1 or -1..-1"));
         CHECK_THROWS_WITH(parseObj(quad + "f 1//1 2//1 3//1\n", "normal.obj"),
                           Catch::Contains("normal.obj: line 4: normal index 1 is out of range: 0 normals") &&
-                              Catch::Contains("none defined yet"));
+                              Catch::Contains("(expected a normal defined before it (none is yet))"));
+        CHECK_THROWS_WITH(parseObj("f 1 2 3\nv 0 0 0\n", "first.obj"),
+                          Catch::Contains("first.obj: line 1: vertex index 1 is out of range: 0 vertices") &&
+                              Catch::Contains("(expected a vertex defined before it (none is yet))"));
     }
     SECTION("face with fewer than 3 vertices") {
         CHECK_THROWS_AS(parseObj(quad + "f 1 2\n", "two.obj"), InvalidInput);
@@ -326,6 +329,16 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
         CHECK(marked.mesh.points().size() == plain.mesh.points().size());
         CHECK(std::ranges::equal(marked.mesh.faceIndices(), plain.mesh.faceIndices()));
         CHECK_THROWS_WITH(parseObj("\xEF\xBB\xBFv 0 0\nx\n", "bom.obj"), Catch::Contains("bom.obj: line 1"));
+    }
+    SECTION("lines ended by CR alone (classic Mac OS) read as lines, their numbers kept") {
+        std::string mac = quad + "f 1 2 3\n";
+        std::replace(mac.begin(), mac.end(), '\n', '\r');
+        const ObjContent plain = parseObj(quad + "f 1 2 3\n", "plain.obj");
+        const ObjContent cr = parseObj(mac, "mac.obj");
+        CHECK(test::sameBits(std::vector<glm::vec3>(cr.mesh.points().begin(), cr.mesh.points().end()),
+                             std::vector<glm::vec3>(plain.mesh.points().begin(), plain.mesh.points().end())));
+        CHECK(std::ranges::equal(cr.mesh.faceIndices(), plain.mesh.faceIndices()));
+        CHECK_THROWS_WITH(parseObj("v 0 0 0\rv 1 0\r", "mac.obj"), Catch::Contains("mac.obj: line 2: "));
     }
     SECTION("NaN and infinity as old Microsoft runtimes print them; a comment right after a number") {
         for (const char* text : {"1.#QNAN", "-1.#IND00", "1.#INF", "1.#SNAN", "-1.#INF0"}) {

@@ -270,6 +270,36 @@ TEST_CASE("point cache: bad caches are refused naming the file, the frame and th
         CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }), Contains("has the sampling 0"));
         test::writeText(pc2, test::pc2Bytes(1.0f, 1.0f, {}));
         CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }), Contains("has 0 vertices and 0 frames"));
+        // No frame at all: nothing a job could read (the writer refuses to write one).
+        std::string empty = test::pc2Bytes(1.0f, 1.0f, {});
+        empty.replace(16, 4, std::string("\x03\0\0\0", 4));  // 3 vertices, 0 samples
+        test::writeText(pc2, empty);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(pc2); }),
+                   Contains("bad.pc2: header: has 3 vertices and 0 frames (expected at least one vertex and "
+                            "one frame)"));
+        std::string emptyMdd;
+        test::appendWord(emptyMdd, int32_t{0}, true);
+        test::appendWord(emptyMdd, int32_t{3}, true);
+        test::writeText(mdd, emptyMdd);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { open(mdd); }),
+                   Contains("bad.mdd: header: has 3 vertices and 0 frames"));
+        // The other byte order: a big-endian PC2 and a little-endian MDD, every word of the file reversed.
+        const auto reversedWords = [](std::string bytes, size_t from) {
+            for (size_t k = from; k + 4 <= bytes.size(); k += 4)
+                std::reverse(bytes.begin() + static_cast<std::ptrdiff_t>(k),
+                             bytes.begin() + static_cast<std::ptrdiff_t>(k) + 4);
+            return bytes;
+        };
+        test::writeText(pc2, reversedWords(test::pc2Bytes(1.0f, 1.0f, frames), 12));
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { open(pc2); }),
+            Contains("bad.pc2: header: has version 16777216, which is version 1 in big-endian byte order "
+                     "(expected PC2 version 1 in little-endian byte order"));
+        test::writeText(mdd, reversedWords(test::mddBytes({0.0f, 1.0f, 2.0f}, frames), 0));
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { open(mdd); }),
+            Contains("bad.mdd: header: reads as 3 frames of 4 vertices, as the file's size says, only in "
+                     "little-endian byte order (expected MDD's big-endian byte order"));
         test::writeText(mdd, test::mddBytes({0.0f, 2.0f, 1.0f}, frames));
         CHECK_THAT(
             test::errorOf<InvalidInput>([&] { open(mdd); }),
