@@ -3,6 +3,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
@@ -112,48 +113,139 @@ class RestPose {
     std::multimap<unsigned, aiMatrix4x4> placements_;
 };
 
-// An ASCII PLY holds one line per element its header declares. assimp fills the lines a header claims but
-// the file lacks with copies of the last ones (1000 vertices declared, 4 given: 996 made up), so the count is
-// checked first. Binary PLYs cut short are refused by assimp's own checks.
-void requireCompleteAsciiPly(const fs::path& path) {
+// A PLY's header declares its elements; assimp does not check that the file holds them. An ASCII PLY with
+// fewer lines than declared gets the missing elements made up from copies of the last lines (1000 vertices
+// declared, 4 given: 996 made up), and a binary PLY cut short fails with "aiMesh::mFaces[0]::mIndices[1] is
+// out of range", which does not say the file is short. Both are checked here first: an ASCII file's data
+// lines are counted, a binary file's elements walked (list properties by their counts) to where they end.
+struct PlyProperty {
+    int32_t size = 0;      // bytes of a scalar, or of a list's count
+    int32_t itemSize = 0;  // bytes of a list's items; 0 for a scalar
+    bool unsignedCount = false;
+};
+struct PlyElement {
+    std::string name;
+    int64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+
+// Bytes of a PLY scalar type, 0 for an unknown one.
+int32_t plyTypeSize(const std::string& type) {
+    static const std::map<std::string, int32_t> sizes = {
+        {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+        {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
+        {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+    const auto it = sizes.find(type);
+    return it == sizes.end() ? 0 : it->second;
+}
+
+void requireCompletePly(const fs::path& path) {
     const std::string text = readFile(path, "PLY file");
     std::istringstream in(text);
-    std::string line;
-    bool ascii = false;
-    std::vector<std::pair<std::string, int64_t>> elements;
+    std::string line, format;
+    std::vector<PlyElement> elements;
+    bool ended = false;
     while (std::getline(in, line)) {
         std::istringstream words(line);
         std::string keyword;
         words >> keyword;
         if (keyword == "format") {
-            std::string kind;
-            words >> kind;
-            ascii = kind == "ascii";
+            words >> format;
         } else if (keyword == "element") {
-            std::string name;
-            int64_t count = -1;
-            words >> name >> count;
-            if (count >= 0) elements.emplace_back(name, count);
+            PlyElement element;
+            element.count = -1;
+            words >> element.name >> element.count;
+            elements.push_back(std::move(element));
+        } else if (keyword == "property" && !elements.empty()) {
+            std::string type;
+            words >> type;
+            PlyProperty property;
+            if (type == "list") {
+                std::string countType, itemType;
+                words >> countType >> itemType;
+                property.size = plyTypeSize(countType);
+                property.itemSize = plyTypeSize(itemType);
+                property.unsignedCount = countType.starts_with('u');
+                if (property.itemSize == 0) property.size = 0;
+            } else {
+                property.size = plyTypeSize(type);
+            }
+            elements.back().properties.push_back(property);
         } else if (keyword == "end_header") {
+            ended = true;
             break;
         }
     }
-    if (!ascii) return;
-    int64_t lines = 0;
-    while (std::getline(in, line))
-        if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
-    int64_t declared = 0;
-    std::string list;
-    for (const auto& [name, count] : elements) {
-        declared += count;
-        list += (list.empty() ? "" : " and ") + std::to_string(count) + " " + name;
+    // What assimp refuses on its own (no header end, an unknown type, a negative count) is left to it.
+    if (!ended) return;
+    for (const PlyElement& element : elements) {
+        if (element.count < 0) return;
+        for (const PlyProperty& property : element.properties)
+            if (property.size == 0) return;
     }
-    if (lines < declared) {
-        throw InvalidInput(
-            formatError(path.string(), "",
-                        "declares " + list + " elements but holds " + std::to_string(lines) + " data lines",
-                        "one line per element the header declares (an ASCII PLY cut short or "
-                        "with a wrong count)"));
+    std::string declared;
+    for (const PlyElement& element : elements)
+        declared += (declared.empty() ? "" : " and ") + std::to_string(element.count) + " " + element.name;
+    if (format == "ascii") {
+        int64_t lines = 0;
+        while (std::getline(in, line))
+            if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
+        int64_t total = 0;
+        for (const PlyElement& element : elements)
+            total += element.count;
+        if (lines < total) {
+            throw InvalidInput(formatError(
+                path.string(), "",
+                "declares " + declared + " elements but holds " + std::to_string(lines) + " data lines",
+                "one line per element the header declares (an ASCII PLY cut short or with a wrong count)"));
+        }
+        return;
+    }
+    const bool big = format == "binary_big_endian";
+    if (!big && format != "binary_little_endian") return;
+    const auto fileSize = static_cast<uint64_t>(text.size());
+    auto at = static_cast<uint64_t>(in.tellg() < 0 ? text.size() : static_cast<size_t>(in.tellg()));
+    const auto shortAt = [&](const PlyElement& element, int64_t index) {
+        throw InvalidInput(formatError(path.string(), "",
+                                       "is cut short: the file has " + std::to_string(fileSize) +
+                                           " bytes and ends in " + element.name + " " +
+                                           std::to_string(index) + " of " + std::to_string(element.count),
+                                       "the " + declared + " elements its header declares"));
+    };
+    for (const PlyElement& element : elements) {
+        const bool lists = std::any_of(element.properties.begin(), element.properties.end(),
+                                       [](const PlyProperty& p) { return p.itemSize > 0; });
+        if (!lists) {
+            uint64_t stride = 0;
+            for (const PlyProperty& property : element.properties)
+                stride += static_cast<uint64_t>(property.size);
+            const uint64_t left = fileSize - std::min(at, fileSize);
+            if (stride > 0 && left / stride < static_cast<uint64_t>(element.count))
+                shortAt(element, static_cast<int64_t>(left / stride));
+            at += stride * static_cast<uint64_t>(element.count);
+            continue;
+        }
+        for (int64_t i = 0; i < element.count; ++i) {
+            for (const PlyProperty& property : element.properties) {
+                const auto size = static_cast<uint64_t>(property.size);
+                if (at + size > fileSize) shortAt(element, i);
+                if (property.itemSize == 0) {
+                    at += size;
+                    continue;
+                }
+                uint64_t items = 0;  // the list's count, in the file's byte order
+                for (uint64_t k = 0; k < size; ++k) {
+                    const auto byte = static_cast<unsigned char>(text[at + (big ? k : size - 1 - k)]);
+                    items = (items << 8) | byte;
+                }
+                // A signed count with its top bit set is negative: assimp refuses that itself.
+                if (!property.unsignedCount && (items >> (8 * size - 1)) != 0) return;
+                at += size;
+                const uint64_t bytes = items * static_cast<uint64_t>(property.itemSize);  // < 2^35
+                if (at + bytes > fileSize) shortAt(element, i);
+                at += bytes;
+            }
+        }
     }
 }
 
@@ -195,7 +287,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     if (!fs::is_regular_file(status))
         throw IoError(formatError(name, "", "is not a regular file", "a mesh file"));
 
-    if (format == MeshFormat::Ply) requireCompleteAsciiPly(path);
+    if (format == MeshFormat::Ply) requireCompletePly(path);
     Assimp::Importer importer;
     const auto check = [&](const aiScene* scene) {
         if (!scene) {

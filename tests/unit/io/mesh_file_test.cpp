@@ -1,5 +1,11 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
+#include <cstring>
+
+#include <array>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -132,6 +138,34 @@ const char* kTwoMaterialCollada = R"(<?xml version="1.0" encoding="utf-8"?>
 </COLLADA>
 )";
 
+// kPly's mesh as a binary PLY in either byte order (the words reversed by hand for big-endian): five vertices
+// of x, y, z, s, t (float) and two faces of a uchar count and int indices.
+std::string binaryPly(bool bigEndian) {
+    const std::vector<std::array<float, 5>> vertices = {
+        {0, 0, 0, 0, 0}, {2, 0, 0, 1, 0}, {2, 1, 0, 1, 0.5f}, {0, 1, 0, 0, 0.5f}, {1, 2, 0, 0.5f, 1}};
+    const std::vector<std::vector<int32_t>> faces = {{0, 1, 2, 3}, {3, 2, 4}};
+    std::string out = std::string("ply\nformat ") +
+                      (bigEndian ? "binary_big_endian" : "binary_little_endian") +
+                      " 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                      "property float s\nproperty float t\nelement face 2\n"
+                      "property list uchar int vertex_indices\nend_header\n";
+    const auto word = [&](auto value) {
+        char bytes[4];
+        std::memcpy(bytes, &value, 4);
+        if (bigEndian) std::reverse(bytes, bytes + 4);
+        out.append(bytes, 4);
+    };
+    for (const auto& v : vertices)
+        for (const float c : v)
+            word(c);
+    for (const auto& f : faces) {
+        out.push_back(static_cast<char>(f.size()));
+        for (const int32_t i : f)
+            word(i);
+    }
+    return out;
+}
+
 std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
     return {m.points().begin(), m.points().end()};
 }
@@ -216,6 +250,39 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
     }
     test::writeText(dir / "crlf.ply", crlf + "\r\n\r\n");
     CHECK(pointsOf(io::readMesh(dir / "crlf.ply").mesh) == pointsOf(m));
+
+    // Binary, both byte orders: the same mesh. Cut short anywhere in its data, or with a header declaring
+    // more than it holds, it is refused naming the element where it ends (assimp itself said "mIndices[1] is
+    // out of range", or read made-up data).
+    for (const bool big : {false, true}) {
+        INFO((big ? "big" : "little") << "-endian");
+        const std::string whole = binaryPly(big);
+        test::writeText(dir / "binary.ply", whole);
+        const geom::Mesh binary = io::readMesh(dir / "binary.ply").mesh;
+        CHECK(pointsOf(binary) == pointsOf(m));
+        CHECK(std::ranges::equal(binary.faceIndices(), m.faceIndices()));
+        const size_t data = whole.find("end_header\n") + 11;
+        // Vertices take 20 bytes each, faces 17 and 13.
+        for (const auto& [cut, where] :
+             {std::pair{size_t{1}, "face 1 of 2"}, std::pair{size_t{13}, "face 1 of 2"},
+              std::pair{size_t{14}, "face 0 of 2"}, std::pair{size_t{30}, "face 0 of 2"},
+              std::pair{size_t{31}, "vertex 4 of 5"}, std::pair{size_t{100}, "vertex 1 of 5"},
+              std::pair{size_t{130}, "vertex 0 of 5"}}) {
+            INFO("cut " << cut);
+            test::writeText(dir / "cut.ply", whole.substr(0, whole.size() - cut));
+            CHECK_THROWS_WITH(
+                io::readMesh(dir / "cut.ply"),
+                Contains("cut.ply: is cut short: the file has " + std::to_string(whole.size() - cut) +
+                         " bytes and ends in " + where) &&
+                    Contains("(expected the 5 vertex and 2 face elements its header declares)"));
+        }
+        CHECK(whole.size() - data == 5 * 20 + 17 + 13);
+        std::string liar = whole;
+        liar.replace(liar.find("element face 2"), 14, "element face 9");
+        test::writeText(dir / "liar.ply", liar);
+        CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
+                          Contains("liar.ply: is cut short: ") && Contains("ends in face 2 of 9"));
+    }
 }
 
 TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and the formats",
