@@ -166,7 +166,9 @@ void requireCompletePly(const fs::path& path) {
                 property.size = plyTypeSize(countType);
                 property.itemSize = plyTypeSize(itemType);
                 property.unsignedCount = countType.starts_with('u');
-                if (property.itemSize == 0) property.size = 0;
+                // A count of floating-point type is left to assimp, as an unknown type is.
+                const bool integer = countType.find("float") == std::string::npos && countType != "double";
+                if (property.itemSize == 0 || !integer) property.size = 0;
             } else {
                 property.size = plyTypeSize(type);
             }
