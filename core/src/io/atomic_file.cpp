@@ -1,6 +1,7 @@
 #include "deformkit/io/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -127,12 +128,26 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
                                   "cannot write: folder '" + folder.string() + "' is not writable",
                                   "a writable folder"));
     }
+    // An existing file is replaced only where it could be written in place: a write-protected one (a
+    // published map) is refused, as a shell's redirection refuses it, and the one replaced keeps its
+    // permissions (a group-writable file stays group-writable).
+    struct stat before {};
+    const bool replacing = fs::is_regular_file(existing) && ::stat(path.c_str(), &before) == 0;
+    if (replacing && ::access(path.c_str(), W_OK) != 0) {
+        throw IoError(
+            formatError(requested.string(), "",
+                        std::string("cannot write: ") +
+                            (path == requested ? "the file" : "its link's target '" + path.string() + "'") +
+                            " is write-protected (" + std::strerror(errno) + ")",
+                        "a file this user may write, or a new path"));
+    }
     const fs::path tmp = temporaryPathFor(path);
     try {
         write(tmp);
         if (!fs::exists(tmp, ec)) {
             throw IoError(formatError(path.string(), "", "the writer produced no file", "a written file"));
         }
+        if (replacing) ::chmod(tmp.c_str(), before.st_mode & 0777);
         flushToDisk(tmp);
         fs::rename(tmp, path, ec);
         if (ec) {

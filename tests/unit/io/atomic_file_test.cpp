@@ -83,6 +83,47 @@ TEST_CASE("an unwritable or missing folder is an IoError naming it; the existing
     CHECK_THROWS_WITH(io::writeFileAtomically(locked, "x"), Catch::Contains("is a folder"));
 }
 
+TEST_CASE("a replaced file keeps its permissions; a write-protected one is refused and stays",
+          "[io][atomic][errors]") {
+    test::TempDir dir;
+    const auto mode = [](const fs::path& file) {
+        struct stat st {};
+        ::stat(file.c_str(), &st);
+        return st.st_mode & 0777;
+    };
+    for (const mode_t kept : {mode_t{0664}, mode_t{0600}, mode_t{0640}}) {
+        const fs::path file = dir / "shared.txt";
+        test::writeText(file, "old");
+        ::chmod(file.c_str(), kept);
+        io::writeFileAtomically(file, "new");
+        CHECK(test::readText(file) == "new");
+        CHECK(mode(file) == kept);
+        fs::remove(file);
+    }
+    // A published file (0444) in a folder anyone may write: refused for a user who may not write it, as a
+    // shell's `>` refuses it, and left as it was.
+    ::chmod(dir.path().c_str(), 0777);
+    const fs::path published = dir / "published.txt";
+    test::writeText(published, "precious");
+    ::chmod(published.c_str(), 0444);
+    const bool refused = test::runUnprivileged([&] {
+        try {
+            io::writeFileAtomically(published, "clobbered");
+            return false;
+        } catch (const IoError& e) {
+            const std::string msg = e.what();
+            return msg.find("published.txt: cannot write: the file is write-protected") !=
+                       std::string::npos &&
+                   msg.find("(expected a file this user may write, or a new path)") != std::string::npos;
+        }
+    });
+    CHECK(refused);
+    CHECK(test::readText(published) == "precious");
+    CHECK(mode(published) == 0444);
+    CHECK(countEntries(dir.path()) == 1);
+    ::chmod(dir.path().c_str(), 0755);
+}
+
 TEST_CASE("createFolder makes missing parents and names a path it cannot make", "[io][atomic][errors]") {
     test::TempDir dir;
     io::createFolder(dir / "a/b/c");
