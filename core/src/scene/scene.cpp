@@ -307,16 +307,21 @@ class Reader {
                         probe->set(p.name, p.value.constant);
                     } else {
                         const size_t keyCount = p.value.curves[0].size();
-                        for (size_t k = 0; k < keyCount; ++k) {
+                        const auto keyValue = [&](size_t k) {
                             std::vector<double> x(p.value.curves.size());
                             for (size_t c = 0; c < x.size(); ++c)
                                 x[c] = p.value.curves[c].keys()[k].value;
+                            return x;
+                        };
+                        for (size_t k = 0; k < keyCount; ++k) {
                             try {
-                                probe->set(p.name, x);
+                                probe->set(p.name, keyValue(k));
                             } catch (const Error& e) {
                                 fail(detail::jsonIndex(p.path + ".keys", k) + ".value", e.what(), "");
                             }
                         }
+                        requireSettableBetweenKeys(*probe, p);
+                        probe->set(p.name, keyValue(keyCount - 1));  // as the keys left it
                     }
                 } catch (const InvalidInput& e) {
                     const std::string what = e.what();
@@ -335,6 +340,35 @@ class Reader {
         for (const host::DeformerType& t : host::deformerTypes())
             known += (known.empty() ? "" : ", ") + std::string(t.name);
         return known + ", uvwarp (last entry)";
+    }
+
+    // A curve between its keys can leave what its parameter takes: a whole-number parameter (FFD divisions, a
+    // slide's vertex) between two whole keys, a Bezier overshooting a range. Such a scene would parse, then
+    // fail at the first frame between those keys. Every segment that is not a step is set at two frames
+    // inside it (its middle, and 0.318 of the way, where a line between whole numbers less than 1000 apart
+    // is not whole): a scene that parses can be set at those frames.
+    void requireSettableBetweenKeys(host::Deformer& probe, const SceneParameter& p) const {
+        const std::vector<Key>& keys = p.value.curves[0].keys();
+        for (size_t k = 0; k + 1 < keys.size(); ++k) {
+            if (keys[k].interpolation == Interpolation::Constant) continue;
+            for (const double along : {0.5, 0.3183098861837907}) {
+                const double frame = keys[k].time + along * (keys[k + 1].time - keys[k].time);
+                const std::vector<double> x = p.value.at(frame);
+                try {
+                    probe.set(p.name, x);
+                } catch (const Error& e) {
+                    std::string value;
+                    for (const double c : x)
+                        value += (value.empty() ? "" : ", ") + numberText(c);
+                    fail(detail::jsonIndex(p.path + ".keys", k),
+                         "interpolates to " + (x.size() > 1 ? "(" + value + ")" : value) + " at frame " +
+                             numberText(frame) + " on its way to keys[" + std::to_string(k + 1) +
+                             "], which the parameter refuses: " + e.what(),
+                         "\"interpolation\": \"constant\" on this key for a whole-number parameter, or keys "
+                         "whose curve stays within what the parameter takes");
+                }
+            }
+        }
     }
 
     // A number in [lo, hi]; whole when `whole`.

@@ -133,6 +133,23 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
         f.error(withEntry(R"({"type": "slide", "params": {"falloff": {"keys": [{"frame": 1, "value": 0},
                    {"frame": 2, "value": 5}]}}})")),
         Contains("params.falloff.keys[1].value") && Contains("parameter 'falloff'"));
+    // A curve that leaves what its parameter takes between its keys (a whole-number parameter between whole
+    // keys) is refused at parse, naming the key, the frame and the value, not at the first frame between.
+    CHECK_THAT(
+        f.error(withEntry(R"({"type": "slide", "params": {"falloff": {"keys": [{"frame": 1, "value": 0,
+                   "interpolation": "linear"}, {"frame": 3, "value": 2}]}}})")),
+        Contains(file + ": objects[0].stack[0].params.falloff.keys[0]: interpolates to 0.6366197723675815 at "
+                        "frame 1.6366197723675815 on its way to keys[1], which the parameter refuses") &&
+            Contains("(expected \"interpolation\": \"constant\" on this key for a whole-number parameter"));
+    CHECK_THAT(f.error(withEntry(R"({"type": "ffd", "params": {"divisions": {"keys": [{"frame": 1,
+                   "value": [1, 1, 1]}, {"frame": 4, "value": [4, 1, 1]}]}}})")),
+               Contains("params.divisions.keys[0]: interpolates to (2.5, 1, 1) at frame 2.5"));
+    // Stepped, or with keys the curve joins by values the parameter takes, it parses.
+    CHECK(f.error(withEntry(R"({"type": "ffd", "params": {"divisions": {"keys": [{"frame": 1,
+              "value": [1, 1, 1], "interpolation": "constant"}, {"frame": 4, "value": [4, 1, 1]}]}}})")) ==
+          "no error");
+    CHECK(f.error(withEntry(R"({"type": "slide", "params": {"falloff": {"keys": [{"frame": 1, "value": 1},
+              {"frame": 3, "value": 1}]}}})")) == "no error");
     CHECK_THAT(f.error(withEntry(R"({"type": "twist", "envelope": [1, 2]})")),
                Contains("objects[0].stack[0].envelope: has 2 components"));
     CHECK_THAT(f.error(withEntry(R"({"type": "twist"}, {"type": "taper", "label": "twist1"})")),
