@@ -46,36 +46,58 @@ inline void requireKnownKeys(const json& object, const std::string& source, cons
     }
 }
 
+// "path[i]" and "path.key" (key alone at the top level).
+inline std::string jsonIndex(const std::string& path, size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+}
+inline std::string jsonMember(const std::string& path, std::string_view key) {
+    return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
 // Parses `text`; ParseError naming `source`, the line and column and what the file should be (`expected`).
-// A key given twice in one object is a ParseError naming it and the keys around it: JSON readers keep one of
-// the two silently (nlohmann the last), so a value the user wrote would be ignored.
+// A key given twice in one object is an InvalidInput naming it by its full path
+// ("objects[1].stack[0].label"): the text is JSON, but JSON readers keep one of the two silently (nlohmann
+// the last), so a value the user wrote would be ignored.
 inline json parseJson(std::string_view text, const std::string& source, const std::string& expected) {
-    std::vector<std::set<std::string>> keys;  // per open object, its keys so far
-    std::vector<std::string> path;            // per open object, the key being read (empty in arrays)
+    // Per open container: an object's keys so far and the key being read, or an array's element index.
+    struct Open {
+        bool array = false;
+        std::set<std::string> keys;
+        std::string key;
+        int64_t index = -1;
+    };
+    std::vector<Open> open;
     std::string duplicate;
+    const auto where = [&](size_t depth) {
+        std::string path;
+        for (size_t d = 0; d < depth; ++d)
+            path = open[d].array ? jsonIndex(path, static_cast<size_t>(open[d].index))
+                                 : jsonMember(path, open[d].key);
+        return path;
+    };
     const json::parser_callback_t check = [&](int, json::parse_event_t event, json& parsed) {
-        if (event == json::parse_event_t::object_start) {
-            keys.emplace_back();
-        } else if (event == json::parse_event_t::object_end && !keys.empty()) {
-            keys.pop_back();
-            path.resize(std::min(path.size(), keys.size()));
-        } else if (event == json::parse_event_t::key && !keys.empty()) {
+        using Event = json::parse_event_t;
+        // A value, an object or an array starting inside an array is its next element.
+        const bool starts =
+            event == Event::value || event == Event::object_start || event == Event::array_start;
+        if (starts && !open.empty() && open.back().array) ++open.back().index;
+        if (event == Event::object_start || event == Event::array_start) {
+            open.push_back(Open{event == Event::array_start, {}, {}, -1});
+        } else if ((event == Event::object_end || event == Event::array_end) && !open.empty()) {
+            open.pop_back();
+        } else if (event == Event::key && !open.empty()) {
             const std::string key = parsed.get<std::string>();
-            if (!keys.back().insert(key).second && duplicate.empty()) {
-                std::string where;
-                for (size_t d = 0; d + 1 < keys.size() && d < path.size(); ++d)
-                    where += (where.empty() ? "" : ".") + path[d];
-                duplicate = where.empty() ? key : where + "." + key;
-            }
-            path.resize(keys.size());
-            path.back() = key;
+            if (!open.back().keys.insert(key).second && duplicate.empty())
+                duplicate = jsonMember(where(open.size() - 1), key);
+            open.back().key = key;
         }
         return true;
     };
     try {
         json root = json::parse(text.begin(), text.end(), check);
         if (!duplicate.empty()) {
-            throw ParseError(formatError(source, duplicate, "is given twice in one object", "each key once"));
+            throw InvalidInput(
+                formatError(source, duplicate, "is given twice in one object", "each key once"));
         }
         return root;
     } catch (const json::exception& e) {
@@ -86,14 +108,6 @@ inline json parseJson(std::string_view text, const std::string& source, const st
         throw ParseError(
             formatError(source, "", at == std::string::npos ? what : what.substr(at + 2), expected));
     }
-}
-
-// "path[i]" and "path.key" (key alone at the top level).
-inline std::string jsonIndex(const std::string& path, size_t i) {
-    return path + "[" + std::to_string(i) + "]";
-}
-inline std::string jsonMember(const std::string& path, std::string_view key) {
-    return path.empty() ? std::string(key) : path + "." + std::string(key);
 }
 
 }  // namespace deformkit::scene::detail
