@@ -21,9 +21,19 @@ std::vector<float> parseWeightsFile(std::string_view text, size_t count, const s
     constexpr const char* kExpected = "a JSON array of one number per vertex, or {\"weights\": [...]}";
     const json root = detail::parseJson(text, source, kExpected);
     const json* array = &root;
-    if (root.is_object() && root.contains("weights")) array = &root.at("weights");
-    if (!array->is_array())
-        throw InvalidInput(formatError(source, "(top level)", "is " + detail::jsonKind(root), kExpected));
+    std::string path;  // of the array: "" at the top level, "weights" in the object form
+    if (root.is_object()) {
+        // The object form holds "weights" and nothing else: a misspelt key is an error, not ignored.
+        detail::requireKnownKeys(root, source, "", {"weights"});
+        if (!root.contains("weights"))
+            throw InvalidInput(formatError(source, "weights", "is missing", kExpected));
+        array = &root.at("weights");
+        path = "weights";
+    }
+    if (!array->is_array()) {
+        throw InvalidInput(formatError(source, path.empty() ? "(top level)" : path,
+                                       "is " + detail::jsonKind(*array), kExpected));
+    }
     if (array->size() != count) {
         throw InvalidInput(formatError(source, "", "has " + std::to_string(array->size()) + " weights",
                                        std::to_string(count) + ", one per vertex of the mesh"));
@@ -31,7 +41,7 @@ std::vector<float> parseWeightsFile(std::string_view text, size_t count, const s
     std::vector<float> weights(count);
     for (size_t i = 0; i < count; ++i) {
         const json& v = (*array)[i];
-        const std::string element = detail::jsonIndex("", i);
+        const std::string element = detail::jsonIndex(path, i);
         if (!v.is_number())
             throw InvalidInput(formatError(source, element, "is " + detail::jsonKind(v), "a number"));
         const double d = v.get<double>();

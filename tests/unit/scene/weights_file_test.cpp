@@ -20,13 +20,28 @@ TEST_CASE("weights file: an array of one number per vertex; errors name the file
     CHECK_THAT(test::errorOf<Error>([] { (void)scene::parseWeightsFile("[0, \"a\", 1]", 3, "w.json"); }),
                Catch::Contains("w.json: [1]: is a string"));
     CHECK_THAT(test::errorOf<Error>([] { (void)scene::parseWeightsFile("{\"w\": 1}", 1, "w.json"); }),
-               Catch::Contains("an object"));
+               Catch::Contains("w.json: w: is not a known key (expected one of: weights)"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)scene::parseWeightsFile("{}", 1, "w.json"); }),
+               Catch::Contains("w.json: weights: is missing"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)scene::parseWeightsFile("7", 1, "w.json"); }),
+               Catch::Contains("w.json: (top level): is a number"));
     CHECK_THROWS_AS(scene::parseWeightsFile("[0, 1", 2, "w.json"), ParseError);
     CHECK_THAT(test::errorOf<Error>([] { (void)scene::parseWeightsFile("[0, 1e999]", 2, "w.json"); }),
                Catch::Contains("w.json"));
     // The scene's object form.
     CHECK(scene::parseWeightsFile(R"({"weights": [0.25, 1]})", 2, "w.json") ==
           std::vector<float>{0.25f, 1.0f});
+    // Its errors name the key: a misspelt neighbour, a value that is not an array, an element.
+    CHECK_THAT(test::errorOf<InvalidInput>([] {
+                   (void)scene::parseWeightsFile(R"({"weights": [1], "wieghts_scale": 0})", 1, "w.json");
+               }),
+               Catch::Contains("w.json: wieghts_scale: is not a known key"));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([] { (void)scene::parseWeightsFile(R"({"weights": 5})", 1, "w.json"); }),
+        Catch::Contains("w.json: weights: is a number"));
+    CHECK_THAT(test::errorOf<InvalidInput>(
+                   [] { (void)scene::parseWeightsFile(R"({"weights": [1, null]})", 2, "w.json"); }),
+               Catch::Contains("w.json: weights[1]: is null"));
 }
 
 TEST_CASE("weights file: written weights read back bit for bit", "[scene][weights_file]") {
