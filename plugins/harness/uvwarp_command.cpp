@@ -19,6 +19,7 @@
 #include "deformkit/io/obj.h"
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
+#include "deformkit/scene/scene.h"
 #include "deformkit/uvwarp/bake.h"
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/html_report.h"
@@ -33,7 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr int64_t kMaxFrames = 1000000;
+using scene::kMaxFrames;
 
 // A decimal integer at text[pos] (an optional leading '-'), advancing pos; false when there is none.
 bool parseInteger(std::string_view text, size_t& pos, int64_t& value) {

@@ -82,7 +82,8 @@ class Reader {
     }
 
     std::string string(const json& v, const std::string& path, const std::string& expected) const {
-        if (!v.is_string() || v.get<std::string>().empty()) fail(path, "is " + detail::jsonKind(v), expected);
+        if (!v.is_string()) fail(path, "is " + detail::jsonKind(v), expected);
+        if (v.get<std::string>().empty()) fail(path, "is empty", expected);
         return v.get<std::string>();
     }
 
@@ -612,6 +613,11 @@ class Reader {
         s.lastFrame = integer(frames[1], "frames[1]");
         if (s.lastFrame < s.firstFrame) {
             fail("frames", "is " + frames.dump(), "[first, last] with last >= first");
+        }
+        const int64_t count = static_cast<int64_t>(s.lastFrame) - s.firstFrame + 1;
+        if (count > kMaxFrames) {
+            fail("frames", "is " + frames.dump() + ", " + std::to_string(count) + " frames",
+                 "at most " + std::to_string(kMaxFrames) + " frames");
         }
         if (!root.contains("objects")) fail("objects", "is missing", "an array of objects");
         const json& objects = root.at("objects");

@@ -103,6 +103,12 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
                Contains(file + ": a.z: is given twice"));  // containers closed inside keep the path right
     CHECK(f.error(withEntry(twist + R"({"endAngle": 1.5}}, )" + twist +
                             R"({"endAngle": 1}, "label": "b"})")) == "no error");
+    // A range of more frames than a job takes (a typo) is refused before anything is written.
+    CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5000000], "objects": []})"),
+               Contains(file + ": frames: is [1,5000000], 5000000 frames (expected at most 1000000 frames)"));
+    CHECK(f.error(R"({"deformkit_scene": 1, "frames": [1, 1000000], "objects": []})") == "no error");
+    CHECK_THAT(f.error(withEntry(R"({"type": "twist", "label": ""})")),
+               Contains(file + ": objects[0].stack[0].label: is empty (expected a non-empty string)"));
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": "1-5", "objects": []})"),
                Contains("frames: is a string") && Contains("[first, last]"));
     CHECK_THAT(

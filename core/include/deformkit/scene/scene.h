@@ -91,6 +91,10 @@ struct SceneObject {
     std::string path;                   // "objects[0]"
 };
 
+// The most frames a job takes: a scene's range, a --frames list. A typo ("frames": [1, 5000000]) is refused
+// before millions of files are written or the frame list fills memory.
+inline constexpr int64_t kMaxFrames = 1000000;
+
 // A DeformKit scene (docs/scene.md): objects, each a rest mesh under a deformer stack whose parameters
 // and envelopes are constant or keyframed, and a default frame range.
 struct Scene {
