@@ -372,6 +372,21 @@ class Reader {
         }
     }
 
+    // Adds a stack entry's label to `labels`, naming the entry when an earlier one has it: its "label", or,
+    // where the entry has none, the default label it was given (its type and entry number).
+    void requireNewLabel(std::set<std::string>& labels, const std::string& label, const json& entry,
+                         const std::string& entryPath) const {
+        if (labels.insert(label).second) return;
+        if (entry.contains("label")) {
+            fail(entryPath + ".label", "is \"" + label + "\", used by an earlier entry",
+                 "a label unique in the stack");
+        }
+        fail(entryPath,
+             "has no label, and its default one (type and entry number), \"" + label +
+                 "\", is an earlier entry's",
+             "a label unique in the stack: give this entry a \"label\"");
+    }
+
     // A number in [lo, hi]; whole when `whole`.
     double ranged(const json& v, const std::string& path, double lo, double hi, bool whole,
                   const std::string& expected) const {
@@ -575,17 +590,11 @@ class Reader {
                         "the UV warp as the last entry: it works in texture space on the stack's result");
                 }
                 o.uvwarp = uvwarp(stack[i], entryPath, i, o.rest);
-                if (!labels.insert(o.uvwarp->label).second) {
-                    fail(entryPath + ".label", "is \"" + o.uvwarp->label + "\", used by an earlier entry",
-                         "a label unique in the stack");
-                }
+                requireNewLabel(labels, o.uvwarp->label, stack[i], entryPath);
                 continue;
             }
             SceneDeformer d = deformer(stack[i], entryPath, i, o.rest, o.meshFile);
-            if (!labels.insert(d.label).second) {
-                fail(entryPath + ".label", "is \"" + d.label + "\", used by an earlier entry",
-                     "a label unique in the stack");
-            }
+            requireNewLabel(labels, d.label, stack[i], entryPath);
             o.stack.push_back(std::move(d));
         }
         return o;

@@ -162,6 +162,10 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
                Contains("objects[0].stack[0].envelope: has 2 components"));
     CHECK_THAT(f.error(withEntry(R"({"type": "twist"}, {"type": "taper", "label": "twist1"})")),
                Contains("objects[0].stack[1].label: is \"twist1\""));
+    CHECK_THAT(f.error(withEntry(R"({"type": "twist", "label": "twist2"}, {"type": "twist"})")),
+               Contains(file + ": objects[0].stack[1]: has no label, and its default one (type and entry "
+                               "number), \"twist2\", is an earlier entry's") &&
+                   Contains("give this entry a \"label\""));
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5], "objects": [{"name": "tube",
                    "mesh": "missing.obj", "stack": []}]})"),
                Contains("objects[0].mesh: names") && Contains("missing.obj, which does not exist"));
