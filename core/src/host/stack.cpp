@@ -151,9 +151,10 @@ std::span<const float> DeformerStack::weights(size_t index) const {
 
 void DeformerStack::setEnvelope(size_t index, double envelope) {
     Entry& e = entry(index);
-    if (!std::isfinite(envelope)) {
+    // Applied in float32, as every parameter: a double beyond float range would become infinite there.
+    if (!std::isfinite(envelope) || std::abs(envelope) > std::numeric_limits<float>::max()) {
         throw InvalidInput(formatError(entryName(index), "parameter 'envelope'", "is " + numberText(envelope),
-                                       "a finite number, usually in [0, 1]"));
+                                       "a finite number within float range, usually in [0, 1]"));
     }
     e.envelope = envelope;
 }

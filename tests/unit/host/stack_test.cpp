@@ -402,6 +402,10 @@ TEST_CASE("bad inputs are reported with the entry and the parameter", "[host][st
                       Contains("stack entry 2 (slide 'slide1'): parameter 'displacement': value 1 is nan"));
     CHECK_THROWS_WITH(stack.set(2, "envelope", std::numeric_limits<double>::infinity()),
                       Contains("stack entry 2 (slide 'slide1'): parameter 'envelope': is inf"));
+    CHECK_THROWS_WITH(
+        stack.set(2, "envelope", 1e39),
+        Contains("stack entry 2 (slide 'slide1'): parameter 'envelope': is 1e+39 (expected a finite "
+                 "number within float range, usually in [0, 1])"));
     CHECK_THROWS_WITH(stack.set(2, "envelope", std::vector<double>{1, 1}),
                       Contains("parameter 'envelope': has 2 values"));
     CHECK_THROWS_WITH(stack.setWeights(0, std::vector<float>(n - 1, 1.0f)),
