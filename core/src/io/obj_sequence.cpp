@@ -168,14 +168,14 @@ ObjContent ObjSequence::read(int frame) {
     }
     const auto counts = mesh.faceCounts();
     const auto indices = mesh.faceIndices();
+    if (counts.size() != referenceCounts_.size()) {
+        throw InvalidInput(formatError(path.string(), "",
+                                       "has " + std::to_string(counts.size()) + " faces instead of " +
+                                           std::to_string(referenceCounts_.size()),
+                                       expected));
+    }
     size_t offset = 0;
-    for (size_t f = 0; f < std::max(counts.size(), referenceCounts_.size()); ++f) {
-        if (f >= counts.size() || f >= referenceCounts_.size()) {
-            throw InvalidInput(formatError(path.string(), "face " + std::to_string(f),
-                                           "has " + std::to_string(counts.size()) + " faces instead of " +
-                                               std::to_string(referenceCounts_.size()),
-                                           expected));
-        }
+    for (size_t f = 0; f < counts.size(); ++f) {
         const auto size = static_cast<size_t>(counts[f]);
         const auto mine = indices.subspan(offset, size);
         const bool sameCount = counts[f] == referenceCounts_[f];

@@ -126,7 +126,7 @@ TEST_CASE("obj sequence: read checks every frame against the first frame read", 
         d.faceIndices.assign(grid.faceIndices().begin(), grid.faceIndices().end() - 4);
         writeObj(sequence.framePath(5), Mesh(std::move(d)));
         CHECK_THROWS_WITH(sequence.read(5),
-                          Catch::Contains("grid.0005.obj: face 5: has 5 faces instead of 6"));
+                          Catch::Contains("grid.0005.obj: has 5 faces instead of 6 (expected the topology"));
     }
     SECTION("a triangle where the quad was") {
         const Mesh grid = liftedGrid(0.0f);
