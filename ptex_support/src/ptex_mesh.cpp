@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <memory>
+#include <unordered_map>
 
 #include <opensubdiv/far/ptexIndices.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -103,16 +104,71 @@ std::vector<FaceInfo> PtexMesh::faceInfos(int8_t ulog2, int8_t vlog2) const {
 }
 
 void PtexMesh::requireMatches(const PtexFile& file, const std::string& fileSource) const {
+    if (file.meshType != MeshType::Quad) {
+        throw InvalidInput(formatError(fileSource, "header", "is a triangle-mesh Ptex file",
+                                       "a quad-mesh Ptex file (Catmull-Clark faces) for mesh " + source_));
+    }
     if (file.faces.size() != meshFace_.size()) {
         throw InvalidInput(formatError(fileSource, "", "has " + std::to_string(file.faces.size()) + " faces",
                                        std::to_string(meshFace_.size()) +
                                            " Ptex faces (one per quad, N per N-gon) for mesh " + source_));
     }
-    if (file.meshType != MeshType::Quad) {
-        throw InvalidInput(formatError(fileSource, "header", "is a triangle-mesh Ptex file",
-                                       "a quad-mesh Ptex file (Catmull-Clark faces) for mesh " + source_));
-    }
+    requireSameMesh(file, fileSource);
     detail::requireAdjacency(file.faces, fileSource);
+}
+
+void PtexMesh::requireSameMesh(const PtexFile& file, const std::string& fileSource) const {
+    const auto find = [&](const char* key) -> const MetaValue* {
+        for (const MetaValue& m : file.metadata)
+            if (m.key == key && m.type == MetaType::Int32) return &m;
+        return nullptr;
+    };
+    const MetaValue* counts = find("PtexFaceVertCounts");
+    const MetaValue* indices = find("PtexFaceVertIndices");
+    if (counts == nullptr || indices == nullptr) return;  // a file without its mesh: the face count decides
+    const std::string expected = "the polygons of mesh " + source_ +
+                                 ", in its order (a file painted on this mesh; its vertices may be "
+                                 "numbered otherwise)";
+    if (counts->int32s.size() != faceCounts_.size()) {
+        throw InvalidInput(formatError(fileSource, "metadata PtexFaceVertCounts",
+                                       "lists " + std::to_string(counts->int32s.size()) + " polygons",
+                                       std::to_string(faceCounts_.size()) + ": " + expected));
+    }
+    // Polygon by polygon, corner by corner: the same sizes, and the file's vertices one-to-one with the
+    // mesh's (a renumbering of vertices keeps every face's texels where they were; another order of
+    // polygons does not).
+    std::unordered_map<int32_t, int32_t> meshVertexOf, fileVertexOf;
+    size_t corner = 0;
+    for (size_t f = 0; f < faceCounts_.size(); ++f) {
+        const int32_t n = faceCounts_[f];
+        const auto polygon = [&](const std::string& problem) {
+            throw InvalidInput(
+                formatError(fileSource, "metadata: polygon " + std::to_string(f), problem, expected));
+        };
+        if (counts->int32s[f] != n) {
+            polygon("has " + std::to_string(counts->int32s[f]) + " corners where mesh polygon " +
+                    std::to_string(f) + " has " + std::to_string(n));
+        }
+        if (indices->int32s.size() < corner + static_cast<size_t>(n))
+            polygon("has no PtexFaceVertIndices left");
+        for (int32_t c = 0; c < n; ++c, ++corner) {
+            const int32_t theirs = indices->int32s[corner], ours = faceIndices_[corner];
+            const auto [mine, addedMine] = meshVertexOf.try_emplace(theirs, ours);
+            const auto [other, addedOther] = fileVertexOf.try_emplace(ours, theirs);
+            if (mine->second != ours || other->second != theirs) {
+                // The earlier pairing this corner breaks: of its file vertex, or of its mesh vertex.
+                const std::string earlier = mine->second != ours
+                                                ? "file vertex " + std::to_string(theirs) +
+                                                      " was mesh vertex " + std::to_string(mine->second)
+                                                : "mesh vertex " + std::to_string(ours) +
+                                                      " was file vertex " + std::to_string(other->second);
+                polygon("corner " + std::to_string(c) + " pairs file vertex " + std::to_string(theirs) +
+                        " with mesh vertex " + std::to_string(ours) + ", but in the polygons before it " +
+                        earlier +
+                        ": the file was painted on another mesh, or on its polygons in another order");
+            }
+        }
+    }
 }
 
 MeshData meshData(const geom::Mesh& mesh) {

@@ -417,6 +417,60 @@ TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and bot
                Catch::Contains("face 3 edge 1"));
 }
 
+TEST_CASE("ptex mesh: a file whose mesh metadata lists other polygons, or these in another order, is refused",
+          "[ptex][mesh]") {
+    const geom::Mesh mesh = mixedMesh();
+    const PtexMesh pm(mesh, "mixed.obj");
+    const std::vector<int32_t> counts(mesh.faceCounts().begin(), mesh.faceCounts().end());
+    const std::vector<int32_t> indices(mesh.faceIndices().begin(), mesh.faceIndices().end());
+    const auto painted = [&](const std::vector<int32_t>& c, const std::vector<int32_t>& i) {
+        ptex::PtexFile file = bakePaint(mesh, pm, 1);
+        file.metadata.push_back(ptex::MetaValue::ofInt32("PtexFaceVertCounts", c));
+        file.metadata.push_back(ptex::MetaValue::ofInt32("PtexFaceVertIndices", i));
+        return file;
+    };
+    const std::vector<float> reference = ptex::vertexValues(pm, bakePaint(mesh, pm, 1), "paint.ptx");
+    // Its own polygons, and the same with the vertices numbered otherwise (one-to-one): read alike.
+    CHECK(ptex::vertexValues(pm, painted(counts, indices), "paint.ptx") == reference);
+    std::vector<int32_t> renumbered = indices;
+    for (int32_t& v : renumbered)
+        v = (v * 7 + 3) % mesh.numVertices();  // 7 is prime to 11 vertices: a permutation
+    CHECK(ptex::vertexValues(pm, painted(counts, renumbered), "paint.ptx") == reference);
+    // The same polygons in another order (Q0 and Q1 swapped: the same face count and sizes), as a mesh
+    // exported again would list them: every face's texels would land on another face.
+    geom::Mesh::Data swapped;
+    swapped.points.assign(mesh.points().begin(), mesh.points().end());
+    swapped.faceCounts = counts;
+    swapped.faceIndices = indices;
+    std::swap_ranges(swapped.faceIndices.begin(), swapped.faceIndices.begin() + 4,
+                     swapped.faceIndices.begin() + 4);
+    const geom::Mesh reordered(std::move(swapped), "reordered");
+    const PtexMesh other(reordered, "reordered.obj");
+    CHECK_THAT(
+        test::errorOf<InvalidInput>(
+            [&] { (void)ptex::vertexValues(other, painted(counts, indices), "paint.ptx"); }),
+        Catch::Contains(
+            "paint.ptx: metadata: polygon 1: corner 0 pairs file vertex 1 with mesh vertex 0, but in "
+            "the polygons before it file vertex 1 was mesh vertex 2: ") &&
+            Catch::Contains("the file was painted on another mesh, or on its polygons in another order "
+                            "(expected the polygons of mesh reordered.obj, in its order"));
+    std::vector<int32_t> triangleFirst = counts;
+    triangleFirst[0] = 3;
+    CHECK_THAT(test::errorOf<InvalidInput>(
+                   [&] { (void)ptex::vertexValues(pm, painted(triangleFirst, indices), "paint.ptx"); }),
+               Catch::Contains("paint.ptx: metadata: polygon 0: has 3 corners where mesh polygon 0 has 4"));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)ptex::vertexValues(pm, painted({4, 4}, {0, 1, 5, 4, 1, 2, 6, 5}), "paint.ptx");
+               }),
+               Catch::Contains("paint.ptx: metadata PtexFaceVertCounts: lists 2 polygons (expected 6: "));
+    // A triangle-mesh file is named as one, whatever its face count.
+    ptex::PtexFile triangles = bakePaint(mesh, pm, 1);
+    triangles.meshType = ptex::MeshType::Triangle;
+    triangles.faces.pop_back();
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::vertexValues(pm, triangles, "tri.ptx"); }),
+               Catch::Contains("tri.ptx: header: is a triangle-mesh Ptex file"));
+}
+
 TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[ptex][mesh][udim]") {
     // UVs are an affine image of the positions, so a painting linear in UV is linear on every face. From
     // UDIM: each texel is the bilinear image sample at its UV, exact for a linear image away from the tile

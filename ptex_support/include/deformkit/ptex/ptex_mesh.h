@@ -62,9 +62,15 @@ class PtexMesh {
     // Face records for a file of this mesh: every face at 2^ulog2 × 2^vlog2, adjacency, sub-face flags.
     [[nodiscard]] std::vector<FaceInfo> faceInfos(int8_t ulog2, int8_t vlog2) const;
 
-    // Throws InvalidInput naming `fileSource` when `file` does not belong to this mesh: its face count
-    // differs (naming both counts and the mesh), or a face's adjacency points outside the file.
+    // Throws InvalidInput naming `fileSource` when `file` does not belong to this mesh: a triangle-mesh
+    // file, another face count (naming both counts and the mesh), mesh metadata of other polygons
+    // (requireSameMesh), or a face's adjacency pointing outside the file.
     void requireMatches(const PtexFile& file, const std::string& fileSource) const;
+    // Where `file` carries the standard mesh metadata (PtexFaceVertCounts and PtexFaceVertIndices, as
+    // DeformKit, Mudbox and Mari write them): its polygons must be this mesh's, in this mesh's order, their
+    // vertices possibly numbered otherwise (one-to-one). A file painted on the same polygons in another
+    // order has the same face count and would put every face's texels on another face.
+    void requireSameMesh(const PtexFile& file, const std::string& fileSource) const;
 
   private:
     std::string source_;
