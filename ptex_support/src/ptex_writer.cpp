@@ -154,6 +154,8 @@ class Writer {
         }
         if (options_.tileBytes == 0) fail("tile size", "is 0 bytes", "at least 1");
         const size_t n = file_.faces.size();
+        // The reference library writes no file without faces, and reads none ("unzip failed").
+        if (n == 0) fail("faces", "are none", "at least one face");
         if (n > 0x7fffffffu) fail("faces", "are " + std::to_string(n), "fewer than 2^31");
         if (file_.texels.size() != n) {
             fail("texels", "has " + std::to_string(file_.texels.size()) + " faces",
@@ -216,6 +218,13 @@ class Writer {
         const size_t size = m.bytes().size();
         if (size > 0xffffffffu) fail(element, "is larger than 4 GiB", "a smaller value");
         if (size == 0) fail(element, "key '" + m.key + "' has no values", "at least one value");
+        // Stored NUL-terminated: readers (the reference library, renderers) stop at the first NUL.
+        if (m.type == MetaType::String && m.string.find('\0') != std::string::npos) {
+            fail(element,
+                 "key '" + m.key + "' has a NUL byte at " + std::to_string(m.string.find('\0')) +
+                     " of its text",
+                 "text without NUL");
+        }
         if (options_.mesh &&
             (m.key == kFaceVertCounts || m.key == kFaceVertIndices || m.key == kVertPositions)) {
             fail(element, "key '" + m.key + "' is also given as WriteOptions::mesh", "one or the other");
@@ -245,6 +254,25 @@ class Writer {
                 fail("mesh vertex index " + std::to_string(i),
                      "is " + std::to_string(mesh.faceVertIndices[i]), "0.." + std::to_string(vertices - 1));
             }
+        }
+        // The faces are the mesh's Ptex faces: a triangle file has one per triangle (and only triangles), a
+        // quad file one per quad and N per other N-gon.
+        int64_t ptexFaces = 0;
+        for (size_t i = 0; i < mesh.faceVertCounts.size(); ++i) {
+            const int32_t count = mesh.faceVertCounts[i];
+            if (file_.meshType == MeshType::Triangle && count != 3) {
+                fail("mesh polygon " + std::to_string(i),
+                     "has " + std::to_string(count) + " vertices in a triangle-mesh file",
+                     "triangles only (or a quad-mesh file)");
+            }
+            ptexFaces += file_.meshType == MeshType::Triangle || count == 4 ? 1 : count;
+        }
+        if (ptexFaces != static_cast<int64_t>(file_.faces.size())) {
+            fail("mesh", "has " + std::to_string(ptexFaces) + " Ptex faces",
+                 std::to_string(file_.faces.size()) + ", the file's faces (" +
+                     (file_.meshType == MeshType::Triangle ? "one per triangle"
+                                                           : "one per quad, N per N-gon") +
+                     ")");
         }
     }
 

@@ -187,7 +187,11 @@ TEST_CASE("a file written to disk reads back the same, with the standard mesh me
     deformkit::test::TempDir dir;
     PtexFile file = sampleFile(DataType::Half, {4, 3}, 99);
     WriteOptions options;
-    options.mesh = MeshData{{4, 3}, {0, 1, 2, 3, 1, 4, 2}, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 2, 0, 0}};
+    // A pentagon (5 Ptex faces) and two quads: the file's 7 faces.
+    options.mesh = MeshData{{5, 4, 4},
+                            {0, 1, 2, 3, 4, 1, 5, 6, 2, 2, 6, 7, 3},
+                            {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 0, 0, 2, 0, 0, 2, 1, 0, 1, 2, 0}};
+    REQUIRE(file.faces.size() == 7);
     writePtex(dir / "mesh.ptx", file, options);
     const PtexFile back = readPtex(dir / "mesh.ptx");
     REQUIRE(back.metadata.size() == 3);
@@ -203,7 +207,7 @@ TEST_CASE("a file written to disk reads back the same, with the standard mesh me
     CHECK(compareFiles(file, withoutMesh) == 0);
 }
 
-TEST_CASE("writing without reductions, or with no faces, still reads back", "[ptex][roundtrip]") {
+TEST_CASE("writing without reductions still reads back; a file of no faces is refused", "[ptex][roundtrip]") {
     PtexFile file = sampleFile(DataType::UInt16, {3, -1}, 7);
     WriteOptions options;
     options.reductions = false;
@@ -211,11 +215,11 @@ TEST_CASE("writing without reductions, or with no faces, still reads back", "[pt
     CHECK(tp::parseHeader(bytes).levels == 1);
     CHECK(compareFiles(file, readPtex(bytes, "flat.ptx")) == 0);
 
+    // The reference library writes none and reads none ("unzip failed").
     PtexFile empty;
     empty.channels = 2;
-    const PtexFile back = readPtex(writePtexBytes(empty), "empty.ptx");
-    CHECK(back.faces.empty());
-    CHECK(back.channels == 2);
+    CHECK_THROWS_WITH(writePtexBytes(empty),
+                      Catch::Matchers::Contains("faces: are none (expected at least one face)"));
 }
 
 TEST_CASE("the writer rejects what it cannot write, naming the face or entry", "[ptex][roundtrip][errors]") {
@@ -247,4 +251,25 @@ TEST_CASE("the writer rejects what it cannot write, naming the face or entry", "
     WriteOptions options;
     options.mesh = MeshData{{4}, {0, 1, 2, 5}, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}};
     CHECK_THROWS_WITH(writePtexBytes(file, options), Catch::Matchers::Contains("vertex index 3"));
+    // Mesh metadata must describe the file's faces: one per triangle in a triangle file, one per quad and N
+    // per N-gon in a quad file.
+    options.mesh = MeshData{{4}, {0, 1, 2, 3}, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}};
+    CHECK_THROWS_WITH(
+        writePtexBytes(file, options),
+        Catch::Matchers::Contains("mesh: has 1 Ptex faces (expected " + std::to_string(file.faces.size()) +
+                                  ", the file's faces (one per quad, N per N-gon))"));
+    bad = file;
+    bad.meshType = MeshType::Triangle;
+    for (FaceInfo& info : bad.faces)
+        info.vlog2 = info.ulog2;
+    for (size_t f = 0; f < bad.faces.size(); ++f)
+        bad.texels[f].resize(bad.faces[f].texelCount() * bad.pixelSize());
+    CHECK_THROWS_WITH(writePtexBytes(bad, options),
+                      Catch::Matchers::Contains("mesh polygon 0: has 4 vertices in a triangle-mesh file"));
+    // Metadata text is stored NUL-terminated: a NUL inside would cut it short in every reader.
+    bad = file;
+    bad.metadata.push_back(MetaValue::ofString("note", std::string("ab\0cd", 5)));
+    CHECK_THROWS_WITH(
+        writePtexBytes(bad),
+        Catch::Matchers::Contains("metadata entry 0: key 'note' has a NUL byte at 2 of its text"));
 }
