@@ -74,10 +74,40 @@ py::array arrayOf(const std::vector<T>& values) {
     return out;
 }
 
+// Ptex metadata text is bytes, Python text is str: bytes that are not UTF-8 (a key or value written by a
+// Latin-1 tool) become surrogate escapes (PEP 383), so a file reads whatever its encoding and writes back
+// byte for byte.
+py::str textOf(const std::string& bytes) {
+    PyObject* text =
+        PyUnicode_DecodeUTF8(bytes.data(), static_cast<Py_ssize_t>(bytes.size()), "surrogateescape");
+    if (text == nullptr) throw py::error_already_set();
+    return py::reinterpret_steal<py::str>(text);
+}
+
+// The bytes of `text` (a str: UTF-8, surrogate escapes back to their bytes); InvalidInput naming `element`
+// for anything else.
+std::string bytesOf(py::handle text, const std::string& source, const std::string& element) {
+    if (!py::isinstance<py::str>(text)) {
+        throw InvalidInput(formatError(source, element,
+                                       "is of type " + std::string(py::str(text.get_type().attr("__name__"))),
+                                       "a str"));
+    }
+    PyObject* bytes = PyUnicode_AsEncodedString(text.ptr(), "utf-8", "surrogateescape");
+    if (bytes == nullptr) {
+        PyErr_Clear();
+        throw InvalidInput(
+            formatError(source, element, "holds a lone surrogate that is no escaped byte",
+                        "text that encodes as UTF-8 (or bytes escaped as read_ptex gives them)"));
+    }
+    std::string out(PyBytes_AS_STRING(bytes), static_cast<size_t>(PyBytes_GET_SIZE(bytes)));
+    Py_DECREF(bytes);
+    return out;
+}
+
 py::object metaValue(const ptex::MetaValue& m) {
     switch (m.type) {
         case ptex::MetaType::String:
-            return py::str(m.string);
+            return textOf(m.string);
         case ptex::MetaType::Int8:
             return arrayOf(m.int8s);
         case ptex::MetaType::Int16:
@@ -93,7 +123,8 @@ py::object metaValue(const ptex::MetaValue& m) {
 }
 
 ptex::MetaValue metaFrom(const std::string& key, py::handle value, const std::string& source) {
-    if (py::isinstance<py::str>(value)) return ptex::MetaValue::ofString(key, value.cast<std::string>());
+    if (py::isinstance<py::str>(value))
+        return ptex::MetaValue::ofString(key, bytesOf(value, source, "metadata '" + key + "'"));
     const py::array a = py::array::ensure(value);
     if (!a || a.ndim() != 1) {
         throw InvalidInput(formatError(
@@ -165,7 +196,7 @@ py::dict toDict(const ptex::PtexFile& file) {
     out["data"] = data;
     py::dict metadata;
     for (const ptex::MetaValue& m : file.metadata)
-        metadata[py::str(m.key)] = metaValue(m);
+        metadata[textOf(m.key)] = metaValue(m);
     out["metadata"] = metadata;
     return out;
 }
@@ -303,8 +334,7 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
         const auto metadata =
             castArgument<py::dict>(d["metadata"], source, "metadata", "a dict of str -> str or array");
         for (const auto& [key, value] : metadata) {
-            const auto k =
-                castArgument<std::string>(key, source, "metadata key " + std::string(py::repr(key)), "a str");
+            const std::string k = bytesOf(key, source, "metadata key " + std::string(py::repr(key)));
             if (mesh && (k == "PtexFaceVertCounts" || k == "PtexFaceVertIndices" || k == "PtexVertPositions"))
                 continue;  // written from the mesh
             file.metadata.push_back(metaFrom(k, value, source));

@@ -112,6 +112,25 @@ def test_bad_input_names_the_problem(tmp_path):
         dk.read_ptex(tmp_path / "bad.ptx")
 
 
+def test_metadata_text_in_any_encoding_reads_and_writes_back_byte_for_byte(tmp_path):
+    # Ptex text is bytes: a Latin-1 tool writes "\xe9" where UTF-8 has "\xc3\xa9". Such bytes read as surrogate
+    # escapes (PEP 383), and written back are the same bytes.
+    latin1 = "caf\udce9"  # b"caf\xe9" read with errors="surrogateescape"
+    assert latin1.encode("utf-8", "surrogateescape") == b"caf\xe9"
+    data = {"data": [np.full((4, 4, 1), 0.5, np.float32)], "metadata": {latin1: "Ren\udce9", "utf8": "Ren\u00e9"}}
+    dk.write_ptex(tmp_path / "a.ptx", data)
+    # Read back as the same escapes: the file holds the lone byte 0xe9, which no UTF-8 text decodes to.
+    back = dk.read_ptex(tmp_path / "a.ptx")
+    assert back["metadata"] == {latin1: "Ren\udce9", "utf8": "Ren\u00e9"}
+    dk.write_ptex(tmp_path / "b.ptx", back)
+    assert dk.read_ptex(tmp_path / "b.ptx")["metadata"] == back["metadata"]
+    # A lone surrogate that is no escaped byte, and a key that is no str, are named.
+    with pytest.raises(dk.InvalidInput, match=r"metadata 'k': holds a lone surrogate"):
+        dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {"k": "\ud800"}})
+    with pytest.raises(dk.InvalidInput, match=r"metadata key 7: is of type int \(expected a str\)"):
+        dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {7: "x"}})
+
+
 def test_arguments_of_the_wrong_type_name_the_argument_and_what_was_expected(tmp_path):
     face = np.zeros((4, 4, 1), np.float32)
     grid = dk.make_grid(2, 2)
