@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <initializer_list>
+#include <map>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -186,9 +187,19 @@ py::dict toDict(const ptex::PtexFile& file) {
         face["constant"] = info.constant;
         face["subface"] = info.subface;
         faces.append(face);
+        const std::vector<py::ssize_t> shape{info.vres(), info.ures(), file.channels};
+        const size_t pixel = file.pixelSize();
+        if (file.texels[f].empty() && file.constData.size() >= (f + 1) * pixel) {
+            // A constant face is its one pixel seen at every texel (numpy.broadcast_to, read-only): a face
+            // declared 32768 x 32768 costs its pixel, not 16 GiB. write_ptex writes such a view back as a
+            // constant face.
+            py::array one(dtypeOf(file.dataType), std::vector<py::ssize_t>{1, 1, file.channels});
+            std::memcpy(one.mutable_data(), file.constData.data() + f * pixel, pixel);
+            data.append(py::module_::import("numpy").attr("broadcast_to")(one, py::tuple(py::cast(shape))));
+            continue;
+        }
         const std::vector<uint8_t> texels = ptex::expandedTexels(file, f);
-        py::array a(dtypeOf(file.dataType),
-                    std::vector<py::ssize_t>{info.vres(), info.ures(), file.channels});
+        py::array a(dtypeOf(file.dataType), shape);
         std::memcpy(a.mutable_data(), texels.data(), texels.size());
         data.append(a);
     }
@@ -241,6 +252,7 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
     ptex::PtexFile file;
     file.faces.resize(data.size());
     file.texels.resize(data.size());
+    std::map<size_t, std::vector<uint8_t>> constantPixels;  // per constant face, its pixel
     for (size_t f = 0; f < data.size(); ++f) {
         const py::array a = py::array::ensure(data[f]);
         const std::string element = "data[" + std::to_string(f) + "]";
@@ -259,11 +271,28 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
         }
         file.faces[f].vlog2 = log2Of(a.shape(0), source, element + " rows");
         file.faces[f].ulog2 = log2Of(a.shape(1), source, element + " columns");
+        if (a.strides(0) == 0 && a.strides(1) == 0) {
+            // One pixel broadcast over the face (read_ptex's constant faces): written as a constant face,
+            // without making the texels.
+            std::vector<uint8_t> pixel(static_cast<size_t>(channels) * static_cast<size_t>(a.itemsize()));
+            for (int32_t k = 0; k < channels; ++k) {
+                const auto* from =
+                    static_cast<const uint8_t*>(a.data()) + (a.ndim() == 3 ? k * a.strides(2) : 0);
+                std::memcpy(pixel.data() + static_cast<size_t>(k) * a.itemsize(), from, a.itemsize());
+            }
+            constantPixels.emplace(f, std::move(pixel));
+            continue;
+        }
         const py::array c = py::array::ensure(a, py::array::c_style);
         file.texels[f].assign(static_cast<const uint8_t*>(c.data()),
                               static_cast<const uint8_t*>(c.data()) + c.nbytes());
     }
     file.constData.assign(file.faces.size() * file.pixelSize(), 0);
+    for (const auto& [f, pixel] : constantPixels) {
+        std::copy(pixel.begin(), pixel.end(),
+                  file.constData.begin() + static_cast<std::ptrdiff_t>(f * pixel.size()));
+        file.faces[f].constant = true;
+    }
     if (d.contains("alpha_channel"))
         file.alphaChannel =
             castArgument<int32_t>(d["alpha_channel"], source, "alpha_channel", "an int (-1: none)");

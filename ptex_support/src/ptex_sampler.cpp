@@ -18,22 +18,24 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
     detail::requireBuffers(file, source);
     const size_t pixel = file.pixelSize(), bytes = bytesPerChannel(file.dataType);
     offsets_.resize(faces_.size() + 1);
+    constant_.resize(faces_.size());
     size_t total = 0;
     for (size_t f = 0; f < faces_.size(); ++f) {
         offsets_[f] = total;
-        total += faces_[f].texelCount() * static_cast<size_t>(channels_);
+        // A constant face (no texels of its own, as files of unpainted 32768^2 faces have) is one value.
+        constant_[f] = file.texels[f].empty() ? 1 : 0;
+        total += (constant_[f] ? 1 : faces_[f].texelCount()) * static_cast<size_t>(channels_);
     }
     offsets_.back() = total;
     values_.resize(total);
     for (size_t f = 0; f < faces_.size(); ++f) {
         float* out = values_.data() + offsets_[f];
-        const size_t count = faces_[f].texelCount() * static_cast<size_t>(channels_);
         const std::vector<uint8_t>& texels = file.texels[f];
-        if (texels.empty()) {  // constant face
-            for (size_t t = 0; t < count; ++t)
-                out[t] = detail::loadValue(file.constData.data() + f * pixel + (t % channels_) * bytes,
-                                           file.dataType);
+        if (constant_[f]) {
+            for (int32_t c = 0; c < channels_; ++c)
+                out[c] = detail::loadValue(file.constData.data() + f * pixel + c * bytes, file.dataType);
         } else {
+            const size_t count = faces_[f].texelCount() * static_cast<size_t>(channels_);
             for (size_t t = 0; t < count; ++t)
                 out[t] = detail::loadValue(texels.data() + t * bytes, file.dataType);
         }
@@ -46,10 +48,7 @@ void PtexSampler::acrossEdge(int32_t f, int edge, int32_t i, int32_t j, float* o
     int32_t g = info.adjFaces[edge];
     int ge = info.adjEdges[edge];
     if (g < 0) {  // boundary: repeat the edge texel
-        const float* src =
-            &values_[offsets_[f] + ((static_cast<size_t>(std::clamp(j, 0, vres - 1)) << info.ulog2) +
-                                    std::clamp(i, 0, ures - 1)) *
-                                       channels_];
+        const float* src = at(f, std::clamp(i, 0, ures - 1), std::clamp(j, 0, vres - 1));
         std::copy(src, src + channels_, out);
         return;
     }
@@ -100,7 +99,7 @@ void PtexSampler::acrossEdge(int32_t f, int edge, int32_t i, int32_t j, float* o
             gi = 0, gj = cell(1.0 - s, gv);
             break;
     }
-    const float* src = &values_[offsets_[g] + ((static_cast<size_t>(gj) << other.ulog2) + gi) * channels_];
+    const float* src = at(g, gi, gj);
     std::copy(src, src + channels_, out);
 }
 
@@ -109,7 +108,7 @@ void PtexSampler::ghost(int32_t f, int32_t i, int32_t j, float* out) const {
     const int32_t ures = info.ures(), vres = info.vres();
     const bool uOut = i < 0 || i >= ures, vOut = j < 0 || j >= vres;
     if (!uOut && !vOut) {
-        const float* src = &values_[offsets_[f] + ((static_cast<size_t>(j) << info.ulog2) + i) * channels_];
+        const float* src = at(f, i, j);
         std::copy(src, src + channels_, out);
         return;
     }
@@ -127,7 +126,7 @@ void PtexSampler::ghost(int32_t f, int32_t i, int32_t j, float* out) const {
     float a[64], b[64];
     acrossEdge(f, uEdge, i, cj, a);
     acrossEdge(f, vEdge, ci, j, b);
-    const float* c = &values_[offsets_[f] + ((static_cast<size_t>(cj) << info.ulog2) + ci) * channels_];
+    const float* c = at(f, ci, cj);
     for (int32_t k = 0; k < channels_; ++k)
         out[k] = a[k] + b[k] - c[k];
 }
@@ -143,11 +142,10 @@ void PtexSampler::sample(int32_t f, double u, double v, std::span<float> out) co
     float g00[64], g10[64], g01[64], g11[64];
     if (i0 >= 0 && j0 >= 0 && i0 + 1 < info.ures() && j0 + 1 < info.vres()) {
         // All four texels inside the face (the common case): read them in place.
-        const size_t row = static_cast<size_t>(info.ures()) * channels_;
-        t00 = &values_[offsets_[f] + ((static_cast<size_t>(j0) << info.ulog2) + i0) * channels_];
-        t10 = t00 + channels_;
-        t01 = t00 + row;
-        t11 = t01 + channels_;
+        t00 = at(f, i0, j0);
+        t10 = at(f, i0 + 1, j0);
+        t01 = at(f, i0, j0 + 1);
+        t11 = at(f, i0 + 1, j0 + 1);
     } else {
         ghost(f, i0, j0, g00);
         ghost(f, i0 + 1, j0, g10);

@@ -131,6 +131,25 @@ def test_metadata_text_in_any_encoding_reads_and_writes_back_byte_for_byte(tmp_p
         dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {7: "x"}})
 
 
+def test_constant_faces_read_as_one_pixel_seen_everywhere_and_write_back_as_constants(tmp_path):
+    # An unpainted face declared 32768 x 32768 (float RGBA: 16 GiB expanded) next to a painted one: read as a
+    # read-only broadcast of its pixel, written back byte for byte, sampled by ptex_vertex_values.
+    value = np.array([0.25, 0.5, 0.75, 1.0], np.float32)
+    painted = np.random.default_rng(3).random((4, 4, 4), dtype=np.float32)
+    dk.write_ptex(tmp_path / "c.ptx", {"data": [np.broadcast_to(value, (32768, 32768, 4)), painted]})
+    back = dk.read_ptex(tmp_path / "c.ptx")
+    big = back["data"][0]
+    assert big.shape == (32768, 32768, 4) and big.strides == (0, 0, 4) and not big.flags.writeable
+    assert back["faces"][0]["constant"] and not back["faces"][1]["constant"]
+    np.testing.assert_array_equal(big[[0, 12345, 32767], [32767, 0, 777]], np.tile(value, (3, 1)))
+    np.testing.assert_array_equal(back["data"][1], painted)
+    dk.write_ptex(tmp_path / "d.ptx", back)
+    assert (tmp_path / "d.ptx").read_bytes() == (tmp_path / "c.ptx").read_bytes()
+    # A face whose texels are all equal is written as a constant too, and so read.
+    dk.write_ptex(tmp_path / "e.ptx", {"data": [np.full((8, 8, 1), 0.5, np.float32)]})
+    assert dk.read_ptex(tmp_path / "e.ptx")["data"][0].strides[:2] == (0, 0)
+
+
 def test_arguments_of_the_wrong_type_name_the_argument_and_what_was_expected(tmp_path):
     face = np.zeros((4, 4, 1), np.float32)
     grid = dk.make_grid(2, 2)

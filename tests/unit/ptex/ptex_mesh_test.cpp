@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -280,6 +281,51 @@ TEST_CASE("ptex sampler: bilinear look-ups reproduce a linear painting across fa
         }
     }
     CHECK(worstInside < 1e-6);
+}
+
+TEST_CASE("ptex sampler: constant faces of any declared size cost one pixel and read across edges",
+          "[ptex][mesh]") {
+    // Faces 0 and 2 constant and declared 32768 x 32768 (float RGBA: 16 GiB each expanded), face 1 painted
+    // (2 x 2) between them: face 0's edge 1 meets face 1's edge 3, face 1's edge 1 meets face 2's edge 3.
+    ptex::PtexFile file;
+    file.dataType = ptex::DataType::Float;
+    file.channels = 4;
+    file.faces.resize(3);
+    file.texels.resize(3);
+    for (const int f : {0, 2}) {
+        file.faces[f].ulog2 = file.faces[f].vlog2 = 15;
+        file.faces[f].constant = true;
+    }
+    file.faces[1].ulog2 = file.faces[1].vlog2 = 1;
+    file.faces[0].adjFaces[1] = 1, file.faces[0].adjEdges[1] = 3;
+    file.faces[1].adjFaces[3] = 0, file.faces[1].adjEdges[3] = 1;
+    file.faces[1].adjFaces[1] = 2, file.faces[1].adjEdges[1] = 3;
+    file.faces[2].adjFaces[3] = 1, file.faces[2].adjEdges[3] = 1;
+    const std::array<float, 4> left{0.1f, 0.2f, 0.3f, 0.4f}, right{0.9f, 0.8f, 0.7f, 0.6f};
+    std::vector<float> painted(2 * 2 * 4);
+    for (size_t k = 0; k < painted.size(); ++k)
+        painted[k] = 0.05f * static_cast<float>(k);
+    file.texels[1].resize(painted.size() * sizeof(float));
+    std::memcpy(file.texels[1].data(), painted.data(), file.texels[1].size());
+    file.constData.resize(3 * file.pixelSize());
+    std::memcpy(file.constData.data(), left.data(), sizeof left);
+    std::memcpy(file.constData.data() + 2 * file.pixelSize(), right.data(), sizeof right);
+    const ptex::PtexSampler sampler(file, "constant.ptx");  // 64 bytes of values, not 32 GiB
+    std::array<float, 4> out{};
+    sampler.sample(0, 0.3, 0.7, out);  // inside a constant face: its value
+    CHECK(out == left);
+    CHECK(sampler.texel(2, 32767, 32767, 2) == right[2]);
+    // Face 1 at u = 0 (texel centres at u = 0.25, 0.75): half its first column, half the ghost column read
+    // from face 0 across the edge, on row j = 0 (v = 0.25, a texel centre).
+    sampler.sample(1, 0.0, 0.25, out);
+    for (int c = 0; c < 4; ++c)
+        CHECK(out[c] == static_cast<float>(left[c] + 0.5 * (static_cast<double>(painted[c]) - left[c])));
+    // And at u = 1 towards face 2.
+    sampler.sample(1, 1.0, 0.25, out);
+    for (int c = 0; c < 4; ++c) {
+        const float last = painted[4 + c];  // texel (1, 0)
+        CHECK(out[c] == static_cast<float>(last + 0.5 * (static_cast<double>(right[c]) - last)));
+    }
 }
 
 TEST_CASE("ptex sampler: continuous across quad, triangle and pentagon edges", "[ptex][mesh]") {
