@@ -10,7 +10,8 @@
 namespace deformkit::ptex {
 
 // Filtered look-ups into a Ptex file's level-0 texels, decoded once to float (u8 and u16 normalised to
-// [0, 1], half widened); a constant face is kept as its one value, whatever resolution it declares. Texel (i, j) of a face is centred at ((i + 0.5) / ures, (j + 0.5) / vres).
+// [0, 1], half widened); a constant face is kept as its one value, whatever resolution it declares. Texel (i,
+// j) of a face is centred at ((i + 0.5) / ures, (j + 0.5) / vres).
 //
 // sample() filters bilinearly between the four texel centres around (u, v). Centres beyond an edge of the
 // face are read from the neighbour across it through the file's adjacency (at the neighbour's own
@@ -43,8 +44,8 @@ class PtexSampler {
     std::string source_;
     int32_t channels_ = 0;
     std::vector<FaceInfo> faces_;
-    std::vector<size_t> offsets_;     // per face, into values_
-    std::vector<uint8_t> constant_;   // per face: 1 for a constant face, stored as one texel
+    std::vector<size_t> offsets_;    // per face, into values_
+    std::vector<uint8_t> constant_;  // per face: 1 for a constant face, stored as one texel
     std::vector<float> values_;
 };
 
