@@ -314,6 +314,53 @@ void NodeCore::evaluateBuffers(double envelope, bool painted) {
     evaluate(pointBuffer_, envelope);
 }
 
+bool NodeCore::restTopologyDiffers(std::span<const int32_t> counts, std::span<const int32_t> indices) const {
+    if (!stack_.hasRest()) return true;
+    const geom::Mesh& rest = stack_.rest();
+    return !std::ranges::equal(rest.faceCounts(), counts) || !std::ranges::equal(rest.faceIndices(), indices);
+}
+
+void NodeCore::evaluateMembers(std::span<const glm::vec3> all, std::span<const int32_t> members,
+                               std::span<const float> memberWeights, double envelope,
+                               std::span<glm::vec3> out) {
+    if (memberWeights.size() != members.size() || out.size() != members.size()) {
+        throw InvalidInput(formatError(stack_.entryName(0), "deformer set",
+                                       "has " + std::to_string(members.size()) + " members, " +
+                                           std::to_string(memberWeights.size()) + " weights and " +
+                                           std::to_string(out.size()) + " outputs",
+                                       "as many of each"));
+    }
+    pointBuffer_.assign(all.begin(), all.end());
+    weightBuffer_.assign(all.size(), 0.0f);
+    for (size_t k = 0; k < members.size(); ++k) {
+        const int32_t v = members[k];
+        if (v < 0 || static_cast<size_t>(v) >= all.size()) {
+            throw InvalidInput(formatError(stack_.entryName(0), "deformer set member " + std::to_string(k),
+                                           "is vertex " + std::to_string(v),
+                                           "a vertex of the mesh's " + std::to_string(all.size())));
+        }
+        weightBuffer_[v] = memberWeights[k];
+    }
+    evaluateBuffers(envelope, true);
+    for (size_t k = 0; k < members.size(); ++k)
+        out[k] = pointBuffer_[members[k]];
+}
+
+NodeCore& NodeGeometry::core(const std::string& type, const std::string& label) {
+    if (!core_ || core_->stack().deformer(0).type() != type) {
+        core_ = std::make_unique<NodeCore>(type, label);
+        rebindSeen_ = false;
+    }
+    return *core_;
+}
+
+bool NodeGeometry::takesRest(bool rebind, std::span<const int32_t> counts, std::span<const int32_t> indices) {
+    if (core_->hasRest() && rebind == rebindSeen_ && !core_->restTopologyDiffers(counts, indices))
+        return false;
+    rebindSeen_ = rebind;
+    return true;
+}
+
 void NodeCore::setWeights(std::span<const float> weights) {
     if (std::ranges::equal(weights, weights_)) return;
     weights_.assign(weights.begin(), weights.end());
@@ -432,10 +479,17 @@ RedirectFiles redirectFilesAt(const RedirectInputs& in, int frame) {
             fileAt(in.orientation, in.tile, frame)};
 }
 
-bool RedirectNode::needsBuild(const RedirectInputs& in) const {
-    return !core_ || in.tile != built_.tile || in.rigidity != built_.rigidity || in.mask != built_.mask ||
-           in.orientation != built_.orientation || in.preset != built_.preset ||
-           !sameOptions(in.options, built_.options);
+bool RedirectNode::needsBuild(const RedirectInputs& in, const geom::Mesh* rest) const {
+    if (!core_ || in.tile != built_.tile || in.rigidity != built_.rigidity || in.mask != built_.mask ||
+        in.orientation != built_.orientation || in.preset != built_.preset ||
+        !sameOptions(in.options, built_.options)) {
+        return true;
+    }
+    if (rest == nullptr || !rest_) return false;
+    const auto same = [](auto a, auto b) { return std::ranges::equal(a, b); };
+    return !same(rest->points(), rest_->points()) || !same(rest->faceCounts(), rest_->faceCounts()) ||
+           !same(rest->faceIndices(), rest_->faceIndices()) || !same(rest->uvs(), rest_->uvs()) ||
+           !same(rest->uvIndices(), rest_->uvIndices());
 }
 
 RedirectNode::Maps RedirectNode::read(const RedirectFiles& files) {
@@ -477,6 +531,7 @@ void RedirectNode::build(const geom::Mesh& rest, const RedirectInputs& in, int f
                                                in.options, kOwn);
     core_ = std::make_unique<RedirectCore>(rest, in.tile, maps.rigidity, maps.mask, options, source,
                                            maps.orientation);
+    rest_ = rest;
     built_ = in;
     loaded_ = files;
     ++builds_;

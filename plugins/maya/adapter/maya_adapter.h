@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -173,6 +174,16 @@ class NodeCore {
     // Deforms points(n) in place; `painted` false ignores the weights buffer (all 1).
     void evaluateBuffers(double envelope, bool painted);
 
+    // Whether a mesh of these polygons (Maya's MFnMesh::getVertices) is not the rest's: another topology
+    // with as many vertices (faces deleted upstream) rebinds too. True without a rest.
+    [[nodiscard]] bool restTopologyDiffers(std::span<const int32_t> counts,
+                                           std::span<const int32_t> indices) const;
+    // A deformer set of some of the mesh's vertices (Edit Membership, `deformer pCube1.vtx[0:19]`): the
+    // deformer sees the whole mesh as bound, `all` its every position, with weight 0 off the set and
+    // `memberWeights` (painted) on it; the members' new positions, in `members`' order, go to `out`.
+    void evaluateMembers(std::span<const glm::vec3> all, std::span<const int32_t> members,
+                         std::span<const float> memberWeights, double envelope, std::span<glm::vec3> out);
+
     [[nodiscard]] const host::DeformerStack& stack() const { return stack_; }
     [[nodiscard]] int64_t bindCount() const { return stack_.bindCount(); }
     [[nodiscard]] int64_t pushCount() const { return pushCount_; }  // parameters pushed since construction
@@ -184,6 +195,33 @@ class NodeCore {
     int64_t pushCount_ = 0;
     std::vector<glm::vec3> pointBuffer_;
     std::vector<float> weightBuffer_;
+};
+
+// One geometry a deformer node deforms (Maya's input[i] and outputGeometry[i]: a node on several meshes
+// deforms each in its own deform() call): its core, with its own rest, weights and parameters pushed, and
+// the rebind toggle it last saw.
+class NodeGeometry {
+  public:
+    // The core, made for `type` (again when the type changes: a dkBarr's kind). `label` names the node.
+    NodeCore& core(const std::string& type, const std::string& label);
+    // Whether the input (its polygons) must become the rest: no rest yet, `rebind` toggled since the last
+    // bind, or another topology (NodeCore::restTopologyDiffers). Call after core().
+    [[nodiscard]] bool takesRest(bool rebind, std::span<const int32_t> counts,
+                                 std::span<const int32_t> indices);
+
+  private:
+    std::unique_ptr<NodeCore> core_;
+    bool rebindSeen_ = false;
+};
+
+// A node's geometries by Maya's multi index, each kept apart.
+class NodeGeometries {
+  public:
+    [[nodiscard]] NodeGeometry& at(unsigned index) { return geometries_[index]; }
+    [[nodiscard]] size_t size() const { return geometries_.size(); }
+
+  private:
+    std::map<unsigned, NodeGeometry> geometries_;
 };
 
 // dkUvRedirect's attributes: the maps as file patterns (<UDIM> for the tile; #### for the frame, 4 digits,
@@ -255,7 +293,9 @@ class RedirectCore {
 // animated map reads its frame's file; a still one is read once).
 class RedirectNode {
   public:
-    [[nodiscard]] bool needsBuild(const RedirectInputs& in) const;
+    // True before the first build and after a change of tile, map pattern or option; with `rest`, also when
+    // it is not the rest mesh built over (a new restMesh, or its UVs or points edited).
+    [[nodiscard]] bool needsBuild(const RedirectInputs& in, const geom::Mesh* rest = nullptr) const;
     // A new solver over `rest` with the maps of `frame`. `source` names the node in errors and headers.
     void build(const geom::Mesh& rest, const RedirectInputs& in, int frame, const std::string& source);
     // The redirect map of `frame` (build first when needsBuild): warm-started when `frame` follows the last
@@ -275,6 +315,7 @@ class RedirectNode {
     Maps read(const RedirectFiles& files);
 
     std::unique_ptr<RedirectCore> core_;
+    std::optional<geom::Mesh> rest_;  // the rest mesh built over
     RedirectInputs built_;
     RedirectFiles loaded_;
     int64_t builds_ = 0;

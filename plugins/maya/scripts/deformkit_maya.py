@@ -6,7 +6,8 @@
     dk.create_frame_lattice((2,2,2))  # select meshes: dkFrameLattice with a locator per lattice point
     dk.create_wire()                  # select meshes, then a NURBS curve: dkWire with a rest copy
     dk.create_mesh_warp()             # select meshes, then the cage mesh: dkMeshWarp with a rest copy
-    dk.create_redirect("rig.<UDIM>.exr", "maps/redirect.<UDIM>.####.exr")  # select the mesh
+    dk.create_redirect("rig.<UDIM>.exr", "maps/redirect.<UDIM>.####.exr")  # select the mesh; its file
+                                      # texture <node>Map reads each frame's map
 
 Each returns the created node. Painting: the deformers' weights are paintable (Paint Attributes tool).
 """
@@ -106,7 +107,10 @@ def create_mesh_warp():
     return node
 
 
-def create_redirect(rigidity, output, tile=1001, mask="", resolution=0):
+def create_redirect(rigidity, output, tile=1001, mask="", resolution=0, preset=""):
+    """dkUvRedirect on the selected mesh's tile, and the file texture `<node>Map` that reads its map. Maya
+    computes an output only when something reads it: the texture reads outFile, so the shading network (the
+    renderer, a viewport material) asks for each frame's map. Connect the texture where the map is used."""
     shape = _selected_meshes()[0]
     node = cmds.createNode("dkUvRedirect")
     rest = cmds.duplicate(shape, name=shape + "UvRest")[0]
@@ -119,6 +123,9 @@ def create_redirect(rigidity, output, tile=1001, mask="", resolution=0):
     cmds.setAttr(node + ".output", output, type="string")
     cmds.setAttr(node + ".tile", tile)
     cmds.setAttr(node + ".resolution", resolution)
+    cmds.setAttr(node + ".preset", preset, type="string")
+    texture = cmds.shadingNode("file", asTexture=True, name=node + "Map")
+    cmds.connectAttr(node + ".outFile", texture + ".fileTextureName")
     return node
 
 

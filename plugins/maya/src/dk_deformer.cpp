@@ -1,11 +1,14 @@
 #include "dk_deformer.h"
 
+#include <algorithm>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <maya/MAngle.h>
 #include <maya/MDagModifier.h>
+#include <maya/MDistance.h>
 #include <maya/MFloatArray.h>
 #include <maya/MFnCompoundAttribute.h>
 #include <maya/MFnDependencyNode.h>
@@ -46,12 +49,30 @@ geom::Mesh meshOf(const MObject& data, const std::string& what) {
     return geom::Mesh(meshDataOf(data, false), what);
 }
 
-// A curve's CVs or a mesh's points appended to `out`, read through `scratch` (both kept by the node).
+// A NURBS curve as a wire takes it: `samples` points at evenly spaced parameters over its knot domain
+// (0: four per CV, at least 16), so the wire follows the curve, not its control hull; in world space, as
+// appendPoints reads cages. A rest curve and its
+// current copy are sampled at the same parameters, so their points correspond.
+void appendCurvePoints(const MObject& data, int samples, std::vector<glm::dvec3>& out) {
+    if (!data.hasFn(MFn::kNurbsCurve)) return;
+    const MFnNurbsCurve curve(data);
+    const int n = samples > 1 ? samples : std::max(16, 4 * curve.numCVs());
+    double start = 0.0, end = 1.0;
+    curve.getKnotDomain(start, end);
+    MPoint p;
+    for (int i = 0; i < n; ++i) {
+        curve.getPointAtParam(start + (end - start) * static_cast<double>(i) / (n - 1), p, MSpace::kWorld);
+        out.emplace_back(p.x, p.y, p.z);
+    }
+}
+
+// A mesh's points appended to `out`, read through `scratch` (both kept by the node). Cages and curves come
+// from world-space plugs (worldMesh[0], worldSpace[0]), whose data holds the shape's points and its world
+// matrix: read in MSpace::kWorld, as cvwrap reads its driver, the matrix is applied (data without one reads
+// as its points).
 void appendPoints(const MObject& data, MPointArray& scratch, std::vector<glm::dvec3>& out) {
-    if (data.hasFn(MFn::kNurbsCurve)) {
-        MFnNurbsCurve(data).getCVs(scratch, MSpace::kObject);
-    } else if (data.hasFn(MFn::kMesh)) {
-        MFnMesh(data).getPoints(scratch, MSpace::kObject);
+    if (data.hasFn(MFn::kMesh)) {
+        MFnMesh(data).getPoints(scratch, MSpace::kWorld);
     } else {
         scratch.clear();
     }
@@ -79,6 +100,14 @@ MStatus DkDeformer::addNumeric(MObject& attribute, const char* name, const char*
     return addAttribute(attribute);
 }
 
+MStatus DkDeformer::addUnit(MObject& attribute, const char* name, const char* shortName,
+                            MFnUnitAttribute::Type type, double value) {
+    MFnUnitAttribute fn;
+    attribute = fn.create(name, shortName, type, value);
+    fn.setKeyable(true);
+    return addAttribute(attribute);
+}
+
 MStatus DkDeformer::addMatrix(MObject& attribute, const char* name, const char* shortName, bool array) {
     MFnMatrixAttribute fn;
     attribute = fn.create(name, shortName);
@@ -100,30 +129,57 @@ MStatus DkDeformer::addRebindAttribute(MObject& attribute) {
 MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& geometryWorld,
                            unsigned int multiIndex) {
     const float envelope = block.inputValue(MPxDeformerNode::envelope).asFloat();
+    if (envelope == 0.0f) return MS::kSuccess;  // the output is the input: nothing read, nothing checked
     try {
-        const std::string type = hostType();
-        if (!core_ || core_->stack().deformer(0).type() != type) {
-            core_ = std::make_unique<NodeCore>(type, MString(name()).asChar());
-        }
-        // The rest: the input mesh, captured at the first evaluation, on a topology change, or on rebind.
+        const std::string label = MString(name()).asChar();
+        NodeGeometry& geometry = geometries_.at(multiIndex);
+        NodeCore& core = geometry.core(hostType(block), label);
+        // The rest: this geometry's input mesh, at its first evaluation, on a topology change, or on rebind.
         MArrayDataHandle inputs = block.outputArrayValue(input);
         inputs.jumpToElement(multiIndex);
         const MObject data = inputs.outputValue().child(inputGeom).asMesh();
+        MFnMesh mesh(data);
+        mesh.getVertices(counts_, indices_);
+        const auto copy = [](const MIntArray& from, std::vector<int32_t>& to) {
+            to.resize(from.length());
+            for (unsigned k = 0; k < from.length(); ++k)
+                to[k] = from[k];
+        };
+        copy(counts_, faceCounts_);
+        copy(indices_, faceIndices_);
         const bool rebindNow = block.inputValue(rebindAttribute()).asBool();
-        if (!core_->hasRest() || rebindNow != rebindSeen_ ||
-            static_cast<int32_t>(iter.count()) != core_->stack().rest().numVertices()) {
-            core_->setRest(meshOf(data, MString(name()).asChar()));
-            rebindSeen_ = rebindNow;
-        }
+        if (geometry.takesRest(rebindNow, faceCounts_, faceIndices_)) core.setRest(meshOf(data, label));
         // Parameters rebuilt in place; the core pushes only those that changed (and the host layer validates
         // only what it is given), so a frame that moves nothing costs comparisons.
         parameters(block, toMaya(geometryWorld), parameters_);
-        core_->set(parameters_);
+        core.set(parameters_);
         // Positions in bulk, into and out of the core's own buffers (no allocation once warm).
         iter.allPositions(positions_);
         const unsigned n = positions_.length();
-        const std::span<glm::vec3> points = core_->points(n);
-        const std::span<float> weights = core_->weights(n);
+        const auto vertices = static_cast<unsigned>(core.stack().rest().numVertices());
+        if (n != vertices) {
+            // A deformer set of some of the vertices: the whole mesh, its members weighted, theirs moved.
+            mesh.getPoints(positions_, MSpace::kObject);
+            all_.resize(positions_.length());
+            for (unsigned k = 0; k < positions_.length(); ++k)
+                all_[k] = {static_cast<float>(positions_[k].x), static_cast<float>(positions_[k].y),
+                           static_cast<float>(positions_[k].z)};
+            members_.clear();
+            memberWeights_.clear();
+            for (iter.reset(); !iter.isDone(); iter.next()) {
+                members_.push_back(iter.index());
+                memberWeights_.push_back(weightValue(block, multiIndex, iter.index()));
+            }
+            moved_.resize(members_.size());
+            core.evaluateMembers(all_, members_, memberWeights_, envelope, moved_);
+            positions_.setLength(static_cast<unsigned>(moved_.size()));
+            for (size_t k = 0; k < moved_.size(); ++k)
+                positions_[static_cast<unsigned>(k)] = MPoint(moved_[k].x, moved_[k].y, moved_[k].z);
+            iter.setAllPositions(positions_);
+            return MS::kSuccess;
+        }
+        const std::span<glm::vec3> points = core.points(n);
+        const std::span<float> weights = core.weights(n);
         bool painted = false;
         unsigned i = 0;
         for (iter.reset(); !iter.isDone() && i < n; iter.next(), ++i) {
@@ -134,7 +190,7 @@ MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& 
             const MPoint& p = positions_[k];
             points[k] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
         }
-        core_->evaluateBuffers(envelope, painted);
+        core.evaluateBuffers(envelope, painted);
         for (unsigned k = 0; k < n; ++k)
             positions_[k] = MPoint(points[k].x, points[k].y, points[k].z);
         iter.setAllPositions(positions_);
@@ -153,7 +209,7 @@ MObject DkSlide::rebind, DkSlide::vertex, DkSlide::radius, DkSlide::geodesic, Dk
 
 MStatus DkSlide::initialize() {
     addNumeric(vertex, "vertex", "vtx", MFnNumericData::kInt, 0.0, false);
-    addNumeric(radius, "radius", "rad", MFnNumericData::kDouble, 1.0);
+    addUnit(radius, "radius", "rad", MFnUnitAttribute::kDistance, 1.0);
     addNumeric(geodesic, "geodesic", "geo", MFnNumericData::kBoolean, 1.0);
     addNumeric(limitSurface, "limitSurface", "lsf", MFnNumericData::kBoolean, 0.0);
     addNumeric(weightsAreFalloff, "weightsAreFalloff", "waf", MFnNumericData::kBoolean, 0.0);
@@ -171,7 +227,7 @@ MStatus DkSlide::initialize() {
 void DkSlide::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
     SlideInputs& in = in_;
     in.vertex = block.inputValue(vertex).asInt();
-    in.radius = block.inputValue(radius).asDouble();
+    in.radius = block.inputValue(radius).asDistance().asCentimeters();
     in.geodesic = block.inputValue(geodesic).asBool();
     in.limitSurface = block.inputValue(limitSurface).asBool();
     in.weightsAreFalloff = block.inputValue(weightsAreFalloff).asBool();
@@ -209,7 +265,7 @@ MStatus DkSlide::accessoryNodeSetup(MDagModifier& modifier) {
 
 const MTypeId DkBarr::id(0x0013A6C1);
 MObject DkBarr::rebind, DkBarr::kind, DkBarr::handleMatrix, DkBarr::startValue, DkBarr::endValue,
-    DkBarr::curvature, DkBarr::lowBound, DkBarr::highBound;
+    DkBarr::startAngle, DkBarr::endAngle, DkBarr::curvature, DkBarr::lowBound, DkBarr::highBound;
 
 MStatus DkBarr::initialize() {
     MFnEnumAttribute fn;
@@ -219,29 +275,37 @@ MStatus DkBarr::initialize() {
     fn.addField("bend", 2);
     addAttribute(kind);
     addMatrix(handleMatrix, "handleMatrix", "hdm");
-    addNumeric(startValue, "startValue", "stv", MFnNumericData::kDouble, 0.0);
+    // Taper's scales are numbers; twist's angles and bend's curvature (an angle per handle length) are
+    // angles, so that typed degrees and a connected joint rotation mean what they say.
+    addNumeric(startValue, "startValue", "stv", MFnNumericData::kDouble, 1.0);
     addNumeric(endValue, "endValue", "env", MFnNumericData::kDouble, 1.0);
-    addNumeric(curvature, "curvature", "cur", MFnNumericData::kDouble, 0.5);
+    addUnit(startAngle, "startAngle", "sta", MFnUnitAttribute::kAngle, 0.0);
+    addUnit(endAngle, "endAngle", "ena", MFnUnitAttribute::kAngle, 1.0);
+    addUnit(curvature, "curvature", "cur", MFnUnitAttribute::kAngle, 0.5);
     addNumeric(lowBound, "lowBound", "lwb", MFnNumericData::kDouble, -1.0);
     addNumeric(highBound, "highBound", "hib", MFnNumericData::kDouble, 1.0);
     addRebindAttribute(rebind);
-    affectsOutput({&kind, &handleMatrix, &startValue, &endValue, &curvature, &lowBound, &highBound});
+    affectsOutput({&kind, &handleMatrix, &startValue, &endValue, &startAngle, &endAngle, &curvature,
+                   &lowBound, &highBound});
     return MS::kSuccess;
 }
 
-const char* DkBarr::hostType() const {
-    return kind_ == 0 ? "taper" : kind_ == 1 ? "twist" : "bend";
+const char* DkBarr::hostType(MDataBlock& block) {
+    const short k = block.inputValue(kind).asShort();
+    return k == 0 ? "taper" : k == 1 ? "twist" : "bend";
 }
 
 void DkBarr::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) {
-    kind_ = block.inputValue(kind).asShort();
     BarrInputs& in = in_;
-    in.type = hostType();
+    in.type = hostType(block);
     in.handleWorld = matrixValue(block, handleMatrix);
     in.geometryWorld = geometryWorld;
-    in.startValue = block.inputValue(startValue).asDouble();
-    in.endValue = block.inputValue(endValue).asDouble();
-    in.curvature = block.inputValue(curvature).asDouble();
+    const bool twist = in.type == std::string("twist");
+    in.startValue =
+        twist ? block.inputValue(startAngle).asAngle().asRadians() : block.inputValue(startValue).asDouble();
+    in.endValue =
+        twist ? block.inputValue(endAngle).asAngle().asRadians() : block.inputValue(endValue).asDouble();
+    in.curvature = block.inputValue(curvature).asAngle().asRadians();
     in.lowBound = block.inputValue(lowBound).asDouble();
     in.highBound = block.inputValue(highBound).asDouble();
     barrParameters(in, out);
@@ -323,6 +387,7 @@ void DkWire::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Para
     in.dropoff.assign(1, block.inputValue(dropoff).asDouble());
     in.scale.assign(1, block.inputValue(scale).asDouble());
     in.smooth = block.inputValue(smooth).asBool();
+    const int count = block.inputValue(samples).asInt();
     in.restWorld.clear();
     in.curveWorld.clear();
     in.curveSizes.clear();
@@ -330,11 +395,11 @@ void DkWire::parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Para
     for (unsigned i = 0; i < rest.elementCount(); ++i, rest.next()) {
         // Curves connected from world-space plugs (worldSpace[0]) carry world positions.
         const size_t before = in.restWorld.size();
-        appendPoints(rest.inputValue().asNurbsCurve(), cvs_, in.restWorld);
+        appendCurvePoints(rest.inputValue().asNurbsCurve(), count, in.restWorld);
         in.curveSizes.push_back(static_cast<int>(in.restWorld.size() - before));
     }
     for (unsigned i = 0; i < now.elementCount(); ++i, now.next())
-        appendPoints(now.inputValue().asNurbsCurve(), cvs_, in.curveWorld);
+        appendCurvePoints(now.inputValue().asNurbsCurve(), count, in.curveWorld);
     wireParameters(in, out);
 }
 

@@ -5,10 +5,12 @@
 
 #include <initializer_list>
 #include <memory>
+#include <vector>
 
 #include <maya/MDataBlock.h>
 #include <maya/MFloatArray.h>
 #include <maya/MFnNumericData.h>
+#include <maya/MFnUnitAttribute.h>
 #include <maya/MIntArray.h>
 #include <maya/MItGeometry.h>
 #include <maya/MMatrix.h>
@@ -20,10 +22,12 @@
 
 namespace deformkit::maya {
 
-// What every node shares: the rest geometry is the node's input mesh, captured at the first evaluation and
-// again when its topology changes or `rebind` is toggled (Maya deformers bind to their input when created);
-// painted weights come from the deformer's weightList (paintable); the envelope is Maya's. A node only says
-// which host type it is and reads its own attributes into host parameters.
+// What every node shares: each geometry the node deforms (input[i]) has its own state (NodeGeometry): its
+// rest is its input mesh, captured at the first evaluation and again when its topology changes or `rebind`
+// is toggled (Maya deformers bind to their input when created); painted weights come from the deformer's
+// weightList (paintable); the envelope is Maya's (0 leaves the input as it is). A deformer set of some of
+// the mesh's vertices deforms those, the deformer seeing the whole mesh. A node only says which host type
+// it is and reads its own attributes into host parameters.
 class DkDeformer : public MPxDeformerNode {
   public:
     MStatus deform(MDataBlock& block, MItGeometry& iter, const MMatrix& geometryWorld,
@@ -37,19 +41,30 @@ class DkDeformer : public MPxDeformerNode {
     static MStatus addNumeric(MObject& attribute, const char* name, const char* shortName,
                               MFnNumericData::Type type, double value, bool keyable = true);
     static MStatus addMatrix(MObject& attribute, const char* name, const char* shortName, bool array = false);
+    // An angle (shown in the scene's angle unit, read in radians) or a distance (shown in the scene's linear
+    // unit, read in Maya's internal centimetres, as the geometry's points are): Maya converts what is
+    // typed or connected (a joint's rotate), as for its own deformers.
+    static MStatus addUnit(MObject& attribute, const char* name, const char* shortName,
+                           MFnUnitAttribute::Type type, double value);
     static void affectsOutput(std::initializer_list<MObject*> attributes);
 
-    [[nodiscard]] virtual const char* hostType() const = 0;
+    // The host type, read from the node's attributes where it depends on them (a dkBarr's kind).
+    [[nodiscard]] virtual const char* hostType(MDataBlock& block) = 0;
     [[nodiscard]] virtual const MObject& rebindAttribute() const = 0;
     // The host parameters from the node's attributes, written into `out` (kept by the node between calls,
     // so a warm deform() allocates nothing); throws deformkit::Error for bad values.
     virtual void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) = 0;
 
   private:
-    std::unique_ptr<NodeCore> core_;
-    bool rebindSeen_ = false;
-    Parameters parameters_;  // the last parameters, rewritten in place each deform()
-    MPointArray positions_;  // the input's positions, read and written in bulk
+    NodeGeometries geometries_;
+    Parameters parameters_;       // the last parameters, rewritten in place each deform()
+    MPointArray positions_;       // the input's positions, read and written in bulk
+    MIntArray counts_, indices_;  // the input's polygons, for the topology check
+    std::vector<int32_t> faceCounts_, faceIndices_;
+    // A deformer set of some vertices: the whole mesh's positions, the members and their results.
+    std::vector<glm::vec3> all_, moved_;
+    std::vector<int32_t> members_;
+    std::vector<float> memberWeights_;
 };
 
 [[nodiscard]] MayaMatrix toMaya(const MMatrix& m);
@@ -67,7 +82,7 @@ class DkSlide : public DkDeformer {
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
-    const char* hostType() const override { return "slide"; }
+    const char* hostType(MDataBlock&) override { return "slide"; }
     void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:
@@ -84,16 +99,16 @@ class DkBarr : public DkDeformer {
     MObject& accessoryAttribute() const override { return handleMatrix; }
     static const MTypeId id;
     static MObject rebind;
-    static MObject kind, handleMatrix, startValue, endValue, curvature, lowBound, highBound;
+    static MObject kind, handleMatrix, startValue, endValue, startAngle, endAngle, curvature, lowBound,
+        highBound;
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
-    // The host type follows the `kind` attribute (the node's core is rebuilt when it changes).
-    const char* hostType() const override;
+    // The host type follows the `kind` attribute (the geometries' cores are made again when it changes).
+    const char* hostType(MDataBlock& block) override;
     void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:
-    short kind_ = 1;
     BarrInputs in_;
 };
 
@@ -107,7 +122,7 @@ class DkFrameLattice : public DkDeformer {
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
-    const char* hostType() const override { return "ffdframes"; }
+    const char* hostType(MDataBlock&) override { return "ffdframes"; }
     void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:
@@ -124,12 +139,11 @@ class DkWire : public DkDeformer {
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
-    const char* hostType() const override { return "wires"; }
+    const char* hostType(MDataBlock&) override { return "wires"; }
     void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:
     WireInputs in_;
-    MPointArray cvs_;
 };
 
 class DkMeshWarp : public DkDeformer {
@@ -142,7 +156,7 @@ class DkMeshWarp : public DkDeformer {
 
   protected:
     const MObject& rebindAttribute() const override { return rebind; }
-    const char* hostType() const override { return "meshwarp"; }
+    const char* hostType(MDataBlock&) override { return "meshwarp"; }
     void parameters(MDataBlock& block, const MayaMatrix& geometryWorld, Parameters& out) override;
 
   private:

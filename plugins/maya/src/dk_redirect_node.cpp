@@ -45,6 +45,7 @@ MStatus DkUvRedirect::initialize() {
     const std::tuple<MObject*, const char*, const char*> strings[] = {{&rigidity, "rigidity", "rig"},
                                                                       {&mask, "mask", "msk"},
                                                                       {&orientation, "orientation", "ori"},
+                                                                      {&preset, "preset", "prs"},
                                                                       {&output, "output", "out"}};
     for (const auto& [attribute, name, shortName] : strings) {
         MFnTypedAttribute fn;
@@ -117,10 +118,10 @@ MStatus DkUvRedirect::compute(const MPlug& plug, MDataBlock& block) {
             }
         }
         const int frame = static_cast<int>(std::lround(block.inputValue(time).asTime().as(MTime::uiUnit())));
-        if (node_.needsBuild(in)) {
-            node_.build(meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar()), in, frame,
-                        in.rigidity);
-        }
+        // The rest mesh is read every frame (a copy of its points, polygons and UVs): a new one, or one
+        // edited, builds the solver again.
+        const geom::Mesh rest = meshWithUVs(block.inputValue(restMesh).asMesh(), MString(name()).asChar());
+        if (node_.needsBuild(in, &rest)) node_.build(rest, in, frame, in.rigidity);
         MFnMesh deformed(block.inputValue(inMesh).asMesh());
         MPointArray points;
         deformed.getPoints(points, MSpace::kObject);

@@ -223,6 +223,103 @@ TEST_CASE("maya adapter: the node core rebinds only for new rest geometry and ap
     CHECK(core.bindCount() == 2);
 }
 
+TEST_CASE("maya adapter: each geometry of a node keeps its own rest, binding once; a topology change rebinds",
+          "[maya]") {
+    // One dkSlide on two meshes of different sizes (input[0] and input[3]), evaluated in turn for 10 frames,
+    // as Maya calls deform() once per geometry: each binds once, and gives what a node of its own gives.
+    const geom::Mesh small = geom::makeGrid({6, 6, 1.0f, 1.0f}), large = geom::makeGrid({8, 8, 1.0f, 1.0f});
+    maya::SlideInputs in;
+    in.vertex = 10;
+    in.radius = 0.6;
+    in.endWorld = {0.0, 0.1, 0.0};
+    const maya::Parameters parameters = maya::slideParameters(in);
+    const auto topology = [](const geom::Mesh& m) {
+        return std::pair(std::vector<int32_t>(m.faceCounts().begin(), m.faceCounts().end()),
+                         std::vector<int32_t>(m.faceIndices().begin(), m.faceIndices().end()));
+    };
+    const auto run = [&](maya::NodeGeometry& geometry, const geom::Mesh& mesh) {
+        maya::NodeCore& core = geometry.core("slide", "dkSlide1");
+        const auto [counts, indices] = topology(mesh);
+        if (geometry.takesRest(false, counts, indices)) core.setRest(mesh);
+        core.set(parameters);
+        std::vector<glm::vec3> points(mesh.points().begin(), mesh.points().end());
+        core.evaluate(points, 1.0);
+        return points;
+    };
+    maya::NodeGeometries node;
+    maya::NodeGeometry alone;
+    std::vector<glm::vec3> shared, own;
+    for (int frame = 0; frame < 10; ++frame) {
+        (void)run(node.at(0), small);
+        shared = run(node.at(3), large);
+        own = run(alone, large);
+    }
+    CHECK(node.size() == 2);
+    CHECK(node.at(0).core("slide", "dkSlide1").bindCount() == 1);
+    CHECK(node.at(3).core("slide", "dkSlide1").bindCount() == 1);
+    CHECK(test::sameBits(shared, own));
+    // A topology change with as many vertices (a row of faces deleted upstream) takes the input as the new
+    // rest; the same topology does not, whatever the positions; a rebind toggle does, once.
+    maya::NodeGeometry& g = node.at(0);
+    auto [counts, indices] = topology(small);
+    CHECK_FALSE(g.takesRest(false, counts, indices));
+    counts.resize(counts.size() - 6);
+    indices.resize(indices.size() - 24);
+    CHECK(g.core("slide", "dkSlide1").restTopologyDiffers(counts, indices));
+    CHECK(g.takesRest(false, counts, indices));
+    // The rest keeps the grid's polygons (the caller did not take the reduced input): no change.
+    const auto [same, sameIndices] = topology(small);
+    CHECK_FALSE(g.takesRest(false, same, sameIndices));
+    CHECK(g.takesRest(true, same, sameIndices));
+    CHECK_FALSE(g.takesRest(true, same, sameIndices));
+    // Another host type (a dkBarr's kind changed) makes a new core, which takes the rest again.
+    maya::NodeGeometry barr;
+    barr.core("twist", "dkBarr1").setRest(small);
+    CHECK_FALSE(barr.takesRest(false, same, sameIndices));
+    CHECK_FALSE(barr.core("taper", "dkBarr1").hasRest());
+    CHECK(barr.takesRest(false, same, sameIndices));
+}
+
+TEST_CASE(
+    "maya adapter: a deformer set of some vertices moves those as the whole mesh with weight 0 elsewhere",
+    "[maya]") {
+    const geom::Mesh mesh = geom::makeGrid({6, 6, 1.0f, 1.0f});
+    maya::BarrInputs in;
+    in.type = "twist";
+    in.handleWorld.m[1] = {0, 0, 1, 0};
+    in.handleWorld.m[2] = {0, -1, 0, 0};
+    in.endValue = 1.0;
+    const std::vector<glm::vec3> all(mesh.points().begin(), mesh.points().end());
+    // Members in the iterator's order (not sorted), with painted weights.
+    const std::vector<int32_t> members{20, 3, 7, 48, 5, 33};
+    const std::vector<float> memberWeights{1.0f, 0.5f, 0.25f, 1.0f, 0.75f, 0.1f};
+    maya::NodeCore subset("twist", "dkBarr1"), whole("twist", "dkBarr1");
+    for (maya::NodeCore* core : {&subset, &whole}) {
+        core->setRest(mesh);
+        core->set(maya::barrParameters(in));
+    }
+    std::vector<glm::vec3> moved(members.size());
+    subset.evaluateMembers(all, members, memberWeights, 0.8, moved);
+    // The reference: the whole mesh with those weights on the members and 0 elsewhere.
+    std::vector<float> weights(all.size(), 0.0f);
+    for (size_t k = 0; k < members.size(); ++k)
+        weights[members[k]] = memberWeights[k];
+    whole.setWeights(weights);
+    std::vector<glm::vec3> reference = all;
+    whole.evaluate(reference, 0.8);
+    for (size_t k = 0; k < members.size(); ++k) {
+        INFO("member " << k);
+        CHECK(moved[k] == reference[members[k]]);
+        CHECK(moved[k] != all[members[k]]);
+    }
+    const std::vector<int32_t> outside{3, 99};
+    const std::vector<float> two{1.0f, 1.0f};
+    std::vector<glm::vec3> out(2);
+    CHECK_THROWS_WITH(
+        subset.evaluateMembers(all, outside, two, 1.0, out),
+        Catch::Contains("deformer set member 1: is vertex 99 (expected a vertex of the mesh's 49)"));
+}
+
 TEST_CASE("maya adapter: the redirect core warm-starts frames in order and starts cold after a jump",
           "[maya]") {
     // Reference: TileWarp driven directly. Frames 1, 2, 3 in order are one warm-started sequence; frame 7
@@ -473,6 +570,21 @@ TEST_CASE(
     changed.options.solver.sweepsPerLevel = {1, 4, 8};
     CHECK(node.needsBuild(changed));
     CHECK_THROWS_WITH(node.solve(changed, 6, pose(6)), Catch::Contains("not built for these inputs"));
+    // The rest mesh built over, given again, needs nothing; another one (a new restMesh), or this one with
+    // its UVs edited, needs a new solver.
+    CHECK_FALSE(node.needsBuild(still, &mesh));
+    geom::Mesh::Data edited{std::vector<glm::vec3>(mesh.points().begin(), mesh.points().end()),
+                            std::vector<int32_t>(mesh.faceCounts().begin(), mesh.faceCounts().end()),
+                            std::vector<int32_t>(mesh.faceIndices().begin(), mesh.faceIndices().end()),
+                            std::vector<glm::vec2>(mesh.uvs().begin(), mesh.uvs().end()),
+                            std::vector<int32_t>(mesh.uvIndices().begin(), mesh.uvIndices().end())};
+    edited.uvs[0].x += 0.01f;
+    const geom::Mesh uvEdited(std::move(edited), "edited");
+    CHECK(node.needsBuild(still, &uvEdited));
+    const geom::Mesh other = geom::makeGrid({12, 12, 1.0f, 1.0f});
+    CHECK(node.needsBuild(still, &other));
+    node.build(other, still, 1, "rig");
+    CHECK_FALSE(node.needsBuild(still, &other));
     // A missing frame of an animated map names the file.
     maya::RedirectNode fresh;
     fresh.build(mesh, in, 1, "rig");

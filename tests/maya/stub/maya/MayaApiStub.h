@@ -51,6 +51,7 @@ class MPointArray {
     unsigned length() const;
     MPoint operator[](unsigned) const;
     MPoint& operator[](unsigned);
+    MStatus setLength(unsigned);
     MStatus clear();
 };
 class MMatrix {
@@ -67,8 +68,18 @@ class MTime {
     double as(Unit) const;
 };
 typedef int int3[3];
+class MAngle {
+  public:
+    double asRadians() const;
+};
+class MDistance {
+  public:
+    double asCentimeters() const;
+};
 class MDataHandle {
   public:
+    MAngle asAngle() const;
+    MDistance asDistance() const;
     float asFloat() const;
     double asDouble() const;
     int asInt() const;
@@ -192,7 +203,7 @@ class MFnStringData {
 };
 class MFnUnitAttribute : public MFnAttribute {
   public:
-    enum Type { kTime };
+    enum Type { kAngle, kDistance, kTime };
     MObject create(const MString&, const MString&, Type, double);
 };
 class MRampAttribute {
@@ -218,6 +229,9 @@ class MFnNurbsCurve {
   public:
     MFnNurbsCurve(const MObject&);
     MStatus getCVs(MPointArray&, MSpace::Space) const;
+    int numCVs(MStatus* = nullptr) const;
+    MStatus getKnotDomain(double&, double&) const;
+    MStatus getPointAtParam(double, MPoint&, MSpace::Space = MSpace::kObject) const;
 };
 class MGlobal {
   public:
