@@ -635,7 +635,7 @@ constexpr const char* kShotDoc =
     "by the argument in messages and headers, or (label, {tile: array}) to name them. A tile without a\n"
     "rigidity map is left unwarped (a note); without a mask the mask is derived from the UVs.\n"
     "out, bake: patterns with a UDIM token and a frame token ('out/redirect.<UDIM>.####.exr'); out is a\n"
-    "2-channel float EXR, bake (with texture) any format; their folders must exist. tiles: None for every\n"
+    "2-channel float EXR, bake (with texture) any format; missing folders are made. tiles: None for every\n"
     "tile of the UVs. resolution and options as UvWarpSolver, but warm_start defaults to False: each frame\n"
     "is solved from the identity, so its maps depend on that frame alone, whatever range the job covers\n"
     "(warm_start=True: from the last frame's warp). filter of the bake: 'bilinear', 'bicubic'.\n"

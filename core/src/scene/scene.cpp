@@ -253,7 +253,7 @@ class Reader {
         try {
             return readWeightsFile(file, static_cast<size_t>(count));
         } catch (const Error& e) {
-            fail(path, e.what(), "a JSON weights file with one finite number per vertex of the rest mesh");
+            fail(path, e.what(), "");  // the file's message says what it expected
         }
     }
 

@@ -36,7 +36,7 @@ std::vector<float> parseWeightsFile(std::string_view text, size_t count, const s
     }
     if (array->size() != count) {
         throw InvalidInput(formatError(source, "", "has " + std::to_string(array->size()) + " weights",
-                                       std::to_string(count) + ", one per vertex of the mesh"));
+                                       std::to_string(count) + ", one per vertex of the rest mesh"));
     }
     std::vector<float> weights(count);
     for (size_t i = 0; i < count; ++i) {
