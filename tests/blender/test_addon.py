@@ -434,6 +434,131 @@ def test_objects_renamed_or_given_another_mesh_are_not_confused():
     assert float(positions(bpy.data.objects["other"])[:, 0].max()) == 2.0
 
 
+def test_modelling_between_stacks_and_with_entries_off_becomes_the_rest_shape():
+    # Removing the last entry forgot nothing: the next first entry restored the shape from before the
+    # modelling done in between. Reset Rest put the old rest back before taking it, so the documented
+    # workflow (entries off, edit, Reset Rest) lost the edit.
+    fresh()
+    obj = grid_object()
+    add("twist")
+    bpy.ops.deformkit.remove()
+    assert not addon.evaluate.has_rest(obj)
+    raised = positions(obj) + np.array([0.0, 0.0, 0.5], np.float32)
+    obj.data.vertices.foreach_set("co", raised.ravel())
+    obj.data.update()
+    slide = add("slide")  # no drag: the mesh stays as modelled
+    assert_same(addon.evaluate.rest_points(obj), raised, "rest shape taken by the new first entry")
+    assert_same(positions(obj), raised, "mesh after adding a slide that does not move")
+
+    # With an entry on, the mesh shows its deformation: Reset Rest refuses, naming the entry.
+    slide.end.location = (0.2, 0.0, 0.5)
+    bpy.context.view_layer.update()
+    try:
+        bpy.ops.deformkit.reset_rest()
+        raise AssertionError("Reset Rest took a deformed shape")
+    except RuntimeError as e:
+        assert "disable every entry first" in str(e) and slide.name in str(e), str(e)
+    # Entries off, the mesh edited: Reset Rest takes the edit, and the entries deform it when on again.
+    slide.enabled = False
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), raised, "mesh with the entry off")
+    edited = raised + np.array([0.0, 0.0, 0.25], np.float32)
+    obj.data.vertices.foreach_set("co", edited.ravel())
+    obj.data.update()
+    assert bpy.ops.deformkit.reset_rest() == {'FINISHED'}
+    assert_same(addon.evaluate.rest_points(obj), edited, "rest shape after Reset Rest")
+    slide.enabled = True
+    bpy.context.view_layer.update()
+    stack = direct_stack(obj, edited)
+    stack.add("slide", "s")
+    displacement = np.array(slide.end.location) - np.array(slide.start.location)
+    set_all(stack, 0, [("vertex", slide.vertex), ("radius", slide.radius), ("geodesic", 1),
+                       ("displacement", displacement)])
+    assert_same(positions(obj), stack.evaluate(edited), "slide over the new rest shape")
+
+
+def test_polygons_changed_under_a_stack_are_refused_until_reset_rest():
+    # New vertices had rest position (0, 0, 0): a cube added in Edit Mode collapsed onto the origin, and
+    # deleted vertices moved the slide's handle to another vertex, without a word.
+    fresh()
+    obj = grid_object()
+    twist = add("twist")
+    twist.start_value = twist.end_value = 0.0
+    before = positions(obj).copy()
+    bpy.ops.object.mode_set(mode='EDIT')
+    bpy.ops.mesh.select_all(action='DESELECT')
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(2.0, 0.0, 0.0))
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.context.view_layer.update()
+    message = obj.deformkit.status
+    assert "the mesh's polygons changed since its rest shape was taken (441 vertices then, 449 vertices now)" in \
+        message and "press Reset Rest" in message, message
+    cube = positions(obj)[441:]
+    assert float(cube[:, 0].min()) > 1.7, cube  # the new vertices where they were modelled
+    assert_same(positions(obj)[:441], before, "the grid, untouched")
+    twist.enabled = False
+    assert bpy.ops.deformkit.reset_rest() == {'FINISHED'}
+    twist.enabled = True
+    assert addon.evaluate.evaluate_safely(obj, force=True) == ""
+    assert float(positions(obj)[441:, 0].min()) > 1.7
+
+
+def test_a_linked_duplicate_with_a_stack_is_refused():
+    # Alt+D gives two objects one mesh: each stack wrote that mesh, the last one evaluated won.
+    fresh()
+    obj = grid_object()
+    add("twist")
+    twin = obj.copy()  # a linked duplicate: the same mesh
+    bpy.context.scene.collection.objects.link(twin)
+    twin.location = (3.0, 0.0, 0.0)
+    message = addon.evaluate.evaluate_safely(obj, force=True)
+    assert f"its mesh '{obj.data.name}' is also '{twin.name}''s" in message and "Make Single User" in message, \
+        message
+
+
+def test_moving_the_deformed_object_evaluates_it_again():
+    # Controls are read in the object's space: moving the object under a still handle changes the
+    # deformation at once, as Blender's SimpleDeform does, not at the next frame change.
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    twist = add("twist")
+    z_up(twist.frame)
+    twist.frame.location = (0.5, 0.0, 0.0)
+    twist.start_value, twist.end_value = 0.0, 1.0
+    bpy.context.view_layer.update()
+    at_origin = positions(obj).copy()
+    obj.location = (0.25, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    moved = positions(obj).copy()
+    assert np.abs(moved - at_origin).max() > 1e-3
+    stack = direct_stack(obj, rest)
+    stack.add("twist", "t")
+    set_all(stack, 0, [("handleOrigin", (0.25, 0.0, 0.0)), ("handleY", (0, 0, 1)), ("startAngle", 0.0),
+                       ("endAngle", 1.0)])
+    assert_same(moved, stack.evaluate(rest), "twist after the object moved")
+
+
+def test_a_scripted_bake_without_frames_bakes_the_scenes_range():
+    fresh()
+    obj = grid_object()
+    layer = obj.data.uv_layers.new(name="UVMap")
+    corners = np.array([obj.data.vertices[l.vertex_index].co[:2] for l in obj.data.loops], np.float32)
+    layer.data.foreach_set("uv", ((corners + 1.0) / 2.0).ravel())
+    add("twist")
+    obj.deformkit.uv_rigidity = bpy.data.images.new("rigidity", 16, 16, float_buffer=True)
+    out = tempfile.mkdtemp()
+    obj.deformkit.uv_output = out
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 2, 4
+    try:
+        assert bpy.ops.deformkit.bake_redirect() == {'FINISHED'}
+    finally:
+        scene.frame_start, scene.frame_end = 1, 250
+    assert sorted(f for f in os.listdir(out) if f.endswith(".exr")) == [
+        f"redirect.1001.{f:04d}.exr" for f in (2, 3, 4)]
+
+
 def test_shape_keys_an_empty_mesh_and_an_unsaved_output_are_refused_with_reports():
     fresh()
     obj = grid_object()
@@ -927,6 +1052,17 @@ def test_live_uv_warp_follows_frame_changes_through_the_material():
                for cells in (128, 1024, 4096))
     assert {k: solver.options[k] for k in dk.uv_warp_live_options(size)} == dk.uv_warp_live_options(size)
     print(f"  live UV warp, Spot at {size}^2: {rate[0]:.1f} frames/s ({rate[1]:.1f} ms a frame)")
+
+    # Renamed, the object stays live (its state followed its name, and stopped without a word).
+    obj.name = "spot renamed"
+    bpy.context.scene.frame_set(4)
+    solver.solve(positions(obj))
+    live.pixels.foreach_get(pixels)
+    assert np.array_equal(pixels.reshape(size, size, 4)[::-1, :, :2], solver.redirect_map()), "after a rename"
+    bpy.context.scene.frame_set(5)
+    solver.solve(positions(obj))
+    live.pixels.foreach_get(pixels)
+    assert addon.uvwarp.live_active(obj)
 
     # Off: frame changes leave the image alone.
     assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}

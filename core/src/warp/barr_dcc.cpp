@@ -87,7 +87,7 @@ ProfileCurve linearProfile(const Range& r, double slope, double offset, const ch
 }  // namespace
 
 BendSetup fromMayaBend(const MayaBend& m) {
-    const char* source = "Maya bend";
+    const char* source = "bend handle frame";  // Maya's and Blender's bend handles alike
     for (int i = 0; i < 3; ++i) {
         requireFinite(m.handleOrigin[i], source, "handle origin");
         requireFinite(m.handleX[i], source, "handle X axis");

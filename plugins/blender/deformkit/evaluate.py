@@ -8,12 +8,17 @@ Controls are read in the deformed object's local space (its inverse world matrix
 object moves its controls' effect with it, as Blender's own deformers behave.
 """
 
+import hashlib
+
 import bpy
 import numpy as np
 
 from .core import dk
 
 REST_ATTRIBUTE = "deformkit_rest"
+# The polygons the rest shape was taken on (a digest of their vertex counts and indices), kept on the mesh
+# beside it: a topology edit under a stack gives new vertices no rest position, so it is refused, not read.
+REST_TOPOLOGY = "deformkit_rest_topology"
 
 # Per object name: the stack, the entry signature it was built for, and the last weights set per entry.
 _cache = {}
@@ -35,8 +40,16 @@ def has_rest(obj):
     return REST_ATTRIBUTE in obj.data.attributes
 
 
+def topology_digest(obj):
+    """The mesh's polygons as a short text: vertex and polygon counts and a digest of every polygon's
+    vertex indices."""
+    counts, indices, _ = topology(obj)
+    digest = hashlib.blake2b(counts.tobytes() + b"/" + indices.tobytes(), digest_size=16).hexdigest()
+    return f"{len(obj.data.vertices)} vertices, {len(counts)} polygons, {digest}"
+
+
 def capture_rest(obj):
-    """Stores the mesh's current vertex positions as the rest shape."""
+    """Stores the mesh's current vertex positions as the rest shape, with the polygons they belong to."""
     mesh = obj.data
     points = np.empty(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", points)
@@ -44,6 +57,46 @@ def capture_rest(obj):
     if attribute is None:
         attribute = mesh.attributes.new(REST_ATTRIBUTE, 'FLOAT_VECTOR', 'POINT')
     attribute.data.foreach_set("vector", points)
+    mesh[REST_TOPOLOGY] = topology_digest(obj)
+
+
+def drop_rest(obj):
+    """Forgets the rest shape (the stack's last entry removed): the next first entry takes the mesh as it is
+    then, with the modelling done in between."""
+    mesh = obj.data
+    attribute = mesh.attributes.get(REST_ATTRIBUTE)
+    if attribute is not None:
+        mesh.attributes.remove(attribute)
+    if REST_TOPOLOGY in mesh:
+        del mesh[REST_TOPOLOGY]
+
+
+def require_rest_topology(obj):
+    """Raises DeformKitError when the mesh's polygons are not those its rest shape was taken on (vertices
+    added, deleted or joined under the stack). A rest shape stored without its polygons is taken as it is."""
+    then = obj.data.get(REST_TOPOLOGY)
+    if then is None:
+        return
+    now = topology_digest(obj)
+    if now != then:
+        raise DeformKitError(
+            f"{obj.name}: the mesh's polygons changed since its rest shape was taken ({then.split(',')[0]} "
+            f"then, {now.split(',')[0]} now): new vertices have no rest position. Disable the entries, make "
+            f"the change, and press Reset Rest")
+
+
+def require_own_mesh(obj):
+    """Raises DeformKitError when another object with DeformKit entries uses this object's mesh (a linked
+    duplicate): each stack writes the mesh's positions, and the last one evaluated would win."""
+    mesh = obj.data
+    if mesh.users < 2:
+        return
+    for other in bpy.data.objects:
+        if other is not obj and other.data == mesh and len(other.deformkit.entries) > 0:
+            raise DeformKitError(
+                f"{obj.name}: its mesh '{mesh.name}' is also '{other.name}''s, which has DeformKit deformers "
+                f"too (a linked duplicate): each stack writes the mesh's positions. Make the mesh single-user "
+                f"(Object > Relations > Make Single User > Object & Data)")
 
 
 def rest_points(obj):
@@ -269,6 +322,7 @@ def _stack_for(obj):
     signature = tuple((e.type, e.name) for e in obj.deformkit.entries)
     cached = _cache.get(_key(obj))
     if cached is None or cached["signature"] != signature or cached["shape"] != _shape(obj):
+        require_rest_topology(obj)
         stack = dk.DeformerStack()
         counts, indices, _ = topology(obj)
         rest = rest_points(obj)  # kept: reading the attribute again every frame costs 14 ms at 1M vertices
@@ -334,6 +388,7 @@ def evaluate_object(obj, depsgraph=None, force=False):
     if obj.data.shape_keys is not None:
         raise DeformKitError(f"{obj.name}: the mesh has shape keys, which Blender shows in place of the vertex "
                              "positions DeformKit writes (apply or remove them, or deform a copy without them)")
+    require_own_mesh(obj)
     entries = evaluated_entries(obj, depsgraph)
     cached = _stack_for(obj)
     stack = cached["stack"]

@@ -23,9 +23,8 @@ def on_frame_change(scene, depsgraph=None):
             evaluate.evaluate_safely(obj, depsgraph)
         # The live UV warp follows the viewport (a render evaluates its own depsgraph and reads baked maps).
         if depsgraph is not None and depsgraph.mode == 'VIEWPORT':
-            for name in list(uvwarp.live_objects()):
-                obj = scene.objects.get(name)
-                if obj is not None:
+            for obj in scene.objects:
+                if uvwarp.live_active(obj):
                     _live_frame(obj, depsgraph)
     finally:
         _busy = False
@@ -47,6 +46,9 @@ def on_depsgraph_update(scene, depsgraph):
     objects = {u.id.original.name for u in depsgraph.updates if isinstance(u.id, bpy.types.Object)}
     data = {u.id.original.name for u in depsgraph.updates
             if isinstance(u.id, (bpy.types.Lattice, bpy.types.Curve, bpy.types.Mesh))}
+    # Objects whose transform changed (not only their mesh: writing the deformed positions updates that).
+    moved = {u.id.original.name for u in depsgraph.updates
+             if isinstance(u.id, bpy.types.Object) and u.is_updated_transform}
     if not objects and not data:
         return
     _busy = True
@@ -63,7 +65,9 @@ def on_depsgraph_update(scene, depsgraph):
             controls = evaluate.controls(obj)
             control_data = {bpy.data.objects[c].data.name for c in controls
                             if c in bpy.data.objects and bpy.data.objects[c].data is not None}
-            if controls & objects or control_data & data:
+            # A control moved, or the object itself (controls are read in its space, as Blender's
+            # modifiers read theirs): evaluated again, which writes nothing when no input changed.
+            if controls & objects or control_data & data or obj.name in moved:
                 evaluate.evaluate_safely(obj, depsgraph)
     finally:
         _busy = False

@@ -223,7 +223,11 @@ class DEFORMKIT_OT_remove(bpy.types.Operator):
         settings.entries.remove(settings.active_index)
         settings.active_index = max(0, min(settings.active_index, len(settings.entries) - 1))
         if len(settings.entries) == 0:
+            # The mesh back to its rest shape, which is then forgotten: modelling done before the next
+            # deformer is added is the rest shape that deformer takes.
             evaluate.restore_rest(obj)
+            evaluate.drop_rest(obj)
+            evaluate.clear_cache()
             settings.status = ""
             return {'FINISHED'}
         message = evaluate.evaluate_safely(obj)
@@ -280,8 +284,8 @@ class DEFORMKIT_OT_evaluate(bpy.types.Operator):
 
 
 class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
-    """Take the mesh's rest shape from its current shape after restoring it (for edits made with the stack
-    off): the deformers rebind to it"""
+    """Take the mesh's current shape as its rest shape (for modelling done with every entry disabled, an
+    Armature applied, polygons added or deleted): the deformers rebind to it"""
     bl_idname = "deformkit.reset_rest"
     bl_label = "Reset Rest Shape"
     bl_options = {'REGISTER', 'UNDO'}
@@ -293,7 +297,15 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        evaluate.restore_rest(obj)
+        if obj.mode == 'EDIT':
+            bpy.ops.object.mode_set(mode='OBJECT')  # the positions Edit Mode keeps apart, written back
+            bpy.ops.object.mode_set(mode='EDIT')
+        active = [e.name for e in obj.deformkit.entries if e.enabled and e.envelope != 0.0]
+        if active:
+            # The mesh shows their deformation: taken as the rest, it would be deformed twice.
+            self.report({'ERROR'}, f"{obj.name}: disable every entry first (the mesh shows the deformation of "
+                                   f"{', '.join(active)}, not a rest shape)")
+            return {'CANCELLED'}
         evaluate.capture_rest(obj)
         evaluate.clear_cache()
         message = evaluate.evaluate_safely(obj)
@@ -302,13 +314,21 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
         return {'FINISHED'}
 
 
+def _scene_range(operator, context):
+    """The operator's frame range: the one it was given, else the scene's (a script calling the operator
+    without frames bakes the scene's range, as the button does)."""
+    for name, scene_value in (("frame_start", context.scene.frame_start), ("frame_end", context.scene.frame_end)):
+        if not operator.properties.is_property_set(name):
+            setattr(operator, name, scene_value)
+
+
 class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
     """Solve the content-aware UV warp of the active mesh over a frame range and write its redirect maps"""
     bl_idname = "deformkit.bake_redirect"
     bl_label = "Bake DeformKit Redirect Maps"
 
-    frame_start: IntProperty(name="Start", default=1)
-    frame_end: IntProperty(name="End", default=1)
+    frame_start: IntProperty(name="Start", default=1, description="First frame (not given: the scene's)")
+    frame_end: IntProperty(name="End", default=1, description="Last frame (not given: the scene's)")
     # Off by default: a rigger baking again after repainting expects new maps.
     resume: BoolProperty(name="Resume", default=False,
                          description="Keep the redirect maps that exist and bake only the missing ones (after an "
@@ -319,10 +339,11 @@ class DEFORMKIT_OT_bake_redirect(bpy.types.Operator):
         return _mesh_object(context) is not None
 
     def invoke(self, context, event):
-        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
+        _scene_range(self, context)
         return self.execute(context)
 
     def execute(self, context):
+        _scene_range(self, context)
         obj = _mesh_object(context)
         settings = obj.deformkit
         if self.frame_end < self.frame_start:
@@ -392,8 +413,8 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
     bl_label = "Add DeformKit Redirect Nodes"
     bl_options = {'REGISTER', 'UNDO'}
 
-    frame_start: IntProperty(name="Start", default=1)
-    frame_end: IntProperty(name="End", default=1)
+    frame_start: IntProperty(name="Start", default=1, description="First frame (not given: the scene's)")
+    frame_end: IntProperty(name="End", default=1, description="Last frame (not given: the scene's)")
 
     @classmethod
     def poll(cls, context):
@@ -401,10 +422,11 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
         return obj is not None and obj.active_material is not None
 
     def invoke(self, context, event):
-        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
+        _scene_range(self, context)
         return self.execute(context)
 
     def execute(self, context):
+        _scene_range(self, context)
         obj = _mesh_object(context)
         try:
             first = os.path.join(_output_folder(obj.deformkit), uvwarp.redirect_name(1001, self.frame_start))

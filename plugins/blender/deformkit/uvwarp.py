@@ -215,16 +215,13 @@ def add_redirect_nodes(material, first_map, frame_start, frame_count):
 
 LIVE_IMAGE = "DeformKit Live {}"
 
-# Per object name: its tile's solver, the image it fills, the last frames' times.
+# Per object (its address, as evaluate.py keys stacks: a renamed object stays live): its tile's solver, the
+# image it fills, the last frames' times.
 _live = {}
 
 
 def live_active(obj):
-    return obj.name in _live
-
-
-def live_objects():
-    return _live.keys()
+    return obj.as_pointer() in _live
 
 
 def start_live(obj, rigidity, mask, resolution):
@@ -260,13 +257,13 @@ def start_live(obj, rigidity, mask, resolution):
     if image is None:
         image = bpy.data.images.new(name, texels, texels, alpha=True, float_buffer=True, is_data=True)
     image.colorspace_settings.name = 'Non-Color'
-    _live[obj.name] = {"solver": solver, "image": image.name, "times": [], "pixels": None}
-    _fill(_live[obj.name], image, solver.redirect_map())  # the identity until the first frame change
+    _live[obj.as_pointer()] = {"solver": solver, "image": image.name, "times": [], "pixels": None}
+    _fill(_live[obj.as_pointer()], image, solver.redirect_map())  # the identity until the first frame change
     return image
 
 
 def stop_live(obj):
-    _live.pop(obj.name, None)
+    _live.pop(obj.as_pointer(), None)
 
 
 def clear_live():
@@ -299,7 +296,7 @@ def live_points(obj, depsgraph, count):
 def live_update(obj, depsgraph):
     """One live frame: the warm-started solve of the deformed mesh, its redirect map into the image.
     Returns the frame's time in ms, also kept for live_rate()."""
-    state = _live.get(obj.name)
+    state = _live.get(obj.as_pointer())
     if state is None:
         return None
     image = bpy.data.images.get(state["image"])
@@ -317,7 +314,7 @@ def live_update(obj, depsgraph):
 
 def live_rate(obj):
     """(frames per second, median ms) over the last frames, or None before the first."""
-    state = _live.get(obj.name)
+    state = _live.get(obj.as_pointer())
     if state is None or not state["times"]:
         return None
     ms = float(np.median(state["times"]))

@@ -314,7 +314,7 @@ TEST_CASE("parameters are validated and named", "[host][deformers][errors]") {
     // Cross-parameter checks the core makes at bind arrive with the deformer's name in front.
     const auto bend = makeDeformer("bend", "b");
     bend->set("handleX", std::vector<double>{2, 0, 0});
-    CHECK_THROWS_WITH(bend->bind(rest), Contains("bend 'b': Maya bend: handle scale"));
+    CHECK_THROWS_WITH(bend->bind(rest), Contains("bend 'b': bend handle frame: handle scale"));
 }
 
 namespace {
