@@ -1,7 +1,9 @@
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 
+#include "deformkit/error.h"
 #include "slider_impl.h"
 
 namespace deformkit::slide {
@@ -126,8 +128,18 @@ void Slider::Impl::prepareLimit(std::span<const glm::vec3> in) {
         same = L.incomingCage[i] == in[L.vertices[i]];
     if (!same) {
         L.incomingCage.resize(L.vertices.size());
-        for (size_t i = 0; i < L.vertices.size(); ++i)
-            L.incomingCage[i] = in[L.vertices[i]];
+        for (size_t i = 0; i < L.vertices.size(); ++i) {
+            // The limit patches read the points around the region's faces too: a non-finite one would make
+            // the limit points of every patch it touches NaN.
+            const glm::vec3& p = in[L.vertices[i]];
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+                throw InvalidInput(
+                    formatError(source, "point of vertex " + std::to_string(L.vertices[i]), "not finite",
+                                "finite x, y, z (the limit surface reads the points around the "
+                                "region's faces)"));
+            }
+            L.incomingCage[i] = p;
+        }
         L.incoming = std::make_unique<geom::LimitSurface>(L.rest->withPoints(L.incomingCage));
     }
     L.current = L.incoming.get();

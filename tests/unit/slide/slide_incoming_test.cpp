@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -97,6 +98,32 @@ TEST_CASE("slide over a rigidly moved mesh is the rigid motion of the rest slide
     // Float positions of coordinates up to ~3 units: rounding of the moved copy (~2e-7) and of the
     // handle rotation recovered from it; a rest-space offset (the old behaviour) is off by ~|d|.
     CHECK(worst < 2e-6 * scale);
+}
+
+TEST_CASE("slide over a uniformly scaled mesh is the scaled rest slide, however small the scale",
+          "[slide][real]") {
+    // slide(s x, s d) = s slide(x, d): a rest mesh in millimetres driven by a rig in metres is s = 1e-3. The
+    // incoming frame's determinant is s^3; an absolute threshold took s <= 1e-3 for a collapsed ring and
+    // the handle travelled 0.1% of the drag.
+    const geom::Mesh& mesh = spot();
+    const double diag = diagonal(mesh.points());
+    const SlideHandle handle{1858, 0.12 * diag};
+    const glm::dvec3 d(0.0, 0.02 * diag, 0.01 * diag);
+    const auto atRest = slideOver(mesh, mesh.points(), handle, d);
+    for (const double s : {0.5, 1e-2, 1e-3, 9e-4, 1e-4}) {
+        INFO("scale " << s);
+        std::vector<glm::vec3> scaled;
+        for (const glm::vec3& p : mesh.points())
+            scaled.emplace_back(s * glm::dvec3(p));
+        const auto over = slideOver(mesh, scaled, handle, s * d);
+        double worst = 0.0;
+        for (int32_t v = 0; v < mesh.numVertices(); ++v)
+            worst = std::max(worst, glm::length(glm::dvec3(over[v]) / s - glm::dvec3(atRest[v])));
+        // Float positions of the scaled copy, relative to its size (a few float ulps of the diagonal).
+        CHECK(worst < 1e-6 * diag);
+        CHECK(glm::length(glm::dvec3(over[1858]) / s - glm::dvec3(mesh.points()[1858])) >
+              0.5 * glm::length(d));
+    }
 }
 
 TEST_CASE("slide over a bent limb follows the limb: the drag turns with it and stays on it", "[slide]") {
@@ -345,6 +372,30 @@ TEST_CASE("slide: a non-finite incoming point it reads is an error naming the ve
     slider.evaluate({&drive, 1}, points);
     CHECK(std::isnan(points[0].x));
     CHECK(points[handle].x > plane.points()[handle].x);
+    // On the limit surface the patches of the region's faces read the points around them too: a NaN there,
+    // outside the region and the handle's ring, made active vertices NaN. Every such point is checked.
+    SlideOptions limit;
+    limit.surface = slide::SurfaceMode::Limit;
+    slide::Slider onLimit(plane, {{handle, 0.3}}, limit);
+    const std::span<const int32_t> active = onLimit.activeVertices();
+    int32_t outside = -1;  // a vertex sharing a face with an active vertex, not active itself
+    for (int32_t f = 0; f < plane.numFaces() && outside < 0; ++f) {
+        const auto face = plane.face(f);
+        const bool touches =
+            std::ranges::any_of(face, [&](int32_t v) { return std::ranges::count(active, v) > 0; });
+        for (const int32_t v : face)
+            if (touches && std::ranges::count(active, v) == 0) outside = v;
+    }
+    REQUIRE(outside >= 0);
+    points = std::vector<glm::vec3>(plane.points().begin(), plane.points().end());
+    for (glm::vec3& p : points)
+        p.z += 0.01f;  // moved: the incoming limit surface is built from the points
+    points[outside].z = std::nanf("");
+    const std::vector<glm::vec3> moved = points;
+    CHECK_THROWS_WITH(onLimit.evaluate({&drive, 1}, points),
+                      Catch::Contains("point of vertex " + std::to_string(outside) + ": not finite") &&
+                          Catch::Contains("the limit surface reads the points around the region's faces"));
+    CHECK(std::memcmp(points.data(), moved.data(), points.size() * sizeof(glm::vec3)) == 0);
 }
 
 TEST_CASE("slide: a drag beyond float range is an error; one within it stays on the surface",
