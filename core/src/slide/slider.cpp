@@ -291,20 +291,39 @@ void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> p
     m.requireCounts(static_cast<int32_t>(weld.weldedOf.size()), points.size(), weights.size());
     // The copies the slide reads must be finite, named by their file index (the welded vertex reads its first
     // copy; the others follow it).
-    for (int32_t v : m.fileActive) {
+    const auto requireFinite = [&](int32_t v) {
         const glm::vec3& p = points[v];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
             throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(v), "not finite",
                                            "finite x, y, z"));
         }
+    };
+    for (int32_t v : m.fileActive)
+        requireFinite(v);
+    for (const SlideHandle& handle : m.handles) {  // the handles' rings, as read: their first copies
+        for (int32_t q : m.surface.neighbors(handle.vertex))
+            requireFinite(weld.firstOf[static_cast<size_t>(q)]);
     }
     for (size_t w = 0; w < weld.firstOf.size(); ++w)
         m.weldedIn[w] = m.weldedPoints[w] = points[static_cast<size_t>(weld.firstOf[w])];
+    // Every file vertex's weight is checked, named by its file index; a welded vertex takes the mean of its
+    // copies' weights (equal where a DCC painted the one vertex they split from).
     std::span<const float> weldedWeights;
     if (!weights.empty()) {
+        for (size_t i = 0; i < weights.size(); ++i) {
+            if (!std::isfinite(weights[i])) {
+                throw InvalidInput(formatError(m.source, "weight of vertex " + std::to_string(i),
+                                               "not finite", "a finite weight, normally in [0, 1]"));
+            }
+        }
         m.weldedWeights.resize(weld.firstOf.size());
-        for (size_t w = 0; w < weld.firstOf.size(); ++w)
-            m.weldedWeights[w] = weights[static_cast<size_t>(weld.firstOf[w])];
+        for (size_t w = 0; w < weld.firstOf.size(); ++w) {
+            double sum = 0.0;
+            const auto copies = weld.copiesOf(static_cast<int32_t>(w));
+            for (const int32_t copy : copies)
+                sum += weights[static_cast<size_t>(copy)];
+            m.weldedWeights[w] = static_cast<float>(sum / static_cast<double>(copies.size()));
+        }
         weldedWeights = m.weldedWeights;
     }
     m.evaluateSurface(drives, m.weldedPoints, weldedWeights, envelope, result);

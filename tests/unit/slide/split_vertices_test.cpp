@@ -147,6 +147,64 @@ TEST_CASE("slide on split vertices: every copy moves bit for bit as the shared v
     CHECK(moved > 1000);  // the drags are real
 }
 
+TEST_CASE("slide on split vertices: every copy's weight counts and is checked, errors name file vertices",
+          "[slide][weld]") {
+    const geom::Mesh& mesh = test::spot();
+    std::vector<int32_t> original;
+    const geom::Mesh split = test::splitCopy(mesh, true, original);  // every face its own corners
+    // A handle and its region on the split mesh: some vertex whose copies the slide moves.
+    const SlideHandle handle{0, 0.15 * test::diagonal(mesh.points())};
+    const SlideDrive drive{glm::dvec3(0.02, 0.01, 0.0) * test::diagonal(mesh.points()), Falloff::smooth()};
+    Slider slider(split, {handle});
+    const std::span<const int32_t> active = slider.activeVertices();
+    REQUIRE(active.size() > 4);
+    // Copies of one original vertex with other weights: the welded vertex takes their mean, as if every copy
+    // had it.
+    const int32_t target = original[static_cast<size_t>(active[2])];
+    std::vector<int32_t> copies;
+    for (int32_t k = 0; k < split.numVertices(); ++k)
+        if (original[static_cast<size_t>(k)] == target) copies.push_back(k);
+    REQUIRE(copies.size() >= 2);
+    std::vector<float> uneven(static_cast<size_t>(split.numVertices()), 1.0f), even = uneven;
+    double sum = 0.0;
+    for (size_t i = 0; i < copies.size(); ++i) {
+        uneven[static_cast<size_t>(copies[i])] = i == 0 ? 0.0f : 1.0f;
+        sum += uneven[static_cast<size_t>(copies[i])];
+    }
+    for (const int32_t k : copies)
+        even[static_cast<size_t>(k)] = static_cast<float>(sum / static_cast<double>(copies.size()));
+    std::vector<glm::vec3> a(split.points().begin(), split.points().end()), b = a;
+    slider.evaluate({&drive, 1}, a, uneven);
+    slider.evaluate({&drive, 1}, b, even);
+    CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0);
+    CHECK(a[static_cast<size_t>(copies[0])] != split.points()[static_cast<size_t>(copies[0])]);
+    // A NaN weight on a copy other than the first, and a NaN point on a handle ring's copy: named by the
+    // file's index, before anything is written.
+    std::vector<float> bad = even;
+    bad[static_cast<size_t>(copies.back())] = std::nanf("");
+    std::vector<glm::vec3> points(split.points().begin(), split.points().end());
+    CHECK_THROWS_WITH(slider.evaluate({&drive, 1}, points, bad),
+                      Contains("weight of vertex " + std::to_string(copies.back()) + ": not finite"));
+    // The handle's ring is read whatever the radius: a slider whose region is the handle alone.
+    const geom::Welding weld = geom::weldVertices(split);
+    const auto welded = [&](int32_t k) { return weld.weldedOf[static_cast<size_t>(k)]; };
+    int32_t ringCopy = -1;  // the first copy of a vertex sharing a face with the handle
+    for (int32_t f = 0; f < split.numFaces() && ringCopy < 0; ++f) {
+        const auto face = split.face(f);
+        if (std::ranges::none_of(face, [&](int32_t v) { return welded(v) == welded(handle.vertex); }))
+            continue;
+        for (const int32_t v : face)
+            if (welded(v) != welded(handle.vertex)) ringCopy = weld.firstOf[static_cast<size_t>(welded(v))];
+    }
+    REQUIRE(ringCopy >= 0);
+    Slider tiny(split, {{handle.vertex, 1e-6 * test::diagonal(mesh.points())}});
+    points[static_cast<size_t>(ringCopy)].x = std::nanf("");
+    const std::vector<glm::vec3> before = points;
+    CHECK_THROWS_WITH(tiny.evaluate({&drive, 1}, points),
+                      Contains("point of vertex " + std::to_string(ringCopy) + ": not finite"));
+    CHECK(std::memcmp(points.data(), before.data(), points.size() * sizeof(glm::vec3)) == 0);
+}
+
 TEST_CASE("slide on split vertices: without welding the split mesh tears", "[slide][weld]") {
     // What the weld prevents: the Fox-like case of every triangle on its own, the handle's triangle alone
     // moves and the others stay, a crack.
