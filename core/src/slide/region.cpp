@@ -117,7 +117,11 @@ SupportRegion buildSupportRegion(const SlideSurface& surface, const geom::Mesh& 
     for (size_t k = 0; k < active; ++k) {
         const int32_t v = region.vertices[k];
         const glm::dvec3 b1 = surface.tangent1(v), b2 = surface.tangent2(v);
-        region.normalizedDistance[k] = static_cast<float>(distance[v] / radius);
+        // Stored in float: a vertex strictly inside the radius whose ratio rounds up to 1 would take the
+        // falloff's outside value (0), not its last; it keeps the largest float below 1.
+        const float ratio = static_cast<float>(distance[v] / radius);
+        region.normalizedDistance[k] =
+            ratio >= 1.0f && distance[v] < radius ? std::nextafter(1.0f, 0.0f) : ratio;
         region.a1Local[k] = glm::dvec2(glm::dot(a1[k], b1), glm::dot(a1[k], b2));
         region.a2Local[k] = glm::dvec2(glm::dot(a2[k], b1), glm::dot(a2[k], b2));
     }

@@ -243,6 +243,33 @@ TEST_CASE("slide: a user falloff ramp replaces the smooth curve", "[slide]") {
     CHECK(worst < 2e-6);
 }
 
+TEST_CASE("slide: a ramp's last value reaches every vertex strictly inside the radius", "[slide]") {
+    // The normalised distance is stored in float: a vertex at 0.99999998 r rounded to 1, the falloff's
+    // outside, and a constant ramp [1, 1] left it behind. Radii picked so that some vertex's distance is
+    // within a float rounding of the radius.
+    const geom::Mesh mesh = test::planeGrid(40, 40, 0.05f);
+    const int handle = 20 * 41 + 20;
+    const glm::dvec3 p0(mesh.points()[handle]);
+    const std::vector<float> flat = {1.0f, 1.0f};
+    int edgeCases = 0;
+    for (const int k : {7, 9, 10}) {
+        // A vertex k grid steps away along x: the radius just beyond it.
+        const double distance = glm::length(glm::dvec3(mesh.points()[handle + k]) - p0);
+        const double radius = distance * (1.0 + 2e-8);
+        REQUIRE(static_cast<float>(distance / radius) == 1.0f);  // the case at stake
+        const glm::dvec3 d(0.01, 0.005, 0.0);
+        const auto out = runSlide(mesh, {{handle, radius}}, {{d, slide::Falloff::ramp(flat)}});
+        for (int v = 0; v < mesh.numVertices(); ++v) {
+            const glm::dvec3 p(mesh.points()[v]);
+            if (glm::length(p - p0) >= radius) continue;
+            INFO("radius " << radius << ", vertex " << v);
+            CHECK(glm::length(glm::dvec3(out[v]) - (p + d)) < 2e-6);  // the flat ramp: every one by d
+            edgeCases += glm::length(p - p0) > radius * (1.0 - 1e-7) ? 1 : 0;
+        }
+    }
+    CHECK(edgeCases >= 3);
+}
+
 TEST_CASE("slide: several handles compose by adding their slides", "[slide]") {
     const geom::Mesh mesh = test::planeGrid(40, 40, 0.05f, someRotation());
     const int h1 = 15 * 41 + 12, h2 = 22 * 41 + 25;
