@@ -86,10 +86,15 @@ TEST_CASE("slide around a cylinder is a rotation about its axis by |d| falloff /
     const double delta = 2.0 * M_PI / around;
     const double chord = 2.0 * R * std::sin(delta / 2.0);
     double worstAngle = 0.0, worstPolygon = 0.0, worstZ = 0.0;
-    int moved = 0;
+    int moved = 0, onTheRadius = 0;
     for (int v = 0; v < mesh.numVertices(); ++v) {
         const glm::dvec3 p(mesh.points()[v]);
-        const double f = test::smoothFalloff(glm::length(p - p0) / radius);
+        const double x = glm::length(p - p0) / radius;
+        // A vertex within a float's rounding of the radius (the slide keeps normalised distances in float;
+        // 16 rows above the handle is 16 x 0.05 = 0.8 in exact arithmetic) falls on either side, here or in
+        // the slide: counted apart, it moves by f < 1e-13 if at all.
+        if (std::abs(x - 1.0) < 1.2e-7) ++onTheRadius;
+        const double f = test::smoothFalloff(x);
         if (f <= 0.0) continue;
         ++moved;
         const glm::dvec3 q(out[v]);
@@ -108,7 +113,8 @@ TEST_CASE("slide around a cylinder is a rotation about its axis by |d| falloff /
         worstZ = std::max(worstZ, std::abs(q.z - p.z));
     }
     INFO("angle error " << worstAngle << ", polygon-length error " << worstPolygon << ", z drift " << worstZ);
-    CHECK(moved == result.moved);
+    CHECK(result.moved >= moved);
+    CHECK(result.moved <= moved + onTheRadius);
     // Along chords the polar angle runs ahead of or behind the arc by at most a (delta^2 / 12) fraction.
     CHECK(worstAngle < travel * delta * delta / 12.0);
     CHECK(worstPolygon < 2e-6);  // exact up to float positions
