@@ -2,6 +2,7 @@
 #include <iostream>
 #include "cli.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -27,12 +28,19 @@ bool parseNumbers(std::string_view text, std::vector<double>& out) {
         const std::string field(
             text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
         if (field.empty()) return false;
-        char* end = nullptr;
-        const double value = std::strtod(field.c_str(), &end);
-        if (end == field.c_str()) return false;
-        while (*end == ' ')
-            ++end;
-        if (*end != '\0' || !std::isfinite(value)) return false;
+        // Decimal numbers only (from_chars, not strtod: "0x1" is no coordinate), spaces around them.
+        const char* begin = field.data();
+        const char* last = field.data() + field.size();
+        while (begin < last && *begin == ' ')
+            ++begin;
+        if (begin < last && *begin == '+') ++begin;
+        double value = 0.0;
+        const auto [end, error] = std::from_chars(begin, last, value, std::chars_format::general);
+        if (error != std::errc() || end == begin) return false;
+        const char* rest = end;
+        while (rest < last && *rest == ' ')
+            ++rest;
+        if (rest != last || !std::isfinite(value)) return false;
         out.push_back(value);
         if (comma == std::string_view::npos) return true;
         start = comma + 1;

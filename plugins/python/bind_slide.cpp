@@ -184,9 +184,16 @@ std::vector<SlideHandle> handlesOf(const std::optional<int64_t>& handle, const s
         }
         return out;
     }
-    if (!handle || !radius) {
+    if (!handle && !radius) {
         throw InvalidInput(
             formatError(source, "handle", "no handle given", "handle and radius, or handles=[...]"));
+    }
+    if (!radius) {
+        throw InvalidInput(
+            formatError(source, "radius", "is missing", "a radius with handle " + std::to_string(*handle)));
+    }
+    if (!handle) {
+        throw InvalidInput(formatError(source, "handle", "is missing", "a handle vertex with the radius"));
     }
     return {{vertexOf(*handle, source, "handle"), *radius, regionOf(region, source, "region")}};
 }
@@ -309,6 +316,10 @@ class PySlider {
         for (size_t h = 0; h < handles; ++h)
             drives.push_back({d[h], f[h]});
         std::vector<glm::vec3> pts = points ? pointsOf(*points, source, "points") : rest_;
+        if (pts.size() != static_cast<size_t>(slider->numVertices())) {
+            throw InvalidInput(formatError(source, "points", "has " + std::to_string(pts.size()) + " rows",
+                                           std::to_string(slider->numVertices()) + ", one per vertex"));
+        }
         const std::vector<float> w = weightsOf(weights, static_cast<size_t>(slider->numVertices()), source);
         SlideResult result;
         {

@@ -267,6 +267,12 @@ def test_bad_input_names_the_argument():
     with pytest.raises(dk.Error):
         dk.slide(pts, counts, idx[:-1], 12, d, 0.5)  # the faces want one more index
 
+    with pytest.raises(dk.InvalidInput, match=r"Slider: radius: is missing \(expected a radius with handle 5\)"):
+        dk.Slider(pts, counts, idx, handle=5)
+    with pytest.raises(dk.InvalidInput, match=r"Slider: handle: is missing \(expected a handle vertex"):
+        dk.Slider(pts, counts, idx, radius=0.5)
+    with pytest.raises(dk.InvalidInput, match=r"Slider.evaluate: points: has 3 rows \(expected 25, one per vertex\)"):
+        dk.Slider(pts, counts, idx, handle=5, radius=0.5).evaluate(d, points=pts[:3])
     with pytest.raises(dk.InvalidInput, match="handles\\[1\\].radius.*missing"):
         dk.Slider(pts, counts, idx, handles=[{"vertex": 1, "radius": 0.5}, {"vertex": 2}])
     with pytest.raises(dk.InvalidInput, match="handles\\[0\\].*'radious'"):
@@ -289,7 +295,7 @@ def test_bad_input_names_the_argument():
         slider.evaluate(d, weights=np.ones(24, dtype=np.float32))
     with pytest.raises(dk.InvalidInput, match="weight of vertex 3"):
         slider.evaluate(d, weights=np.float32([1, 1, 1, np.nan] + [1] * 21))
-    with pytest.raises(dk.InvalidInput, match="points: 24 given"):
+    with pytest.raises(dk.InvalidInput, match=r"Slider.evaluate: points: has 24 rows \(expected 25, one per vertex\)"):
         slider.evaluate(d, points=pts[:24])
     with pytest.raises(dk.InvalidInput, match=r"region.*handle.*\[0, 1\)"):
         slider.region(1)

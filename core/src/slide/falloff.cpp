@@ -27,7 +27,7 @@ Falloff Falloff::ramp(std::span<const float> samples, std::string_view name) {
     for (size_t i = 0; i < samples.size(); ++i) {
         const float v = samples[i];
         if (!std::isfinite(v) || v < 0.0f || v > 1.0f) {
-            throw InvalidInput(formatError(name, "sample " + std::to_string(i), "value " + std::to_string(v),
+            throw InvalidInput(formatError(name, "sample " + std::to_string(i), "is " + numberText(v),
                                            "a finite value in [0, 1]"));
         }
         f.samples_.push_back(v);

@@ -58,6 +58,13 @@ TEST_CASE("slide command: points and falloffs parse, bad text names the option",
                Catch::Contains("three finite numbers"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parsePoint("1,,2,3", "--to"); }),
                Catch::Contains("not a point"));
+    // Decimal only: strtod read a hexadecimal float ("0x1" as 1) and "infinity" words.
+    CHECK(harness::parsePoint("+0.5,1e2, -3", "--to") == glm::dvec3(0.5, 100.0, -3.0));
+    for (const char* text : {"0x1,0,0", "1,0x1p3,0", "inf,0,0", "1,2,3,"}) {
+        INFO(text);
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::parsePoint(text, "--from"); }),
+                   Catch::Contains("is not a point"));
+    }
 
     CHECK(harness::parseFalloff("smooth").isSmooth());
     // The linear curve and a ramp: values at x = 0.25 against 1 - x and the samples' interpolation.
