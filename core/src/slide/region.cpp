@@ -129,8 +129,10 @@ SupportRegion buildSupportRegion(const SlideSurface& surface, const geom::Mesh& 
         if (!inside(v) || slot[v] >= 0) continue;
         if (surface.hasFrame(v)) {
             ++region.unreachable;
+            region.unreachableVertices.push_back(v);
         } else {
             ++region.withoutTangentPlane;
+            region.verticesWithoutTangentPlane.push_back(v);
         }
     }
     return region;

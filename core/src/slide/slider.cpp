@@ -152,6 +152,23 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
             m.active.push_back(v);
         }
     }
+    // The result's counts, of distinct vertices: one a handle cannot reach but another's region moves is
+    // not unreachable, and one in several regions counts once.
+    {
+        std::vector<uint8_t> seen(static_cast<size_t>(m.surface.numVertices()), 0);
+        for (const SupportRegion& region : m.regions) {
+            for (const int32_t v : region.unreachableVertices) {
+                if (slotOf[v] >= 0 || seen[v] != 0) continue;
+                seen[v] = 1;
+                ++m.unreachable;
+            }
+            for (const int32_t v : region.verticesWithoutTangentPlane) {
+                if (seen[v] == 2) continue;
+                seen[v] = 2;
+                ++m.withoutTangentPlane;
+            }
+        }
+    }
     for (const SupportRegion& region : m.regions) {
         std::vector<int32_t> slots(region.vertices.size());
         for (size_t k = 0; k < slots.size(); ++k)
@@ -465,12 +482,8 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
         result->limited = counts.boundaryStopped + counts.walkLimitStopped;
         result->flippedTriangles = flipped;
         result->foldScale = scales;
-        result->unreachable = 0;
-        result->withoutTangentPlane = 0;
-        for (const SupportRegion& region : m.regions) {
-            result->unreachable += region.unreachable;
-            result->withoutTangentPlane += region.withoutTangentPlane;
-        }
+        result->unreachable = m.unreachable;
+        result->withoutTangentPlane = m.withoutTangentPlane;
         result->degenerateTriangles = m.degenerateTriangles;
     }
 }

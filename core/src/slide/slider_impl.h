@@ -75,6 +75,8 @@ struct Slider::Impl {
     using Stop = detail::Stop;
 
     std::string source;
+    // Distinct vertices within a radius that no region moves, and without a tangent plane (SlideResult).
+    int32_t unreachable = 0, withoutTangentPlane = 0;
     geom::Mesh mesh;
     SlideOptions options;
     std::vector<SlideHandle> handles;

@@ -340,6 +340,17 @@ TEST_CASE("slide: parts inside the radius that the propagation cannot reach stay
     }
     CHECK(expectedUnreachable > 20);
     CHECK(result.unreachable == expectedUnreachable);
+    // A second handle on the second sheet moves what the first cannot reach: nothing is unreachable then
+    // (the count was each handle's own, 2 x the sheet's share, while every one of them moved).
+    const int other = a.numVertices() + handle;
+    SlideResult both;
+    const glm::dvec3 d(0.05, 0.0, 0.0);
+    const auto twice = runSlide(mesh, {{handle, 0.4}, {other, 0.4}}, {{d}, {d}}, {}, 1.0f, &both);
+    CHECK(both.unreachable == 0);
+    int movedOnB = 0;
+    for (int v = a.numVertices(); v < mesh.numVertices(); ++v)
+        movedOnB += twice[v] != mesh.points()[v] ? 1 : 0;
+    CHECK(movedOnB >= expectedUnreachable - 8);  // all but those on the radius, where the falloff is 0
 }
 
 namespace {

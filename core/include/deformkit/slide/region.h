@@ -35,10 +35,13 @@ struct SupportRegion {
     std::vector<glm::dvec2> a1Local, a2Local;
 
     // Vertices within the radius that the propagation cannot reach through active vertices (another
-    // part of the mesh, or one joined only through vertices outside the region): left unmoved.
+    // part of the mesh, or one joined only through vertices outside the region): left unmoved by this
+    // handle (another handle's region may move them).
     int32_t unreachable = 0;
+    std::vector<int32_t> unreachableVertices;
     // Vertices within the radius whose triangles are all degenerate: no tangent plane, left unmoved.
     int32_t withoutTangentPlane = 0;
+    std::vector<int32_t> verticesWithoutTangentPlane;
 };
 
 // Builds the support region of `handle` with radius `radius` (scene units). The caller validates the
