@@ -22,6 +22,13 @@ bool barycentric(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, 
     return true;
 }
 
+// Whether barycentric coordinates put the point in the triangle: none below -1e-12, and summing to 1. A
+// target far beyond the triangle (a drag of 1e24 radii) loses every digit to cancellation, and all three
+// come out 0: not inside, the walk goes on (to its limit).
+bool inside(const glm::dvec3& b) {
+    return glm::all(glm::greaterThanEqual(b, glm::dvec3(-1e-12))) && std::abs(b.x + b.y + b.z - 1.0) < 1e-6;
+}
+
 glm::dvec3 clampBarycentric(glm::dvec3 b) {
     b = glm::max(b, glm::dvec3(0.0));
     const double sum = b.x + b.y + b.z;
@@ -152,8 +159,7 @@ Slider::Impl::Landing Slider::Impl::walk(int32_t slot, int32_t p, const glm::dve
 
     // Corner order of the start triangle is (p, a, b) from corner `start`.
     glm::dvec3 bary(0.0);
-    if (barycentric(glm::dvec2(0.0), ca, cb, target, bary) &&
-        glm::all(glm::greaterThanEqual(bary, glm::dvec3(-1e-12)))) {
+    if (barycentric(glm::dvec2(0.0), ca, cb, target, bary) && inside(bary)) {
         glm::dvec3 ordered(0.0);
         ordered[start % 3] = bary.x;
         ordered[SlideSurface::next(start) % 3] = bary.y;
@@ -194,8 +200,7 @@ Slider::Impl::Landing Slider::Impl::walk(int32_t slot, int32_t p, const glm::dve
         const double h = glm::length(glm::cross(toW, u)) / std::sqrt(edgeLength2);
         const glm::dvec2 cw = e0 + t * along + (h / alongLength) * glm::dvec2(along.y, -along.x);
         const glm::dvec2 cEntry = e1, cNext = e0;  // vertex(entry), vertex(next(entry))
-        if (barycentric(cEntry, cNext, cw, target, bary) &&
-            glm::all(glm::greaterThanEqual(bary, glm::dvec3(-1e-12)))) {
+        if (barycentric(cEntry, cNext, cw, target, bary) && inside(bary)) {
             glm::dvec3 ordered(0.0);
             ordered[entry % 3] = bary.x;
             ordered[SlideSurface::next(entry) % 3] = bary.y;

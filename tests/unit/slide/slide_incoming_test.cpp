@@ -420,6 +420,18 @@ TEST_CASE("slide: a drag beyond float range is an error; one within it stays on 
         CHECK((p.x >= -1e-6f && p.x <= 1.0f + 1e-6f && p.y >= -1e-6f && p.y <= 1.0f + 1e-6f));
     }
     CHECK(points[handle].x > plane.points()[handle].x);
+    // Drags of 1e15 to 1e30 radii walk to the limit or the boundary: none lands in its start triangle (the
+    // barycentric coordinates of a target that far lost every digit, read as "reached" at 1e24).
+    for (const double radii : {1e15, 1e24, 1e30}) {
+        INFO(radii << " radii");
+        points.assign(plane.points().begin(), plane.points().end());
+        const SlideDrive drag{glm::dvec3(0.3 * radii, 0.1 * radii, 0.0), Falloff::linear()};
+        SlideResult result;
+        slider.evaluate({&drag, 1}, points, {}, 1.0f, &result);
+        CHECK(result.moved > 0);
+        CHECK(result.limited == result.moved);
+        CHECK(points[handle].x > 0.9f);  // the handle reached the far boundary
+    }
 }
 
 TEST_CASE("slide over a stretched plane: the handle follows the locator", "[slide]") {
