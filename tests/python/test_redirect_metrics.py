@@ -182,3 +182,15 @@ def test_bad_inputs_name_what_is_wrong():
         dk.redirect_metrics(mesh, 1001, rig, points, bad)
     with pytest.raises(dk.InvalidInput, match="UDIM tile 1002: holds no UV face"):
         dk.redirect_metrics(mesh, 1002, rig, points, identity_map())
+    # The rigidity map and the deformed points are checked as the solver checks them: a NaN or a 5 in the
+    # map, a NaN point, changed the figures without a word.
+    for value, shown in ((np.nan, "nan"), (5.0, "5"), (-0.5, "-0.5")):
+        wrong = rig.copy()
+        wrong[7, 9] = value
+        with pytest.raises(dk.InvalidInput,
+                           match=rf"rigidity map texel \(9, 7\): is {shown} \(expected a finite value in \[0, 1\]\)"):
+            dk.redirect_metrics(mesh, 1001, wrong, points, identity_map())
+    moved = points.copy()
+    moved[3, 1] = np.nan
+    with pytest.raises(dk.InvalidInput, match=r"deformed position of vertex 3: is not finite"):
+        dk.redirect_metrics(mesh, 1001, rig, moved, identity_map())

@@ -322,6 +322,28 @@ def file_bytes(folder):
     return {name: (folder / name).read_bytes() for name in sorted(os.listdir(folder))}
 
 
+def test_a_texture_file_bakes_in_its_own_pixel_type(tmp_path):
+    # A float EXR texture (a displacement map) baked to EXR keeps float: it was written as half, 2.4e-4 off
+    # apply_redirect. A half texture stays half; a texture given as an array takes the format's default.
+    mesh = two_tiles()
+    rig, tex = shot_maps()
+    for kind in ("float", "half"):
+        folder = tmp_path / kind
+        folder.mkdir()
+        for tile in (1001, 1002):
+            dk.write_image(str(folder / f"tex.{tile}.exr"), tex[tile], type=kind)
+        dk.uvwarp_shot(*mesh, [2], lambda f: pose(mesh[0], f), rig, str(folder / OUT),
+                       texture=str(folder / "tex.<UDIM>.exr"), bake=str(folder / "col.<UDIM>.####.exr"), **OPTIONS)
+        for tile in (1001, 1002):
+            baked = str(folder / f"col.{tile}.0002.exr")
+            assert dk.read_image_info(baked)["pixel_type"] == kind
+            redirect = dk.read_image(str(folder / f"redirect.{tile}.0002.exr"))
+            expected = dk.apply_redirect(dk.read_image(str(folder / f"tex.{tile}.exr")), redirect)
+            if kind == "half":
+                expected = expected.astype(np.float16).astype(np.float32)
+            np.testing.assert_array_equal(dk.read_image(baked), expected)
+
+
 def test_shot_writes_the_solvers_maps_frame_by_frame_with_provenance(tmp_path):
     mesh = two_tiles()
     rig, tex = shot_maps()

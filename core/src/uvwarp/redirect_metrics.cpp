@@ -418,6 +418,17 @@ void RedirectMetrics::setRigidity(io::Image rigidity) {
                                        std::to_string(rigidity.width) + " texels per side",
                                        std::to_string(m.texels) + ", the bound map's size"));
     }
+    // Channel 0, finite and in [0, 1], as the solver takes it: a NaN or a 5 would change the figures.
+    for (int32_t y = 0; y < rigidity.height; ++y) {
+        for (int32_t x = 0; x < rigidity.width; ++x) {
+            const float r = rigidity.at(x, y, 0);
+            if (!(r >= 0.0f && r <= 1.0f)) {
+                throw InvalidInput(formatError(
+                    m.source, "rigidity map texel (" + std::to_string(x) + ", " + std::to_string(y) + ")",
+                    "is " + numberText(r), "a finite value in [0, 1]"));
+            }
+        }
+    }
     if (rigidity.channels == 1) {  // channel 0 is the map: kept as it comes, without a copy
         m.rigidity = std::move(rigidity);
         return;
@@ -447,6 +458,13 @@ DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed, c
                                            std::to_string(redirect.height) + " with " +
                                            std::to_string(redirect.channels) + " channels",
                                        std::to_string(t) + " x " + std::to_string(t) + " with 2 channels"));
+    }
+    for (size_t v = 0; v < deformed.size(); ++v) {
+        const glm::vec3& p = deformed[v];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            throw InvalidInput(formatError(m.source, "deformed position of vertex " + std::to_string(v),
+                                           "is not finite", "finite x, y, z"));
+        }
     }
     for (int32_t y = 0; y < t; ++y) {
         for (int32_t x = 0; x < t; ++x) {

@@ -53,6 +53,7 @@ struct TilePlan {
     TileWarpOptions options;                                 // the job's, or its preset's for this tile
     std::optional<TileWarp> warp;                            // bound at the first frame it solves
     io::Image texturePixels, redirect, baked;
+    io::PixelType texturePixelType = io::PixelType::Auto;  // the texture file's, kept by a bake of its format
     // Animated maps: the rigidity, mask and orientation images last given to the warp, to tell a change.
     io::Image lastRigidity, lastMask, lastOrientation;
     nlohmann::json inputs;
@@ -422,6 +423,24 @@ std::optional<int> ShotSolver::lastNeededFrame() const {
 
 namespace {
 
+// A file name's extension in lower case (".exr").
+std::string lowercaseExtension(const fs::path& path) {
+    std::string extension = path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+// The pixel type an image file stores (Auto for one a writer cannot write as such).
+io::PixelType pixelTypeOf(const fs::path& file) {
+    const std::string type = io::readImageInfo(file).pixelType;
+    if (type == "float") return io::PixelType::Float;
+    if (type == "half") return io::PixelType::Half;
+    if (type == "uint16") return io::PixelType::UInt16;
+    if (type == "uint8") return io::PixelType::UInt8;
+    return io::PixelType::Auto;
+}
+
 // The file of `map` at `frame`: its frame's file when animated, its one file otherwise.
 std::optional<fs::path> mapFile(const TileMap& map, int frame) {
     if (!map.framePattern.empty()) return io::ObjSequence(map.framePattern).framePath(frame);
@@ -459,7 +478,9 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     const io::Image mask = readMap(plan.mask, frame, plan.tile, "warp mask");
     const io::Image orientation = readMap(plan.orientation, frame, plan.tile, "orientation map");
     if (plan.texture.file) {
-        plan.texturePixels = io::readImage(*mapFile(plan.texture, frame));
+        const fs::path file = *mapFile(plan.texture, frame);
+        plan.texturePixels = io::readImage(file);
+        plan.texturePixelType = pixelTypeOf(file);
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
     }
@@ -474,7 +495,11 @@ void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame) {
     const bool rigidityMoves = !plan.rigidity.framePattern.empty();
     const bool maskMoves = !plan.mask.framePattern.empty();
     const bool orientationMoves = !plan.orientation.framePattern.empty();
-    if (!plan.texture.framePattern.empty()) plan.texturePixels = io::readImage(*mapFile(plan.texture, frame));
+    if (!plan.texture.framePattern.empty()) {
+        const fs::path file = *mapFile(plan.texture, frame);
+        plan.texturePixels = io::readImage(file);
+        plan.texturePixelType = pixelTypeOf(file);
+    }
     if (!rigidityMoves && !maskMoves && !orientationMoves) return;
     bool changed = false;
     const auto next = [&](const TileMap& map, io::Image& last, const char* role) {
@@ -566,8 +591,12 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             // Only EXR keeps arbitrary header attributes; other formats get the pixels alone.
             t = Clock::now();
             if (plan.bakePaths[k].has_parent_path()) io::createFolder(plan.bakePaths[k].parent_path());
-            io::writeImage(plan.bakePaths[k], plan.baked,
-                           extension == ".exr" ? attributes : io::ImageWriteOptions{});
+            // The texture's pixel type where the bake has the texture's format (a float EXR texture bakes to
+            // a float EXR, a displacement map keeps its precision); the format's default otherwise.
+            io::ImageWriteOptions bakeWrite = extension == ".exr" ? attributes : io::ImageWriteOptions{};
+            if (plan.texture.file && lowercaseExtension(*plan.texture.file) == extension)
+                bakeWrite.type = plan.texturePixelType;
+            io::writeImage(plan.bakePaths[k], plan.baked, bakeWrite);
             r.files.push_back(plan.bakePaths[k]);
             writeSeconds += secondsSince(t);
             ++r.baked;
