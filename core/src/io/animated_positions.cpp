@@ -57,9 +57,15 @@ VertexOrderCheck::VertexOrderCheck(const geom::Mesh& rest) {
         restLength_.push_back(length);
     }
     restSpread_ = spread(points);
+    vertices_ = points.size();
 }
 
 std::optional<VertexOrderCheck::Tear> VertexOrderCheck::tear(std::span<const glm::vec3> points) const {
+    if (points.size() != vertices_) {
+        throw InvalidInput(formatError("vertex order check", "frame",
+                                       "has " + std::to_string(points.size()) + " points",
+                                       std::to_string(vertices_) + ", the rest mesh's vertex count"));
+    }
     const auto edges = static_cast<int32_t>(edges_.size());
     if (edges < kFewestEdges || !(restSpread_ > 0.0)) return std::nullopt;
     const double grown = spread(points);

@@ -469,6 +469,10 @@ TEST_CASE(
     CHECK_FALSE(io::VertexOrderCheck(quad).tear(reversed).has_value());
     const std::vector<glm::vec3> point(grid.points().size(), glm::vec3(1.0f));
     CHECK_FALSE(io::VertexOrderCheck(grid).tear(point).has_value());
+    // A frame of another size is an error, not read past its end.
+    const std::vector<glm::vec3> shorter(grid.points().begin(), grid.points().end() - 1);
+    CHECK_THROWS_WITH(io::VertexOrderCheck(grid).tear(shorter),
+                      Catch::Contains("has 624 points (expected 625"));
 }
 
 TEST_CASE(

@@ -41,15 +41,16 @@ class VertexOrderCheck {
         int32_t edges = 0;   // edges judged
         double scale = 1.0;  // how much the whole mesh grew
     };
-    // The tear of `points` (as many as the rest mesh's vertices, finite) when more than a quarter of the
-    // edges judged are torn; nothing when the frame keeps the order, or cannot be judged (too few edges, or
-    // the rest mesh or the frame all in one point).
+    // The tear of `points` (as many as the rest mesh's vertices, else InvalidInput) when more than a quarter
+    // of the edges judged are torn; nothing when the frame keeps the order, or cannot be judged (too few
+    // edges, or the rest mesh or the frame all in one point).
     [[nodiscard]] std::optional<Tear> tear(std::span<const glm::vec3> points) const;
 
   private:
     std::vector<std::pair<int32_t, int32_t>> edges_;
     std::vector<double> restLength_;
     double restSpread_ = 0.0;
+    size_t vertices_ = 0;
 };
 
 // The deformed positions of one mesh, frame by frame, as pipelines hand them over: an OBJ sequence
