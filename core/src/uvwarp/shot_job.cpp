@@ -585,9 +585,7 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
             bakeOptions.filter = job.filter;
             bakeTexture(plan.texturePixels, plan.redirect, plan.baked, bakeOptions);
             seconds["bake"] = secondsSince(t);
-            std::string extension = plan.bakePaths[k].extension().string();
-            std::transform(extension.begin(), extension.end(), extension.begin(),
-                           [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+            const std::string extension = lowercaseExtension(plan.bakePaths[k]);
             // Only EXR keeps arbitrary header attributes; other formats get the pixels alone.
             t = Clock::now();
             if (plan.bakePaths[k].has_parent_path()) io::createFolder(plan.bakePaths[k].parent_path());
@@ -722,10 +720,7 @@ void setOutputPatterns(ShotJob& job, const fs::path& out, const fs::path& bake, 
         }
     };
     check(out, outName);
-    std::string extension = out.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (extension != ".exr") {
+    if (lowercaseExtension(out) != ".exr") {
         throw InvalidInput(formatError(outName, out.string(), "is not an .exr file",
                                        "an OpenEXR file: the redirect map is 2 float channels with header "
                                        "attributes"));

@@ -154,10 +154,8 @@ MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& 
         parameters(block, toMaya(geometryWorld), parameters_);
         core.set(parameters_);
         // Positions in bulk, into and out of the core's own buffers (no allocation once warm).
-        iter.allPositions(positions_);
-        const unsigned n = positions_.length();
         const auto vertices = static_cast<unsigned>(core.stack().rest().numVertices());
-        if (n != vertices) {
+        if (static_cast<unsigned>(iter.count()) != vertices) {
             // A deformer set of some of the vertices: the whole mesh, its members weighted, theirs moved.
             mesh.getPoints(positions_, MSpace::kObject);
             all_.resize(positions_.length());
@@ -178,6 +176,8 @@ MStatus DkDeformer::deform(MDataBlock& block, MItGeometry& iter, const MMatrix& 
             iter.setAllPositions(positions_);
             return MS::kSuccess;
         }
+        iter.allPositions(positions_);
+        const unsigned n = positions_.length();
         const std::span<glm::vec3> points = core.points(n);
         const std::span<float> weights = core.weights(n);
         bool painted = false;
