@@ -27,10 +27,12 @@ constexpr double kCoreScales[] = {0.5, 0.25, 0.125, 0.0};
 
 class FoldRepairer {
   public:
-    FoldRepairer(io::Image& redirect, const ContentCheck& mayShow, const ContentRowCheck& refusedInRow)
+    FoldRepairer(io::Image& redirect, const ContentCheck& mayShow, const ContentRowCheck& refusedInRow,
+                 const TexelCheck& held)
         : r_(redirect),
           mayShow_(mayShow),
           refusedInRow_(refusedInRow),
+          held_(held),
           t_(redirect.width),
           u_(static_cast<size_t>(t_)),
           v_(u_.size()) {
@@ -140,6 +142,7 @@ class FoldRepairer {
         std::vector<int64_t> suspects = cells;
         for (int64_t id : movers) {
             const int32_t x = cellX(id), y = cellY(id);
+            if (held_ && !displaced(x, y) && held_(x, y)) continue;  // masked content stays painted
             glm::dvec2 sum(0.0);
             for (int32_t dy = -1; dy <= 1; ++dy)
                 for (int32_t dx = -1; dx <= 1; ++dx)
@@ -334,6 +337,7 @@ class FoldRepairer {
     io::Image& r_;
     const ContentCheck& mayShow_;
     const ContentRowCheck& refusedInRow_;
+    const TexelCheck& held_;
     int32_t t_;
     std::vector<float> u_, v_;
     FoldRepair report_;
@@ -341,8 +345,8 @@ class FoldRepairer {
 
 }  // namespace
 
-FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow,
-                       const ContentRowCheck& refusedInRow) {
+FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow, const ContentRowCheck& refusedInRow,
+                       const TexelCheck& held) {
     if (redirect.width < 1 || redirect.height != redirect.width || redirect.channels < 2 ||
         redirect.pixels.size() != static_cast<size_t>(redirect.width) * redirect.height * redirect.channels) {
         throw InvalidInput(formatError("fold repair", "redirect map",
@@ -351,7 +355,7 @@ FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow,
                                            std::to_string(redirect.channels) + " channels",
                                        "a square T x T map with 2 channels (u', v')"));
     }
-    return FoldRepairer(redirect, mayShow, refusedInRow).run();
+    return FoldRepairer(redirect, mayShow, refusedInRow, held).run();
 }
 
 std::vector<ReportedFigure> reportedFigures(const FoldRepair& r) {

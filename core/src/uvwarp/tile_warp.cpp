@@ -301,11 +301,31 @@ const WarpGrid& TileWarp::solve(std::span<const glm::vec3> deformedPoints) {
 FoldRepair TileWarp::redirect(io::Image& out) const {
     const Impl& m = *impl_;
     invertWarp(m.delivering().warp(), m.texels, out);
+    // A texel is held where the mask fixes every point of the delivered grid around its centre (1, 2 or 4
+    // of them): W is the identity there, so the inversion leaves the texel at its centre, and so does the
+    // repair. In exact integers: the centre sits at (2x + 1) n / 2T points along u, (2T - 2y - 1) n / 2T
+    // along v.
+    const std::vector<uint8_t>& mask = m.deliveredMask();
+    const int64_t n = m.deliveredCells(), side = n + 1, twoT = 2 * static_cast<int64_t>(m.texels);
+    const auto around = [&](int64_t numerator, int64_t& lo, int64_t& hi) {
+        lo = numerator / twoT;
+        hi = lo + (numerator % twoT != 0 ? 1 : 0);
+    };
+    const TexelCheck held = [&](int32_t x, int32_t y) {
+        int64_t i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+        around((2 * x + 1) * n, i0, i1);
+        around((twoT - 2 * y - 1) * n, j0, j1);
+        for (int64_t j = j0; j <= j1; ++j)
+            for (int64_t i = i0; i <= i1; ++i)
+                if (mask[static_cast<size_t>(j * side + i)] != 0) return false;
+        return true;
+    };
     return repairFolds(
         out, [&m](int32_t x, int32_t y, glm::dvec2 r) { return m.delivered->mayShow(x, y, r); },
         [&m](const io::Image& map, int32_t y, std::vector<int32_t>& refused) {
             m.delivered->refusedInRow(map, y, refused);
-        });
+        },
+        held);
 }
 
 io::Image TileWarp::redirect() const {

@@ -267,6 +267,53 @@ TEST_CASE("a fold the smoothing cannot end is scaled back around it, or with its
     }
 }
 
+TEST_CASE("held texels at their centres never move, and the folds next to them still end",
+          "[uvwarp][repair]") {
+    // The smooth warp on the square [0.4, 0.9]^2 of the tile, the identity elsewhere; the tile's left third
+    // (x < t / 3, at the identity) held. Spikes a texel or two right of the held band fold cells whose
+    // corners are held: the repair ends every fold without moving a held texel, by smoothing the others or
+    // scaling their displacement back.
+    std::mt19937 rng(1207);
+    std::uniform_real_distribution<double> amplitude(0.0, 0.05), offset(-3.0, 3.0);
+    int64_t foldsMade = 0, heldMovers = 0;
+    for (int c = 0; c < 100; ++c) {
+        const int32_t t = 48 << (c % 2), band = t / 3;
+        io::Image map = smoothMap(t, amplitude(rng), 0.4, 0.9);
+        for (int32_t y = 0; y < t; ++y) {
+            for (int32_t x = 0; x < band; ++x) {  // the identity as the inversion writes it, in float
+                map.at(x, y, 0) = (x + 0.5f) / static_cast<float>(t);
+                map.at(x, y, 1) = 1.0f - (y + 0.5f) / static_cast<float>(t);
+            }
+        }
+        for (int k = 0; k < 3; ++k) {
+            const int32_t x = band + static_cast<int32_t>(rng() % 2),
+                          y = 2 + static_cast<int32_t>(rng() % (t - 4));
+            map.at(x, y, 0) += static_cast<float>(offset(rng) / t);
+            map.at(x, y, 1) += static_cast<float>(offset(rng) / t);
+        }
+        const io::Image given = map;
+        const TexelCheck held = [band](int32_t x, int32_t) { return x < band; };
+        foldsMade += invertedReference(map);
+        INFO("case " << c);
+        (void)repairFolds(map, kAnything, {}, held);
+        CHECK(invertedReference(map) == 0);
+        for (int32_t y = 0; y < t; ++y) {
+            for (int32_t x = 0; x < band; ++x) {
+                CHECK(map.at(x, y, 0) == given.at(x, y, 0));
+                CHECK(map.at(x, y, 1) == given.at(x, y, 1));
+            }
+        }
+        // Without the held band, the smoothing moves some of those texels.
+        io::Image free = given;
+        (void)repairFolds(free, kAnything);
+        for (int32_t y = 0; y < t; ++y)
+            for (int32_t x = 0; x < band; ++x)
+                heldMovers += free.at(x, y, 0) != given.at(x, y, 0) || free.at(x, y, 1) != given.at(x, y, 1);
+    }
+    CHECK(foldsMade > 300);
+    CHECK(heldMovers > 100);
+}
+
 TEST_CASE("the repair is bit-identical for 1 and 2 threads", "[uvwarp][repair]") {
     std::mt19937 rng(3);
     io::Image map = smoothMap(128, 0.05);
