@@ -68,6 +68,29 @@ inline float weightOf(const WeightTerms& t, glm::vec2 x) {
     return std::pow(base, t.b);
 }
 
+// A point whose float weights sum below this has every feature far away for its a and b: float keeps
+// neither their ratios nor, further out, anything but 0 (a = 10, b = 30: every pixel past 52 from the
+// features). Such a point takes relativeWeights instead.
+constexpr double kSmallestWeightSum = 1e-30;
+
+// Eq. (3)'s weights at x divided by the largest of them, which the normalised sum divides out: w_i =
+// exp(b_i ln base_i - max_j b_j ln base_j) in double, base_i as weightOf rounds it. All 0 when every base is
+// 0 (the identity, as for weights that sum to 0).
+void relativeWeights(std::span<const WeightTerms> terms, glm::vec2 x, double* w) {
+    double largest = -std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < terms.size(); ++i) {
+        const WeightTerms& t = terms[i];
+        const glm::vec2 rel = x - t.p;
+        const float u = std::clamp(glm::dot(rel, t.d) * t.invLengthSq, 0.0f, 1.0f);
+        const glm::vec2 off = rel - u * t.d;
+        const float base = t.lengthPow / (t.a + std::sqrt(off.x * off.x + off.y * off.y));
+        w[i] = t.b == 0.0f ? 0.0 : static_cast<double>(t.b) * std::log(static_cast<double>(base));
+        largest = std::max(largest, w[i]);
+    }
+    for (size_t i = 0; i < terms.size(); ++i)
+        w[i] = std::isinf(largest) ? 0.0 : std::exp(w[i] - largest);
+}
+
 double pointSegmentDistance(glm::dvec2 x, glm::dvec2 p, glm::dvec2 q) {
     const glm::dvec2 d = q - p;
     const double u = std::clamp(glm::dot(x - p, d) / glm::dot(d, d), 0.0, 1.0);
@@ -215,14 +238,26 @@ void BeierNeelyWarp::bind(std::span<const glm::vec3> restPoints, SparseFields& f
     fields.transform.reserve(restPoints.size() * n);
     fields.strength.reserve(restPoints.size() * n);
     fields.weight.reserve(restPoints.size() * n);
+    std::vector<double> relative;
     for (size_t u = 0; u < restPoints.size(); ++u) {
         const glm::vec2 x(restPoints[u]);
         if (!geom::isFinite(x)) {
             throw InvalidInput(formatError("Beier-Neely warp", "rest point " + std::to_string(u),
                                            "is not finite", "finite coordinates"));
         }
-        for (size_t i = 0; i < n; ++i)
-            fields.add(static_cast<int32_t>(i), 1.0f, weightOf(terms_[i], x));
+        const size_t first = fields.weight.size();
+        double sum = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            const float w = weightOf(terms_[i], x);
+            fields.add(static_cast<int32_t>(i), 1.0f, w);
+            sum += w;
+        }
+        if (sum < kSmallestWeightSum) {
+            relative.resize(n);
+            relativeWeights(terms_, x, relative.data());
+            for (size_t i = 0; i < n; ++i)
+                fields.weight[first + i] = static_cast<float>(relative[i]);
+        }
         fields.endPoint();
     }
 }
@@ -235,8 +270,26 @@ void BeierNeelyWarp::transformations(Transformations& out) const {
 
 namespace {
 
+// Eq. (3) for a point whose float weights sum below kSmallestWeightSum, with relativeWeights (the
+// engine's sum over the fields bind writes for it, up to their float rounding).
+glm::vec2 mapFar(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
+    std::vector<double> w(terms.size());
+    relativeWeights(terms, x, w.data());
+    double dx = 0.0, dy = 0.0, weightSum = 0.0;
+    for (size_t i = 0; i < terms.size(); ++i) {
+        const Affine& t = transforms[i];
+        const float mx = t.linear[0][0] * x.x + t.linear[1][0] * x.y + t.translation.x;
+        const float my = t.linear[0][1] * x.x + t.linear[1][1] * x.y + t.translation.y;
+        dx += w[i] * static_cast<double>((x.x + (mx - x.x)) - x.x);
+        dy += w[i] * static_cast<double>((x.y + (my - x.y)) - x.y);
+        weightSum += w[i];
+    }
+    if (!(weightSum > 0.0)) return x;
+    return {x.x + static_cast<float>(dx / weightSum), x.y + static_cast<float>(dy / weightSum)};
+}
+
 // Eq. (3) for one point with the same arithmetic as evaluateWarp: float displacement per feature,
-// double accumulation, all-zero weights give the identity.
+// double accumulation; a point every feature is far from, mapFar; all-zero weights give the identity.
 inline glm::vec2 mapOne(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
     double dx = 0.0, dy = 0.0, weightSum = 0.0;
     for (size_t i = 0; i < terms.size(); ++i) {
@@ -249,7 +302,7 @@ inline glm::vec2 mapOne(glm::vec2 x, std::span<const WeightTerms> terms, std::sp
         dy += w * static_cast<double>((x.y + (my - x.y)) - x.y);
         weightSum += w;
     }
-    if (!(weightSum > 0.0)) return x;
+    if (weightSum < kSmallestWeightSum) return mapFar(x, terms, transforms);
     return {x.x + static_cast<float>(dx / weightSum), x.y + static_cast<float>(dy / weightSum)};
 }
 
@@ -347,9 +400,9 @@ void BeierNeelyWarp::mapPixelCentres(int32_t width, int32_t height, std::span<gl
             glm::vec2* row = out.data() + static_cast<size_t>(y) * width;
             for (int32_t x = 0; x < width; ++x) {
                 const float px = static_cast<float>(x) + 0.5f;
-                row[x] = ws[x] > 0.0 ? glm::vec2(px + static_cast<float>(dx[x] / ws[x]),
-                                                 cy + static_cast<float>(dy[x] / ws[x]))
-                                     : glm::vec2(px, cy);
+                row[x] = ws[x] >= kSmallestWeightSum ? glm::vec2(px + static_cast<float>(dx[x] / ws[x]),
+                                                                 cy + static_cast<float>(dy[x] / ws[x]))
+                                                     : mapFar(glm::vec2(px, cy), terms_, transforms_);
             }
         }
     }

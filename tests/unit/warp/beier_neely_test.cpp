@@ -234,6 +234,56 @@ TEST_CASE("Beier-Neely: the global variant removes the fold-over of the Fig. 15 
     CHECK(negGlobal == 0);
 }
 
+TEST_CASE("Beier-Neely: a rigid motion moves pixels rigidly however far from the features",
+          "[warp][beier_neely]") {
+    // Eq. (3) is a weighted mean, so a pure translation of every segment translates every point, whatever a,
+    // b and p. Far from the features the float weights (1 / (a + dist))^b fall below float's range (a = 10,
+    // b = 30: every pixel past 52 from them; b = 12, a = 1: past 1,000) and must not leave pixels in place.
+    // Random features and parameters with a fixed seed, 16 features apart by different b too, on a strip
+    // 8,192 wide; every path: the map, mapPoints, and bind with the engine.
+    std::mt19937 rng(1207);
+    std::uniform_real_distribution<float> at(0.0f, 64.0f), aOf(0.5f, 10.0f), bOf(6.0f, 40.0f),
+        pOf(0.0f, 1.0f);
+    for (int c = 0; c < 12; ++c) {
+        const glm::vec2 shift(at(rng) - 32.0f, at(rng) / 8.0f);
+        std::vector<SegmentPair> pairs;
+        const int count = 1 + c % 4;
+        for (int i = 0; i < count; ++i) {
+            const glm::vec2 p(at(rng), at(rng) / 4.0f),
+                q = p + glm::vec2(4.0f + at(rng) / 4.0f, at(rng) / 16.0f);
+            pairs.push_back(pair(p, q, p + shift, q + shift, aOf(rng), bOf(rng), pOf(rng)));
+        }
+        const int32_t width = 8192, height = 4;
+        for (auto variant : {BeierNeelyVariant::Original, BeierNeelyVariant::Global}) {
+            INFO("case " << c << ", variant " << static_cast<int>(variant));
+            BeierNeelyWarp warp(pairs, {variant});
+            std::vector<glm::vec2> map(static_cast<size_t>(width) * height);
+            warp.mapPixelCentres(width, height, map);
+            std::vector<glm::vec2> centres = pixelCentres(width, height);
+            std::vector<glm::vec2> mapped(centres.size());
+            warp.mapPoints(centres, mapped);
+            std::vector<glm::vec3> points, generic(centres.size());
+            for (const glm::vec2& x : centres)
+                points.emplace_back(x, 0.0f);
+            SparseFields fields;
+            warp.bind(points, fields);
+            Transformations transforms;
+            warp.transformations(transforms);
+            evaluateWarp(points, fields, transforms, generic);
+            float worst = 0.0f;
+            for (size_t k = 0; k < centres.size(); ++k) {
+                const glm::vec2 expected = centres[k] + shift;
+                worst = std::max({worst, glm::length(map[k] - expected), glm::length(mapped[k] - expected),
+                                  glm::length(glm::vec2(generic[k]) - expected)});
+            }
+            // Float: positions near 8,192 lie 9.8e-4 apart and are rounded three times (T<x>, the
+            // displacement, the sum), and each T's linear part is 1 to within 6e-8 (5e-4 at 8,192). Left in
+            // place, a pixel would be off by the whole shift.
+            CHECK(worst <= 4e-3f);
+        }
+    }
+}
+
 TEST_CASE("Beier-Neely: fast 2-D path equals the generic engine path", "[warp][beier_neely]") {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> uni(-10.0f, 74.0f);
