@@ -23,10 +23,20 @@ def points_at(local):
 
 
 def bernstein(d, t):
+    """B^d_i(t) for t in [0, 1]; beyond it continued from the end with the value and derivative there
+    (outside="extrapolate"), B_i(e) + (t - e) d (B^(d-1)_(i-1)(e) - B^(d-1)_i(e))."""
     i = np.arange(d + 1)
     coef = np.array([math.comb(d, int(k)) for k in i], dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)[:, None]
-    return coef * t**i * (1.0 - t) ** (d - i)
+    e = np.clip(t, 0.0, 1.0)
+    value = coef * e**i * (1.0 - e) ** (d - i)
+    lower = np.zeros_like(value)  # B^(d-1)_k(e) at column k, 0 past d - 1
+    lower[:, :d] = np.array([math.comb(d - 1, int(k)) for k in range(d)]) * e ** np.arange(d) * (
+        1.0 - e
+    ) ** (d - 1 - np.arange(d))
+    shifted = np.zeros_like(value)  # B^(d-1)_(i-1)(e)
+    shifted[:, 1:] = lower[:, :d]
+    return value + (t - e) * d * (shifted - lower)
 
 
 def ffd_reference(points, div, target):

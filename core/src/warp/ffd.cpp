@@ -24,6 +24,8 @@ constexpr const char* kDivisionNames[3] = {"divisions[0] (l)", "divisions[1] (m)
 // inside; they are evaluated with their unclamped coordinates, so nothing is clamped.
 constexpr double kInsideTolerance = 1e-5;
 constexpr int64_t kMaxControls = int64_t{1} << 24;
+// The tension of Blender's "Cardinal" spline.
+constexpr float kCardinalTension = 0.71f;
 
 void validate(const Lattice& lattice, const FfdOptions& options) {
     const char* source = "FFD lattice";
@@ -85,7 +87,7 @@ void splineWeights(FfdBasis basis, float u, float* b) {
         case FfdBasis::CatmullRom: {
             // The cardinal spline of tension a: the Hermite curve through controls 1 and 2 with tangents
             // a (P_2 - P_0) and a (P_3 - P_1); Blender's "Cardinal" takes a = 0.71, Catmull-Rom a = 1/2.
-            const float a = basis == FfdBasis::Cardinal ? 0.71f : 0.5f;
+            const float a = basis == FfdBasis::Cardinal ? kCardinalTension : 0.5f;
             b[0] = -a * u3 + 2.0f * a * u2 - a * u;
             b[1] = (2.0f - a) * u3 + (a - 3.0f) * u2 + 1.0f;
             b[2] = (a - 2.0f) * u3 + (3.0f - 2.0f * a) * u2 + a * u;
@@ -191,8 +193,30 @@ void blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> point
 }
 
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
+// Beyond the lattice (x < 0 or x > d; FfdOutside::Extrapolate, the only case that asks) every basis but a
+// spline with repeated ends continues from its end face with the value and slope it has there, T_0 + x k
+// (T_1 - T_0) or T_d + (x - d) k (T_d - T_(d-1)): k = 1 for the Bernstein polynomial, the linear basis, the
+// B-spline and Catmull-Rom with extrapolated ends, 2 a for the cardinal spline of tension a (its end tangent
+// over the extrapolated control). Linear in x, so an affine lattice stays affine however far, where the
+// polynomials themselves amplify float rounding by (2 |s| + 1)^degree (docs/decisions.md, "FFD points outside
+// the lattice"). The SoA kernels (ffd_kernels.h) compute the same weights with the same operations.
 inline int32_t basisWeights(FfdBasis basis, FfdEnds ends, int32_t d, const float* binomial, float x,
                             int32_t& first, float* w) {
+    if ((x < 0.0f || x > static_cast<float>(d)) &&
+        (basis == FfdBasis::Bernstein || ends != FfdEnds::Repeat)) {
+        const float slope = basis == FfdBasis::Cardinal ? 2.0f * kCardinalTension : 1.0f;
+        if (x < 0.0f) {
+            first = 0;
+            w[0] = 1.0f - slope * x;
+            w[1] = slope * x;
+            return 2;
+        }
+        const float e = x - static_cast<float>(d);
+        first = d - 1;
+        w[0] = -(slope * e);
+        w[1] = 1.0f + slope * e;
+        return 2;
+    }
     if (basis == FfdBasis::Bernstein && d == 3) {
         // The common cubic in closed form.
         const float s = x / 3.0f, r = 1.0f - s;

@@ -78,6 +78,19 @@ typedef float Float8 __attribute__((vector_size(32)));
     std::memcpy(out.z, &d[2], sizeof(out.z));
 }
 
+// Beyond the lattice (x < 0 or x > 3) the window weights continue linearly from the end face, as
+// basisWeights computes them per point (slope 1): 1 - x and x on controls 0 and 1, -(x - 3) and 1 + (x - 3)
+// on controls 2 and 3. Lanes inside keep w.
+[[gnu::always_inline]] inline void continueBeyondEnds(const Float8& x, Float8 (&w)[4]) {
+    typedef int Int8 __attribute__((vector_size(32)));
+    const Float8 zero = {}, e = x - 3.0f;
+    const Int8 below = x<0.0f, above = x> 3.0f;
+    w[0] = below ? 1.0f - x : (above ? zero : w[0]);
+    w[1] = below ? x : (above ? zero : w[1]);
+    w[2] = below ? zero : (above ? -e : w[2]);
+    w[3] = below ? zero : (above ? 1.0f + e : w[3]);
+}
+
 // The Bernstein cubic's weights of eight points, as basisWeights' closed form computes them per point.
 [[gnu::always_inline]] inline void bernsteinWeights(const LocalBlock& in, Float8 (&w)[3][4]) {
     const float* coords[3] = {in.x, in.y, in.z};
@@ -89,6 +102,7 @@ typedef float Float8 __attribute__((vector_size(32)));
         w[a][1] = 3.0f * s * r * r;
         w[a][2] = 3.0f * s * s * r;
         w[a][3] = s * s * s;
+        continueBeyondEnds(x, w[a]);
     }
 }
 
@@ -110,7 +124,8 @@ typedef float Float8 __attribute__((vector_size(32)));
 // The uniform cubic B-spline's window weights on 3 divisions with linearly extrapolated end controls: the
 // per-point path's arithmetic (ffd.cpp, basisWeights with FfdEnds::Extrapolate and splineWeights) lane by
 // lane, so the same bits. The span is clamp(floor(x), 0, 2), here (x >= 1) + (x >= 2); u = x - span; the
-// end spans fold the missing control into their neighbours; control c of the window takes b[c - span + 1].
+// end spans fold the missing control into their neighbours; control c of the window takes b[c - span + 1];
+// beyond the lattice, continueBeyondEnds.
 [[gnu::always_inline]] inline void bsplineWeights444(const LocalBlock& in, WeightBlock& out) {
     typedef int Int8 __attribute__((vector_size(32)));
     const float* coords[3] = {in.x, in.y, in.z};
@@ -129,8 +144,9 @@ typedef float Float8 __attribute__((vector_size(32)));
         // Span 0: b1 += 2 b0, b2 -= b0; span 2: b2 += 2 b3, b1 -= b3.
         const Float8 b1First = b1 + 2.0f * b0, b2First = b2 - b0;
         const Float8 b2Last = b2 + 2.0f * b3, b1Last = b1 - b3;
-        const Float8 w[4] = {first ? b1First : (middle ? b0 : zero), first ? b2First : (middle ? b1 : b0),
-                             first ? b3 : (middle ? b2 : b1Last), first ? zero : (middle ? b3 : b2Last)};
+        Float8 w[4] = {first ? b1First : (middle ? b0 : zero), first ? b2First : (middle ? b1 : b0),
+                       first ? b3 : (middle ? b2 : b1Last), first ? zero : (middle ? b3 : b2Last)};
+        continueBeyondEnds(x, w);
         for (int c = 0; c < 4; ++c)
             std::memcpy(out.w[a][c], &w[c], sizeof(Float8));
     }

@@ -79,7 +79,17 @@ glm::dvec3 controlRef(const Lattice& l, int i, int j, int k) {
            glm::dvec3(l.axes[2]) * (double(k) / l.divisions.z);
 }
 
-// Sederberg-Parry: X_ffd = sum_ijk B_i(s) B_j(t) B_k(u) P*_ijk, written as p + sum B (P* - P).
+// B_i beyond [0, 1] continued from the end with its value and derivative there, B_i(e) + (t - e) B_i'(e),
+// B_i' = d (B^(d-1)_(i-1) - B^(d-1)_i) (FfdOutside::Extrapolate); B_i itself inside.
+double bernsteinContinued(int d, int i, double t) {
+    if (t >= 0.0 && t <= 1.0) return bernstein(d, i, t);
+    const double e = t < 0.0 ? 0.0 : 1.0;
+    const auto lower = [&](int k) { return k < 0 || k > d - 1 ? 0.0 : bernstein(d - 1, k, e); };
+    return bernstein(d, i, e) + (t - e) * d * (lower(i - 1) - lower(i));
+}
+
+// Sederberg-Parry: X_ffd = sum_ijk B_i(s) B_j(t) B_k(u) P*_ijk, written as p + sum B (P* - P), with the
+// basis continued beyond the lattice.
 glm::vec3 bernsteinRef(const Lattice& l, const std::vector<glm::vec3>& target, const glm::vec3& p) {
     const glm::dvec3 s = cramer(l, p);
     const glm::ivec3 d = l.divisions;
@@ -87,7 +97,8 @@ glm::vec3 bernsteinRef(const Lattice& l, const std::vector<glm::vec3>& target, c
     for (int i = 0; i <= d.x; ++i)
         for (int j = 0; j <= d.y; ++j)
             for (int k = 0; k <= d.z; ++k) {
-                const double w = bernstein(d.x, i, s.x) * bernstein(d.y, j, s.y) * bernstein(d.z, k, s.z);
+                const double w = bernsteinContinued(d.x, i, s.x) * bernsteinContinued(d.y, j, s.y) *
+                                 bernsteinContinued(d.z, k, s.z);
                 out += w * (glm::dvec3(target[(i * (d.y + 1) + j) * (d.z + 1) + k]) - controlRef(l, i, j, k));
             }
     return glm::vec3(out);
@@ -336,7 +347,7 @@ TEST_CASE("ffd: outside points, unchanged or extrapolated", "[warp][ffd]") {
         } else {
             CHECK(glm::length(outNone[i] - ref) < 1e-5f);
         }
-        CHECK(glm::length(outExtra[i] - ref) < 2e-5f);  // the polynomial beyond [0, 1]
+        CHECK(glm::length(outExtra[i] - ref) < 2e-5f);  // continued from the faces beyond [0, 1]
     }
     SparseFields f;
     none.bind(pts, f);
@@ -344,7 +355,7 @@ TEST_CASE("ffd: outside points, unchanged or extrapolated", "[warp][ffd]") {
         if (outsideUnit(cramer(l, pts[i]))) CHECK(f.offsets[i + 1] == f.offsets[i]);
     }
 
-    // B-spline extrapolation continues the end span's cubic: continuous across the face.
+    // B-spline extrapolation continues from the end face: continuous across it.
     Ffd bs(l, {FfdBasis::BSpline, FfdOutside::Extrapolate});
     bs.setTargets(target);
     const glm::vec3 onFace = l.origin + l.axes * glm::vec3(1.0f, 0.4f, 0.6f);
@@ -353,6 +364,106 @@ TEST_CASE("ffd: outside points, unchanged or extrapolated", "[warp][ffd]") {
     const auto moved = viaEngine(bs, across);
     const glm::vec3 jump = (moved[1] - across[1]) - (moved[0] - across[0]);
     CHECK(glm::length(jump) < 2e-3f);
+}
+
+TEST_CASE("ffd: extrapolated, an affine lattice stays affine however far, every basis and degree",
+          "[warp][ffd]") {
+    // Targets an affine map of the controls (A p + b, A a shear and scale): the FFD of any basis but the
+    // cardinal spline (not linearly precise) reproduces it inside, and the continuation from the faces does
+    // beyond them, at any degree. Evaluated as polynomials, Bernstein of degree 20 sent a point one box out
+    // to half its place, degree 64 to 1e21 or NaN: float rounding amplified by (2 |s| + 1)^degree.
+    const glm::mat3 shear(glm::vec3(2.0f, 0.1f, 0.0f), glm::vec3(0.2f, 1.5f, -0.1f),
+                          glm::vec3(0.0f, 0.3f, 0.8f));
+    const glm::vec3 move(0.5f, -1.0f, 2.0f);
+    const auto affine = [&](glm::vec3 p) { return shear * p + move; };
+    std::mt19937 rng(1207);
+    std::uniform_real_distribution<float> far(-100.0f, 101.0f), near(-2.0f, 3.0f);
+    struct Case {
+        FfdBasis basis;
+        int32_t divisions;
+    };
+    for (const Case c :
+         {Case{FfdBasis::Bernstein, 3}, Case{FfdBasis::Bernstein, 20}, Case{FfdBasis::Bernstein, 64},
+          Case{FfdBasis::BSpline, 64}, Case{FfdBasis::BSpline, 3}, Case{FfdBasis::CatmullRom, 7},
+          Case{FfdBasis::Linear, 5}}) {
+        Lattice l = skewLattice({c.divisions, 2, 3});
+        std::vector<glm::vec3> target = l.controlPoints();
+        for (glm::vec3& p : target)
+            p = affine(p);
+        std::vector<glm::vec3> pts;
+        for (int k = 0; k < 400; ++k) {
+            auto& dist = k % 2 == 0 ? far : near;
+            pts.push_back(l.origin + l.axes * glm::vec3(dist(rng), dist(rng), dist(rng)));
+        }
+        for (FfdKernel kernel : {FfdKernel::Auto, FfdKernel::PerPoint}) {
+            Ffd ffd(l, {FfdBases(c.basis), FfdOutside::Extrapolate, kernel});
+            ffd.setTargets(target);
+            std::vector<glm::vec3> oneOff, bound = pts;
+            oneOff = pts;
+            ffd.bindAndEvaluate(pts, oneOff);
+            ffd.bind(pts);
+            ffd.evaluate(bound);
+            const auto engine = viaEngine(ffd, pts);
+            // Float: the sum rounds each weight's share, so its error is bounded by a few float epsilons of
+            // sum |w| max |T|, sum |w| = prod over axes of (1 + 2 k d_a g_a), g_a the distance outside in box
+            // lengths (the continuation's weights 1 + k e and -k e, e = d_a g_a), and the engine's generic
+            // path rounds each share's (P + T) - P at P's size too. The bound grows with the distance, not
+            // the degree; the polynomials' grew as (2 |s| + 1)^degree.
+            double maxT = 0.0;
+            for (size_t k = 0; k < target.size(); ++k)
+                maxT = std::max(maxT, static_cast<double>(glm::length(target[k] - l.controlPoints()[k])));
+            double worst = 0.0;
+            for (size_t u = 0; u < pts.size(); ++u) {
+                const glm::dvec3 s = cramer(l, pts[u]);
+                double weightSum = 1.0;
+                for (int a = 0; a < 3; ++a) {
+                    const double outside = std::max({0.0, -s[a], s[a] - 1.0});
+                    weightSum *= 1.0 + 2.0 * l.divisions[a] * outside;
+                }
+                const double size = glm::length(pts[u]);
+                const double allowed = 4.0 * 6e-8 * weightSum * (maxT + size) + 1e-6 * (1.0 + size);
+                const glm::vec3 expected = affine(pts[u]);
+                for (const glm::vec3& got : {oneOff[u], bound[u], engine[u]})
+                    worst = std::max(worst, glm::length(glm::dvec3(got) - glm::dvec3(expected)) / allowed);
+            }
+            INFO("basis " << static_cast<int>(c.basis) << ", " << c.divisions << " divisions");
+            CHECK(worst < 1.0);  // the error within its float bound
+        }
+    }
+}
+
+TEST_CASE("ffd: extrapolated, continuous with its slope across the faces", "[warp][ffd]") {
+    // Random lattices of every basis: across a face (1e-3 of the box each side) the displacement and its
+    // derivative along the face normal direction agree on both sides (the continuation takes the end face's
+    // value and slope), within the finite difference's own error.
+    std::mt19937 rng(31);
+    for (FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline, FfdBasis::CatmullRom, FfdBasis::Cardinal,
+                           FfdBasis::Linear}) {
+        const Lattice l = skewLattice({4, 3, 5});
+        Ffd ffd(l, {FfdBases(basis), FfdOutside::Extrapolate});
+        ffd.setTargets(randomTargets(l, rng, 0.3f));
+        const float h = 1e-3f;
+        std::vector<glm::vec3> pts;
+        for (float face : {0.0f, 1.0f}) {
+            for (float at : {0.3f, 0.55f}) {
+                const glm::vec3 on = l.origin + l.axes * glm::vec3(face, at, 0.4f);
+                for (float k : {-2.0f, -1.0f, 1.0f, 2.0f})
+                    pts.push_back(on + k * h * l.axes[0]);
+            }
+        }
+        const auto moved = viaEngine(ffd, pts);
+        for (size_t g = 0; g < pts.size(); g += 4) {
+            glm::vec3 d[4];
+            for (int k = 0; k < 4; ++k)
+                d[k] = moved[g + k] - pts[g + k];
+            const glm::vec3 slopeIn = (d[1] - d[0]) / h, slopeOut = (d[3] - d[2]) / h;
+            const glm::vec3 across = d[2] - d[1];
+            INFO("basis " << static_cast<int>(basis) << ", group " << g / 4);
+            // No step: the change across the face is the slope's over 2 h, to second order (curvature h^2).
+            CHECK(glm::length(across - h * (slopeIn + slopeOut)) < 2e-4f);
+            CHECK(glm::length(slopeIn - slopeOut) < 0.05f * (1.0f + glm::length(slopeIn)));
+        }
+    }
 }
 
 TEST_CASE("ffd: B-spline variant equals a Cox-de Boor evaluation over phantom controls", "[warp][ffd]") {
