@@ -32,19 +32,29 @@ std::string controlName(const Lattice& l, size_t c) {
 
 namespace {
 
-// The affine map taking `from` to `to`, or nothing for a non-finite frame or a singular source basis (the
-// cases frameToFrame names): the checks without the message, so an update builds no control names.
-std::optional<Affine> mapBetween(const Frame& from, const Frame& to) {
-    if (!finite(from) || !finite(to)) return std::nullopt;
+// A source basis without three linearly independent vectors (relative to their lengths).
+bool singular(const Frame& from) {
     const glm::dmat3 b(from.basis);
     double lengths = 1.0;
     for (int a = 0; a < 3; ++a)
         lengths *= glm::length(b[a]);
-    const double det = glm::determinant(b);
-    if (!(std::abs(det) > 1e-9 * lengths) || lengths == 0.0) return std::nullopt;
-    const glm::dmat3 linear = glm::dmat3(to.basis) * glm::inverse(b);
+    return !(std::abs(glm::determinant(b)) > 1e-9 * lengths) || lengths == 0.0;
+}
+
+// The affine map taking `from` to `to`, or nothing for a non-finite frame, a singular source basis or a map
+// beyond float range (the cases frameToFrame names): the checks without the message, so an update builds
+// no control names.
+std::optional<Affine> mapBetween(const Frame& from, const Frame& to) {
+    if (!finite(from) || !finite(to) || singular(from)) return std::nullopt;
+    const glm::dmat3 linear = glm::dmat3(to.basis) * glm::inverse(glm::dmat3(from.basis));
     const glm::dvec3 translation = glm::dvec3(to.origin) - linear * glm::dvec3(from.origin);
-    return Affine{glm::mat3(linear), glm::vec3(translation)};
+    const Affine map{glm::mat3(linear), glm::vec3(translation)};
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(map.linear[c][r])) return std::nullopt;
+    for (int r = 0; r < 3; ++r)
+        if (!std::isfinite(map.translation[r])) return std::nullopt;
+    return map;
 }
 
 }  // namespace
@@ -55,8 +65,12 @@ Affine frameToFrame(const Frame& from, const Frame& to, const std::string& eleme
         throw InvalidInput(
             formatError("FFD frames", element, "is not finite", "finite origins and basis vectors"));
     }
-    throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
-                                   "three linearly independent basis vectors"));
+    if (singular(from)) {
+        throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
+                                       "three linearly independent basis vectors"));
+    }
+    throw InvalidInput(formatError("FFD frames", element, "maps onto its target frame beyond float range",
+                                   "a source basis at least about 1e-38 of the target's size"));
 }
 
 FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : LatticeWarp(lattice, options) {

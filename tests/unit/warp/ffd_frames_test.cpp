@@ -213,6 +213,12 @@ TEST_CASE("ffd frames: bad input names the control", "[warp][ffd][frames][errors
     CHECK_THROWS_AS(frames.setSourceFrames(f), InvalidInput);
     CHECK_THROWS_WITH(frames.setSourceFrames(f), Catch::Contains("control 21 (i=2, j=1, k=0)") &&
                                                      Catch::Contains("singular source basis"));
+    // A well-conditioned basis 1e-39 long (a denormal scale) maps onto a unit target by 1e39: beyond float,
+    // refused rather than NaN points.
+    f = {frames.sourceFrames().begin(), frames.sourceFrames().end()};
+    f[l.index(1, 1, 1)].basis = glm::mat3(1e-39f);
+    CHECK_THROWS_WITH(frames.setSourceFrames(f),
+                      Catch::Contains("control 13 (i=1, j=1, k=1)") && Catch::Contains("beyond float range"));
     f = {frames.sourceFrames().begin(), frames.sourceFrames().end()};
     f[5].origin.y = std::numeric_limits<float>::quiet_NaN();
     CHECK_THROWS_WITH(frames.setTargetFrames(f),
