@@ -2,8 +2,11 @@
 
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
 #include "deformkit/error.h"
 #include "deformkit/io/read_file.h"
+#include "deformkit/warp/beier_neely.h"
 #include "scene/json_reading.h"
 
 namespace deformkit::scene {
@@ -38,11 +41,14 @@ void segment(const json& line, const char* key, const std::string& source, const
     }
     p = point(v[0], source, here + "[0]");
     q = point(v[1], source, here + "[1]");
-    if (p == q) {
+    if (const float length = glm::length(q - p); !(length > warp::kMinSegmentLength)) {
+        const std::string ends = "[" + numberText(p.x) + ", " + numberText(p.y) + "]";
+        const std::string what = length == 0.0f
+                                     ? "has zero length (both ends at " + ends + ")"
+                                     : "is " + numberText(length) + " long (from " + ends + " to [" +
+                                           numberText(q.x) + ", " + numberText(q.y) + "])";
         throw InvalidInput(formatError(
-            source, here,
-            "has zero length (both ends at [" + std::to_string(p.x) + ", " + std::to_string(p.y) + "])",
-            "two distinct points"));
+            source, here, what, "a segment longer than " + numberText(warp::kMinSegmentLength) + " pixels"));
     }
 }
 

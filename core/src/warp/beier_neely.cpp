@@ -20,9 +20,6 @@ std::string str(glm::vec2 v) {
     return s.str();
 }
 
-// Segments shorter than this (pixels) are treated as zero-length: their frame is undefined.
-constexpr float kMinLength = 1e-6f;
-
 void checkSegment(const std::string& source, const std::string& element, const char* which, glm::vec2 p,
                   glm::vec2 q) {
     if (!geom::isFinite(p) || !geom::isFinite(q)) {
@@ -31,10 +28,12 @@ void checkSegment(const std::string& source, const std::string& element, const c
                         std::string(which) + " segment has a non-finite endpoint " + str(p) + " -> " + str(q),
                         "finite pixel coordinates"));
     }
-    if (glm::length(q - p) <= kMinLength) {
-        throw InvalidInput(formatError(
-            source, element, std::string(which) + " segment has zero length (P = Q = " + str(p) + ")",
-            "distinct endpoints P != Q"));
+    if (const float length = glm::length(q - p); !(length > kMinSegmentLength)) {
+        const std::string what = length == 0.0f ? " segment has zero length (P = Q = " + str(p) + ")"
+                                                : " segment is " + numberText(length) +
+                                                      " long (P = " + str(p) + ", Q = " + str(q) + ")";
+        throw InvalidInput(formatError(source, element, std::string(which) + what,
+                                       "a segment longer than " + numberText(kMinSegmentLength)));
     }
 }
 

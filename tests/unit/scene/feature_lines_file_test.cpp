@@ -41,6 +41,10 @@ TEST_CASE("feature lines file: bad JSON names the JSON path", "[scene][feature_l
                Catch::Contains("lines[1].src") && Catch::Contains("an array of 1"));
     CHECK_THAT(fails(R"({"lines": [{"src": [[1, 2], [1, 2]], "dst": [[5, 6], [7, 8]]}]})"),
                Catch::Contains("lines[0].src") && Catch::Contains("zero length"));
+    // Distinct ends 1e-7 apart: too short for a direction, named with its path and length.
+    CHECK_THAT(fails(R"({"lines": [{"src": [[0, 0], [1, 0]], "dst": [[0, 0], [1e-7, 0]]}]})"),
+               Catch::Contains("lines.json: lines[0].dst: is 1e-07 long (from [0, 0] to [1e-07, 0])") &&
+                   Catch::Contains("longer than 1e-06 pixels"));
     CHECK_THAT(fails(R"({"a": 0, "lines": []})"),
                Catch::Contains("lines.json: a: is 0") && Catch::Contains("a > 0"));
     CHECK_THAT(fails(R"({"lines": [{"src": [[1, 2], [3, 4]], "dst": [[5, 6], [7, 8]], "b": -1}]})"),

@@ -390,6 +390,12 @@ TEST_CASE("Beier-Neely: bad input names the segment pair", "[warp][beier_neely][
     zeroSrc.srcP = zeroSrc.srcQ;
     CHECK_THROWS_WITH(BeierNeelyWarp(withSecond(zeroSrc)),
                       Catch::Contains("segment pair 1") && Catch::Contains("source segment has zero length"));
+    SegmentPair shortDst = good;
+    shortDst.dstQ = shortDst.dstP + glm::vec2(1e-6f, 0.0f);
+    CHECK_THROWS_WITH(
+        beierNeelyMap(8, 8, withSecond(shortDst)),
+        Catch::Contains("segment pair 1: destination segment is 1e-06 long (P = (0, 0), Q = (1e-06, 0))") &&
+            Catch::Contains("longer than 1e-06"));
     SegmentPair nanEnd = good;
     nanEnd.dstP.y = nan;
     CHECK_THROWS_WITH(beierNeelyMap(8, 8, withSecond(nanEnd)),

@@ -37,8 +37,11 @@ struct BeierNeelyOptions {
     BeierNeelyVariant variant = BeierNeelyVariant::Original;
 };
 
-// Throws InvalidInput naming `source` and "segment pair i" for a zero-length or non-finite segment,
-// a <= 0, b < 0, p < 0 or a non-finite parameter.
+// Segments this long or shorter (pixels, or scene units) have no direction: refused.
+inline constexpr float kMinSegmentLength = 1e-6f;
+
+// Throws InvalidInput naming `source` and "segment pair i" for a segment up to kMinSegmentLength long or
+// non-finite, a <= 0, b < 0, p < 0 or a non-finite parameter.
 void validateSegmentPairs(std::span<const SegmentPair> pairs, const std::string& source = "Beier-Neely warp");
 
 // Weighting field of feature i at point x (§4.2): (length_i^p_i / (a_i + dist_i(x)))^b_i with length_i

@@ -97,14 +97,15 @@ class BeierNeelyDeformer final : public EngineDeformer {
         if ((index == b_ || index == p_) && !(value[0] >= 0.0))
             fail(index, "is " + numberText(value[0]), "a number >= 0");
         if (index == rest_ || index == features_) {
-            // The core's test, on the float endpoints: a segment up to 1e-6 long has no direction.
+            // The core's test, on the float endpoints: a segment up to kMinSegmentLength long has no
+            // direction.
             for (size_t i = 0; i < value.size(); i += 4) {
                 const glm::vec2 p(static_cast<float>(value[i]), static_cast<float>(value[i + 1]));
                 const glm::vec2 q(static_cast<float>(value[i + 2]), static_cast<float>(value[i + 3]));
                 const float length = glm::length(q - p);
-                if (!(length > 1e-6f)) {
+                if (!(length > warp::kMinSegmentLength)) {
                     fail(index, "feature " + std::to_string(i / 4) + " has length " + numberText(length),
-                         "segments longer than 1e-06 scene units");
+                         "segments longer than " + numberText(warp::kMinSegmentLength) + " scene units");
                 }
             }
         }
