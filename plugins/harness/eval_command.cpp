@@ -390,7 +390,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
 void addEvalCommand(CommandLine& cli) {
     struct Options {
         EvalCommand command;
-        std::string scene, frames, out, report;
+        std::string scene, out, report;
         bool noPreviews = false, noObjs = false;
     };
     auto o = std::make_shared<Options>();
@@ -401,7 +401,6 @@ void addEvalCommand(CommandLine& cli) {
             EvalCommand& c = o->command;
             c.scene = o->scene;
             c.outDir = o->out;
-            if (!o->frames.empty()) c.frames = parseFrames(o->frames);
             c.previews = !o->noPreviews;
             c.objs = !o->noObjs;
             if (!o->report.empty()) c.report = o->report;
@@ -412,7 +411,9 @@ void addEvalCommand(CommandLine& cli) {
             return 0;
         });
     eval.option("SCENE", o->scene, "scene (.json, docs/scene.md)").required();
-    eval.option("--frames", o->frames, "frames: 1-24, or a list such as 1-10,15; default: the scene's");
+    eval.option(
+        "--frames", [o](const std::string& value) { o->command.frames = parseFrames(value); }, "the scene's",
+        "frames: 1-24, or a list such as 1-10,15 (an empty value is refused)");
     eval.option("--out", o->out,
                 "output folder: <object>.<frame>.obj and .png, <object>.contact.png, <object>.mp4")
         .showDefault();

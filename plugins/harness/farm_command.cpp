@@ -248,7 +248,7 @@ void addFarmCommands(CommandLine& cli) {
 
     struct PlanOptions {
         FarmPlanCommand command;
-        std::string scene, frames, out, plan;
+        std::string scene, out, plan;
     };
     auto p = std::make_shared<PlanOptions>();
     Command plan =
@@ -257,14 +257,15 @@ void addFarmCommands(CommandLine& cli) {
             c.scene = p->scene;
             c.outDir = p->out;
             c.plan = p->plan;
-            if (!p->frames.empty()) c.frames = parseFrames(p->frames);
             const scene::FarmPlan made = farmPlanCommand(c);
             std::cout << "farm: wrote " << farmPlanPath(c).string() << ": " << made.tasks.size()
                       << (made.tasks.size() == 1 ? " task" : " tasks") << "\n";
             return 0;
         });
     plan.option("SCENE", p->scene, "scene (.json, docs/scene.md)").required();
-    plan.option("--frames", p->frames, "frames: 1-240, or a list such as 1-10,15; default: the scene's");
+    plan.option(
+        "--frames", [p](const std::string& value) { p->command.frames = parseFrames(value); }, "the scene's",
+        "frames: 1-240, or a list such as 1-10,15 (an empty value is refused)");
     plan.option("--chunk", p->command.chunk, "frames per task at most").showDefault();
     plan.option("--tiles-per-task", p->command.tilesPerTask,
                 "UDIM tiles per UV-warp task at most (scenes with a uvwarp stage)")

@@ -75,10 +75,12 @@ std::vector<int> parseFrames(std::string_view text, const std::string& option) {
                 throw InvalidInput(formatError(option, "", quoted + " is not a frame range", expected));
             }
         }
-        constexpr int64_t lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
-        if (first < lo || first > hi || last < lo || last > hi)
-            throw InvalidInput(
-                formatError(option, "", quoted + " is out of range", "frames that fit in 32 bits"));
+        constexpr int64_t limit = scene::kMaxFrameNumber;
+        if (first < -limit || first > limit || last < -limit || last > limit) {
+            throw InvalidInput(formatError(option, "", quoted + " is out of range",
+                                           "frames from -" + std::to_string(scene::kMaxFrameNumber) + " to " +
+                                               std::to_string(scene::kMaxFrameNumber)));
+        }
         if (last < first)
             throw InvalidInput(formatError(option, "", quoted + " ends before it starts", expected));
         if (static_cast<int64_t>(frames.size()) + (last - first + 1) > kMaxFrames) {

@@ -417,6 +417,14 @@ sed 's/endAngle/endAngel/' "$work/shot.json" >"$work/bad_shot.json"
 expect eval-bad-param 2 "$dk" eval "$work/bad_shot.json" --out "$work/eval-bad"
 contains eval-bad-param "$work/err" "objects[0].stack[0].params.endAngel"
 [ ! -e "$work/eval-bad" ] || { echo "FAIL eval-bad-param: output folder created"; failures=$((failures + 1)); }
+# An empty --frames (a wrapper's unset variable) is refused, not the whole shot; frames beyond +-1e9 are
+# refused by every command, so a plan never holds frames its tasks refuse (a range up to 2^31 - 1 never ended).
+expect eval-empty-frames 2 "$dk" eval "$work/shot.json" --frames "" --out "$work/eval-empty"
+contains eval-empty-frames "$work/err" "--frames: '' is not a frame"
+[ ! -e "$work/eval-empty" ] || { echo "FAIL eval-empty-frames: output folder created"; failures=$((failures + 1)); }
+expect farm-plan-empty-frames 2 "$dk" farm plan "$work/shot.json" --frames "" --out "$work/plan-empty"
+expect farm-plan-top-frame 2 timeout 20 "$dk" farm plan "$work/shot.json" --frames 2147483646-2147483647 --out "$work/plan-top"
+contains farm-plan-top-frame "$work/err" "out of range (expected frames from -1000000000 to 1000000000)"
 # The shot as a point cache instead of OBJs, fed back to uvwarp as its deformed frames; bad caches are exit 2
 # naming the file and the frame.
 expect eval-pc2 0 "$dk" eval "$work/shot.json" --out "$work/eval-pc2" --no-previews --cache pc2 --no-objs

@@ -128,8 +128,12 @@ class PlanReader {
     }
 
     int integer(const json& j, const std::string& at) const {
-        if (!j.is_number_integer() || j.get<int64_t>() < -1000000000 || j.get<int64_t>() > 1000000000)
-            fail(at, "is " + describe(j), "a whole number");
+        if (!j.is_number_integer() || j.get<int64_t>() < -kMaxFrameNumber ||
+            j.get<int64_t>() > kMaxFrameNumber) {
+            fail(at, "is " + describe(j),
+                 "a whole number from -" + std::to_string(kMaxFrameNumber) + " to " +
+                     std::to_string(kMaxFrameNumber));
+        }
         return static_cast<int>(j.get<int64_t>());
     }
 

@@ -77,7 +77,11 @@ class Reader {
 
     int integer(const json& v, const std::string& path) const {
         const double d = number(v, path);
-        if (d != std::floor(d) || std::abs(d) > 1.0e9) fail(path, "is " + v.dump(), "a whole frame number");
+        if (d != std::floor(d) || std::abs(d) > static_cast<double>(kMaxFrameNumber)) {
+            fail(path, "is " + v.dump(),
+                 "a whole frame number from -" + std::to_string(kMaxFrameNumber) + " to " +
+                     std::to_string(kMaxFrameNumber));
+        }
         return static_cast<int>(d);
     }
 

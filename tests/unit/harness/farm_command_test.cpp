@@ -282,6 +282,8 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
         const test::PlanEdit cases[] = {
             {"\"frames\":[4,6]", "\"frames\":[4,9]", ": tasks[1].frames: is [4,9], 6 frames"},
             {"\"frames\":[7,7]", "\"frames\":[7]", ": tasks[2].frames: is [7] (expected [first, last])"},
+            {"\"frames\":[7,7]", "\"frames\":[7,1500000000]",
+             ": tasks[2].frames[1]: is 1500000000 (expected a whole number from -1000000000 to 1000000000)"},
             {"\"bent.0006.obj\"],\"tiles\":[]", "\"bent.0006.obj\"],\"tiles\":[1001]",
              ": tasks[1].outputs[0]: is \"tube.0004.obj\", the scene makes nothing"},
             {"\"tiles\":[]", "\"tiles\":1001", ": tasks[0].tiles: is 1001 (expected an array of UDIM tiles)"},

@@ -143,6 +143,13 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
                Catch::Contains("'' is not a frame"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames("0-2000000"); }),
                Catch::Contains("more than 1000000"));
+    CHECK(harness::parseFrames("999999999-1000000000") == std::vector<int>{999999999, 1000000000});
+    for (const char* far :
+         {"1000000001", "2147483647", "-1000000001", "-9223372036854775808", "1-2147483648"})
+        CHECK_THAT(test::errorOf<Error>([far] { (void)harness::parseFrames(far); }),
+                   Catch::Contains("is out of range (expected frames from -1000000000 to 1000000000)"));
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames(""); }),
+               Catch::Contains("'' is not a frame"));
     CHECK(harness::parseTiles("1002,1001,1002") == std::vector<int>{1001, 1002});
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1001,1000"); }),
                Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));

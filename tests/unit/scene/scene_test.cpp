@@ -107,6 +107,10 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5000000], "objects": []})"),
                Contains(file + ": frames: is [1,5000000], 5000000 frames (expected at most 1000000 frames)"));
     CHECK(f.error(R"({"deformkit_scene": 1, "frames": [1, 1000000], "objects": []})") == "no error");
+    CHECK_THAT(
+        f.error(R"({"deformkit_scene": 1, "frames": [2147483646, 2147483647], "objects": []})"),
+        Contains(file + ": frames[0]: is 2147483646 (expected a whole frame number from -1000000000 to "
+                        "1000000000)"));
     CHECK_THAT(f.error(withEntry(R"({"type": "twist", "label": ""})")),
                Contains(file + ": objects[0].stack[0].label: is empty (expected a non-empty string)"));
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": "1-5", "objects": []})"),

@@ -94,6 +94,9 @@ struct SceneObject {
 // The most frames a job takes: a scene's range, a --frames list. A typo ("frames": [1, 5000000]) is refused
 // before millions of files are written or the frame list fills memory.
 inline constexpr int64_t kMaxFrames = 1000000;
+// Frame numbers a job takes, in a scene, a plan or --frames: -kMaxFrameNumber to kMaxFrameNumber, so a
+// frame, the next one and any offset a task adds stay within int.
+inline constexpr int64_t kMaxFrameNumber = 1000000000;
 
 // A DeformKit scene (docs/scene.md): objects, each a rest mesh under a deformer stack whose parameters
 // and envelopes are constant or keyframed, and a default frame range.
