@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <cstdio>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -175,6 +176,16 @@ std::optional<std::string> unknownCommand(const CLI::App& app) {
     return "'" + left.front() + "' is not " + where + " (expected one of: " + names + ")";
 }
 
+// `code`, or 1 when standard output could not be written (a full disk under a redirect): what a command
+// prints there is its result or, for a farm task, its log. An exit code that already reports an error stays.
+int checkedStdout(int code) {
+    std::cout.flush();
+    const bool written = std::cout.good() && std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
+    if (written || code != 0) return code;
+    std::cerr << "deformkit: error: standard output: cannot write (expected a writable standard output)\n";
+    return 1;
+}
+
 }  // namespace
 
 int CommandLine::run(int argc, char** argv) {
@@ -182,7 +193,7 @@ int CommandLine::run(int argc, char** argv) {
         app_->parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // Help and version print and exit 0; a usage error is one line on stderr and exit code 2.
-        if (e.get_exit_code() == 0) return app_->exit(e);
+        if (e.get_exit_code() == 0) return checkedStdout(app_->exit(e));
         std::cerr << "deformkit: usage error: " << unknownCommand(*app_).value_or(e.what())
                   << " (see deformkit --help)\n";
         return 2;
@@ -192,8 +203,13 @@ int CommandLine::run(int argc, char** argv) {
     }
     try {
         for (const auto& [command, run] : commands_) {
-            if (command->parsed()) return run();
+            if (command->parsed()) return checkedStdout(run());
         }
+    } catch (const StorageError& e) {
+        // Storage that failed while writing (a full disk): not the input's fault, exit 1 as for anything a
+        // retry may cure (docs/farm.md, Exit codes).
+        std::cerr << "deformkit: error: " << e.what() << "\n";
+        return 1;
     } catch (const Error& e) {
         std::cerr << "deformkit: error: " << e.what() << "\n";
         return 2;

@@ -154,7 +154,8 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     }
     uvwarp::ShotReport report = uvwarp::runShotJob(job, frames, interrupter);
     if (command.log && !logFile.flush()) {
-        throw IoError(formatError(command.log->string(), "", "cannot write the log", "a writable file"));
+        throw StorageError(
+            formatError(command.log->string(), "", "cannot write the log", "enough space to write"));
     }
     if (command.report) {
         uvwarp::ShotLog log;

@@ -311,6 +311,15 @@ expect uvwarp 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr
 contains uvwarp "$work/out" "uvwarp: tile 1001: 2 frames written (2 baked), 0 replayed, 0 skipped"
 [ "$(wc -l <"$work/uv/logs/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
 [ -s "$work/uv/out/albedo.1001.0002.png" ] || { echo "FAIL uvwarp: bake missing"; failures=$((failures + 1)); }
+# Storage that fails while writing (a full disk, here /dev/full) is exit 1, not bad input: so is standard
+# output that cannot be written (a farm task's log, a listing redirected to a full disk).
+if [ -w /dev/full ]; then
+    expect uvwarp-log-full 1 uvwarp --frames 1-2 --out "$work/uv/full/redirect.<UDIM>.####.exr" --log /dev/full
+    contains uvwarp-log-full "$work/err" "/dev/full: cannot write the log (expected enough space to write)"
+    "$dk" deformers --markdown >/dev/full 2>"$work/err"
+    [ $? -eq 1 ] && grep -qF "standard output: cannot write" "$work/err" && passed=$((passed + 1)) ||
+        { echo "FAIL stdout-full: expected exit 1 naming standard output"; cat "$work/err"; failures=$((failures + 1)); }
+fi
 # The shot's page: from the run (--report), and from logs merged with a broken one (its file and line in the
 # page, exit 0); no log at all is exit 2.
 expect uvwarp-report 0 uvwarp --frames 1-2 --out "$work/uv/rep/redirect.<UDIM>.####.exr" --report "$work/uv/rep/report.html"

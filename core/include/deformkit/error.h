@@ -9,7 +9,7 @@ namespace deformkit {
 // Every error DeformKit raises on user data derives from Error. The message names the input (a file
 // path, or a label such as "mesh 'body'"), the element (a line, a face, a vertex, a pixel) and what
 // was expected. Library code never aborts on user data; hosts convert Error at their boundary
-// (CLI: one line on stderr and exit code 2).
+// (CLI: one line on stderr and exit code 2; 1 for a StorageError).
 class Error : public std::runtime_error {
   public:
     explicit Error(const std::string& message) : std::runtime_error(message) {}
@@ -19,6 +19,13 @@ class Error : public std::runtime_error {
 class IoError : public Error {
   public:
     using Error::Error;
+};
+
+// Storage that failed while a file was written: a full disk, an I/O error. Not the input's fault: the CLI
+// exits 1 for it (anything else it names is exit 2), and a farm retries it, as any IoError.
+class StorageError : public IoError {
+  public:
+    using IoError::IoError;
 };
 
 // A file whose bytes do not follow its format: OBJ syntax, a truncated or corrupt image.

@@ -204,7 +204,7 @@ void writeFileAtomically(const fs::path& path, std::string_view bytes) {
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         out.flush();
         if (!out) {
-            throw IoError(
+            throw StorageError(
                 formatError(path.string(), "", "write failed (disk full?)", "enough space to write"));
         }
     });

@@ -301,14 +301,14 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
                             "a type the format stores, such as " + out->openedPixelType());
         }
         if (!writePixels(*out)) {
-            throw IoError(formatError(path.string(), "pixels",
-                                      "cannot write: " + oiioError(oiio, out->error()),
-                                      "enough space to write"));
+            throw StorageError(formatError(path.string(), "pixels",
+                                           "cannot write: " + oiioError(oiio, out->error()),
+                                           "enough space to write"));
         }
         if (!out->close()) {
-            throw IoError(formatError(path.string(), "",
-                                      "cannot finish writing: " + oiioError(oiio, out->error()),
-                                      "enough space to write"));
+            throw StorageError(formatError(path.string(), "",
+                                           "cannot finish writing: " + oiioError(oiio, out->error()),
+                                           "enough space to write"));
         }
         // Rejected only now: a PNG writer closed before its pixels makes libpng print to stderr.
         if (!rejected.empty()) throw InvalidInput(rejected);

@@ -360,7 +360,8 @@ void PointCacheWriter::append(std::span<const glm::vec3> points) {
             storeWord(buffer_.data() + v * kBytesPerVertex + 4 * c, std::bit_cast<uint32_t>(q[c]), big);
     }
     out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    if (!out_) throw IoError(formatError(name, frame, "write failed (disk full?)", "enough space to write"));
+    if (!out_)
+        throw StorageError(formatError(name, frame, "write failed (disk full?)", "enough space to write"));
     ++written_;
 }
 
@@ -374,7 +375,8 @@ void PointCacheWriter::finish() {
     }
     out_.close();
     if (!out_)
-        throw IoError(formatError(path_.string(), "", "write failed (disk full?)", "enough space to write"));
+        throw StorageError(
+            formatError(path_.string(), "", "write failed (disk full?)", "enough space to write"));
     writeAtomically(path_, [this](const fs::path& tmp) {
         std::error_code ec;
         fs::rename(staging_, tmp, ec);

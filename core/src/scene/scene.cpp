@@ -47,6 +47,12 @@ class Reader {
         throw InvalidInput(formatError(source_, path, problem, expected));
     }
 
+    // "which does not exist", or what stands there instead of a file.
+    static std::string missingFile(const fs::path& file) {
+        std::error_code ec;
+        return fs::is_directory(file, ec) ? ", which is a folder, not a file" : ", which does not exist";
+    }
+
     // Whether `file` is a regular file; a path the system cannot even look up (a name too long, a folder
     // without permission) is an error naming the JSON path.
     bool isRegularFile(const fs::path& file, const std::string& path) const {
@@ -571,7 +577,7 @@ class Reader {
                  "restFrame only with a frame sequence (\"mesh\": \"anim.####.obj\")");
         }
         if (!isRegularFile(o.meshFile, path + ".mesh"))
-            fail(path + ".mesh", "names " + o.meshFile.string() + ", which does not exist", "a mesh file");
+            fail(path + ".mesh", "names " + o.meshFile.string() + missingFile(o.meshFile), "a mesh file");
         try {
             io::ObjContent content = io::readMesh(o.meshFile);
             o.rest = std::move(content.mesh);
