@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <tuple>
@@ -173,6 +174,10 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5], "objects": [{"name": "tube",
                    "mesh": "missing.obj", "stack": []}]})"),
                Contains("objects[0].mesh: names") && Contains("missing.obj, which does not exist"));
+    std::filesystem::create_directories(f.dir / "meshes.obj");
+    CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5], "objects": [{"name": "tube",
+                   "mesh": "meshes.obj", "stack": []}]})"),
+               Contains("objects[0].mesh: names") && Contains("meshes.obj, which is a folder, not a file"));
     CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 5], "objects": [{"name": "a/b",
                    "mesh": "tube.obj", "stack": []}]})"),
                Contains("objects[0].name: is \"a/b\""));
