@@ -77,6 +77,28 @@ int farmExitCode(const std::exception& error) {
     return 1;
 }
 
+namespace {
+
+// `--output=` for a log beside the plan, `pattern` the file name with Slurm's own replacement symbols (%A,
+// %a, %j). sbatch reads the whole path as a pattern: a '%' of the folder or the plan's name is written %%; a
+// backslash anywhere turns every symbol off (the tasks' logs would overwrite one another, and Slurm drops
+// the backslash, so the folder is not found), so such a path is refused.
+std::string slurmOutput(const fs::path& planAbs, const std::string& suffix) {
+    const std::string literal = (planAbs.parent_path() / planAbs.stem()).string();
+    if (literal.find('\\') != std::string::npos) {
+        throw InvalidInput(
+            formatError(planAbs.string(), "",
+                        "has a backslash in its path, which sbatch's --output reads as 'no patterns'",
+                        "a plan whose folder and name have no backslash"));
+    }
+    std::string escaped;
+    for (const char c : literal)
+        escaped += c == '%' ? std::string("%%") : std::string(1, c);
+    return "--output=" + escaped + suffix;
+}
+
+}  // namespace
+
 std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const fs::path& planFile,
                                              const fs::path& deformkit,
                                              const std::vector<std::string>& extra) {
@@ -86,7 +108,7 @@ std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const 
         "--array=0-" + std::to_string(plan.tasks.size() - 1),
         "--job-name=deformkit-farm-" + plan.scene.stem().string(),
         // Slurm's %A (job) and %a (array index, the task) keep one log per task beside the plan.
-        "--output=" + (planAbs.parent_path() / (planAbs.stem().string() + ".%A_%a.log")).string(),
+        slurmOutput(planAbs, ".%A_%a.log"),
     };
     args.insert(args.end(), extra.begin(), extra.end());
     args.push_back("--wrap=exec " + shellQuote(absolutePath(deformkit).string()) + " farm run " +
@@ -142,7 +164,7 @@ std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, 
         "--parsable",
         "--dependency=afterany:" + arrayJob,
         "--job-name=deformkit-report-" + plan.scene.stem().string(),
-        "--output=" + (planAbs.parent_path() / (planAbs.stem().string() + "-report.%j.out")).string(),
+        slurmOutput(planAbs, "-report.%j.out"),
     };
     const ArrayOptions split = splitArrayOptions(extra);
     args.insert(args.end(), split.rest.begin(), split.rest.end());

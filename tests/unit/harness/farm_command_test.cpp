@@ -419,6 +419,28 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
                Contains("deformkit-test-no-such-sbatch: not found on PATH"));
 }
 
+TEST_CASE("farm submit: a '%' of the plan's path reaches sbatch as %%, a backslash is refused",
+          "[harness][farm][slurm]") {
+    // sbatch reads --output as a pattern: '100%x_%j' in a folder name would become the job's name and id,
+    // and every element fail to open its log.
+    scene::FarmPlan plan;
+    plan.scene = "/shows/x/shot.json";
+    plan.tasks.resize(2);
+    const std::vector<std::string> args =
+        harness::farmSbatchArguments(plan, "/shows/r2 100%x_%j/plan%.json", "/opt/dk/bin/deformkit", {});
+    CHECK(std::find(args.begin(), args.end(), "--output=/shows/r2 100%%x_%%j/plan%%.%A_%a.log") !=
+          args.end());
+    const std::vector<std::string> report = harness::farmReportSbatchArguments(
+        plan, "/shows/r2 100%x_%j/plan%.json", "/opt/dk/bin/deformkit", {}, "123");
+    CHECK(std::find(report.begin(), report.end(), "--output=/shows/r2 100%%x_%%j/plan%%-report.%j.out") !=
+          report.end());
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)harness::farmSbatchArguments(plan, "/shows/back\\slash/plan.json",
+                                                      "/opt/dk/bin/deformkit", {});
+               }),
+               Contains("/shows/back\\slash/plan.json: has a backslash in its path"));
+}
+
 TEST_CASE("farm submit: --sbatch-args splits like a shell", "[harness][farm]") {
     CHECK(harness::splitArguments("  --partition=batch   --comment='two words' \"a\\\"b\" c\\ d ",
                                   "--sbatch-args") ==
