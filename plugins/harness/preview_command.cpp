@@ -1,4 +1,5 @@
 // `deformkit preview MESH --out FILE`: a shaded, optionally textured or weight-coloured view of a mesh.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -22,9 +23,10 @@ namespace {
 glm::vec3 parseVec3(const std::string& text) {
     glm::vec3 v;
     char tail = 0;
-    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3) {
-        throw InvalidInput(
-            formatError("--view", "", "'" + text + "' is not a direction", "three numbers: x,y,z"));
+    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3 || !std::isfinite(v.x) ||
+        !std::isfinite(v.y) || !std::isfinite(v.z) || (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f)) {
+        throw InvalidInput(formatError("--view", "", "'" + text + "' is not a direction",
+                                       "three finite numbers x,y,z, not all 0"));
     }
     return v;
 }

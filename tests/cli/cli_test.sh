@@ -226,6 +226,9 @@ expect preview 0 "$dk" preview "$work/demo/tube.obj" --texture "$work/demo/albed
 expect preview-size 0 "$dk" info "$work/p.png"
 contains preview-size "$work/out" "200 x 150"
 expect preview-bad-view 2 "$dk" preview "$work/demo/tube.obj" --view 1,2 --out "$work/q.png"
+expect preview-zero-view 2 "$dk" preview "$work/demo/tube.obj" --view 0,0,0 --out "$work/q.png"
+contains preview-zero-view "$work/err" "--view: '0,0,0' is not a direction (expected three finite numbers x,y,z, not all 0)"
+expect preview-nan-view 2 "$dk" preview "$work/demo/tube.obj" --view nan,1,1 --out "$work/q.png"
 # Out of memory (a 16384² picture under a 400 MB address-space limit): exit 1, a retry elsewhere may cure it.
 expect out-of-memory 1 bash -c 'ulimit -v 400000; exec "$0" preview "$1" --out "$2" --width 16384 --height 16384' \
     "$dk" "$work/demo/tube.obj" "$work/huge.png"

@@ -90,8 +90,19 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
     const geom::Box3 box = o.frame ? *o.frame : mesh.bounds();
     const glm::vec3 centre = box.center();
     const float radius = std::max(0.5f * glm::length(box.extent()), 1e-6f);
-    const glm::vec3 forward =
-        glm::length(o.viewDirection) > 0.0f ? glm::normalize(o.viewDirection) : glm::vec3(0.0f, 0.0f, -1.0f);
+    const double viewLength = glm::length(glm::dvec3(o.viewDirection));
+    if (!std::isfinite(viewLength) || !(viewLength > 0.0)) {
+        throw InvalidInput(formatError("preview", "view direction",
+                                       "is (" + numberText(o.viewDirection.x) + ", " +
+                                           numberText(o.viewDirection.y) + ", " +
+                                           numberText(o.viewDirection.z) + ")",
+                                       "three finite numbers, not all 0"));
+    }
+    // Normalised in float as before; in double where float's length overflows (components near 1e30).
+    const float floatLength = glm::length(o.viewDirection);
+    const glm::vec3 forward = std::isfinite(floatLength) && floatLength > 0.0f
+                                  ? glm::normalize(o.viewDirection)
+                                  : glm::vec3(glm::dvec3(o.viewDirection) / viewLength);
     const glm::vec3 worldUp =
         std::abs(forward.y) > 0.99f ? glm::vec3(0.0f, 0.0f, -1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
     const glm::vec3 right = glm::normalize(glm::cross(forward, worldUp));

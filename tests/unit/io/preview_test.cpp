@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <glm/geometric.hpp>
@@ -107,6 +108,21 @@ TEST_CASE("preview: bad input is reported", "[io][preview][errors]") {
     io::PreviewOptions o;
     o.width = 0;
     CHECK_THROWS_AS(io::renderPreview(noUVs, o), InvalidInput);
+    // A view direction of zero length or not finite is refused, not replaced by another view.
+    for (const glm::vec3 view :
+         {glm::vec3(0.0f), glm::vec3(std::numeric_limits<float>::quiet_NaN(), 1.0f, 1.0f),
+          glm::vec3(std::numeric_limits<float>::infinity(), 1.0f, 1.0f)}) {
+        io::PreviewOptions bad;
+        bad.viewDirection = view;
+        CHECK_THROWS_WITH(io::renderPreview(noUVs, bad),
+                          Catch::Contains("preview: view direction: is (") &&
+                              Catch::Contains("(expected three finite numbers, not all 0)"));
+    }
+    // Components whose float length overflows still give a direction: the same picture as the unit one.
+    io::PreviewOptions huge, unit;
+    huge.viewDirection = {0.0f, -1e30f, -3e30f};
+    unit.viewDirection = {0.0f, -1.0f, -3.0f};
+    CHECK(io::renderPreview(noUVs, huge).pixels == io::renderPreview(noUVs, unit).pixels);
 }
 
 TEST_CASE("preview: a framing box sets the camera as the box's bounds would", "[io][preview]") {
