@@ -486,17 +486,18 @@ expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-p
 contains farm-plan-tiles "$work/farm-uv/farm_plan.json" '"tiles":[1001]'
 expect farm-run-tiles 0 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 3
 contains farm-run-tiles "$work/farm-uv/farm_plan.json" '"warmUp": 6'
-# The farm's page from the tasks' logs as Slurm names them: task 2 (frame 1's map) has not run yet, then runs
-# and its log also holds an error line.
+# The farm's page from the tasks' logs as Slurm names them: the mesh tasks 0 and 1 and task 2 (frame 1's
+# map) have not run yet, then task 2 runs and its log also holds an error line.
 cp "$work/out" "$work/farm-uv/farm_plan.77_3.log"
 expect farm-report-missing 0 "$dk" farm report "$work/farm-uv/farm_plan.json"
-contains farm-report-missing "$work/out" "farm: report $work/farm-uv/report.html (1 log lines, 1 problem)"
+contains farm-report-missing "$work/out" "farm: report $work/farm-uv/report.html (1 log lines, 3 problems)"
+contains farm-report-missing "$work/farm-uv/report.html" 'data-task="0">task 0 (frames 1–1, meshes): no log line'
 contains farm-report-missing "$work/farm-uv/report.html" 'data-task="2">task 2 (frames 1–1, tiles 1001): no log line'
 contains farm-report-missing "$work/farm-uv/report.html" "deformkit farm run $work/farm-uv/farm_plan.json --task 2"
 "$dk" farm run "$work/farm-uv/farm_plan.json" --task 2 >"$work/farm-uv/farm_plan.77_2.log" 2>&1
 echo "deformkit: error: an earlier attempt failed" >>"$work/farm-uv/farm_plan.77_2.log"
 expect farm-report 0 "$dk" report --plan "$work/farm-uv/farm_plan.json"
-contains farm-report "$work/out" "(2 log lines, 8 pictures beside it; 1 problem)"
+contains farm-report "$work/out" "(2 log lines, 8 pictures beside it; 3 problems)"
 contains farm-report "$work/farm-uv/report.html" "farm_plan.77_2.log:2: is not JSON: 'deformkit: error: an earlier attempt failed'"
 # Each frame from the identity (a scene's default): the task of frame 2 writes eval's bytes, warmed up or not.
 cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||

@@ -355,20 +355,25 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
     {
         std::set<std::pair<int, int>> done;                        // (tile, frame), any object
         std::set<std::tuple<std::string, int, int>> doneByObject;  // (object, tile, frame)
+        std::set<std::pair<int, int>> meshDone;                    // (task, frame) of a mesh task
         std::set<int> logged;
         for (const ShotLogLine& line : log.lines) {
             if (line.task) logged.insert(*line.task);
-            if (line.tile && (line.status == "written" || line.status == "skipped")) {
+            const bool finished = line.status == "written" || line.status == "skipped";
+            if (line.tile && finished) {
                 done.insert({*line.tile, line.frame});
                 doneByObject.insert({line.object, *line.tile, line.frame});
+            } else if (!line.tile && line.task && finished) {
+                meshDone.insert({*line.task, line.frame});
             }
         }
         for (const HtmlReportOptions::Task& task : options.tasks) {
-            if (task.tiles.empty()) continue;
             Missing m{&task, {}, logged.contains(task.index)};
             for (int frame = task.first; frame <= task.last; ++frame) {
+                // A mesh task's lines (no tile) say each frame's OBJs were written or were there.
                 const bool all =
-                    task.objectTiles.empty()
+                    task.tiles.empty() ? meshDone.contains({task.index, frame})
+                    : task.objectTiles.empty()
                         ? std::all_of(task.tiles.begin(), task.tiles.end(),
                                       [&](int tile) {
                                           return done.contains({tile, frame});
@@ -430,7 +435,8 @@ HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const
         html << "<h2 id=\"problems\">Problems</h2><ul>";
         for (const Missing& m : missing) {
             html << "<li class=\"bad missing-task\" data-task=\"" << m.task->index << "\">task "
-                 << m.task->index << " (frames " << m.task->first << "–" << m.task->last << ", tiles";
+                 << m.task->index << " (frames " << m.task->first << "–" << m.task->last
+                 << (m.task->tiles.empty() ? ", meshes" : ", tiles");
             for (const int tile : m.task->tiles)
                 html << ' ' << tile;
             html << "): "

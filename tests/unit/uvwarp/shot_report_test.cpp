@@ -321,12 +321,23 @@ TEST_CASE(
         frame = test::stretchedAndBent(rest, f);
         return frame;
     });
+    // Mesh tasks' lines, as farm run prints them (no tile): task 2 wrote frames 1-6 of its 1-7, task 5 all of
+    // its 1-2 (frame 2 found written before).
+    std::string meshLines;
+    for (int f = 1; f <= 6; ++f)
+        meshLines += R"({"task":2,"frame":)" + std::to_string(f) +
+                     R"(,"status":"written","seconds":0.02})"
+                     "\n";
+    meshLines += R"({"task":5,"frame":1,"status":"written","seconds":0.02})"
+                 "\n";
+    meshLines += R"({"task":5,"frame":2,"status":"skipped"})"
+                 "\n";
     const fs::path logFile = dir / "shot.jsonl";
-    test::writeText(logFile, logText.str() + "not a line\n");
+    test::writeText(logFile, logText.str() + meshLines + "not a line\n");
 
     uvwarp::ShotLog log;
     uvwarp::readShotLogFile(logFile, log);
-    REQUIRE(log.lines.size() == 10);
+    REQUIRE(log.lines.size() == 18);
     uvwarp::HtmlReportOptions options;
     options.title = "two <tiles>";
     // The maps are in memory, the deformed frames made here: both through the callbacks.
@@ -342,13 +353,14 @@ TEST_CASE(
     // expects only that object's.
     options.tasks = {{0, 1, 5, {1001, 1002}, {}, "rerun 0"},
                      {1, 6, 7, {1002}, {}, "rerun 1"},
-                     {2, 1, 7, {}, {}, ""},
+                     {2, 1, 7, {}, {}, "rerun 2"},
                      {3, 1, 5, {1001}, {{"", 1001}, {"other", 1001}}, "rerun 3"},
-                     {4, 1, 5, {1001}, {{"", 1001}}, "rerun 4"}};
+                     {4, 1, 5, {1001}, {{"", 1001}}, "rerun 4"},
+                     {5, 1, 2, {}, {}, "rerun 5"}};
     const fs::path page = dir / "shot.html";
     const uvwarp::HtmlReportResult result = uvwarp::writeHtmlReport(log, page, options);
     CHECK(result.notes.empty());
-    CHECK(result.problems == 3);                    // the broken line and the missing tasks 1 and 3
+    CHECK(result.problems == 4);  // the broken line and the missing tasks 1, 2 (a mesh task's frame 7) and 3
     REQUIRE(result.files.size() == 1 + 2 * 4 * 2);  // per tile 4 pictures and their thumbnails
     for (const fs::path& f : result.files)
         CHECK(fs::file_size(f) > 0);
@@ -357,12 +369,16 @@ TEST_CASE(
     CHECK_THAT(html, Contains("<title>two &lt;tiles&gt;</title>"));
     CHECK(html.find("<script src") == std::string::npos);
     CHECK(html.find("http") == std::string::npos);  // nothing from a network
-    CHECK_THAT(html, Contains("shot.jsonl:11: is not JSON: 'not a line'"));
+    CHECK_THAT(html, Contains("shot.jsonl:19: is not JSON: 'not a line'"));
     CHECK_THAT(html, Contains("data-task=\"1\">task 1 (frames 6–7, tiles 1002): no log line"));
     CHECK_THAT(html, Contains("rerun 1"));
     CHECK(html.find("data-task=\"0\"") == std::string::npos);
     CHECK_THAT(html, Contains("data-task=\"3\">task 3 (frames 1–5, tiles 1001)"));
     CHECK(html.find("data-task=\"4\"") == std::string::npos);
+    CHECK_THAT(html,
+               Contains("data-task=\"2\">task 2 (frames 1–7, meshes): failed or still running: 1 frame"));
+    CHECK_THAT(html, Contains("rerun 2"));
+    CHECK(html.find("data-task=\"5\"") == std::string::npos);
     const std::string tag = "id=\"deformkit-shot\">";
     const size_t begin = html.find(tag) + tag.size();
     REQUIRE(begin > tag.size());

@@ -47,12 +47,12 @@ struct HtmlReportOptions {
     // Command lines that run the shot again, shown as given. Empty: one `deformkit uvwarp` line made from
     // the worst frame's header when its inputs are files.
     std::vector<std::string> rerun;
-    // A farm plan's tasks: a task whose tiles and frames the logs do not show written or skipped is listed
-    // as missing or failed, with its command line.
+    // A farm plan's tasks: a task whose tiles and frames (a mesh task: whose frames) the logs do not show
+    // written or skipped is listed as missing or failed, with its command line.
     struct Task {
         int index = 0;
         int first = 0, last = 0;  // frames, inclusive
-        std::vector<int> tiles;   // empty: a mesh task (not checked)
+        std::vector<int> tiles;   // empty: a mesh task (its lines have no tile)
         // The (object, tile) pairs the task writes maps for; empty: any object's line counts for a tile.
         std::vector<std::pair<std::string, int>> objectTiles;
         std::string rerun;
