@@ -314,6 +314,10 @@ expect uvwarp 0 uvwarp --frames 1-2 --out "$work/uv/out/redirect.<UDIM>.####.exr
 contains uvwarp "$work/out" "uvwarp: tile 1001: 2 frames written (2 baked), 0 replayed, 0 skipped"
 [ "$(wc -l <"$work/uv/logs/log.jsonl")" -eq 2 ] || { echo "FAIL uvwarp-log: expected 2 lines"; failures=$((failures + 1)); }
 [ -s "$work/uv/out/albedo.1001.0002.png" ] || { echo "FAIL uvwarp: bake missing"; failures=$((failures + 1)); }
+# A --mask that matches no tile's file (a typo) is refused before anything is written.
+expect uvwarp-mask-typo 2 uvwarp --frames 1-2 --out "$work/uv/typo/redirect.<UDIM>.####.exr" --mask "$work/demo/msak.<UDIM>.exr"
+contains uvwarp-mask-typo "$work/err" "msak.<UDIM>.exr: matches no file for any of the mesh's tiles"
+[ ! -e "$work/uv/typo" ] || { echo "FAIL uvwarp-mask-typo: output folder created"; failures=$((failures + 1)); }
 # Storage that fails while writing (a full disk, here /dev/full) is exit 1, not bad input: so is standard
 # output that cannot be written (a farm task's log, a listing redirected to a full disk).
 if [ -w /dev/full ]; then

@@ -276,6 +276,24 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                            "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
         }
     }
+    // A mask or orientation pattern that matches no file for any of the mesh's tiles is a typo, not a choice
+    // (a tile without one falls back, with a note): refused before anything is written. Any of the mesh's
+    // tiles, not only the job's: a farm task of one tile may have none where another tile has its map.
+    for (const auto& [source, what] :
+         {std::pair{&j.mask, "warp mask"}, std::pair{&j.orientation, "orientation map"}}) {
+        if (!source->given()) continue;
+        const std::vector<int> meshTiles = shotTiles(*j.rest, j.restName, {}, "tiles");
+        if (std::none_of(meshTiles.begin(), meshTiles.end(),
+                         [&](int tile) { return findTileMap(*source, tile, j.frames).found(); })) {
+            std::string list;
+            for (const int tile : meshTiles)
+                list += (list.empty() ? "" : ", ") + std::to_string(tile);
+            throw InvalidInput(formatError(source->name.empty() ? what : source->name,
+                                           source->pattern.empty() ? "" : source->pattern.string(),
+                                           "matches no file for any of the mesh's tiles (" + list + ")",
+                                           std::string(what) + "s for some tiles, or none given"));
+        }
+    }
     const int32_t resolution = j.options.cells;
     const bool wantBake = j.texture.given();
     bool saidNoUVs = false;

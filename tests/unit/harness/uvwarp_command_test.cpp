@@ -417,14 +417,15 @@ TEST_CASE("uvwarp command: an orientation map scales the orientation preservatio
     // And the amount matters on this scene: 0.5 everywhere differs from 0.
     CHECK(none.pixels != run(nullptr, 0.0f).pixels);
 
-    // A missing tile is reported (and means the density heuristic's map, a shot's default); a wrong size or a
-    // value outside [0, 1] is an error naming the file.
+    // A pattern that matches no tile's map is a typo, refused before anything is written (a tile without
+    // one, where another tile has its map, means the density heuristic's map, with a note: test_uvwarp.py);
+    // a wrong size or a value outside [0, 1] is an error naming the file.
     Scene missing;
     missing.command.orientation = missing.dir / "orient.<UDIM>.exr";
-    const uvwarp::ShotReport report = harness::uvwarpCommand(missing.command, nullptr);
-    REQUIRE(report.tiles.size() == 1);
-    REQUIRE(report.tiles[0].notes.size() == 1);
-    CHECK_THAT(report.tiles[0].notes[0], Catch::Contains("no orientation map"));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(missing.command, nullptr); }),
+               Catch::Contains("--orientation: " + (missing.dir / "orient.<UDIM>.exr").string() +
+                               ": matches no file for any of the mesh's tiles (1001) (expected orientation "
+                               "maps for some tiles, or none given)"));
 
     Scene wrongSize;
     io::writeImage(wrongSize.dir / "orient.1001.exr", io::Image(kTexels / 2, kTexels / 2, 1),
