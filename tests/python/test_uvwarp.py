@@ -564,6 +564,10 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(deformed=lambda f: (np.where(np.arange(len(mesh[0]))[:, None] == 7, np.nan, pose(mesh[0], f))
                                       .astype(np.float32), f"take_{f}.abc")),
              dk.InvalidInput, "take_1.abc: frame 1: vertex 7: is not finite"),
+            # Without a name the frame is the input's name, said once.
+            (dict(deformed=lambda f: np.where(np.arange(len(mesh[0]))[:, None] == 7, np.nan, pose(mesh[0], f))
+                  .astype(np.float32)),
+             dk.InvalidInput, r"^frame 1: vertex 7: is not finite"),
             (dict(progress=3), dk.InvalidInput, "progress: is an int"),
             (dict(smoothing=2.0), dk.InvalidInput, "uvwarp_shot: smoothing: is 2.0"),
             (dict(filter="nearest"), dk.InvalidInput, "filter: is 'nearest'")):

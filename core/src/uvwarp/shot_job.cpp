@@ -659,11 +659,13 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
             inputName, "", "has " + std::to_string(deformed.size()) + " vertices",
             std::to_string(vertices) + ", the vertex count of the rest mesh '" + s.job.restName + "'"));
     }
-    // Named here, by the frame's own input: the imager's own check names the rest mesh it was bound to.
+    // Named here, by the frame's own input: the imager's own check names the rest mesh it was bound to. The
+    // frame once: an input without a file is named by its frame already ("frame 2").
     if (const size_t v = geom::firstNonFinite(deformed); v < deformed.size()) {
-        throw InvalidInput(formatError(inputName,
-                                       "frame " + std::to_string(frame) + ": vertex " + std::to_string(v),
-                                       "is not finite", "finite coordinates"));
+        const std::string frameText = "frame " + std::to_string(frame);
+        throw InvalidInput(formatError(
+            inputName, (inputName == frameText ? "" : frameText + ": ") + "vertex " + std::to_string(v),
+            "is not finite", "finite coordinates"));
     }
     const size_t k = s.nextFrame++;
     for (TilePlan& plan : s.plans) {
