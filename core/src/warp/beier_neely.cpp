@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -168,9 +169,12 @@ std::vector<Affine> beierNeelyTransformations(std::span<const SegmentPair> pairs
             // §5.2: N*_i = normalised sum_j w^_ij R_j<N_i>, R_j the rotation taking L_j's direction to
             // L*_j's; w_ij = (len_j^p_j / ((a_j + dist_ij)(a_j + |d_i . d_j| / len_i)))^b_j
             // (reconstruction: docs/decisions.md, BN-3).
+            // The weights divided by the largest (exp(ln w_j - max ln w)): the normalised sum is the same,
+            // and features far apart for their a and b (w below double's range) keep their ratios.
             const double lengthI = glm::length(d);
-            glm::dvec2 sum(0.0);
-            double weightSum = 0.0;
+            std::vector<double> logWeight(n);
+            std::vector<glm::dvec2> rotations(n);
+            double largest = -std::numeric_limits<double>::infinity();
             for (size_t j = 0; j < n; ++j) {
                 const SegmentPair& t = pairs[j];
                 const glm::dvec2 dj = glm::dvec2(t.dstQ - t.dstP), ej = glm::dvec2(t.srcQ - t.srcP);
@@ -183,8 +187,15 @@ std::vector<Affine> beierNeelyTransformations(std::span<const SegmentPair> pairs
                 const double parallel = std::abs(glm::dot(d, dj)) / lengthI;
                 const double base =
                     std::pow(lengthJ, static_cast<double>(t.p)) / ((t.a + dist) * (t.a + parallel));
-                const double w = std::pow(base, static_cast<double>(t.b));
-                sum += w * rotated;
+                logWeight[j] = t.b == 0.0f ? 0.0 : static_cast<double>(t.b) * std::log(base);
+                rotations[j] = rotated;
+                largest = std::max(largest, logWeight[j]);
+            }
+            glm::dvec2 sum(0.0);
+            double weightSum = 0.0;
+            for (size_t j = 0; j < n && !std::isinf(largest); ++j) {
+                const double w = std::exp(logWeight[j] - largest);
+                sum += w * rotations[j];
                 weightSum += w;
             }
             const double len = glm::length(sum);

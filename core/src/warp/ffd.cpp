@@ -197,9 +197,10 @@ void blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> point
 // spline with repeated ends continues from its end face with the value and slope it has there, T_0 + x k
 // (T_1 - T_0) or T_d + (x - d) k (T_d - T_(d-1)): k = 1 for the Bernstein polynomial, the linear basis, the
 // B-spline and Catmull-Rom with extrapolated ends, 2 a for the cardinal spline of tension a (its end tangent
-// over the extrapolated control). Linear in x, so an affine lattice stays affine however far, where the
-// polynomials themselves amplify float rounding by (2 |s| + 1)^degree (docs/decisions.md, "FFD points outside
-// the lattice"). The SoA kernels (ffd_kernels.h) compute the same weights with the same operations.
+// over the extrapolated control). Linear in x, so an affine lattice stays affine at any degree (float
+// rounding growing with the weights' size, the distance), where the polynomials amplify it by (2 |s| +
+// 1)^degree (docs/decisions.md, "FFD points outside the lattice"). The SoA kernels (ffd_kernels.h) compute
+// the same weights with the same operations.
 inline int32_t basisWeights(FfdBasis basis, FfdEnds ends, int32_t d, const float* binomial, float x,
                             int32_t& first, float* w) {
     if ((x < 0.0f || x > static_cast<float>(d)) &&

@@ -219,6 +219,30 @@ TEST_CASE("Beier-Neely: global variant target basis matches the reconstructed Se
     CHECK(glm::length(o[0].linear * glm::vec3(0, 1, 0) - glm::vec3(0, 1, 0)) <= 1e-7f);
 }
 
+TEST_CASE("Beier-Neely: the global variant's weights keep their ratios below double's range",
+          "[warp][beier_neely]") {
+    // The shear case with a = 10, b = 400: w_00 = (40^0.5 / (10 * 50))^400 ~ 1e-1139 and w_01 = (28^0.5 /
+    // (14 * 10))^400 ~ 1e-569 both underflow in double, which left N*_0 its own perpendicular; their ratio
+    // (1e570 for w_01) makes N*_0 the turned one. Reference in long double (range to 1e-4951).
+    std::vector<SegmentPair> pairs = shearCase();
+    for (SegmentPair& s : pairs) {
+        s.a = 10.0f;
+        s.b = 400.0f;
+    }
+    const long double w00 = std::pow(std::sqrt(40.0L) / (10.0L * 50.0L), 400.0L);
+    const long double w01 = std::pow(std::sqrt(28.0L) / (14.0L * 10.0L), 400.0L);
+    REQUIRE(w00 > 0.0L);
+    REQUIRE(static_cast<double>(w01) == 0.0);  // below double's range
+    const long double tilt = 1.1L;
+    const long double x = (w01 * -std::sin(tilt)) / (w00 + w01),
+                      y = (w00 + w01 * std::cos(tilt)) / (w00 + w01);
+    const long double norm = std::sqrt(x * x + y * y);
+    const std::vector<Affine> t = beierNeelyTransformations(pairs, {BeierNeelyVariant::Global});
+    const glm::vec3 got = t[0].linear * glm::vec3(0, 1, 0);
+    CHECK(got.x == Approx(static_cast<double>(x / norm)).margin(1e-6));
+    CHECK(got.y == Approx(static_cast<double>(y / norm)).margin(1e-6));
+}
+
 TEST_CASE("Beier-Neely: the global variant removes the fold-over of the Fig. 15 shear",
           "[warp][beier_neely]") {
     const std::vector<SegmentPair> pairs = shearCase();

@@ -366,7 +366,7 @@ TEST_CASE("ffd: outside points, unchanged or extrapolated", "[warp][ffd]") {
     CHECK(glm::length(jump) < 2e-3f);
 }
 
-TEST_CASE("ffd: extrapolated, an affine lattice stays affine however far, every basis and degree",
+TEST_CASE("ffd: extrapolated, an affine lattice stays affine up to float rounding, every basis and degree",
           "[warp][ffd]") {
     // Targets an affine map of the controls (A p + b, A a shear and scale): the FFD of any basis but the
     // cardinal spline (not linearly precise) reproduces it inside, and the continuation from the faces does
