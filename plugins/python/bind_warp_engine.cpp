@@ -1,4 +1,7 @@
 // deformkit.warp_engine: the framework's Eq. (3) on dense per-point fields, for studio prototypes.
+#include <cmath>
+#include <string>
+
 #include <pybind11/numpy.h>
 
 #include "bindings.h"
@@ -28,6 +31,24 @@ void requireShape(const FloatArray& a, const char* name, std::initializer_list<p
     }
 }
 
+// Every entry of `a` finite, or InvalidInput naming the first by its index ("transforms[1, 2, 3]").
+void requireFinite(const FloatArray& a, const char* name) {
+    const float* data = a.data();
+    const auto count = static_cast<size_t>(a.size());
+    for (size_t e = 0; e < count; ++e) {
+        if (std::isfinite(data[e])) continue;
+        std::string index;
+        size_t rest = e;
+        for (py::ssize_t d = a.ndim() - 1; d >= 0; --d) {
+            index =
+                std::to_string(rest % static_cast<size_t>(a.shape(d))) + (index.empty() ? "" : ", ") + index;
+            rest /= static_cast<size_t>(a.shape(d));
+        }
+        throw InvalidInput(formatError("warp_engine", std::string(name) + "[" + index + "]",
+                                       "is " + numberText(data[e]), "finite numbers"));
+    }
+}
+
 }  // namespace
 
 void bindWarpEngine(py::module_& m) {
@@ -44,6 +65,11 @@ void bindWarpEngine(py::module_& m) {
             requireShape(transforms, "transforms", {k, 3, 4});
             requireShape(strengths, "strengths", {n, k});
             requireShape(weights, "weights", {n, k});
+            // Eq. (3) turns a non-finite entry into NaN output, or a NaN weight into no weight at all.
+            requireFinite(points, "points");
+            requireFinite(transforms, "transforms");
+            requireFinite(strengths, "strengths");
+            requireFinite(weights, "weights");
             warp::Transformations t;
             for (py::ssize_t i = 0; i < k; ++i) {
                 warp::Affine a;
@@ -75,7 +101,8 @@ void bindWarpEngine(py::module_& m) {
         },
         py::arg("points"), py::arg("transforms"), py::arg("strengths"), py::arg("weights"),
         "Eq. (3) of the warp framework: points (N, 3), transforms (n, 3, 4) affine maps, strengths and\n"
-        "weights (N, n); displacement method, normalised weights, all-zero weights leave a point.");
+        "weights (N, n), all finite; displacement method, normalised weights, all-zero weights leave a\n"
+        "point.");
 }
 
 }  // namespace deformkit::python

@@ -37,3 +37,19 @@ def test_shape_errors_name_the_argument():
     with pytest.raises(dk.InvalidInput, match="strengths"):
         dk.warp_engine(np.zeros((4, 3), np.float32), np.zeros((2, 3, 4), np.float32),
                        np.zeros((4, 3), np.float32), np.zeros((4, 2), np.float32))
+
+
+def test_non_finite_entries_are_refused_by_index():
+    # Eq. (3) would turn each into NaN output, or a NaN weight into no weight at all (the point left put).
+    points = np.array([[0, 0, 0], [1, 1, 1]], np.float32)
+    transforms = np.zeros((2, 3, 4), np.float32)
+    transforms[:, :, :3] = np.eye(3)
+    ones = np.ones((2, 2), np.float32)
+    for name, index, value in (("points", (0, 0), np.nan), ("transforms", (1, 2, 3), np.inf),
+                               ("strengths", (0, 1), np.nan), ("weights", (1, 0), -np.inf)):
+        args = dict(points=points.copy(), transforms=transforms.copy(), strengths=ones.copy(),
+                    weights=ones.copy())
+        args[name][index] = value
+        text = f"warp_engine: {name}[{', '.join(map(str, index))}]: is {'nan' if np.isnan(value) else str(value)}"
+        with pytest.raises(dk.InvalidInput, match=text.replace("[", r"\[").replace("]", r"\]")):
+            dk.warp_engine(**args)
