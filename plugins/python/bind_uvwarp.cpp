@@ -255,8 +255,10 @@ py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::Wa
 }
 
 // A redirect map argument: (T, T, >= 2) float32, channels 0 and 1 the tile-local (u', v').
+// A redirect map as redirect_map returns it: exactly two channels (u', v'); a third one is more likely a
+// texture passed in its place (the arguments swapped) than a map, so it is refused, not read past.
 io::Image redirectOf(const FloatArray& a, const std::string& source, const char* expected) {
-    if (a.ndim() != 3 || a.shape(2) < 2)
+    if (a.ndim() != 3 || a.shape(2) != 2)
         throw InvalidInput(formatError(source, "redirect", "has shape " + shapeOf(a), expected));
     return imageOf(a, source, "redirect", expected);
 }
@@ -751,9 +753,11 @@ void bindUvWarp(py::module_& m) {
     m.def(
         "uv_warp_live_options",
         [](int64_t cells) {
-            if (cells < 1 || cells > (int64_t{1} << 15))
+            // The grids the solver takes (requireCells): a preset for another size would name a grid that
+            // cannot be.
+            if (cells < 1 || cells > (int64_t{1} << 15) || (cells & (cells - 1)) != 0)
                 throw InvalidInput(formatError("uv_warp_live_options", "cells", "is " + std::to_string(cells),
-                                               "a grid size from 1 to 32768"));
+                                               "a power of two from 1 to 32768"));
             const TileWarpOptions o =
                 uvwarp::presetOptions(uvwarp::Preset::Live, static_cast<int32_t>(cells));
             py::dict options;

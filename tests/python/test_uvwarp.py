@@ -275,11 +275,16 @@ def test_bad_input_names_what_is_wrong():
             dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, **{option: value})
     with pytest.raises(dk.InvalidInput, match="uv_warp_live_options: cells: is 0"):
         dk.uv_warp_live_options(0)
+    with pytest.raises(dk.InvalidInput, match=r"cells: is 3 \(expected a power of two from 1 to 32768\)"):
+        dk.uv_warp_live_options(3)
     identity = texel_centres().astype(np.float32)
     with pytest.raises(dk.InvalidInput, match="filter: is 'nearest'"):
         dk.apply_redirect(rig, identity, filter="nearest")
     with pytest.raises(dk.InvalidInput, match=r"redirect: has shape \(64, 64\)"):
         dk.apply_redirect(rig, identity[..., 0])
+    # The arguments swapped: an RGB texture is no redirect map.
+    with pytest.raises(dk.InvalidInput, match=r"redirect: has shape \(64, 64, 3\) \(expected \(R, R, 2\)"):
+        dk.apply_redirect(identity, np.dstack([rig, rig, rig]))
     nan = identity.copy()
     nan[3, 4, 1] = np.nan
     with pytest.raises(dk.InvalidInput, match=r"\(4, 3\)"):
