@@ -145,8 +145,31 @@ Box3 Mesh::bounds() const {
     return box;
 }
 
+namespace {
+
+// The UDIM cell (column, row) of a uv, clamped in float before the cast (a UV of 1e30 would not fit an int):
+// columns 0 to 9, rows 0 to 899 (tiles 9991 to 9999, the last UDIM row); not finite: 0.
+glm::ivec2 tileCell(glm::vec2 uv) {
+    const auto cell = [](float c, float last) {
+        return std::isfinite(c) ? static_cast<int>(std::clamp(std::floor(c), 0.0f, last)) : 0;
+    };
+    return {cell(uv.x, 9.0f), cell(uv.y, 899.0f)};
+}
+
+// (column, row) of face f's tile: its UV centroid's, clamped into the UDIM range.
+glm::ivec2 faceTileCell(std::span<const glm::vec2> uvs, std::span<const int32_t> corners) {
+    glm::vec2 centroid(0.0f);
+    for (int32_t t : corners)
+        centroid += uvs[t];
+    centroid /= static_cast<float>(corners.size());
+    return tileCell(centroid);
+}
+
+}  // namespace
+
 int udimTileOf(const glm::vec2& uv) {
-    return 1001 + static_cast<int>(std::floor(uv.x)) + 10 * static_cast<int>(std::floor(uv.y));
+    const glm::ivec2 cell = tileCell(uv);
+    return 1001 + cell.x + 10 * cell.y;
 }
 
 std::vector<int> Mesh::udimTiles() const {
@@ -155,20 +178,6 @@ std::vector<int> Mesh::udimTiles() const {
         if (faceHasUVs(f)) tiles.insert(faceUdimTile(f));
     return {tiles.begin(), tiles.end()};
 }
-
-namespace {
-
-// (column, row) of face f's tile: its UV centroid's, clamped into the UDIM range.
-glm::ivec2 faceTileCell(std::span<const glm::vec2> uvs, std::span<const int32_t> corners) {
-    glm::vec2 centroid(0.0f);
-    for (int32_t t : corners)
-        centroid += uvs[t];
-    centroid /= static_cast<float>(corners.size());
-    return {std::clamp(static_cast<int>(std::floor(centroid.x)), 0, 9),
-            std::max(static_cast<int>(std::floor(centroid.y)), 0)};
-}
-
-}  // namespace
 
 int Mesh::faceUdimTile(int32_t f) const {
     if (!faceHasUVs(f)) return 0;

@@ -1,6 +1,7 @@
 #include "deformkit/geom/primitives.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "deformkit/error.h"
@@ -28,6 +29,14 @@ void addFace(Mesh::Data& d, std::initializer_list<int32_t> verts, std::initializ
 Mesh makeGrid(const GridOptions& o) {
     requireAtLeast("cellsX", o.cellsX, 1);
     requireAtLeast("cellsY", o.cellsY, 1);
+    // Every face corner is an int32 index: refused at once, not after minutes of filling memory.
+    const int64_t corners = int64_t{4} * o.cellsX * o.cellsY;
+    if (corners > std::numeric_limits<int32_t>::max()) {
+        throw InvalidInput(formatError("primitive", "cellsX x cellsY",
+                                       "is " + std::to_string(o.cellsX) + " x " + std::to_string(o.cellsY) +
+                                           ", " + std::to_string(corners) + " face corners",
+                                       "at most 2147483647 face corners (4 a cell)"));
+    }
     Mesh::Data d;
     const int32_t nx = o.cellsX + 1;
     for (int32_t j = 0; j <= o.cellsY; ++j) {

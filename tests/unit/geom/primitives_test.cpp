@@ -45,6 +45,11 @@ TEST_CASE("grid: counts, extent and UVs", "[geom][primitives]") {
     CHECK(g.udimTiles() == std::vector<int>{1001});
     for (int32_t f = 0; f < g.numFaces(); ++f)
         CHECK(uvArea(g, f) > 0.0);
+    // A grid whose face corners would not fit int32 indices is refused at once (it took minutes and all
+    // memory before failing).
+    CHECK_THROWS_WITH(makeGrid({50000, 50000}),
+                      Catch::Contains("cellsX x cellsY: is 50000 x 50000, 10000000000 face corners") &&
+                          Catch::Contains("at most 2147483647"));
 }
 
 TEST_CASE("sphere volume converges to 4/3 pi r^3 and is outward oriented", "[geom][primitives]") {
