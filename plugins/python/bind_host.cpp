@@ -172,6 +172,16 @@ py::list entryList(const scene::SceneObject& object) {
     return out;
 }
 
+// A stack entry's index from Python: a negative one (Python's from-the-end) is named as the stack names one
+// past its end, not left to the int conversion's TypeError.
+size_t entryIndex(int64_t entry) {
+    if (entry < 0) {
+        throw InvalidInput(formatError("stack", "entry " + std::to_string(entry), "does not exist",
+                                       "an index from 0, in stack order"));
+    }
+    return static_cast<size_t>(entry);
+}
+
 }  // namespace
 
 void bindHost(py::module_& m) {
@@ -245,7 +255,8 @@ void bindHost(py::module_& m) {
             "The entries' labels in stack order.")
         .def(
             "type",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 return s.stack.deformer(index).type();
             },
@@ -259,7 +270,8 @@ void bindHost(py::module_& m) {
             "label"_a, "The index of the entry labelled `label`.")
         .def(
             "parameters",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 std::vector<host::ParamInfo> infos;
                 {
                     Lock lock(s.mutex);
@@ -274,7 +286,8 @@ void bindHost(py::module_& m) {
             "a new bind; stride > 0: resizable, any positive multiple of stride values.")
         .def(
             "set",
-            [](PyStack& s, size_t index, const std::string& name, py::handle value) {
+            [](PyStack& s, int64_t entry, const std::string& name, py::handle value) {
+                const size_t index = entryIndex(entry);
                 const std::optional<std::vector<double>> values = valuesOf(value);
                 const std::string found = values ? std::string() : "is " + aTypeName(value);
                 Lock lock(s.mutex);
@@ -289,14 +302,16 @@ void bindHost(py::module_& m) {
             "(flattened in C order). Setting an animatable parameter never rebinds.")
         .def(
             "get",
-            [](PyStack& s, size_t index, const std::string& name) {
+            [](PyStack& s, int64_t entry, const std::string& name) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 return s.stack.get(index, name);
             },
             "index"_a, "name"_a, "A parameter's value as a list of floats.")
         .def(
             "set_weights",
-            [](PyStack& s, size_t index, py::handle weights) {
+            [](PyStack& s, int64_t entry, py::handle weights) {
+                const size_t index = entryIndex(entry);
                 std::string problem;
                 std::optional<std::vector<float>> values = weightValuesOf(weights, problem);
                 Lock lock(s.mutex);
@@ -312,7 +327,8 @@ void bindHost(py::module_& m) {
             "empty sequence for all 1.")
         .def(
             "weights",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 std::vector<float> weights;
                 {
                     Lock lock(s.mutex);
@@ -324,21 +340,24 @@ void bindHost(py::module_& m) {
             "index"_a, "A copy of entry `index`'s painted weights, (n,) float32; empty when none.")
         .def(
             "set_envelope",
-            [](PyStack& s, size_t index, double envelope) {
+            [](PyStack& s, int64_t entry, double envelope) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 s.stack.setEnvelope(index, envelope);
             },
             "index"_a, "envelope"_a, "Animatable, any finite value; 0 skips the entry.")
         .def(
             "envelope",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 return s.stack.envelope(index);
             },
             "index"_a)
         .def(
             "is_active",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 return s.stack.isActive(index);
             },
@@ -389,7 +408,8 @@ void bindHost(py::module_& m) {
             "Binds done by this stack in total.")
         .def(
             "bind_count_of",
-            [](PyStack& s, size_t index) {
+            [](PyStack& s, int64_t entry) {
+                const size_t index = entryIndex(entry);
                 Lock lock(s.mutex);
                 return s.stack.bindCount(index);
             },

@@ -33,7 +33,17 @@ void bindPointCache(py::module_& m) {
         .def_property_readonly("sampling", &io::PointCache::sampling, "frames per sample")
         .def_property_readonly("frames", &io::PointCache::frames, "the whole frames that are samples")
         .def_property_readonly("times", &io::PointCache::times, "an MDD's frame times in seconds (PC2: [])")
-        .def("sample_frame", &io::PointCache::sampleFrame, py::arg("sample"))
+        .def(
+            "sample_frame",
+            [](const io::PointCache& cache, int64_t sample) {
+                if (sample < 0 || sample >= cache.sampleCount()) {
+                    throw InvalidInput(formatError(
+                        cache.path().string(), "sample " + std::to_string(sample), "does not exist",
+                        "a sample from 0 to " + std::to_string(cache.sampleCount() - 1)));
+                }
+                return cache.sampleFrame(static_cast<int32_t>(sample));
+            },
+            py::arg("sample"), "The frame of sample `sample` (0 to sample_count - 1).")
         .def(
             "read",
             [](io::PointCache& cache, int frame) {

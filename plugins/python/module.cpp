@@ -147,6 +147,10 @@ PYBIND11_MODULE(deformkit, m) {
     m.def(
         "read_image",
         [](const std::filesystem::path& path, int32_t channels) {
+            if (channels < 0) {
+                throw InvalidInput(formatError("read_image", "channels", "is " + std::to_string(channels),
+                                               "0 (every channel the file has) or a channel count > 0"));
+            }
             io::Image img;
             {
                 py::gil_scoped_release release;

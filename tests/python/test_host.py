@@ -201,6 +201,11 @@ def test_errors_name_the_entry_and_parameter():
         st.set_envelope(0, float("nan"))
     with pytest.raises(dk.InvalidInput, match=r"stack: entry 7: does not exist"):
         st.set(7, "endAngle", 1.0)
+    # Python's from-the-end indices are not the stack's: named, not a TypeError of the int conversion.
+    for call in (lambda: st.set(-1, "endAngle", 1.0), lambda: st.is_active(-1), lambda: st.weights(-1),
+                 lambda: st.envelope(-1), lambda: st.type(-2)):
+        with pytest.raises(dk.InvalidInput, match=r"stack: entry -\d: does not exist"):
+            call()
     with pytest.raises(dk.InvalidInput, match=r"stack: deformer 'nope': does not exist.*'tw', 'bd'"):
         st.find("nope")
     with pytest.raises(dk.InvalidInput, match=r"stack: points: has 5 positions \(expected %d" % n):

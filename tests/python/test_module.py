@@ -63,6 +63,8 @@ def test_image_round_trips(tmp_path):
     png = dk.read_image(_write(tmp_path / "b.png", unit, "uint8"), channels=1)
     assert png.shape == (4, 6, 1)
     assert np.allclose(png[..., 0], np.round(unit * 255) / 255, atol=1e-7)
+    with pytest.raises(dk.InvalidInput, match=r"read_image: channels: is -1"):
+        dk.read_image(tmp_path / "b.png", channels=-1)
 
 
 def _write(path, data, type):

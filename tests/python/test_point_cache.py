@@ -54,6 +54,10 @@ def test_written_caches_parse_by_hand_and_read_back(tmp_path):
 
     with pytest.raises(dk.Error, match=r"a.pc2: frame 3: is not in the cache \(expected one of its frames -2 to 2\)"):
         pc2.read(3)
+    assert [pc2.sample_frame(k) for k in range(5)] == [-2.0, -1.0, 0.0, 1.0, 2.0]
+    for sample in (5, -1):
+        with pytest.raises(dk.InvalidInput, match=rf"a.pc2: sample {sample}: does not exist \(expected a sample from 0 to 4\)"):
+            pc2.sample_frame(sample)
     with pytest.raises(dk.Error, match=r"\(frames, vertices, 3\)"):
         dk.write_point_cache(tmp_path / "b.pc2", positions[0])
     bad = positions.copy()
