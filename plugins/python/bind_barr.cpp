@@ -80,8 +80,8 @@ py::array_t<float> run(AxialWarp& warp, std::mutex* mutex, const FloatArray& poi
 // The direct path's bind (no engine fields), reading the rest points in place (at construction: no other
 // thread has the object yet).
 template <class W>
-void bindRest(W& warp, const FloatArray& rest, const char* source) {
-    const std::span<const glm::vec3> pts = pointsView(rest, source, "rest_points");
+void bindRest(W& warp, const FloatArray& rest, const char* source, const char* argument = "rest_points") {
+    const std::span<const glm::vec3> pts = pointsView(rest, source, argument);
     py::gil_scoped_release release;
     warp.bind(pts);
 }
@@ -116,7 +116,7 @@ void defineProfileWarpFunction(py::module_& m, const char* name, const char* doc
                const FloatArray& z, const FloatArray& v, const std::optional<FloatArray>& weights,
                float envelope) {
             W w({vec3Of(origin, name, "axis_origin"), vec3Of(axis, name, "axis_dir")}, profileOf(z, v, name));
-            bindRest(w, points, name);
+            bindRest(w, points, name, "points");  // the one-off's own argument
             return run(w, nullptr, points, weights, envelope, name);
         },
         "points"_a, "axis_origin"_a, "axis_dir"_a, "z_samples"_a, "value_samples"_a, "weights"_a = py::none(),
@@ -177,7 +177,7 @@ void bindBarr(py::module_& m) {
             warp::BendWarp w({vec3Of(origin, "bend", "axis_origin"), vec3Of(axis, "bend", "axis_dir"),
                               vec3Of(up, "bend", "up_dir")},
                              {rate, centre, lo, hi});
-            bindRest(w, points, "bend");
+            bindRest(w, points, "bend", "points");  // the one-off's own argument
             return run(w, nullptr, points, weights, envelope, "bend");
         },
         "points"_a, "axis_origin"_a, "axis_dir"_a, "up_dir"_a, "rate"_a, "centre"_a, "lo"_a, "hi"_a,

@@ -173,6 +173,13 @@ void requireAttributesStored(const codec::Codec& oiio, const fs::path& path, con
             formatError(path.string(), "", "cannot read back the written header: " + oiioError(oiio)));
     for (const auto& [name, value] : options.attributes) {
         if (!in->hasAttribute(name)) {
+            // An EXR stores any attribute but those its own header defines under that name (channels, ...).
+            if (format == "openexr") {
+                throw InvalidInput(
+                    formatError(path.string(), "attribute '" + name + "'",
+                                "is a name the EXR header itself uses, so it is not stored as given",
+                                "another name, such as 'studio:" + name + "'"));
+            }
             throw InvalidInput(formatError(path.string(), "attribute '" + name + "'",
                                            std::string(format) + " files cannot store this header attribute",
                                            "a format with arbitrary metadata, such as .exr"));

@@ -458,6 +458,10 @@ TEST_CASE("writeImage rejects what it cannot store faithfully and leaves no file
     // TIFF keeps only its standard tags: a custom attribute would be lost.
     CHECK_THROWS_WITH(writeImage(dir / "a.tif", img, {PixelType::Auto, {{"deformkit:solver", "x"}}}),
                       Catch::Contains("attribute 'deformkit:solver'") && Catch::Contains("cannot store"));
+    // An EXR stores any attribute but one named as its own header's (channels): said so, not "use an EXR".
+    CHECK_THROWS_WITH(writeImage(dir / "a.exr", img, {PixelType::Auto, {{"channels", "x"}}}),
+                      Catch::Contains("attribute 'channels': is a name the EXR header itself uses") &&
+                          Catch::Contains("'studio:channels'"));
     CHECK(folderEntries(dir.path()).empty());
 
     // A rejected write over an existing file leaves it as it was.
