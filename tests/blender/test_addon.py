@@ -212,6 +212,14 @@ def test_twist_about_an_empty_and_vertex_group_weights():
     entry.envelope = 0.5
     stack.set_envelope(0, 0.5)
     assert_same(positions(obj), stack.evaluate(rest), "twist at envelope 0.5")
+    # A renamed group is followed, as Blender's own modifiers follow it: the entry takes the new name and
+    # keeps its weights (it said the group did not exist).
+    group.name = "painted"
+    bpy.context.view_layer.update()
+    bpy.context.scene.frame_set(bpy.context.scene.frame_current)
+    assert obj.deformkit.status == "", obj.deformkit.status
+    assert entry.vertex_group == "painted", entry.vertex_group
+    assert_same(positions(obj), stack.evaluate(rest), "twist after the group's rename")
 
 
 def test_ffd_follows_lattice_points():

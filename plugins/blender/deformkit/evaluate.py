@@ -335,6 +335,33 @@ def _stack_for(obj):
     return cached
 
 
+_following = set()  # objects whose entries are being renamed (their update callbacks wait)
+
+
+def _follow_renamed_groups(obj, cached):
+    """Entries follow a vertex group renamed since the last evaluation, as Blender's own modifiers do: the
+    same groups in the same order, a name changed at its index and the old one gone. Earlier renames stay
+    known to this evaluation (its evaluated entries may still hold the old name)."""
+    names = [group.name for group in obj.vertex_groups]
+    before = cached.get("group_names")
+    cached["group_names"] = names
+    if before is None or len(before) != len(names):
+        return
+    renamed = {old: new for old, new in zip(before, names) if old != new and old not in names}
+    if not renamed:
+        return
+    for old, new in list(cached.setdefault("renamed", {}).items()):
+        cached["renamed"][old] = renamed.get(new, new)
+    cached["renamed"].update(renamed)
+    _following.add(_key(obj))
+    try:
+        for entry in obj.deformkit.entries:
+            if entry.vertex_group in renamed:
+                entry.vertex_group = renamed[entry.vertex_group]
+    finally:
+        _following.discard(_key(obj))
+
+
 def mark_weights_changed(obj):
     """Vertex-group weights are read again at the next evaluation (after weight painting)."""
     cached = _cache.get(_key(obj))
@@ -346,6 +373,7 @@ def mark_weights_changed(obj):
 def _weights(obj, cached, name):
     # Reading a vertex group walks every vertex in Python: done once per group until the weights are
     # marked changed (the handlers do when the object is edited in Weight Paint mode).
+    name = cached.get("renamed", {}).get(name, name)
     if name not in cached["group_weights"]:
         weights = vertex_group_weights(obj, name)
         stale = cached["stale_weights"].get(name)
@@ -389,8 +417,9 @@ def evaluate_object(obj, depsgraph=None, force=False):
         raise DeformKitError(f"{obj.name}: the mesh has shape keys, which Blender shows in place of the vertex "
                              "positions DeformKit writes (apply or remove them, or deform a copy without them)")
     require_own_mesh(obj)
-    entries = evaluated_entries(obj, depsgraph)
     cached = _stack_for(obj)
+    _follow_renamed_groups(obj, cached)
+    entries = evaluated_entries(obj, depsgraph)
     stack = cached["stack"]
     inputs = []
     for i, entry in enumerate(entries):
@@ -425,6 +454,8 @@ def evaluate_object(obj, depsgraph=None, force=False):
 def evaluate_safely(obj, depsgraph=None, force=False):
     """evaluate_object for handlers and property updates: a failure is kept in the stack's status line
     (shown in the panel) instead of raising; returns the message, or an empty string."""
+    if _key(obj) in _following:
+        return ""  # an entry renamed by the evaluation under way, which goes on with the new name
     try:
         evaluate_object(obj, depsgraph, force)
         message = ""
