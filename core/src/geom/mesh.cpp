@@ -53,9 +53,9 @@ Mesh::Mesh(Data data, const std::string& source)
                                            "has " + std::to_string(faceCounts_[f]) + " vertices",
                                            "at least 3 vertices per face"));
         }
-        total += faceCounts_[f];
-        if (total > static_cast<int64_t>(faceIndices_.size())) break;
-        faceOffsets_[f + 1] = static_cast<int32_t>(total);
+        total += faceCounts_[f];  // summed to the end, so that a mismatch names the whole sum
+        if (total <= static_cast<int64_t>(faceIndices_.size()))
+            faceOffsets_[f + 1] = static_cast<int32_t>(total);
     }
     if (total != static_cast<int64_t>(faceIndices_.size())) {
         throw InvalidInput(formatError(source, "face indices",

@@ -56,6 +56,13 @@ TEST_CASE("mesh rejects bad connectivity and values, naming the element", "[geom
         d.faceIndices[0] = -1;
         CHECK_THROWS_AS(Mesh(d), InvalidInput);
     }
+    SECTION("face counts past the indices name their whole sum") {
+        auto d = quadAndTriangle();
+        d.faceCounts = {2147483647, 2147483647};
+        CHECK_THROWS_WITH(Mesh(d),
+                          Catch::Contains("count 7 does not match the face vertex counts, which sum to "
+                                          "4294967294"));
+    }
     SECTION("repeated vertex") {
         auto d = quadAndTriangle();
         d.faceIndices[6] = 1;
