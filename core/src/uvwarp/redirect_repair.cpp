@@ -24,6 +24,8 @@ constexpr int32_t kClusterGap = 2;
 constexpr int32_t kFirstReach = 4;
 constexpr int32_t kLastReach = 256;
 constexpr double kCoreScales[] = {0.5, 0.25, 0.125, 0.0};
+// How close to its centre (in texels) a texel `held` names must be to be held: the inversion's rounding.
+constexpr float kHeldReach = 1e-3f;
 
 class FoldRepairer {
   public:
@@ -142,7 +144,7 @@ class FoldRepairer {
         std::vector<int64_t> suspects = cells;
         for (int64_t id : movers) {
             const int32_t x = cellX(id), y = cellY(id);
-            if (held_ && !displaced(x, y) && held_(x, y)) continue;  // masked content stays painted
+            if (held_ && nearCentre(x, y) && held_(x, y)) continue;  // masked content stays painted
             glm::dvec2 sum(0.0);
             for (int32_t dy = -1; dy <= 1; ++dy)
                 for (int32_t dx = -1; dx <= 1; ++dx)
@@ -170,6 +172,14 @@ class FoldRepairer {
         for (int64_t id : suspects)
             if (isInverted(id)) inverted.push_back(id);
         return inverted;
+    }
+
+    // Within kHeldReach texel of its centre: where the inversion leaves a texel W fixes (exactly when a texel
+    // spans a power-of-two number of cells, within a float rounding otherwise).
+    [[nodiscard]] bool nearCentre(int32_t x, int32_t y) const {
+        const glm::vec2 q = identityTexel(x, y);
+        const float reach = kHeldReach / static_cast<float>(t_);
+        return std::abs(r_.at(x, y, 0) - q.x) <= reach && std::abs(r_.at(x, y, 1) - q.y) <= reach;
     }
 
     [[nodiscard]] bool displaced(int32_t x, int32_t y) const {

@@ -19,8 +19,8 @@ using ContentCheck = std::function<bool(int32_t x, int32_t y, glm::dvec2 r)>;
 using ContentRowCheck =
     std::function<void(const io::Image& redirect, int32_t y, std::vector<int32_t>& refused)>;
 // Whether texel (x, y) of a redirect map is held where the warp mask keeps it (TileWarp: every point of the
-// delivered grid around its centre fixed by the mask). A held texel the inversion left at its own centre
-// is never moved by the repair.
+// delivered grid around its centre fixed by the mask). A held texel the inversion left at its own centre (within
+// 1e-3 texel: its rounding where a texel spans no power-of-two number of cells) is never smoothed.
 using TexelCheck = std::function<bool(int32_t x, int32_t y)>;
 
 // What repairFolds did to a map.
@@ -48,8 +48,8 @@ struct FoldRepair {
 //     map, so where R is locally affine it barely moves), in ascending order, pass after pass over the cells
 //     still inverted; after every 16 passes the moved set grows by a ring. A mean `mayShow` refuses (past a
 //     chart border) gives way to the point halfway to the texel's own centre, then to the centre, then no
-//     move. A texel `held` names that sits at its own centre never moves. This ends almost every fold within
-//     a few texels of it.
+//     move. A texel `held` names that sits at its own centre (within 1e-3 texel) never moves. This ends
+//     almost every fold within a few texels of it.
 //  2. Local scale-back: if folds remain after 256 passes, each cluster of them (folds fewer than 2 cells
 //     apart) has the displacement around it scaled back: in a window 4, 8, ... 256 texels past the
 //     cluster's box, by 1/2, 1/4, 1/8 or 0 within half the window's reach of the box, rising linearly to 1
@@ -62,8 +62,8 @@ struct FoldRepair {
 // Smoothing never moves texels on the tile's border. Serial over the texels concerned after parallel scans:
 // bit-identical for any thread count. Throws InvalidInput for a map that is not square with >= 2 channels.
 // `refusedInRow`, when given, must agree with mayShow; it makes step 0's scan of every texel cheaper. Steps
-// 0, 2 and 3 move displaced texels only, so a held texel at its centre keeps it through every step: masked
-// content stays where it is painted.
+// 0, 2 and 3 move displaced texels only, towards their centres, so a held texel keeps its centre through
+// every step: masked content stays where it is painted.
 FoldRepair repairFolds(io::Image& redirect, const ContentCheck& mayShow,
                        const ContentRowCheck& refusedInRow = {}, const TexelCheck& held = {});
 
