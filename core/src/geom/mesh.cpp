@@ -168,8 +168,11 @@ glm::ivec2 faceTileCell(std::span<const glm::vec2> uvs, std::span<const int32_t>
 }  // namespace
 
 int udimTileOf(const glm::vec2& uv) {
-    const glm::ivec2 cell = tileCell(uv);
-    return 1001 + cell.x + 10 * cell.y;
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return 0;
+    // Not clamped into the UDIM range (a point off the tiles names no tile of them: u = -0.3 is 1000), but
+    // within +-1e6 before the cast, so that a UV of 1e30 does not overflow the int.
+    const auto cell = [](float c) { return static_cast<int>(std::clamp(std::floor(c), -1.0e6f, 1.0e6f)); };
+    return 1001 + cell(uv.x) + 10 * cell(uv.y);
 }
 
 std::vector<int> Mesh::udimTiles() const {

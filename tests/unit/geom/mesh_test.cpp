@@ -126,9 +126,9 @@ TEST_CASE("UDIM tile numbers follow 1001 + floor(u) + 10 floor(v)", "[geom][mesh
     CHECK(udimTileOf({9.99f, 0.1f}) == 1010);
     CHECK(udimTileOf({0.2f, 1.5f}) == 1011);
     CHECK(udimTileOf({3.5f, 2.5f}) == 1024);
-    // Clamped into the UDIM range before any cast to int (1e30 does not fit one), as a face's tile is.
-    CHECK(udimTileOf({12.5f, 0.5f}) == 1010);
-    CHECK(udimTileOf({-3.0f, -1e30f}) == 1001);
-    CHECK(udimTileOf({0.5f, 1e30f}) == 9991);
-    CHECK(udimTileOf({std::nanf(""), 1.5f}) == 1011);
+    // Off the tiles a number no tile has (a preview draws no texture there); huge and non-finite coordinates
+    // stay defined (1e30 does not fit an int).
+    CHECK(udimTileOf({-0.3f, 0.5f}) == 1000);
+    CHECK(udimTileOf({0.5f, 1e30f}) == 1001 + 10000000);
+    CHECK(udimTileOf({std::nanf(""), 1.5f}) == 0);
 }

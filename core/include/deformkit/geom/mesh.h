@@ -101,8 +101,8 @@ class Mesh {
     std::shared_ptr<TopologyCache> topology_;
 };
 
-// UDIM tile number of a UV coordinate: 1001 + floor(u) + 10 floor(v), with floor(u) clamped to 0..9 and
-// floor(v) to 0..899 (tiles 1001 to 9999) as a face's tile is; a non-finite coordinate counts as 0.
+// UDIM tile number of a UV coordinate: 1001 + floor(u) + 10 floor(v), each floor kept within +-1e6 (a tile
+// number for u in [0, 10), v >= 0; off the tiles, a number no tile has); 0 for a non-finite coordinate.
 [[nodiscard]] int udimTileOf(const glm::vec2& uv);
 
 // Faces whose UV corners reach outside their UDIM tile by more than `tolerance` (UV units): how many, the
