@@ -254,9 +254,8 @@ py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::Wa
     return d;
 }
 
-// A redirect map argument: (T, T, >= 2) float32, channels 0 and 1 the tile-local (u', v').
-// A redirect map as redirect_map returns it: exactly two channels (u', v'); a third one is more likely a
-// texture passed in its place (the arguments swapped) than a map, so it is refused, not read past.
+// A redirect map argument: (T, T, 2) float32, the tile-local (u', v'), as redirect_map returns it. A third
+// channel is more likely a texture passed in its place (the arguments swapped) than a map: refused.
 io::Image redirectOf(const FloatArray& a, const std::string& source, const char* expected) {
     if (a.ndim() != 3 || a.shape(2) != 2)
         throw InvalidInput(formatError(source, "redirect", "has shape " + shapeOf(a), expected));
@@ -588,7 +587,8 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
         report = uvwarp::runShotJob(job, deformedFrames, interrupter ? &*interrupter : nullptr);
     }
     if (logFile.is_open() && !logFile.flush()) {
-        throw IoError(formatError(logPath.string(), "", "cannot write the log", "a writable file"));
+        throw StorageError(
+            formatError(logPath.string(), "", "cannot write the log", "enough space to write"));
     }
     py::dict result;
     for (const uvwarp::ShotTileReport& t : report.tiles)

@@ -56,8 +56,8 @@ inline std::string jsonMember(const std::string& path, std::string_view key) {
 
 // nlohmann's DOM builder with a check of every object's keys: the first key given twice in one object is
 // kept by its full path ("objects[1].stack[0].label"). A SAX handler, not a parse callback: nlohmann's
-// callback parser scans the enclosing array at the end of every object, so a plan of 240,000 tasks took 22 s
-// to read instead of 0.3.
+// callback parser scans the enclosing array at the end of every object, so reading a plan took time
+// quadratic in its tasks (a task of a 240,000-task plan: 10.5 s instead of 2).
 class DuplicateKeyDom {
   public:
     explicit DuplicateKeyDom(json& root) : dom_(root) {}

@@ -193,12 +193,12 @@ void blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> point
 }
 
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
-// Beyond the lattice (x < 0 or x > d; FfdOutside::Extrapolate, the only case that asks) every basis but a
-// spline with repeated ends continues from its end face with the value and slope it has there, T_0 + x k
-// (T_1 - T_0) or T_d + (x - d) k (T_d - T_(d-1)): k = 1 for the Bernstein polynomial, the linear basis, the
-// B-spline and Catmull-Rom with extrapolated ends, 2 a for the cardinal spline of tension a (its end tangent
-// over the extrapolated control). Linear in x, so an affine lattice stays affine at any degree (float
-// rounding growing with the weights' size, the distance), where the polynomials amplify it by (2 |s| +
+// Beyond the lattice (x < 0 or x > d: FfdOutside::Extrapolate, or round-off within kInsideTolerance) every
+// basis but a spline with repeated ends continues from its end face with the value and slope it has there,
+// T_0 + x k (T_1 - T_0) or T_d + (x - d) k (T_d - T_(d-1)): k = 1 for the Bernstein polynomial, the linear
+// basis, the B-spline and Catmull-Rom with extrapolated ends, 2 a for the cardinal spline of tension a (its
+// end tangent over the extrapolated control). Linear in x, so an affine lattice stays affine at any degree
+// (float rounding growing with the weights' size, the distance), where the polynomials amplify it by (2 |s| +
 // 1)^degree (docs/decisions.md, "FFD points outside the lattice"). The SoA kernels (ffd_kernels.h) compute
 // the same weights with the same operations.
 inline int32_t basisWeights(FfdBasis basis, FfdEnds ends, int32_t d, const float* binomial, float x,

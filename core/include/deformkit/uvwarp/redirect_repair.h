@@ -19,8 +19,8 @@ using ContentCheck = std::function<bool(int32_t x, int32_t y, glm::dvec2 r)>;
 using ContentRowCheck =
     std::function<void(const io::Image& redirect, int32_t y, std::vector<int32_t>& refused)>;
 // Whether texel (x, y) of a redirect map is held where the warp mask keeps it (TileWarp: every point of the
-// delivered grid around its centre fixed by the mask). A held texel the inversion left at its own centre (within
-// 1e-3 texel: its rounding where a texel spans no power-of-two number of cells) is never smoothed.
+// delivered grid around its centre fixed by the mask). A held texel the inversion left at its own centre
+// (within 1e-3 texel: its rounding where a texel spans no power-of-two number of cells) is never smoothed.
 using TexelCheck = std::function<bool(int32_t x, int32_t y)>;
 
 // What repairFolds did to a map.

@@ -45,8 +45,8 @@ struct FfdBases {
 
 enum class FfdOutside {
     None,         // points outside the lattice are left where they are (Maya's default)
-    Extrapolate,  // the basis is evaluated beyond [0, 1]: the polynomial (Bernstein), the end span's
-                  // polynomial (splines with FfdEnds::Extrapolate), or the end controls (FfdEnds::Repeat)
+    Extrapolate,  // the deformation continues beyond [0, 1] from each face with its value and slope there
+                  // (linear per axis); splines with FfdEnds::Repeat: the end controls, as Blender's
 };
 
 // How the spline bases (all but Bernstein) make up the controls a span needs beyond the end faces.

@@ -28,12 +28,13 @@ class LatticeDeformer : public Deformer {
                                       "<= 64), 1 uniform cubic B-spline, 2 linear, 3 cardinal (tension "
                                       "0.71), 4 Catmull-Rom: Blender's four lattice interpolations are 1-4"},
                               {0.0});
-        outside_ = addParameter({.name = "outside",
-                                 .rebinds = true,
-                                 .doc = "0 points outside the lattice stay put (Maya's default), 1 the basis "
-                                        "is evaluated beyond it (with ends 1: the end controls move them, as "
-                                        "in Blender)"},
-                                {0.0});
+        outside_ =
+            addParameter({.name = "outside",
+                          .rebinds = true,
+                          .doc = "0 points outside the lattice stay put (Maya's default), 1 the "
+                                 "deformation continues beyond it from each face with its value and "
+                                 "slope there (with ends 1: the end controls move them, as in Blender)"},
+                         {0.0});
         ends_ =
             addParameter({.name = "ends",
                           .rebinds = true,
