@@ -283,7 +283,8 @@ namespace {
 // Eq. (3) for a point whose float weights sum below kSmallestWeightSum, with relativeWeights (the
 // engine's sum over the fields bind writes for it, up to their float rounding).
 glm::vec2 mapFar(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
-    std::vector<double> w(terms.size());
+    thread_local std::vector<double> w;  // one per thread: no allocation per point in the parallel loops
+    w.resize(terms.size());
     relativeWeights(terms, x, w.data());
     double dx = 0.0, dy = 0.0, weightSum = 0.0;
     for (size_t i = 0; i < terms.size(); ++i) {

@@ -32,6 +32,16 @@ std::string controlName(const Lattice& l, size_t c) {
 
 namespace {
 
+constexpr double kMaxFrameScale = 1e18, kMaxFrameTranslation = 1e30;
+
+double largestEntry(const glm::dmat3& m) {
+    double largest = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            largest = std::max(largest, std::abs(m[c][r]));
+    return largest;
+}
+
 // A source basis without three linearly independent vectors (relative to their lengths).
 bool singular(const Frame& from) {
     const glm::dmat3 b(from.basis);
@@ -42,19 +52,18 @@ bool singular(const Frame& from) {
 }
 
 // The affine map taking `from` to `to`, or nothing for a non-finite frame, a singular source basis or a map
-// beyond float range (the cases frameToFrame names): the checks without the message, so an update builds
+// beyond kMaxFrameScale (the cases frameToFrame names): the checks without the message, so an update builds
 // no control names.
 std::optional<Affine> mapBetween(const Frame& from, const Frame& to) {
     if (!finite(from) || !finite(to) || singular(from)) return std::nullopt;
     const glm::dmat3 linear = glm::dmat3(to.basis) * glm::inverse(glm::dmat3(from.basis));
     const glm::dvec3 translation = glm::dvec3(to.origin) - linear * glm::dvec3(from.origin);
-    const Affine map{glm::mat3(linear), glm::vec3(translation)};
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r)
-            if (!std::isfinite(map.linear[c][r])) return std::nullopt;
+    // A map that scales by more than kMaxFrameScale (a source basis 1e-38 long: finite, yet a point a unit
+    // away goes to 1e38 and an extrapolated one to inf) is refused: no rig's frames are that far apart.
+    if (largestEntry(linear) > kMaxFrameScale) return std::nullopt;
     for (int r = 0; r < 3; ++r)
-        if (!std::isfinite(map.translation[r])) return std::nullopt;
-    return map;
+        if (!(std::abs(translation[r]) <= kMaxFrameTranslation)) return std::nullopt;
+    return Affine{glm::mat3(linear), glm::vec3(translation)};
 }
 
 }  // namespace
@@ -69,8 +78,9 @@ Affine frameToFrame(const Frame& from, const Frame& to, const std::string& eleme
         throw InvalidInput(formatError("FFD frames", element, "has a singular source basis",
                                        "three linearly independent basis vectors"));
     }
-    throw InvalidInput(formatError("FFD frames", element, "maps onto its target frame beyond float range",
-                                   "a source basis at least about 1e-38 of the target's size"));
+    throw InvalidInput(formatError(
+        "FFD frames", element, "maps onto its target frame with a scale beyond 1e18 or a shift beyond 1e30",
+        "a source basis at least 1e-18 of the target's size"));
 }
 
 FfdFrames::FfdFrames(const Lattice& lattice, const FfdOptions& options) : LatticeWarp(lattice, options) {

@@ -213,12 +213,21 @@ TEST_CASE("ffd frames: bad input names the control", "[warp][ffd][frames][errors
     CHECK_THROWS_AS(frames.setSourceFrames(f), InvalidInput);
     CHECK_THROWS_WITH(frames.setSourceFrames(f), Catch::Contains("control 21 (i=2, j=1, k=0)") &&
                                                      Catch::Contains("singular source basis"));
-    // A well-conditioned basis 1e-39 long (a denormal scale) maps onto a unit target by 1e39: beyond float,
-    // refused rather than NaN points.
+    // A well-conditioned basis 1e-39 long (a denormal scale) maps onto a unit target by 1e39 (NaN points),
+    // one 1e-38 long by 1e38 (finite, but infinite once extrapolated): refused at any control, the origin's
+    // too.
+    for (const size_t c : {l.index(1, 1, 1), l.index(0, 0, 0)}) {
+        for (const float scale : {1e-39f, 1e-38f, 1e-19f}) {
+            f = {frames.sourceFrames().begin(), frames.sourceFrames().end()};
+            f[c].basis = glm::mat3(scale);
+            CHECK_THROWS_WITH(frames.setSourceFrames(f), Catch::Contains("control " + std::to_string(c)) &&
+                                                             Catch::Contains("with a scale beyond 1e18"));
+        }
+    }
+    // A scale of 1e6 (a basis 1e-6 long) is a frame, if an extreme one.
     f = {frames.sourceFrames().begin(), frames.sourceFrames().end()};
-    f[l.index(1, 1, 1)].basis = glm::mat3(1e-39f);
-    CHECK_THROWS_WITH(frames.setSourceFrames(f),
-                      Catch::Contains("control 13 (i=1, j=1, k=1)") && Catch::Contains("beyond float range"));
+    f[l.index(1, 1, 1)].basis = glm::mat3(1e-6f);
+    CHECK_NOTHROW(frames.setSourceFrames(f));
     f = {frames.sourceFrames().begin(), frames.sourceFrames().end()};
     f[5].origin.y = std::numeric_limits<float>::quiet_NaN();
     CHECK_THROWS_WITH(frames.setTargetFrames(f),
