@@ -27,11 +27,21 @@ fs::path temporaryPathFor(const fs::path& path) {
            ("." + path.stem().string() + ".tmp-" + uniqueToken() + path.extension().string());
 }
 
-void flushToDisk(const fs::path& file) {
+// Flushes `file` to the storage before it is renamed into place: shared storage (NFS) often reports a full
+// disk or a quota only here, and a file it did not keep must not take the output's name. `path` names it.
+void flushToDisk(const fs::path& file, const fs::path& path) {
     const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd >= 0) {
-        ::fsync(fd);
-        ::close(fd);
+    if (fd < 0) return;  // written by another handle just now; nothing of ours to flush
+    const int synced = ::fsync(fd);
+    const int syncError = errno;
+    const int closed = ::close(fd);
+    const int closeError = errno;
+    // EINVAL: a file system without fsync (a pipe-like special file); nothing was lost.
+    if ((synced != 0 && syncError != EINVAL) || closed != 0) {
+        throw StorageError(formatError(path.string(), "",
+                                       std::string("the storage did not keep the written file: ") +
+                                           std::strerror(synced != 0 ? syncError : closeError),
+                                       "enough space to write"));
     }
 }
 
@@ -148,11 +158,14 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
             throw IoError(formatError(path.string(), "", "the writer produced no file", "a written file"));
         }
         if (replacing) ::chmod(tmp.c_str(), before.st_mode & 0777);
-        flushToDisk(tmp);
+        flushToDisk(tmp, path);
         fs::rename(tmp, path, ec);
         if (ec) {
-            throw IoError(formatError(path.string(), "", "cannot replace the file: " + ec.message(),
-                                      "a writable destination"));
+            // EIO: the storage failed (a retry may do); anything else is the destination's fault.
+            const std::string problem = "cannot replace the file: " + ec.message();
+            if (ec == std::errc::io_error)
+                throw StorageError(formatError(path.string(), "", problem, "working storage"));
+            throw IoError(formatError(path.string(), "", problem, "a writable destination"));
         }
     } catch (...) {
         fs::remove(tmp, ec);
