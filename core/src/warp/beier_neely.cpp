@@ -55,12 +55,17 @@ WeightTerms weightTerms(const SegmentPair& s) {
     return t;
 }
 
-inline float weightOf(const WeightTerms& t, glm::vec2 x) {
+// length^p / (a + dist(x)), in float.
+inline float baseOf(const WeightTerms& t, glm::vec2 x) {
     const glm::vec2 rel = x - t.p;
     const float u = std::clamp(glm::dot(rel, t.d) * t.invLengthSq, 0.0f, 1.0f);
     const glm::vec2 off = rel - u * t.d;
     const float dist = std::sqrt(off.x * off.x + off.y * off.y);
-    const float base = t.lengthPow / (t.a + dist);
+    return t.lengthPow / (t.a + dist);
+}
+
+inline float weightOf(const WeightTerms& t, glm::vec2 x) {
+    const float base = baseOf(t, x);
     // b = 1 and 2 are the common choices; pow is the hot spot of the image warp otherwise.
     if (t.b == 2.0f) return base * base;
     if (t.b == 1.0f) return base;
@@ -80,11 +85,7 @@ void relativeWeights(std::span<const WeightTerms> terms, glm::vec2 x, double* w)
     double largest = -std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < terms.size(); ++i) {
         const WeightTerms& t = terms[i];
-        const glm::vec2 rel = x - t.p;
-        const float u = std::clamp(glm::dot(rel, t.d) * t.invLengthSq, 0.0f, 1.0f);
-        const glm::vec2 off = rel - u * t.d;
-        const float base = t.lengthPow / (t.a + std::sqrt(off.x * off.x + off.y * off.y));
-        w[i] = t.b == 0.0f ? 0.0 : static_cast<double>(t.b) * std::log(static_cast<double>(base));
+        w[i] = t.b == 0.0f ? 0.0 : static_cast<double>(t.b) * std::log(static_cast<double>(baseOf(t, x)));
         largest = std::max(largest, w[i]);
     }
     for (size_t i = 0; i < terms.size(); ++i)
@@ -280,41 +281,45 @@ void BeierNeelyWarp::transformations(Transformations& out) const {
 
 namespace {
 
-// Eq. (3) for a point whose float weights sum below kSmallestWeightSum, with relativeWeights (the
-// engine's sum over the fields bind writes for it, up to their float rounding).
-glm::vec2 mapFar(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
-    thread_local std::vector<double> w;  // one per thread: no allocation per point in the parallel loops
-    w.resize(terms.size());
-    relativeWeights(terms, x, w.data());
-    double dx = 0.0, dy = 0.0, weightSum = 0.0;
-    for (size_t i = 0; i < terms.size(); ++i) {
+// Eq. (3)'s weighted mean at x with the arithmetic of evaluateWarp (float displacement per feature, double
+// accumulation), feature i weighing weight(i); sets the weights' sum.
+template <class Weight>
+glm::vec2 weightedMean(glm::vec2 x, std::span<const Affine> transforms, const Weight& weight,
+                       double& weightSum) {
+    double dx = 0.0, dy = 0.0;
+    weightSum = 0.0;
+    for (size_t i = 0; i < transforms.size(); ++i) {
         const Affine& t = transforms[i];
         const float mx = t.linear[0][0] * x.x + t.linear[1][0] * x.y + t.translation.x;
         const float my = t.linear[0][1] * x.x + t.linear[1][1] * x.y + t.translation.y;
-        dx += w[i] * static_cast<double>((x.x + (mx - x.x)) - x.x);
-        dy += w[i] * static_cast<double>((x.y + (my - x.y)) - x.y);
-        weightSum += w[i];
-    }
-    if (!(weightSum > 0.0)) return x;
-    return {x.x + static_cast<float>(dx / weightSum), x.y + static_cast<float>(dy / weightSum)};
-}
-
-// Eq. (3) for one point with the same arithmetic as evaluateWarp: float displacement per feature,
-// double accumulation; a point every feature is far from, mapFar; all-zero weights give the identity.
-inline glm::vec2 mapOne(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
-    double dx = 0.0, dy = 0.0, weightSum = 0.0;
-    for (size_t i = 0; i < terms.size(); ++i) {
-        const Affine& t = transforms[i];
-        const float mx = t.linear[0][0] * x.x + t.linear[1][0] * x.y + t.translation.x;
-        const float my = t.linear[0][1] * x.x + t.linear[1][1] * x.y + t.translation.y;
-        const double w = weightOf(terms[i], x);
+        const double w = weight(i);
         // (P + 1 * (T<P> - P)) - P, rounded as the engine's displacement-method product is.
         dx += w * static_cast<double>((x.x + (mx - x.x)) - x.x);
         dy += w * static_cast<double>((x.y + (my - x.y)) - x.y);
         weightSum += w;
     }
-    if (weightSum < kSmallestWeightSum) return mapFar(x, terms, transforms);
+    if (!(weightSum > 0.0)) return x;
     return {x.x + static_cast<float>(dx / weightSum), x.y + static_cast<float>(dy / weightSum)};
+}
+
+// Eq. (3) for a point whose float weights sum below kSmallestWeightSum, with relativeWeights (the engine's
+// sum over the fields bind writes for it, up to their float rounding).
+glm::vec2 mapFar(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
+    thread_local std::vector<double> w;  // one per thread: no allocation per point in the parallel loops
+    w.resize(terms.size());
+    relativeWeights(terms, x, w.data());
+    double weightSum = 0.0;
+    return weightedMean(
+        x, transforms, [&](size_t i) { return w[i]; }, weightSum);
+}
+
+// Eq. (3) for one point: the float weights (weightOf); a point every feature is far from, mapFar; all-zero
+// weights give the identity.
+inline glm::vec2 mapOne(glm::vec2 x, std::span<const WeightTerms> terms, std::span<const Affine> transforms) {
+    double weightSum = 0.0;
+    const glm::vec2 mean = weightedMean(
+        x, transforms, [&](size_t i) { return static_cast<double>(weightOf(terms[i], x)); }, weightSum);
+    return weightSum < kSmallestWeightSum ? mapFar(x, terms, transforms) : mean;
 }
 
 enum class Falloff { Square, Linear, Constant, Power };
