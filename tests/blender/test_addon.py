@@ -1095,6 +1095,228 @@ def test_live_uv_warp_refuses_udim_layouts_with_a_report():
         assert "tile 1001 only" in str(e) and "1012" in str(e), str(e)
     assert not addon.uvwarp.live_active(obj)
 
+def _select(*objects):
+    for other in bpy.context.view_layer.objects:
+        other.select_set(False)
+    for obj in objects:
+        obj.select_set(True)
+    bpy.context.view_layer.objects.active = objects[-1]
+
+
+def test_a_mesh_joined_into_an_object_takes_its_own_rest_shape():
+    # Join copied the twisted object's rest attribute into the active one, (0, 0, 0) for its own vertices and
+    # no polygons beside it: its first entry kept that rest, and a taper by 1 collapsed the mesh on the origin.
+    fresh()
+    twisted = grid_object("twisted")
+    twist = add("twist")
+    twist.start_value, twist.end_value = 0.0, 1.0
+    plain = grid_object("plain")
+    plain.location = (3.0, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    _select(twisted, plain)
+    assert bpy.ops.object.join() == {'FINISHED'}
+    joined = bpy.context.object
+    shape = positions(joined).copy()
+    taper = add("taper")
+    taper.start_value = taper.end_value = 1.0  # the identity
+    assert addon.evaluate.evaluate_safely(joined, force=True) == ""
+    assert_same(addon.evaluate.rest_points(joined), shape, "rest shape of the joined mesh's first entry")
+    assert_same(positions(joined), shape, "joined mesh under a taper by 1")
+
+
+def test_a_deformation_that_cannot_be_taken_back_is_never_taken_as_the_rest():
+    # Following the refusal's advice after a cube was added under a twist (entries off, Reset Rest) took the
+    # twisted grid as the rest: the twist was applied twice when the entry came back on.
+    fresh()
+    obj = grid_object()
+    rest = positions(obj).copy()
+    twist = add("twist")
+    twist.start_value, twist.end_value = 0.0, 1.0
+    bpy.context.view_layer.update()
+    twisted = positions(obj).copy()
+    assert np.abs(twisted - rest).max() > 0.1
+    bpy.ops.object.mode_set(mode='EDIT')
+    bpy.ops.mesh.select_all(action='DESELECT')
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(2.0, 0.0, 0.0))
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.context.view_layer.update()
+    assert "Undo the change" in obj.deformkit.status, obj.deformkit.status
+    twist.enabled = False
+    bpy.context.view_layer.update()
+    try:
+        bpy.ops.deformkit.reset_rest()
+        raise AssertionError("Reset Rest took the twisted grid as the rest")
+    except RuntimeError as e:
+        assert "still shows its deformation" in str(e) and "441 vertices then, 449 vertices now" in str(e), str(e)
+    assert_same(addon.evaluate.rest_points(obj)[:441], rest, "the rest shape, kept")
+    # Removing the stack keeps the mesh as it shows (the new cube has no rest position to go back to).
+    bpy.ops.deformkit.remove()
+    assert not addon.evaluate.has_rest(obj)
+    assert_same(positions(obj)[:441], twisted, "the grid as shown")
+    assert float(positions(obj)[441:, 0].min()) > 1.7, "the cube where it was modelled"
+
+    # The way the message gives: the entry off first (the mesh back at rest), then the change, then Reset Rest.
+    fresh()
+    obj = grid_object()
+    twist = add("twist")
+    twist.start_value, twist.end_value = 0.0, 1.0
+    bpy.context.view_layer.update()
+    assert addon.evaluate.shows_deformation(obj)
+    twist.enabled = False
+    bpy.context.view_layer.update()
+    assert not addon.evaluate.shows_deformation(obj)
+    bpy.ops.object.mode_set(mode='EDIT')
+    bpy.ops.mesh.select_all(action='DESELECT')
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(2.0, 0.0, 0.0))
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert bpy.ops.deformkit.reset_rest() == {'FINISHED'}
+    twist.enabled = True
+    assert addon.evaluate.evaluate_safely(obj, force=True) == ""
+    stack = dk.DeformerStack()
+    counts = np.array([len(p.vertices) for p in obj.data.polygons], np.int32)
+    indices = np.array([v for p in obj.data.polygons for v in p.vertices], np.int32)
+    new_rest = addon.evaluate.rest_points(obj)
+    assert_same(new_rest[:441], rest, "the grid's rest, from before the change")
+    stack.set_rest(dk.Mesh(new_rest, counts, indices))
+    stack.add("twist", "t")
+    set_all(stack, 0, addon.evaluate.entry_parameters(obj, twist))
+    assert_same(positions(obj), stack.evaluate(new_rest), "the twist, once, over grid and cube")
+
+
+def test_polygons_flipped_under_a_stack_are_refused_in_the_session_as_after_reopening():
+    # Flipping normals keeps the counts: the session went on with the old polygons, the saved file refused.
+    fresh()
+    obj = grid_object()
+    twist = add("twist")
+    twist.start_value, twist.end_value = 0.0, 1.0
+    bpy.context.view_layer.update()
+    bpy.ops.object.mode_set(mode='EDIT')
+    bpy.ops.mesh.select_all(action='SELECT')
+    bpy.ops.mesh.flip_normals()
+    bpy.ops.object.mode_set(mode='OBJECT')
+    twist.end_value = 1.5
+    bpy.context.view_layer.update()
+    message = obj.deformkit.status
+    assert "polygons changed since its rest shape was taken (the same 441 vertices)" in message, message
+    path = os.path.join(tempfile.mkdtemp(), "flipped.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    obj = bpy.data.objects["grid"]
+    assert addon.evaluate.evaluate_safely(obj, force=True) == message
+    bpy.ops.wm.read_factory_settings(use_empty=True)  # the tests after this one start from an unsaved file
+
+
+def test_a_linked_mesh_and_a_deleted_control_are_reported():
+    # A mesh linked from a library ignored the positions written to it: the object stayed at its saved
+    # shape on every frame, without a word. A control deleted with X stayed in the file through the
+    # entry's pointer, hidden, and went on deforming.
+    fresh()
+    obj = grid_object("linked grid")
+    add("twist")
+    library = os.path.join(tempfile.mkdtemp(), "library.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=library)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon.evaluate.clear_cache()
+    with bpy.data.libraries.load(library, link=True) as (source, target):
+        target.objects = ["linked grid"]
+    linked = target.objects[0]
+    bpy.context.scene.collection.objects.link(linked)
+    message = addon.evaluate.evaluate_safely(linked, force=True)
+    assert f"its mesh 'linked grid' is linked from '{library}'" in message and "Make Local" in message, message
+
+    fresh()
+    obj = grid_object()
+    twist = add("twist")
+    handle = twist.frame
+    _select(handle)
+    assert bpy.ops.object.delete() == {'FINISHED'}
+    bpy.context.view_layer.update()
+    twist.end_value = 2.0
+    message = obj.deformkit.status
+    assert f"its handle Empty '{handle.name}' was deleted (it is in no scene)" in message, message
+
+
+def test_apply_keeps_the_deformation_and_bend_curvature_takes_either_sign():
+    fresh()
+    obj = grid_object()
+    bend = add("bend")
+    bend.curvature = -0.75  # away from the Empty's X; 0 is straight
+    bpy.context.view_layer.update()
+    assert obj.deformkit.status == ""
+    rest = addon.evaluate.rest_points(obj).copy()
+    stack = direct_stack(obj, rest)
+    stack.add("bend", "b")
+    set_all(stack, 0, addon.evaluate.entry_parameters(obj, bend))
+    bent = stack.evaluate(rest)
+    assert_same(positions(obj), bent, "bend with a negative curvature")
+    assert np.abs(bent - rest).max() > 0.05
+    bend.curvature = 0.0
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), rest, "bend with curvature 0")
+    bend.curvature = -0.75
+    bpy.context.view_layer.update()
+    assert bpy.ops.deformkit.apply() == {'FINISHED'}
+    assert len(obj.deformkit.entries) == 0 and not addon.evaluate.has_rest(obj)
+    assert_same(positions(obj), bent, "the applied bend")
+    add("taper")  # a new first entry starts from the applied shape
+    assert_same(addon.evaluate.rest_points(obj), bent, "rest after applying")
+
+
+def test_redirect_nodes_read_the_solved_uv_map_through_the_materials_mapping():
+    # The live warp solved on the active UV map while its nodes read the render map, and the texture's own
+    # Mapping node (4 x tiling) was unlinked.
+    fresh()
+    obj = grid_object()
+    layout = obj.data.uv_layers.new(name="UVMap")
+    corners = np.array([obj.data.vertices[l.vertex_index].co[:2] for l in obj.data.loops], np.float32)
+    layout.data.foreach_set("uv", (corners * 0.45 + 0.5).ravel())
+    flipped = obj.data.uv_layers.new(name="Flipped")
+    flipped.data.foreach_set("uv", (corners[:, ::-1] * 0.45 + 0.5).ravel())
+    add("twist")
+    rigidity = bpy.data.images.new("rigidity", 32, 32, float_buffer=True)
+    obj.deformkit.uv_rigidity = rigidity
+    material = bpy.data.materials.new("skin")
+    material.use_nodes = True
+    obj.data.materials.append(material)
+    tree = material.node_tree
+    texture = tree.nodes.new('ShaderNodeTexImage')
+    texture.image = bpy.data.images.new("albedo", 8, 8)
+    uv_node = tree.nodes.new('ShaderNodeUVMap')
+    uv_node.uv_map = "UVMap"
+    mapping = tree.nodes.new('ShaderNodeMapping')
+    tree.links.new(uv_node.outputs["UV"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    obj.data.uv_layers.active = flipped  # edited in the UV editor; the texture reads "UVMap"
+    try:
+        bpy.ops.deformkit.uvwarp_live()
+        raise AssertionError("live mode solved one UV map for a texture reading another")
+    except RuntimeError as e:
+        assert "image texture 'Image Texture' reads UV map 'UVMap', but the warp is solved on the active UV " \
+            "map 'Flipped'" in str(e), str(e)
+    assert not addon.uvwarp.live_active(obj)
+    obj.data.uv_layers.active = layout
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    group = next(n for n in tree.nodes if n.type == 'GROUP')
+    assert texture.inputs["Vector"].links[0].from_node == mapping, "the Mapping node stays before the texture"
+    assert mapping.inputs["Vector"].links[0].from_node == group, "the redirect comes before the Mapping"
+    source = group.inputs["UV"].links[0].from_node
+    assert source.type == 'UVMAP' and source.uv_map == "UVMap"
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}  # off
+
+    # Another object renamed to take this one's name while live: each keeps its own image.
+    first = obj
+    first_image = addon.uvwarp._live.get(first.as_pointer())
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    first.name = "renamed"
+    second = grid_object("grid")
+    second.data.uv_layers.new(name="UVMap").data.foreach_set("uv", (corners * 0.45 + 0.5).ravel())
+    add("twist")
+    second.deformkit.uv_rigidity = rigidity
+    assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    images = {addon.uvwarp._live[o.as_pointer()]["image"] for o in (first, second)}
+    assert len(images) == 2, images
+    assert first_image is None
+
 
 def main():
     failures = 0

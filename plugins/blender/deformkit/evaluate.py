@@ -19,6 +19,9 @@ REST_ATTRIBUTE = "deformkit_rest"
 # The polygons the rest shape was taken on (a digest of their vertex counts and indices), kept on the mesh
 # beside it: a topology edit under a stack gives new vertices no rest position, so it is refused, not read.
 REST_TOPOLOGY = "deformkit_rest_topology"
+# True on the mesh while its positions show a deformation (the last evaluation moved a vertex off its rest
+# position): Reset Rest must not take them as the rest, and removing the stack cannot always put the rest back.
+SHOWS_DEFORMATION = "deformkit_shows_deformation"
 
 # Per object name: the stack, the entry signature it was built for, and the last weights set per entry.
 _cache = {}
@@ -61,14 +64,26 @@ def capture_rest(obj):
 
 
 def drop_rest(obj):
-    """Forgets the rest shape (the stack's last entry removed): the next first entry takes the mesh as it is
-    then, with the modelling done in between."""
+    """Forgets the rest shape (the stack's last entry removed, or the stack applied): the next first entry
+    takes the mesh as it is then, with the modelling done in between."""
     mesh = obj.data
     attribute = mesh.attributes.get(REST_ATTRIBUTE)
     if attribute is not None:
         mesh.attributes.remove(attribute)
-    if REST_TOPOLOGY in mesh:
-        del mesh[REST_TOPOLOGY]
+    for key in (REST_TOPOLOGY, SHOWS_DEFORMATION):
+        if key in mesh:
+            del mesh[key]
+
+
+def rest_topology_changed(obj):
+    """True when the mesh's polygons are not those its rest shape was taken on."""
+    then = obj.data.get(REST_TOPOLOGY)
+    return then is not None and then != topology_digest(obj)
+
+
+def shows_deformation(obj):
+    """True while the mesh's positions are a deformation of its rest shape, as the last evaluation wrote them."""
+    return bool(obj.data.get(SHOWS_DEFORMATION, False))
 
 
 def require_rest_topology(obj):
@@ -79,10 +94,23 @@ def require_rest_topology(obj):
         return
     now = topology_digest(obj)
     if now != then:
+        before, after = then.split(',')[0], now.split(',')[0]
+        counts = f"the same {after}" if before == after else f"{before} then, {after} now"
         raise DeformKitError(
-            f"{obj.name}: the mesh's polygons changed since its rest shape was taken ({then.split(',')[0]} "
-            f"then, {now.split(',')[0]} now): new vertices have no rest position. Disable the entries, make "
-            f"the change, and press Reset Rest")
+            f"{obj.name}: the mesh's polygons changed since its rest shape was taken ({counts}): new vertices "
+            f"have no rest position. Undo the change, disable the entries (the mesh goes back to its rest "
+            f"shape), make the change and press Reset Rest; or remove every entry to keep the mesh as it is")
+
+
+def require_writable_mesh(obj):
+    """Raises DeformKitError for a mesh linked from a library: Blender ignores writes to its positions, so the
+    object would keep the shape it was saved with."""
+    library = obj.data.library
+    if library is not None:
+        raise DeformKitError(
+            f"{obj.name}: its mesh '{obj.data.name}' is linked from '{library.filepath}', whose vertex "
+            f"positions Blender does not let DeformKit write. Make the object and its mesh local (Object > "
+            f"Relations > Make Local > Selected Objects and Data) or append it")
 
 
 def require_own_mesh(obj):
@@ -170,6 +198,10 @@ def _need(entry, attribute, what):
     control = getattr(entry, attribute)
     if control is None:
         raise DeformKitError(f"{entry.name}: no {what} set")
+    if not control.original.users_scene:
+        # Deleted from the scene: the entry's pointer keeps it in the file, hidden, but it is gone for the user.
+        raise DeformKitError(f"{entry.name}: its {what} '{control.name}' was deleted (it is in no scene); pick "
+                             f"another or add the entry again")
     return control
 
 
@@ -304,7 +336,11 @@ def _shape(obj):
     samples = ()
     if attribute is not None and n > 0 and len(attribute.data) == n:
         samples = tuple(tuple(attribute.data[i].vector) for i in (0, n // 2, n - 1))
-    return (mesh.as_pointer(), n, len(mesh.polygons), len(mesh.loops), samples)
+    # Three corners' vertices too: polygons edited without changing the counts (normals flipped) are noticed
+    # in the session, as a reopened file notices them.
+    loops = len(mesh.loops)
+    corners = tuple(mesh.loops[i].vertex_index for i in (0, loops // 2, loops - 1)) if loops > 0 else ()
+    return (mesh.as_pointer(), n, len(mesh.polygons), loops, samples, corners)
 
 
 def take_pending(obj):
@@ -416,6 +452,7 @@ def evaluate_object(obj, depsgraph=None, force=False):
     if obj.data.shape_keys is not None:
         raise DeformKitError(f"{obj.name}: the mesh has shape keys, which Blender shows in place of the vertex "
                              "positions DeformKit writes (apply or remove them, or deform a copy without them)")
+    require_writable_mesh(obj)
     require_own_mesh(obj)
     cached = _stack_for(obj)
     _follow_renamed_groups(obj, cached)
@@ -448,6 +485,10 @@ def evaluate_object(obj, depsgraph=None, force=False):
     out = stack.evaluate(cached["rest"])
     obj.data.vertices.foreach_set("co", out.ravel())
     obj.data.update()
+    active = any(entry.enabled and entry.envelope != 0.0 for entry in entries)
+    deformed = active and not np.array_equal(out, cached["rest"])
+    if shows_deformation(obj) != deformed:
+        obj.data[SHOWS_DEFORMATION] = deformed
     cached["inputs"] = inputs
 
 

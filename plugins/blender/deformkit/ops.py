@@ -179,7 +179,9 @@ class DEFORMKIT_OT_add(bpy.types.Operator):
         try:
             if len(obj.data.vertices) == 0:
                 raise evaluate.DeformKitError(f"{obj.name}: the mesh has no vertices to deform")
-            if not evaluate.has_rest(obj):
+            if len(settings.entries) == 0 or not evaluate.has_rest(obj):
+                # A first entry takes the mesh as it is: a rest shape already on the mesh without entries
+                # came with its data from elsewhere (objects joined into this one) and is not this mesh's.
                 evaluate.capture_rest(obj)
             entry = settings.entries.add()
             try:
@@ -224,11 +226,17 @@ class DEFORMKIT_OT_remove(bpy.types.Operator):
         settings.active_index = max(0, min(settings.active_index, len(settings.entries) - 1))
         if len(settings.entries) == 0:
             # The mesh back to its rest shape, which is then forgotten: modelling done before the next
-            # deformer is added is the rest shape that deformer takes.
-            evaluate.restore_rest(obj)
+            # deformer is added is the rest shape that deformer takes. Polygons changed under the stack leave
+            # new vertices without a rest position: the mesh then keeps the shape it shows.
+            kept = evaluate.rest_topology_changed(obj)
+            if not kept:
+                evaluate.restore_rest(obj)
             evaluate.drop_rest(obj)
             evaluate.clear_cache()
             settings.status = ""
+            if kept:
+                self.report({'WARNING'}, f"{obj.name}: the mesh keeps the shape it shows (its polygons changed "
+                                         "since its rest shape was taken, so the rest shape cannot be put back)")
             return {'FINISHED'}
         message = evaluate.evaluate_safely(obj)
         if message:
@@ -306,11 +314,47 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
             self.report({'ERROR'}, f"{obj.name}: disable every entry first (the mesh shows the deformation of "
                                    f"{', '.join(active)}, not a rest shape)")
             return {'CANCELLED'}
+        if evaluate.shows_deformation(obj):
+            # The entries were turned off, but the mesh was not put back to its rest shape yet (or could not
+            # be: its polygons changed under the stack). Taken as the rest, the deformation would be doubled.
+            evaluate.evaluate_safely(obj, force=True)
+            if evaluate.shows_deformation(obj):
+                self.report({'ERROR'}, f"{obj.name}: the mesh still shows its deformation, which cannot be taken "
+                                       f"back ({obj.deformkit.status or 'its rest shape could not be restored'})")
+                return {'CANCELLED'}
         evaluate.capture_rest(obj)
         evaluate.clear_cache()
         message = evaluate.evaluate_safely(obj)
         if message:
             self.report({'WARNING'}, message)
+        return {'FINISHED'}
+
+
+class DEFORMKIT_OT_apply(bpy.types.Operator):
+    """Keep the stack's deformation at the current frame as the mesh and remove every entry (their controls
+    stay in the scene)"""
+    bl_idname = "deformkit.apply"
+    bl_label = "Apply DeformKit Stack"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _mesh_object(context)
+        return obj is not None and len(obj.deformkit.entries) > 0 and obj.mode != 'EDIT'
+
+    def execute(self, context):
+        obj = _mesh_object(context)
+        settings = obj.deformkit
+        message = evaluate.evaluate_safely(obj, context.evaluated_depsgraph_get(), force=True)
+        if message:
+            # The mesh does not hold this frame's deformation: applying it would keep something else.
+            self.report({'ERROR'}, message)
+            return {'CANCELLED'}
+        settings.entries.clear()
+        settings.active_index = 0
+        evaluate.drop_rest(obj)
+        evaluate.clear_cache()
+        settings.status = ""
         return {'FINISHED'}
 
 
@@ -436,8 +480,12 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
         if not os.path.exists(first):
             self.report({'ERROR'}, f"no redirect map {first}; bake the redirect maps first")
             return {'CANCELLED'}
-        uvwarp.add_redirect_nodes(obj.active_material, first, self.frame_start,
-                                  self.frame_end - self.frame_start + 1)
+        try:
+            uvwarp.add_redirect_nodes(obj.active_material, obj, first, self.frame_start,
+                                      self.frame_end - self.frame_start + 1)
+        except uvwarp.UvWarpError as e:
+            self.report({'ERROR'}, str(e))
+            return {'CANCELLED'}
         return {'FINISHED'}
 
 
@@ -459,20 +507,21 @@ class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
             return {'FINISHED'}
         settings = obj.deformkit
         try:
+            uvwarp.check_material(obj.active_material, obj)
             image = uvwarp.start_live(obj, settings.uv_rigidity, settings.uv_mask, settings.uv_resolution)
             uvwarp.live_update(obj, context.evaluated_depsgraph_get())
+            if obj.active_material is not None:
+                uvwarp.add_live_nodes(obj.active_material, obj, image)
         except Exception as e:  # noqa: BLE001 - reported to the user
             uvwarp.stop_live(obj)
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
-        if obj.active_material is not None:
-            uvwarp.add_live_nodes(obj.active_material, image)
         self.report({'INFO'}, f"{obj.name}: live UV warp on, {image.size[0]}² redirect map '{image.name}'")
         return {'FINISHED'}
 
 
 _classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_open_uvwarp_report,
             DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
-            DEFORMKIT_OT_reset_rest)
+            DEFORMKIT_OT_reset_rest, DEFORMKIT_OT_apply)
 
 register, unregister = bpy.utils.register_classes_factory(_classes)

@@ -83,8 +83,9 @@ class DeformKitEntry(bpy.types.PropertyGroup):
                                default=1.0, update=_evaluate)
     end_value: FloatProperty(name="End", description="Scale (taper) or angle (twist) at the high bound",
                              default=1.0, update=_evaluate)
-    curvature: FloatProperty(name="Curvature", description="Bend radians per handle unit", default=0.5,
-                             min=1e-6, update=_evaluate)
+    curvature: FloatProperty(name="Curvature", default=0.5, update=_evaluate,
+                             description="Bend radians per handle unit: towards the Empty's X when positive, "
+                             "away from it when negative, straight at 0")
     low_bound: FloatProperty(name="Low", description="Handle units along the Empty's Y axis", default=-1.0,
                              update=_evaluate)
     high_bound: FloatProperty(name="High", description="Handle units along the Empty's Y axis", default=1.0,

@@ -93,6 +93,7 @@ class DEFORMKIT_PT_stack(bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("deformkit.evaluate", icon='FILE_REFRESH', text="Evaluate")
         row.operator("deformkit.reset_rest", text="Reset Rest")
+        row.operator("deformkit.apply", icon='CHECKMARK', text="Apply")
 
         box = layout.box()
         box.label(text="UV Warp", icon='UV')

@@ -35,12 +35,18 @@ def redirect_name(tile, frame):
     return dk.tile_frame_path(REDIRECT_PATTERN, tile, frame)
 
 
+def solved_uv_map(obj):
+    """The UV map the warp is solved on: the mesh's active one (the UV editor's)."""
+    layer = obj.data.uv_layers.active
+    if layer is None:
+        raise UvWarpError(f"{obj.name}: the mesh has no UV map")
+    return layer.name
+
+
 def mesh_with_uvs(obj, points):
     """(points, counts, indices, uvs, uv_indices) of the object's mesh with its active UV map."""
     mesh = obj.data
-    layer = mesh.uv_layers.active
-    if layer is None:
-        raise UvWarpError(f"{obj.name}: the mesh has no UV map")
+    layer = mesh.uv_layers[solved_uv_map(obj)]
     counts, indices, order = evaluate.topology(obj)
     uvs = np.empty(len(mesh.loops) * 2, np.float32)
     layer.data.foreach_get("uv", uvs)
@@ -168,13 +174,70 @@ def redirect_group():
     return group
 
 
-def _insert_redirect(material, image):
-    """Inserts the redirect between the UVs and every image texture of `material`: a UV Map node, the
-    redirect image read at the original UVs, and the group. Returns the redirect image node."""
+def _uv_source(texture):
+    """Where an image texture's coordinates come from: (the input socket its UVs enter the chain at, the
+    socket giving them or None for the default UV map, the UV map's name or '' for the render map), walking
+    up through Mapping and vector nodes; None when the texture is not read at UVs (object coordinates)."""
+    socket = texture.inputs["Vector"]
+    while socket.is_linked:
+        link = socket.links[0]
+        node, output = link.from_node, link.from_socket
+        if node.type == 'UVMAP':
+            return socket, output, node.uv_map
+        if node.type == 'TEX_COORD':
+            return (socket, output, "") if output.name == "UV" else None
+        if node.type == 'GROUP' and node.node_tree is not None and node.node_tree.name == GROUP_NAME:
+            return None  # read through a redirect already
+        upstream = node.inputs.get("Vector") if node.type in ('MAPPING', 'VECTOR_ROTATE', 'VECT_TRANSFORM') \
+            else node.inputs[0] if node.type == 'VECT_MATH' else None
+        if upstream is None:
+            return None
+        socket = upstream
+    return socket, None, ""
+
+
+def _uv_textures(material, obj):
+    """The material's image textures read at UVs, each with its _uv_source; raises UvWarpError for one that
+    reads another UV map than the warp is solved on."""
+    solved = solved_uv_map(obj)
+    render = next((layer.name for layer in obj.data.uv_layers if layer.active_render), solved)
+    found = []
+    for node in material.node_tree.nodes if material.use_nodes else ():
+        if node.type != 'TEX_IMAGE' or node.label == GROUP_NAME:
+            continue
+        source = _uv_source(node)
+        if source is None:
+            continue
+        read = source[2] or render
+        if read != solved:
+            raise UvWarpError(f"material '{material.name}': image texture '{node.name}' reads UV map '{read}', "
+                              f"but the warp is solved on the active UV map '{solved}': make '{read}' the "
+                              f"active UV map and solve again")
+        found.append((node, source))
+    return found
+
+
+def check_material(material, obj):
+    """Raises UvWarpError when the material's textures cannot be read through the warp of obj's UVs."""
+    if material is not None:
+        _uv_textures(material, obj)
+
+
+def _insert_redirect(material, image, obj):
+    """Reads every image texture of `material` read at UVs through `image`: the redirect nodes it has are
+    pointed at it, or a UV Map node of the solved map, the redirect image read there and the group are put
+    where each texture's UVs enter its chain (its Mapping and vector nodes stay after the redirect). Returns
+    the redirect image node."""
     material.use_nodes = True
+    existing = _redirect_nodes(material)
+    for node in existing:
+        node.image = image
+    if existing:
+        return existing[0]
     tree = material.node_tree
-    textures = [n for n in tree.nodes if n.type == 'TEX_IMAGE' and n.label != GROUP_NAME]
+    textures = _uv_textures(material, obj)
     uv = tree.nodes.new('ShaderNodeUVMap')
+    uv.uv_map = solved_uv_map(obj)
     redirect = tree.nodes.new('ShaderNodeTexImage')
     redirect.label = GROUP_NAME
     redirect.image = image
@@ -185,9 +248,9 @@ def _insert_redirect(material, image):
     tree.links.new(uv.outputs["UV"], redirect.inputs["Vector"])
     tree.links.new(uv.outputs["UV"], group.inputs["UV"])
     tree.links.new(redirect.outputs["Color"], group.inputs["Redirect"])
-    for texture in textures:
-        tree.links.new(group.outputs["UV"], texture.inputs["Vector"])
-    x = min((n.location.x for n in textures), default=0.0) - 700
+    for _, (entry, _, _) in textures:
+        tree.links.new(group.outputs["UV"], entry)
+    x = min((node.location.x for node, _ in textures), default=0.0) - 900
     uv.location, redirect.location, group.location = (x - 400, 0), (x - 200, -150), (x + 100, 0)
     return redirect
 
@@ -197,13 +260,14 @@ def _redirect_nodes(material):
     return [n for n in tree.nodes if n.type == 'TEX_IMAGE' and n.label == GROUP_NAME] if tree else []
 
 
-def add_redirect_nodes(material, first_map, frame_start, frame_count):
-    """Reads every image texture of `material` through the baked redirect map sequence (first file
-    `first_map`). Returns the group node."""
+def add_redirect_nodes(material, obj, first_map, frame_start, frame_count):
+    """Reads every image texture of `material` read at obj's UVs through the baked redirect map sequence
+    (first file `first_map`). Returns the group node."""
+    check_material(material, obj)
     image = bpy.data.images.load(first_map, check_existing=True)
     image.source = 'SEQUENCE'
     image.colorspace_settings.name = 'Non-Color'
-    redirect = _insert_redirect(material, image)
+    redirect = _insert_redirect(material, image, obj)
     redirect.image_user.frame_start = frame_start
     redirect.image_user.frame_duration = frame_count
     redirect.image_user.frame_offset = frame_start - 1
@@ -251,7 +315,9 @@ def start_live(obj, rigidity, mask, resolution):
     texels = solver.texels
     name = LIVE_IMAGE.format(obj.name)
     image = bpy.data.images.get(name)
-    if image is not None and tuple(image.size) != (texels, texels):
+    if image is not None and any(state["image"] == name for key, state in _live.items() if key != obj.as_pointer()):
+        image = None  # another object's live image (that object was renamed since): Blender names a new one
+    elif image is not None and tuple(image.size) != (texels, texels):
         bpy.data.images.remove(image)
         image = None
     if image is None:
@@ -321,11 +387,7 @@ def live_rate(obj):
     return 1000.0 / ms, ms
 
 
-def add_live_nodes(material, image):
-    """Reads every image texture of `material` through the live image: the redirect node the material
-    has (a bake's) is pointed at it, or the nodes are inserted."""
-    existing = _redirect_nodes(material)
-    for node in existing:
-        node.image = image
-    if not existing:
-        _insert_redirect(material, image)
+def add_live_nodes(material, obj, image):
+    """Reads every image texture of `material` read at obj's UVs through the live image: the redirect node
+    the material has (a bake's) is pointed at it, or the nodes are inserted."""
+    _insert_redirect(material, image, obj)
