@@ -782,7 +782,7 @@ DeformedFrames animatedFrames(const fs::path& path, const std::vector<int>& fram
                               const geom::Mesh& rest, const std::string& restName,
                               std::optional<double> cacheFirstFrame) {
     auto source = std::make_shared<io::AnimatedPositions>(path, name, cacheFirstFrame);
-    if (source->isCache()) source->setReference(rest, restName);
+    source->setReference(rest, restName);  // a cache in the rest mesh's order, a sequence its topology
     source->requireFrames(frames);
     auto points = std::make_shared<std::vector<glm::vec3>>();
     return [source, points](int frame, std::string& frameName) -> std::span<const glm::vec3> {

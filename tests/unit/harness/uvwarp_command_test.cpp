@@ -300,6 +300,28 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
         CHECK(fs::exists(s.redirect(1)));  // frames before it are complete
         CHECK_FALSE(fs::exists(s.redirect(2)));
     }
+    SECTION("a sequence whose faces list the rest mesh's vertices in another order") {
+        // Each face starts at its second corner: the same positions, another topology. The first frame read
+        // is held to the rest mesh, as a scene holds it, not taken as the sequence's own reference.
+        Scene s;
+        const double stretch[3] = {1.0, 1.25, 1.5};
+        for (int f = 1; f <= 3; ++f) {
+            std::istringstream in(planeObj(stretch[f - 1]));
+            std::string rotated;
+            for (std::string line; std::getline(in, line);) {
+                if (line.rfind("f ", 0) == 0) {
+                    const size_t second = line.find(' ', 2);
+                    line = "f" + line.substr(second) + " " + line.substr(2, second - 2);
+                }
+                rotated += line + "\n";
+            }
+            test::writeText(s.dir / ("anim.000" + std::to_string(f) + ".obj"), rotated);
+        }
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("anim.0001.obj: face 0: has 4 vertices (1 18 17 0) where rest.obj has "
+                                   "4 vertices (0 1 18 17)"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
     SECTION("a rest mesh without UVs") {
         Scene s;
         test::writeText(s.dir / "rest.obj", planeObj(1.0, {0}, false));
