@@ -6,6 +6,7 @@ and values just outside the range are refused with the same message, naming the 
 spells it. The names are checked against a conversion written here."""
 import json
 import os
+import pathlib
 import re
 import subprocess
 
@@ -154,6 +155,14 @@ def test_scenes_take_every_option_by_its_name_and_range(shot):
                 dk.read_scene(scene(folder, {o["name"]: bad}))
     with pytest.raises(dk.InvalidInput, match=r"params.borderWidth: is not a UV-warp option"):
         dk.read_scene(scene(folder, {"borderWidth": 2}))
+    # The entry's own "resolution" and the same option in its params: one would be dropped without a word.
+    twice = json.loads(pathlib.Path(scene(folder, {"resolution": 32})).read_text())
+    twice["objects"][0]["stack"][0]["resolution"] = 64
+    (folder / "twice.json").write_text(json.dumps(twice))
+    with pytest.raises(dk.InvalidInput, match=re.escape(
+            "objects[0].stack[0].params.resolution: is given as well as objects[0].stack[0].resolution "
+            "(expected the resolution given once, in either place)")):
+        dk.read_scene(str(folder / "twice.json"))
 
 
 def test_the_live_preset_by_name_in_python_the_command_line_and_scenes(shot):

@@ -511,6 +511,10 @@ class Reader {
                         known += (known.empty() ? "" : ", ") + std::string(s.name);
                     fail(pp + "." + item.key(), "is not a UV-warp option", "one of: " + known);
                 }
+                if (spec == uvwarp::findOption("resolution") && v.contains("resolution")) {
+                    fail(pp + ".resolution", "is given as well as " + path + ".resolution",
+                         "the resolution given once, in either place");
+                }
                 uvwarpOption(u.options, *spec, item.value(), pp + "." + item.key());
                 u.presetOwn.emplace_back(spec->name);
             }

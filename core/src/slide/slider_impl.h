@@ -106,7 +106,7 @@ struct Slider::Impl {
     std::vector<int32_t> fileActive;         // every copy of the active vertices, ascending
     std::vector<glm::vec3> weldedPoints;     // scratch: the incoming points of the welded vertices
     std::vector<glm::vec3> weldedIn;         // scratch: the same before the slide
-    std::vector<float> weldedWeights;        // scratch: each welded vertex's first copy's weight
+    std::vector<float> weldedWeights;        // scratch: each welded vertex's weight, the mean of its copies'
     std::vector<int32_t> fileFaceOffsets;    // the file's faces: corners [offsets[f], offsets[f + 1])
     std::vector<int32_t> fileFaceIndices;    // of fileFaceIndices
 

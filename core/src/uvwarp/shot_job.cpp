@@ -276,14 +276,16 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
                                            "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
         }
     }
-    // A mask or orientation pattern that matches no file for any of the mesh's tiles is a typo, not a choice
-    // (a tile without one falls back, with a note): refused before anything is written. Any of the mesh's
-    // tiles, not only the job's: a farm task of one tile may have none where another tile has its map.
-    const std::vector<int> meshTiles = j.mask.given() || j.orientation.given()
+    // A mask, orientation or texture pattern that matches no file for any of the mesh's tiles is a typo, not
+    // a choice (a tile without one falls back, or is not baked, with a note): refused before anything is
+    // written. Any of the mesh's tiles, not only the job's: a farm task of one tile may have none where
+    // another tile has its map.
+    const std::vector<int> meshTiles = j.mask.given() || j.orientation.given() || j.texture.given()
                                            ? shotTiles(*j.rest, j.restName, {}, "tiles")
                                            : std::vector<int>{};
     for (const auto& [source, what] :
-         {std::pair{&j.mask, "warp mask"}, std::pair{&j.orientation, "orientation map"}}) {
+         {std::pair{&j.mask, "warp mask"}, std::pair{&j.orientation, "orientation map"},
+          std::pair{&j.texture, "texture"}}) {
         if (!source->given()) continue;
         if (std::none_of(meshTiles.begin(), meshTiles.end(),
                          [&](int tile) { return findTileMap(*source, tile, j.frames).found(); })) {

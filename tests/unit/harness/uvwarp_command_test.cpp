@@ -322,6 +322,15 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
                                    "4 vertices (0 1 18 17)"));
         CHECK(fs::is_empty(s.dir / "out"));
     }
+    SECTION("a texture pattern that matches no file for any tile") {
+        Scene s;
+        s.command.texture = s.dir / "colr.<UDIM>.exr";  // col.1001.exr is there
+        s.command.bake = s.dir / "out/col.<UDIM>.####.exr";
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("colr.<UDIM>.exr: matches no file for any of the mesh's tiles (1001) "
+                                   "(expected textures for some tiles, or none given)"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
     SECTION("a rest mesh without UVs") {
         Scene s;
         test::writeText(s.dir / "rest.obj", planeObj(1.0, {0}, false));

@@ -133,8 +133,9 @@ class Slider {
     // points: #V positions of the surface to slide over (the rest positions, or a deformed copy with the
     // rest mesh's connectivity), replaced in place by the slid positions. drives: one per handle, the
     // displacements in the space of `points`. weights: #V painted weights in [0, 1] (empty: all 1), acting
-    // as options.weights says (a welded vertex takes its first copy's weight). envelope scales every slide.
-    // Throws InvalidInput for a wrong count or a non-finite value, naming it, before anything is written.
+    // as options.weights says (a welded vertex takes the mean of its copies' weights). envelope scales every
+    // slide. Throws InvalidInput for a wrong count or a non-finite value, naming it, before anything is
+    // written.
     void evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
                   std::span<const float> weights = {}, float envelope = 1.0f, SlideResult* result = nullptr);
 
