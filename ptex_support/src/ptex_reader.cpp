@@ -64,7 +64,8 @@ class Reader {
         }
     }
 
-    // Counts memory that grows with declared sizes (texels, face records, tiles, metadata entries).
+    // Counts memory that grows with declared sizes (texels, face records, tiles, metadata entries), before it
+    // is allocated or inflated.
     void charge(const std::string& section, uint64_t offset, uint64_t bytes) {
         decoded_ += bytes;
         if (decoded_ > options_.maxDecodedBytes) {
@@ -72,6 +73,8 @@ class Reader {
                  "at most " + std::to_string(options_.maxDecodedBytes) + " (ReadOptions::maxDecodedBytes)");
         }
     }
+    // Gives back what a charge counted for a buffer that has been freed (an inflated section once parsed).
+    void release(uint64_t bytes) { decoded_ -= bytes; }
 
     void checkInflatable(const std::string& section, uint64_t offset, uint64_t zipSize,
                          uint64_t expected) const {
@@ -263,21 +266,27 @@ class Reader {
 
     void readFaceInfo() {
         const uint64_t offset = pos_;
-        const std::vector<uint8_t> raw =
-            unzip("face info", offset, faceInfoSize_, uint64_t{faceCount_} * kFaceInfoSize);
-        charge("face info", offset, uint64_t{faceCount_} * (sizeof(FaceInfo) + sizeof(std::vector<uint8_t>)));
+        const uint64_t inflated = uint64_t{faceCount_} * kFaceInfoSize;
+        checkInflatable("face info", offset, faceInfoSize_, inflated);  // an impossible size, said as such
+        charge("face info", offset,
+               inflated + uint64_t{faceCount_} * (sizeof(FaceInfo) + sizeof(std::vector<uint8_t>)));
+        std::vector<uint8_t> raw = unzip("face info", offset, faceInfoSize_, inflated);
         file_.faces.resize(faceCount_);
         for (size_t f = 0; f < faceCount_; ++f) {
             file_.faces[f] = loadFaceInfo(raw.data() + f * kFaceInfoSize);
             validateFaceInfo(file_.faces[f], "face info", offset, "face " + std::to_string(f),
                              " (record at inflated byte " + std::to_string(f * kFaceInfoSize) + ")");
         }
+        std::vector<uint8_t>().swap(raw);
+        release(inflated);
         pos_ += faceInfoSize_;
     }
 
     void readConstData() {
-        file_.constData =
-            unzip("constant data", pos_, constDataSize_, uint64_t{faceCount_} * file_.pixelSize());
+        const uint64_t bytes = uint64_t{faceCount_} * file_.pixelSize();
+        checkInflatable("constant data", pos_, constDataSize_, bytes);
+        charge("constant data", pos_, bytes);
+        file_.constData = unzip("constant data", pos_, constDataSize_, bytes);
         pos_ += constDataSize_;
     }
 
@@ -349,8 +358,11 @@ class Reader {
 
     void readLevelHeaders(Level& level, size_t index) {
         const std::string section = "level " + std::to_string(index) + " face-data headers";
-        const std::vector<uint8_t> raw =
-            unzip(section, level.offset, level.headerZipSize, uint64_t{level.faces} * 4);
+        const uint64_t inflated = uint64_t{level.faces} * 4;
+        checkInflatable(section, level.offset, level.headerZipSize, inflated);
+        charge(section, level.offset,
+               inflated + uint64_t{level.faces} * (sizeof(uint32_t) + sizeof(uint64_t)));
+        std::vector<uint8_t> raw = unzip(section, level.offset, level.headerZipSize, inflated);
         level.headers.resize(level.faces);
         level.blockOffsets.resize(level.faces);
         uint64_t offset = level.offset + level.headerZipSize;
@@ -373,6 +385,8 @@ class Reader {
                      std::to_string(end),
                  "face-data header sizes that add up to the level size");
         }
+        std::vector<uint8_t>().swap(raw);
+        release(inflated);
     }
 
     // Decodes a face (or a face edit) block into interleaved texels. `constPixel` is the face's ConstData.

@@ -292,6 +292,31 @@ TEST_CASE("decoded texels are capped by ReadOptions::maxDecodedBytes", "[ptex][e
                           Contains("maxDecodedBytes"));
 }
 
+TEST_CASE("face records and constant data are capped before they are inflated", "[ptex][errors]") {
+    // 4096 constant 1 x 1 faces of 64 float channels: a few hundred zipped bytes declare 1 MiB of constant
+    // data and 80 KiB of face records, counted before zlib is asked for them.
+    tp::HandStream s;
+    s.dataType = 3;  // float32
+    s.channels = 64;
+    tp::HandFace constant;
+    constant.flags = 1;
+    s.faces.assign(4096, constant);
+    s.constData.assign(4096 * 64 * 4, 0);
+    s.blocks.assign(4096, {});
+    s.headers.assign(4096, 0);
+    ReadOptions options;
+    options.maxDecodedBytes = uint64_t{512} << 10;
+    CHECK_THROWS_WITH(readPtex(s.bytes(), "consts.ptx", options), Contains("constant data") &&
+                                                                      Contains("decoded data would reach") &&
+                                                                      Contains("maxDecodedBytes"));
+    options.maxDecodedBytes = uint64_t{64} << 10;
+    CHECK_THROWS_WITH(
+        readPtex(s.bytes(), "consts.ptx", options),
+        Contains("face info" + at(tp::HandStream::kFaceInfoOffset)) && Contains("maxDecodedBytes"));
+    options.maxDecodedBytes = uint64_t{4} << 20;
+    CHECK(readPtex(s.bytes(), "consts.ptx", options).constData.size() == 4096u * 64 * 4);
+}
+
 TEST_CASE("a 1 x 1 face is read from ConstData whatever its block holds", "[ptex][errors]") {
     tp::HandStream s = validStream();
     s.faces[1].ulog2 = 0;
