@@ -33,6 +33,8 @@ class OiioReader final : public codec::Reader {
         spec_.depth = s.depth;
         spec_.channels = s.nchannels;
         spec_.deep = s.deep;
+        spec_.tileWidth = s.tile_width;
+        spec_.tileHeight = s.tile_height;
         spec_.pixelType = typeName(s.format);
         spec_.channelNames = s.channelnames;
         for (const OIIO::ParamValue& p : s.extra_attribs) {

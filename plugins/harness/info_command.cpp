@@ -148,6 +148,11 @@ void describe(const fs::path& file, std::ostream& out) {
         throw IoError(
             formatError(file.string(), "", "no such file", "an existing mesh, image or UDIM pattern"));
     }
+    if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == 0 && !ec) {
+        // Nothing to tell its format by (an image reader probes a file's first bytes).
+        throw ParseError(
+            formatError(file.string(), "", "is empty (0 bytes)", "a mesh, a point cache or an image"));
+    }
     if (io::meshFormat(file)) {
         describeMesh(file, out);
     } else if (io::pointCacheFormat(file)) {

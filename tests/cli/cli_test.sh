@@ -48,6 +48,9 @@ contains info-ply "$work/out" "faces       1 (triangles 0, quads 1, n-gons 0)"
 echo "not a mesh" >"$work/notes.txt"
 expect info-unknown 2 "$dk" info "$work/notes.txt"
 contains info-unknown "$work/err" "is neither a mesh, a point cache nor an image (expected a mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)"
+: >"$work/empty.exr"
+expect info-empty 2 "$dk" info "$work/empty.exr"
+contains info-empty "$work/err" "$work/empty.exr: is empty (0 bytes) (expected a mesh, a point cache or an image)"
 # Images are read through DeformKit's OpenImageIO module, loaded on the first image read or write: a command
 # on meshes alone never needs it; an image command without it names the image, the module and why.
 expect image-module-unused 0 env DEFORMKIT_IMAGE_MODULE="$work/none/deformkit_image_oiio.so" "$dk" info "$work/quad.ply"

@@ -94,14 +94,43 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
     return in;
 }
 
+// The fewest bytes a file can hold the declared pixels in: an OpenEXR file has an 8-byte offset and a chunk
+// header of at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles); other
+// formats compress by at most 4096 to 1 (deflate 1032, LZW under 2731, run lengths 128). A header that
+// declares more (a few hundred bytes claiming gigapixels) is refused before its pixels are allocated.
+uint64_t fewestFileBytes(const codec::Spec& spec, std::string_view format) {
+    const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
+    if (format == "openexr") {
+        uint64_t chunks = 0;
+        if (spec.tileWidth > 0 && spec.tileHeight > 0) {
+            chunks =
+                ((w + static_cast<uint64_t>(spec.tileWidth) - 1) / static_cast<uint64_t>(spec.tileWidth)) *
+                ((h + static_cast<uint64_t>(spec.tileHeight) - 1) / static_cast<uint64_t>(spec.tileHeight));
+        } else {
+            uint64_t lines = 256;  // DWAB's, the most; an unknown compression gets it too
+            for (const auto& [name, value] : spec.stringAttributes) {
+                if (name != "compression") continue;
+                if (value == "none" || value == "rle" || value == "zips") lines = 1;
+                if (value == "zip" || value == "pxr24") lines = 16;
+                if (value == "piz" || value == "b44" || value == "b44a" || value.rfind("dwaa", 0) == 0)
+                    lines = 32;
+            }
+            chunks = (h + lines - 1) / lines;
+        }
+        return chunks * 16;
+    }
+    return w * h * static_cast<uint64_t>(spec.channels) / 4096;
+}
+
 uint32_t bigEndian32(const unsigned char* p) {
     return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
 }
 
 // libpng prints its own message to stderr before failing on a truncated or corrupt file, and
 // OpenImageIO gives no way to silence it. Walking the chunk structure first (lengths, CRCs, a final
-// IEND) catches those files with a precise error and keeps the one-line error contract.
-void requireCompletePng(const fs::path& path) {
+// IEND) catches those files with a precise error and keeps the one-line error contract. `headerOnly`: the
+// chunks before the pixels (IDAT), which a header read parses.
+void requireCompletePng(const fs::path& path, bool headerOnly = false) {
     static constexpr std::array<unsigned char, 8> kSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     std::ifstream in(path, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -116,6 +145,7 @@ void requireCompletePng(const fs::path& path) {
         }
         const uint32_t length = bigEndian32(data + pos);
         const std::string type(bytes.data() + pos + 4, 4);
+        if (headerOnly && type == "IDAT") return;
         if (length > bytes.size() - pos - 12) {
             throw ParseError(formatError(path.string(), "chunk " + type + " at byte " + std::to_string(pos),
                                          "declares " + std::to_string(length) +
@@ -200,6 +230,25 @@ Image readImage(const fs::path& path, const ImageReadOptions& options) {
         throw InvalidInput(formatError(path.string(), options.role, "has " + channelCount(spec.channels),
                                        channelCount(options.expectedChannels)));
     }
+    const std::string pixels = std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                               " pixels with " + channelCount(spec.channels);
+    std::error_code ec;
+    const uint64_t fileBytes = fs::file_size(path, ec);
+    const uint64_t fewest = fewestFileBytes(spec, in->formatName());
+    if (!ec && fileBytes < fewest) {
+        throw ParseError(formatError(path.string(), "header",
+                                     "declares " + pixels + ", which take at least " +
+                                         std::to_string(fewest) + " bytes, but the file has " +
+                                         std::to_string(fileBytes),
+                                     "a complete, uncorrupted image file"));
+    }
+    size_t count = 0;
+    if (__builtin_mul_overflow(static_cast<size_t>(spec.width), static_cast<size_t>(spec.height), &count) ||
+        __builtin_mul_overflow(count, static_cast<size_t>(spec.channels), &count) ||
+        count > std::vector<float>().max_size()) {
+        throw InvalidInput(formatError(path.string(), "", "image of " + pixels + " is too large to load",
+                                       "an image that fits in memory"));
+    }
     Image image;
     try {
         image = Image(spec.width, spec.height, spec.channels);
@@ -221,6 +270,7 @@ Image readImage(const fs::path& path, const ImageReadOptions& options) {
 
 ImageInfo readImageInfo(const fs::path& path) {
     requireReadableFile(path);
+    requireCompletePng(path, true);
     const codec::Codec& oiio = codec::load(path.string());
     auto in = openInput(oiio, path);
     const codec::Spec& spec = in->spec();

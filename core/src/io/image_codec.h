@@ -27,6 +27,8 @@ struct Spec {
     int32_t depth = 0;
     int32_t channels = 0;
     bool deep = false;
+    int32_t tileWidth = 0;  // 0: scanlines
+    int32_t tileHeight = 0;
     std::string pixelType;
     std::vector<std::string> channelNames;
     std::vector<std::pair<std::string, std::string>> stringAttributes;  // in the file's order

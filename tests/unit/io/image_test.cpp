@@ -25,6 +25,44 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The header of a single-part OpenEXR file of `channels` float channels, uncompressed, declaring width x
+// height pixels, followed by its offset table (of zeros) and no chunks (spelled out from the OpenEXR file
+// layout: magic, version, attributes, an empty name closing them). Tiled: one tile of `tile` x `tile` pixels.
+std::string exrWithoutPixels(int32_t width, int32_t height, int channels, int32_t tile = 0) {
+    std::string out;
+    auto bytes = [&](const void* p, size_t n) { out.append(static_cast<const char*>(p), n); };
+    auto i32 = [&](int32_t v) { bytes(&v, 4); };
+    auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+        out += name + '\0' + type + '\0';
+        i32(static_cast<int32_t>(value.size()));
+        out += value;
+    };
+    auto packed = [](std::initializer_list<int32_t> values) {
+        std::string v;
+        for (int32_t x : values)
+            v.append(reinterpret_cast<const char*>(&x), 4);
+        return v;
+    };
+    out += "\x76\x2f\x31\x01";
+    i32(tile > 0 ? 2 | 0x200 : 2);
+    std::string list;
+    for (int c = 0; c < channels; ++c)
+        list +=
+            "c" + std::to_string(c) + '\0' + packed({2, 0, 1, 1});  // float, pLinear 0 + reserved, sampling
+    attribute("channels", "chlist", list + '\0');
+    attribute("compression", "compression", std::string(1, '\0'));
+    attribute("dataWindow", "box2i", packed({0, 0, width - 1, height - 1}));
+    attribute("displayWindow", "box2i", packed({0, 0, width - 1, height - 1}));
+    attribute("lineOrder", "lineOrder", std::string(1, '\0'));
+    attribute("pixelAspectRatio", "float", packed({0x3f800000}));
+    attribute("screenWindowCenter", "v2f", packed({0, 0}));
+    attribute("screenWindowWidth", "float", packed({0x3f800000}));
+    if (tile > 0) attribute("tiles", "tiledesc", packed({tile, tile}) + '\0');
+    out += '\0';
+    out += std::string(8 * static_cast<size_t>(tile > 0 ? 1 : height), '\0');  // the chunks' offset table
+    return out;
+}
+
 // Independent float -> half -> float reference: round to 11 significant bits (10 stored), ties to even,
 // with the subnormal quantum 2^-24 below 2^-14 and overflow to infinity past 65504.
 float roundToHalf(float value) {
@@ -342,6 +380,25 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         CHECK_THROWS_AS(readImage(dir.path()), IoError);
     }
 
+    SECTION("a header declaring more pixels than the file can hold, or than memory can") {
+        // 30000 uncompressed scanlines are 30000 chunks of at least 16 bytes (an offset and a chunk header):
+        // a file of 240 KB cannot hold them, refused before 3.6 GB are allocated for its pixels.
+        writeText(dir / "bomb.exr", exrWithoutPixels(30000, 30000, 1));
+        CHECK_THROWS_AS(readImage(dir / "bomb.exr"), ParseError);
+        CHECK_THROWS_WITH(
+            readImage(dir / "bomb.exr"),
+            Catch::Contains((dir / "bomb.exr").string() +
+                            ": header: declares 30000x30000 pixels with 1 channel, which take at "
+                            "least 480000 bytes, but the file has "));
+        CHECK(readImageInfo(dir / "bomb.exr").width == 30000);  // the header alone reads
+        // One tile of 2^29 x 2^29 pixels of 64 channels: 2^64 floats, whose count wraps in size_t.
+        writeText(dir / "wrap.exr", exrWithoutPixels(1 << 29, 1 << 29, 64, 1 << 29));
+        CHECK_THROWS_AS(readImage(dir / "wrap.exr"), InvalidInput);
+        CHECK_THROWS_WITH(readImage(dir / "wrap.exr"),
+                          Catch::Contains("wrap.exr: image of 536870912x536870912 pixels with 64 channels is "
+                                          "too large to load"));
+    }
+
     SECTION("truncated EXR and PNG") {
         writeImage(dir / "t.exr", patternImage(64, 64, 3), {PixelType::Float, {}});
         writeImage(dir / "t.png", patternImage(64, 64, 3));
@@ -355,6 +412,11 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         CHECK_THROWS_WITH(readImage(dir / "t.png"), Catch::Contains((dir / "t.png").string()) &&
                                                         Catch::Contains("chunk IDAT") &&
                                                         Catch::Contains("truncated PNG"));
+        // A header read checks the chunks before the pixels (libpng would print its own message first).
+        std::string bytes = readText(dir / "t.png");
+        writeText(dir / "t.png", bytes.substr(0, bytes.find("IHDR") + 10));
+        CHECK_THROWS_WITH(readImageInfo(dir / "t.png"),
+                          Catch::Contains("chunk IHDR at byte 8") && Catch::Contains("truncated PNG"));
     }
 
     SECTION("a PNG with a flipped byte inside its pixel data fails its CRC") {
