@@ -211,10 +211,13 @@ class ObjParser {
         if (*first == '+' && first + 1 < end_ && first[1] != '+' && first[1] != '-') ++first;
         auto [ptr, ec] = std::from_chars(first, end_, value);
         if (ec == std::errc::result_out_of_range) {
-            // Underflow (a tiny value) is fine: it rounds to zero or a subnormal.
-            double wide = 0.0;
+            // Underflow (a tiny value) is fine: it rounds to zero or a subnormal. Beyond double's range too
+            // (1e-400), the sign of the value's exponent tells underflow from overflow.
+            long double wide = 0.0L;
             const auto r = std::from_chars(first, end_, wide);
-            const auto narrowed = static_cast<float>(wide);
+            auto narrowed = static_cast<float>(wide);
+            if (r.ec == std::errc() && !std::isfinite(narrowed) && !finite)
+                narrowed = 0.0f;  // ignored anyway
             if (r.ec != std::errc() || !std::isfinite(narrowed)) {
                 fail<InvalidInput>(
                     line_, "number " + printable(tokenAt(p_)) + " is out of the range of a 32-bit float",
@@ -618,11 +621,14 @@ ObjContent parseObj(std::string_view text, const std::string& source) {
     // UTF-8 with a byte order mark (what Windows editors write as "UTF-8") is UTF-8: the mark is skipped,
     // line numbers stay.
     if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-    // Lines ended by CR alone (classic Mac OS editors and exporters) would read as one line: such a file,
-    // with a CR and no LF anywhere, is read with its CRs as line ends.
-    if (text.find('\n') == std::string_view::npos && text.find('\r') != std::string_view::npos) {
+    // A CR alone ends a line (classic Mac OS editors and exporters, or files pasted together from both): read
+    // as a blank, it would join two statements and drop the second. CR LF stays one line end.
+    auto loneCr = [&](size_t i) { return text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'); };
+    for (size_t i = text.find('\r'); i != std::string_view::npos; i = text.find('\r', i + 1)) {
+        if (!loneCr(i)) continue;
         std::string lines(text);
-        std::replace(lines.begin(), lines.end(), '\r', '\n');
+        for (size_t j = i; j < lines.size(); ++j)
+            if (loneCr(j)) lines[j] = '\n';
         return ObjParser(lines, source).parse();
     }
     return ObjParser(text, source).parse();

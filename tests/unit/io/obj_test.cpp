@@ -339,6 +339,14 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
                              std::vector<glm::vec3>(plain.mesh.points().begin(), plain.mesh.points().end())));
         CHECK(std::ranges::equal(cr.mesh.faceIndices(), plain.mesh.faceIndices()));
         CHECK_THROWS_WITH(parseObj("v 0 0 0\rv 1 0\r", "mac.obj"), Catch::Contains("mac.obj: line 2: "));
+        // Mixed with LF and CR LF (files pasted together): a CR alone still ends its line, so no statement is
+        // joined to the one before it and dropped.
+        const ObjContent mixed =
+            parseObj("v 0 0 0\nv 1 0 0\r\ns off\rv 1 1 0\r\nv 0 1 0\nf -4 -3 -2 -1\n", "mix.obj");
+        CHECK(mixed.mesh.numVertices() == 4);
+        CHECK(std::ranges::equal(mixed.mesh.faceIndices(), std::vector<int32_t>{0, 1, 2, 3}));
+        CHECK_THROWS_WITH(parseObj("v 0 0 0\ns off\rv 1 0\r\n", "mix.obj"),
+                          Catch::Contains("mix.obj: line 3: "));
     }
     SECTION("NaN and infinity as old Microsoft runtimes print them; a comment right after a number") {
         for (const char* text : {"1.#QNAN", "-1.#IND00", "1.#INF", "1.#SNAN", "-1.#INF0"}) {
@@ -368,6 +376,14 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
         CHECK(m.points()[0].x == 0.0f);
         CHECK(std::signbit(m.points()[0].y));
         CHECK(m.points()[0].z == 1e-40f);
+        // Beyond a double's range as well; an ignored fourth value (w, or a colour) may overflow too.
+        const Mesh tinier =
+            parseObj("v 1e-400 -1e-400 0 1e400\nv 1 0 0 nan\nv 0 1 0\nf 1 2 3\n", "tiny.obj").mesh;
+        CHECK(tinier.points()[0].x == 0.0f);
+        CHECK(std::signbit(tinier.points()[0].y));
+        CHECK_THROWS_WITH(
+            parseObj("v 1e400 0 0\n", "big.obj"),
+            Catch::Contains("big.obj: line 1: number '1e400' is out of the range of a 32-bit float"));
     }
     SECTION("some faces with UVs and some without: those without belong to no tile") {
         const std::string text = quad + "vt 0 0\nvt 1 0\n# faces\nf 1/1 2/2 3/1\nf 3 2 1\nf 1 3 2\n";
