@@ -4,7 +4,9 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 #include <cctype>
 #include <cmath>
 #include <map>
@@ -281,6 +283,62 @@ std::vector<std::string> meshGroupNames(const aiScene& scene) {
     return names;
 }
 
+// assimp drops what it cannot read (faces with an index past the vertices, a UV stream shorter than the
+// vertices, a trailing vertex that makes no triangle) and says so only in a warning: those warnings are
+// collected while a file is read on this thread, and the file is refused. Other warnings (an unreferenced
+// vertex, a bone weight out of range) lose nothing the mesh keeps.
+class DroppedDataLog : public Assimp::LogStream {
+  public:
+    // The warnings of the reads under way on this thread, while a Collect lives.
+    struct Collect {
+        Collect() {
+            install();
+            warnings().clear();
+            active() = true;
+        }
+        ~Collect() { active() = false; }
+        Collect(const Collect&) = delete;
+        Collect& operator=(const Collect&) = delete;
+        [[nodiscard]] std::optional<std::string> dropped() const {
+            for (const std::string& w : warnings())
+                for (const char* sign :
+                     {"dropped", "does not match the vertex count", "out-of-range indices"})
+                    if (w.find(sign) != std::string::npos) return w;
+            return std::nullopt;
+        }
+    };
+
+    void write(const char* message) override {
+        if (!active()) return;
+        std::string text(message);
+        while (!text.empty() && (text.back() == '\n' || text.back() == '\r'))
+            text.pop_back();
+        const size_t body = text.find(": ");  // after "Warn,  T0"
+        warnings().push_back(body == std::string::npos ? text : text.substr(body + 2));
+    }
+
+  private:
+    static bool& active() {
+        thread_local bool on = false;
+        return on;
+    }
+    static std::vector<std::string>& warnings() {
+        thread_local std::vector<std::string> list;
+        return list;
+    }
+    // Once per process: a logger when the process has none (assimp's default logs nothing), this stream on
+    // its warnings. A logger another part of the process made keeps its own streams.
+    static void install() {
+        static const bool installed = [] {
+            if (Assimp::DefaultLogger::isNullLogger())
+                Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no debugger
+            Assimp::DefaultLogger::get()->attachStream(new DroppedDataLog, Assimp::Logger::Warn);
+            return true;
+        }();
+        (void)installed;
+    }
+};
+
 ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     const std::string name = path.string();
     std::error_code ec;
@@ -302,7 +360,12 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     // Meshes stay apart (one group each) while their vertices move to world space: by assimp's
     // pre-transform, or for skinned and morphed glTF meshes by their rest pose (RestPose).
     importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
+    const DroppedDataLog::Collect log;
     const aiScene* scene = check(importer.ReadFile(path.string(), aiProcess_ValidateDataStructure));
+    if (const std::optional<std::string> dropped = log.dropped()) {
+        throw InvalidInput(formatError(name, "", "assimp left data out while reading it: " + *dropped,
+                                       "faces and UVs that all refer to the file's vertices"));
+    }
     std::optional<RestPose> rest;
     if (format == MeshFormat::Gltf && RestPose::needed(*scene)) {
         rest.emplace(*scene);

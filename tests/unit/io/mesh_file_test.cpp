@@ -200,6 +200,37 @@ TEST_CASE("mesh files: a glTF's nodes place its meshes, one group each, vertices
     CHECK(content.groups[1].faces == std::vector<int32_t>{2, 3});
 }
 
+TEST_CASE("mesh files: a glTF whose faces or UVs assimp would leave out is refused, naming why",
+          "[io][mesh_file][errors]") {
+    // assimp drops such data with a warning only: the mesh read would miss faces or every UV, without a word.
+    const test::TempDir dir;
+    const std::string good = kGltf;
+    const auto variant = [&](const std::string& from, const std::string& to) {
+        std::string text = good;
+        text.replace(text.find(from), from.size(), to);
+        return text;
+    };
+    const std::vector<std::pair<std::string, std::string>> broken = {
+        // Index 3 of the last triangle made 9 (of 4 vertices).
+        {variant("AAIAAwA=", "AAIACQA="), "Some faces had out-of-range indices"},
+        // The UV accessor holds 2 UVs for 4 vertices.
+        {variant(R"("count": 4, "type": "VEC2"})", R"("count": 2, "type": "VEC2"})"),
+         "Texcoord stream size in mesh \"quad\" does not match the vertex count"},
+        // 5 indices: not whole triangles.
+        {variant(R"("count": 6, "type": "SCALAR"})", R"("count": 5, "type": "SCALAR"})"),
+         "not compatible with the TRIANGLES mode"},
+    };
+    for (const auto& [text, why] : broken) {
+        test::writeText(dir / "broken.gltf", text);
+        CHECK_THROWS_WITH(
+            io::readMesh(dir / "broken.gltf"),
+            Contains((dir / "broken.gltf").string() + ": assimp left data out while reading it: ") &&
+                Contains(why));
+    }
+    test::writeText(dir / "quad.gltf", good);
+    CHECK(io::readMesh(dir / "quad.gltf").mesh.numFaces() == 4);  // the warnings of one file end with it
+}
+
 TEST_CASE("mesh files: a skinned, morphed glTF mesh rests where its joints and default weights put it",
           "[io][mesh_file]") {
     // The glTF rest pose written out by hand: p = sum_j w_j G_j IBM_j (v + m (0, 0, 1)), the mesh node's
