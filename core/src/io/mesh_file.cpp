@@ -9,6 +9,7 @@
 #include <assimp/LogStream.hpp>
 #include <cctype>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -147,7 +148,9 @@ void requireCompletePly(const fs::path& path) {
     std::string line, format;
     std::vector<PlyElement> elements;
     bool ended = false;
+    int64_t lineNumber = 0;
     while (std::getline(in, line)) {
+        ++lineNumber;
         std::istringstream words(line);
         std::string keyword;
         words >> keyword;
@@ -191,6 +194,7 @@ void requireCompletePly(const fs::path& path) {
     for (const PlyElement& element : elements)
         declared += (declared.empty() ? "" : " and ") + std::to_string(element.count) + " " + element.name;
     if (format == "ascii") {
+        const std::streampos data = in.tellg();
         int64_t lines = 0;
         while (std::getline(in, line))
             if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
@@ -202,6 +206,45 @@ void requireCompletePly(const fs::path& path) {
                 path.string(), "",
                 "declares " + declared + " elements but holds " + std::to_string(lines) + " data lines",
                 "one line per element the header declares (an ASCII PLY cut short or with a wrong count)"));
+        }
+        // Each element on its own line with one value per scalar property and a list's count, then its items:
+        // assimp reads the values as a stream, so a line short of a value takes the next line's first one.
+        in.clear();
+        in.seekg(data);
+        size_t e = 0;
+        int64_t index = 0;
+        while (std::getline(in, line)) {
+            ++lineNumber;
+            if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+            while (e < elements.size() && index == elements[e].count) {
+                ++e;
+                index = 0;
+            }
+            if (e == elements.size()) break;  // lines after the declared elements: assimp ignores them
+            const PlyElement& element = elements[e];
+            std::istringstream values(line);
+            const std::vector<std::string> tokens{std::istream_iterator<std::string>(values), {}};
+            size_t needed = 0;
+            for (const PlyProperty& property : element.properties) {
+                if (property.itemSize == 0) {
+                    ++needed;
+                    continue;
+                }
+                if (needed >= tokens.size()) break;
+                const std::string& count = tokens[needed];
+                const bool whole = !count.empty() && count.size() < 10 &&
+                                   count.find_first_not_of("0123456789") == std::string::npos;
+                needed += 1 + (whole ? static_cast<size_t>(std::stoul(count)) : 0);
+            }
+            if (tokens.size() != needed) {
+                throw InvalidInput(formatError(
+                    path.string(),
+                    "line " + std::to_string(lineNumber) + " (" + element.name + " " + std::to_string(index) +
+                        ")",
+                    "holds " + std::to_string(tokens.size()) + " values",
+                    std::to_string(needed) + ", as the header's properties of " + element.name + " declare"));
+            }
+            ++index;
         }
         return;
     }

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -273,6 +274,16 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
         test::writeText(dir / "liar.ply", liar);
         CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
                           Contains("liar.ply: declares ") && Contains("elements but holds 7 data lines"));
+    }
+    // A line short of a value (or with one too many) would take its neighbour's: refused, naming its line.
+    for (const auto& [from, to, where] :
+         {std::tuple{"2 1 0 1 0.5\n", "2 1 0 1\n0.5 ", "line 14 (vertex 2): holds 4 values (expected 5"},
+          std::tuple{"3 3 2 4\n", "3 3 2\n", "line 18 (face 1): holds 3 values (expected 4"},
+          std::tuple{"4 0 1 2 3\n", "4 0 1 2 3 1\n", "line 17 (face 0): holds 6 values (expected 5"}}) {
+        std::string split = kPly;
+        split.replace(split.find(from), std::string(from).size(), to);
+        test::writeText(dir / "split.ply", split);
+        CHECK_THROWS_WITH(io::readMesh(dir / "split.ply"), Contains("split.ply: " + std::string(where)));
     }
     std::string crlf;
     for (const char c : std::string(kPly)) {
