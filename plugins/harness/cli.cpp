@@ -213,6 +213,9 @@ int CommandLine::run(int argc, char** argv) {
     } catch (const Error& e) {
         std::cerr << "deformkit: error: " << e.what() << "\n";
         return 2;
+    } catch (const OutOfMemory& e) {
+        std::cerr << "deformkit: error: " << e.what() << "\n";  // names the input
+        return 1;
     } catch (const std::bad_alloc&) {
         // Exit 1, as for anything a retry on a larger machine may cure (docs/farm.md, Exit codes).
         std::cerr

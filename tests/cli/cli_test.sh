@@ -48,6 +48,13 @@ contains info-ply "$work/out" "faces       1 (triangles 0, quads 1, n-gons 0)"
 echo "not a mesh" >"$work/notes.txt"
 expect info-unknown 2 "$dk" info "$work/notes.txt"
 contains info-unknown "$work/err" "is neither a mesh, a point cache nor an image (expected a mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)"
+# A file larger than the memory the process may have (a sparse 20 GB OBJ under a 4 GB limit) is exit 1,
+# naming it, as any out-of-memory.
+if truncate -s 20G "$work/sparse.obj" 2>/dev/null; then
+    expect info-too-large 1 bash -c "ulimit -v 4000000 && exec \"\$0\" info \"\$1\"" "$dk" "$work/sparse.obj"
+    contains info-too-large "$work/err" "$work/sparse.obj: cannot be read into memory (21474836481 bytes) (expected the OBJ file to fit in this machine's memory)"
+    rm -f "$work/sparse.obj"
+fi
 : >"$work/empty.exr"
 expect info-empty 2 "$dk" info "$work/empty.exr"
 contains info-empty "$work/err" "$work/empty.exr: is empty (0 bytes) (expected a mesh, a point cache or an image)"

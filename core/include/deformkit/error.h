@@ -1,8 +1,10 @@
 #pragma once
 
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace deformkit {
 
@@ -45,6 +47,18 @@ class InvalidInput : public Error {
 class TopologyError : public InvalidInput {
   public:
     using InvalidInput::InvalidInput;
+};
+
+// Memory that ran out for a named input (a file too large to read into this machine's memory): a
+// std::bad_alloc, as any allocation failure (the CLI exits 1, Python raises MemoryError), whose what() names
+// the input and its size.
+class OutOfMemory : public std::bad_alloc {
+  public:
+    explicit OutOfMemory(std::string message) : message_(std::move(message)) {}
+    [[nodiscard]] const char* what() const noexcept override { return message_.c_str(); }
+
+  private:
+    std::string message_;
 };
 
 // Builds the message used across the library: "<source>: <element>: <problem> (expected <expected>)".

@@ -30,9 +30,18 @@ std::string readFile(const fs::path& path, const std::string& kind) {
     }
     std::string bytes;
     size_t size = 0;
-    bytes.resize(S_ISREG(info.st_mode) ? static_cast<size_t>(info.st_size) + 1 : 65536);
+    const auto grow = [&](size_t to) {
+        try {
+            bytes.resize(to);
+        } catch (const std::bad_alloc&) {
+            throw OutOfMemory(formatError(path.string(), "",
+                                          "cannot be read into memory (" + std::to_string(to) + " bytes)",
+                                          "the " + kind + " to fit in this machine's memory"));
+        }
+    };
+    grow(S_ISREG(info.st_mode) ? static_cast<size_t>(info.st_size) + 1 : 65536);
     while (true) {
-        if (size == bytes.size()) bytes.resize(bytes.size() * 2);
+        if (size == bytes.size()) grow(bytes.size() * 2);
         const ssize_t got = ::read(fd, bytes.data() + size, bytes.size() - size);
         if (got == 0) break;
         if (got < 0) {
