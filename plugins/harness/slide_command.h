@@ -29,7 +29,7 @@ struct SlideCommand {
     std::optional<std::filesystem::path> weights;      // JSON array, one number per vertex
     std::optional<std::filesystem::path> weightsPtex;  // or a Ptex map of the mesh (its per-vertex values)
     int32_t weightsChannel = 0;                        // the Ptex map's channel
-    float envelope = 1.0f;
+    double envelope = 1.0;
     slide::SlideOptions options;
 };
 

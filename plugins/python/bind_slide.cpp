@@ -127,7 +127,7 @@ std::vector<Falloff> falloffsOf(py::handle value, size_t handles, const std::str
 }
 
 // Displacements: (3,) for one handle, (H, 3) for H handles.
-std::vector<glm::dvec3> displacementsOf(const FloatArray& a, size_t handles, const std::string& source) {
+std::vector<glm::dvec3> displacementsOf(const DoubleArray& a, size_t handles, const std::string& source) {
     const bool single = a.ndim() == 1 && a.shape(0) == 3 && handles == 1;
     const bool rows = a.ndim() == 2 && a.shape(1) == 3 && static_cast<size_t>(a.shape(0)) == handles;
     if (!single && !rows) {
@@ -137,7 +137,7 @@ std::vector<glm::dvec3> displacementsOf(const FloatArray& a, size_t handles, con
     }
     std::vector<glm::dvec3> out(handles);
     for (size_t h = 0; h < handles; ++h) {
-        const float* d = a.data() + 3 * h;
+        const double* d = a.data() + 3 * h;
         out[h] = glm::dvec3(d[0], d[1], d[2]);
     }
     return out;
@@ -304,8 +304,8 @@ class PySlider {
         rest_.assign(mesh.points().begin(), mesh.points().end());
     }
 
-    PySlideResult evaluate(const FloatArray& displacement, py::handle falloff,
-                           const std::optional<FloatArray>& weights, float envelope,
+    PySlideResult evaluate(const DoubleArray& displacement, py::handle falloff,
+                           const std::optional<FloatArray>& weights, double envelope,
                            const std::optional<FloatArray>& points) const {
         const std::string source = "Slider.evaluate";
         const std::shared_ptr<Slider> slider = slider_;
@@ -356,8 +356,8 @@ void bindSlide(py::module_& m) {
     m.def(
         "slide",
         [](const FloatArray& points, const IntArray& counts, const IntArray& indices, int64_t handle,
-           const FloatArray& displacement, double radius, py::object falloff,
-           const std::optional<FloatArray>& weights, float envelope, const std::string& region,
+           const DoubleArray& displacement, double radius, py::object falloff,
+           const std::optional<FloatArray>& weights, double envelope, const std::string& region,
            const std::string& surface, const std::optional<std::filesystem::path>& weightsPtex,
            int32_t weightsChannel, const std::string& paintedWeights, bool foldLimit, double weldTolerance) {
             const std::string source = "slide";
@@ -387,7 +387,7 @@ void bindSlide(py::module_& m) {
         },
         py::arg("points"), py::arg("face_counts"), py::arg("face_indices"), py::arg("handle"),
         py::arg("displacement"), py::arg("radius"), py::arg("falloff") = "smooth",
-        py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("region") = "euclidean",
+        py::arg("weights") = py::none(), py::arg("envelope") = 1.0, py::arg("region") = "euclidean",
         py::arg("surface") = "cage", py::arg("weights_ptex") = py::none(), py::arg("weights_channel") = 0,
         py::arg("painted_weights") = "scale", py::arg("fold_limit") = false, py::arg("weld_tolerance") = 0.0,
         "Slide vertices over the surface (Pinskiy, 'Sliding deformation'): the region within `radius` of "
@@ -465,7 +465,7 @@ void bindSlide(py::module_& m) {
              "Bind again, to a new rest mesh or handle set; arguments as the constructor.")
         .def(
             "evaluate", &PySlider::evaluate, py::arg("displacement"), py::arg("falloff") = "smooth",
-            py::arg("weights") = py::none(), py::arg("envelope") = 1.0f, py::arg("points") = py::none(),
+            py::arg("weights") = py::none(), py::arg("envelope") = 1.0, py::arg("points") = py::none(),
             "Slide for displacement (3,) (one handle) or (H, 3) (one row per handle); falloff one value for\n"
             "every handle or a list of one per handle; weights (N,), envelope scalar; points (N, 3): the\n"
             "surface to slide over, a deformed copy of the rest mesh (default: the rest points), with\n"

@@ -27,6 +27,8 @@
 namespace deformkit::python {
 
 using FloatArray = pybind11::array_t<float, pybind11::array::c_style | pybind11::array::forcecast>;
+// Values read in double (a few parameters: a float32 copy would turn 4e38 into inf before it is checked).
+using DoubleArray = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
 
 // Whole numbers from Python (a list, a numpy array of any integer or float type) as int32, converted
 // exactly: numpy's own cast would truncate 1.9 to 1 and wrap 2^32 + 2 to 2. The conversion never fails

@@ -1,6 +1,7 @@
 """deformkit.slide and deformkit.Slider (Pinskiy, "Sliding deformation") against closed forms written here in
 numpy: on a plane the slide is the in-plane translation d * falloff(|P - P0| / r); landings reproduce the
 points; several handles add; bad input raises deformkit.InvalidInput naming the argument."""
+import re
 import threading
 
 import numpy as np
@@ -299,6 +300,15 @@ def test_bad_input_names_the_argument():
         slider.evaluate(d, points=pts[:24])
     with pytest.raises(dk.InvalidInput, match=r"region.*handle.*\[0, 1\)"):
         slider.region(1)
+    # Values beyond float range are named as given, not as the infinity a float32 copy would make of them.
+    with pytest.raises(dk.InvalidInput, match=re.escape("handle 0 displacement: has length 4e+38 (expected a "
+                                                        "length within float range")):
+        slider.evaluate([4e38, 0.0, 0.0])
+    with pytest.raises(dk.InvalidInput, match=re.escape("envelope: is 1e+39 (expected a finite envelope within "
+                                                        "float range")):
+        slider.evaluate(d, envelope=1e39)
+    with pytest.raises(dk.InvalidInput, match=re.escape("handle 0 (vertex 12): radius -1e-09 (expected")):
+        dk.Slider(pts, counts, idx, handle=12, radius=-1e-9)
     # A rejected call changes nothing: the next one gives the plain result.
     x = distances(pts, 12) / 0.5
     np.testing.assert_allclose(slider.evaluate(d).points, pts + smoothstep_falloff(x)[:, None] * d, atol=TOL)

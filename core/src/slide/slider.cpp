@@ -92,8 +92,8 @@ Slider::Slider(const geom::Mesh& rest, std::vector<SlideHandle> handles, const S
                                            "a vertex in [0, " + std::to_string(rest.numVertices()) + ")"));
         }
         if (!std::isfinite(handle.radius) || !(handle.radius > 0.0)) {
-            throw InvalidInput(formatError(source, element, "radius " + std::to_string(handle.radius),
-                                           "a finite radius > 0"));
+            throw InvalidInput(
+                formatError(source, element, "radius " + numberText(handle.radius), "a finite radius > 0"));
         }
     }
     // Split vertices (coincident copies, as glTF and FBX files have them) are welded: the slide binds on the
@@ -296,7 +296,7 @@ int32_t Slider::weldedVertices() const {
 }
 
 void Slider::evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
-                      std::span<const float> weights, float envelope, SlideResult* result) {
+                      std::span<const float> weights, double envelope, SlideResult* result) {
     Impl& m = *impl_;
     const std::lock_guard<std::mutex> lock(m.mutex);
     if (!m.weld) {
@@ -387,7 +387,7 @@ void Slider::Impl::requireCounts(int32_t vertices, size_t points, size_t weights
 }
 
 void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
-                                   std::span<const float> weights, float envelope, SlideResult* result) {
+                                   std::span<const float> weights, double envelope, SlideResult* result) {
     Impl& m = *this;
     const int32_t nv = m.surface.numVertices();
     if (drives.size() != m.handles.size()) {
@@ -416,9 +416,9 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
                                            "a finite weight, normally in [0, 1]"));
         }
     }
-    if (!std::isfinite(envelope)) {
-        throw InvalidInput(
-            formatError(m.source, "envelope", "not finite", "a finite envelope, normally in [0, 1]"));
+    if (!std::isfinite(envelope) || std::abs(envelope) > std::numeric_limits<float>::max()) {
+        throw InvalidInput(formatError(m.source, "envelope", "is " + numberText(envelope),
+                                       "a finite envelope within float range, normally in [0, 1]"));
     }
 
     // The incoming points the slide reads: the active vertices and the handles' rings (landings outside
@@ -490,7 +490,7 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
 
 std::vector<glm::vec3> slide(const geom::Mesh& mesh, std::span<const SlideHandle> handles,
                              std::span<const SlideDrive> drives, std::span<const float> weights,
-                             float envelope, const SlideOptions& options, SlideResult* result) {
+                             double envelope, const SlideOptions& options, SlideResult* result) {
     Slider slider(mesh, std::vector<SlideHandle>(handles.begin(), handles.end()), options);
     std::vector<glm::vec3> points(mesh.points().begin(), mesh.points().end());
     slider.evaluate(drives, points, weights, envelope, result);

@@ -122,7 +122,7 @@ struct Slider::Impl {
     void requireCounts(int32_t vertices, size_t points, size_t weights) const;
     // The evaluation on the surface's own vertices (the welded ones when `weld` is set).
     void evaluateSurface(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
-                         std::span<const float> weights, float envelope, SlideResult* result);
+                         std::span<const float> weights, double envelope, SlideResult* result);
 
     Impl(const geom::Mesh& rest, std::vector<SlideHandle> h, const SlideOptions& o, std::string s)
         : source(std::move(s)), mesh(rest), options(o), handles(std::move(h)), surface(rest, source) {}

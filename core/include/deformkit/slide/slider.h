@@ -137,7 +137,7 @@ class Slider {
     // slide. Throws InvalidInput for a wrong count or a non-finite value, naming it, before anything is
     // written.
     void evaluate(std::span<const SlideDrive> drives, std::span<glm::vec3> points,
-                  std::span<const float> weights = {}, float envelope = 1.0f, SlideResult* result = nullptr);
+                  std::span<const float> weights = {}, double envelope = 1.0, SlideResult* result = nullptr);
 
   private:
     struct Impl;
@@ -147,7 +147,7 @@ class Slider {
 // One-off: bind and evaluate once, returning the slid copy of the mesh's points.
 [[nodiscard]] std::vector<glm::vec3> slide(const geom::Mesh& mesh, std::span<const SlideHandle> handles,
                                            std::span<const SlideDrive> drives,
-                                           std::span<const float> weights = {}, float envelope = 1.0f,
+                                           std::span<const float> weights = {}, double envelope = 1.0,
                                            const SlideOptions& options = {}, SlideResult* result = nullptr);
 
 }  // namespace deformkit::slide
