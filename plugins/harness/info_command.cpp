@@ -42,7 +42,9 @@ void describeMesh(const fs::path& file, std::ostream& out) {
     }
     if (obj.repairedFaces > 0) {
         out << "repaired    " << obj.repairedFaces << (obj.repairedFaces == 1 ? " polygon" : " polygons")
-            << " that visited a vertex twice (first on line " << obj.firstRepairedLine
+            << " that visited a vertex twice (first "
+            << (obj.firstRepairedLine > 0 ? "on line " + std::to_string(obj.firstRepairedLine)
+                                          : "at " + obj.firstRepairedFace)
             << "): repeats dropped, split into loops\n";
     }
     out << std::setprecision(6) << "bounds      (" << box.min.x << ", " << box.min.y << ", " << box.min.z

@@ -22,6 +22,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/read_file.h"
+#include "polygon_loops.h"
 
 namespace deformkit::io {
 namespace fs = std::filesystem;
@@ -422,6 +423,8 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     for (unsigned m = 0; m < scene->mNumMeshes; ++m)
         anyUVs = anyUVs || scene->mMeshes[m]->HasTextureCoords(0);
     std::map<PositionKey, int32_t> welded;
+    int64_t repaired = 0;
+    std::string firstRepaired;
     const std::vector<std::string> groupNames = meshGroupNames(*scene);
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& mesh = *scene->mMeshes[m];
@@ -459,24 +462,32 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         }
         FaceGroup group;
         group.name = groupNames[m];
+        std::vector<int32_t> points;
         for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
             const aiFace& face = mesh.mFaces[f];
-            // Corners in order; a corner welded onto the one before it is dropped (a sliver of coincident
-            // points), and a face left with fewer than 3 corners (points, lines, such slivers) is left out.
-            std::vector<unsigned> corners;
-            for (unsigned c = 0; c < face.mNumIndices; ++c) {
-                const unsigned k = face.mIndices[c];
-                if (!corners.empty() && pointOf[corners.back()] == pointOf[k]) continue;
-                corners.push_back(k);
+            // The polygon's loops, as an OBJ's (polygon_loops.h): a corner welded onto the one before it is
+            // dropped (a sliver of coincident points), a polygon that comes back to a point (a hole bridged
+            // to its outline) is split there, and what is left with fewer than 3 corners (points, lines,
+            // slivers) is left out.
+            points.clear();
+            for (unsigned c = 0; c < face.mNumIndices; ++c)
+                points.push_back(pointOf[face.mIndices[c]]);
+            const std::vector<std::vector<size_t>> loops = polygonLoops(points);
+            // Repaired, as an OBJ counts it: a polygon that has a point twice (after welding).
+            std::sort(points.begin(), points.end());
+            const auto distinct =
+                static_cast<size_t>(std::unique(points.begin(), points.end()) - points.begin());
+            if (face.mNumIndices >= 3 && distinct < face.mNumIndices) {
+                if (repaired++ == 0) firstRepaired = "mesh '" + meshName + "' face " + std::to_string(f);
             }
-            while (corners.size() > 1 && pointOf[corners.back()] == pointOf[corners.front()])
-                corners.pop_back();
-            if (corners.size() < 3) continue;
-            group.faces.push_back(static_cast<int32_t>(data.faceCounts.size()));
-            data.faceCounts.push_back(static_cast<int32_t>(corners.size()));
-            for (const unsigned k : corners) {
-                data.faceIndices.push_back(pointOf[k]);
-                if (anyUVs) data.uvIndices.push_back(uvs ? uvBase + static_cast<int32_t>(k) : -1);
+            for (const std::vector<size_t>& loop : loops) {
+                group.faces.push_back(static_cast<int32_t>(data.faceCounts.size()));
+                data.faceCounts.push_back(static_cast<int32_t>(loop.size()));
+                for (const size_t c : loop) {
+                    const unsigned k = face.mIndices[c];
+                    data.faceIndices.push_back(pointOf[k]);
+                    if (anyUVs) data.uvIndices.push_back(uvs ? uvBase + static_cast<int32_t>(k) : -1);
+                }
             }
         }
         if (!group.faces.empty()) groups.push_back(std::move(group));
@@ -487,6 +498,8 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                                        "a file with at least one mesh of polygons"));
     }
     ObjContent content{geom::Mesh(std::move(data), name), std::move(groups)};
+    content.repairedFaces = repaired;
+    content.firstRepairedFace = firstRepaired;
     return content;
 }
 

@@ -12,6 +12,7 @@
 #include "deformkit/geom/finite.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/read_file.h"
+#include "polygon_loops.h"
 
 namespace deformkit::io {
 namespace fs = std::filesystem;
@@ -396,70 +397,23 @@ class ObjParser {
         }
     }
 
-    // Exporters write polygons that visit a vertex twice: corners repeated one after the other (a long line
-    // repeating its corners), or a polygon with a hole joined to its outline by an edge walked both ways
-    // (CAD). Repeats one after the other are dropped, then the polygon is split where it comes back to a
-    // vertex: each loop is a face, loops of fewer than 3 corners are dropped. The count is reported
-    // (ObjContent::repairedFaces). Replaces the polygon's last `corners` entries; faceCorners_ gets the
-    // corner counts of the faces it becomes.
+    // A polygon that visits a vertex twice becomes the loops it is made of (polygon_loops.h); the count is
+    // reported (ObjContent::repairedFaces). Replaces the polygon's last `corners` entries; faceCorners_ gets
+    // the corner counts of the faces it becomes.
     void splitRepeats(int32_t corners) {
         const size_t n = static_cast<size_t>(corners);
-        std::vector<int32_t> v(data_.faceIndices.end() - static_cast<ptrdiff_t>(n), data_.faceIndices.end());
-        std::vector<int32_t> t(data_.uvIndices.end() - static_cast<ptrdiff_t>(n), data_.uvIndices.end());
+        const std::vector<int32_t> v(data_.faceIndices.end() - static_cast<ptrdiff_t>(n),
+                                     data_.faceIndices.end());
+        const std::vector<int32_t> t(data_.uvIndices.end() - static_cast<ptrdiff_t>(n),
+                                     data_.uvIndices.end());
         data_.faceIndices.resize(data_.faceIndices.size() - n);
         data_.uvIndices.resize(data_.uvIndices.size() - n);
-        // Consecutive repeats, around the polygon too.
-        std::vector<int32_t> cv, ct;
-        for (size_t k = 0; k < n; ++k) {
-            if (!cv.empty() && cv.back() == v[k]) continue;
-            cv.push_back(v[k]);
-            ct.push_back(t[k]);
-        }
-        while (cv.size() > 1 && cv.back() == cv.front()) {
-            cv.pop_back();
-            ct.pop_back();
-        }
-        // Split at revisited vertices, loop by loop.
-        std::vector<std::pair<std::vector<int32_t>, std::vector<int32_t>>> pending{{cv, ct}};
-        std::vector<std::vector<int32_t>>
-            emitted;  // the loops made into faces, rotated to start at their least vertex
-        while (!pending.empty()) {
-            auto [pv, pt] = std::move(pending.back());
-            pending.pop_back();
-            // The first corner that revisits a vertex (`again`) and that vertex's first corner (`first`), in
-            // one pass: a long polygon must not cost the square of its corners.
-            size_t first = 0, again = 0;
-            std::unordered_map<int32_t, size_t> seen;
-            for (size_t j = 0; j < pv.size(); ++j) {
-                const auto [at, inserted] = seen.try_emplace(pv[j], j);
-                if (!inserted) {
-                    first = at->second;
-                    again = j;
-                    break;
-                }
+        for (const std::vector<size_t>& loop : polygonLoops(v)) {
+            for (const size_t k : loop) {
+                data_.faceIndices.push_back(v[k]);
+                data_.uvIndices.push_back(t[k]);
             }
-            if (again == 0) {
-                if (pv.size() < 3) continue;
-                // A loop walked again (a line repeating its corners) is one face, not a stack of copies.
-                std::vector<int32_t> key = pv;
-                std::rotate(key.begin(), std::min_element(key.begin(), key.end()), key.end());
-                if (std::find(emitted.begin(), emitted.end(), key) != emitted.end()) continue;
-                emitted.push_back(std::move(key));
-                data_.faceIndices.insert(data_.faceIndices.end(), pv.begin(), pv.end());
-                data_.uvIndices.insert(data_.uvIndices.end(), pt.begin(), pt.end());
-                faceCorners_.push_back(static_cast<int32_t>(pv.size()));
-                continue;
-            }
-            std::vector<int32_t> lv(pv.begin() + static_cast<ptrdiff_t>(first),
-                                    pv.begin() + static_cast<ptrdiff_t>(again));
-            std::vector<int32_t> lt(pt.begin() + static_cast<ptrdiff_t>(first),
-                                    pt.begin() + static_cast<ptrdiff_t>(again));
-            pv.erase(pv.begin() + static_cast<ptrdiff_t>(first) + 1,
-                     pv.begin() + static_cast<ptrdiff_t>(again) + 1);
-            pt.erase(pt.begin() + static_cast<ptrdiff_t>(first) + 1,
-                     pt.begin() + static_cast<ptrdiff_t>(again) + 1);
-            pending.emplace_back(std::move(pv), std::move(pt));
-            pending.emplace_back(std::move(lv), std::move(lt));
+            faceCorners_.push_back(static_cast<int32_t>(loop.size()));
         }
         if (faceCorners_.empty()) {
             fail<InvalidInput>(statementLine_, "face has fewer than 3 distinct vertices",

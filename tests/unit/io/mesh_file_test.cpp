@@ -7,6 +7,7 @@
 #include <array>
 
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -230,6 +231,33 @@ TEST_CASE("mesh files: a glTF whose faces or UVs assimp would leave out is refus
     }
     test::writeText(dir / "quad.gltf", good);
     CHECK(io::readMesh(dir / "quad.gltf").mesh.numFaces() == 4);  // the warnings of one file end with it
+}
+
+TEST_CASE("mesh files: a polygon that visits a vertex twice is split into its loops, as an OBJ's",
+          "[io][mesh_file]") {
+    // A square (0-3) with a triangular hole (4-6) bridged to it by the edge 0-4 walked both ways (CAD), and a
+    // triangle whose last corner repeats its first: the same loops as the OBJ reader makes of them.
+    const test::TempDir dir;
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 7\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+        "end_header\n";
+    const std::string points = "0 0 0\n4 0 0\n4 4 0\n0 4 0\n1 1 0\n1 2 0\n2 1 0\n";
+    test::writeText(dir / "bridged.ply", header + points + "9 0 1 2 3 0 4 5 6 4\n4 1 2 3 1\n");
+    std::string objText;
+    std::istringstream in(points);
+    for (std::string line; std::getline(in, line);)
+        objText += "v " + line + "\n";
+    test::writeText(dir / "bridged.obj", objText + "f 1 2 3 4 1 5 6 7 5\nf 2 3 4 2\n");
+    const io::ObjContent ply = io::readMesh(dir / "bridged.ply");
+    const io::ObjContent reference = io::readMesh(dir / "bridged.obj");
+    CHECK(std::vector<int32_t>(ply.mesh.faceCounts().begin(), ply.mesh.faceCounts().end()) ==
+          std::vector<int32_t>{4, 3, 3});
+    CHECK(std::ranges::equal(ply.mesh.faceIndices(), reference.mesh.faceIndices()));
+    CHECK(std::ranges::equal(ply.mesh.faceCounts(), reference.mesh.faceCounts()));
+    CHECK(ply.repairedFaces == 2);
+    CHECK(reference.repairedFaces == 2);
+    CHECK(ply.firstRepairedFace == "mesh 'mesh0' face 0");
 }
 
 TEST_CASE("mesh files: a skinned, morphed glTF mesh rests where its joints and default weights put it",

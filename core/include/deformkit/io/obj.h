@@ -22,6 +22,7 @@ struct ObjContent {
     // the first: `deformkit info` reports them.
     int64_t repairedFaces = 0;
     int64_t firstRepairedLine = 0;
+    std::string firstRepairedFace;  // files without lines (glTF, FBX, PLY, Collada): "mesh 'quad' face 3"
     // Faces without texture coordinates in a file whose other faces have them (they belong to no UDIM tile:
     // texture-space work leaves them alone), and the line of the first.
     int64_t facesWithoutUVs = 0;
