@@ -11,6 +11,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/geom/limit_surface.h"
+#include "deformkit/geom/weld.h"
 #include "texel_access.h"
 
 namespace deformkit::ptex {
@@ -25,6 +26,35 @@ std::array<double, 4> bilinear(double u, double v) {
     return {(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v};
 }
 
+// The faces' corners on welded vertices (geom/weld.h): split copies of a vertex (glTF, FBX) are one vertex,
+// so the Ptex faces around a seam are neighbours, as on the shared-vertex mesh a painter used. `weldedOf`:
+// per file vertex, its welded vertex; `firstOf`: per welded vertex, its first file vertex. The file's own
+// corners where nothing welds, or where welding would give a face the same vertex twice (a sliver of
+// coincident points).
+std::vector<int32_t> weldedCorners(const geom::Mesh& mesh, std::vector<int32_t>& weldedOf,
+                                   std::vector<int32_t>& firstOf) {
+    const std::span<const int32_t> corners = mesh.faceIndices();
+    weldedOf.resize(static_cast<size_t>(mesh.numVertices()));
+    for (size_t v = 0; v < weldedOf.size(); ++v)
+        weldedOf[v] = static_cast<int32_t>(v);
+    firstOf = weldedOf;
+    const geom::Welding weld = geom::weldVertices(mesh);
+    if (weld.merged() == 0) return {corners.begin(), corners.end()};
+    std::vector<int32_t> welded(corners.size());
+    for (size_t c = 0; c < corners.size(); ++c)
+        welded[c] = weld.weldedOf[static_cast<size_t>(corners[c])];
+    for (int32_t f = 0; f < mesh.numFaces(); ++f) {
+        const std::span<const int32_t> face = std::span<const int32_t>(welded).subspan(
+            static_cast<size_t>(mesh.faceOffsets()[f]), static_cast<size_t>(mesh.faceCounts()[f]));
+        for (size_t i = 0; i < face.size(); ++i)
+            for (size_t j = 0; j < i; ++j)
+                if (face[i] == face[j]) return {corners.begin(), corners.end()};
+    }
+    weldedOf = weld.weldedOf;
+    firstOf = weld.firstOf;
+    return welded;
+}
+
 }  // namespace
 
 PtexMesh::PtexMesh(const geom::Mesh& mesh, const std::string& source)
@@ -36,12 +66,15 @@ PtexMesh::PtexMesh(const geom::Mesh& mesh, const std::string& source)
     faceCounts_.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
     faceOffsets_.assign(mesh.faceOffsets().begin(), mesh.faceOffsets().end());
     faceIndices_.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());
+    std::vector<int32_t> firstOf;
+    connectivity_ = weldedCorners(mesh, weldedOf_, firstOf);
+    numWelded_ = static_cast<int32_t>(firstOf.size());
 
     Far::TopologyDescriptor desc;
-    desc.numVertices = mesh.numVertices();
+    desc.numVertices = numWelded_;
     desc.numFaces = mesh.numFaces();
     desc.numVertsPerFace = faceCounts_.data();
-    desc.vertIndicesPerFace = faceIndices_.data();
+    desc.vertIndicesPerFace = connectivity_.data();
     using RefinerFactory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
     std::unique_ptr<Far::TopologyRefiner> refiner(
         RefinerFactory::Create(desc, RefinerFactory::Options(Sdc::SCHEME_CATMARK)));
@@ -152,7 +185,7 @@ void PtexMesh::requireSameMesh(const PtexFile& file, const std::string& fileSour
         if (indices->int32s.size() < corner + static_cast<size_t>(n))
             polygon("has no PtexFaceVertIndices left");
         for (int32_t c = 0; c < n; ++c, ++corner) {
-            const int32_t theirs = indices->int32s[corner], ours = faceIndices_[corner];
+            const int32_t theirs = indices->int32s[corner], ours = connectivity_[corner];
             const auto [mine, addedMine] = meshVertexOf.try_emplace(theirs, ours);
             const auto [other, addedOther] = fileVertexOf.try_emplace(ours, theirs);
             if (mine->second != ours || other->second != theirs) {
@@ -174,9 +207,11 @@ void PtexMesh::requireSameMesh(const PtexFile& file, const std::string& fileSour
 MeshData meshData(const geom::Mesh& mesh) {
     MeshData data;
     data.faceVertCounts.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
-    data.faceVertIndices.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());
-    data.vertPositions.reserve(static_cast<size_t>(mesh.numVertices()) * 3);
-    for (const glm::vec3& p : mesh.points()) {
+    std::vector<int32_t> weldedOf, firstOf;
+    data.faceVertIndices = weldedCorners(mesh, weldedOf, firstOf);  // the polygons a painter's mesh has
+    data.vertPositions.reserve(firstOf.size() * 3);
+    for (const int32_t v : firstOf) {
+        const glm::vec3& p = mesh.points()[static_cast<size_t>(v)];
         data.vertPositions.push_back(p.x);
         data.vertPositions.push_back(p.y);
         data.vertPositions.push_back(p.z);

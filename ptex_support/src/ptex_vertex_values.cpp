@@ -23,6 +23,8 @@ void sumCorners(const PtexMesh& mesh, const PtexFile& file, const std::string& f
             file.texels[p].empty()
                 ? file.constData.data() + static_cast<size_t>(p) * pixel
                 : file.texels[p].data() + ((static_cast<size_t>(j) << file.faces[p].ulog2) + i) * pixel;
+        vertex =
+            mesh.weldedVertex(vertex);  // every copy of a split vertex sums into one (its faces around it)
         double* out = sum.data() + static_cast<size_t>(vertex) * channels;
         for (int32_t c = 0; c < channels; ++c) {
             const double value = detail::loadValue(texel + c * bytes, Type);
@@ -62,8 +64,8 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
     detail::requireBuffers(file, fileSource);
     // Only the corner texels are read, straight from the file's bytes.
     const int32_t channels = file.channels;
-    std::vector<double> sum(static_cast<size_t>(mesh.numVertices()) * channels, 0.0);
-    std::vector<int32_t> count(static_cast<size_t>(mesh.numVertices()), 0);
+    std::vector<double> sum(static_cast<size_t>(mesh.numWeldedVertices()) * channels, 0.0);
+    std::vector<int32_t> count(static_cast<size_t>(mesh.numWeldedVertices()), 0);
     switch (file.dataType) {
         case DataType::UInt8:
             sumCorners<DataType::UInt8>(mesh, file, fileSource, sum, count);
@@ -78,11 +80,14 @@ std::vector<float> vertexValues(const PtexMesh& mesh, const PtexFile& file, cons
             sumCorners<DataType::Float>(mesh, file, fileSource, sum, count);
             break;
     }
-    std::vector<float> values(sum.size(), 0.0f);
-    for (size_t v = 0; v < count.size(); ++v) {
-        if (count[v] == 0) continue;
+    // Each file vertex takes its welded vertex's mean: split copies read alike, as the shared vertex does.
+    std::vector<float> values(static_cast<size_t>(mesh.numVertices()) * channels, 0.0f);
+    for (int32_t v = 0; v < mesh.numVertices(); ++v) {
+        const auto w = static_cast<size_t>(mesh.weldedVertex(v));
+        if (count[w] == 0) continue;
         for (int32_t c = 0; c < channels; ++c)
-            values[v * channels + c] = static_cast<float>(sum[v * channels + c] / count[v]);
+            values[static_cast<size_t>(v) * channels + c] =
+                static_cast<float>(sum[w * channels + c] / count[w]);
     }
     return values;
 }

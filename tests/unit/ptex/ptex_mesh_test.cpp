@@ -517,6 +517,53 @@ TEST_CASE("ptex mesh: a file whose mesh metadata lists other polygons, or these 
                Catch::Contains("tri.ptx: header: is a triangle-mesh Ptex file"));
 }
 
+TEST_CASE("ptex mesh: split vertices (glTF, FBX) are one vertex: faces across a seam are neighbours",
+          "[ptex][mesh]") {
+    // mixedMesh with every face on its own copies of its corners, as a glTF splits a mesh at every seam.
+    const geom::Mesh shared = mixedMesh();
+    geom::Mesh::Data d;
+    for (int32_t f = 0; f < shared.numFaces(); ++f) {
+        d.faceCounts.push_back(static_cast<int32_t>(shared.face(f).size()));
+        for (const int32_t v : shared.face(f)) {
+            d.faceIndices.push_back(static_cast<int32_t>(d.points.size()));
+            d.points.push_back(shared.points()[static_cast<size_t>(v)]);
+        }
+    }
+    const geom::Mesh split(std::move(d), "split.gltf");
+    const PtexMesh a(shared, "mixed.obj"), b(split, "split.gltf");
+    REQUIRE(a.numPtexFaces() == b.numPtexFaces());
+    for (int32_t p = 0; p < a.numPtexFaces(); ++p) {
+        CHECK(a.adjFaces(p) == b.adjFaces(p));
+        CHECK(a.adjEdges(p) == b.adjEdges(p));
+    }
+    // A file painted on the shared-vertex mesh (its metadata: that mesh's polygons) belongs to the split one,
+    // whose per-vertex values are each copy's vertex's.
+    ptex::PtexFile painted = bakePaint(shared, a, 1);
+    const ptex::MeshData metadata = ptex::meshData(shared);
+    painted.metadata.push_back(ptex::MetaValue::ofInt32("PtexFaceVertCounts", metadata.faceVertCounts));
+    painted.metadata.push_back(ptex::MetaValue::ofInt32("PtexFaceVertIndices", metadata.faceVertIndices));
+    const std::vector<float> onShared = ptex::vertexValues(a, painted, "paint.ptx");
+    const std::vector<float> onSplit = ptex::vertexValues(b, painted, "paint.ptx");
+    for (int32_t f = 0, corner = 0; f < shared.numFaces(); ++f)
+        for (const int32_t v : shared.face(f))
+            CHECK(onSplit[static_cast<size_t>(corner++)] ==
+                  Approx(onShared[static_cast<size_t>(v)]).margin(1e-6));
+    // The split mesh's own metadata lists the shared polygons, their 11 vertices numbered by first use (one
+    // to one with the shared mesh's, at the same positions), not 23 copies.
+    const ptex::MeshData own = ptex::meshData(split);
+    REQUIRE(own.faceVertIndices.size() == metadata.faceVertIndices.size());
+    CHECK(own.vertPositions.size() == 3u * 11);
+    std::map<int32_t, int32_t> sharedOf;
+    for (size_t c = 0; c < own.faceVertIndices.size(); ++c) {
+        const int32_t mine = own.faceVertIndices[c], theirs = metadata.faceVertIndices[c];
+        CHECK(sharedOf.try_emplace(mine, theirs).first->second == theirs);
+        for (size_t k = 0; k < 3; ++k)
+            CHECK(own.vertPositions[3 * static_cast<size_t>(mine) + k] ==
+                  metadata.vertPositions[3 * static_cast<size_t>(theirs) + k]);
+    }
+    CHECK(sharedOf.size() == 11u);
+}
+
 TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[ptex][mesh][udim]") {
     // UVs are an affine image of the positions, so a painting linear in UV is linear on every face. From
     // UDIM: each texel is the bilinear image sample at its UV, exact for a linear image away from the tile

@@ -27,7 +27,9 @@ namespace deformkit::ptex {
 // Adjacency (neighbour face and the neighbour's edge across each edge, -1 on a boundary) is OpenSubdiv's
 // Far::PtexIndices::GetAdjacency.
 //
-// Built once from the mesh's connectivity; queries are const and thread-safe.
+// Built once from the mesh's connectivity, on its welded vertices (geom/weld.h: split copies of a vertex, as
+// glTF and FBX have them, are one vertex, so faces across a seam are neighbours); queries are const and
+// thread-safe.
 class PtexMesh {
   public:
     // Throws InvalidInput naming `source` for a mesh without faces and TopologyError when OpenSubdiv cannot
@@ -53,6 +55,11 @@ class PtexMesh {
     [[nodiscard]] std::span<const int32_t> faceVertices(int32_t face) const {
         return std::span<const int32_t>(faceIndices_).subspan(faceOffsets_[face], faceCounts_[face]);
     }
+    // The welded vertices (split copies as one), numWeldedVertices() of them, and a file vertex's.
+    [[nodiscard]] int32_t numWeldedVertices() const { return numWelded_; }
+    [[nodiscard]] int32_t weldedVertex(int32_t vertex) const {
+        return weldedOf_[static_cast<size_t>(vertex)];
+    }
 
     // The mesh point at (u, v) of a Ptex face as weights over its mesh face's corners (count = the face's
     // corner count, in corner order, summing to 1): bilinear over the quad, or over the sub-face quad whose
@@ -68,8 +75,8 @@ class PtexMesh {
     void requireMatches(const PtexFile& file, const std::string& fileSource) const;
     // Where `file` carries the standard mesh metadata (PtexFaceVertCounts and PtexFaceVertIndices, as
     // DeformKit, Mudbox and Mari write them): its polygons must be this mesh's, in this mesh's order, their
-    // vertices possibly numbered otherwise (one-to-one). A file painted on the same polygons in another
-    // order has the same face count and would put every face's texels on another face.
+    // vertices possibly numbered otherwise (one-to-one with the welded vertices). A file painted on the same
+    // polygons in another order has the same face count and would put every face's texels on another face.
     void requireSameMesh(const PtexFile& file, const std::string& fileSource) const;
 
   private:
@@ -77,7 +84,10 @@ class PtexMesh {
     int32_t numVertices_ = 0;
     std::vector<int32_t> faceCounts_;  // per mesh face
     std::vector<int32_t> faceOffsets_;
-    std::vector<int32_t> faceIndices_;
+    std::vector<int32_t> faceIndices_;   // the file's vertices (per-vertex values are the file's)
+    std::vector<int32_t> connectivity_;  // the same corners on welded vertices: adjacency, mesh metadata
+    std::vector<int32_t> weldedOf_;      // per file vertex
+    int32_t numWelded_ = 0;
     std::vector<int32_t> firstPtex_;  // #mesh faces + 1
     std::vector<int32_t> meshFace_;   // per Ptex face
     std::vector<int32_t> subFace_;
@@ -85,7 +95,9 @@ class PtexMesh {
     std::vector<std::array<uint8_t, 4>> adjEdges_;
 };
 
-// The standard mesh metadata of a mesh (face vertex counts and indices, positions), for WriteOptions::mesh.
+// The standard mesh metadata of a mesh (face vertex counts and indices, positions), for WriteOptions::mesh:
+// its polygons on welded vertices, each at its first copy's position, as a painter's shared-vertex mesh has
+// them.
 [[nodiscard]] MeshData meshData(const geom::Mesh& mesh);
 
 }  // namespace deformkit::ptex
