@@ -426,6 +426,10 @@ std::vector<RedirectOptionAttribute> redirectOptionAttributes() {
                 break;
         }
         if (a.kind != RedirectOptionAttribute::Kind::Text) a.number = value.front();
+        if (a.kind == RedirectOptionAttribute::Kind::Int || a.kind == RedirectOptionAttribute::Kind::Double) {
+            if (!spec.lowOpen) a.minimum = spec.low;
+            a.maximum = spec.high;
+        }
         out.push_back(std::move(a));
     }
     return out;

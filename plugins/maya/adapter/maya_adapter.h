@@ -246,6 +246,10 @@ struct RedirectOptionAttribute {
     Kind kind = Kind::Int;
     double number = 0.0;  // the default of Int, Double and Boolean attributes
     std::string text;     // the default of a Text attribute
+    // The declared range of an Int or Double attribute, for its slider and Maya's own clamping (a value
+    // below or above it never reaches compute); a range open at its low end gets no minimum there (the
+    // option's check names such a value at compute). Unset for Boolean and Text attributes.
+    std::optional<double> minimum, maximum;
 };
 [[nodiscard]] std::vector<RedirectOptionAttribute> redirectOptionAttributes();
 

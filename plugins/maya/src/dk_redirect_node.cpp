@@ -72,6 +72,8 @@ MStatus DkUvRedirect::initialize() {
                                                                   : MFnNumericData::kBoolean;
             MFnNumericAttribute fn;
             attribute = fn.create(name, name, type, a.number);
+            if (a.minimum) fn.setMin(*a.minimum);
+            if (a.maximum) fn.setMax(*a.maximum);
         }
         addAttribute(attribute);
         options.push_back(attribute);

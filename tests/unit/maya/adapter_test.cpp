@@ -684,16 +684,21 @@ TEST_CASE("maya adapter: dkUvRedirect has an attribute per UV-warp option, named
             case uvwarp::OptionType::Flag:
                 CHECK(a.kind == Kind::Boolean);
                 CHECK(a.number == first);
+                CHECK((!a.minimum && !a.maximum));
                 inRange = first != 0 ? 0.0 : 1.0;
                 break;
             case uvwarp::OptionType::Integer:
                 CHECK(a.kind == Kind::Int);
                 CHECK(a.number == first);
+                CHECK(a.minimum == std::optional<double>(spec.low));
+                CHECK(a.maximum == std::optional<double>(spec.high));
                 inRange = spec.powerOfTwo ? 8.0 : first < spec.high ? first + 1.0 : first - 1.0;
                 break;
             case uvwarp::OptionType::Number:
                 CHECK(a.kind == Kind::Double);
                 CHECK(a.number == first);
+                CHECK(a.minimum == (spec.lowOpen ? std::nullopt : std::optional<double>(spec.low)));
+                CHECK(a.maximum == std::optional<double>(spec.high));
                 inRange = first < spec.high ? (first + spec.high) / 2 : (spec.low + spec.high) / 2;
                 above = spec.high + 0.5;
                 if (!spec.lowOpen) below = spec.low - 0.5;

@@ -182,6 +182,8 @@ class MFnNumericAttribute : public MFnAttribute {
   public:
     MObject create(const MString&, const MString&, MFnNumericData::Type, double = 0, MStatus* = nullptr);
     MStatus setDefault(int, int, int);
+    MStatus setMin(double);
+    MStatus setMax(double);
 };
 class MFnMatrixAttribute : public MFnAttribute {
   public:
