@@ -169,39 +169,52 @@ void PtexMesh::requireSameMesh(const PtexFile& file, const std::string& fileSour
     }
     // Polygon by polygon, corner by corner: the same sizes, and the file's vertices one-to-one with the
     // mesh's (a renumbering of vertices keeps every face's texels where they were; another order of
-    // polygons does not).
-    std::unordered_map<int32_t, int32_t> meshVertexOf, fileVertexOf;
-    size_t corner = 0;
-    for (size_t f = 0; f < faceCounts_.size(); ++f) {
-        const int32_t n = faceCounts_[f];
-        const auto polygon = [&](const std::string& problem) {
-            throw InvalidInput(
-                formatError(fileSource, "metadata: polygon " + std::to_string(f), problem, expected));
-        };
-        if (counts->int32s[f] != n) {
-            polygon("has " + std::to_string(counts->int32s[f]) + " corners where mesh polygon " +
-                    std::to_string(f) + " has " + std::to_string(n));
-        }
-        if (indices->int32s.size() < corner + static_cast<size_t>(n))
-            polygon("has no PtexFaceVertIndices left");
-        for (int32_t c = 0; c < n; ++c, ++corner) {
-            const int32_t theirs = indices->int32s[corner], ours = connectivity_[corner];
-            const auto [mine, addedMine] = meshVertexOf.try_emplace(theirs, ours);
-            const auto [other, addedOther] = fileVertexOf.try_emplace(ours, theirs);
-            if (mine->second != ours || other->second != theirs) {
-                // The earlier pairing this corner breaks: of its file vertex, or of its mesh vertex.
-                const std::string earlier = mine->second != ours
-                                                ? "file vertex " + std::to_string(theirs) +
-                                                      " was mesh vertex " + std::to_string(mine->second)
-                                                : "mesh vertex " + std::to_string(ours) +
-                                                      " was file vertex " + std::to_string(other->second);
-                polygon("corner " + std::to_string(c) + " pairs file vertex " + std::to_string(theirs) +
-                        " with mesh vertex " + std::to_string(ours) + ", but in the polygons before it " +
-                        earlier +
-                        ": the file was painted on another mesh, or on its polygons in another order");
+    // polygons does not): with the welded vertices (a painter's shared-vertex mesh, DeformKit's metadata),
+    // or else with the file's own (metadata that lists the split vertices, as a tool writing the split mesh
+    // as it is would).
+    const auto pairing = [&](const std::vector<int32_t>& mine) -> std::string {
+        std::unordered_map<int32_t, int32_t> meshVertexOf, fileVertexOf;
+        size_t corner = 0;
+        for (size_t f = 0; f < faceCounts_.size(); ++f) {
+            const int32_t n = faceCounts_[f];
+            const std::string polygon = "metadata: polygon " + std::to_string(f);
+            if (counts->int32s[f] != n) {
+                return formatError(fileSource, polygon,
+                                   "has " + std::to_string(counts->int32s[f]) +
+                                       " corners where mesh polygon " + std::to_string(f) + " has " +
+                                       std::to_string(n),
+                                   expected);
+            }
+            if (indices->int32s.size() < corner + static_cast<size_t>(n))
+                return formatError(fileSource, polygon, "has no PtexFaceVertIndices left", expected);
+            for (int32_t c = 0; c < n; ++c, ++corner) {
+                const int32_t theirs = indices->int32s[corner], ours = mine[corner];
+                const auto [meshSide, addedMine] = meshVertexOf.try_emplace(theirs, ours);
+                const auto [fileSide, addedOther] = fileVertexOf.try_emplace(ours, theirs);
+                if (meshSide->second != ours || fileSide->second != theirs) {
+                    // The earlier pairing this corner breaks: of its file vertex, or of its mesh vertex.
+                    const std::string earlier =
+                        meshSide->second != ours ? "file vertex " + std::to_string(theirs) +
+                                                       " was mesh vertex " + std::to_string(meshSide->second)
+                                                 : "mesh vertex " + std::to_string(ours) +
+                                                       " was file vertex " + std::to_string(fileSide->second);
+                    return formatError(fileSource, polygon,
+                                       "corner " + std::to_string(c) + " pairs file vertex " +
+                                           std::to_string(theirs) + " with mesh vertex " +
+                                           std::to_string(ours) + ", but in the polygons before it " +
+                                           earlier +
+                                           ": the file was painted on another mesh, or on its polygons in "
+                                           "another order",
+                                       expected);
+                }
             }
         }
-    }
+        return {};
+    };
+    const std::string welded = pairing(connectivity_);
+    if (welded.empty()) return;
+    if (connectivity_ != faceIndices_ && pairing(faceIndices_).empty()) return;
+    throw InvalidInput(welded);
 }
 
 MeshData meshData(const geom::Mesh& mesh) {

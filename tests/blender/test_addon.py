@@ -1303,19 +1303,51 @@ def test_redirect_nodes_read_the_solved_uv_map_through_the_materials_mapping():
     assert source.type == 'UVMAP' and source.uv_map == "UVMap"
     assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}  # off
 
+    # Through a Reroute and an offset added to the UVs, the redirect goes where the UVs enter (not into the
+    # offset's constant); a texture read at object coordinates is left alone, and said so.
+    fresh_material = bpy.data.materials.new("offset")
+    fresh_material.use_nodes = True
+    obj.data.materials[0] = fresh_material
+    tree = fresh_material.node_tree
+    shifted = tree.nodes.new('ShaderNodeTexImage')
+    shifted.image = bpy.data.images.new("detail", 8, 8)
+    add_offset = tree.nodes.new('ShaderNodeVectorMath')
+    add_offset.operation = 'ADD'
+    reroute = tree.nodes.new('NodeReroute')
+    uv_node = tree.nodes.new('ShaderNodeUVMap')
+    uv_node.uv_map = "UVMap"
+    tree.links.new(uv_node.outputs["UV"], reroute.inputs[0])
+    tree.links.new(reroute.outputs[0], add_offset.inputs[1])  # input 0 keeps its constant offset
+    tree.links.new(add_offset.outputs["Vector"], shifted.inputs["Vector"])
+    projected = tree.nodes.new('ShaderNodeTexImage')
+    projected.image = bpy.data.images.new("projected", 8, 8)
+    coordinates = tree.nodes.new('ShaderNodeTexCoord')
+    tree.links.new(coordinates.outputs["Object"], projected.inputs["Vector"])
+    skipped = []
+    addon.uvwarp.add_live_nodes(fresh_material, obj, bpy.data.images.new("live", 8, 8), skipped)
+    group = next(n for n in tree.nodes if n.type == 'GROUP')
+    assert not add_offset.inputs[0].is_linked, "the offset's constant stays"
+    assert add_offset.inputs[1].links[0].from_node == reroute
+    assert reroute.inputs[0].links[0].from_node == group
+    assert group.inputs["UV"].links[0].from_node.uv_map == "UVMap"
+    assert projected.inputs["Vector"].links[0].from_node == coordinates
+    assert skipped == [projected.name], skipped
+
     # Another object renamed to take this one's name while live: each keeps its own image.
     first = obj
-    first_image = addon.uvwarp._live.get(first.as_pointer())
     assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
+    first_image = addon.uvwarp._live[first.as_pointer()]["image"]
+    assert first_image == "DeformKit Live grid"
     first.name = "renamed"
     second = grid_object("grid")
     second.data.uv_layers.new(name="UVMap").data.foreach_set("uv", (corners * 0.45 + 0.5).ravel())
     add("twist")
     second.deformkit.uv_rigidity = rigidity
     assert bpy.ops.deformkit.uvwarp_live() == {'FINISHED'}
-    images = {addon.uvwarp._live[o.as_pointer()]["image"] for o in (first, second)}
-    assert len(images) == 2, images
-    assert first_image is None
+    assert addon.uvwarp._live[first.as_pointer()]["image"] == first_image
+    second_image = addon.uvwarp._live[second.as_pointer()]["image"]
+    assert second_image != first_image, second_image
+    assert bpy.data.images[second_image] != bpy.data.images[first_image]
 
 
 def main():

@@ -94,32 +94,29 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
     return in;
 }
 
-// The fewest bytes a file can hold the declared pixels in: an OpenEXR file has an 8-byte offset and a chunk
-// header of at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles); other
-// formats compress by at most 4096 to 1 (deflate 1032, LZW under 2731, run lengths 128). A header that
-// declares more (a few hundred bytes claiming gigapixels) is refused before its pixels are allocated.
+// The fewest bytes an OpenEXR file can hold the declared pixels in: an 8-byte offset and a chunk header of
+// at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles), whatever the
+// pixels hold. A header that declares more (a few hundred bytes claiming gigapixels) is refused before its
+// pixels are allocated. 0 for other formats, whose packing (1-bit PNGs, bilevel TIFFs) bounds nothing here.
 uint64_t fewestFileBytes(const codec::Spec& spec, std::string_view format) {
+    if (format != "openexr") return 0;
     const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
-    if (format == "openexr") {
-        uint64_t chunks = 0;
-        if (spec.tileWidth > 0 && spec.tileHeight > 0) {
-            chunks =
-                ((w + static_cast<uint64_t>(spec.tileWidth) - 1) / static_cast<uint64_t>(spec.tileWidth)) *
-                ((h + static_cast<uint64_t>(spec.tileHeight) - 1) / static_cast<uint64_t>(spec.tileHeight));
-        } else {
-            uint64_t lines = 256;  // DWAB's, the most; an unknown compression gets it too
-            for (const auto& [name, value] : spec.stringAttributes) {
-                if (name != "compression") continue;
-                if (value == "none" || value == "rle" || value == "zips") lines = 1;
-                if (value == "zip" || value == "pxr24") lines = 16;
-                if (value == "piz" || value == "b44" || value == "b44a" || value.rfind("dwaa", 0) == 0)
-                    lines = 32;
-            }
-            chunks = (h + lines - 1) / lines;
+    uint64_t chunks = 0;
+    if (spec.tileWidth > 0 && spec.tileHeight > 0) {
+        chunks = ((w + static_cast<uint64_t>(spec.tileWidth) - 1) / static_cast<uint64_t>(spec.tileWidth)) *
+                 ((h + static_cast<uint64_t>(spec.tileHeight) - 1) / static_cast<uint64_t>(spec.tileHeight));
+    } else {
+        uint64_t lines = 256;  // DWAB's, the most; an unknown compression gets it too
+        for (const auto& [name, value] : spec.stringAttributes) {
+            if (name != "compression") continue;
+            if (value == "none" || value == "rle" || value == "zips") lines = 1;
+            if (value == "zip" || value == "pxr24") lines = 16;
+            if (value == "piz" || value == "b44" || value == "b44a" || value.rfind("dwaa", 0) == 0)
+                lines = 32;
         }
-        return chunks * 16;
+        chunks = (h + lines - 1) / lines;
     }
-    return w * h * static_cast<uint64_t>(spec.channels) / 4096;
+    return chunks * 16;
 }
 
 uint32_t bigEndian32(const unsigned char* p) {
@@ -253,11 +250,11 @@ Image readImage(const fs::path& path, const ImageReadOptions& options) {
     try {
         image = Image(spec.width, spec.height, spec.channels);
     } catch (const std::bad_alloc&) {
-        throw InvalidInput(formatError(path.string(), "",
-                                       "image of " + std::to_string(spec.width) + "x" +
-                                           std::to_string(spec.height) + " pixels with " +
-                                           channelCount(spec.channels) + " is too large to load",
-                                       "an image that fits in memory"));
+        // Memory that ran out, not a bad file: exit 1, as any out-of-memory (a larger machine may do).
+        throw OutOfMemory(formatError(path.string(), "",
+                                      "cannot be read into memory: " + pixels + " (" +
+                                          std::to_string(count * sizeof(float)) + " bytes)",
+                                      "the image to fit in this machine's memory"));
     }
     if (!in->readFloats(image.pixels.data())) {
         throw ParseError(formatError(path.string(), "pixels", "cannot read: " + oiioError(oiio, in->error()),

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -327,33 +328,36 @@ std::vector<std::string> meshGroupNames(const aiScene& scene) {
     return names;
 }
 
-// assimp drops what it cannot read (faces with an index past the vertices, a UV stream shorter than the
-// vertices, a trailing vertex that makes no triangle) and says so only in a warning: those warnings are
-// collected while a file is read on this thread, and the file is refused. Other warnings (an unreferenced
-// vertex, a bone weight out of range) lose nothing the mesh keeps.
+// assimp drops what it cannot read of what the mesh keeps (faces with an index past the vertices, a UV
+// stream shorter than the vertices, a trailing vertex that makes no triangle, a morph target's positions of
+// another count) and says so only in a warning: those warnings are collected while a file is read, and the
+// file is refused. Other warnings (an unreferenced vertex, normals or colours of another count, lines left
+// out) lose nothing the mesh keeps. Reads go one at a time: assimp's logger writes every message through
+// one shared buffer, and the warnings must be the file's own.
 class DroppedDataLog : public Assimp::LogStream {
   public:
-    // The warnings of the reads under way on this thread, while a Collect lives.
-    struct Collect {
-        Collect() {
+    // While a Collect lives: reads are serialised and their warnings kept.
+    class Collect {
+      public:
+        Collect() : lock_(mutex()) {
             install();
             warnings().clear();
-            active() = true;
         }
-        ~Collect() { active() = false; }
         Collect(const Collect&) = delete;
         Collect& operator=(const Collect&) = delete;
         [[nodiscard]] std::optional<std::string> dropped() const {
             for (const std::string& w : warnings())
-                for (const char* sign :
-                     {"dropped", "does not match the vertex count", "out-of-range indices"})
+                for (const char* sign : {"Texcoord stream size", "not compatible with the TRIANGLE",
+                                         "out-of-range indices", "Positions of target"})
                     if (w.find(sign) != std::string::npos) return w;
             return std::nullopt;
         }
+
+      private:
+        std::lock_guard<std::mutex> lock_;
     };
 
     void write(const char* message) override {
-        if (!active()) return;
         std::string text(message);
         while (!text.empty() && (text.back() == '\n' || text.back() == '\r'))
             text.pop_back();
@@ -362,24 +366,25 @@ class DroppedDataLog : public Assimp::LogStream {
     }
 
   private:
-    static bool& active() {
-        thread_local bool on = false;
-        return on;
+    static std::mutex& mutex() {
+        static std::mutex m;
+        return m;
     }
     static std::vector<std::string>& warnings() {
-        thread_local std::vector<std::string> list;
+        static std::vector<std::string> list;
         return list;
     }
-    // Once per process: a logger when the process has none (assimp's default logs nothing), this stream on
-    // its warnings. A logger another part of the process made keeps its own streams.
+    // A logger when the process has none (assimp's default logs nothing), and this stream on its warnings;
+    // again on a logger made since (another part of the process may replace it). Under the lock.
     static void install() {
-        static const bool installed = [] {
-            if (Assimp::DefaultLogger::isNullLogger())
-                Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no debugger
-            Assimp::DefaultLogger::get()->attachStream(new DroppedDataLog, Assimp::Logger::Warn);
-            return true;
-        }();
-        (void)installed;
+        static Assimp::Logger* attachedTo = nullptr;
+        if (Assimp::DefaultLogger::isNullLogger())
+            Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no debugger
+        Assimp::Logger* logger = Assimp::DefaultLogger::get();
+        if (logger != attachedTo) {
+            logger->attachStream(new DroppedDataLog, Assimp::Logger::Warn);
+            attachedTo = logger;
+        }
     }
 };
 
@@ -473,11 +478,12 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
             for (unsigned c = 0; c < face.mNumIndices; ++c)
                 points.push_back(pointOf[face.mIndices[c]]);
             const std::vector<std::vector<size_t>> loops = polygonLoops(points);
-            // Repaired, as an OBJ counts it: a polygon that has a point twice (after welding).
+            // Repaired, as an OBJ counts it: a polygon that has a point twice (after welding) and keeps a
+            // loop (a sliver of coincident points is left out, as points and lines are).
             std::sort(points.begin(), points.end());
             const auto distinct =
                 static_cast<size_t>(std::unique(points.begin(), points.end()) - points.begin());
-            if (face.mNumIndices >= 3 && distinct < face.mNumIndices) {
+            if (face.mNumIndices >= 3 && distinct < face.mNumIndices && !loops.empty()) {
                 if (repaired++ == 0) firstRepaired = "mesh '" + meshName + "' face " + std::to_string(f);
             }
             for (const std::vector<size_t>& loop : loops) {

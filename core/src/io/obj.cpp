@@ -213,7 +213,7 @@ class ObjParser {
         auto [ptr, ec] = std::from_chars(first, end_, value);
         if (ec == std::errc::result_out_of_range) {
             // Underflow (a tiny value) is fine: it rounds to zero or a subnormal. Beyond double's range too
-            // (1e-400), the sign of the value's exponent tells underflow from overflow.
+            // (1e-400): read in long double, which holds it, and narrowed to 0.
             long double wide = 0.0L;
             const auto r = std::from_chars(first, end_, wide);
             auto narrowed = static_cast<float>(wide);
@@ -577,7 +577,14 @@ ObjContent parseObj(std::string_view text, const std::string& source) {
     if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
     // A CR alone ends a line (classic Mac OS editors and exporters, or files pasted together from both): read
     // as a blank, it would join two statements and drop the second. CR LF stays one line end.
-    auto loneCr = [&](size_t i) { return text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'); };
+    // CRs before an LF (CR LF, or CR CR LF from a file converted twice) are blanks of that one line end.
+    auto loneCr = [&](size_t i) {
+        if (text[i] != '\r') return false;
+        size_t next = i + 1;
+        while (next < text.size() && text[next] == '\r')
+            ++next;
+        return next == text.size() || text[next] != '\n';
+    };
     for (size_t i = text.find('\r'); i != std::string_view::npos; i = text.find('\r', i + 1)) {
         if (!loneCr(i)) continue;
         std::string lines(text);

@@ -473,6 +473,8 @@ class Reader {
                 if (!std::binary_search(meshTiles.begin(), meshTiles.end(), tile))
                     fail(tp, "is " + std::to_string(tile) + ", a tile without UV faces",
                          "a tile of the rest mesh: " + have);
+                if (std::find(u.tiles.begin(), u.tiles.end(), tile) != u.tiles.end())
+                    fail(tp, "is " + std::to_string(tile) + ", listed before", "each tile once");
                 u.tiles.push_back(tile);
             }
             std::sort(u.tiles.begin(), u.tiles.end());

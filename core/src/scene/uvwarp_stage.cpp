@@ -114,6 +114,9 @@ uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpSt
     if (stage.orientation) job.orientation.pattern = *stage.orientation;
     if (stage.texture) job.texture.pattern = *stage.texture;
     job.rigidity.name = scene.source + ": " + stage.path + ".rigidity";
+    if (stage.mask) job.mask.name = scene.source + ": " + stage.path + ".mask";
+    if (stage.orientation) job.orientation.name = scene.source + ": " + stage.path + ".orientation";
+    if (stage.texture) job.texture.name = scene.source + ": " + stage.path + ".texture";
     const std::string name = o.name;
     const fs::path outDir = run.outDir;
     job.outPath = [name, outDir](int tile, int frame) {

@@ -336,17 +336,26 @@ def _shape(obj):
     samples = ()
     if attribute is not None and n > 0 and len(attribute.data) == n:
         samples = tuple(tuple(attribute.data[i].vector) for i in (0, n // 2, n - 1))
-    # Three corners' vertices too: polygons edited without changing the counts (normals flipped) are noticed
-    # in the session, as a reopened file notices them.
+    # Three corners' vertices too: polygons edited without changing the counts (every normal flipped) are
+    # noticed when such a corner changes; leaving Edit Mode rebuilds the stack, which checks every polygon
+    # (put_off), as a reopened file does.
     loops = len(mesh.loops)
     corners = tuple(mesh.loops[i].vertex_index for i in (0, loops // 2, loops - 1)) if loops > 0 else ()
     return (mesh.as_pointer(), n, len(mesh.polygons), loops, samples, corners)
 
 
+def put_off(obj):
+    """`obj` is in Edit Mode, where Blender keeps its mesh apart: its evaluation waits for Object Mode, and
+    the stack is built again then (its polygons checked against the rest shape's)."""
+    _pending.add(_key(obj))
+
+
 def take_pending(obj):
-    """True once after an evaluation of `obj` was put off because it was in Edit Mode."""
+    """True once after an evaluation of `obj` was put off because it was in Edit Mode; its cached stack is
+    dropped, so the next evaluation checks the mesh's polygons again."""
     if _key(obj) in _pending:
         _pending.discard(_key(obj))
+        _cache.pop(_key(obj), None)
         return True
     return False
 
@@ -447,7 +456,7 @@ def evaluate_object(obj, depsgraph=None, force=False):
     if obj.mode == 'EDIT':
         # Blender keeps an Edit Mode mesh apart and writes it back on leaving: positions written now
         # would be lost. The evaluation waits for Object Mode (take_pending).
-        _pending.add(_key(obj))
+        put_off(obj)
         return
     if obj.data.shape_keys is not None:
         raise DeformKitError(f"{obj.name}: the mesh has shape keys, which Blender shows in place of the vertex "

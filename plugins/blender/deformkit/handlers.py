@@ -54,7 +54,10 @@ def on_depsgraph_update(scene, depsgraph):
     _busy = True
     try:
         for obj in _stacked_objects(scene):
-            if obj.mode != 'EDIT' and evaluate.take_pending(obj):
+            if obj.mode == 'EDIT':
+                evaluate.put_off(obj)  # edited apart: evaluated, its polygons checked, on leaving
+                continue
+            if evaluate.take_pending(obj):
                 # Back from Edit Mode, which wrote its own positions: the current frame, evaluated again.
                 evaluate.evaluate_safely(obj, depsgraph, force=True)
                 continue

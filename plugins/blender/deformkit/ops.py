@@ -451,6 +451,14 @@ class DEFORMKIT_OT_open_uvwarp_report(bpy.types.Operator):
         return {'FINISHED'}
 
 
+def _report_skipped(operator, material, skipped):
+    """Says which image textures the redirect leaves alone (read at other coordinates than UVs)."""
+    if skipped:
+        operator.report({'WARNING'}, f"material '{material.name}': image textures not read at UVs (through "
+                                     f"a node group, object coordinates or a constant) are left alone: "
+                                     f"{', '.join(skipped)}")
+
+
 class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
     """Read every image texture of the active material through the baked redirect maps (tile 1001)"""
     bl_idname = "deformkit.redirect_material"
@@ -480,12 +488,14 @@ class DEFORMKIT_OT_redirect_material(bpy.types.Operator):
         if not os.path.exists(first):
             self.report({'ERROR'}, f"no redirect map {first}; bake the redirect maps first")
             return {'CANCELLED'}
+        skipped = []
         try:
             uvwarp.add_redirect_nodes(obj.active_material, obj, first, self.frame_start,
-                                      self.frame_end - self.frame_start + 1)
+                                      self.frame_end - self.frame_start + 1, skipped)
         except uvwarp.UvWarpError as e:
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
+        _report_skipped(self, obj.active_material, skipped)
         return {'FINISHED'}
 
 
@@ -510,12 +520,14 @@ class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
             uvwarp.check_material(obj.active_material, obj)
             image = uvwarp.start_live(obj, settings.uv_rigidity, settings.uv_mask, settings.uv_resolution)
             uvwarp.live_update(obj, context.evaluated_depsgraph_get())
+            skipped = []
             if obj.active_material is not None:
-                uvwarp.add_live_nodes(obj.active_material, obj, image)
+                uvwarp.add_live_nodes(obj.active_material, obj, image, skipped)
         except Exception as e:  # noqa: BLE001 - reported to the user
             uvwarp.stop_live(obj)
             self.report({'ERROR'}, str(e))
             return {'CANCELLED'}
+        _report_skipped(self, obj.active_material, skipped)
         self.report({'INFO'}, f"{obj.name}: live UV warp on, {image.size[0]}² redirect map '{image.name}'")
         return {'FINISHED'}
 

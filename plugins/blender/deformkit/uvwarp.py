@@ -177,8 +177,11 @@ def redirect_group():
 def _uv_source(texture):
     """Where an image texture's coordinates come from: (the input socket its UVs enter the chain at, the
     socket giving them or None for the default UV map, the UV map's name or '' for the render map), walking
-    up through Mapping and vector nodes; None when the texture is not read at UVs (object coordinates)."""
+    up through Reroutes, Mapping and vector nodes; None when the texture is not read at UVs (object
+    coordinates, a constant, a node group or another node this walk does not know)."""
     socket = texture.inputs["Vector"]
+    if not socket.is_linked:
+        return socket, None, ""  # an image texture's own unlinked Vector reads the render UV map
     while socket.is_linked:
         link = socket.links[0]
         node, output = link.from_node, link.from_socket
@@ -186,19 +189,25 @@ def _uv_source(texture):
             return socket, output, node.uv_map
         if node.type == 'TEX_COORD':
             return (socket, output, "") if output.name == "UV" else None
-        if node.type == 'GROUP' and node.node_tree is not None and node.node_tree.name == GROUP_NAME:
-            return None  # read through a redirect already
-        upstream = node.inputs.get("Vector") if node.type in ('MAPPING', 'VECTOR_ROTATE', 'VECT_TRANSFORM') \
-            else node.inputs[0] if node.type == 'VECT_MATH' else None
-        if upstream is None:
+        if node.type == 'REROUTE':
+            socket = node.inputs[0]
+        elif node.type in ('MAPPING', 'VECTOR_ROTATE', 'VECT_TRANSFORM'):
+            socket = node.inputs["Vector"]
+        elif node.type == 'VECT_MATH':
+            # The vector operand the UVs come through: the one input of the first two that is linked.
+            linked = [i for i in node.inputs[:2] if i.is_linked]
+            if len(linked) != 1:
+                return None
+            socket = linked[0]
+        else:
             return None
-        socket = upstream
-    return socket, None, ""
+    return None  # an unlinked input inside the chain holds a constant, not the UVs
 
 
-def _uv_textures(material, obj):
+def _uv_textures(material, obj, skipped=None):
     """The material's image textures read at UVs, each with its _uv_source; raises UvWarpError for one that
-    reads another UV map than the warp is solved on."""
+    reads another UV map than the warp is solved on. The names of textures read otherwise (object
+    coordinates, through a node group) go to `skipped`."""
     solved = solved_uv_map(obj)
     render = next((layer.name for layer in obj.data.uv_layers if layer.active_render), solved)
     found = []
@@ -207,6 +216,8 @@ def _uv_textures(material, obj):
             continue
         source = _uv_source(node)
         if source is None:
+            if skipped is not None and not _redirected(node):
+                skipped.append(node.name)
             continue
         read = source[2] or render
         if read != solved:
@@ -217,17 +228,30 @@ def _uv_textures(material, obj):
     return found
 
 
+def _redirected(texture):
+    """True when the texture already reads through the redirect group (a bake's or live nodes)."""
+    socket = texture.inputs["Vector"]
+    while socket.is_linked:
+        node = socket.links[0].from_node
+        if node.type == 'GROUP' and node.node_tree is not None and node.node_tree.name == GROUP_NAME:
+            return True
+        socket = node.inputs[0] if len(node.inputs) > 0 else None
+        if socket is None:
+            return False
+    return False
+
+
 def check_material(material, obj):
     """Raises UvWarpError when the material's textures cannot be read through the warp of obj's UVs."""
     if material is not None:
         _uv_textures(material, obj)
 
 
-def _insert_redirect(material, image, obj):
+def _insert_redirect(material, image, obj, skipped=None):
     """Reads every image texture of `material` read at UVs through `image`: the redirect nodes it has are
     pointed at it, or a UV Map node of the solved map, the redirect image read there and the group are put
     where each texture's UVs enter its chain (its Mapping and vector nodes stay after the redirect). Returns
-    the redirect image node."""
+    the redirect image node. Textures not read at UVs are left alone, their names added to `skipped`."""
     material.use_nodes = True
     existing = _redirect_nodes(material)
     for node in existing:
@@ -235,7 +259,7 @@ def _insert_redirect(material, image, obj):
     if existing:
         return existing[0]
     tree = material.node_tree
-    textures = _uv_textures(material, obj)
+    textures = _uv_textures(material, obj, skipped)
     uv = tree.nodes.new('ShaderNodeUVMap')
     uv.uv_map = solved_uv_map(obj)
     redirect = tree.nodes.new('ShaderNodeTexImage')
@@ -260,14 +284,14 @@ def _redirect_nodes(material):
     return [n for n in tree.nodes if n.type == 'TEX_IMAGE' and n.label == GROUP_NAME] if tree else []
 
 
-def add_redirect_nodes(material, obj, first_map, frame_start, frame_count):
+def add_redirect_nodes(material, obj, first_map, frame_start, frame_count, skipped=None):
     """Reads every image texture of `material` read at obj's UVs through the baked redirect map sequence
-    (first file `first_map`). Returns the group node."""
+    (first file `first_map`); the names of those it leaves alone go to `skipped`. Returns the group node."""
     check_material(material, obj)
     image = bpy.data.images.load(first_map, check_existing=True)
     image.source = 'SEQUENCE'
     image.colorspace_settings.name = 'Non-Color'
-    redirect = _insert_redirect(material, image, obj)
+    redirect = _insert_redirect(material, image, obj, skipped)
     redirect.image_user.frame_start = frame_start
     redirect.image_user.frame_duration = frame_count
     redirect.image_user.frame_offset = frame_start - 1
@@ -387,7 +411,8 @@ def live_rate(obj):
     return 1000.0 / ms, ms
 
 
-def add_live_nodes(material, obj, image):
+def add_live_nodes(material, obj, image, skipped=None):
     """Reads every image texture of `material` read at obj's UVs through the live image: the redirect node
-    the material has (a bake's) is pointed at it, or the nodes are inserted."""
-    _insert_redirect(material, image, obj)
+    the material has (a bake's) is pointed at it, or the nodes are inserted; the names of textures left
+    alone go to `skipped`."""
+    _insert_redirect(material, image, obj, skipped)

@@ -347,6 +347,9 @@ TEST_CASE("obj: errors name the file, the line and what was expected", "[io][obj
         CHECK(std::ranges::equal(mixed.mesh.faceIndices(), std::vector<int32_t>{0, 1, 2, 3}));
         CHECK_THROWS_WITH(parseObj("v 0 0 0\ns off\rv 1 0\r\n", "mix.obj"),
                           Catch::Contains("mix.obj: line 3: "));
+        // CR CR LF (a file converted twice) is one line end, so line numbers stay the editor's.
+        CHECK_THROWS_WITH(parseObj("v 0 0 0\r\r\nv 1 0 0\r\r\nv 1 0\r\r\n", "twice.obj"),
+                          Catch::Contains("twice.obj: line 3: "));
     }
     SECTION("NaN and infinity as old Microsoft runtimes print them; a comment right after a number") {
         for (const char* text : {"1.#QNAN", "-1.#IND00", "1.#INF", "1.#SNAN", "-1.#INF0"}) {

@@ -562,6 +562,16 @@ TEST_CASE("ptex mesh: split vertices (glTF, FBX) are one vertex: faces across a 
                   metadata.vertPositions[3 * static_cast<size_t>(theirs) + k]);
     }
     CHECK(sharedOf.size() == 11u);
+    // Metadata that lists the split vertices themselves (a tool writing the split mesh as it is) belongs too.
+    ptex::PtexFile asSplit = bakePaint(shared, a, 1);
+    asSplit.metadata.push_back(ptex::MetaValue::ofInt32("PtexFaceVertCounts", metadata.faceVertCounts));
+    asSplit.metadata.push_back(ptex::MetaValue::ofInt32(
+        "PtexFaceVertIndices", std::vector<int32_t>(split.faceIndices().begin(), split.faceIndices().end())));
+    CHECK(ptex::vertexValues(b, asSplit, "split.ptx") == onSplit);
+    // and not to the shared mesh, two of whose corners it numbers apart.
+    CHECK_THROWS_WITH(
+        ptex::vertexValues(a, asSplit, "split.ptx"),
+        Catch::Contains("split.ptx: metadata: polygon 1: corner 0 pairs file vertex 4 with mesh vertex 1"));
 }
 
 TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[ptex][mesh][udim]") {

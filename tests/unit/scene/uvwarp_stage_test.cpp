@@ -79,6 +79,8 @@ TEST_CASE("scene uvwarp: bad UV-warp entries name the scene file and the JSON pa
          ": objects[0].stack[0].tiles[1]: is 1005, a tile without UV faces (expected a tile of the rest "
          "mesh: "
          "1001 1002)"},
+        {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "tiles": [1002, 1001, 1002]}])",
+         ": objects[0].stack[0].tiles[2]: is 1002, listed before (expected each tile once)"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "resolution": 48}])",
          ": objects[0].stack[0].resolution: is 48"},
         {"tubes.obj", R"([{"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "envelope": 0.5}])",
