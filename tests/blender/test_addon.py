@@ -1183,8 +1183,8 @@ def test_a_deformation_that_cannot_be_taken_back_is_never_taken_as_the_rest():
     assert_same(positions(obj), stack.evaluate(new_rest), "the twist, once, over grid and cube")
 
 
-def test_polygons_flipped_under_a_stack_are_refused_in_the_session_as_after_reopening():
-    # Flipping normals keeps the counts: the session went on with the old polygons, the saved file refused.
+def test_polygons_flipped_under_a_stack_are_refused_at_once_as_after_reopening():
+    # Flipping normals keeps the counts: the open file went on with the old polygons, the reopened one refused.
     fresh()
     obj = grid_object()
     twist = add("twist")

@@ -533,7 +533,7 @@ class DEFORMKIT_OT_uvwarp_live(bpy.types.Operator):
 
 
 _classes = (DEFORMKIT_OT_uvwarp_live, DEFORMKIT_OT_bake_redirect, DEFORMKIT_OT_open_uvwarp_report,
-            DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move, DEFORMKIT_OT_evaluate,
-            DEFORMKIT_OT_reset_rest, DEFORMKIT_OT_apply)
+            DEFORMKIT_OT_redirect_material, DEFORMKIT_OT_add, DEFORMKIT_OT_remove, DEFORMKIT_OT_move,
+            DEFORMKIT_OT_evaluate, DEFORMKIT_OT_reset_rest, DEFORMKIT_OT_apply)
 
 register, unregister = bpy.utils.register_classes_factory(_classes)
