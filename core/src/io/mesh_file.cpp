@@ -12,8 +12,10 @@
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <set>
+#include <span>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -467,26 +469,11 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         }
         FaceGroup group;
         group.name = groupNames[m];
-        std::vector<int32_t> points;
+        std::vector<int32_t> points, sorted;
+        std::vector<size_t> corners;  // 0 .. n - 1: a polygon of distinct points (nearly all) as it is
         for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
             const aiFace& face = mesh.mFaces[f];
-            // The polygon's loops, as an OBJ's (polygon_loops.h): a corner welded onto the one before it is
-            // dropped (a sliver of coincident points), a polygon that comes back to a point (a hole bridged
-            // to its outline) is split there, and what is left with fewer than 3 corners (points, lines,
-            // slivers) is left out.
-            points.clear();
-            for (unsigned c = 0; c < face.mNumIndices; ++c)
-                points.push_back(pointOf[face.mIndices[c]]);
-            const std::vector<std::vector<size_t>> loops = polygonLoops(points);
-            // Repaired, as an OBJ counts it: a polygon that has a point twice (after welding) and keeps a
-            // loop (a sliver of coincident points is left out, as points and lines are).
-            std::sort(points.begin(), points.end());
-            const auto distinct =
-                static_cast<size_t>(std::unique(points.begin(), points.end()) - points.begin());
-            if (face.mNumIndices >= 3 && distinct < face.mNumIndices && !loops.empty()) {
-                if (repaired++ == 0) firstRepaired = "mesh '" + meshName + "' face " + std::to_string(f);
-            }
-            for (const std::vector<size_t>& loop : loops) {
+            const auto emit = [&](std::span<const size_t> loop) {
                 group.faces.push_back(static_cast<int32_t>(data.faceCounts.size()));
                 data.faceCounts.push_back(static_cast<int32_t>(loop.size()));
                 for (const size_t c : loop) {
@@ -494,7 +481,28 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                     data.faceIndices.push_back(pointOf[k]);
                     if (anyUVs) data.uvIndices.push_back(uvs ? uvBase + static_cast<int32_t>(k) : -1);
                 }
+            };
+            points.clear();
+            for (unsigned c = 0; c < face.mNumIndices; ++c)
+                points.push_back(pointOf[face.mIndices[c]]);
+            sorted = points;
+            std::sort(sorted.begin(), sorted.end());
+            if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) {
+                if (points.size() < 3) continue;  // points and lines are left out
+                corners.resize(points.size());
+                std::iota(corners.begin(), corners.end(), size_t{0});
+                emit(corners);
+                continue;
             }
+            // The polygon's loops, as an OBJ's (polygon_loops.h): a corner welded onto the one before it is
+            // dropped (a sliver of coincident points), a polygon that comes back to a point (a hole bridged
+            // to its outline) is split there, and what is left with fewer than 3 corners is left out.
+            // Repaired, as an OBJ counts it, when a loop is kept.
+            const std::vector<std::vector<size_t>> loops = polygonLoops(points);
+            if (face.mNumIndices >= 3 && !loops.empty() && repaired++ == 0)
+                firstRepaired = "mesh '" + meshName + "' face " + std::to_string(f);
+            for (const std::vector<size_t>& loop : loops)
+                emit(loop);
         }
         if (!group.faces.empty()) groups.push_back(std::move(group));
     }

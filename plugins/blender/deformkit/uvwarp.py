@@ -174,11 +174,16 @@ def redirect_group():
     return group
 
 
+# _uv_source of a texture that already reads through the redirect group (a bake's or live nodes).
+_REDIRECTED = "redirected"
+
+
 def _uv_source(texture):
     """Where an image texture's coordinates come from: (the input socket its UVs enter the chain at, the
     socket giving them or None for the default UV map, the UV map's name or '' for the render map), walking
-    up through Reroutes, Mapping and vector nodes; None when the texture is not read at UVs (object
-    coordinates, a constant, a node group or another node this walk does not know)."""
+    up through Reroutes, Mapping and vector nodes; _REDIRECTED at the redirect group; None when the texture
+    is not read at UVs (object coordinates, a constant, a node group or another node this walk does not
+    know)."""
     socket = texture.inputs["Vector"]
     if not socket.is_linked:
         return socket, None, ""  # an image texture's own unlinked Vector reads the render UV map
@@ -189,6 +194,8 @@ def _uv_source(texture):
             return socket, output, node.uv_map
         if node.type == 'TEX_COORD':
             return (socket, output, "") if output.name == "UV" else None
+        if node.type == 'GROUP' and node.node_tree is not None and node.node_tree.name == GROUP_NAME:
+            return _REDIRECTED
         if node.type == 'REROUTE':
             socket = node.inputs[0]
         elif node.type in ('MAPPING', 'VECTOR_ROTATE', 'VECT_TRANSFORM'):
@@ -215,9 +222,9 @@ def _uv_textures(material, obj, skipped=None):
         if node.type != 'TEX_IMAGE' or node.label == GROUP_NAME:
             continue
         source = _uv_source(node)
-        if source is None:
-            if skipped is not None and not _redirected(node):
-                skipped.append(node.name)
+        if source is None and skipped is not None:
+            skipped.append(node.name)
+        if source is None or source == _REDIRECTED:
             continue
         read = source[2] or render
         if read != solved:
@@ -226,19 +233,6 @@ def _uv_textures(material, obj, skipped=None):
                               f"active UV map and solve again")
         found.append((node, source))
     return found
-
-
-def _redirected(texture):
-    """True when the texture already reads through the redirect group (a bake's or live nodes)."""
-    socket = texture.inputs["Vector"]
-    while socket.is_linked:
-        node = socket.links[0].from_node
-        if node.type == 'GROUP' and node.node_tree is not None and node.node_tree.name == GROUP_NAME:
-            return True
-        socket = node.inputs[0] if len(node.inputs) > 0 else None
-        if socket is None:
-            return False
-    return False
 
 
 def check_material(material, obj):
