@@ -511,10 +511,8 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                                        "has no polygon (" + std::to_string(scene->mNumMeshes) + " meshes)",
                                        "a file with at least one mesh of polygons"));
     }
-    ObjContent content{geom::Mesh(std::move(data), name), std::move(groups)};
-    content.repairedFaces = repaired;
-    content.firstRepairedFace = firstRepaired;
-    return content;
+    // Every member named (no line numbers in these files; every face here has its UVs or none has).
+    return ObjContent{geom::Mesh(std::move(data), name), std::move(groups), repaired, 0, firstRepaired, 0, 0};
 }
 
 }  // namespace
