@@ -4,7 +4,7 @@
         [--rounds N] [--grid-only | --mesh-only] [--profile]
 
 Two meshes: Keenan Crane's Spot (tests/data/spot) subdivided twice by Blender's Subdivision Surface
-(46,850 vertices), and a 1,001,000-vertex grid. On each, six scenes hold a copy of the mesh:
+(46,850 vertices), and a 1,001,000-vertex grid. On each, seven scenes hold a copy of the mesh:
   plain       no deformer: what a frame change costs anyway
   write       a handler writes precomputed positions into the mesh: the floor of any add-on that deforms
               by writing the mesh from Python (Blender then copies and evaluates the mesh again)
@@ -12,10 +12,11 @@ Two meshes: Keenan Crane's Spot (tests/data/spot) subdivided twice by Blender's 
               reads (the mesh left alone; the object tagged for evaluation)
   nodes       the same positions written into a vertex-only helper mesh that a Geometry Nodes modifier
               copies onto the mesh (Object Info, Sample Index by index, Set Position)
+  shapekey    the same positions written into a shape key of value 1 (the mesh left alone, its Key tagged)
   blender     SimpleDeform TWIST (angle keyed) then a Lattice modifier (4 x 4 x 4 points, B-spline, moved)
   deformkit   the add-on's stack: twist (angles keyed to the same twist) then FFD "As the Lattice" on the
               same lattice object
-write, cache and nodes are the three ways a Python add-on can hand Blender positions from a frame handler;
+write, cache, nodes and shapekey are the ways a Python add-on can hand Blender positions from a frame handler;
 each is checked to show, after frame_set, the shape its handler wrote in that frame. Each round sets every
 scene to the next frame with `scene.frame_set` (rounds alternate the scenes, so load from other processes
 falls on all of them alike) and times it. Printed: medians over the rounds, the
@@ -110,9 +111,9 @@ def pc2_header(vertices):
 
 
 def handler_floors(scenes, points):
-    """The three ways a Python add-on can give Blender positions from frame_change_post, each writing
-    precomputed positions (two sets, alternately): into the mesh, into a PC2 file read by a Mesh Cache
-    modifier, into a helper mesh read by a Geometry Nodes modifier."""
+    """The ways a Python add-on can give Blender positions from frame_change_post, each writing precomputed
+    positions (two sets, alternately): into the mesh, into a PC2 file read by a Mesh Cache modifier, into a
+    helper mesh read by a Geometry Nodes modifier, into a shape key."""
     SHAPES[:] = [points.ravel().copy(), (points * 1.001).ravel()]
 
     def alternate(kind, own, write):
@@ -181,10 +182,21 @@ def handler_floors(scenes, points):
 
     alternate("nodes", scene, write_helper)
 
+    scene, obj = scenes["shapekey"]
+    obj.shape_key_add(name="Basis")
+    block = obj.shape_key_add(name="Positions")
+    block.value = 1.0
+
+    def write_key(shape, block=block, key=obj.data.shape_keys):
+        block.data.foreach_set("co", shape)
+        key.update_tag()
+
+    alternate("shapekey", scene, write_key)
+
 
 def check_floors(scenes):
     """Each floor scene shows, after frame_set, the shape its handler wrote in that frame (no frame of lag)."""
-    for kind in ("write", "cache", "nodes"):
+    for kind in ("write", "cache", "nodes", "shapekey"):
         scene, obj = scenes[kind]
         scene.frame_set(7)
         evaluated = obj.evaluated_get(scene.view_layers[0].depsgraph).data
@@ -207,7 +219,7 @@ def build(mesh):
     for point in lattice_data.points:
         point.co_deform = mathutils.Vector(point.co) + mathutils.Vector(rng.uniform(-0.25, 0.25, 3))
     scenes = {}
-    for kind in ("plain", "write", "cache", "nodes", "blender", "deformkit"):
+    for kind in ("plain", "write", "cache", "nodes", "shapekey", "blender", "deformkit"):
         # The add-on's operators work on the context's scene: the deformkit copy goes there.
         scene = bpy.context.scene if kind == "deformkit" else bpy.data.scenes.new(kind)
         obj = bpy.data.objects.new(f"{mesh.name}_{kind}", mesh.copy())
@@ -287,7 +299,7 @@ def report(name, scenes):
     check_floors(scenes)
     t = time_scenes(scenes)
     blender_net, ours_net = t["blender"] - t["plain"], t["deformkit"] - t["plain"]
-    write_net, cache_net, nodes_net = (t[k] - t["plain"] for k in ("write", "cache", "nodes"))
+    write_net, cache_net, nodes_net, key_net = (t[k] - t["plain"] for k in ("write", "cache", "nodes", "shapekey"))
     vertices = len(scenes["plain"][1].data.vertices)
     print(f"{name} ({vertices:,} vertices), median of {rounds} frame changes each:")
     print(f"  plain frame change              {t['plain']:8.2f} ms")
@@ -299,6 +311,8 @@ def report(name, scenes):
           f"({cache_net / blender_net:.2f}x)")
     print(f"  a helper mesh + Geometry Nodes  {t['nodes']:8.2f} ms   net {nodes_net:8.2f} ms   "
           f"({nodes_net / blender_net:.2f}x)")
+    print(f"  a shape key                     {t['shapekey']:8.2f} ms   net {key_net:8.2f} ms   "
+          f"({key_net / blender_net:.2f}x)")
     print(f"  DeformKit / Blender (net)       {ours_net / blender_net:8.2f}x   (goal <= 0.5x)")
     print(f"  same deformation: meshes differ by {difference:.1e} of the bounding-box diagonal")
 
