@@ -180,27 +180,12 @@ void Deformer::prepare(size_t in, size_t out) {
 
 namespace {
 
-std::string pointText(const glm::vec3& p) {
-    std::string text = "(";
-    text += numberText(p.x);
-    text += ", ";
-    text += numberText(p.y);
-    text += ", ";
-    text += numberText(p.z);
-    text += ")";
-    return text;
-}
-
 // Parameters within float range can still take a point beyond it (an envelope of 1e38, a bend of
-// 3e38 radians a unit): refused here, naming the point, rather than handed on as NaN or infinity.
+// 3e38 radians a unit): refused here, naming the point, rather than handed on as NaN or infinity. The
+// input is finite (the stack checks it), so the message gives the point before and after.
 void requireFiniteOutput(const std::string& context, std::span<const glm::vec3> in,
                          std::span<const glm::vec3> out) {
-    const size_t u = geom::firstNonFinite(out);
-    if (u == out.size()) return;
-    throw InvalidInput(formatError(context, "point " + std::to_string(u),
-                                   "is deformed from " + pointText(in[u]) + " to " + pointText(out[u]),
-                                   "finite positions: parameters that keep the deformation within float "
-                                   "range"));
+    warp::requireFiniteResult(context, in, out, static_cast<int64_t>(geom::firstNonFinite(out)));
 }
 
 }  // namespace
@@ -233,7 +218,9 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
         } else {
             deform(in, out);
             // k = 1 everywhere gives the deformed positions bit for bit: no pass needed.
-            if (!weights.empty() || envelope != 1.0) warp::applyEnvelope(in, out, weights, envelope, out);
+            // Its first point that is not finite is found again below, with the deform's own output.
+            if (!weights.empty() || envelope != 1.0)
+                (void)warp::applyEnvelope(in, out, weights, envelope, out);
         }
     } catch (const Error&) {
         rethrowWithContext(context_);

@@ -11,6 +11,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
+#include "warp/checks.h"
 #include "warp/point_text.h"
 
 namespace deformkit::warp {
@@ -30,17 +31,6 @@ void requireFinitePoints(std::span<const glm::vec3> points, const std::string& s
     }
 }
 
-// 1 when the point's coordinates are finite, 0 otherwise, without a branch (a loop's flag, kept with &):
-// x * 0 is 0 for a finite x and NaN for an infinite or NaN one.
-inline int finiteBits(const glm::vec3& p) {
-    return static_cast<int>(p.x * 0.0f + p.y * 0.0f + p.z * 0.0f == 0.0f);
-}
-
-// The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
-int64_t firstNonFinite(std::span<const glm::vec3> points) {
-    return static_cast<int64_t>(geom::firstNonFinite(points));
-}
-
 // sin(t)/t and (1 - cos t)/t, stable at and near t = 0.
 double sinc(double t) {
     return std::abs(t) < 1e-4 ? 1.0 - t * t / 6.0 : std::sin(t) / t;
@@ -56,7 +46,12 @@ float versincf(float t) {
     return 2.0f * s * s / t;
 }
 
-// The profile curve for the direct paths: the same Fritsch-Carlson Hermite segments as
+}  // namespace
+
+namespace detail {
+
+// The profile curve for the direct paths (outside the anonymous namespace: Taper and Twist's run<Check>
+// member templates capture it): the same Fritsch-Carlson Hermite segments as
 // ProfileCurve::operator(), evaluated inline in float. ProfileCurve works in double behind a call into
 // another translation unit, which was most of the per-point cost of taper and twist; the two agree to float
 // rounding (the engine path, which uses ProfileCurve, is checked against this one to 1e-5).
@@ -82,6 +77,10 @@ class InlineProfile {
     const float *z_, *y_, *m_;
     size_t n_;
 };
+
+}  // namespace detail
+
+namespace {
 
 // sinc and versinc from an already computed s = sin t, c = cos t, sparing the bend's direct path two more
 // trigonometric calls per point: (1 - cos t) / t = sin^2 t / ((1 + cos t) t), exact algebra, well
@@ -163,6 +162,19 @@ int64_t forEachAngleBlock(int64_t n, const AngleOf angleOf, const Apply apply) {
         bad = std::min(bad, apply(begin, count, t, sinT, cosT));
     }
     return bad;
+}
+
+// Points a taper's parallel loop takes at a time, checking their outputs after (Check) while they are in
+// cache: a vectorised pass over a run costs less than a test of each point.
+constexpr int64_t kRun = 512;
+
+// For a block of outputs just written (Check): the first point of out[begin, begin + count) that is not
+// finite, or n; n without looking when not checking.
+template <bool Check>
+int64_t firstNonFiniteOf(std::span<const glm::vec3> out, int64_t begin, int count, int64_t n) {
+    if constexpr (!Check) return n;
+    const std::span<const glm::vec3> written = out.subspan(begin, count);
+    return detail::allFinite(written) ? n : begin + detail::firstNonFinite(written);
 }
 
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
@@ -292,24 +304,25 @@ void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weigh
     requireFinitePoints(points, name_, "point");
     requireFiniteEnvelope(name_, weights, envelope);
     if (envelope == 1.0f && weights.empty()) {
-        evaluate(points, points);  // what the envelope gives for k = 1, without the copy
+        // What the envelope gives for k = 1, without the copy; the input is finite (above), so a point that
+        // is not is one the warp took beyond float range.
+        requireFiniteResult(name_, {}, points, evaluateFinite(points, points));
         return;
     }
     scratch_.resize(points.size());
-    evaluate(points, scratch_);
-    applyEnvelope(points, scratch_, weights, envelope, points);
+    requireFiniteResult(name_, points, scratch_, evaluateFinite(points, scratch_));
+    requireFiniteResult(name_, {}, points, applyEnvelope(points, scratch_, weights, envelope, points));
 }
 
 void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> out,
                        std::span<const float> weights, float envelope) {
     requireBound(points.size(), "points");
     requireFiniteEnvelope(name_, weights, envelope);
-    const int64_t bad = evaluateFinite(points, out);
-    if (bad < static_cast<int64_t>(points.size())) {
-        throw InvalidInput(formatError(name_, "point " + std::to_string(bad),
-                                       "is " + detail::pointText(points[bad]), "finite coordinates"));
-    }
-    if (envelope != 1.0f || !weights.empty()) applyEnvelope(points, out, weights, envelope, out);
+    // The output's first point that is not finite: the input's (named as such), or one the warp or the
+    // envelope took beyond float range.
+    requireFiniteResult(name_, points, out, evaluateFinite(points, out));
+    if (envelope != 1.0f || !weights.empty())
+        requireFiniteResult(name_, points, out, applyEnvelope(points, out, weights, envelope, out));
 }
 
 // ---- taper ----
@@ -323,30 +336,35 @@ Affine TaperWarp::transformationAt(float z) const {
 }
 
 void TaperWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    (void)run(points, out, false);
+    (void)run<false>(points, out);
 }
 
 int64_t TaperWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    return run(points, out, true);
+    return run<true>(points, out);
 }
 
-int64_t TaperWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
+template <bool Check>
+int64_t TaperWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
-    const InlineProfile profile(profile_);
+    const detail::InlineProfile profile(profile_);
     const auto n = static_cast<int64_t>(points.size());
+    const int64_t runs = (n + kRun - 1) / kRun;
     int finite = 1;
     // Dynamic chunks of 4096 points (here and in twist and bend): a thread the host deschedules does not
     // hold up the others. Each point depends on its own inputs only: any schedule gives the same output.
-#pragma omp parallel for schedule(dynamic, 4096) reduction(& : finite)
-    for (int64_t u = 0; u < n; ++u) {
-        const glm::vec3 p = points[u];
-        if (check) finite &= finiteBits(p);
-        const glm::vec3 d = p - o;
-        const glm::vec3 radial = d - glm::dot(d, a) * a;
-        out[u] = p + (profile(restZ_[u]) - 1.0f) * radial;
+#pragma omp parallel for schedule(dynamic, 8) reduction(& : finite)
+    for (int64_t run = 0; run < runs; ++run) {
+        const int64_t begin = run * kRun, end = std::min(n, begin + kRun);
+        for (int64_t u = begin; u < end; ++u) {
+            const glm::vec3 p = points[u];
+            const glm::vec3 d = p - o;
+            const glm::vec3 radial = d - glm::dot(d, a) * a;
+            out[u] = p + (profile(restZ_[u]) - 1.0f) * radial;
+        }
+        if constexpr (Check) finite &= static_cast<int>(detail::allFinite(out.subspan(begin, end - begin)));
     }
-    return check && finite == 0 ? firstNonFinite(points) : n;
+    return Check && finite == 0 ? detail::firstNonFinite(out) : n;
 }
 
 // ---- twist ----
@@ -360,34 +378,32 @@ Affine TwistWarp::transformationAt(float z) const {
 }
 
 void TwistWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    (void)run(points, out, false);
+    (void)run<false>(points, out);
 }
 
 int64_t TwistWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    return run(points, out, true);
+    return run<true>(points, out);
 }
 
-int64_t TwistWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
+template <bool Check>
+int64_t TwistWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
     requireBound(points, out);
     const glm::vec3 o = frame_.origin, a = frame_.axis;
-    const InlineProfile angle(profile_);
+    const detail::InlineProfile angle(profile_);
     const float* z = restZ_.data();
     const auto n = static_cast<int64_t>(points.size());
     return forEachAngleBlock(
         n, [angle, z](int64_t u) { return angle(z[u]); },
-        [o, a, points, out, n, check](int64_t begin, int count, const float*, const float* sinT,
-                                      const float* cosT) {
-            int finite = 1;
+        [o, a, points, out, n](int64_t begin, int count, const float*, const float* sinT, const float* cosT) {
             for (int i = 0; i < count; ++i) {
                 const int64_t u = begin + i;
                 const glm::vec3 p = points[u];
-                if (check) finite &= finiteBits(p);
                 const glm::vec3 d = p - o;
                 const glm::vec3 radial = d - glm::dot(d, a) * a;
                 // Rodrigues on the radial part: R r = cos t r + sin t (a x r).
                 out[u] = p + (cosT[i] - 1.0f) * radial + sinT[i] * glm::cross(a, radial);
             }
-            return check && finite == 0 ? begin + firstNonFinite(points.subspan(begin, count)) : n;
+            return firstNonFiniteOf<Check>(out, begin, count, n);
         });
 }
 
@@ -423,31 +439,30 @@ Affine BendWarp::transformationAt(float z) const {
 }
 
 void BendWarp::evaluate(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    (void)run(points, out, false);
+    (void)run<false>(points, out);
 }
 
 int64_t BendWarp::evaluateFinite(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
-    return run(points, out, true);
+    return run<true>(points, out);
 }
 
-int64_t BendWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const {
+template <bool Check>
+int64_t BendWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const {
     requireBound(points, out);
     const float k = params_.rate, z0 = params_.centre, lo = params_.lo, hi = params_.hi;
     const OrthoFrame f = frame_;
     const auto n = static_cast<int64_t>(points.size());
     if (k == 0.0f) {  // Barr's bend with k = 0 is the identity
         if (out.data() != points.data()) std::copy(points.begin(), points.end(), out.begin());
-        return check ? firstNonFinite(points) : n;
+        return Check ? detail::firstNonFinite(out) : n;
     }
     const float* z = restZ_.data();
     return forEachAngleBlock(
         n, [k, z0, lo, hi, z](int64_t u) { return k * (std::clamp(z[u], lo, hi) - z0); },
-        [f, z0, lo, hi, z, points, out, n, check](int64_t begin, int count, const float* t, const float* sinT,
-                                                  const float* cosT) {
-            int finite = 1;
+        [f, z0, lo, hi, z, points, out, n](int64_t begin, int count, const float* t, const float* sinT,
+                                           const float* cosT) {
             for (int i = 0; i < count; ++i) {
                 const int64_t u = begin + i;
-                if (check) finite &= finiteBits(points[u]);
                 const glm::vec3 l = f.toLocal(points[u]);
                 const float zc = std::clamp(z[u], lo, hi);
                 const float d = zc - z0;
@@ -457,7 +472,7 @@ int64_t BendWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> ou
                 const float zz = z0 + d * sincFrom(t[i], s) - s * l.y + c * along;
                 out[u] = f.origin + l.x * f.side + y * f.up + zz * f.axis;
             }
-            return check && finite == 0 ? begin + firstNonFinite(points.subspan(begin, count)) : n;
+            return firstNonFiniteOf<Check>(out, begin, count, n);
         });
 }
 

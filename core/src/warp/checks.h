@@ -3,11 +3,45 @@
 // Size checks the warp framework's entry points share, with the message every one of them gives.
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
 #include <string>
 
+#include <glm/vec3.hpp>
+
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 
 namespace deformkit::warp::detail {
+
+// 1 when the point's coordinates are finite, 0 otherwise, without a branch (a loop's flag, kept with & or
+// a min): x * 0 is 0 for a finite x and NaN for an infinite or NaN one.
+inline int finiteBits(const glm::vec3& p) {
+    return static_cast<int>(p.x * 0.0f + p.y * 0.0f + p.z * 0.0f == 0.0f);
+}
+
+// Whether every coordinate of `points` is finite: a float whose exponent bits are all ones is infinite or
+// NaN, and adding one to such an exponent carries into the sign bit. Integer operations over the coordinates
+// as one array, which the compiler vectorises: the check a loop makes on a run of outputs it has just written
+// (still in cache) instead of a per-point test.
+inline bool allFinite(std::span<const glm::vec3> points) {
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 holds three packed floats");
+    const float* f = &points.data()->x;
+    const size_t n = 3 * points.size();
+    uint32_t any = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, f + i, sizeof(bits));
+        any |= (bits & 0x7f800000u) + 0x00800000u;
+    }
+    return (any & 0x80000000u) == 0;
+}
+
+// The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
+inline int64_t firstNonFinite(std::span<const glm::vec3> points) {
+    return static_cast<int64_t>(geom::firstNonFinite(points));
+}
 
 // "<source>: <what>: has <got> entries (expected <expected> entries)".
 inline void requireCount(const char* source, const char* what, size_t got, size_t expected) {

@@ -100,7 +100,9 @@ void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> 
     requireFiniteEnvelope("warp evaluate", weights, envelope);
     update();
     evaluateWarp(points, fields_, transforms_, deformed_, warp_.engineOptions());
-    applyEnvelope(points, deformed_, weights, envelope, points);
+    // In place: a point the warp or the envelope takes beyond float range is named by its output only.
+    requireFiniteResult("warp evaluate", {}, points,
+                        applyEnvelope(points, deformed_, weights, envelope, points));
 }
 
 }  // namespace deformkit::warp

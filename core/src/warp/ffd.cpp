@@ -13,6 +13,7 @@
 #include "deformkit/warp/envelope.h"
 #include "ffd_kernels.h"
 #include "simd/cpu.h"
+#include "warp/checks.h"
 #include "warp/point_text.h"
 
 namespace deformkit::warp {
@@ -157,39 +158,63 @@ decltype(detail::FfdKernels::bernsteinWeights444) laneWeights444(const detail::F
     return options.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444 : kernels.bsplineWeights444;
 }
 
+// The blocked loops below go over runs of kRunBlocks blocks (512 points) and check each run's outputs once
+// written, while they are in cache, in one vectorised pass: a check per point costs the 4x4x4 kernels, whose
+// per-point work is small, about a tenth of their time.
+constexpr int64_t kRunBlocks = 64;
+
+// The first point of `run` whose output is not finite, or n: the check of a run once written (in cache).
+int64_t firstNonFiniteOfRun(std::span<const glm::vec3> out, int64_t run, int64_t n) {
+    const int64_t begin = run * kRunBlocks * detail::kBlock;
+    const std::span<const glm::vec3> written =
+        out.subspan(begin, std::min(n - begin, kRunBlocks * detail::kBlock));
+    return detail::allFinite(written) ? n : begin + detail::firstNonFinite(written);
+}
+
 // The 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates and
 // whether the warp reaches it, kernel(local block, displacements) their displacements D; out[u] = points[u] +
 // envelope * weight * D(u) for those it reaches, points[u] for the others (out may be points). Each block
-// reads and writes its own points only: the output does not depend on the schedule.
+// reads and writes its own points only: the output does not depend on the schedule. Returns the first point
+// whose output is not finite, or n.
 template <class Local, class Kernel>
-void blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> points, std::span<glm::vec3> out,
-               std::span<const float> weights, float envelope, const Local& local) {
+int64_t blocks444(int64_t n, const Kernel& kernel, std::span<const glm::vec3> points,
+                  std::span<glm::vec3> out, std::span<const float> weights, float envelope,
+                  const Local& local) {
     constexpr int kBlock = detail::kBlock;
     const int64_t blocks = (n + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 512)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const int64_t begin = b * kBlock;
-        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
-        detail::LocalBlock in{};
-        bool active[kBlock] = {};
-        for (int lane = 0; lane < count; ++lane) {
-            const glm::vec3 l = local(begin + lane, active[lane]);
-            in.x[lane] = l.x;
-            in.y[lane] = l.y;
-            in.z[lane] = l.z;
-        }
-        detail::DisplacementBlock d;
-        kernel(in, d);
-        for (int lane = 0; lane < count; ++lane) {
-            const int64_t u = begin + lane;
-            if (!active[lane]) {
-                out[u] = points[u];
-                continue;
+    const int64_t runs = (blocks + kRunBlocks - 1) / kRunBlocks;
+    int64_t bad = n;
+    // The loop over runs is written out here and in deformWindow444: through a shared lambda the Bernstein
+    // evaluate took 1.14-1.17x the unchecked loop's time, written out 1.05-1.07x.
+#pragma omp parallel for schedule(dynamic, 8) reduction(min : bad)
+    for (int64_t run = 0; run < runs; ++run) {
+        const int64_t lastBlock = std::min(blocks, (run + 1) * kRunBlocks);
+        for (int64_t b = run * kRunBlocks; b < lastBlock; ++b) {
+            const int64_t begin = b * kBlock;
+            const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
+            detail::LocalBlock in{};
+            bool active[kBlock] = {};
+            for (int lane = 0; lane < count; ++lane) {
+                const glm::vec3 l = local(begin + lane, active[lane]);
+                in.x[lane] = l.x;
+                in.y[lane] = l.y;
+                in.z[lane] = l.z;
             }
-            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-            out[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+            detail::DisplacementBlock d;
+            kernel(in, d);
+            for (int lane = 0; lane < count; ++lane) {
+                const int64_t u = begin + lane;
+                if (!active[lane]) {
+                    out[u] = points[u];
+                    continue;
+                }
+                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+                out[u] = points[u] + k * glm::vec3(d.x[lane], d.y[lane], d.z[lane]);
+            }
         }
+        bad = std::min(bad, firstNonFiniteOfRun(out, run, n));
     }
+    return bad;
 }
 
 // Weights of controls first .. first + count - 1 along one axis of d divisions at x = local coordinate * d.
@@ -368,8 +393,9 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
         return l;
     };
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
+    int64_t notFinite = n;
     if (bernstein) {
-        blocks444(
+        notFinite = blocks444(
             n,
             [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
                 kernels.bernstein444(in, translations, d);
@@ -378,7 +404,7 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
     } else {
         // The spline weights as deformWindow444 computes them (inactive lanes' sums are not used).
         const auto splineWeights = laneWeights444(kernels, options_);
-        blocks444(
+        notFinite = blocks444(
             n,
             [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
                 detail::WeightBlock w;
@@ -387,6 +413,7 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
             },
             points, out, weights, envelope, local);
     }
+    requireFiniteResult("FFD evaluate", points, out, notFinite);
     return true;
 }
 
@@ -483,7 +510,8 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
     const float* data = deltas.data();
     const bool blocks = options_.kernel != FfdKernel::PerPoint;
     if (blocks && options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
-        deformBernstein444(points, out, data, weights, envelope);
+        requireFiniteResult("FFD evaluate", points, out,
+                            deformBernstein444(points, out, data, weights, envelope));
         return;
     }
     // Every point's weights fit a 4x4x4 window of controls: along each axis a spline with >= 3 divisions,
@@ -493,14 +521,17 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
         window = window && (options_.basis[a] == FfdBasis::Bernstein ? div[a] == 3 : div[a] >= 3);
     // The 4x4x4 lattice: a spline basis with translations (weights from bind), or any basis with affine maps.
     if (blocks && window && div == glm::ivec3(3) && (stride == 12 || windowSpline_)) {
-        deformWindow444(points, out, data, stride, weights, envelope);
+        requireFiniteResult("FFD evaluate", points, out,
+                            deformWindow444(points, out, data, stride, weights, envelope));
         return;
     }
 
-#pragma omp parallel for schedule(dynamic, 4096)
+    int finite = 1;
+#pragma omp parallel for schedule(dynamic, 4096) reduction(& : finite)
     for (int64_t u = 0; u < n; ++u) {
         if (!active_[u]) {
             out[u] = points[u];
+            finite &= detail::finiteBits(points[u]);
             continue;
         }
         const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
@@ -551,15 +582,18 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
             d = glm::vec3(acc[0], acc[1], acc[2]) * p.x + glm::vec3(acc[3], acc[4], acc[5]) * p.y +
                 glm::vec3(acc[6], acc[7], acc[8]) * p.z + glm::vec3(acc[9], acc[10], acc[11]);
         }
-        out[u] = p + k * d;
+        const glm::vec3 r = p + k * d;
+        out[u] = r;
+        finite &= detail::finiteBits(r);
     }
+    if (finite == 0) requireFiniteResult("FFD evaluate", points, out, detail::firstNonFinite(out));
 }
 
-void FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
-                                    const float* translations, std::span<const float> weights,
-                                    float envelope) const {
+int64_t FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                                       const float* translations, std::span<const float> weights,
+                                       float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
-    blocks444(
+    return blocks444(
         numBoundPoints(),
         [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
             kernels.bernstein444(in, translations, d);
@@ -571,9 +605,9 @@ void FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span
         });
 }
 
-void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
-                                 const float* data, int32_t stride, std::span<const float> weights,
-                                 float envelope) const {
+int64_t FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
+                                    const float* data, int32_t stride, std::span<const float> weights,
+                                    float envelope) const {
     const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
     // Weights in eight lanes (Bernstein, cubic B-splines), or point by point for the other bases.
     const auto laneWeights = laneWeights444(kernels, options_);
@@ -599,55 +633,62 @@ void FfdLattice::deformWindow444(std::span<const glm::vec3> points, std::span<gl
         }
     }
     // Each block reads and writes its own points only: the output does not depend on the schedule.
-#pragma omp parallel for schedule(dynamic, 512)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const int64_t begin = b * kBlock;
-        const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
-        detail::WeightBlock in;
-        if (cached != nullptr) {
-            std::memcpy(in.w, cached + static_cast<size_t>(b) * kBlockFloats, sizeof(in.w));
-        } else {
-            if (laneWeights != nullptr) {
-                // Inactive lanes get weights too: their sums are computed and not used.
-                detail::LocalBlock local{};
-                for (int lane = 0; lane < count; ++lane) {
-                    const glm::vec3& l = local_[begin + lane];
-                    local.x[lane] = l.x;
-                    local.y[lane] = l.y;
-                    local.z[lane] = l.z;
-                }
-                laneWeights(local, in);
+    const int64_t runs = (blocks + kRunBlocks - 1) / kRunBlocks;
+    int64_t bad = n;
+#pragma omp parallel for schedule(dynamic, 8) reduction(min : bad)
+    for (int64_t run = 0; run < runs; ++run) {
+        const int64_t lastBlock = std::min(blocks, (run + 1) * kRunBlocks);
+        for (int64_t b = run * kRunBlocks; b < lastBlock; ++b) {
+            const int64_t begin = b * kBlock;
+            const int count = static_cast<int>(std::min<int64_t>(kBlock, n - begin));
+            detail::WeightBlock in;
+            if (cached != nullptr) {
+                std::memcpy(in.w, cached + static_cast<size_t>(b) * kBlockFloats, sizeof(in.w));
             } else {
-                windowWeightsOf(begin, count, &in.w[0][0][0]);
+                if (laneWeights != nullptr) {
+                    // Inactive lanes get weights too: their sums are computed and not used.
+                    detail::LocalBlock local{};
+                    for (int lane = 0; lane < count; ++lane) {
+                        const glm::vec3& l = local_[begin + lane];
+                        local.x[lane] = l.x;
+                        local.y[lane] = l.y;
+                        local.z[lane] = l.z;
+                    }
+                    laneWeights(local, in);
+                } else {
+                    windowWeightsOf(begin, count, &in.w[0][0][0]);
+                }
+                if (keep != nullptr)
+                    std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
             }
-            if (keep != nullptr)
-                std::memcpy(keep + static_cast<size_t>(b) * kBlockFloats, in.w, sizeof(in.w));
-        }
-        // Translations (stride 3) or affine maps (stride 12): each active point's displacement.
-        detail::DisplacementBlock d;
-        detail::AffineBlock m;
-        if (stride == 3) {
-            kernels.window444(in, data, d);
-        } else {
-            kernels.frames444(in, data, m);
-        }
-        for (int lane = 0; lane < count; ++lane) {
-            const int64_t u = begin + lane;
-            const glm::vec3 p = points[u];
-            if (!active_[u]) {
-                out[u] = p;
-                continue;
+            // Translations (stride 3) or affine maps (stride 12): each active point's displacement.
+            detail::DisplacementBlock d;
+            detail::AffineBlock m;
+            if (stride == 3) {
+                kernels.window444(in, data, d);
+            } else {
+                kernels.frames444(in, data, m);
             }
-            const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-            const glm::vec3 shift = stride == 3
-                                        ? glm::vec3(d.x[lane], d.y[lane], d.z[lane])
-                                        : glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
-                                              glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
-                                              glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
-                                              glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
-            out[u] = p + k * shift;
+            for (int lane = 0; lane < count; ++lane) {
+                const int64_t u = begin + lane;
+                const glm::vec3 p = points[u];
+                if (!active_[u]) {
+                    out[u] = p;
+                    continue;
+                }
+                const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
+                const glm::vec3 shift = stride == 3
+                                            ? glm::vec3(d.x[lane], d.y[lane], d.z[lane])
+                                            : glm::vec3(m.a[0][lane], m.a[1][lane], m.a[2][lane]) * p.x +
+                                                  glm::vec3(m.a[3][lane], m.a[4][lane], m.a[5][lane]) * p.y +
+                                                  glm::vec3(m.a[6][lane], m.a[7][lane], m.a[8][lane]) * p.z +
+                                                  glm::vec3(m.a[9][lane], m.a[10][lane], m.a[11][lane]);
+                out[u] = p + k * shift;
+            }
         }
+        bad = std::min(bad, firstNonFiniteOfRun(out, run, n));
     }
+    return bad;
 }
 
 void FfdLattice::windowWeightsOf(int64_t begin, int count, float* block) const {

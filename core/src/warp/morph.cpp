@@ -22,7 +22,7 @@ void requireFiniteParameter(const char* what, float t) {
 void morphByEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, float t,
                      std::span<glm::vec3> out) {
     requireFiniteParameter("t", t);
-    applyEnvelope(in, deformed, {}, t, out);
+    requireFiniteResult("morph", in, out, applyEnvelope(in, deformed, {}, t, out));
 }
 
 void morphTransformations(const Transformations& in, std::span<const float> t, Transformations& out) {

@@ -9,6 +9,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/warp/envelope.h"
+#include "warp/checks.h"
 #include "warp/weighted_mean.h"
 
 namespace deformkit::warp {
@@ -546,11 +547,13 @@ void Wires::evaluate(std::span<glm::vec3> points, std::span<const float> weights
         }
     }
     const double m = options_.exponent;
-#pragma omp parallel for schedule(dynamic, 4096)
+    int finite = 1;  // 0 once a point's output is not finite
+#pragma omp parallel for schedule(dynamic, 4096) reduction(& : finite)
     for (int64_t u = 0; u < n; ++u) {
         const int32_t begin = fields_.offsets[u], end = fields_.offsets[u + 1];
-        if (begin == end) continue;
         const glm::vec3 p = points[u];
+        finite &= detail::finiteBits(p);
+        if (begin == end) continue;
         // Eq. (3) as in evaluateWarp: displacements accumulated in double, weights times |d|^m.
         glm::dvec3 mean;
         const bool any = detail::weightedMeanDisplacement(
@@ -566,8 +569,11 @@ void Wires::evaluate(std::span<glm::vec3> points, std::span<const float> weights
         if (!any) continue;
         const glm::vec3 moved = p + glm::vec3(mean);
         const float k = envelope * (weights.empty() ? 1.0f : weights[u]);
-        points[u] = p + k * (moved - p);
+        const glm::vec3 r = p + k * (moved - p);
+        points[u] = r;
+        finite &= detail::finiteBits(r);
     }
+    if (finite == 0) requireFiniteResult("wires", {}, points, detail::firstNonFinite(points));
 }
 
 }  // namespace deformkit::warp

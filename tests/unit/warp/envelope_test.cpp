@@ -115,3 +115,129 @@ TEST_CASE("requireFiniteEnvelope takes large finite values and names the first b
     CHECK_THROWS_WITH(requireFiniteEnvelope("x", weights, 1.0), Catch::Contains("point 70000: is nan"));
     CHECK_NOTHROW(requireFiniteEnvelope("x", {}, 0.0));
 }
+
+namespace {
+
+// 20,000 points between radius 1 and 2 about the z axis, z in [0, 1].
+std::vector<glm::vec3> ringPoints() {
+    std::vector<glm::vec3> points;
+    for (int i = 0; i < 20000; ++i) {
+        const float a = 0.01f * static_cast<float>(i), r = 1.0f + static_cast<float>(i % 97) / 97.0f;
+        points.emplace_back(r * std::cos(a), r * std::sin(a), static_cast<float>(i % 89) / 89.0f);
+    }
+    return points;
+}
+
+// A deformer that moves every point by more than 1 (evaluate(weights, envelope, out)), given painted
+// weights 0 below point 12345 and 1 from it on and an envelope of 3e38, takes points 12345 on beyond float
+// range: it is refused naming point 12345, the first (whatever the threads' schedule), as deformed from its
+// input when the input is still there (`from`), as deformed to its result when the output overwrote it.
+void checkOverflow(const std::string& name, bool from, const Evaluate& evaluate) {
+    CAPTURE(name);
+    const std::vector<glm::vec3> rest = ringPoints();
+    std::vector<float> weights(rest.size(), 0.0f);
+    std::fill(weights.begin() + 12345, weights.end(), 1.0f);
+    std::vector<glm::vec3> out = rest;
+    evaluate(weights, 1e30f, out);  // within range: runs
+    out = rest;
+    CHECK_THROWS_WITH(evaluate(weights, 3e38f, out),
+                      Catch::Contains(name + ": point 12345: is deformed " + (from ? "from (" : "to (")) &&
+                          Catch::Contains("inf") &&
+                          Catch::Contains("expected finite positions: parameters that keep the deformation "
+                                          "within float range"));
+}
+
+}  // namespace
+
+TEST_CASE("every deformer refuses a result beyond float range, naming the first point", "[warp][envelope]") {
+    const std::vector<glm::vec3> rest = ringPoints();
+
+    TaperWarp taper({{0, 0, 0}, {0, 0, 1}, {0, 1, 0}}, ProfileCurve::constant(5.0f));
+    taper.bind(rest);
+    checkOverflow("taper", true, [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
+        taper.deform(rest, out, w, e);
+    });
+    checkOverflow("taper", false, [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
+        taper.deform(out, w, e);  // in place
+    });
+    // With the envelope at 1, the factor alone: 3e38 at radius 1 to 2.
+    TaperWarp huge({{0, 0, 0}, {0, 0, 1}, {0, 1, 0}}, ProfileCurve::constant(3e38f));
+    huge.bind(rest);
+    std::vector<glm::vec3> out(rest.size());
+    CHECK_THROWS_WITH(huge.deform(rest, out, {}, 1.0f),
+                      Catch::Contains("taper: point ") && Catch::Contains(": is deformed from ("));
+    out = rest;
+    CHECK_THROWS_WITH(huge.deform(out, {}, 1.0f),
+                      Catch::Contains("taper: point ") && Catch::Contains(": is deformed to ("));
+
+    for (const glm::ivec3 divisions :
+         {glm::ivec3(3), glm::ivec3(2)}) {  // the 4x4x4 blocks, the per-point path
+        Lattice lattice;
+        lattice.origin = {-2.5f, -2.5f, -0.5f};
+        lattice.axes = glm::mat3(5.0f);
+        lattice.divisions = divisions;
+        for (const FfdBasis basis : {FfdBasis::Bernstein, FfdBasis::BSpline}) {
+            if (basis == FfdBasis::BSpline && divisions != glm::ivec3(3)) continue;
+            FfdOptions options;
+            options.basis = basis;
+            Ffd ffd(lattice, options);
+            std::vector<glm::vec3> targets(ffd.sourcePoints().begin(), ffd.sourcePoints().end());
+            for (glm::vec3& t : targets)
+                t += glm::vec3(2.0f, 0.0f, 0.0f);
+            ffd.setTargets(targets);
+            if (divisions == glm::ivec3(3)) {
+                checkOverflow("FFD evaluate", true,
+                              [&](std::span<const float> w, float e, std::vector<glm::vec3>& o) {
+                                  ffd.bindAndEvaluate(rest, rest, o, w, e);  // the unbound fast path
+                              });
+            }
+            ffd.bind(rest);
+            checkOverflow("FFD evaluate", true,
+                          [&](std::span<const float> w, float e, std::vector<glm::vec3>& o) {
+                              ffd.evaluate(rest, o, w, e);
+                          });
+            WarpDeformer deformer(ffd);
+            deformer.bind(rest);
+            checkOverflow("warp evaluate", false,
+                          [&](std::span<const float> w, float e, std::vector<glm::vec3>& o) {
+                              deformer.evaluate(o, w, e);
+                          });
+        }
+    }
+
+    Wire wire;
+    wire.reference = {{-3, 0, 0.5f}, {3, 0, 0.5f}};
+    wire.wire = {{-3, 2, 0.5f}, {3, 2, 0.5f}};
+    wire.radius = 100.0f;
+    Wires wires({wire}, {WiresVariant::Original});
+    wires.bind(rest);
+    checkOverflow("wires", false, [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
+        wires.evaluate(out, w, e);
+    });
+}
+
+TEST_CASE("applyEnvelope returns the first point whose result is not finite", "[warp][envelope]") {
+    const std::vector<glm::vec3> in(100000, glm::vec3(1.0f));
+    std::vector<glm::vec3> deformed(in.size(), glm::vec3(3.0f)), out(in.size());
+    std::vector<float> weights(in.size(), 0.0f);
+    CHECK(applyEnvelope(in, deformed, weights, 1e38, out) == 100000);
+    weights[70001] = 1.0f;
+    weights[99999] = 1.0f;
+    CHECK(applyEnvelope(in, deformed, weights, 1e38, out) == 100000);  // 1 + 2e38: within range
+    CHECK(applyEnvelope(in, deformed, weights, 3e38, out) == 70001);
+    CHECK(out[70001].x == std::numeric_limits<float>::infinity());
+    CHECK(out[70000] == in[70000]);
+    deformed[5].y = kNaN;  // k = 0 there: the input is taken as it is, finite
+    CHECK(applyEnvelope(in, deformed, weights, 3e38, out) == 70001);
+    weights[5] = 1.0f;
+    CHECK(applyEnvelope(in, deformed, weights, 1.0, out) == 5);
+    CHECK_THROWS_WITH(requireFiniteResult("x", in, out, 5),
+                      Catch::Contains("x: point 5: is deformed from (1, 1, 1) to (3, nan, 3)"));
+    CHECK_THROWS_WITH(requireFiniteResult("x", {}, out, 5),
+                      Catch::Contains("x: point 5: is deformed to (3, nan"));
+    std::vector<glm::vec3> bad = in;
+    bad[5].z = kInf;
+    CHECK_THROWS_WITH(requireFiniteResult("x", bad, out, 5),
+                      Catch::Contains("x: point 5: is (1, 1, inf) (expected finite coordinates)"));
+    CHECK_NOTHROW(requireFiniteResult("x", in, out, static_cast<int64_t>(out.size())));
+}

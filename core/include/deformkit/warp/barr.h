@@ -67,10 +67,12 @@ class AxialWarp : public Warp {
 
     // Deformer over the direct path: points deformed in place, P + envelope * weight * (T<P> - P);
     // weights: #points painted weights or empty for 1. Throws InvalidInput if not bound, on a count
-    // mismatch, or a non-finite point.
+    // mismatch, a non-finite point, or a point deformed beyond float range (then `points` holds partial
+    // results).
     void deform(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
-    // The same into `out` (as many points, not aliasing `points`): no copy of the input, read once (its
-    // finiteness checked as it is deformed; on that error `out` holds partial results).
+    // The same into `out` (as many points, not aliasing `points`): no copy of the input, read once (the
+    // output's finiteness checked as it is written, which also finds an input point that is not finite; on
+    // that error `out` holds partial results).
     void deform(std::span<const glm::vec3> points, std::span<glm::vec3> out, std::span<const float> weights,
                 float envelope);
 
@@ -81,8 +83,9 @@ class AxialWarp : public Warp {
 
   protected:
     AxialWarp(const AxisFrame& frame, bool needUp, std::string name);
-    // evaluate() that also finds the first point that is not finite (points.size() when all are), in the
-    // same pass: deform() into another buffer reads its input once.
+    // evaluate() that also finds the first output point that is not finite (points.size() when all are), in
+    // the same pass: deform() into another buffer reads its input once. A point that is not finite stays so
+    // in the output.
     [[nodiscard]] virtual int64_t evaluateFinite(std::span<const glm::vec3> points,
                                                  std::span<glm::vec3> out) const = 0;
     void requireBound(size_t count, const char* what) const;
@@ -126,7 +129,8 @@ class TaperWarp final : public ProfiledAxialWarp {
   private:
     [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
                                          std::span<glm::vec3> out) const override;
-    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
+    template <bool Check>
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const;
 };
 
 // Barr's twist: T(z) = rotation by theta(z) radians about the axis, right-handed about the axis direction.
@@ -140,7 +144,8 @@ class TwistWarp final : public ProfiledAxialWarp {
   private:
     [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
                                          std::span<glm::vec3> out) const override;
-    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
+    template <bool Check>
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const;
 };
 
 // Barr's (1984) global bend, in the plane of the axis and the up direction.
@@ -169,7 +174,8 @@ class BendWarp final : public AxialWarp {
   private:
     [[nodiscard]] int64_t evaluateFinite(std::span<const glm::vec3> points,
                                          std::span<glm::vec3> out) const override;
-    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out, bool check) const;
+    template <bool Check>
+    int64_t run(std::span<const glm::vec3> points, std::span<glm::vec3> out) const;
     BendParams params_;
 };
 

@@ -96,7 +96,8 @@ class WarpDeformer {
     // same count) deformed into out (#points; may alias in). Allocates nothing.
     void apply(std::span<const glm::vec3> in, std::span<glm::vec3> out) const;
     // update() and apply() in place, then painted weights (#points, or empty for 1) and the envelope as
-    // applyEnvelope (warp/envelope.h) says.
+    // applyEnvelope (warp/envelope.h) says; a point whose result is not finite is refused by name
+    // (requireFiniteResult), the points then holding partial results.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
 
   private:

@@ -144,7 +144,9 @@ class FfdLattice {
         deform(points, points, deltas, stride, weights, envelope);
     }
     // The same from `in` into `out` (as many points; the same span, or not overlapping): out[u] = in[u] +
-    // envelope * weight[u] * D_u(in[u]), one pass over the input instead of a copy and a pass.
+    // envelope * weight[u] * D_u(in[u]), one pass over the input instead of a copy and a pass. Throws
+    // InvalidInput naming the first point whose output is not finite (an input point that is not, or one
+    // taken beyond float range); `out` then holds partial results.
     void deform(std::span<const glm::vec3> in, std::span<glm::vec3> out, std::span<const float> deltas,
                 int32_t stride, std::span<const float> weights, float envelope) const;
 
@@ -153,13 +155,16 @@ class FfdLattice {
     [[nodiscard]] glm::vec3 boundCoordinates(const glm::vec3& p, const glm::dvec3& scale, bool& inside) const;
     // deform() for Bernstein divisions (3, 3, 3) with translations: SoA blocks of 8 points through the
     // kernel options_.kernel selects (ffd.cpp).
-    void deformBernstein444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
-                            const float* translations, std::span<const float> weights, float envelope) const;
+    // Both return the first point whose output is not finite, or #points.
+    [[nodiscard]] int64_t deformBernstein444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
+                                             const float* translations, std::span<const float> weights,
+                                             float envelope) const;
     // The same lattice in any basis whose weights fit the 4x4x4 window (B-splines), and any basis with affine
     // maps (stride 12, FFD with frames): each point's weights as the per-point path computes them (at bind
     // for splines), the sum in eight-lane blocks; the per-point path's bytes.
-    void deformWindow444(std::span<const glm::vec3> in, std::span<glm::vec3> out, const float* data,
-                         int32_t stride, std::span<const float> weights, float envelope) const;
+    [[nodiscard]] int64_t deformWindow444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
+                                          const float* data, int32_t stride, std::span<const float> weights,
+                                          float envelope) const;
     // The window weights of points begin .. begin + count - 1 into a block ([axis][control][lane], 8 lanes;
     // zero for inactive points and lanes past count).
     void windowWeightsOf(int64_t begin, int count, float* block) const;

@@ -96,7 +96,9 @@ class Wires : public Warp {
     // Fast path: bind caches the fields only (throws InvalidInput naming a non-finite rest point);
     // evaluate deforms points (the bound rest points or upstream points of the same count) in place;
     // painted weights (#points, or empty for 1) and the envelope scale the displacement as in
-    // WarpDeformer. OpenMP over points; allocates nothing; bit-identical for any thread count.
+    // WarpDeformer; a point whose result is not finite (its input, or taken beyond float range) is refused
+    // by name, the points then holding partial results. OpenMP over points; allocates nothing; bit-identical
+    // for any thread count.
     void bind(std::span<const glm::vec3> restPoints);
     [[nodiscard]] bool isBound() const { return bound_; }
     [[nodiscard]] const SparseFields& fields() const { return fields_; }
