@@ -240,7 +240,7 @@ void addPtexCommands(CommandLine& cli) {
     toUdim.option("MESH", tu->command.mesh, "mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
     toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
-    toUdim.option("--tiles", tu->tiles, "tiles to write (default: every tile of the mesh)");
+    toUdim.option("--tiles", tu->tiles, "tiles to write, each once (default: every tile of the mesh)");
     toUdim.option("--padding", tu->command.padding, "texels of edge padding around the UV charts")
         .showDefault();
     toUdim.flag("--coverage", tu->command.coverage,

@@ -105,10 +105,14 @@ std::vector<int> parseTiles(std::string_view text, const std::string& option) {
             throw InvalidInput(formatError(option, "", "'" + std::string(item) + "' is not a UDIM tile",
                                            "tile numbers 1001..9999, comma separated"));
         }
+        // Each tile once, as a scene's "tiles" (a tile named twice is most likely a typo for another).
+        if (std::find(tiles.begin(), tiles.end(), tile) != tiles.end()) {
+            throw InvalidInput(formatError(option, "", "lists tile " + std::to_string(tile) + " twice",
+                                           "each tile once, comma separated"));
+        }
         tiles.push_back(static_cast<int>(tile));
     });
     std::sort(tiles.begin(), tiles.end());
-    tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
     return tiles;
 }
 
@@ -260,7 +264,8 @@ void addUvWarpCommand(CommandLine& cli) {
         uvwarp.option("--bake", o->bake, "baked textures, e.g. 'out/col.<UDIM>.####.exr' (needs --texture)");
     texture.needs(bake);
     bake.needs(texture);
-    uvwarp.option("--tiles", o->tiles, "UDIM tiles, e.g. 1001,1002; default: every tile of the rest UVs");
+    uvwarp.option("--tiles", o->tiles,
+                  "UDIM tiles, each once, e.g. 1001,1002; default: every tile of the rest UVs");
     uvwarp.option("--log", o->log, "JSON-lines log, appended: one line per tile and frame");
     uvwarp.option(
         "--report", o->report,

@@ -150,7 +150,9 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
                    Catch::Contains("is out of range (expected frames from -1000000000 to 1000000000)"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseFrames(""); }),
                Catch::Contains("'' is not a frame"));
-    CHECK(harness::parseTiles("1002,1001,1002") == std::vector<int>{1001, 1002});
+    CHECK(harness::parseTiles("1012,1001,1002") == std::vector<int>{1001, 1002, 1012});
+    CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1002,1001,1002"); }),
+               Catch::Contains("--tiles: lists tile 1002 twice (expected each tile once, comma separated)"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1001,1000"); }),
                Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));
     CHECK(uvwarp::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
