@@ -212,20 +212,22 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,
         throw InvalidInput(
             formatError(context_, "envelope", "is " + numberText(envelope), "a finite number"));
     }
+    int64_t bad = -1;  // the first point whose output is not finite, once known
     try {
         if (weightMode() == WeightMode::Native) {
             deformWeighted(in, out, weights, envelope);
         } else {
             deform(in, out);
-            // k = 1 everywhere gives the deformed positions bit for bit: no pass needed.
-            // Its first point that is not finite is found again below, with the deform's own output.
+            // k = 1 everywhere gives the deformed positions bit for bit: no pass needed. The blend finds
+            // its first point that is not finite as it writes.
             if (!weights.empty() || envelope != 1.0)
-                (void)warp::applyEnvelope(in, out, weights, envelope, out);
+                bad = warp::applyEnvelope(in, out, weights, envelope, out);
         }
     } catch (const Error&) {
         rethrowWithContext(context_);
     }
-    requireFiniteOutput(context_, in, out);
+    if (bad < 0) bad = static_cast<int64_t>(geom::firstNonFinite(out));
+    warp::requireFiniteResult(context_, in, out, bad);
 }
 
 }  // namespace deformkit::host

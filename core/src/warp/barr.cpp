@@ -173,8 +173,7 @@ constexpr int64_t kRun = 512;
 template <bool Check>
 int64_t firstNonFiniteOf(std::span<const glm::vec3> out, int64_t begin, int count, int64_t n) {
     if constexpr (!Check) return n;
-    const std::span<const glm::vec3> written = out.subspan(begin, count);
-    return detail::allFinite(written) ? n : begin + detail::firstNonFinite(written);
+    return detail::firstNonFiniteOfRun(out, begin, count, n);
 }
 
 // The world map x -> o + F M F^T (x - o) + F t, F = [side up axis]: a local-frame affine map in world space.
@@ -309,8 +308,9 @@ void AxialWarp::deform(std::span<glm::vec3> points, std::span<const float> weigh
         requireFiniteResult(name_, {}, points, evaluateFinite(points, points));
         return;
     }
+    // Where k = 0 the input stands whatever the warp gave there: only the blend is checked.
     scratch_.resize(points.size());
-    requireFiniteResult(name_, points, scratch_, evaluateFinite(points, scratch_));
+    evaluate(points, scratch_);
     requireFiniteResult(name_, {}, points, applyEnvelope(points, scratch_, weights, envelope, points));
 }
 
@@ -319,10 +319,14 @@ void AxialWarp::deform(std::span<const glm::vec3> points, std::span<glm::vec3> o
     requireBound(points.size(), "points");
     requireFiniteEnvelope(name_, weights, envelope);
     // The output's first point that is not finite: the input's (named as such), or one the warp or the
-    // envelope took beyond float range.
-    requireFiniteResult(name_, points, out, evaluateFinite(points, out));
-    if (envelope != 1.0f || !weights.empty())
-        requireFiniteResult(name_, points, out, applyEnvelope(points, out, weights, envelope, out));
+    // envelope took beyond float range. With an envelope or weights only the blend is checked: where k = 0
+    // the input stands whatever the warp gave there.
+    if (envelope == 1.0f && weights.empty()) {
+        requireFiniteResult(name_, points, out, evaluateFinite(points, out));
+        return;
+    }
+    evaluate(points, out);
+    requireFiniteResult(name_, points, out, applyEnvelope(points, out, weights, envelope, out));
 }
 
 // ---- taper ----

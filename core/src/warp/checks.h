@@ -1,6 +1,7 @@
 #pragma once
 
-// Size checks the warp framework's entry points share, with the message every one of them gives.
+// Checks the warp framework's entry points and loops share: sizes, with the message every one of them gives,
+// and the finiteness of the points a loop writes.
 
 #include <cstddef>
 #include <cstdint>
@@ -27,7 +28,7 @@ inline int finiteBits(const glm::vec3& p) {
 // (still in cache) instead of a per-point test.
 inline bool allFinite(std::span<const glm::vec3> points) {
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 holds three packed floats");
-    const float* f = &points.data()->x;
+    const auto* f = reinterpret_cast<const float*>(points.data());
     const size_t n = 3 * points.size();
     uint32_t any = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -41,6 +42,16 @@ inline bool allFinite(std::span<const glm::vec3> points) {
 // The first point that is not finite, or points.size(): the slow path once a loop's flag says there is one.
 inline int64_t firstNonFinite(std::span<const glm::vec3> points) {
     return static_cast<int64_t>(geom::firstNonFinite(points));
+}
+
+// The first point of out[begin, begin + count) that is not finite, or n: the check of a run of outputs once
+// written, a vectorised pass, then the search only when it fails.
+inline int64_t firstNonFiniteOfRun(std::span<const glm::vec3> out, int64_t begin, int64_t count, int64_t n) {
+    const std::span<const glm::vec3> written =
+        out.subspan(static_cast<size_t>(begin), static_cast<size_t>(count));
+    if (allFinite(written)) return n;
+    const int64_t i = firstNonFinite(written);
+    return i < count ? begin + i : n;
 }
 
 // "<source>: <what>: has <got> entries (expected <expected> entries)".

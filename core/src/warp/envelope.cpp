@@ -72,9 +72,14 @@ void requireFiniteResult(std::string_view source, std::span<const glm::vec3> in,
         throw InvalidInput(
             formatError(std::string(source), element, "is " + coordinates(in[u]), "finite coordinates"));
     }
+    if (!known) {  // the output overwrote the input: a point that came in so, or one taken beyond range
+        throw InvalidInput(formatError(std::string(source), element,
+                                       "is " + coordinates(out[u]) + " once deformed",
+                                       "finite points, and parameters that keep the deformation within "
+                                       "float range"));
+    }
     throw InvalidInput(formatError(
-        std::string(source), element,
-        (known ? "is deformed from " + coordinates(in[u]) + " to " : "is deformed to ") + coordinates(out[u]),
+        std::string(source), element, "is deformed from " + coordinates(in[u]) + " to " + coordinates(out[u]),
         "finite positions: parameters that keep the deformation within float range"));
 }
 

@@ -166,9 +166,7 @@ constexpr int64_t kRunBlocks = 64;
 // The first point of `run` whose output is not finite, or n: the check of a run once written (in cache).
 int64_t firstNonFiniteOfRun(std::span<const glm::vec3> out, int64_t run, int64_t n) {
     const int64_t begin = run * kRunBlocks * detail::kBlock;
-    const std::span<const glm::vec3> written =
-        out.subspan(begin, std::min(n - begin, kRunBlocks * detail::kBlock));
-    return detail::allFinite(written) ? n : begin + detail::firstNonFinite(written);
+    return detail::firstNonFiniteOfRun(out, begin, std::min(n - begin, kRunBlocks * detail::kBlock), n);
 }
 
 // The 4x4x4 lattice in blocks of eight points: local(u, active) gives point u's bound coordinates and

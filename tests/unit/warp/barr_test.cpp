@@ -368,7 +368,8 @@ TEST_CASE("Barr: bad input is named", "[barr][warp][errors]") {
     CHECK_FALSE(bend.isBound());
 }
 
-TEST_CASE("Barr: deform into another buffer checks its input as it reads it", "[barr][warp][errors]") {
+TEST_CASE("Barr: deform into another buffer names a non-finite input point as it writes",
+          "[barr][warp][errors]") {
     // Many blocks, so the parallel pass sees the bad points in several threads; the first one is named, and
     // a finite input gives the in-place deform's bytes.
     const TestFrame tf;

@@ -1,5 +1,6 @@
 // Every deformer's evaluate refuses a non-finite envelope or painted weight, naming it, before it writes a
-// point: NaN or infinity would make every point it scales NaN.
+// point: NaN or infinity would make every point it scales NaN. And it refuses a result beyond float range,
+// naming the first point.
 #include <catch2/catch.hpp>
 
 #include <functional>
@@ -12,6 +13,7 @@
 #include "deformkit/warp/engine.h"
 #include "deformkit/warp/envelope.h"
 #include "deformkit/warp/ffd.h"
+#include "deformkit/warp/morph.h"
 #include "deformkit/warp/wires.h"
 
 using namespace deformkit;
@@ -118,10 +120,10 @@ TEST_CASE("requireFiniteEnvelope takes large finite values and names the first b
 
 namespace {
 
-// 20,000 points between radius 1 and 2 about the z axis, z in [0, 1].
+// 20,003 points between radius 1 and 2 about the z axis, z in [0, 1]: not a whole number of blocks or runs.
 std::vector<glm::vec3> ringPoints() {
     std::vector<glm::vec3> points;
-    for (int i = 0; i < 20000; ++i) {
+    for (int i = 0; i < 20003; ++i) {
         const float a = 0.01f * static_cast<float>(i), r = 1.0f + static_cast<float>(i % 97) / 97.0f;
         points.emplace_back(r * std::cos(a), r * std::sin(a), static_cast<float>(i % 89) / 89.0f);
     }
@@ -129,22 +131,34 @@ std::vector<glm::vec3> ringPoints() {
 }
 
 // A deformer that moves every point by more than 1 (evaluate(weights, envelope, out)), given painted
-// weights 0 below point 12345 and 1 from it on and an envelope of 3e38, takes points 12345 on beyond float
-// range: it is refused naming point 12345, the first (whatever the threads' schedule), as deformed from its
-// input when the input is still there (`from`), as deformed to its result when the output overwrote it.
+// weights 0 below point `first` and 1 from it on and an envelope of 3e38, takes points `first` on beyond
+// float range: it is refused naming point `first` (whatever the threads' schedule), as deformed from its
+// input when the input is still there (`from`), by its result alone when the output overwrote it. First
+// points 12345 (inside a run) and 20000 (in the last, partial, run).
 void checkOverflow(const std::string& name, bool from, const Evaluate& evaluate) {
     CAPTURE(name);
     const std::vector<glm::vec3> rest = ringPoints();
-    std::vector<float> weights(rest.size(), 0.0f);
-    std::fill(weights.begin() + 12345, weights.end(), 1.0f);
-    std::vector<glm::vec3> out = rest;
-    evaluate(weights, 1e30f, out);  // within range: runs
-    out = rest;
-    CHECK_THROWS_WITH(evaluate(weights, 3e38f, out),
-                      Catch::Contains(name + ": point 12345: is deformed " + (from ? "from (" : "to (")) &&
-                          Catch::Contains("inf") &&
-                          Catch::Contains("expected finite positions: parameters that keep the deformation "
-                                          "within float range"));
+    for (const int first : {12345, 20000}) {
+        CAPTURE(first);
+        std::vector<float> weights(rest.size(), 0.0f);
+        std::fill(weights.begin() + first, weights.end(), 1.0f);
+        std::vector<glm::vec3> out = rest;
+        CHECK_NOTHROW(evaluate(weights, 1e30f, out));  // within range
+        out = rest;
+        const std::string point = name + ": point " + std::to_string(first) + ": is ";
+        if (from) {
+            CHECK_THROWS_WITH(evaluate(weights, 3e38f, out),
+                              Catch::Contains(point + "deformed from (") && Catch::Contains("inf") &&
+                                  Catch::Contains("expected finite positions: parameters that keep the "
+                                                  "deformation within float range"));
+        } else {
+            CHECK_THROWS_WITH(
+                evaluate(weights, 3e38f, out),
+                Catch::Contains(point + "(") && Catch::Contains("inf") &&
+                    Catch::Contains(") once deformed (expected finite points, and parameters that "
+                                    "keep the deformation within float range"));
+        }
+    }
 }
 
 }  // namespace
@@ -168,7 +182,11 @@ TEST_CASE("every deformer refuses a result beyond float range, naming the first 
                       Catch::Contains("taper: point ") && Catch::Contains(": is deformed from ("));
     out = rest;
     CHECK_THROWS_WITH(huge.deform(out, {}, 1.0f),
-                      Catch::Contains("taper: point ") && Catch::Contains(": is deformed to ("));
+                      Catch::Contains("taper: point ") && Catch::Contains(") once deformed"));
+    // Where the envelope is 0 the input stands, whatever the warp gave there.
+    std::vector<float> none(rest.size(), 0.0f);
+    CHECK_NOTHROW(huge.deform(rest, out, none, 1.0f));
+    CHECK(out == rest);
 
     for (const glm::ivec3 divisions :
          {glm::ivec3(3), glm::ivec3(2)}) {  // the 4x4x4 blocks, the per-point path
@@ -227,6 +245,9 @@ TEST_CASE("applyEnvelope returns the first point whose result is not finite", "[
     CHECK(applyEnvelope(in, deformed, weights, 3e38, out) == 70001);
     CHECK(out[70001].x == std::numeric_limits<float>::infinity());
     CHECK(out[70000] == in[70000]);
+    weights[20001] = 1.0f;  // in the first half: another thread's part than 70001's
+    CHECK(applyEnvelope(in, deformed, weights, 3e38, out) == 20001);
+    weights[20001] = 0.0f;
     deformed[5].y = kNaN;  // k = 0 there: the input is taken as it is, finite
     CHECK(applyEnvelope(in, deformed, weights, 3e38, out) == 70001);
     weights[5] = 1.0f;
@@ -234,7 +255,12 @@ TEST_CASE("applyEnvelope returns the first point whose result is not finite", "[
     CHECK_THROWS_WITH(requireFiniteResult("x", in, out, 5),
                       Catch::Contains("x: point 5: is deformed from (1, 1, 1) to (3, nan, 3)"));
     CHECK_THROWS_WITH(requireFiniteResult("x", {}, out, 5),
-                      Catch::Contains("x: point 5: is deformed to (3, nan"));
+                      Catch::Contains("x: point 5: is (3, nan, 3) once deformed"));
+    std::vector<glm::vec3> blend(in.size());
+    CHECK_THROWS_WITH(morphByEnvelope(in, deformed, 3e38f, blend),
+                      Catch::Contains("morph: point 0: is deformed from"));
+    CHECK_NOTHROW(morphByEnvelope(in, std::vector<glm::vec3>(in.size(), glm::vec3(3.0f)), 0.5f, blend));
+    CHECK(blend[5] == glm::vec3(2.0f));
     std::vector<glm::vec3> bad = in;
     bad[5].z = kInf;
     CHECK_THROWS_WITH(requireFiniteResult("x", bad, out, 5),

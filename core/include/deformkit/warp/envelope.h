@@ -23,7 +23,8 @@ namespace deformkit::warp {
 // Throws InvalidInput naming `source` and point `bad` when bad < out.size(): a deformer's output is never
 // handed on with NaN or infinite coordinates. `bad` is the first point a deformer's loop found not finite in
 // its output. `in` is the deformer's input: named in the message (its point not finite, or the point it was
-// deformed from) unless it is empty or the output overwrote it (the same span).
+// deformed from) unless it is empty or the output overwrote it (the same span); then the message gives the
+// result, which may be a point that came in not finite.
 void requireFiniteResult(std::string_view source, std::span<const glm::vec3> in,
                          std::span<const glm::vec3> out, int64_t bad);
 

@@ -118,7 +118,8 @@ class FfdLattice {
     [[nodiscard]] bool isBound() const { return bound_; }
     // A one-off without the bind cache: bind(restPoints) then deform(points, translations, 3, ...), the same
     // bytes, each point's coordinates computed where it is deformed (no per-point memory). Done for the
-    // Bernstein 4x4x4 lattice only; returns false (doing nothing) otherwise. Throws as bind() does.
+    // Bernstein 4x4x4 lattice only; returns false (doing nothing) otherwise. Throws as bind() does, and as
+    // deform() does on an output point that is not finite.
     // `in` and `out` as deform()'s.
     bool deformUnbound(std::span<const glm::vec3> restPoints, std::span<const glm::vec3> in,
                        std::span<glm::vec3> out, const float* translations, std::span<const float> weights,

@@ -21,7 +21,7 @@ namespace deformkit::warp {
 // and 3 follow the components (rotations swing through the arc) and differ from 1.
 
 // 1: out = in + t (deformed - in). All spans #points; out may alias in. Throws InvalidInput on size
-// mismatch or a non-finite t.
+// mismatch, a non-finite t, or a point the blend takes beyond float range (requireFiniteResult).
 void morphByEnvelope(std::span<const glm::vec3> in, std::span<const glm::vec3> deformed, float t,
                      std::span<glm::vec3> out);
 
