@@ -178,18 +178,6 @@ void Deformer::prepare(size_t in, size_t out) {
     }
 }
 
-namespace {
-
-// Parameters within float range can still take a point beyond it (an envelope of 1e38, a bend of
-// 3e38 radians a unit): refused here, naming the point, rather than handed on as NaN or infinity. The
-// input is finite (the stack checks it), so the message gives the point before and after.
-void requireFiniteOutput(const std::string& context, std::span<const glm::vec3> in,
-                         std::span<const glm::vec3> out) {
-    warp::requireFiniteResult(context, in, out, static_cast<int64_t>(geom::firstNonFinite(out)));
-}
-
-}  // namespace
-
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out) {
     prepare(in.size(), out.size());
     try {
@@ -197,7 +185,10 @@ void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out)
     } catch (const Error&) {
         rethrowWithContext(context_);
     }
-    requireFiniteOutput(context_, in, out);
+    // Parameters within float range can still take a point beyond it (an envelope of 3e38, a bend of 3e38
+    // radians a unit): refused here, naming the point, rather than handed on as NaN or infinity. The input
+    // is finite (the stack checks it), so the message gives the point before and after.
+    warp::requireFiniteResult(context_, in, out, static_cast<int64_t>(geom::firstNonFinite(out)));
 }
 
 void Deformer::evaluate(std::span<const glm::vec3> in, std::span<glm::vec3> out,

@@ -366,7 +366,7 @@ int64_t TaperWarp::run(std::span<const glm::vec3> points, std::span<glm::vec3> o
             const glm::vec3 radial = d - glm::dot(d, a) * a;
             out[u] = p + (profile(restZ_[u]) - 1.0f) * radial;
         }
-        if constexpr (Check) finite &= static_cast<int>(detail::allFinite(out.subspan(begin, end - begin)));
+        if constexpr (Check) finite &= static_cast<int>(geom::allFinite(out.subspan(begin, end - begin)));
     }
     return Check && finite == 0 ? detail::firstNonFinite(out) : n;
 }

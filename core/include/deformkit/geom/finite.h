@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <span>
 
 #include <glm/vec2.hpp>
@@ -15,6 +17,23 @@ namespace deformkit::geom {
 }
 [[nodiscard]] inline bool isFinite(const glm::vec3& p) {
     return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+// Whether every coordinate of `points` is finite: a float whose exponent bits are all ones is infinite or
+// NaN, and adding one to such an exponent carries into the sign bit. Integer operations over the coordinates
+// as one array, which the compiler vectorises; inline, so that a loop can check a run of outputs it has just
+// written (still in cache) instead of testing each point.
+[[nodiscard]] inline bool allFinite(std::span<const glm::vec3> points) {
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 holds three packed floats");
+    const auto* f = reinterpret_cast<const float*>(points.data());
+    const size_t n = 3 * points.size();
+    uint32_t any = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, f + i, sizeof(bits));
+        any |= (bits & 0x7f800000u) + 0x00800000u;
+    }
+    return (any & 0x80000000u) == 0;
 }
 
 // The index of the first point of `points` that is not finite, or points.size() when every one is: one
