@@ -8,6 +8,8 @@ axes and units that make its numbers the OBJ's (Y up; FBX without its unit scale
 each; every face must come back with the OBJ's corner positions and UVs (as multisets of faces: exporters
 may order faces differently), and the vertex count each format's rule gives: glTF and PLY keep the file's
 split vertices (one per distinct position, UV and normal), FBX and Collada are welded back to the OBJ's 290.
+The skinned Fox (Fox.glb), its mesh and armature moved, turned and scaled and posed, exported as glTF, FBX
+and Collada, reads as Blender's OBJ of its rest pose.
 """
 
 import os
@@ -31,6 +33,10 @@ FOX = os.path.join(os.environ.get("DEFORMKIT_TEST_DATA", os.path.join(os.path.di
 # floats through their own axis conversions. At the Fox's size (|x| < 128, a float32 ulp of 7.6e-6) they are
 # measured at most 2 ulps apart (glb 1.5e-5, dae 1.1e-5, fbx 3.8e-6, ply 9.5e-7): the tolerance is 4 ulps.
 TOLERANCE = 4 * 2.0 ** -23 * 128
+# The rigged Fox moved, turned and scaled by 1.5 (|x| < 256, an ulp of 1.5e-5) is posed through matrix
+# products in another order than Blender's: measured at most 3.5 ulps (glb 5.3e-5, dae 4.6e-5, fbx 2.3e-5);
+# the tolerance is 8 ulps. Leaving out Collada's bind shape matrix moves the mesh by 10.
+RIGGED_TOLERANCE = 8 * 2.0 ** -23 * 256
 
 
 def faces_of(mesh):
@@ -91,10 +97,59 @@ def test_formats_read_as_the_obj(folder):
         assert ".obj, .gltf, .glb, .fbx, .ply, .dae" in str(e), str(e)
 
 
+def test_rigged_formats_read_at_rest(folder):
+    """A skinned character placed as riggers place one: the Fox (Fox.glb, its armature and skin) with the mesh
+    moved and turned relative to its armature, and the armature moved, turned and scaled, posed by its Run
+    clip. Collada, FBX and glTF exports read as Blender's OBJ of the rest pose (the armature at rest): Collada
+    writes the mesh's placement relative to the armature as its bind shape matrix, under the armature's
+    node."""
+    for alias, kind in (("bool", bool), ("int", int), ("float", float), ("object", object), ("str", str)):
+        if alias not in np.__dict__:  # Debian's Blender 3.4 glTF importer uses aliases numpy 1.24 removed
+            setattr(np, alias, kind)
+    for block in list(bpy.data.objects):
+        bpy.data.objects.remove(block)
+    bpy.ops.import_scene.gltf(filepath=os.path.join(os.path.dirname(FOX), "Fox.glb"))
+    scene = bpy.context.scene
+    mesh = next(o for o in scene.objects if o.type == "MESH")
+    armature = next(o for o in scene.objects if o.type == "ARMATURE")
+    assert mesh.parent == armature
+    mesh.rotation_mode = armature.rotation_mode = "XYZ"
+    mesh.location.x += 10
+    mesh.rotation_euler.z += 0.3
+    armature.location.y += 5
+    armature.rotation_euler.x += 0.2
+    armature.rotation_euler.z += 0.5
+    armature.scale = (1.5, 1.5, 1.5)
+    run = [a for a in bpy.data.actions if a.name.startswith("Run")]
+    assert run, [a.name for a in bpy.data.actions]
+    armature.animation_data.action = run[-1]
+    scene.frame_set(8)
+    bpy.ops.object.select_all(action="DESELECT")
+    mesh.select_set(True)
+    armature.select_set(True)
+    bpy.context.view_layer.objects.active = mesh
+    paths = {ext: os.path.join(folder, "rigged." + ext) for ext in ("obj", "glb", "fbx", "dae")}
+    bpy.ops.export_scene.gltf(filepath=paths["glb"], export_format="GLB", use_selection=True)
+    bpy.ops.export_scene.fbx(filepath=paths["fbx"], use_selection=True, apply_scale_options="FBX_SCALE_UNITS")
+    bpy.ops.wm.collada_export(filepath=paths["dae"], selected=True)
+    armature.data.pose_position = "REST"
+    scene.frame_set(8)
+    armature.select_set(False)
+    bpy.ops.export_scene.obj(filepath=paths["obj"], use_selection=True, use_materials=False)
+    want = faces_of(dk.read_mesh(paths["obj"]))
+    for ext in ("glb", "fbx", "dae"):
+        got = faces_of(dk.read_mesh(paths[ext]))
+        assert got.shape == want.shape, (ext, got.shape, want.shape)
+        error = float(np.abs(got - want).max())
+        print(f"rigged {ext}: corners within {error:g} of the rest OBJ's")
+        assert np.abs(want[:, :, :3]).max() < 256
+        assert error <= RIGGED_TOLERANCE, (ext, error)
+
+
 def main():
     addon_utils.enable("io_scene_gltf2")
     addon_utils.enable("io_scene_fbx")
-    blender_tests.run((test_formats_read_as_the_obj,))
+    blender_tests.run((test_formats_read_as_the_obj, test_rigged_formats_read_at_rest))
 
 
 main()

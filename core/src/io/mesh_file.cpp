@@ -35,14 +35,23 @@ namespace {
 // Exact position key for welding assimp's per-corner vertices.
 using PositionKey = std::tuple<float, float, float>;
 
-// A glTF mesh's rest positions where pre-transforming its vertices by its node is wrong: a mesh skinned to
-// joints, or with morph targets at non-zero default weights. glTF places a skinned mesh by its joints alone
-// (the mesh node's own transform is ignored), so the rest pose is
-//   p = sum_j w_j (G(joint_j) * offset_j) (v + sum_k m_k (target_k - v)),
-// G the joint nodes' global transforms as the file poses them, offset_j their inverse bind matrices, m_k the
-// default morph weights: what Blender's importer shows at rest.
+// A mesh's rest positions where pre-transforming its vertices by its node is wrong: a mesh skinned to
+// joints, or with morph targets at non-zero default weights.
+// - glTF places a skinned mesh by its joints alone (the mesh node's own transform is ignored):
+//     p = sum_j w_j (G(joint_j) * offset_j) (v + sum_k m_k (target_k - v)),
+//   G the joint nodes' global transforms as the file poses them, offset_j their inverse bind matrices, m_k
+//   the default morph weights: what Blender's importer shows at rest.
+// - Collada (Placement::NodeThenJoints): p = N * sum_j w_j (F(joint_j) * offset_j) v, N the global
+//   transform of the node instancing the skin, F a joint's transform in the file's space (below assimp's
+//   root, which holds the up-axis and unit conversion N already has). assimp folds the bind shape matrix B
+//   into each offset (offset_j = inverse bind_j * B), so at the bind pose p = N * B * v: Blender writes the
+//   mesh node under its armature's node and the mesh's placement relative to the armature as B, and
+//   assimp's pre-transform (N * v) would leave B out. A file whose skin node is at the origin reads as the
+//   Collada specification skins it.
 class RestPose {
   public:
+    enum class Placement { JointsOnly, NodeThenJoints };
+
     // Whether `scene` has such a mesh; only then is the file read without assimp's pre-transform.
     static bool needed(const aiScene& scene) {
         for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
@@ -54,7 +63,9 @@ class RestPose {
         return false;
     }
 
-    explicit RestPose(const aiScene& scene) : scene_(scene) { visit(*scene.mRootNode, aiMatrix4x4()); }
+    RestPose(const aiScene& scene, Placement placement) : scene_(scene), placement_(placement) {
+        visit(*scene.mRootNode, aiMatrix4x4());
+    }
 
     // False when a mesh is placed by no node or by several (instances): the caller keeps assimp's
     // pre-transform then.
@@ -86,7 +97,11 @@ class RestPose {
         for (unsigned b = 0; b < mesh.mNumBones; ++b) {
             const aiBone& bone = *mesh.mBones[b];
             const aiNode* joint = scene_.mRootNode->FindNode(bone.mName);
-            const aiMatrix4x4 toWorld = (joint ? global(*joint) : node) * bone.mOffsetMatrix;
+            aiMatrix4x4 toWorld = node * bone.mOffsetMatrix;
+            if (joint != nullptr) {
+                toWorld = placement_ == Placement::JointsOnly ? global(*joint) * bone.mOffsetMatrix
+                                                              : node * belowRoot(*joint) * bone.mOffsetMatrix;
+            }
             for (unsigned i = 0; i < bone.mNumWeights; ++i) {
                 const aiVertexWeight& w = bone.mWeights[i];
                 if (w.mVertexId >= v.size()) continue;
@@ -116,7 +131,17 @@ class RestPose {
         return g;
     }
 
+    // The node's transform in the file's own space: without the root's, where assimp puts its conversions
+    // (a Collada file's up axis and unit), which the node instancing the skin applies once.
+    static aiMatrix4x4 belowRoot(const aiNode& n) {
+        aiMatrix4x4 g = n.mTransformation;
+        for (const aiNode* p = n.mParent; p && p->mParent; p = p->mParent)
+            g = p->mTransformation * g;
+        return n.mParent ? g : aiMatrix4x4();
+    }
+
     const aiScene& scene_;
+    Placement placement_;
     std::multimap<unsigned, aiMatrix4x4> placements_;
 };
 
@@ -409,7 +434,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         return scene;
     };
     // Meshes stay apart (one group each) while their vertices move to world space: by assimp's
-    // pre-transform, or for skinned and morphed glTF meshes by their rest pose (RestPose).
+    // pre-transform, or for skinned and morphed glTF and Collada meshes by their rest pose (RestPose).
     importer.SetPropertyBool(AI_CONFIG_PP_PTV_KEEP_HIERARCHY, true);
     const DroppedDataLog::Collect log;
     const aiScene* scene = check(importer.ReadFile(path.string(), aiProcess_ValidateDataStructure));
@@ -418,8 +443,9 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
                                        "faces and UVs that all refer to the file's vertices"));
     }
     std::optional<RestPose> rest;
-    if (format == MeshFormat::Gltf && RestPose::needed(*scene)) {
-        rest.emplace(*scene);
+    if ((format == MeshFormat::Gltf || format == MeshFormat::Collada) && RestPose::needed(*scene)) {
+        rest.emplace(*scene, format == MeshFormat::Gltf ? RestPose::Placement::JointsOnly
+                                                        : RestPose::Placement::NodeThenJoints);
         if (!rest->placesEveryMeshOnce()) rest.reset();
     }
     if (!rest) scene = check(importer.ApplyPostProcessing(aiProcess_PreTransformVertices));

@@ -106,6 +106,51 @@ const char* kSkinnedGltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes"
                {"bufferView": 4, "componentType": 5126, "count": 2, "type": "MAT4"},
                {"bufferView": 5, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 1], "max": [0, 0, 1]}]})";
 
+// A triangle (0,0,0) (1,0,0) (0,1,0) skinned in a Z-up Collada file as Blender lays one out: the mesh's node
+// under its armature's node "arm" (at (0, 0, 2)), with the identity, and the mesh's placement relative to the
+// armature, (10, 0, 0), as the bind shape matrix. Joints "root" (file space (5, 0, 2), inverse bind matrix
+// translate(-5, 0, -2)) and "tip" (its bind (5, 3, 2), inverse bind translate(-5, -3, -2); posed TIPZ
+// higher): vertex 0 follows root, vertex 1 tip, vertex 2 half each. Made by hand; Blender 3.4's Collada
+// importer puts the bind pose where the test below expects it.
+const char* kSkinnedCollada = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="tri" name="tri"><mesh>
+      <source id="p"><float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array>
+        <technique_common><accessor source="#pa" count="3" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+      <triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_controllers><controller id="ctrl" name="ctrl"><skin source="#tri">
+    <bind_shape_matrix>1 0 0 10 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
+    <source id="j"><Name_array id="ja" count="2">root tip</Name_array>
+      <technique_common><accessor source="#ja" count="2" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>
+    <source id="b"><float_array id="ba" count="32">1 0 0 -5 0 1 0 0 0 0 1 -2 0 0 0 1 1 0 0 -5 0 1 0 -3 0 0 1 -2 0 0 0 1</float_array>
+      <technique_common><accessor source="#ba" count="2" stride="16"><param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+    <source id="w"><float_array id="wa" count="2">1 0.5</float_array>
+      <technique_common><accessor source="#wa" count="2" stride="1"><param name="WEIGHT" type="float"/></accessor></technique_common></source>
+    <joints><input semantic="JOINT" source="#j"/><input semantic="INV_BIND_MATRIX" source="#b"/></joints>
+    <vertex_weights count="3"><input semantic="JOINT" source="#j" offset="0"/><input semantic="WEIGHT" source="#w" offset="1"/>
+      <vcount>1 1 2</vcount><v>0 0 1 0 0 1 1 1</v></vertex_weights>
+  </skin></controller></library_controllers>
+  <library_visual_scenes><visual_scene id="s">
+    <node id="arm" name="arm" type="NODE"><matrix sid="transform">1 0 0 0 0 1 0 0 0 0 1 2 0 0 0 1</matrix>
+      <node id="root" name="root" sid="root" type="JOINT"><matrix sid="transform">1 0 0 5 0 1 0 0 0 0 1 0 0 0 0 1</matrix>
+        <node id="tip" name="tip" sid="tip" type="JOINT"><matrix sid="transform">1 0 0 0 0 1 0 3 0 0 1 TIPZ 0 0 0 1</matrix></node>
+      </node>
+      <node id="skin" name="skin" type="NODE">
+        <instance_controller url="#ctrl"><skeleton>#root</skeleton></instance_controller>
+      </node>
+    </node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)";
+
 // kCollada's quad with one triangle in material "Red" and one in "Blue", instanced by two nodes (the second
 // moved by (0, 0, 1)): assimp gives four meshes, each named "quad".
 const char* kTwoMaterialCollada = R"(<?xml version="1.0" encoding="utf-8"?>
@@ -277,6 +322,34 @@ TEST_CASE("mesh files: a skinned, morphed glTF mesh rests where its joints and d
         for (size_t i = 0; i < 3; ++i) {
             CAPTURE(i, got[i].x, got[i].y, got[i].z);
             CHECK(glm::length(got[i] - want[i]) < 1e-6f);
+        }
+    }
+}
+
+TEST_CASE("mesh files: a skinned Collada mesh rests at its node, its bind shape and its joints' pose",
+          "[io][mesh_file]") {
+    // Written out by hand: p = N * sum_j w_j F_j IBM_j B v in the file's Z-up space (N the node instancing
+    // the skin, F the joints' transforms, B the bind shape matrix), then Y up: (x, y, z) -> (x, z, -y). At
+    // the bind pose F_j IBM_j is the identity, so p = N B v = v + (10, 0, 2); assimp's pre-transform alone
+    // gave v + (0, 0, 2), the bind shape left out. With the tip posed 1 higher, vertex 1 moves by (0, 0, 1)
+    // and vertex 2, half on the tip, by half that.
+    const test::TempDir dir;
+    for (const int tip : {0, 1}) {
+        std::string text = kSkinnedCollada;
+        text.replace(text.find("TIPZ"), 4, std::to_string(tip));
+        test::writeText(dir / "skinned.dae", text);
+        const io::ObjContent content = io::readMesh(dir / "skinned.dae");
+        const std::vector<glm::vec3> got = pointsOf(content.mesh);
+        const float t = static_cast<float>(tip);
+        const std::vector<glm::vec3> zUp{
+            {10.0f, 0.0f, 2.0f}, {11.0f, 0.0f, 2.0f + t}, {10.0f, 1.0f, 2.0f + t / 2}};
+        CAPTURE(tip);
+        REQUIRE(got.size() == 3);
+        REQUIRE(content.mesh.numFaces() == 1);
+        for (size_t i = 0; i < 3; ++i) {
+            const glm::vec3 want{zUp[i].x, zUp[i].z, -zUp[i].y};
+            CAPTURE(i, got[i].x, got[i].y, got[i].z);
+            CHECK(glm::length(got[i] - want) < 1e-6f);
         }
     }
 }
