@@ -24,12 +24,13 @@ TEST_CASE("demo uv warp: the bent tube's side tile keeps its features closer to 
                                                              assets.mask.at(1001), assets.albedo.at(1001));
     // What the previews show, measured on the redirect map (redirect_metrics.h). The bend stretches the outer
     // side ~1.5x and squashes the inner side ~0.5x; compression cannot be fully undone in a bounded tile
-    // (paper §6). docs/uvwarp_quality.md reports 72.8% of the rigid stretch removed: the test asks for at
-    // least 72%, so the docs cannot drift from what the demo does; and the fold repair's guarantee.
+    // (paper §6). docs/uvwarp_quality.md reports 74.8% of the rigid stretch removed: the test asks for
+    // 74-76%, so the docs cannot drift from what the demo does either way; and the fold repair's guarantee.
     const uvwarp::DeliveredMetrics& d = demo.delivered;
     INFO("rigid stretch error: identity " << d.identityStretchError << ", through the map "
                                           << d.rigidStretchError);
-    CHECK(d.removed >= 0.72);
+    CHECK(d.removed >= 0.74);
+    CHECK(d.removed <= 0.76);
     CHECK(d.invertedTriangles == 0);
     CHECK(d.offChartTexels == 0);
     // The solver's grid (diagnostics): no fold, masked points and the border still.

@@ -17,7 +17,7 @@ namespace deformkit::uvwarp {
 
 // A UV-warp shot as one HTML page a farm TD reads at a glance (`deformkit report`, `uvwarp --report`,
 // `eval --report`, `farm report`, Python's shot_report, the Blender add-on's bake). Readable offline: no
-// network, no script; plots are inline SVG, thumbnails inline PNG (up to 3 MB of them, then beside the
+// network, no script; plots are inline SVG, thumbnails inline PNG (up to 1 MB of them, then beside the
 // page), full-size pictures (at most 2048 px a side) beside the page in `<page stem>_files/`. Per object and
 // tile:
 // - plots over frames of the figures the logs carry, measured on the delivered maps: rigid stretch
