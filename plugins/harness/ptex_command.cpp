@@ -3,6 +3,8 @@
 #include "cli.h"
 #include "uvwarp_command.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <map>
 
@@ -101,6 +103,13 @@ void ptexInfo(const fs::path& file, std::ostream& out) {
 }
 
 size_t ptexToVertexCommand(const PtexToVertexCommand& command) {
+    // Checked first: a Ptex or mesh file named as --out would be overwritten with JSON.
+    std::string extension = command.out.extension().string();
+    std::ranges::transform(extension, extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (extension != ".json") {
+        throw InvalidInput(formatError("--out", "", "is '" + command.out.string() + "'",
+                                       "a weights file name ending in .json"));
+    }
     const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     const std::vector<float> weights =
         ptex::weightsFromPtex(mesh, command.mesh.string(), command.ptex, command.channel, "");
@@ -121,11 +130,21 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
     options.tiles = command.tiles;
     options.padding = command.padding;
     options.coverageChannel = command.coverage;
+    // An EXR keeps the map's precision: float for float and 16-bit data, half for half and 8-bit data
+    // (every 8-bit value within half a step of 1/255). Other formats take their own default (8 bits).
+    io::ImageWriteOptions write;
+    std::string extension = fs::path(command.out).extension().string();
+    std::ranges::transform(extension, extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (extension == ".exr") {
+        write.type = file.dataType == ptex::DataType::Float || file.dataType == ptex::DataType::UInt16
+                         ? io::PixelType::Float
+                         : io::PixelType::Half;
+    }
     std::vector<fs::path> written;
     for (const ptex::UdimTile& tile :
          ptex::ptexToUdim(ptexMesh, mesh, file, command.ptex.string(), options)) {
         written.emplace_back(io::expandUdim(command.out, tile.tile));
-        io::writeImage(written.back(), tile.image);
+        io::writeImage(written.back(), tile.image, write);
     }
     return written;
 }
@@ -134,7 +153,7 @@ int32_t ptexFromUdimCommand(const PtexFromUdimCommand& command) {
     const geom::Mesh mesh = io::readMesh(command.mesh).mesh;
     std::vector<ptex::UdimTile> tiles;
     for (const io::UdimFile& f : io::findUdimFiles(command.pattern))
-        tiles.push_back({f.tile, io::readImage(f.path)});
+        tiles.push_back({f.tile, io::readImage(f.path), f.path.string()});
     const ptex::PtexMesh ptexMesh(mesh, command.mesh.string());
     ptex::FromUdimOptions options;
     options.ulog2 = options.vlog2 = command.faceLog2;
@@ -169,8 +188,8 @@ ptex::DataType parsePtexType(const std::string& text) {
     throw InvalidInput(formatError("--type", "", "is '" + text + "'", "u8, u16, half or float"));
 }
 
-int8_t parseFaceResolution(const std::string& text) {
-    if (text == "auto") return -1;
+int8_t parseFaceResolution(const std::string& text, bool allowAuto) {
+    if (text == "auto" && allowAuto) return -1;
     int value = 0;
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (error == std::errc() && end == text.data() + text.size() && value >= 1 && value <= 32768 &&
@@ -180,8 +199,9 @@ int8_t parseFaceResolution(const std::string& text) {
             ++log2;
         return log2;
     }
-    throw InvalidInput(formatError("--face-res", "", "is '" + text + "'",
-                                   "auto or a power of two from 1 to 32768 (texels per face side)"));
+    throw InvalidInput(formatError(
+        "--face-res", "", "is '" + text + "'",
+        std::string(allowAuto ? "auto or " : "") + "a power of two from 1 to 32768 (texels per face side)"));
 }
 
 namespace {
@@ -189,10 +209,11 @@ namespace {
 // The options of a command that writes a Ptex file: texels per face side (--face-res) and the data type
 // (--type), read into the command's own fields.
 void addPtexOutputOptions(Command& command, int8_t& faceLog2, ptex::DataType& type,
-                          const std::string& faceRes, const std::string& faceResHelp) {
+                          const std::string& faceRes, const std::string& faceResHelp, bool allowAuto) {
     command.option(
-        "--face-res", [&faceLog2](const std::string& text) { faceLog2 = parseFaceResolution(text); }, faceRes,
-        faceResHelp);
+        "--face-res",
+        [&faceLog2, allowAuto](const std::string& text) { faceLog2 = parseFaceResolution(text, allowAuto); },
+        faceRes, faceResHelp);
     command.option(
         "--type", [&type](const std::string& text) { type = parsePtexType(text); }, "float",
         "u8, u16, half or float");
@@ -261,7 +282,7 @@ void addPtexCommands(CommandLine& cli) {
     fromUdim.option("MESH", fu->mesh, "mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     fromUdim.option("--out", fu->out, "Ptex file (.ptx)").required();
     addPtexOutputOptions(fromUdim, fu->faceLog2, fu->type, "auto",
-                         "texels per face side: auto or a power of two");
+                         "texels per face side: auto or a power of two", true);
 
     auto fv = std::make_shared<PtexFromVertexCommand>();
     Command fromVertex =
@@ -273,7 +294,8 @@ void addPtexCommands(CommandLine& cli) {
     fromVertex.option("WEIGHTS", fv->weights, "weights file (.json), one per vertex").required();
     fromVertex.option("MESH", fv->mesh, "mesh (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     fromVertex.option("--out", fv->out, "Ptex file (.ptx)").required();
-    addPtexOutputOptions(fromVertex, fv->faceLog2, fv->type, "16", "texels per face side, a power of two");
+    addPtexOutputOptions(fromVertex, fv->faceLog2, fv->type, "16", "texels per face side, a power of two",
+                         false);
 }
 
 }  // namespace deformkit::harness

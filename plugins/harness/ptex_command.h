@@ -65,7 +65,8 @@ void ptexFromVertexCommand(const PtexFromVertexCommand& command);
 
 // "u8", "u16", "half" or "float"; InvalidInput naming --type otherwise.
 [[nodiscard]] ptex::DataType parsePtexType(const std::string& text);
-// "auto" (-1) or a face size 1, 2, 4, ... 32768 (its log2); InvalidInput naming --face-res otherwise.
-[[nodiscard]] int8_t parseFaceResolution(const std::string& text);
+// A face size 1, 2, 4, ... 32768 (its log2), or "auto" (-1) where `allowAuto`; InvalidInput naming
+// --face-res and what it takes otherwise.
+[[nodiscard]] int8_t parseFaceResolution(const std::string& text, bool allowAuto = true);
 
 }  // namespace deformkit::harness

@@ -177,11 +177,20 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
         throw InvalidInput(formatError(fileSource, "padding", "is " + std::to_string(options.padding),
                                        "texels of edge padding in [0, 65536]"));
     }
-    std::vector<int> tiles = options.tiles.empty() ? mesh.udimTiles() : options.tiles;
+    const std::vector<int> meshTiles = mesh.udimTiles();
+    std::vector<int> tiles = options.tiles.empty() ? meshTiles : options.tiles;
     for (int tile : tiles) {  // the mesh's own tiles are valid (Mesh::udimTiles); asked-for ones are checked
         if (tile < 1001 || tile > 9999) {
             throw InvalidInput(formatError(fileSource, "tiles", std::to_string(tile) + " is not a UDIM tile",
                                            "tile numbers 1001 to 9999"));
+        }
+        if (!std::ranges::binary_search(meshTiles, tile)) {  // it would be written blank
+            std::string have;
+            for (int t : meshTiles)
+                have.append(have.empty() ? "" : " ").append(std::to_string(t));
+            throw InvalidInput(formatError(fileSource, "tile " + std::to_string(tile),
+                                           "the mesh '" + ptexMesh.source() + "' has no UV face in it",
+                                           "tiles of the mesh: " + have));
         }
     }
     const PtexSampler sampler(file, fileSource);
@@ -235,7 +244,7 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
         geom::rasterizeAttributes({res, res}, positions, triangles, attributes, 2, raster);
         const std::vector<uint8_t> chart = chartMask(mesh, tile, origin, res);
         fillFromNeighbours(raster, positions, triangles, attributes, chart, options.padding);
-        UdimTile result{tile, io::Image(res, res, outChannels, 0.0f)};
+        UdimTile result{tile, io::Image(res, res, outChannels, 0.0f), {}};
         for (int32_t y = 0; y < res; ++y) {
             for (int32_t x = 0; x < res; ++x) {
                 const size_t pixel = static_cast<size_t>(y) * res + x;
@@ -271,6 +280,16 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
                                                std::to_string(tiles.front().tile) + ", at least 1x1"));
         }
         byTile[t.tile] = &t.image;
+        for (size_t k = 0; k < t.image.pixels.size(); ++k) {
+            if (std::isfinite(t.image.pixels[k])) continue;
+            const auto c = static_cast<int32_t>(k % static_cast<size_t>(channels));
+            const auto texel = static_cast<int64_t>(k / static_cast<size_t>(channels));
+            throw InvalidInput(
+                formatError(t.source.empty() ? "UDIM tile " + std::to_string(t.tile) : t.source,
+                            "texel (" + std::to_string(texel % t.image.width) + ", " +
+                                std::to_string(texel / t.image.width) + ") channel " + std::to_string(c),
+                            "is " + numberText(t.image.pixels[k]), "a finite value"));
+        }
     }
     if (channels < 1 || channels > 64) {
         throw InvalidInput(formatError("UDIM tile " + std::to_string(tiles.front().tile), "",

@@ -3,7 +3,9 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -236,4 +238,96 @@ TEST_CASE("ptex command: from-vertex bakes weights that interpolate the face's c
                    harness::ptexFromVertexCommand(command);
                }),
                Contains("--face-res"));
+}
+
+TEST_CASE("ptex command: bad outputs and inputs are refused before anything is written", "[harness][ptex]") {
+    Fixture f;
+    const std::string before = test::readText(f.dir / "paint.ptx");
+    SECTION("to-vertex writes only a .json weights file: a Ptex or mesh named as --out is left alone") {
+        for (const char* name : {"paint.ptx", "grid.obj", "weights.txt"}) {
+            const harness::PtexToVertexCommand command{f.dir / "paint.ptx", f.dir / "grid.obj", f.dir / name,
+                                                       0};
+            CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::ptexToVertexCommand(command); }),
+                       Contains("--out: is '") && Contains(name) &&
+                           Contains("(expected a weights file name ending in .json)"));
+        }
+        CHECK(test::readText(f.dir / "paint.ptx") == before);
+        CHECK(io::readObj(f.dir / "grid.obj").mesh.numVertices() == f.mesh.numVertices());
+        const harness::PtexToVertexCommand upper{f.dir / "paint.ptx", f.dir / "grid.obj", f.dir / "W.JSON",
+                                                 0};
+        CHECK(harness::ptexToVertexCommand(upper) == static_cast<size_t>(f.mesh.numVertices()));
+    }
+    SECTION("from-udim refuses a NaN or infinite texel, naming the image, the texel and the channel") {
+        for (const float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+            io::Image image(16, 16, 2, 0.5f);
+            image.at(5, 3, 1) = bad;
+            io::writeImage(f.dir / "bad.1001.exr", image, {io::PixelType::Float, {}});
+            harness::PtexFromUdimCommand from;
+            from.pattern = (f.dir / "bad.<UDIM>.exr").string();
+            from.mesh = f.dir / "grid.obj";
+            from.out = f.dir / "bad.ptx";
+            CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::ptexFromUdimCommand(from); }),
+                       Contains("bad.1001.exr: texel (5, 3) channel 1: is ") &&
+                           Contains("(expected a finite value)"));
+            CHECK_FALSE(std::filesystem::exists(f.dir / "bad.ptx"));
+        }
+    }
+    SECTION("to-udim refuses a tile the mesh has no UV face in (it would be written blank)") {
+        harness::PtexToUdimCommand to;
+        to.ptex = f.dir / "paint.ptx";
+        to.mesh = f.dir / "grid.obj";
+        to.out = (f.dir / "t.<UDIM>.exr").string();
+        to.resolution = 16;
+        to.tiles = {1001, 1002};
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::ptexToUdimCommand(to); }),
+                   Contains("tile 1002: the mesh '") && Contains("(expected tiles of the mesh: 1001)"));
+        CHECK_FALSE(std::filesystem::exists(f.dir / "t.1001.exr"));
+    }
+    SECTION("--face-res offers auto only where it is taken") {
+        CHECK_THAT(test::errorOf<InvalidInput>([] { (void)harness::parseFaceResolution("0", false); }),
+                   Contains("(expected a power of two from 1 to 32768") && !Contains("auto"));
+        CHECK_THAT(test::errorOf<InvalidInput>([] { (void)harness::parseFaceResolution("auto", false); }),
+                   Contains("is 'auto'"));
+        CHECK_THAT(test::errorOf<InvalidInput>([] { (void)harness::parseFaceResolution("0"); }),
+                   Contains("(expected auto or a power of two"));
+    }
+}
+
+TEST_CASE("ptex command: to-udim writes an EXR with the map's precision", "[harness][ptex]") {
+    // Values a half float cannot hold (1000.3 rounds to 1000.5 in half, 1e5 overflows it) come back exactly
+    // from a float map; a half map's EXR is half.
+    Fixture f;
+    for (const ptex::DataType type : {ptex::DataType::Float, ptex::DataType::Half}) {
+        if (type == ptex::DataType::Float) {
+            ptex::WriteOptions options;
+            options.mesh = ptex::meshData(f.mesh);
+            ptex::writePtex(f.dir / "big.ptx",
+                            test::constantFaces(ptex::PtexMesh(f.mesh), 1, 2,
+                                                [](int32_t p, int32_t) { return p < 32 ? 1000.3f : 1e5f; }),
+                            options);
+        } else {  // a half map baked from weights of 0.25
+            std::string json = "[0.25";
+            for (int32_t v = 1; v < f.mesh.numVertices(); ++v)
+                json += ", 0.25";
+            test::writeText(f.dir / "w.json", json + "]");
+            harness::ptexFromVertexCommand(
+                {f.dir / "w.json", f.dir / "grid.obj", f.dir / "big.ptx", 2, type});
+        }
+        harness::PtexToUdimCommand to;
+        to.ptex = f.dir / "big.ptx";
+        to.mesh = f.dir / "grid.obj";
+        to.out = (f.dir / "big.<UDIM>.exr").string();
+        to.resolution = 32;
+        const auto written = harness::ptexToUdimCommand(to);
+        REQUIRE(written.size() == 1);
+        CHECK(io::readImageInfo(written[0]).pixelType == (type == ptex::DataType::Float ? "float" : "half"));
+        const io::Image image = io::readImage(written[0]);
+        std::set<float> values(image.pixels.begin(), image.pixels.end());
+        if (type == ptex::DataType::Float) {
+            CHECK(values.count(1000.3f) == 1);
+            CHECK(values.count(1e5f) == 1);
+        } else {
+            CHECK(values.count(0.25f) == 1);
+        }
+    }
 }

@@ -25,6 +25,7 @@ class PtexMesh;  // ptex_mesh.h
 struct UdimTile {
     int tile = 1001;
     io::Image image;
+    std::string source;  // the image's file, named in errors ("UDIM tile 1001" when empty)
 };
 struct ToUdimOptions {
     int32_t resolution = 1024;  // each tile resolution × resolution
@@ -41,7 +42,8 @@ struct ToUdimOptions {
 // image per tile, all with the same channel count. Face resolution: fixed (ulog2/vlog2 >= 0) or, with -1,
 // per face the power of two nearest the face's extent in texels of its tile (each axis, in [0, 12]).
 // A face without UVs (Mesh::faceHasUVs) is in no tile: its Ptex faces are written 0. Throws InvalidInput
-// naming the mesh (no UVs) or the face whose UVs fall in a tile that is not given.
+// naming the mesh (no UVs), the face whose UVs fall in a tile that is not given, or the first texel of an
+// image that is not finite (NaN or infinite: a Ptex file holds none).
 struct FromUdimOptions {
     int8_t ulog2 = -1;
     int8_t vlog2 = -1;
