@@ -73,9 +73,15 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
         }
     }
     fs::path page = command.out;
+    std::vector<std::pair<fs::path, std::string>> planFiles;  // the plan and its outputs, by what they are
     if (command.plan) {
         const scene::FarmPlan plan = scene::readFarmPlan(*command.plan);
         const fs::path planFile = fs::absolute(*command.plan);
+        planFiles.emplace_back(planFile, "the plan");
+        for (size_t k = 0; k < plan.tasks.size(); ++k)
+            for (const std::string& output : plan.tasks[k].outputs)
+                planFiles.emplace_back(plan.outDir / output,
+                                       "an output of task " + std::to_string(k) + " of the plan");
         if (command.logs.empty()) logs = logsIn(planFile.parent_path(), planFile.stem().string() + ".");
         // Which objects write maps of which tiles, so that a task killed after one object's maps and
         // before another's is missing; without the scene, any object's line counts for its tile.
@@ -120,6 +126,21 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
                          : std::string("a JSON-lines shot log (uvwarp --log, farm run)")));
     }
     if (page.empty()) page = logs.front().parent_path() / "report.html";
+    // The page is written over no log it reads and no output of the plan (a map the page replaced would be
+    // skipped as done by a task run again).
+    const auto key = [](const fs::path& path) { return fs::absolute(path).lexically_normal(); };
+    const fs::path pageKey = key(page);
+    for (const fs::path& file : logs) {
+        if (key(file) == pageKey) {
+            throw InvalidInput(formatError(page.string(), "", "is a log the page reads",
+                                           "a page apart from the shot's logs and outputs"));
+        }
+    }
+    for (const auto& [file, what] : planFiles) {
+        if (key(file) == pageKey)
+            throw InvalidInput(formatError(page.string(), "", "is " + what,
+                                           "a page apart from the shot's logs and outputs"));
+    }
     uvwarp::ShotLog log;
     for (const fs::path& file : logs)
         uvwarp::readShotLogFile(file, log);

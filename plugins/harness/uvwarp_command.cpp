@@ -148,14 +148,26 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     job.preset = command.preset;
     job.presetOwn = command.presetOwn;
     job.filter = command.filter;
+    // The command's own files are not the job's outputs: a map written over the deformed frames, the log or
+    // the report (which a resumed job would then skip as done) is refused before anything is written.
+    if (command.log) job.reservedFiles.emplace_back(*command.log, "the log (--log)");
+    if (command.report) job.reservedFiles.emplace_back(*command.report, "the report (--report)");
+    if (io::ObjSequence::isPattern(command.deformed.string())) {
+        const io::ObjSequence sequence(command.deformed);
+        for (const int frame : command.frames)
+            job.reservedFiles.emplace_back(sequence.framePath(frame),
+                                           "the deformed frame " + std::to_string(frame) + " (--deformed)");
+    } else {
+        job.reservedFiles.emplace_back(command.deformed, "the deformed shot (--deformed)");
+    }
     std::ofstream logFile;
     std::ostringstream logLines;  // for the page when there is no log file
-    if (command.log) {
-        uvwarp::openShotLog(*command.log, logFile);
-        job.log = &logFile;
-    } else if (command.report) {
-        job.log = &logLines;
-    }
+    if (command.log) job.log = &logFile;
+    if (!command.log && command.report) job.log = &logLines;
+    job.planned = [&] {  // folders of the page made, and the log opened, once nothing else is refused
+        if (command.report) uvwarp::prepareHtmlReport(*command.report);
+        if (command.log) uvwarp::openShotLog(*command.log, logFile);
+    };
     uvwarp::ShotReport report = uvwarp::runShotJob(job, frames, interrupter);
     if (command.log && !logFile.flush()) {
         throw StorageError(

@@ -519,6 +519,14 @@ echo "deformkit: error: an earlier attempt failed" >>"$work/farm-uv/farm_plan.77
 expect farm-report 0 "$dk" report --plan "$work/farm-uv/farm_plan.json"
 contains farm-report "$work/out" "(2 log lines, 8 pictures beside it; 3 problems)"
 contains farm-report "$work/farm-uv/report.html" "farm_plan.77_2.log:2: is not JSON: 'deformkit: error: an earlier attempt failed'"
+# The page is written over none of the plan's outputs and none of the logs it reads.
+cp "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/map-before.exr"
+expect farm-report-over-map 2 "$dk" farm report "$work/farm-uv/farm_plan.json" --out "$work/farm-uv/grid.redirect.1001.0002.exr"
+contains farm-report-over-map "$work/err" "grid.redirect.1001.0002.exr: is an output of task 3 of the plan (expected a page apart"
+cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/map-before.exr" ||
+    { echo "FAIL farm-report-over-map: the map was written over"; failures=$((failures + 1)); }
+expect farm-report-over-log 2 "$dk" farm report "$work/farm-uv/farm_plan.json" --out "$work/farm-uv/farm_plan.77_2.log"
+contains farm-report-over-log "$work/err" "farm_plan.77_2.log: is a log the page reads"
 # Each frame from the identity (a scene's default): the task of frame 2 writes eval's bytes, warmed up or not.
 cmp -s "$work/farm-uv/grid.redirect.1001.0002.exr" "$work/eval-uv/grid.redirect.1001.0002.exr" ||
     { echo "FAIL farm-run-tiles: the task of frame 2 should write eval's frame 2"; failures=$((failures + 1)); }

@@ -181,6 +181,12 @@ std::string requestedType(PixelType type, std::string_view format) {
     return format == "openexr" ? "half" : "uint8";
 }
 
+InvalidInput noWriter(const fs::path& path) {
+    return InvalidInput(formatError(path.string(), "",
+                                    "no image format for the extension '" + path.extension().string() + "'",
+                                    "an extension OpenImageIO writes, such as .exr, .png or .tif"));
+}
+
 bool hasAttribute(const ImageWriteOptions& options, std::string_view name) {
     for (const auto& [key, value] : options.attributes) {
         if (key == name) return true;
@@ -301,11 +307,7 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
     discardPendingOiioErrors(oiio);
     // Created from the final name (nothing is opened yet): its format decides the checks below.
     std::unique_ptr<codec::Writer> probe = oiio.createWriter(path.string());
-    if (!probe) {
-        throw InvalidInput(formatError(
-            path.string(), "", "no image format for the extension '" + path.extension().string() + "'",
-            "an extension OpenImageIO writes, such as .exr, .png or .tif"));
-    }
+    if (!probe) throw noWriter(path);
     const std::string format = probe->formatName();
     if (channels > 4 && !probe->supportsAnyChannelCount()) {
         throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
@@ -421,6 +423,14 @@ void writeImageInBands(const fs::path& path, int32_t width, int32_t height, int3
         }
         return true;
     });
+}
+
+void requireImageWriter(const fs::path& path) {
+    const codec::Codec& oiio = codec::load(path.string());
+    discardPendingOiioErrors(oiio);
+    const bool known = oiio.createWriter(path.string()) != nullptr;
+    discardPendingOiioErrors(oiio);
+    if (!known) throw noWriter(path);
 }
 
 bool isImageFileName(const fs::path& path) {

@@ -305,6 +305,12 @@ details{margin:6px 0}img{image-rendering:pixelated;border:1px solid #ddd})";
 
 }  // namespace
 
+void prepareHtmlReport(const fs::path& page) {
+    const fs::path folder = page.has_parent_path() ? page.parent_path() : fs::path(".");
+    io::createFolder(folder);
+    io::createFolder(folder / (page.stem().string() + "_files"));
+}
+
 HtmlReportResult writeHtmlReport(const ShotLog& log, const fs::path& page, const HtmlReportOptions& options) {
     if (options.thumbnail < 16) {
         throw InvalidInput(

@@ -246,6 +246,63 @@ struct ShotSolver::Impl {
                    const std::string& inputName);
 };
 
+namespace {
+
+// A path as outputs and inputs are compared: absolute and lexically normal (nothing is opened).
+std::string pathKey(const fs::path& path) {
+    std::error_code error;
+    const fs::path absolute = fs::absolute(path, error);
+    return (error ? path : absolute).lexically_normal().string();
+}
+
+// Every output of the job has a name of its own: no two alike, none the name of an input (the rest mesh,
+// a map's file at any frame, the caller's reserved files). Otherwise a report or log, another tile's map or
+// an input is overwritten, and a resumed job takes the damaged file for a finished output.
+void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJob& j) {
+    std::map<std::string, std::string> outputs;  // path key -> what is written there
+    const auto output = [&](const fs::path& path, const std::string& what) {
+        if (const auto [it, added] = outputs.emplace(pathKey(path), what); !added) {
+            throw InvalidInput(formatError(path.string(), "", "is both " + it->second + " and " + what,
+                                           "a file of its own for each output"));
+        }
+    };
+    for (const detail::TilePlan& plan : plans) {
+        if (!plan.report.warped) continue;
+        for (size_t k = 0; k < j.frames.size(); ++k) {
+            const std::string at =
+                "tile " + std::to_string(plan.tile) + ", frame " + std::to_string(j.frames[k]);
+            output(plan.outPaths[k], "the redirect map of " + at);
+            if (!plan.bakePaths[k].empty()) output(plan.bakePaths[k], "the bake of " + at);
+        }
+    }
+    const auto input = [&](const fs::path& path, const std::string& what) {
+        if (const auto it = outputs.find(pathKey(path)); it != outputs.end()) {
+            throw InvalidInput(formatError(path.string(), "", "is " + what + ", and " + it->second,
+                                           "outputs apart from the job's inputs and the caller's files"));
+        }
+    };
+    input(j.restName, "the rest mesh");
+    for (const auto& [path, what] : j.reservedFiles)
+        input(path, what);
+    for (const detail::TilePlan& plan : plans) {
+        for (const auto& [map, what] :
+             {std::pair{&plan.rigidity, "rigidity map"}, std::pair{&plan.mask, "warp mask"},
+              std::pair{&plan.orientation, "orientation map"}, std::pair{&plan.texture, "texture"}}) {
+            if (!map->file) continue;
+            const std::string of = std::string("the ") + what + " of tile " + std::to_string(plan.tile);
+            if (map->framePattern.empty()) {
+                input(*map->file, of);
+                continue;
+            }
+            const io::ObjSequence sequence(map->framePattern);
+            for (const int frame : j.frames)
+                input(sequence.framePath(frame), of + " at frame " + std::to_string(frame));
+        }
+    }
+}
+
+}  // namespace
+
 ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
     Impl& s = *impl_;
     s.job = std::move(job);
@@ -390,6 +447,8 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
             plan.texture = findTileMap(j.texture, tile, j.frames);
             if (!plan.texture.found())
                 plan.report.notes.push_back("no texture '" + plan.texture.name + "': not baked");
+            else
+                io::requireImageWriter(j.bakePath(tile, j.frames.front()));  // before any frame is solved
         }
         for (size_t k = 0; k < j.frames.size(); ++k) {
             const int frame = j.frames[k];
@@ -409,6 +468,7 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         if (plan.texture.found()) plan.inputs["texture"] = plan.texture.name;
         s.plans.push_back(std::move(plan));
     }
+    requireOutputsApart(s.plans, j);
     if (!s.plans.empty() &&
         std::none_of(s.plans.begin(), s.plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
         std::string list;
@@ -714,6 +774,7 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
             formatError("uvwarp", "job", "has no deformed positions", "a DeformedFrames function"));
     }
     ShotSolver solver(job);
+    if (job.planned) job.planned();
     const std::optional<int> last = solver.lastNeededFrame();
     const InterrupterScope scope(interrupter, "uvwarp", solver.units());
     for (int frame : job.frames) {

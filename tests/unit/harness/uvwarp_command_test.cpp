@@ -615,3 +615,61 @@ TEST_CASE("uvwarp command: a PC2 or MDD cache of the shot writes the maps and ba
                         "mesh"));
     CHECK(test::filesIn(bad.dir / "out").empty());
 }
+
+TEST_CASE(
+    "uvwarp command: an output named as another output, an input or the log is refused, the file untouched",
+    "[harness][uvwarp]") {
+    // Each case would have overwritten a file, and a rerun would then have skipped the damaged output as
+    // done.
+    Scene s;
+    const fs::path map1 = s.redirect(1);
+    test::writeText(map1, "a finished map");  // the file an output's name points at, as before a rerun
+    const auto refused = [&](const std::string& expected) {
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains(expected));
+        CHECK(test::readText(map1) == "a finished map");
+        CHECK_FALSE(fs::exists(s.redirect(2)));
+    };
+    SECTION("the report") {
+        s.command.report = map1;
+        refused(
+            "redirect.1001.0001.exr: is the report (--report), and the redirect map of tile 1001, frame 1");
+    }
+    SECTION("the log, not opened") {
+        s.command.log = map1;
+        refused("redirect.1001.0001.exr: is the log (--log), and the redirect map of tile 1001, frame 1");
+    }
+    SECTION("a bake pattern spelled another way") {
+        s.command.texture = s.dir / "col.<UDIM>.exr";
+        s.command.bake = s.dir / "out/redirect.<UDIM>.%04d.exr";
+        refused(
+            "redirect.1001.0001.exr: is both the redirect map of tile 1001, frame 1 and the bake of tile "
+            "1001, frame 1 (expected a file of its own for each output)");
+    }
+    SECTION("an animated rigidity map") {
+        for (int f = 1; f <= 3; ++f)
+            io::writeImage(s.dir / ("out/redirect.1001.000" + std::to_string(f) + ".exr"), disks(),
+                           {io::PixelType::Float, {}});
+        s.command.rigidity = s.command.out;
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(s.command); }),
+            Catch::Contains("is the rigidity map of tile 1001 at frame 1, and the redirect map of tile "
+                            "1001, frame 1"));
+        CHECK(io::readImage(s.redirect(2)).pixels == disks().pixels);
+    }
+    SECTION("a deformed frame") {
+        s.command.deformed = s.dir / "out/redirect.1001.####.exr";
+        fs::remove(map1);
+        for (int f = 1; f <= 3; ++f)
+            fs::copy_file(s.dir / ("anim.000" + std::to_string(f) + ".obj"), s.redirect(f));
+        s.command.out = s.dir / "out/redirect.<UDIM>.####.exr";
+        CHECK_THAT(
+            test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(s.command); }),
+            Catch::Contains("is the deformed frame 1 (--deformed), and the redirect map of tile 1001"));
+    }
+    SECTION("a bake extension no writer takes, before any frame is solved") {
+        s.command.texture = s.dir / "col.<UDIM>.exr";
+        s.command.bake = s.dir / "out/col.<UDIM>.####.xyz";
+        refused("col.1001.0001.xyz: no image format for the extension '.xyz'");
+    }
+}

@@ -64,6 +64,10 @@ struct ImageInfo {
 // True when OpenImageIO has a reader for the file name's extension (the file is not opened).
 [[nodiscard]] bool isImageFileName(const std::filesystem::path& path);
 
+// Throws InvalidInput, as writeImage would, when OpenImageIO has no writer for the file name's extension
+// (nothing is opened): for outputs checked before the work that makes them.
+void requireImageWriter(const std::filesystem::path& path);
+
 // Writes atomically (temporary file in the same folder, then rename): on failure no partial file is
 // left and an existing file is intact. The format follows the extension. Throws InvalidInput for an
 // empty image, a pixel count that does not match width * height * channels, or a pixel type the format

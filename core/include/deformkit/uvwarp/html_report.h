@@ -77,6 +77,10 @@ struct HtmlReportResult {
 HtmlReportResult writeHtmlReport(const ShotLog& log, const std::filesystem::path& page,
                                  const HtmlReportOptions& options = {});
 
+// Makes the page's folder and its folder of pictures where missing, for a caller that writes the page after
+// long work: one that cannot be made fails first (IoError naming it), before the work.
+void prepareHtmlReport(const std::filesystem::path& page);
+
 // The colour of remaining rigid stretch e (| length ratio - 1 |) in the heatmaps: 0 dark blue through
 // yellow at kHeatmapTop and above.
 inline constexpr double kHeatmapTop = 0.25;

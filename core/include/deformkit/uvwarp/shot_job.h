@@ -49,7 +49,9 @@ namespace deformkit::uvwarp {
 //   frame after it ("skipped"). A tile whose outputs all exist is not bound. Frames solved from the
 //   identity (SolverOptions::warmStart false) need no replay and no warm-up: only the missing outputs are
 //   solved.
-// - Checks before anything is written: map patterns have a UDIM token; output folders exist; per tile the
+// - Checks before anything is written: map patterns have a UDIM token; output folders exist; outputs have
+//   names of their own (no two alike, none an input's or ShotJob::reservedFiles'); a bake's extension is one
+//   OpenImageIO writes; per tile the
 //   maps' sizes (square, equal, a power of two when the grid takes the map's size). A tile without a rigidity
 //   map is left unwarped (no outputs) and reported, unless no tile has one (an error). A missing mask tile is
 //   derived from the UVs, a missing orientation tile means the density heuristic's map where
@@ -113,6 +115,14 @@ struct ShotJob {
     std::ostream* log = nullptr;
     int logTask = -1;
     std::string logObject;
+    // Files the job must not write, each with what it is ("the log (--log)"): the caller's inputs (the
+    // deformed frames' files) and its own outputs (a log, a report). Checked before anything is written,
+    // as the job's own inputs (the rest mesh, every map file) are: an output with such a name, or two
+    // outputs with one name, is InvalidInput naming both.
+    std::vector<std::pair<std::filesystem::path, std::string>> reservedFiles;
+    // runShotJob calls it once the job is planned and checked, before any frame is solved or any output
+    // written: a caller opens its log there, so that a job refused leaves the file as it was.
+    std::function<void()> planned;
 };
 
 struct ShotTileReport {
