@@ -108,8 +108,10 @@ def reference(points, uvs, faces, charts, deformed, rig, redirect):
         identity_error += np.abs(length[keep] / rest[keep] - 1).sum()
         identity_edges += keep.sum()
         keep = same & rigid_r[ia] & rigid_r[ib]
-        rest = np.linalg.norm(fo_r[ib] - fo_r[ia], axis=1)
-        error += np.abs(length[keep] / rest[keep] - 1).sum()
+        rest = np.linalg.norm(fo_r[ib] - fo_r[ia], axis=1)[keep]
+        # Content collapsed to one rest point (no measurable rest length) counts with an error of 1.
+        collapsed = rest <= 1e-9 * np.linalg.norm(points.max(0) - points.min(0))
+        error += np.where(collapsed, 1.0, np.abs(length[keep] / np.where(collapsed, 1.0, rest) - 1)).sum()
         edges += keep.sum()
 
     R = redirect.astype(np.float64)
@@ -132,6 +134,8 @@ def check(got, expected):
     for key in ("rigid_stretch_error", "identity_stretch_error"):
         assert got[key] == pytest.approx(expected[key], rel=1e-6, abs=1e-12), key
     removed = 1 - expected["rigid_stretch_error"] / expected["identity_stretch_error"]
+    if expected["rigid_edges"] == 0:  # no rigid content shown: none of its stretch removed
+        removed = 0.0
     assert got["rigid_stretch_removed"] == pytest.approx(removed, rel=1e-6, abs=1e-9)
 
 
@@ -154,6 +158,14 @@ def test_the_delivered_figures_equal_an_independent_computation():
     outside = identity_map().copy()
     outside[30:34, 20:24] = (0.5, 0.5)  # content from the gap between the charts
     cases["outside"] = outside
+    # Rigid content collapsed: every texel of a disk's neighbourhood shows the disk's centre (rigid), and a
+    # map whose every texel shows one rigid point.
+    patch = identity_map().copy()
+    patch[int((1 - 0.6) * T) - 6:int((1 - 0.6) * T) + 6, int(0.2 * T) - 6:int(0.2 * T) + 6] = (0.2, 0.6)
+    cases["collapsed disk"] = patch
+    cases["collapsed"] = np.broadcast_to(np.float32([0.2, 0.6]), (T, T, 2)).copy()
+    # A map showing elastic content only (a point between the disks of chart 0).
+    cases["elastic only"] = np.broadcast_to(np.float32([0.25, 0.45]), (T, T, 2)).copy()
     for name, redirect in cases.items():
         got = dk.redirect_metrics(mesh, 1001, rig, deformed, redirect)
         expected = reference(points, uvs, faces, charts, deformed, rig, redirect)
@@ -163,6 +175,14 @@ def test_the_delivered_figures_equal_an_independent_computation():
     assert dk.redirect_metrics(mesh, 1001, rig, deformed, cases["identity"])["rigid_stretch_removed"] == 0.0
     assert dk.redirect_metrics(mesh, 1001, rig, deformed, cases["folded"])["inverted_triangles"] > 0
     assert dk.redirect_metrics(mesh, 1001, rig, deformed, cases["outside"])["off_chart_texels"] == 16
+    # A map that collapses or hides rigid detail does not score as if it removed its stretch.
+    identity = dk.redirect_metrics(mesh, 1001, rig, deformed, cases["identity"])
+    disk = dk.redirect_metrics(mesh, 1001, rig, deformed, cases["collapsed disk"])
+    assert disk["rigid_stretch_error"] > identity["rigid_stretch_error"] and disk["rigid_stretch_removed"] < 0
+    collapsed = dk.redirect_metrics(mesh, 1001, rig, deformed, cases["collapsed"])
+    assert collapsed["rigid_stretch_error"] == 1.0 and collapsed["rigid_stretch_removed"] < 0
+    hidden = dk.redirect_metrics(mesh, 1001, rig, deformed, cases["elastic only"])
+    assert hidden["rigid_edges"] == 0 and hidden["rigid_stretch_removed"] == 0.0
     # The solver's metrics() report the figures of its own redirect map.
     m = solver.metrics()
     check(m, reference(points, uvs, faces, charts, deformed, rig, cases["solver"]))

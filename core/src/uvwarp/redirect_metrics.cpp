@@ -261,14 +261,14 @@ struct RedirectMetrics::Impl {
             }
         }
         if (a.located && b.located && a.rigid && b.rigid) {
+            // Content collapsed to one rest point counts as an error of 1 (DeliveredMetrics), so that a map
+            // smearing rigid detail cannot score as if it removed its stretch.
             const double rest = glm::length(b.rest - a.rest);
-            if (rest > minLength) {
-                const double error = std::abs(deformedLength / rest - 1.0);
-                sums.error += error;
-                ++sums.edges;
-                texel.x += error;
-                texel.y += 1.0;
-            }
+            const double error = rest > minLength ? std::abs(deformedLength / rest - 1.0) : 1.0;
+            sums.error += error;
+            ++sums.edges;
+            texel.x += error;
+            texel.y += 1.0;
         }
     }
 };
@@ -537,8 +537,9 @@ DeliveredMetrics RedirectMetrics::measure(std::span<const glm::vec3> deformed, c
     out.rigidStretchError = total.edges > 0 ? total.error / static_cast<double>(total.edges) : 0.0;
     out.identityStretchError =
         total.identityEdges > 0 ? total.identityError / static_cast<double>(total.identityEdges) : 0.0;
-    out.removed =
-        out.identityStretchError > 0.0 ? 1.0 - out.rigidStretchError / out.identityStretchError : 0.0;
+    out.removed = out.identityStretchError > 0.0 && total.edges > 0
+                      ? 1.0 - out.rigidStretchError / out.identityStretchError
+                      : 0.0;
     out.invertedTriangles = total.inverted;
     out.offChartTexels = total.offChart;
     out.chartTexels = total.chart;

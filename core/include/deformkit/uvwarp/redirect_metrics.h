@@ -26,12 +26,15 @@ struct DeliveredMetrics {
     // Rigid-stretch error: the mean, over 4-connected texel edges (a, b) whose texels lie in one chart and
     // whose content r_a and r_b both lies where the rigidity map is >= 0.5, of
     //   | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) - f_O(r_a)| - 1 |.
-    // The identity's (r = q) is the stretch the texture would show without the warp. Edges whose rest length
-    // is not measurable (below 1e-9 of the rest mesh's bounding-box diagonal) are left out.
+    // The identity's (r = q) is the stretch the texture would show without the warp. An edge whose texels
+    // show one rest point (its rest length at most 1e-9 of the rest mesh's bounding-box diagonal: content
+    // collapsed to a point, smeared over the edge) counts with an error of 1, the error of the ratio taken
+    // the other way, rest over deformed; at the identity such edges (a degenerate rest mesh) are left out.
     double rigidStretchError = 0.0;
     double identityStretchError = 0.0;
-    // 1 - rigidStretchError / identityStretchError: the share of the rigid stretch removed (0 when the
-    // identity has none).
+    // 1 - rigidStretchError / identityStretchError: the share of the rigid stretch removed; 0 when the
+    // identity has none, and when the map shows none of the rigid content the identity shows (no rigid
+    // edge through the map: nothing of it is removed, it is gone).
     double removed = 0.0;
     int64_t rigidEdges = 0;          // edges averaged over, through the map
     int64_t identityRigidEdges = 0;  // and for the identity
