@@ -54,11 +54,6 @@ Option& Option::positive() {
     return *this;
 }
 
-Option& Option::delimiter(char separator) {
-    option_->delimiter(separator);
-    return *this;
-}
-
 Option& Option::needs(const Option& other) {
     option_->needs(other.option_);
     return *this;
@@ -108,6 +103,14 @@ Option Command::option(const std::string& name, std::vector<double>& target, con
 Option Command::option(const std::string& name, std::function<void(const std::string& value)> parse,
                        const std::string& shownDefault, const std::string& help) {
     CLI::Option* option = app_->add_option_function<std::string>(name, std::move(parse), help);
+    option->default_str(shownDefault);
+    return Option(option);
+}
+
+Option Command::listOption(const std::string& name,
+                           std::function<void(const std::vector<std::string>& values)> parse,
+                           const std::string& shownDefault, const std::string& help) {
+    CLI::Option* option = app_->add_option_function<std::vector<std::string>>(name, std::move(parse), help);
     option->default_str(shownDefault);
     return Option(option);
 }

@@ -28,7 +28,6 @@ class Option {
     Option& range(double lo, double hi);
     Option& nonNegative();
     Option& positive();
-    Option& delimiter(char separator);  // a list option takes "a,b,c" too
     Option& needs(const Option& other);
     Option& typeName(const std::string& name);  // what --help shows for the value: INT, FLOAT, FILE...
     [[nodiscard]] bool given() const;           // after parsing: the command line gave it
@@ -55,6 +54,11 @@ class Command {
     // error, exit 2); `shownDefault` is what --help shows when it is not given.
     Option option(const std::string& name, std::function<void(const std::string& value)> parse,
                   const std::string& shownDefault, const std::string& help);
+    // A list option: `parse` reads its values as given, one or more ("1 1 10", "1,1,10"), with every item
+    // there (an empty item between commas is the parser's to refuse, not dropped).
+    Option listOption(const std::string& name,
+                      std::function<void(const std::vector<std::string>& values)> parse,
+                      const std::string& shownDefault, const std::string& help);
     // An option that, as soon as it is parsed, calls `print` with its value (`fallback` when none is given)
     // and ends the program with exit code 0, as --help does: the command's other options, required ones
     // included, are not needed then.

@@ -73,7 +73,9 @@ scene::FarmTaskReport farmRunCommand(const FarmRunCommand& command, std::ostream
 }
 
 int farmExitCode(const std::exception& error) {
-    if (dynamic_cast<const InvalidInput*>(&error) || dynamic_cast<const ParseError*>(&error)) return 2;
+    if (dynamic_cast<const InvalidInput*>(&error) || dynamic_cast<const ParseError*>(&error) ||
+        dynamic_cast<const FarmReportRefused*>(&error))
+        return 2;
     return 1;
 }
 
@@ -220,10 +222,18 @@ std::string farmSubmitCommand(const FarmSubmitCommand& command, std::string* rep
         submitJob(sbatch, farmSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs),
                   "the job array accepted");
     if (command.report) {
-        const std::string report = submitJob(
-            sbatch, farmReportSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs, id),
-            "the report job accepted");
-        if (reportJob) *reportJob = report;
+        // The array is queued now: a refused report job must not lead anyone to submit the plan again.
+        try {
+            const std::string report = submitJob(
+                sbatch, farmReportSbatchArguments(plan, command.plan, deformkit, command.sbatchArgs, id),
+                "the report job accepted");
+            if (reportJob) *reportJob = report;
+        } catch (const Error& e) {
+            throw FarmReportRefused(id, std::string(e.what()) + "; the job array " + id +
+                                            " is queued and runs without it: do not submit the plan again, "
+                                            "run 'deformkit farm report " +
+                                            fs::absolute(command.plan).string() + "' once its tasks end");
+        }
     }
     return id;
 }
@@ -343,7 +353,12 @@ void addFarmCommands(CommandLine& cli) {
                 s->command.plan = s->plan;
                 s->command.sbatchArgs = splitArguments(s->sbatchArgs, "--sbatch-args");
                 std::string reportJob;
-                std::cout << farmSubmitCommand(s->command, &reportJob) << "\n";
+                try {
+                    std::cout << farmSubmitCommand(s->command, &reportJob) << "\n";
+                } catch (const FarmReportRefused& e) {
+                    std::cout << e.arrayJob << "\n";  // the array's id, as when all went well
+                    throw;
+                }
                 if (!reportJob.empty()) {
                     std::cerr << "farm: report job " << reportJob
                               << " writes report.html into the plan's output folder after the tasks\n";

@@ -82,9 +82,17 @@ struct FarmSubmitCommand {
                                                            const std::filesystem::path& deformkit,
                                                            const std::vector<std::string>& extra);
 
+// The job array was queued but sbatch refused the report job after it: exit code 2 (submitting the plan
+// again would queue a second array); the message names the array and how to write the page instead.
+struct FarmReportRefused : Error {
+    FarmReportRefused(std::string array, const std::string& message)
+        : Error(message), arrayJob(std::move(array)) {}
+    std::string arrayJob;
+};
+
 // Reads the plan, runs sbatch and returns the job id it prints; with `report`, sets `reportJob` to the
 // report job's id. InvalidInput when sbatch is not found (naming PATH), as readFarmPlan for a bad plan;
-// Error with sbatch's output when it fails.
+// Error with sbatch's output when it fails; FarmReportRefused when only the report job is refused.
 std::string farmSubmitCommand(const FarmSubmitCommand& command, std::string* reportJob = nullptr);
 
 // Splits a shell-like argument string: whitespace separates, '...' and "..." quote, backslash escapes

@@ -59,6 +59,26 @@ void forEachItem(std::string_view text, Item&& item) {
 
 }  // namespace
 
+std::vector<double> parseNumberList(const std::vector<std::string>& values, const std::string& option) {
+    std::vector<double> numbers;
+    for (const std::string& value : values) {
+        forEachItem(value, [&](std::string_view item) {
+            double number = 0.0;
+            const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), number);
+            if (item.empty() || error != std::errc() || end != item.data() + item.size()) {
+                throw InvalidInput(
+                    formatError(option, "",
+                                "'" + value + "' has " +
+                                    (item.empty() ? std::string("an empty item")
+                                                  : "'" + std::string(item) + "', not a number"),
+                                "numbers separated by commas or spaces, such as 4,8,16"));
+            }
+            numbers.push_back(number);
+        });
+    }
+    return numbers;
+}
+
 std::vector<int> parseFrames(std::string_view text, const std::string& option) {
     const char* expected = "frames such as 1-24, 7 or 1-10,15 (first-last)";
     std::vector<int> frames;
@@ -299,10 +319,21 @@ void addUvWarpCommand(CommandLine& cli) {
                     names, o->flags[i],
                     std::string(spec.meaning) + " (" + uvwarp::cliName(spec) + "=false turns it off)"));
                 break;
-            case uvwarp::OptionType::IntegerList:
+            case uvwarp::OptionType::IntegerList: {
+                std::string shown;
+                for (const double v : o->values[i])
+                    shown += (shown.empty() ? "" : ",") + numberText(v);
                 o->given.push_back(
-                    uvwarp.option(names, o->values[i], help).delimiter(',').typeName("INT").showDefault());
+                    uvwarp
+                        .listOption(
+                            names,
+                            [o, i, name = uvwarp::cliName(spec)](const std::vector<std::string>& values) {
+                                o->values[i] = parseNumberList(values, name);
+                            },
+                            "[" + shown + "]", help)
+                        .typeName("INT"));
                 break;
+            }
             case uvwarp::OptionType::Integer:
                 o->given.push_back(
                     uvwarp.option(names, o->values[i].front(), help).typeName("INT").showDefault());

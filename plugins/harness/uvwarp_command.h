@@ -64,6 +64,11 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
 // naming `option` for anything else, a range whose end is before its start, or more than 1,000,000 frames.
 [[nodiscard]] std::vector<int> parseFrames(std::string_view text, const std::string& option = "--frames");
 
+// The values of a list option ("1 1 10" as three values, "1,1,10" as one, or both), each item a number;
+// InvalidInput naming `option` for an empty item ("4,,8") or one that is not a number.
+[[nodiscard]] std::vector<double> parseNumberList(const std::vector<std::string>& values,
+                                                  const std::string& option);
+
 // "1001,1002": UDIM tile numbers (1001..9999), sorted, without repeats. InvalidInput naming `option`.
 [[nodiscard]] std::vector<int> parseTiles(std::string_view text, const std::string& option = "--tiles");
 

@@ -483,10 +483,18 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
     job.rest = &rest;
     job.restName = restName;
     job.frames = frames;
-    if (tiles) {
+    if (tiles) {  // None is every tile; a list names each tile once, as --tiles and a scene's "tiles" do
+        if (tiles->empty()) {
+            throw InvalidInput(
+                formatError(kShot, "tiles", "is an empty list", "None for every tile, or tiles"));
+        }
         job.tiles = *tiles;
         std::sort(job.tiles.begin(), job.tiles.end());
-        job.tiles.erase(std::unique(job.tiles.begin(), job.tiles.end()), job.tiles.end());
+        if (const auto twice = std::adjacent_find(job.tiles.begin(), job.tiles.end());
+            twice != job.tiles.end()) {
+            throw InvalidInput(formatError(kShot, "tiles", "lists tile " + std::to_string(*twice) + " twice",
+                                           "each tile once"));
+        }
     }
     if (rigidity.is_none())
         throw InvalidInput(formatError(kShot, "rigidity", "is None", "the rigidity maps"));
@@ -638,7 +646,8 @@ constexpr const char* kShotDoc =
     "rigidity map is left unwarped (a note); without a mask the mask is derived from the UVs.\n"
     "out, bake: patterns with a UDIM token and a frame token ('out/redirect.<UDIM>.####.exr'); out is a\n"
     "2-channel float EXR, bake (with texture) any format; missing folders are made. tiles: None for every\n"
-    "tile of the UVs. resolution and options as UvWarpSolver, but warm_start defaults to False: each frame\n"
+    "tile of the UVs, or a list naming each tile once. resolution and options as UvWarpSolver, but "
+    "warm_start defaults to False: each frame\n"
     "is solved from the identity, so its maps depend on that frame alone, whatever range the job covers\n"
     "(warm_start=True: from the last frame's warp). filter of the bake: 'bilinear', 'bicubic'.\n"
     "skip_existing: keep outputs that exist (warm-started, the warm start is replayed), so a rerun after a\n"

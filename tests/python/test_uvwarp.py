@@ -247,6 +247,10 @@ def test_bad_input_names_what_is_wrong():
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig[:, :32])
     with pytest.raises(dk.InvalidInput, match="warp mask.*32 texels per side"):
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, mask=np.ones((32, 32), np.float32))
+    nan_mask = np.ones_like(rig)
+    nan_mask[3, 5] = np.nan  # neither side of 0.5: it froze the texel's points without a word
+    with pytest.raises(dk.InvalidInput, match=r"warp mask.*texel \(5, 3\): warp mask value is NaN"):
+        dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, mask=nan_mask)
     with pytest.raises(dk.InvalidInput, match="orientation map, UDIM tile 1001: 32 texels per side"):
         dk.UvWarpSolver(pts, counts, idx, uvs, uv_idx, 1001, rig, orientation=np.ones((32, 32), np.float32))
     with pytest.raises(dk.InvalidInput, match="resolution: is 48"):
@@ -560,6 +564,11 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(frames=[]), dk.InvalidInput, "frames: is empty"),
             (dict(frames=[2, 1]), dk.InvalidInput, "frames: are not ascending"),
             (dict(tiles=[1005]), dk.InvalidInput, "tile 1005: the rest mesh 'rest mesh' has no UV face in it"),
+            # An empty list is not None (every tile): a farm split that made one would rewrite every tile.
+            (dict(tiles=[]), dk.InvalidInput, r"uvwarp_shot: tiles: is an empty list \(expected None for every tile"),
+            (dict(tiles=[1002, 1001, 1002]), dk.InvalidInput, "tiles: lists tile 1002 twice"),
+            (dict(mask={1001: np.full((32, 32), np.nan, np.float32)}), dk.InvalidInput,
+             r"mask tile 1001.*texel \(0, 0\): warp mask value is NaN"),
             (dict(deformed=7), dk.InvalidInput, "deformed: is an int"),
             (dict(deformed="anim.obj"), dk.InvalidInput, "uvwarp_shot: deformed: anim.obj: has no frame token"),
             (dict(deformed=str(tmp_path / "anim.####.obj")), dk.IoError, "anim.0001.obj: frame 1: is missing"),

@@ -128,16 +128,29 @@ io::Image deriveWarpMask(const detail::TileUVs& uvs, int32_t texels, const Deriv
     return maskOf(uvs, texels, options);
 }
 
+namespace {
+
+// A mask's channel 0 is thresholded at 0.5; NaN is neither side of it.
+void requireMaskNumbers(const io::Image& mask, const MapLabel& label) {
+    for (int32_t y = 0; y < mask.height; ++y) {
+        for (int32_t x = 0; x < mask.width; ++x) {
+            if (std::isnan(mask.at(x, y, 0))) {
+                throw InvalidInput(formatError(sourceOf(label), texelName(x, y), "warp mask value is NaN",
+                                               "a number (thresholded at 0.5)"));
+            }
+        }
+    }
+}
+
+}  // namespace
+
 io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label) {
     requireSquareMap(mask, label);
+    requireMaskNumbers(mask, label);
     io::Image out(mask.width, mask.height, 1);
     for (int32_t y = 0; y < mask.height; ++y) {
         for (int32_t x = 0; x < mask.width; ++x) {
             const float value = mask.at(x, y, 0);
-            if (std::isnan(value)) {
-                throw InvalidInput(formatError(sourceOf(label), texelName(x, y), "warp mask value is NaN",
-                                               "a number (thresholded at 0.5)"));
-            }
             out.at(x, y, 0) = value >= 0.5f ? 1.0f : 0.0f;
         }
     }
@@ -217,6 +230,7 @@ PointField rigidityAtPoints(const io::Image& rigidity, int32_t cells, const MapL
 PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& label) {
     requireCells(cells, label);
     requireSquareMap(mask, label);
+    requireMaskNumbers(mask, label);
     const int32_t size = mask.width;
     const int32_t side = cells + 1;
     const double scale = static_cast<double>(size) / cells;

@@ -530,13 +530,17 @@ std::optional<fs::path> mapFile(const TileMap& map, int frame) {
 }
 
 io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
-    // Files are checked as they are read (values in [0, 1], finite), naming the file and texel; maps in
-    // memory by TileWarp, naming the source.
-    if (const std::optional<fs::path> file = mapFile(map, frame)) {
-        if (std::string_view(role) == "warp mask") return readWarpMask(*file, tile);
-        return readRigidityMap(*file, tile, role);
-    }
-    return map.image ? *map.image : io::Image{};
+    // Files are checked as they are read (values in [0, 1], finite; a mask's not NaN), naming the file and
+    // texel; maps in memory likewise here, named as the caller named them ("mask tile 1001", a label).
+    const bool mask = std::string_view(role) == "warp mask";
+    if (const std::optional<fs::path> file = mapFile(map, frame))
+        return mask ? readWarpMask(*file, tile) : readRigidityMap(*file, tile, role);
+    if (!map.image) return {};
+    if (mask)
+        (void)binariseWarpMask(*map.image, MapLabel{map.name, 0});
+    else
+        validateRigidityMap(*map.image, MapLabel{map.name, 0});
+    return *map.image;
 }
 
 // The headers name an animated map's file of the frame.

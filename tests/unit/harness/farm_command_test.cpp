@@ -400,6 +400,25 @@ TEST_CASE("farm submit: one sbatch job array element per task running farm run -
                   "--wrap=exec '/opt/dk/bin/deformkit' report --plan '" + planAbs.string() + "' '/logs/x'"});
     }
     CHECK(test::readText(shot.dir / "sbatch.args") == recorded);
+
+    // The array accepted, the report job refused: the array's id is in the error, and exit code 2 (submitting
+    // again would queue a second array).
+    fs::remove(shot.dir / "sbatch.n");
+    test::writeText(
+        fake,
+        "#!/bin/sh\nif [ -e \"$0.n\" ]; then echo 'sbatch: error: Job dependency problem' >&2; exit 1; "
+        "fi\ntouch \"$0.n\"; echo '4242;c1'\n");
+    try {
+        (void)harness::farmSubmitCommand(submit, &reportJob);
+        FAIL("no error");
+    } catch (const harness::FarmReportRefused& e) {
+        CHECK(e.arrayJob == "4242");
+        CHECK_THAT(e.what(),
+                   Contains("Job dependency problem") &&
+                       Contains("the job array 4242 is queued and runs without it: do not submit the "
+                                "plan again, run 'deformkit farm report "));
+        CHECK(harness::farmExitCode(e) == 2);
+    }
     submit.report = false;
 
     // sbatch refusing the job: its message, exit code 1.

@@ -155,6 +155,14 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
                Catch::Contains("--tiles: lists tile 1002 twice (expected each tile once, comma separated)"));
     CHECK_THAT(test::errorOf<Error>([] { (void)harness::parseTiles("1001,1000"); }),
                Catch::Contains("--tiles") && Catch::Contains("'1000' is not a UDIM tile"));
+    // A list option's values: spaces and commas alike; an empty item is refused, not dropped.
+    CHECK(harness::parseNumberList({"1", "1", "10"}, "--sweeps") == std::vector<double>{1, 1, 10});
+    CHECK(harness::parseNumberList({"4,8", "16"}, "--sweeps") == std::vector<double>{4, 8, 16});
+    for (const char* bad : {"4,,8", "4,8,", ",4", ""})
+        CHECK_THAT(test::errorOf<InvalidInput>([bad] { (void)harness::parseNumberList({bad}, "--sweeps"); }),
+                   Catch::Contains(std::string("--sweeps: '") + bad + "' has an empty item"));
+    CHECK_THAT(test::errorOf<InvalidInput>([] { (void)harness::parseNumberList({"4,x"}, "--sweeps"); }),
+               Catch::Contains("'4,x' has 'x', not a number"));
     CHECK(uvwarp::tileFramePath("out/r.<UDIM>.####.exr", 1012, 7) == fs::path("out/r.1012.0007.exr"));
     CHECK(uvwarp::tileFramePath("r_<UVTILE>.%03d.exr", 1012, -4) == fs::path("r_u2_v2.-004.exr"));
 }

@@ -317,10 +317,14 @@ TEST_CASE("mask at grid points: one fixed texel fixes the points within one texe
             expected.emplace_back(i, j);
     }
     CHECK(zeros(maskAtPoints(mask, 16)) == expected);
-    // Non-binary values are thresholded at 0.5 (NaN counts as fixed).
+    // Non-binary values are thresholded at 0.5; NaN is neither side of it: refused, naming the texel (a mask
+    // in memory took it as fixed without a word).
     mask.at(3, 2, 0) = 0.6f;
-    mask.at(0, 0, 0) = std::numeric_limits<float>::quiet_NaN();
+    mask.at(0, 0, 0) = 0.0f;
     CHECK(zeros(maskAtPoints(mask, 8)) == std::vector<std::pair<int, int>>{{0, 7}, {1, 7}, {0, 8}, {1, 8}});
+    mask.at(0, 0, 0) = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)maskAtPoints(mask, 8, {"paint", 1001}); }),
+               Catch::Contains("texel (0, 0): warp mask value is NaN"));
 }
 
 TEST_CASE("derived mask bad input", "[uvwarp][mask]") {

@@ -78,10 +78,11 @@ void validateRigidityMap(const io::Image& rigidity, const MapLabel& label = {});
                                           const MapLabel& label = {});
 
 // Warp mask at the grid points: point (i, j) gets the minimum of the binarised texels (channel 0 >= 0.5
-// is 1, anything else, NaN included, is 0) whose centres lie within one texel, or one cell when the map is
-// finer than the grid (T > n), of the point along u and along v: a point of a cell holding a fixed texel
-// does not move (for n = T: the 2 x 2 texels around the point). Returns a 1-channel PointField of 0s and 1s.
-// Throws InvalidInput for an empty or non-square image or cells not a power of two.
+// is 1, anything else is 0) whose centres lie within one texel, or one cell when the map is finer than the
+// grid (T > n), of the point along u and along v: a point of a cell holding a fixed texel does not move
+// (for n = T: the 2 x 2 texels around the point). Returns a 1-channel PointField of 0s and 1s. Throws
+// InvalidInput for an empty or non-square image, cells not a power of two, and a NaN texel (neither side of
+// 0.5), naming the label, tile and texel as binariseWarpMask does.
 [[nodiscard]] PointField maskAtPoints(const io::Image& mask, int32_t cells, const MapLabel& label = {});
 
 }  // namespace deformkit::uvwarp
