@@ -323,7 +323,9 @@ TEST_CASE("mask at grid points: one fixed texel fixes the points within one texe
     mask.at(0, 0, 0) = 0.0f;
     CHECK(zeros(maskAtPoints(mask, 8)) == std::vector<std::pair<int, int>>{{0, 7}, {1, 7}, {0, 8}, {1, 8}});
     mask.at(0, 0, 0) = std::numeric_limits<float>::quiet_NaN();
-    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)maskAtPoints(mask, 8, {"paint", 1001}); }),
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)maskAtPoints(mask, 8, {"paint", 1001});
+               }),
                Catch::Contains("texel (0, 0): warp mask value is NaN"));
 }
 
