@@ -1,5 +1,6 @@
 #include "farm_command.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <iostream>
@@ -12,6 +13,7 @@
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/ptex/ptex_mesh.h"
+#include "deformkit/scene/uvwarp_stage.h"
 #include "process.h"
 #include "report_command.h"
 #include "uvwarp_command.h"
@@ -51,8 +53,25 @@ scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
     options.chunk = command.chunk;
     options.tilesPerTask = command.tilesPerTask;
     options.warmUp = command.warmUp;
-    const scene::FarmPlan plan =
-        scene::planFarm(readScene(command.scene), command.scene, command.outDir, options);
+    const scene::Scene scene = readScene(command.scene);
+    const scene::FarmPlan plan = scene::planFarm(scene, command.scene, command.outDir, options);
+    // The UV-warp stages planned as eval plans them before it writes anything (map patterns that match no
+    // file, maps of the wrong size, outputs named as inputs): a scene eval refuses is refused here, not by
+    // every task on the farm.
+    std::vector<int> frames;
+    for (const scene::FarmTask& task : plan.tasks)
+        for (int f = task.firstFrame; f <= task.lastFrame; ++f)
+            frames.push_back(f);
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    for (size_t o = 0; o < scene.objects.size(); ++o) {
+        if (!scene.objects[o].uvwarp) continue;
+        scene::UvWarpStageRun run;
+        run.frames = frames;
+        run.tiles = scene.objects[o].uvwarp->tiles;
+        run.outDir = plan.outDir;
+        (void)scene::uvwarpStageSolver(scene, o, run);
+    }
     io::createFolder(plan.outDir);
     scene::writeFarmPlan(plan, farmPlanPath(command));
     return plan;

@@ -320,6 +320,13 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
     const Scene& scene = evaluator.scene();
     const std::vector<std::string> expected = farmTaskOutputs(scene, t.firstFrame, t.lastFrame, t.tiles);
     if (expected != t.outputs) {
+        // A map the plan was made with and that has gone is named itself (it is not the scene that changed).
+        if (const std::string missing =
+                missingPlannedMap(scene, t.outputs, t.firstFrame, t.lastFrame, t.tiles);
+            !missing.empty()) {
+            throw InvalidInput(formatError(planName, taskPath, missing,
+                                           "the maps the plan was made with, there while its tasks run"));
+        }
         size_t i = 0;
         while (i < expected.size() && i < t.outputs.size() && expected[i] == t.outputs[i])
             ++i;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <system_error>
 #include <utility>
 
@@ -84,6 +85,32 @@ void requireRigidityMaps(const Scene& scene, size_t object, int frame) {
         list += (list.empty() ? "'" : ", '") + tileFile(stage.rigidity, tile, frame).string() + "'";
     throw IoError(formatError(scene.source + ": " + stage.path + ".rigidity", stage.rigidity.string(),
                               "no tile has a rigidity map", "at least one of " + list));
+}
+
+std::string missingPlannedMap(const Scene& scene, const std::vector<std::string>& plannedOutputs,
+                              int firstFrame, int lastFrame, const std::vector<int>& tiles) {
+    const std::set<std::string> planned(plannedOutputs.begin(), plannedOutputs.end());
+    for (const SceneObject& object : scene.objects) {
+        if (!object.uvwarp) continue;
+        const SceneUvWarp& stage = *object.uvwarp;
+        for (const int tile : tiles) {
+            for (int frame = firstFrame; frame <= lastFrame; ++frame) {
+                const auto missing = [&](const fs::path& pattern, const char* key) {
+                    const fs::path file = tileFile(pattern, tile, frame);
+                    return fileExists(file) ? std::string()
+                                            : scene.source + ": " + stage.path + "." + key + ": " +
+                                                  file.string() + " does not exist";
+                };
+                if (planned.contains(uvwarpRedirectName(object.name, tile, frame))) {
+                    if (std::string m = missing(stage.rigidity, "rigidity"); !m.empty()) return m;
+                }
+                if (stage.texture && planned.contains(uvwarpBakeName(object, tile, frame))) {
+                    if (std::string m = missing(*stage.texture, "texture"); !m.empty()) return m;
+                }
+            }
+        }
+    }
+    return {};
 }
 
 std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame) {

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/scene/farm_plan.h"
 #include "deformkit/scene/uvwarp_stage.h"
@@ -502,4 +503,53 @@ TEST_CASE("eval and farm plan check every input before any work: a vertex out of
     const std::string planNoMap = test::errorOf<IoError>([&] { (void)harness::farmPlanCommand(plan); });
     CHECK_THAT(planNoMap, Contains("objects[0].stack[1].rigidity") && Contains("no tile has a rigidity map"));
     CHECK_FALSE(fs::exists(shot.dir / "farm" / "farm_plan.json"));
+
+    // The maps there but wrong as eval checks them (a mask pattern that matches nothing, a map of another
+    // size): the plan is refused with eval's message, not written for tasks that would all fail.
+    io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
+    io::writeImage(shot.dir / "mask16.1001.exr", io::Image(16, 16, 1, 1.0f));
+    for (const char* mask : {"msk.<UDIM>.exr", "mask16.<UDIM>.exr"}) {
+        std::string withMask = kScene;
+        withMask.replace(
+            twistEnd, 0,
+            std::string(R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "mask": ")") + mask + R"("})");
+        test::writeText(shot.scene, withMask);
+        const std::string evalMask = test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(eval); });
+        CHECK_THAT(evalMask, Contains("objects[0].stack[1]"));
+        CHECK(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }) == evalMask);
+        CHECK_FALSE(fs::exists(shot.dir / "farm" / "farm_plan.json"));
+    }
+}
+
+TEST_CASE("farm run: a map removed after planning is named, not taken for a changed scene",
+          "[harness][farm][errors]") {
+    Shot shot;
+    std::string text = kScene;
+    const size_t twistEnd = text.find("}}}]}") + 3;
+    text.replace(twistEnd, 0,
+                 R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr"})");
+    test::writeText(shot.scene, text);
+    io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
+    io::writeImage(shot.dir / "col.1001.exr", io::Image(32, 32, 3, 0.5f));
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.outDir = shot.dir / "farm";
+    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    int uvTask = -1;
+    for (size_t k = 0; k < plan.tasks.size() && uvTask < 0; ++k)
+        if (!plan.tasks[k].tiles.empty()) uvTask = static_cast<int>(k);
+    REQUIRE(uvTask >= 0);
+    harness::FarmRunCommand run;
+    run.plan = shot.dir / "farm" / "farm_plan.json";
+    run.task = uvTask;
+    for (const char* file : {"col.1001.exr", "rig.1001.exr"}) {
+        fs::rename(shot.dir / file, shot.dir / "gone.exr");
+        const std::string error = test::errorOf<InvalidInput>([&] { (void)harness::farmRunCommand(run); });
+        CHECK_THAT(error,
+                   Contains(std::string(".stack[1].") + (file[0] == 'c' ? "texture: " : "rigidity: ")) &&
+                       Contains(std::string(file) + " does not exist (expected the maps the plan was made "
+                                                    "with, there while its tasks run)"));
+        CHECK_THAT(error, !Contains("plan again"));
+        fs::rename(shot.dir / "gone.exr", shot.dir / file);
+    }
 }

@@ -38,6 +38,14 @@ namespace deformkit::scene {
 // "<object>.bake.<tile>.<frame><texture extension>" (the stage must have a texture).
 [[nodiscard]] std::string uvwarpBakeName(const SceneObject& object, int tile, int frame);
 
+// For a farm task's outputs as planned: the first map file a planned output needs that is not there (the
+// rigidity map of a planned redirect map, the texture of a planned bake), as "<scene>: <JSON path>: <file>
+// does not exist"; empty when every one is. A map removed after planning names itself this way instead of
+// a plan that no longer matches the scene.
+[[nodiscard]] std::string missingPlannedMap(const Scene& scene,
+                                            const std::vector<std::string>& plannedOutputs, int firstFrame,
+                                            int lastFrame, const std::vector<int>& tiles);
+
 // The stage's tiles that are warped: those with a rigidity map on disk (an animated map: its file at
 // `frame`), ascending. A tile without one is left unwarped (no outputs).
 [[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame);
