@@ -93,6 +93,9 @@ def test_host_parameterisations():
     sheared = np.array([[1, 0, 0], [0.5, 0.8660254, 0], [0, 0, 1]], dtype=np.float32)
     with pytest.raises(dk.InvalidInput, match=r"basis x and y axes: are not orthogonal"):
         dk.blender_simple_deform_params("TWIST", mesh, angle=1.0, basis=sheared)
+    # A NaN origin is named as the origin (the finite points were blamed).
+    with pytest.raises(dk.InvalidInput, match=r"Blender twist: origin: is \(nan, 0, 0\) \(expected finite"):
+        dk.blender_simple_deform_params("TWIST", mesh, angle=1.0, origin=np.float32([np.nan, 0, 0]))
     b = dk.blender_simple_deform_params("BEND", np.array([[-1, 0, 0], [1, 0, 0]], dtype=np.float32), angle=math.pi)
     out = dk.bend(np.array([[2, 0, 0]], dtype=np.float32), **b)
     np.testing.assert_allclose(out[0], [2 / math.pi, 2 / math.pi + 1, 0], atol=1e-6)

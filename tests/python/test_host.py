@@ -320,6 +320,10 @@ def test_scene_evaluator_matches_a_stack_driven_by_hand(tmp_path):
 
     with pytest.raises(dk.InvalidInput, match=r"shot.json: object 3: does not exist"):
         ev.evaluate(3, 1.0)
+    # A frame that is no frame: named as the frame (NaN reached the curves as a bad value, inf their ends).
+    for frame, text in ((float("nan"), "nan"), (float("inf"), "inf"), (-2e9, "-2e\\+09")):
+        with pytest.raises(dk.InvalidInput, match=rf"shot.json: frame: is {text} \(expected a frame from -1000000000"):
+            ev.evaluate(0, frame)
     with pytest.raises(dk.IoError, match="missing.json"):
         dk.SceneEvaluator(tmp_path / "missing.json")
     text = path.read_text().replace('"startAngle": -0.4', '"startAngle": "a"')

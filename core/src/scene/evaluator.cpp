@@ -97,6 +97,13 @@ const geom::Mesh& SceneEvaluator::evaluate(size_t object, double frame) {
         throw InvalidInput(formatError(scene_.source, "object " + std::to_string(object), "does not exist",
                                        "an index below " + std::to_string(objects_.size())));
     }
+    // Frames as a scene or --frames takes them (fractions allowed): a NaN frame would reach the curves as a
+    // bad parameter value, an infinite one their end values without a word.
+    if (!(std::abs(frame) <= static_cast<double>(kMaxFrameNumber))) {
+        throw InvalidInput(formatError(
+            scene_.source, "frame", "is " + numberText(frame),
+            "a frame from -" + std::to_string(kMaxFrameNumber) + " to " + std::to_string(kMaxFrameNumber)));
+    }
     setFrame(object, frame, false);
     Object& ob = objects_[object];
     ++ob.evaluations;

@@ -54,6 +54,14 @@ Range blenderLimits(const BlenderSimpleDeform& b, std::span<const glm::vec3> poi
             }
         }
     }
+    for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(b.origin[a])) {
+            throw InvalidInput(formatError(source, "origin",
+                                           "is (" + numberText(b.origin.x) + ", " + numberText(b.origin.y) +
+                                               ", " + numberText(b.origin.z) + ")",
+                                           "finite coordinates"));
+        }
+    }
     double lower = std::numeric_limits<double>::infinity(), upper = -lower;
     const glm::dvec3 dir(b.basis[axis]);
     for (size_t i = 0; i < points.size(); ++i) {

@@ -38,7 +38,8 @@ class SceneEvaluator {
     // input is the rest positions, or for an object with an animated input that frame's positions (whole
     // frames only; an OBJ must exist and have the rest mesh's connectivity, a point cache the rest mesh's
     // vertex count and the frame). The reference stays valid until the next evaluate() of that object.
-    // Throws InvalidInput for an object index out of range, and naming the scene, the object's "mesh" (or
+    // Throws InvalidInput for an object index out of range, a frame not finite or beyond +-kMaxFrameNumber,
+    // and naming the scene, the object's "mesh" (or
     // "deformed") and the file for an input frame that is missing, fractional or of another connectivity.
     const geom::Mesh& evaluate(size_t object, double frame);
 

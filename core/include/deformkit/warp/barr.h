@@ -151,7 +151,7 @@ class TwistWarp final : public ProfiledAxialWarp {
 // Barr's (1984) global bend, in the plane of the axis and the up direction.
 struct BendParams {
     float rate = 0.0f;    // k, radians per scene unit along the axis; > 0 bends towards up, 0 = identity
-    float centre = 0.0f;  // z0, the axis coordinate that stays fixed (with its tangent)
+    float centre = 0.0f;  // z0, the arc's fixed slice (with its tangent); outside [lo, hi] it is carried
     float lo = -1.0f;     // zmin: the bent range is [lo, hi]; outside it the shape continues rigidly
     float hi = 1.0f;      // zmax, >= lo
 };
