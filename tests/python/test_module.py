@@ -139,3 +139,16 @@ def test_preview_of_a_grid_fills_the_expected_region():
     background = np.array([0.16, 0.17, 0.19], np.float32)
     covered = np.any(np.abs(img - background) > 1e-3, axis=2)
     assert 0.1 < covered.mean() < 0.9
+
+
+def test_points_and_uvs_written_after_the_mesh_was_made_are_checked_where_used():
+    # Mesh.points and Mesh.uvs are writable: a NaN written there is named as the vertex or UV it is, not as
+    # a corner of a triangle being rasterised.
+    mesh = dk.make_capped_tube()
+    mesh.points[500] = np.nan
+    with pytest.raises(dk.InvalidInput, match=r"^preview: vertex 500: is \(nan, nan, nan\)"):
+        dk.render_preview(mesh, width=64, height=48)
+    mesh = dk.make_capped_tube()
+    mesh.uvs[500] = np.nan
+    with pytest.raises(dk.InvalidInput, match=r"UV 500: is \(nan, nan\) \(expected finite texture coordinates\)"):
+        dk.UvWarpSolver(mesh, 1001, np.zeros((64, 64), np.float32))

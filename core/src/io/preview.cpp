@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/geom/normals.h"
 #include "deformkit/geom/rasterizer.h"
 #include "deformkit/geom/triangulation.h"
@@ -79,6 +80,26 @@ Image renderPreview(const geom::Mesh& mesh, const PreviewOptions& o, const Previ
         throw InvalidInput(formatError("preview", "vertex colours",
                                        "has " + std::to_string(o.vertexColors.size()) + " colours",
                                        std::to_string(mesh.numVertices()) + ", one per vertex"));
+    }
+    // Points and UVs as they are now (a host may have written them after the mesh was made): a NaN is named
+    // as the vertex or UV it is, not as a corner of a triangle being drawn.
+    if (const size_t bad = geom::firstNonFinite(mesh.points()); bad < mesh.points().size()) {
+        const glm::vec3 p = mesh.points()[bad];
+        throw InvalidInput(
+            formatError("preview", "vertex " + std::to_string(bad),
+                        "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")",
+                        "finite coordinates"));
+    }
+    if (texture) {
+        const auto uvs = mesh.uvs();
+        for (size_t i = 0; i < uvs.size(); ++i) {
+            if (!std::isfinite(uvs[i].x) || !std::isfinite(uvs[i].y)) {
+                throw InvalidInput(
+                    formatError("preview", "UV " + std::to_string(i),
+                                "is (" + numberText(uvs[i].x) + ", " + numberText(uvs[i].y) + ")",
+                                "finite texture coordinates"));
+            }
+        }
     }
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384) {
         throw InvalidInput(formatError("preview", "size",

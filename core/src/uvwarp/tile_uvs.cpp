@@ -47,6 +47,15 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
     const auto uvs = mesh.uvs();
     const auto uvIndices = mesh.uvIndices();
     const auto faceIndices = mesh.faceIndices();
+    // A mesh's UVs may have been written after it was made (Python's Mesh.uvs is writable): a NaN would
+    // reach the rasteriser as a triangle's corner, not as the UV it is.
+    for (size_t i = 0; i < uvs.size(); ++i) {
+        if (!std::isfinite(uvs[i].x) || !std::isfinite(uvs[i].y)) {
+            throw InvalidInput(formatError(label, "UV " + std::to_string(i),
+                                           "is (" + numberText(uvs[i].x) + ", " + numberText(uvs[i].y) + ")",
+                                           "finite texture coordinates"));
+        }
+    }
 
     // The tile's faces (Mesh::faceUdimTile), refusing those that overhang it by more than kMaxOverhang.
     std::vector<uint8_t> inTile(static_cast<size_t>(mesh.numFaces()), 0);
