@@ -582,6 +582,9 @@ def test_shot_bad_input_names_what_is_wrong(tmp_path):
             (dict(deformed=lambda f: np.where(np.arange(len(mesh[0]))[:, None] == 7, np.nan, pose(mesh[0], f))
                   .astype(np.float32)),
              dk.InvalidInput, r"^frame 1: vertex 7: is not finite"),
+            # Finite but where the solver's squared lengths would overflow: named by the frame, not the rest.
+            (dict(deformed=lambda f: (pose(mesh[0], f) * np.float32(1e18)).astype(np.float32)),
+             dk.InvalidInput, r"^frame 1: vertex 1: is \(7.1874998e\+16, 0, 0\) \(expected finite coordinates within \+-1e15"),
             (dict(progress=3), dk.InvalidInput, "progress: is an int"),
             (dict(smoothing=2.0), dk.InvalidInput, "uvwarp_shot: smoothing: is 2.0"),
             (dict(filter="nearest"), dk.InvalidInput, "filter: is 'nearest'")):

@@ -333,18 +333,28 @@ GeometryImager::GeometryImager(const geom::Mesh& rest, int tile, int32_t cells,
     detail::encodeRowRuns(pointTriangle, side, side, rowRunBegin_, runStart_, runTriangle_);
 }
 
+size_t firstUnusablePoint(std::span<const glm::vec3> points) {
+    for (size_t v = 0; v < points.size(); ++v) {
+        const glm::vec3& p = points[v];
+        if (!(std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+              std::abs(p.z) <= kMaxCoordinate))
+            return v;
+    }
+    return points.size();
+}
+
 void GeometryImager::sample(std::span<const glm::vec3> positions, PointField& out) const {
     if (positions.size() != static_cast<size_t>(numVertices_)) {
         throw InvalidInput(formatError(label_, "positions",
                                        "has " + std::to_string(positions.size()) + " vertices",
                                        std::to_string(numVertices_) + " (the rest mesh's vertex count)"));
     }
-    for (size_t v = 0; v < positions.size(); ++v) {
+    if (const size_t v = firstUnusablePoint(positions); v < positions.size()) {
         const glm::vec3& p = positions[v];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            throw InvalidInput(formatError(label_, "vertex " + std::to_string(v), "position is not finite",
-                                           "finite coordinates"));
-        }
+        throw InvalidInput(formatError(
+            label_, "vertex " + std::to_string(v),
+            "position is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")",
+            "finite coordinates within +-1e15"));
     }
     const int32_t side = cells_ + 1;
     out.cells = cells_;

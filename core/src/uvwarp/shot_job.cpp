@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/geom/finite.h"
+#include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/io/animated_positions.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
@@ -729,11 +729,15 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
     }
     // Named here, by the frame's own input: the imager's own check names the rest mesh it was bound to. The
     // frame once: an input without a file is named by its frame already ("frame 2").
-    if (const size_t v = geom::firstNonFinite(deformed); v < deformed.size()) {
+    if (const size_t v = firstUnusablePoint(deformed); v < deformed.size()) {
         const std::string frameText = "frame " + std::to_string(frame);
+        const glm::vec3 p = deformed[v];
+        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
         throw InvalidInput(formatError(
             inputName, (inputName == frameText ? "" : frameText + ": ") + "vertex " + std::to_string(v),
-            "is not finite", "finite coordinates"));
+            finite ? "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")"
+                   : std::string("is not finite"),
+            "finite coordinates within +-1e15 (the solver squares lengths in float)"));
     }
     const size_t k = s.nextFrame++;
     for (TilePlan& plan : s.plans) {

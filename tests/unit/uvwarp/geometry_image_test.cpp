@@ -402,6 +402,15 @@ TEST_CASE("geometry image bad input is reported with its element", "[uvwarp][geo
         std::vector<glm::vec3> nan(chart.points().begin(), chart.points().end());
         nan[4].y = std::numeric_limits<float>::quiet_NaN();
         CHECK_THROWS_WITH(imager.sample(nan, out), Catch::Contains("vertex 4"));
+        // Finite but beyond where squared lengths stay finite in float (a mesh scaled to 1e18 gave NaN
+        // positions): refused at 1e15, the bound's margin; 1e15 itself is taken.
+        std::vector<glm::vec3> far(chart.points().begin(), chart.points().end());
+        far[6] = glm::vec3(1e15f, 0.0f, -1e15f);
+        CHECK_NOTHROW(imager.sample(far, out));
+        far[6].x = 1.0001e15f;
+        CHECK_THROWS_WITH(imager.sample(far, out),
+                          Catch::Contains("vertex 6: position is (1.0001e+15, 0, -1e+15)") &&
+                              Catch::Contains("(expected finite coordinates within +-1e15)"));
     }
 }
 

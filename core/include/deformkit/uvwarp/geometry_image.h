@@ -38,6 +38,15 @@ struct TileUVs;  // a tile's UV triangles (uvwarp/tile_uvs.h, private to the lib
 // continuation exists (past straight and convex chart borders). Points beyond `dilationRings` copy the
 // nearest covered point (Euclidean, exact distance transform; ties go to the lower column, then the lower
 // row). The rings and weights are computed once at bind; each frame only re-applies them.
+// The largest coordinate magnitude a surface sampled for the UV warp may have: the solver measures squared
+// lengths in float, which overflow near 1e19 (a mesh scaled to 1e18 gave NaN positions); 1e15 keeps a
+// margin of 1e4 below that, and far above any scene's units.
+inline constexpr float kMaxCoordinate = 1e15f;
+
+// The first of `points` with a coordinate that is not finite or beyond kMaxCoordinate in magnitude, or
+// points.size() when there is none.
+[[nodiscard]] size_t firstUnusablePoint(std::span<const glm::vec3> points);
+
 struct GeometryImageOptions {
     int32_t dilationRings = 4;   // rings of linear continuation past chart borders, 0..64
     std::string label = "mesh";  // names the mesh in errors, e.g. "rest.obj" or "mesh 'body'"
@@ -71,7 +80,7 @@ class GeometryImager {
     // positions with the rest mesh's topology (the rest positions give f_O, a deformed frame f_D). Scene
     // units. Allocates only when `out` is not yet sized; OpenMP over rows, bit-identical for any thread
     // count. Throws InvalidInput naming the mesh label for a vertex count other than the rest mesh's or a
-    // non-finite position (naming the vertex).
+    // position not finite or beyond kMaxCoordinate (naming the vertex).
     void sample(std::span<const glm::vec3> positions, PointField& out) const;
     [[nodiscard]] PointField sample(std::span<const glm::vec3> positions) const;
 
