@@ -13,7 +13,6 @@
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
-#include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/io/animated_positions.h"
 #include "deformkit/io/atomic_file.h"
 #include "deformkit/io/image.h"
@@ -21,6 +20,7 @@
 #include "deformkit/io/obj_sequence.h"
 #include "deformkit/io/udim.h"
 #include "deformkit/uvwarp/bake.h"
+#include "deformkit/uvwarp/geometry_image.h"
 #include "deformkit/uvwarp/grid.h"
 #include "deformkit/uvwarp/mask.h"
 #include "deformkit/uvwarp/options.h"
