@@ -128,7 +128,11 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
     if (page.empty()) page = logs.front().parent_path() / "report.html";
     // The page is written over no log it reads and no output of the plan (a map the page replaced would be
     // skipped as done by a task run again).
-    const auto key = [](const fs::path& path) { return fs::absolute(path).lexically_normal(); };
+    const auto key = [](const fs::path& path) {  // absolute, links of its existing part resolved
+        std::error_code error;
+        const fs::path resolved = fs::weakly_canonical(path, error);
+        return (error ? fs::absolute(path) : resolved).lexically_normal();
+    };
     const fs::path pageKey = key(page);
     for (const fs::path& file : logs) {
         if (key(file) == pageKey) {
@@ -144,6 +148,19 @@ ReportCommandResult reportCommand(const ReportCommand& command) {
     uvwarp::ShotLog log;
     for (const fs::path& file : logs)
         uvwarp::readShotLogFile(file, log);
+    // Nor over a map or bake a log names (as the job named it: relative to where the job ran, which is
+    // here or the log's folder).
+    for (const uvwarp::ShotLogLine& line : log.lines) {
+        for (const std::string& output : {line.redirect, line.bake}) {
+            if (output.empty()) continue;
+            const fs::path named(output);
+            if (key(named) == pageKey || key(fs::path(line.file).parent_path() / named) == pageKey) {
+                throw InvalidInput(formatError(page.string(), "",
+                                               "is an output the log " + line.file + " names",
+                                               "a page apart from the shot's logs and outputs"));
+            }
+        }
+    }
     ReportCommandResult result;
     result.page = page;
     result.logLines = static_cast<int64_t>(log.lines.size());

@@ -62,7 +62,18 @@ void forEachItem(std::string_view text, Item&& item) {
 std::vector<double> parseNumberList(const std::vector<std::string>& values, const std::string& option) {
     std::vector<double> numbers;
     for (const std::string& value : values) {
-        forEachItem(value, [&](std::string_view item) {
+        // Commas and spaces both separate ("4, 8" and "4 8" as one argument); a comma with nothing before or
+        // after it is an empty item.
+        std::string commas = value;
+        for (size_t k = 0; k < commas.size(); ++k) {
+            if (commas[k] != ' ' && commas[k] != '\t') continue;
+            const size_t end = commas.find_first_not_of(" \t", k);
+            const bool joined =
+                k > 0 && commas[k - 1] != ',' && end != std::string::npos && commas[end] != ',';
+            commas.replace(k, (end == std::string::npos ? commas.size() : end) - k, joined ? "," : "");
+        }
+        forEachItem(commas, [&](std::string_view item) {
+            if (!item.empty() && item.front() == '+') item.remove_prefix(1);
             double number = 0.0;
             const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), number);
             if (item.empty() || error != std::errc() || end != item.data() + item.size()) {
@@ -170,15 +181,15 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     job.filter = command.filter;
     // The command's own files are not the job's outputs: a map written over the deformed frames, the log or
     // the report (which a resumed job would then skip as done) is refused before anything is written.
-    if (command.log) job.reservedFiles.emplace_back(*command.log, "the log (--log)");
-    if (command.report) job.reservedFiles.emplace_back(*command.report, "the report (--report)");
+    if (command.log) job.callerFiles.push_back({*command.log, "the log (--log)", true});
+    if (command.report) job.callerFiles.push_back({*command.report, "the report (--report)", true});
     if (io::ObjSequence::isPattern(command.deformed.string())) {
         const io::ObjSequence sequence(command.deformed);
         for (const int frame : command.frames)
-            job.reservedFiles.emplace_back(sequence.framePath(frame),
-                                           "the deformed frame " + std::to_string(frame) + " (--deformed)");
+            job.callerFiles.push_back(
+                {sequence.framePath(frame), "the deformed frame " + std::to_string(frame) + " (--deformed)"});
     } else {
-        job.reservedFiles.emplace_back(command.deformed, "the deformed shot (--deformed)");
+        job.callerFiles.push_back({command.deformed, "the deformed shot (--deformed)"});
     }
     std::ofstream logFile;
     std::ostringstream logLines;  // for the page when there is no log file

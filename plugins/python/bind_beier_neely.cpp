@@ -129,7 +129,7 @@ class PyBeierNeely {
         std::vector<glm::vec3> points = points3(rest, "rest_points");
         py::gil_scoped_release release;
         const Lock lock(mutex_);
-        auto deformer = std::make_unique<warp::WarpDeformer>(*warp_);
+        auto deformer = std::make_unique<warp::WarpDeformer>(*warp_, kBeierNeely);
         deformer->bind(points);
         deformer_ = std::move(deformer);
     }

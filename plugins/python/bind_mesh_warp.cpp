@@ -45,7 +45,7 @@ class PyMeshWarp {
                float beta, float gamma, float mu)
         : warp_(std::make_unique<warp::MeshWarp>(cageOf(cagePoints, counts, indices),
                                                  optionsOf(alpha, beta, gamma, mu), kMeshWarp)),
-          deformer_(std::make_unique<warp::WarpDeformer>(*warp_)) {}
+          deformer_(std::make_unique<warp::WarpDeformer>(*warp_, kMeshWarp)) {}
 
     void bind(const FloatArray& restPoints) {
         std::vector<glm::vec3> rest = pointsOf(restPoints, kMeshWarp, "rest_points");

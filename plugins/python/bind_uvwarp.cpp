@@ -527,8 +527,17 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
     // in progress().
     uvwarp::DeformedFrames sequence;
     if (isPath(deformed)) {
-        sequence = uvwarp::animatedFrames(deformed.cast<std::filesystem::path>(), frames,
-                                          std::string(kShot) + ": deformed", rest, restName, cacheStart);
+        const auto path = deformed.cast<std::filesystem::path>();
+        sequence = uvwarp::animatedFrames(path, frames, std::string(kShot) + ": deformed", rest, restName,
+                                          cacheStart);
+        if (io::ObjSequence::isPattern(path.string())) {  // the frames' files are inputs, never outputs
+            const io::ObjSequence files(path);
+            for (const int frame : frames)
+                job.callerFiles.push_back(
+                    {files.framePath(frame), "the deformed frame " + std::to_string(frame)});
+        } else {
+            job.callerFiles.push_back({path, "the deformed shot"});
+        }
     } else if (!PyCallable_Check(deformed.ptr())) {
         throw InvalidInput(
             formatError(kShot, "deformed", "is " + aTypeName(deformed),
@@ -549,8 +558,9 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
             throw InvalidInput(formatError(kShot, "log", "is " + aTypeName(log), "None or a file path"));
         }
         logPath = log.cast<std::filesystem::path>();
-        uvwarp::openShotLog(logPath, logFile);
         job.log = &logFile;
+        job.callerFiles.push_back({logPath, "the log (log)", true});
+        job.planned = [&] { uvwarp::openShotLog(logPath, logFile); };  // once the job is checked
     }
 
     const auto vertices = static_cast<py::ssize_t>(rest.numVertices());

@@ -500,6 +500,12 @@ expect report-scene 0 "$dk" report "$work/eval-uv-c/uvwarp.jsonl" --scene "$work
 contains report-scene "$work/eval-uv-c/again.html" "measured again from its files: the same"
 expect report-no-scene 0 "$dk" report "$work/eval-uv-c/uvwarp.jsonl" --out "$work/eval-uv-c/bare.html"
 contains report-no-scene "$work/out" "grid tile 1001: no heatmaps: the deformed mesh 'grid.000"
+# Nor is a page written over a map its log names (a rerun would skip the map as done).
+cp "$work/eval-uv-c/grid.redirect.1001.0002.exr" "$work/map-c.exr"
+expect report-over-map 2 "$dk" report "$work/eval-uv-c/uvwarp.jsonl" --out "$work/eval-uv-c/grid.redirect.1001.0002.exr"
+contains report-over-map "$work/err" "grid.redirect.1001.0002.exr: is an output the log"
+cmp -s "$work/eval-uv-c/grid.redirect.1001.0002.exr" "$work/map-c.exr" ||
+    { echo "FAIL report-over-map: the map was written over"; failures=$((failures + 1)); }
 expect eval-uvwarp-info 0 "$dk" info "$work/eval-uv/grid.redirect.1001.0002.exr"
 contains eval-uvwarp-info "$work/out" "deformkit:uvwarp:frame = 2"
 expect farm-plan-tiles 0 "$dk" farm plan "$work/uvshot.json" --chunk 1 --tiles-per-task 1 --out "$work/farm-uv"

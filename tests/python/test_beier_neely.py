@@ -116,3 +116,18 @@ def test_errors():
         dk.beier_neely_map(8, 8, good, np.zeros((1, 3), np.float32))
     with pytest.raises(dk.InvalidInput, match="0 pixels"):
         dk.beier_neely(np.zeros((0, 4, 3), np.float32), good, good)
+
+
+def test_evaluate_names_the_class_and_a_point_as_it_came_in():
+    # The engine-backed classes name themselves, and a point that came in not finite as it came in (not as a
+    # result "once deformed"); the points are left as they were.
+    dst = lines([[5, 5], [30, 10]])
+    bn = dk.BeierNeely(dst, dst)
+    pts = np.concatenate([centres(10, 8).reshape(-1, 2), np.zeros((80, 1))], axis=1).astype(np.float32)
+    bn.bind(pts)
+    bad = pts.copy()
+    bad[40] = (np.nan, 0.5, 0.0)
+    with pytest.raises(dk.InvalidInput, match=r"^beier_neely: point 40: is \(nan, 0.5, 0\) \(expected finite"):
+        bn.evaluate(bad)
+    with pytest.raises(dk.InvalidInput, match=r"^beier_neely: points: has 10 entries \(expected 80"):
+        bn.evaluate(pts[:10])

@@ -9,9 +9,9 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "docs").rglob("*.md")) + [ROOT / "README.md", ROOT / "scripts" / "farm" / "README.md"]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
-# A repository file named in backticks: a top-level folder of the project, then a path with an extension.
-NAMED = re.compile(r"`((?:core|plugins|ptex_support|scripts|tests|docs)/[A-Za-z0-9_./-]+\.[A-Za-z0-9]+)")
-MACHINE = re.compile(r"(?<![\w.])/(?:home|work|root)/\w")
+# A repository file or folder named in a page: a top-level folder of the project, then a path.
+NAMED = re.compile(r"(?<![\w/.-])((?:core|plugins|ptex_support|scripts|tests|docs)/[A-Za-z0-9_/-]+(?:\.[A-Za-z0-9]+)?)")
+MACHINE = re.compile(r"(?<![\w.])(?:/(?:home|work|root|tmp|mnt|Users)/\w|[A-Z]:\\\\\w)")
 
 
 def relative(page):

@@ -103,16 +103,20 @@ def reference(points, uvs, faces, charts, deformed, rig, redirect):
     for ia, ib in ((index[:, :-1].ravel(), index[:, 1:].ravel()), (index[:-1, :].ravel(), index[1:, :].ravel())):
         same = (chart[ia] >= 0) & (chart[ia] == chart[ib])
         length = np.linalg.norm(fd_q[ib] - fd_q[ia], axis=1)
-        keep = same & rigid_q[ia] & rigid_q[ib]
         rest = np.linalg.norm(fo_q[ib] - fo_q[ia], axis=1)
+        # At the identity, edges without a measurable rest length (a degenerate rest surface) are left out.
+        keep = same & rigid_q[ia] & rigid_q[ib] & (rest > 1e-9 * np.linalg.norm(points.max(0) - points.min(0)))
         identity_error += np.abs(length[keep] / rest[keep] - 1).sum()
         identity_edges += keep.sum()
         keep = same & rigid_r[ia] & rigid_r[ib]
         rest = np.linalg.norm(fo_r[ib] - fo_r[ia], axis=1)[keep]
-        # Content collapsed to one rest point (no measurable rest length) counts with an error of 1.
-        collapsed = rest <= 1e-9 * np.linalg.norm(points.max(0) - points.min(0))
-        error += np.where(collapsed, 1.0, np.abs(length[keep] / np.where(collapsed, 1.0, rest) - 1)).sum()
-        edges += keep.sum()
+        # Both texels showing one point of the map count with an error of 1; other edges without a
+        # measurable rest length (a degenerate rest surface) are left out.
+        tiny = rest <= 1e-9 * np.linalg.norm(points.max(0) - points.min(0))
+        collapsed = tiny & np.all(r[ib][keep] == r[ia][keep], axis=1)
+        counted = ~tiny | collapsed
+        error += np.where(collapsed, 1.0, np.abs(length[keep] / np.where(tiny, 1.0, rest) - 1))[counted].sum()
+        edges += counted.sum()
 
     R = redirect.astype(np.float64)
     p00, p10, p01, p11 = R[:-1, :-1], R[:-1, 1:], R[1:, :-1], R[1:, 1:]
@@ -187,6 +191,26 @@ def test_the_delivered_figures_equal_an_independent_computation():
     m = solver.metrics()
     check(m, reference(points, uvs, faces, charts, deformed, rig, cases["solver"]))
     assert m["rigid_stretch_removed"] > 0.3 and m["inverted_triangles"] == 0 and m["off_chart_texels"] == 0
+
+
+def test_a_degenerate_rest_surface_is_left_out_through_the_map_as_at_the_identity():
+    # The rest mesh collapsed to a point around one vertex (its four quads degenerate there): edges without
+    # a measurable rest length whose texels show distinct points are left out through any map, as at the
+    # identity, so the identity still removes nothing; a map collapsing content there counts as before.
+    mesh, points, uvs, faces, charts = two_charts()
+    centre = 4 * (N + 1) + 4  # vertex (4, 4) of chart 0
+    squashed = points.copy()
+    for v in (centre - N - 2, centre - N - 1, centre - N, centre - 1, centre + 1, centre + N, centre + N + 1,
+              centre + N + 2):
+        squashed[v] = points[centre]
+    idx = faces.ravel().astype(np.int32)
+    degenerate = dk.Mesh(squashed, np.full(len(faces), 4, np.int32), idx, uvs, idx.copy())
+    rig = np.ones((T, T), np.float32)
+    deformed = deform(squashed)
+    got = dk.redirect_metrics(degenerate, 1001, rig, deformed, identity_map())
+    check(got, reference(squashed, uvs, faces, charts, deformed, rig, identity_map()))
+    assert got["rigid_stretch_removed"] == 0.0
+    assert got["rigid_edges"] == got["identity_rigid_edges"]
 
 
 def test_bad_inputs_name_what_is_wrong():

@@ -174,7 +174,7 @@ def test_a_non_finite_envelope_or_weight_is_refused_by_every_deformer():
         "FFD evaluate: painted weight of point 0": lambda: ffd.evaluate(P, weights=nan_weights),
         "wires: envelope": lambda: dk.wires(P, [REF], [REF + np.float32(0.2)], envelope=float("nan")),
         "wires: painted weight of point 0": lambda: dk.wires(P, [REF], [REF + np.float32(0.2)], weights=nan_weights),
-        "warp evaluate: envelope": lambda: beier_neely.evaluate(P, envelope=float("nan")),
+        "beier_neely: envelope": lambda: beier_neely.evaluate(P, envelope=float("nan")),
         "twist: painted weight of point 0": lambda: dk.twist(P, [0, 0, 0], [0, 1, 0], [-1, 1], [0, 1.5], weights=nan_weights),
     }
     for text, call in calls.items():

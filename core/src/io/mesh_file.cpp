@@ -46,8 +46,10 @@ using PositionKey = std::tuple<float, float, float>;
 //   root, which holds the up-axis and unit conversion N already has). assimp folds the bind shape matrix B
 //   into each offset (offset_j = inverse bind_j * B), so at the bind pose p = N * B * v: Blender writes the
 //   mesh node under its armature's node and the mesh's placement relative to the armature as B, and
-//   assimp's pre-transform (N * v) would leave B out. A file whose skin node is at the origin reads as the
-//   Collada specification skins it.
+//   assimp's pre-transform (N * v) would leave B out. Exact where the file's joints are at their bind pose
+//   (Blender writes the rest pose) or its skin node is at the origin (the Collada specification's skin);
+//   a posed joint under a moved skin node is turned about the node's frame as well (assimp gives B only
+//   folded into the offsets). A vertex no joint weighs goes with the first joint.
 class RestPose {
   public:
     enum class Placement { JointsOnly, NodeThenJoints };
@@ -94,6 +96,9 @@ class RestPose {
         }
         std::vector<aiVector3D> skinned(v.size(), aiVector3D(0, 0, 0));
         std::vector<double> weight(v.size(), 0.0);
+        // Where a vertex no joint moves goes: with the mesh's node; in Collada with the first joint, whose
+        // offset holds the bind shape matrix the node alone would leave out (at the bind pose, N * B * v).
+        aiMatrix4x4 unweighted = node;
         for (unsigned b = 0; b < mesh.mNumBones; ++b) {
             const aiBone& bone = *mesh.mBones[b];
             const aiNode* joint = scene_.mRootNode->FindNode(bone.mName);
@@ -102,6 +107,7 @@ class RestPose {
                 toWorld = placement_ == Placement::JointsOnly ? global(*joint) * bone.mOffsetMatrix
                                                               : node * belowRoot(*joint) * bone.mOffsetMatrix;
             }
+            if (b == 0 && placement_ == Placement::NodeThenJoints) unweighted = toWorld;
             for (unsigned i = 0; i < bone.mNumWeights; ++i) {
                 const aiVertexWeight& w = bone.mWeights[i];
                 if (w.mVertexId >= v.size()) continue;
@@ -111,7 +117,7 @@ class RestPose {
         }
         // Weights that do not sum to 1 are normalised; a vertex no joint moves stays with the mesh's node.
         for (size_t i = 0; i < v.size(); ++i)
-            v[i] = weight[i] > 0.0 ? skinned[i] / static_cast<float>(weight[i]) : node * v[i];
+            v[i] = weight[i] > 0.0 ? skinned[i] / static_cast<float>(weight[i]) : unweighted * v[i];
         return v;
     }
 

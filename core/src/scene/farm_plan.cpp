@@ -295,6 +295,9 @@ FarmPlan readFarmPlan(const fs::path& path) {
         throw InvalidInput(
             formatError(path.string(), "", "does not exist", "a plan from deformkit farm plan"));
     }
+    if (fs::is_directory(path, ec)) {  // bad input (exit 2), as a missing plan: a retry would fail alike
+        throw InvalidInput(formatError(path.string(), "", "is a folder", "a plan from deformkit farm plan"));
+    }
     return parseFarmPlan(io::readFile(path, "farm plan"), path);
 }
 
@@ -320,7 +323,8 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
     const Scene& scene = evaluator.scene();
     const std::vector<std::string> expected = farmTaskOutputs(scene, t.firstFrame, t.lastFrame, t.tiles);
     if (expected != t.outputs) {
-        // A map the plan was made with and that has gone is named itself (it is not the scene that changed).
+        // A map the plan was made with and that has gone is named itself (it is not the scene that changed):
+        // bad input, exit 2, as any missing file the scene names (docs/farm.md, Exit codes).
         if (const std::string missing =
                 missingPlannedMap(scene, t.outputs, t.firstFrame, t.lastFrame, t.tiles);
             !missing.empty()) {

@@ -144,9 +144,13 @@ void requireMaskNumbers(const io::Image& mask, const MapLabel& label) {
 
 }  // namespace
 
-io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label) {
+void validateWarpMask(const io::Image& mask, const MapLabel& label) {
     requireSquareMap(mask, label);
     requireMaskNumbers(mask, label);
+}
+
+io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label) {
+    validateWarpMask(mask, label);
     io::Image out(mask.width, mask.height, 1);
     for (int32_t y = 0; y < mask.height; ++y) {
         for (int32_t x = 0; x < mask.width; ++x) {

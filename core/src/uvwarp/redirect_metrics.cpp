@@ -109,6 +109,7 @@ struct TexelSample {
     bool identityRigid = false;    // the content at q is
     glm::dvec3 deformed{0.0};      // f_D(q)
     glm::dvec3 rest{0.0};          // f_O(r)
+    glm::dvec2 r{0.0};             // r = R(q), tile-local
     glm::dvec3 identityRest{0.0};  // f_O(q)
 };
 
@@ -236,6 +237,7 @@ struct RedirectMetrics::Impl {
         s.identityRest = pointOn(restPoints, t, lq);
         s.identityRigid = rigidity.at(x, y, 0) >= 0.5f;
         const glm::dvec2 r = detail::redirectAt(redirect, x, y);
+        s.r = r;
         glm::dvec3 lr;
         const int32_t tr = locate(r, lr);
         if (tr >= 0) {
@@ -261,14 +263,17 @@ struct RedirectMetrics::Impl {
             }
         }
         if (a.located && b.located && a.rigid && b.rigid) {
-            // Content collapsed to one rest point counts as an error of 1 (DeliveredMetrics), so that a map
-            // smearing rigid detail cannot score as if it removed its stretch.
+            // Both texels showing one point of the map counts as an error of 1 (DeliveredMetrics), so that a
+            // map smearing rigid detail cannot score as if it removed its stretch; distinct points on a rest
+            // surface degenerate there are left out, as at the identity.
             const double rest = glm::length(b.rest - a.rest);
-            const double error = rest > minLength ? std::abs(deformedLength / rest - 1.0) : 1.0;
-            sums.error += error;
-            ++sums.edges;
-            texel.x += error;
-            texel.y += 1.0;
+            if (rest > minLength || a.r == b.r) {
+                const double error = rest > minLength ? std::abs(deformedLength / rest - 1.0) : 1.0;
+                sums.error += error;
+                ++sums.edges;
+                texel.x += error;
+                texel.y += 1.0;
+            }
         }
     }
 };

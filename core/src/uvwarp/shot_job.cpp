@@ -248,15 +248,17 @@ struct ShotSolver::Impl {
 
 namespace {
 
-// A path as outputs and inputs are compared: absolute and lexically normal (nothing is opened).
+// A path as outputs and inputs are compared: absolute, with the symbolic links of its existing part resolved
+// (a folder reached through a link is the same folder), lexically normal.
 std::string pathKey(const fs::path& path) {
     std::error_code error;
-    const fs::path absolute = fs::absolute(path, error);
-    return (error ? path : absolute).lexically_normal().string();
+    fs::path key = fs::weakly_canonical(path, error);
+    if (error) key = fs::absolute(path, error);
+    return (error ? path : key).lexically_normal().string();
 }
 
 // Every output of the job has a name of its own: no two alike, none the name of an input (the rest mesh,
-// a map's file at any frame, the caller's reserved files). Otherwise a report or log, another tile's map or
+// a map's file at any frame, the caller's files). Otherwise a report or log, another tile's map or
 // an input is overwritten, and a resumed job takes the damaged file for a finished output.
 void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJob& j) {
     std::map<std::string, std::string> outputs;  // path key -> what is written there
@@ -275,15 +277,18 @@ void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJ
             if (!plan.bakePaths[k].empty()) output(plan.bakePaths[k], "the bake of " + at);
         }
     }
+    for (const ShotJob::CallerFile& file : j.callerFiles)
+        if (file.written) output(file.path, file.what);
     const auto input = [&](const fs::path& path, const std::string& what) {
         if (const auto it = outputs.find(pathKey(path)); it != outputs.end()) {
             throw InvalidInput(formatError(path.string(), "", "is " + what + ", and " + it->second,
                                            "outputs apart from the job's inputs and the caller's files"));
         }
     };
-    input(j.restName, "the rest mesh");
-    for (const auto& [path, what] : j.reservedFiles)
-        input(path, what);
+    std::error_code error;
+    if (fs::is_regular_file(j.restName, error)) input(j.restName, "the rest mesh");  // not a host's label
+    for (const ShotJob::CallerFile& file : j.callerFiles)
+        if (!file.written) input(file.path, file.what);
     for (const detail::TilePlan& plan : plans) {
         for (const auto& [map, what] :
              {std::pair{&plan.rigidity, "rigidity map"}, std::pair{&plan.mask, "warp mask"},
@@ -362,13 +367,6 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         TilePlan plan;
         plan.tile = tile;
         plan.report.tile = tile;
-        std::vector<fs::path> folders = {j.outPath(tile, j.frames.front()).parent_path()};
-        if (wantBake) folders.push_back(j.bakePath(tile, j.frames.front()).parent_path());
-        // Made when missing (as eval makes its own), before any work: a path that cannot be a folder fails
-        // here, naming it.
-        for (const fs::path& folder : folders) {
-            if (!folder.empty()) io::createFolder(folder);
-        }
         plan.rigidity = findTileMap(j.rigidity, tile, j.frames);
         if (!plan.rigidity.found()) {
             plan.report.warped = false;
@@ -469,6 +467,15 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         s.plans.push_back(std::move(plan));
     }
     requireOutputsApart(s.plans, j);
+    // Output folders made when missing (as eval makes its own), once nothing is refused and before any work:
+    // a path that cannot be a folder fails here, naming it.
+    for (const TilePlan& plan : s.plans) {
+        std::vector<fs::path> folders = {j.outPath(plan.tile, j.frames.front()).parent_path()};
+        if (wantBake) folders.push_back(j.bakePath(plan.tile, j.frames.front()).parent_path());
+        for (const fs::path& folder : folders) {
+            if (!folder.empty()) io::createFolder(folder);
+        }
+    }
     if (!s.plans.empty() &&
         std::none_of(s.plans.begin(), s.plans.end(), [](const TilePlan& p) { return p.report.warped; })) {
         std::string list;
@@ -537,7 +544,7 @@ io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
         return mask ? readWarpMask(*file, tile) : readRigidityMap(*file, tile, role);
     if (!map.image) return {};
     if (mask)
-        (void)binariseWarpMask(*map.image, MapLabel{map.name, 0});
+        validateWarpMask(*map.image, MapLabel{map.name, 0});
     else
         validateRigidityMap(*map.image, MapLabel{map.name, 0});
     return *map.image;

@@ -1,5 +1,6 @@
 #include "deformkit/warp/engine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -80,10 +81,9 @@ void WarpDeformer::bind(std::span<const glm::vec3> restPoints) {
 
 void WarpDeformer::requireBound(size_t points) const {
     if (!bound_) {
-        throw InvalidInput(
-            formatError("warp deformer", "evaluate", "called before bind", "bind(restPoints) first"));
+        throw InvalidInput(formatError(source_, "evaluate", "called before bind", "bind(restPoints) first"));
     }
-    detail::requireCount("warp engine", "points", points, deformed_.size());
+    detail::requireCount(source_.c_str(), "points", points, deformed_.size());
 }
 
 void WarpDeformer::update() {
@@ -97,12 +97,15 @@ void WarpDeformer::apply(std::span<const glm::vec3> in, std::span<glm::vec3> out
 
 void WarpDeformer::evaluate(std::span<glm::vec3> points, std::span<const float> weights, float envelope) {
     requireBound(points.size());
-    requireFiniteEnvelope("warp evaluate", weights, envelope);
+    requireFiniteEnvelope(source_, weights, envelope);
     update();
     evaluateWarp(points, fields_, transforms_, deformed_, warp_.engineOptions());
-    // In place: a point the warp or the envelope takes beyond float range is named by its output only.
-    requireFiniteResult("warp evaluate", {}, points,
-                        applyEnvelope(points, deformed_, weights, envelope, points));
+    // Blended into the deformed copy while the input is still there, so that a point refused is named as it
+    // came in (not finite) or as it was deformed from, then copied back: the points change only when every
+    // one is finite.
+    requireFiniteResult(source_, points, deformed_,
+                        applyEnvelope(points, deformed_, weights, envelope, deformed_));
+    std::copy(deformed_.begin(), deformed_.end(), points.begin());
 }
 
 }  // namespace deformkit::warp

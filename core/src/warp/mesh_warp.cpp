@@ -332,7 +332,7 @@ void meshWarp(std::span<glm::vec3> points, const geom::Mesh& cage,
               std::span<const float> weights, float envelope) {
     MeshWarp warp(cage, options);
     warp.setTarget(targetCagePoints);
-    WarpDeformer deformer(warp);
+    WarpDeformer deformer(warp, "mesh warp");
     deformer.bind(points);
     deformer.evaluate(points, weights, envelope);
 }

@@ -314,6 +314,11 @@ TEST_CASE("farm run: a bad plan or task index is InvalidInput naming the file an
                        (void)harness::farmRunCommand({missing, 0});
                    }),
                    Contains(missing.string() + ": does not exist"));
+        fs::create_directories(shot.dir / "folder.json");  // a folder named as the plan: bad input too
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)harness::farmRunCommand({shot.dir / "folder.json", 0});
+                   }),
+                   Contains("folder.json: is a folder (expected a plan from deformkit farm plan)"));
         CHECK(harness::farmExitCode(IoError("x")) == 1);
         CHECK(harness::farmExitCode(std::runtime_error("x")) == 1);
         if (!test::runningAsRoot()) {

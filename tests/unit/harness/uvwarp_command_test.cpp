@@ -158,6 +158,8 @@ TEST_CASE("uvwarp command: frame lists, tile lists and output paths parse", "[ha
     // A list option's values: spaces and commas alike; an empty item is refused, not dropped.
     CHECK(harness::parseNumberList({"1", "1", "10"}, "--sweeps") == std::vector<double>{1, 1, 10});
     CHECK(harness::parseNumberList({"4,8", "16"}, "--sweeps") == std::vector<double>{4, 8, 16});
+    CHECK(harness::parseNumberList({"4, 8", " 16 32 ", "+2"}, "--sweeps") ==
+          std::vector<double>{4, 8, 16, 32, 2});
     for (const char* bad : {"4,,8", "4,8,", ",4", ""})
         CHECK_THAT(test::errorOf<InvalidInput>([bad] { (void)harness::parseNumberList({bad}, "--sweeps"); }),
                    Catch::Contains(std::string("--sweeps: '") + bad + "' has an empty item"));
@@ -641,11 +643,29 @@ TEST_CASE(
     SECTION("the report") {
         s.command.report = map1;
         refused(
-            "redirect.1001.0001.exr: is the report (--report), and the redirect map of tile 1001, frame 1");
+            "redirect.1001.0001.exr: is both the redirect map of tile 1001, frame 1 and the report "
+            "(--report)");
     }
     SECTION("the log, not opened") {
         s.command.log = map1;
-        refused("redirect.1001.0001.exr: is the log (--log), and the redirect map of tile 1001, frame 1");
+        refused("redirect.1001.0001.exr: is both the redirect map of tile 1001, frame 1 and the log (--log)");
+    }
+    SECTION("the report over the log, an input or a map through a linked folder") {
+        s.command.log = s.dir / "shot.jsonl";
+        s.command.report = s.dir / "shot.jsonl";
+        refused("shot.jsonl: is both the log (--log) and the report (--report)");
+        s.command.log.reset();
+        s.command.report = s.dir / "rig.1001.exr";
+        refused("rig.1001.exr: is the rigidity map of tile 1001, and the report (--report)");
+        s.command.report = s.dir / "anim.0002.obj";
+        refused("anim.0002.obj: is the deformed frame 2 (--deformed), and the report (--report)");
+        s.command.report.reset();
+        s.command.log = s.dir / "rest.obj";
+        refused("rest.obj: is the rest mesh, and the log (--log)");
+        fs::create_directory_symlink(s.dir / "out", s.dir / "link");
+        s.command.log = s.dir / "link/redirect.1001.0001.exr";
+        refused("is both the redirect map of tile 1001, frame 1 and the log (--log)");
+        CHECK(test::readText(s.dir / "rest.obj") == planeObj(1.0));
     }
     SECTION("a bake pattern spelled another way") {
         s.command.texture = s.dir / "col.<UDIM>.exr";

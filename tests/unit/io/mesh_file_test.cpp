@@ -352,6 +352,18 @@ TEST_CASE("mesh files: a skinned Collada mesh rests at its node, its bind shape 
             CHECK(glm::length(got[i] - want) < 1e-6f);
         }
     }
+    // A vertex no joint weighs keeps the bind shape matrix (it goes with the first joint): at the bind pose
+    // N B v, (0, 1, 0) + (10, 0, 2), not N v.
+    std::string text = kSkinnedCollada;
+    text.replace(text.find("TIPZ"), 4, "0");
+    text.replace(text.find("<vcount>1 1 2</vcount><v>0 0 1 0 0 1 1 1</v>"),
+                 std::string("<vcount>1 1 2</vcount><v>0 0 1 0 0 1 1 1</v>").size(),
+                 "<vcount>1 1 0</vcount><v>0 0 1 0</v>");
+    test::writeText(dir / "unweighted.dae", text);
+    const std::vector<glm::vec3> got = pointsOf(io::readMesh(dir / "unweighted.dae").mesh);
+    REQUIRE(got.size() == 3);
+    CAPTURE(got[2].x, got[2].y, got[2].z);
+    CHECK(glm::length(got[2] - glm::vec3(10.0f, 2.0f, -1.0f)) < 1e-6f);
 }
 
 TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_file]") {

@@ -87,9 +87,9 @@ TEST_CASE("every deformer refuses a non-finite envelope or painted weight, namin
     checkRefusals("FFD evaluate", [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
         ffd.evaluate(rest, out, w, e);
     });
-    WarpDeformer deformer(ffd);
+    WarpDeformer deformer(ffd, "engine FFD");
     deformer.bind(rest);
-    checkRefusals("warp evaluate", [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
+    checkRefusals("engine FFD", [&](std::span<const float> w, float e, std::vector<glm::vec3>& out) {
         deformer.evaluate(out, w, e);
     });
 
@@ -214,9 +214,10 @@ TEST_CASE("every deformer refuses a result beyond float range, naming the first 
                           [&](std::span<const float> w, float e, std::vector<glm::vec3>& o) {
                               ffd.evaluate(rest, o, w, e);
                           });
-            WarpDeformer deformer(ffd);
+            WarpDeformer deformer(ffd, "engine FFD");
             deformer.bind(rest);
-            checkOverflow("warp evaluate", false,
+            // The input is kept until the blend is checked: a point refused is named with where it came from.
+            checkOverflow("engine FFD", true,
                           [&](std::span<const float> w, float e, std::vector<glm::vec3>& o) {
                               deformer.evaluate(o, w, e);
                           });

@@ -50,6 +50,8 @@ struct DerivedMaskOptions {
 // the same size. Throws InvalidInput naming the label, tile and texel for a NaN, and for an empty or
 // non-square image.
 [[nodiscard]] io::Image binariseWarpMask(const io::Image& mask, const MapLabel& label = {});
+// binariseWarpMask's checks alone (square, no NaN in channel 0), without making the binary image.
+void validateWarpMask(const io::Image& mask, const MapLabel& label = {});
 
 // Reads a warp mask file (any format io::readImage reads) and binarises it as above; errors name the file.
 [[nodiscard]] io::Image readWarpMask(const std::filesystem::path& path, int tile = 0);

@@ -27,9 +27,10 @@ struct DeliveredMetrics {
     // whose content r_a and r_b both lies where the rigidity map is >= 0.5, of
     //   | |f_D(q_b) - f_D(q_a)| / |f_O(r_b) - f_O(r_a)| - 1 |.
     // The identity's (r = q) is the stretch the texture would show without the warp. An edge whose texels
-    // show one rest point (its rest length at most 1e-9 of the rest mesh's bounding-box diagonal: content
-    // collapsed to a point, smeared over the edge) counts with an error of 1, the error of the ratio taken
-    // the other way, rest over deformed; at the identity such edges (a degenerate rest mesh) are left out.
+    // show one point of the map (r_a = r_b: content collapsed to a point, smeared over the edge) counts with
+    // an error of 1, the error of the ratio taken the other way, rest over deformed; an edge whose rest
+    // length is not measurable otherwise (at most 1e-9 of the rest mesh's bounding-box diagonal: a
+    // degenerate rest surface) is left out, through the map as at the identity.
     double rigidStretchError = 0.0;
     double identityStretchError = 0.0;
     // 1 - rigidStretchError / identityStretchError: the share of the rigid stretch removed; 0 when the

@@ -115,11 +115,17 @@ struct ShotJob {
     std::ostream* log = nullptr;
     int logTask = -1;
     std::string logObject;
-    // Files the job must not write, each with what it is ("the log (--log)"): the caller's inputs (the
-    // deformed frames' files) and its own outputs (a log, a report). Checked before anything is written,
-    // as the job's own inputs (the rest mesh, every map file) are: an output with such a name, or two
-    // outputs with one name, is InvalidInput naming both.
-    std::vector<std::pair<std::filesystem::path, std::string>> reservedFiles;
+    // The caller's own files, each with what it is ("the log (--log)"): those it writes (a log, a report)
+    // and those it reads (the deformed frames' files). Checked before anything is written with the job's
+    // outputs and inputs (the rest mesh when restName is a file, every map file at every frame): two
+    // outputs with one name, or an output named as an input, is InvalidInput naming both. Names are
+    // compared with symbolic links resolved.
+    struct CallerFile {
+        std::filesystem::path path;
+        std::string what;
+        bool written = false;  // an output of the caller's (a log, a report); else an input it reads
+    };
+    std::vector<CallerFile> callerFiles;
     // runShotJob calls it once the job is planned and checked, before any frame is solved or any output
     // written: a caller opens its log there, so that a job refused leaves the file as it was.
     std::function<void()> planned;

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -83,7 +84,9 @@ class Warp {
 // them. The host layer's engine-backed deformers (beierneely, meshwarp) are this class behind parameters.
 class WarpDeformer {
   public:
-    explicit WarpDeformer(Warp& warp) : warp_(warp) {}
+    // `source` names the deformer in errors ("MeshWarp", a stack entry's label).
+    explicit WarpDeformer(Warp& warp, std::string source = "warp deformer")
+        : warp_(warp), source_(std::move(source)) {}
 
     // Fields on the rest points. Throws InvalidInput when the warp's fields do not cover every point once.
     void bind(std::span<const glm::vec3> restPoints);
@@ -96,14 +99,15 @@ class WarpDeformer {
     // same count) deformed into out (#points; may alias in). Allocates nothing.
     void apply(std::span<const glm::vec3> in, std::span<glm::vec3> out) const;
     // update() and apply() in place, then painted weights (#points, or empty for 1) and the envelope as
-    // applyEnvelope (warp/envelope.h) says; a point whose result is not finite is refused by name
-    // (requireFiniteResult), the points then holding partial results.
+    // applyEnvelope (warp/envelope.h) says; a point that came in not finite, or whose result is not, is
+    // refused by name (requireFiniteResult), the points then unchanged.
     void evaluate(std::span<glm::vec3> points, std::span<const float> weights = {}, float envelope = 1.0f);
 
   private:
     void requireBound(size_t points) const;
 
     Warp& warp_;
+    std::string source_;
     SparseFields fields_;
     Transformations transforms_;
     std::vector<glm::vec3> deformed_;

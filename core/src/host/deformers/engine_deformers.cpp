@@ -31,7 +31,7 @@ class EngineDeformer : public Deformer {
     void bindWarp(std::unique_ptr<warp::Warp> warp, const geom::Mesh& rest) {
         engine_.reset();
         warp_ = std::move(warp);
-        engine_.emplace(*warp_);
+        engine_.emplace(*warp_, label().empty() ? type() : label());
         engine_->bind(rest.points());
     }
     // Hands the animatable controls to the bound warp.
