@@ -183,14 +183,9 @@ uvwarp::ShotReport uvwarpCommand(const UvWarpCommand& command, Interrupter* inte
     // the report (which a resumed job would then skip as done) is refused before anything is written.
     if (command.log) job.callerFiles.push_back({*command.log, "the log (--log)", true});
     if (command.report) job.callerFiles.push_back({*command.report, "the report (--report)", true});
-    if (io::ObjSequence::isPattern(command.deformed.string())) {
-        const io::ObjSequence sequence(command.deformed);
-        for (const int frame : command.frames)
-            job.callerFiles.push_back(
-                {sequence.framePath(frame), "the deformed frame " + std::to_string(frame) + " (--deformed)"});
-    } else {
-        job.callerFiles.push_back({command.deformed, "the deformed shot (--deformed)"});
-    }
+    for (uvwarp::ShotJob::CallerFile& file :
+         uvwarp::deformedShotFiles(command.deformed, command.frames, " (--deformed)"))
+        job.callerFiles.push_back(std::move(file));
     std::ofstream logFile;
     std::ostringstream logLines;  // for the page when there is no log file
     if (command.log) job.log = &logFile;

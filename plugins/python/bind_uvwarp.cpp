@@ -530,14 +530,9 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
         const auto path = deformed.cast<std::filesystem::path>();
         sequence = uvwarp::animatedFrames(path, frames, std::string(kShot) + ": deformed", rest, restName,
                                           cacheStart);
-        if (io::ObjSequence::isPattern(path.string())) {  // the frames' files are inputs, never outputs
-            const io::ObjSequence files(path);
-            for (const int frame : frames)
-                job.callerFiles.push_back(
-                    {files.framePath(frame), "the deformed frame " + std::to_string(frame)});
-        } else {
-            job.callerFiles.push_back({path, "the deformed shot"});
-        }
+        for (uvwarp::ShotJob::CallerFile& file :
+             uvwarp::deformedShotFiles(path, frames))  // inputs, never outputs
+            job.callerFiles.push_back(std::move(file));
     } else if (!PyCallable_Check(deformed.ptr())) {
         throw InvalidInput(
             formatError(kShot, "deformed", "is " + aTypeName(deformed),

@@ -802,6 +802,16 @@ ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interr
     return solver.finish();
 }
 
+std::vector<ShotJob::CallerFile> deformedShotFiles(const fs::path& deformed, const std::vector<int>& frames,
+                                                   const std::string& named) {
+    if (!io::ObjSequence::isPattern(deformed.string())) return {{deformed, "the deformed shot" + named}};
+    const io::ObjSequence sequence(deformed);
+    std::vector<ShotJob::CallerFile> files;
+    for (const int frame : frames)
+        files.push_back({sequence.framePath(frame), "the deformed frame " + std::to_string(frame) + named});
+    return files;
+}
+
 fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {
     return io::ObjSequence(io::expandUdim(pattern.string(), tile)).framePath(frame);
 }

@@ -194,6 +194,13 @@ class ShotSolver {
 // the frame's input. The span must stay valid until the next call.
 using DeformedFrames = std::function<std::span<const glm::vec3>(int frame, std::string& name)>;
 
+// The files of a deformed shot as ShotJob::callerFiles, inputs the job must not write: an OBJ sequence's file
+// at each of `frames`, or the one file (a point cache). Each is "the deformed frame 7" or "the deformed
+// shot", then `named` (" (--deformed)").
+[[nodiscard]] std::vector<ShotJob::CallerFile> deformedShotFiles(const std::filesystem::path& deformed,
+                                                                 const std::vector<int>& frames,
+                                                                 const std::string& named = {});
+
 // The whole job: ShotSolver fed by `deformed`, asked once per frame up to the last needed one. The
 // interrupter, when given, is started with the job's units, told after each tile and frame, and ended.
 ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interrupter* interrupter = nullptr);
