@@ -66,7 +66,7 @@ void BM_FfdBind(benchmark::State& state) {
     bindLoop(state, {});
 }
 
-// A spline basis binds its points' weights too (the evaluate then only sums them).
+// The B-spline binds the same bound coordinates (its evaluate computes the weights from them).
 void BM_FfdBSplineBind(benchmark::State& state) {
     bindLoop(state, {FfdBasis::BSpline});
 }

@@ -158,6 +158,15 @@ decltype(detail::FfdKernels::bernsteinWeights444) laneWeights444(const detail::F
     return options.ends == FfdEnds::Repeat ? kernels.bsplineRepeatWeights444 : kernels.bsplineWeights444;
 }
 
+// The kernel giving the 4x4x4 sums of eight points with their weights computed in registers, for these
+// options: the Bernstein cubic or a cubic B-spline (either end rule) on every axis; nullptr for the others.
+decltype(detail::FfdKernels::bernstein444) laneKernel444(const detail::FfdKernels& kernels,
+                                                         const FfdOptions& options) {
+    if (options.basis.all(FfdBasis::Bernstein)) return kernels.bernstein444;
+    if (!options.basis.all(FfdBasis::BSpline)) return nullptr;
+    return options.ends == FfdEnds::Repeat ? kernels.bsplineRepeat444 : kernels.bspline444;
+}
+
 // The blocked loops below go over runs of kRunBlocks blocks (512 points) and check each run's outputs once
 // written, while they are in cache, in one vectorised pass: a check per point costs the 4x4x4 kernels, whose
 // per-point work is small, about a tenth of their time.
@@ -390,27 +399,10 @@ bool FfdLattice::deformUnbound(std::span<const glm::vec3> restPoints, std::span<
         active = inside || extrapolate;
         return l;
     };
-    const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
-    int64_t notFinite = n;
-    if (bernstein) {
-        notFinite = blocks444(
-            n,
-            [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
-                kernels.bernstein444(in, translations, d);
-            },
-            points, out, weights, envelope, local);
-    } else {
-        // The spline weights as deformWindow444 computes them (inactive lanes' sums are not used).
-        const auto splineWeights = laneWeights444(kernels, options_);
-        notFinite = blocks444(
-            n,
-            [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
-                detail::WeightBlock w;
-                splineWeights(in, w);
-                kernels.window444(w, translations, d);
-            },
-            points, out, weights, envelope, local);
-    }
+    const auto kernel = laneKernel444(ffdKernels(options_.kernel), options_);
+    const int64_t notFinite = blocks444(
+        n, [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) { kernel(in, translations, d); },
+        points, out, weights, envelope, local);
     requireFiniteResult("FFD evaluate", points, out, notFinite);
     return true;
 }
@@ -507,9 +499,10 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
     const int32_t ny = div.y + 1, nz = div.z + 1;
     const float* data = deltas.data();
     const bool blocks = options_.kernel != FfdKernel::PerPoint;
-    if (blocks && options_.basis.all(FfdBasis::Bernstein) && div == glm::ivec3(3) && stride == 3) {
+    const auto laneKernel = laneKernel444(ffdKernels(options_.kernel), options_);
+    if (blocks && laneKernel != nullptr && div == glm::ivec3(3) && stride == 3) {
         requireFiniteResult("FFD evaluate", points, out,
-                            deformBernstein444(points, out, data, weights, envelope));
+                            deformLanes444(laneKernel, points, out, data, weights, envelope));
         return;
     }
     // Every point's weights fit a 4x4x4 window of controls: along each axis a spline with >= 3 divisions,
@@ -587,15 +580,12 @@ void FfdLattice::deform(std::span<const glm::vec3> points, std::span<glm::vec3> 
     if (finite == 0) requireFiniteResult("FFD evaluate", points, out, detail::firstNonFinite(out));
 }
 
-int64_t FfdLattice::deformBernstein444(std::span<const glm::vec3> points, std::span<glm::vec3> out,
-                                       const float* translations, std::span<const float> weights,
-                                       float envelope) const {
-    const detail::FfdKernels& kernels = ffdKernels(options_.kernel);
+int64_t FfdLattice::deformLanes444(LaneKernel kernel, std::span<const glm::vec3> points,
+                                   std::span<glm::vec3> out, const float* translations,
+                                   std::span<const float> weights, float envelope) const {
     return blocks444(
         numBoundPoints(),
-        [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) {
-            kernels.bernstein444(in, translations, d);
-        },
+        [&](const detail::LocalBlock& in, detail::DisplacementBlock& d) { kernel(in, translations, d); },
         points, out, weights, envelope,
         [&](int64_t u, bool& active) {
             active = active_[u] != 0;

@@ -43,6 +43,9 @@ struct FfdKernels {
     void (*bernsteinWeights444)(const LocalBlock& in, WeightBlock& out);
     void (*bsplineWeights444)(const LocalBlock& in, WeightBlock& out);
     void (*bsplineRepeatWeights444)(const LocalBlock& in, WeightBlock& out);
+    // The B-spline sums with their weights computed in registers (either end rule), as bernstein444.
+    void (*bspline444)(const LocalBlock& in, const float* translations, DisplacementBlock& out);
+    void (*bsplineRepeat444)(const LocalBlock& in, const float* translations, DisplacementBlock& out);
 };
 
 extern const FfdKernels kBaselineFfdKernels;
@@ -195,6 +198,22 @@ typedef float Float8 __attribute__((vector_size(32)));
         for (int c = 0; c < 4; ++c)
             std::memcpy(&w[a][c], in.w[a][c], sizeof(Float8));
     sum444(w, deltas, out);
+}
+
+// The weights and the sum in one kernel: the weights stay in registers, as bernstein444's do. The same
+// arithmetic as bsplineWeights444 then window444, so the same bits.
+[[gnu::always_inline]] inline void bspline444(const LocalBlock& in, const float* deltas,
+                                              DisplacementBlock& out) {
+    WeightBlock w;
+    bsplineWeights444(in, w);
+    window444(w, deltas, out);
+}
+
+[[gnu::always_inline]] inline void bsplineRepeat444(const LocalBlock& in, const float* deltas,
+                                                    DisplacementBlock& out) {
+    WeightBlock w;
+    bsplineRepeatWeights444(in, w);
+    window444(w, deltas, out);
 }
 
 // The same sum with 12 floats per control (affine maps): one pass over (i, j) per control k of the run, so

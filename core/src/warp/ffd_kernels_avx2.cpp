@@ -10,7 +10,8 @@
 namespace deformkit::warp::detail {
 
 const FfdKernels kAvx2FfdKernels = {bernstein444,        window444,         frames444,
-                                    bernsteinWeights444, bsplineWeights444, bsplineRepeatWeights444};
+                                    bernsteinWeights444, bsplineWeights444, bsplineRepeatWeights444,
+                                    bspline444,          bsplineRepeat444};
 
 }  // namespace deformkit::warp::detail
 #endif

@@ -14,6 +14,11 @@
 
 namespace deformkit::warp {
 
+namespace detail {
+struct LocalBlock;  // ffd_kernels.h
+struct DisplacementBlock;
+}  // namespace detail
+
 // Free-form deformation (paper §4.1, Sederberg and Parry 1986): point features on a uniform lattice in a
 // parallelepiped, strength 1, transformations T_ijk = P*_ijk - P_ijk, weighting fields the trivariate
 // Bernstein polynomials of the point's local coordinates. Also the local B-spline variant (§4.1, after
@@ -154,15 +159,17 @@ class FfdLattice {
   private:
     // A point's local coordinates times the divisions, and whether it lies in the lattice (bind's formula).
     [[nodiscard]] glm::vec3 boundCoordinates(const glm::vec3& p, const glm::dvec3& scale, bool& inside) const;
-    // deform() for Bernstein divisions (3, 3, 3) with translations: SoA blocks of 8 points through the
-    // kernel options_.kernel selects (ffd.cpp).
+    // A kernel of eight points' 4x4x4 sums with their weights (ffd_kernels.h): Bernstein or B-spline.
+    using LaneKernel = void (*)(const detail::LocalBlock&, const float*, detail::DisplacementBlock&);
+    // deform() for divisions (3, 3, 3) with translations in the Bernstein cubic or a cubic B-spline: SoA
+    // blocks of 8 points, the weights computed from the bound coordinates in registers (ffd.cpp).
     // Both return the first point whose output is not finite, or #points.
-    [[nodiscard]] int64_t deformBernstein444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
-                                             const float* translations, std::span<const float> weights,
-                                             float envelope) const;
-    // The same lattice in any basis whose weights fit the 4x4x4 window (B-splines), and any basis with affine
-    // maps (stride 12, FFD with frames): each point's weights as the per-point path computes them (at bind
-    // for splines), the sum in eight-lane blocks; the per-point path's bytes.
+    [[nodiscard]] int64_t deformLanes444(LaneKernel kernel, std::span<const glm::vec3> in,
+                                         std::span<glm::vec3> out, const float* translations,
+                                         std::span<const float> weights, float envelope) const;
+    // The same lattice in the other bases whose weights fit the 4x4x4 window (Catmull-Rom, cardinal, linear),
+    // and any basis with affine maps (stride 12, FFD with frames): each point's weights as the per-point path
+    // computes them (at bind for splines), the sum in eight-lane blocks; the per-point path's bytes.
     [[nodiscard]] int64_t deformWindow444(std::span<const glm::vec3> in, std::span<glm::vec3> out,
                                           const float* data, int32_t stride, std::span<const float> weights,
                                           float envelope) const;
