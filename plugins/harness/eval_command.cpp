@@ -175,6 +175,8 @@ void checkSize(const char* what, int32_t value, int32_t lo, int32_t hi) {
     }
 }
 
+constexpr const char* kUvwarpLogName = "uvwarp.jsonl";  // in the output folder
+
 // The UV-warp stages' log written as DIR/uvwarp.jsonl and the shot's page (EvalCommand::report).
 void writeShotPage(const EvalCommand& command, EvalReport& report, const std::string& logText,
                    std::ostream* progress) {
@@ -182,7 +184,7 @@ void writeShotPage(const EvalCommand& command, EvalReport& report, const std::st
         report.notes.push_back("no UV-warp stage wrote a frame: no report");
         return;
     }
-    const fs::path logFile = command.outDir / "uvwarp.jsonl";
+    const fs::path logFile = command.outDir / kUvwarpLogName;
     io::writeFileAtomically(logFile, logText);
     report.files.push_back(logFile);
     uvwarp::ShotLog log;
@@ -282,6 +284,50 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     // Every input checked before anything is written: the stacks bound (vertex ranges, bind-time values),
     // sequence files, and below the UV-warp stages' maps.
     evaluator.check(report.frames);
+    // eval's outputs, each a file of its own and none a file it reads (written over as the shot runs); the
+    // UV-warp stages check their maps against both.
+    std::vector<uvwarp::ShotJob::CallerFile> files = scene::sceneInputFiles(scene, report.frames);
+    const auto output = [&](const fs::path& file, const std::string& what) {
+        files.push_back({file, what, true});
+    };
+    for (const scene::SceneObject& object : scene.objects) {
+        for (const int frame : report.frames) {
+            const std::string at = " of " + object.name + " at frame " + std::to_string(frame);
+            if (command.objs)
+                output(command.outDir / scene::frameFileName(object.name, frame), "the deformed mesh" + at);
+            if (previews)
+                output(command.outDir / scene::frameFileName(object.name, frame, ".png"), "the preview" + at);
+        }
+        if (!command.cache.empty() && !report.frames.empty())
+            output(command.outDir / (object.name + "." + command.cache), "the point cache of " + object.name);
+        if (previews)
+            output(command.outDir / (object.name + ".contact.png"), "the contact sheet of " + object.name);
+        if (previews && command.movie)
+            output(command.outDir / (object.name + ".mp4"), "the movie of " + object.name);
+    }
+    if (command.report) {
+        output(command.outDir / kUvwarpLogName, "the UV-warp stages' log");
+        output(*command.report, "the report (--report)");
+    }
+    uvwarp::requireFilesApart(files);
+    // The UV-warp stages: one shot solver per object with a stage, fed the frame the OBJ is written from.
+    std::vector<std::optional<uvwarp::ShotSolver>> stages(numObjects);
+    std::ostringstream uvwarpLog;
+    for (size_t o = 0; o < numObjects; ++o) {
+        const scene::SceneObject& object = scene.objects[o];
+        if (!object.uvwarp || report.frames.empty()) continue;
+        scene::UvWarpStageRun run;
+        run.frames = report.frames;
+        run.tiles = object.uvwarp->tiles;
+        run.outDir = command.outDir;
+        if (command.report) run.log = &uvwarpLog;
+        run.callerFiles = files;
+        stages[o] = scene::uvwarpStageSolver(scene, o, run);
+    }
+    // The page is written after the last frame: a folder that cannot be made fails now.
+    const bool anyStage =
+        std::any_of(stages.begin(), stages.end(), [](const auto& s) { return s.has_value(); });
+    if (command.report && anyStage) uvwarp::prepareHtmlReport(*command.report);
     io::createFolder(command.outDir);
 
     // One point cache per object, moved into place complete when every frame is in.
@@ -301,20 +347,6 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         for (const scene::SceneObject& object : scene.objects)
             restBounds.push_back(object.rest.bounds());
         pngs.resize(numObjects);
-    }
-
-    // The UV-warp stages: one shot solver per object with a stage, fed the frame the OBJ is written from.
-    std::vector<std::optional<uvwarp::ShotSolver>> stages(numObjects);
-    std::ostringstream uvwarpLog;
-    for (size_t o = 0; o < numObjects; ++o) {
-        const scene::SceneObject& object = scene.objects[o];
-        if (!object.uvwarp || report.frames.empty()) continue;
-        scene::UvWarpStageRun run;
-        run.frames = report.frames;
-        run.tiles = object.uvwarp->tiles;
-        run.outDir = command.outDir;
-        if (command.report) run.log = &uvwarpLog;
-        stages[o] = scene::uvwarpStageSolver(scene, o, run);
     }
 
     for (size_t i = 0; i < report.frames.size(); ++i) {

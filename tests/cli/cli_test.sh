@@ -492,6 +492,14 @@ contains eval-uvwarp-report "$work/out" "eval: report $work/eval-uv-r/shot.html 
 contains eval-uvwarp-report "$work/eval-uv-r/uvwarp.jsonl" '"object":"grid"'
 contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "measured again from its files: the same"
 contains eval-uvwarp-report "$work/eval-uv-r/shot.html" "deformkit eval $work/uvshot.json --frames 1-2"
+# A report named as the scene, or as one of eval's own outputs, is refused before anything is written.
+cp "$work/uvshot.json" "$work/uvshot-keep.json"
+expect eval-report-scene 2 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv-s" --no-previews --report "$work/uvshot.json"
+contains eval-report-scene "$work/err" "$work/uvshot.json: is the scene, and the report (--report)"
+cmp -s "$work/uvshot.json" "$work/uvshot-keep.json" || { echo "FAIL eval-report-scene: the scene was written"; failures=$((failures + 1)); }
+[ -e "$work/eval-uv-s" ] && { echo "FAIL eval-report-scene: the output folder was made"; failures=$((failures + 1)); }
+expect eval-report-log 2 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv-s" --no-previews --report "$work/eval-uv-s/uvwarp.jsonl"
+contains eval-report-log "$work/err" "is both the UV-warp stages' log and the report (--report)"
 # Written as a point cache alone (no per-frame OBJ): the page's heatmaps come from the scene itself.
 expect eval-uvwarp-report-cache 0 "$dk" eval "$work/uvshot.json" --out "$work/eval-uv-c" --no-previews --cache pc2 --no-objs \
     --report "$work/eval-uv-c/shot.html"

@@ -163,7 +163,29 @@ uvwarp::ShotJob uvwarpStageJob(const Scene& scene, size_t object, const UvWarpSt
     job.log = run.log;
     job.logTask = run.logTask;
     job.logObject = name;
+    job.callerFiles = run.callerFiles;
     return job;
+}
+
+std::vector<uvwarp::ShotJob::CallerFile> sceneInputFiles(const Scene& scene, const std::vector<int>& frames) {
+    std::vector<uvwarp::ShotJob::CallerFile> files;
+    std::error_code error;
+    if (fs::is_regular_file(scene.source, error)) files.push_back({scene.source, "the scene"});
+    for (const SceneObject& object : scene.objects) {
+        const std::string of = " of " + scene.source + ": " + object.path;
+        files.push_back({object.meshFile, "the rest mesh" + of});
+        if (!object.sequence.empty()) {
+            for (uvwarp::ShotJob::CallerFile& file :
+                 uvwarp::deformedShotFiles(object.sequence, frames, of + " (animated input)"))
+                files.push_back(std::move(file));
+        }
+        for (const SceneDeformer& deformer : object.stack) {
+            if (!deformer.weightsFile.empty() && fs::is_regular_file(deformer.weightsFile, error))
+                files.push_back(
+                    {deformer.weightsFile, "the weights of " + scene.source + ": " + deformer.path});
+        }
+    }
+    return files;
 }
 
 std::optional<uvwarp::ShotSolver> uvwarpStageSolver(const Scene& scene, size_t object,

@@ -257,38 +257,48 @@ std::string pathKey(const fs::path& path) {
     return (error ? path : key).lexically_normal().string();
 }
 
-// Every output of the job has a name of its own: no two alike, none the name of an input (the rest mesh,
-// a map's file at any frame, the caller's files). Otherwise a report or log, another tile's map or
-// an input is overwritten, and a resumed job takes the damaged file for a finished output.
-void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJob& j) {
-    std::map<std::string, std::string> outputs;  // path key -> what is written there
-    const auto output = [&](const fs::path& path, const std::string& what) {
-        if (const auto [it, added] = outputs.emplace(pathKey(path), what); !added) {
+// Names written and read, checked as they are added: no two outputs alike, no output the name of an input.
+// Otherwise a report or log, another tile's map or an input is overwritten, and a resumed job takes the
+// damaged file for a finished output. Add every output before the inputs.
+class FileNames {
+  public:
+    void output(const fs::path& path, const std::string& what) {
+        if (const auto [it, added] = outputs_.emplace(pathKey(path), what); !added) {
             throw InvalidInput(formatError(path.string(), "", "is both " + it->second + " and " + what,
                                            "a file of its own for each output"));
         }
-    };
+    }
+    void input(const fs::path& path, const std::string& what) const {
+        if (const auto it = outputs_.find(pathKey(path)); it != outputs_.end()) {
+            throw InvalidInput(formatError(path.string(), "", "is " + what + ", and " + it->second,
+                                           "outputs apart from the job's inputs and the caller's files"));
+        }
+    }
+
+  private:
+    std::map<std::string, std::string> outputs_;  // path key -> what is written there
+};
+
+// Every output of the job has a name of its own, none the name of an input (the rest mesh, a map's file at
+// any frame, the caller's files).
+void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJob& j) {
+    FileNames names;
     for (const detail::TilePlan& plan : plans) {
         if (!plan.report.warped) continue;
         for (size_t k = 0; k < j.frames.size(); ++k) {
             const std::string at =
                 "tile " + std::to_string(plan.tile) + ", frame " + std::to_string(j.frames[k]);
-            output(plan.outPaths[k], "the redirect map of " + at);
-            if (!plan.bakePaths[k].empty()) output(plan.bakePaths[k], "the bake of " + at);
+            names.output(plan.outPaths[k], "the redirect map of " + at);
+            if (!plan.bakePaths[k].empty()) names.output(plan.bakePaths[k], "the bake of " + at);
         }
     }
     for (const ShotJob::CallerFile& file : j.callerFiles)
-        if (file.written) output(file.path, file.what);
-    const auto input = [&](const fs::path& path, const std::string& what) {
-        if (const auto it = outputs.find(pathKey(path)); it != outputs.end()) {
-            throw InvalidInput(formatError(path.string(), "", "is " + what + ", and " + it->second,
-                                           "outputs apart from the job's inputs and the caller's files"));
-        }
-    };
+        if (file.written) names.output(file.path, file.what);
     std::error_code error;
-    if (fs::is_regular_file(j.restName, error)) input(j.restName, "the rest mesh");  // not a host's label
+    if (fs::is_regular_file(j.restName, error))
+        names.input(j.restName, "the rest mesh");  // not a host's label
     for (const ShotJob::CallerFile& file : j.callerFiles)
-        if (!file.written) input(file.path, file.what);
+        if (!file.written) names.input(file.path, file.what);
     for (const detail::TilePlan& plan : plans) {
         for (const auto& [map, what] :
              {std::pair{&plan.rigidity, "rigidity map"}, std::pair{&plan.mask, "warp mask"},
@@ -296,12 +306,12 @@ void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJ
             if (!map->file) continue;
             const std::string of = std::string("the ") + what + " of tile " + std::to_string(plan.tile);
             if (map->framePattern.empty()) {
-                input(*map->file, of);
+                names.input(*map->file, of);
                 continue;
             }
             const io::ObjSequence sequence(map->framePattern);
             for (const int frame : j.frames)
-                input(sequence.framePath(frame), of + " at frame " + std::to_string(frame));
+                names.input(sequence.framePath(frame), of + " at frame " + std::to_string(frame));
         }
     }
 }
@@ -810,6 +820,14 @@ std::vector<ShotJob::CallerFile> deformedShotFiles(const fs::path& deformed, con
     for (const int frame : frames)
         files.push_back({sequence.framePath(frame), "the deformed frame " + std::to_string(frame) + named});
     return files;
+}
+
+void requireFilesApart(const std::vector<ShotJob::CallerFile>& files) {
+    FileNames names;
+    for (const ShotJob::CallerFile& file : files)
+        if (file.written) names.output(file.path, file.what);
+    for (const ShotJob::CallerFile& file : files)
+        if (!file.written) names.input(file.path, file.what);
 }
 
 fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {

@@ -491,3 +491,68 @@ TEST_CASE("scene uvwarp: a plan made before a UV-warp stage was added is stale",
                    Contains("plan again after changing it"));
     CHECK(test::filesIn(plan.outDir) == std::vector<fs::path>{"farm_plan.json"});
 }
+
+TEST_CASE("scene uvwarp: eval refuses an output named as another or as a file it reads, before writing",
+          "[harness][uvwarp][eval][errors]") {
+    Shot shot;
+    const std::string sceneText = test::readText(shot.scene);
+    const fs::path out = shot.dir / "eval";
+    const auto refused = [&](const fs::path& report, const std::string& first, const std::string& second) {
+        harness::EvalCommand command;
+        command.scene = shot.scene;
+        command.outDir = out;
+        command.previews = false;
+        command.report = report;
+        CHECK_THROWS_AS(harness::evalCommand(command), InvalidInput);
+        CHECK_THROWS_WITH(harness::evalCommand(command),
+                          Contains(report.string()) && Contains(first) && Contains(second));
+        // Nothing written: no output folder, the scene as it was.
+        CHECK_FALSE(fs::exists(out));
+        CHECK(test::readText(shot.scene) == sceneText);
+    };
+    refused(shot.scene, "the scene", "the report (--report)");
+    refused(shot.dir / "tubes.obj", "the rest mesh of", "the report (--report)");
+    refused(out / "tubes.0002.obj", "the deformed mesh of tubes at frame 2", "the report (--report)");
+    refused(out / "uvwarp.jsonl", "the UV-warp stages' log", "the report (--report)");
+    refused(shot.dir / "rig.1002.exr", "the rigidity map of tile 1002", "the report (--report)");
+    refused(out / scene::uvwarpRedirectName("tubes", 1002, 3), "the redirect map of tile 1002, frame 3",
+            "the report (--report)");
+    // Through a symbolic link to the output folder, left from an earlier run: nothing is written in it.
+    fs::create_directory(out);
+    fs::create_directory_symlink(out, shot.dir / "link");
+    harness::EvalCommand linked;
+    linked.scene = shot.scene;
+    linked.outDir = out;
+    linked.previews = false;
+    linked.report = shot.dir / "link" / "tubes.0001.obj";
+    CHECK_THROWS_WITH(harness::evalCommand(linked),
+                      Contains(linked.report->string()) && Contains("the deformed mesh of tubes at frame 1"));
+    CHECK(fs::is_empty(out));
+    fs::remove(shot.dir / "link");
+    fs::remove(out);
+
+    // An OBJ sequence read as the animated input, evaluated into its own folder: each frame would be written
+    // over the file it is read from.
+    for (int frame = 0; frame <= 3; ++frame) {  // the rest pose at frame 0
+        geom::Mesh posed = shot.rest;
+        posed.setPoints(stackPoints(shot.rest, frame));
+        io::writeObj(shot.dir / scene::frameFileName("tubes", frame), posed);
+    }
+    const fs::path sequenceScene = shot.dir / "sequence.json";
+    test::writeText(sequenceScene, R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
+      {"name": "tubes", "mesh": "tubes.####.obj", "restFrame": 0, "stack": []}]})");
+    harness::EvalCommand command;
+    command.scene = sequenceScene;
+    command.outDir = shot.dir.path();
+    command.previews = false;
+    const std::string before = test::readText(shot.dir / "tubes.0002.obj");
+    CHECK_THROWS_AS(harness::evalCommand(command), InvalidInput);
+    CHECK_THROWS_WITH(harness::evalCommand(command), Contains("tubes.0001.obj") &&
+                                                         Contains("animated input") &&
+                                                         Contains("the deformed mesh of tubes at frame 1"));
+    CHECK(test::readText(shot.dir / "tubes.0002.obj") == before);
+    // Into another folder it runs.
+    command.outDir = shot.dir / "elsewhere";
+    const harness::EvalReport report = harness::evalCommand(command);
+    CHECK(report.files.size() == 3);
+}

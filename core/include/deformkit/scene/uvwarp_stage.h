@@ -65,7 +65,17 @@ struct UvWarpStageRun {
     bool skipExisting = false;    // true: keep existing outputs and replay the warm start (farm tasks)
     std::ostream* log = nullptr;  // JSON lines per tile x frame (ShotJob::log)
     int logTask = -1;
+    // The caller's own files (ShotJob::callerFiles): those it writes beside the maps and those it reads,
+    // checked with the stage's outputs and inputs before anything is written.
+    std::vector<uvwarp::ShotJob::CallerFile> callerFiles;
 };
+
+// The files a job over `frames` reads from the scene, as ShotJob::callerFiles (not written): the scene file
+// (when `scene.source` names one), each object's rest mesh, its animated input at those frames (an OBJ
+// sequence's files, or the point cache) and its stack's weights files. The UV-warp stages' maps are the
+// stages' own inputs (ShotJob).
+[[nodiscard]] std::vector<uvwarp::ShotJob::CallerFile> sceneInputFiles(const Scene& scene,
+                                                                       const std::vector<int>& frames);
 
 // The shot job of object `object`'s UV-warp stage (it must have one) over the run, its outputs named as
 // above. Throws InvalidInput naming the scene and the object when it has no stage.

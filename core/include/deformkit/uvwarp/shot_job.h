@@ -201,6 +201,11 @@ using DeformedFrames = std::function<std::span<const glm::vec3>(int frame, std::
                                                                  const std::vector<int>& frames,
                                                                  const std::string& named = {});
 
+// A caller's own files checked as a job checks its outputs (ShotJob::callerFiles): no two written files
+// share a name and none is named as a file read, names compared with symbolic links resolved. InvalidInput
+// naming the file and both uses.
+void requireFilesApart(const std::vector<ShotJob::CallerFile>& files);
+
 // The whole job: ShotSolver fed by `deformed`, asked once per frame up to the last needed one. The
 // interrupter, when given, is started with the job's units, told after each tile and frame, and ended.
 ShotReport runShotJob(const ShotJob& job, const DeformedFrames& deformed, Interrupter* interrupter = nullptr);
