@@ -75,7 +75,7 @@ class PlanReader {
     static constexpr int64_t kMaxTaskFrames = 1000000;
 
     FarmTask task(const json& j, const std::string& at, int chunk) const {
-        requireObject(j, at, {"frames", "tiles", "outputs"});
+        requireObject(j, at, {"frames", "tiles", "outputs", "maps"});
         FarmTask task;
         const json& frames = member(j, at, "frames");
         if (!frames.is_array() || frames.size() != 2)
@@ -107,6 +107,15 @@ class PlanReader {
             if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
                 fail(element, "is \"" + name + "\"", "a file name in the output folder, without '/'");
             task.outputs.push_back(name);
+        }
+        if (const auto it = j.find("maps"); it != j.end()) {  // UV-warp tasks
+            if (!it->is_array() || task.tiles.empty())
+                fail(at + ".maps", "is " + describe(*it), "a UV-warp task's array of map files");
+            for (size_t i = 0; i < it->size(); ++i) {
+                const std::string element = at + ".maps[" + std::to_string(i) + "]";
+                if (!(*it)[i].is_string()) fail(element, "is " + describe((*it)[i]), "a file name");
+                task.maps.push_back((*it)[i].get<std::string>());
+            }
         }
         return task;
     }
@@ -256,6 +265,7 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
                 tiles.begin() + static_cast<ptrdiff_t>(
                                     std::min(tiles.size(), t + static_cast<size_t>(options.tilesPerTask))));
             task.outputs = farmTaskOutputs(scene, first, last, task.tiles);
+            task.maps = uvwarpOptionalMaps(scene, first, last, task.tiles);
             plan.tasks.push_back(std::move(task));
         }
     }
@@ -271,8 +281,8 @@ std::string formatFarmPlan(const FarmPlan& plan) {
         << ",\n  \"warmUp\": " << plan.warmUp << ",\n  \"tasks\": [";
     for (size_t k = 0; k < plan.tasks.size(); ++k) {
         const FarmTask& t = plan.tasks[k];
-        const json task = {
-            {"frames", {t.firstFrame, t.lastFrame}}, {"tiles", t.tiles}, {"outputs", t.outputs}};
+        json task = {{"frames", {t.firstFrame, t.lastFrame}}, {"tiles", t.tiles}, {"outputs", t.outputs}};
+        if (!t.tiles.empty()) task["maps"] = t.maps;
         out << (k ? ",\n    " : "\n    ") << task.dump();
     }
     out << "\n  ]\n}\n";
@@ -339,6 +349,26 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
         throw InvalidInput(formatError(planName, taskPath + ".outputs[" + std::to_string(i) + "]",
                                        "is " + listed + ", the scene makes " + made,
                                        "the outputs of the scene as planned (plan again after changing it)"));
+    }
+    // The optional maps as planned: one removed would give the tile a derived mask (or the density
+    // heuristic), one added a mask the other tasks did not have.
+    if (!t.tiles.empty()) {
+        const std::vector<std::string> maps = uvwarpOptionalMaps(scene, t.firstFrame, t.lastFrame, t.tiles);
+        for (const std::string& file : t.maps) {
+            if (std::find(maps.begin(), maps.end(), file) == maps.end()) {
+                throw InvalidInput(formatError(planName, taskPath + ".maps",
+                                               "names " + file + ", which does not exist now",
+                                               "the maps the plan was made with, there while its tasks run"));
+            }
+        }
+        for (const std::string& file : maps) {
+            if (std::find(t.maps.begin(), t.maps.end(), file) == t.maps.end()) {
+                throw InvalidInput(
+                    formatError(planName, taskPath + ".maps",
+                                "does not name " + file + ", which the scene's stage reads now",
+                                "the maps the plan was made with (plan again after adding one)"));
+            }
+        }
     }
     // A UV-warp stage added to the scene after planning has no task: every task checks the plan still
     // covers the tiles the scene warps (at the plan's first frame, as planned).

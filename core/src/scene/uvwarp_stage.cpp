@@ -113,6 +113,27 @@ std::string missingPlannedMap(const Scene& scene, const std::vector<std::string>
     return {};
 }
 
+std::vector<std::string> uvwarpOptionalMaps(const Scene& scene, int firstFrame, int lastFrame,
+                                            const std::vector<int>& tiles) {
+    std::vector<std::string> maps;
+    std::set<std::string> seen;
+    for (const SceneObject& object : scene.objects) {
+        if (!object.uvwarp) continue;
+        const SceneUvWarp& stage = *object.uvwarp;
+        for (const int tile : tiles) {
+            if (!std::binary_search(stage.tiles.begin(), stage.tiles.end(), tile)) continue;
+            for (int frame = firstFrame; frame <= lastFrame; ++frame) {
+                for (const auto* pattern : {&stage.mask, &stage.orientation}) {
+                    if (!*pattern) continue;
+                    const std::string file = tileFile(**pattern, tile, frame).string();
+                    if (fileExists(file) && seen.insert(file).second) maps.push_back(file);
+                }
+            }
+        }
+    }
+    return maps;
+}
+
 std::vector<std::string> uvwarpOutputs(const SceneObject& object, int tile, int frame) {
     if (!object.uvwarp) return {};
     const SceneUvWarp& stage = *object.uvwarp;

@@ -558,3 +558,58 @@ TEST_CASE("farm run: a map removed after planning is named, not taken for a chan
         fs::rename(shot.dir / "gone.exr", shot.dir / file);
     }
 }
+
+TEST_CASE("farm run: a warp mask or orientation map removed or added after planning is named",
+          "[harness][farm][errors]") {
+    // Either map is optional per tile: without the file the tile takes a derived mask or the density
+    // heuristic, so a change after planning would warp this task's tiles unlike the tasks run before it.
+    Shot shot;
+    std::string text = kScene;
+    const size_t twistEnd = text.find("}}}]}") + 3;
+    text.replace(twistEnd, 0,
+                 R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "mask": "mask.<UDIM>.exr"})");
+    test::writeText(shot.scene, text);
+    io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
+    io::writeImage(shot.dir / "mask.1001.exr", io::Image(32, 32, 1, 1.0f));
+    harness::FarmPlanCommand planCommand;
+    planCommand.scene = shot.scene;
+    planCommand.outDir = shot.dir / "farm";
+    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    int uvTask = -1;
+    for (size_t k = 0; k < plan.tasks.size() && uvTask < 0; ++k)
+        if (!plan.tasks[k].tiles.empty()) uvTask = static_cast<int>(k);
+    REQUIRE(uvTask >= 0);
+    const std::string mask = (shot.dir / "mask.1001.exr").string();
+    CHECK(plan.tasks[static_cast<size_t>(uvTask)].maps == std::vector<std::string>{mask});
+    // Written and read back.
+    const fs::path planFile = shot.dir / "farm" / "farm_plan.json";
+    CHECK(scene::readFarmPlan(planFile).tasks[static_cast<size_t>(uvTask)].maps ==
+          std::vector<std::string>{mask});
+    harness::FarmRunCommand run;
+    run.plan = planFile;
+    run.task = uvTask;
+
+    fs::rename(mask, shot.dir / "gone.exr");
+    std::string error = test::errorOf<InvalidInput>([&] { (void)harness::farmRunCommand(run); });
+    CHECK_THAT(error, Contains("tasks[" + std::to_string(uvTask) + "].maps: names " + mask +
+                               ", which does not exist now"));
+    fs::rename(shot.dir / "gone.exr", mask);
+
+    // A plan that lists no mask (made before the mask was painted): the mask found now is named.
+    const std::string good = test::readText(planFile);
+    std::string edited = good;
+    const std::string listed = nlohmann::json(std::vector<std::string>{mask}).dump();
+    REQUIRE(edited.find(listed) != std::string::npos);
+    edited.replace(edited.find(listed), listed.size(), "[]");
+    test::writeText(planFile, edited);
+    error = test::errorOf<InvalidInput>([&] { (void)harness::farmRunCommand(run); });
+    CHECK_THAT(error, Contains("does not name " + mask + ", which the scene's stage reads now") &&
+                          Contains("plan again"));
+    CHECK_FALSE(fs::exists(shot.dir / "farm" / scene::uvwarpRedirectName("tube", 1001, 1)));
+    test::writeText(planFile, good);
+
+    // As planned, the task runs.
+    const scene::FarmTaskReport report = harness::farmRunCommand(run);
+    CHECK_FALSE(report.written.empty());
+    CHECK(fs::exists(shot.dir / "farm" / scene::uvwarpRedirectName("tube", 1001, 1)));
+}

@@ -35,6 +35,9 @@ struct FarmTask {
     std::vector<int> tiles;
     // File names in the plan's output folder, frame by frame, objects in scene order.
     std::vector<std::string> outputs;
+    // UV-warp tasks: the warp masks and orientation maps there when the plan was made (uvwarpOptionalMaps),
+    // absolute paths; the task refuses to run when the files there differ.
+    std::vector<std::string> maps;
 };
 
 struct FarmPlan {

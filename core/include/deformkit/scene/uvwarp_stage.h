@@ -46,6 +46,13 @@ namespace deformkit::scene {
                                             const std::vector<std::string>& plannedOutputs, int firstFrame,
                                             int lastFrame, const std::vector<int>& tiles);
 
+// The warp masks and orientation maps the UV-warp stages find for `tiles` over frames first..last, each file
+// once, in scene, tile and frame order. Either map is optional per tile (without one a tile takes a derived
+// mask, or the density heuristic), so a farm plan records the ones there when it is made and each task
+// checks them (FarmTask::maps): a map removed or added in between would change the task's warp silently.
+[[nodiscard]] std::vector<std::string> uvwarpOptionalMaps(const Scene& scene, int firstFrame, int lastFrame,
+                                                          const std::vector<int>& tiles);
+
 // The stage's tiles that are warped: those with a rigidity map on disk (an animated map: its file at
 // `frame`), ascending. A tile without one is left unwarped (no outputs).
 [[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame);
