@@ -23,6 +23,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/point_cache.h"
@@ -309,7 +310,7 @@ EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
         output(command.outDir / kUvwarpLogName, "the UV-warp stages' log");
         output(*command.report, "the report (--report)");
     }
-    uvwarp::requireFilesApart(files);
+    io::requireFilesApart(files);
     // The UV-warp stages: one shot solver per object with a stage, fed the frame the OBJ is written from.
     std::vector<std::optional<uvwarp::ShotSolver>> stages(numObjects);
     std::ostringstream uvwarpLog;

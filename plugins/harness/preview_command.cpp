@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "deformkit/error.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
@@ -50,6 +51,11 @@ geom::Box3 parseBox(const std::string& text) {
 }  // namespace
 
 void preview(const PreviewCommand& command) {
+    std::vector<io::FileUse> files = {{command.out, "the picture (--out)", true}, {command.mesh, "the mesh"}};
+    if (command.texture) files.push_back({*command.texture, "the texture (--texture)"});
+    if (command.weights) files.push_back({*command.weights, "the weights (--weights)"});
+    if (command.weightsPtex) files.push_back({*command.weightsPtex, "the weights (--weights-ptex)"});
+    io::requireFilesApart(files);
     const io::ObjContent obj = io::readMesh(command.mesh);
     std::optional<io::PreviewTexture> texture;
     if (command.texture) texture = io::loadPreviewTexture(*command.texture);

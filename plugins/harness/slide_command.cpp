@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "deformkit/error.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/mesh_file.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/ptex/ptex_mesh.h"
@@ -71,6 +72,11 @@ slide::Falloff parseFalloff(std::string_view text, const std::string& option) {
 }
 
 slide::SlideResult slideCommand(const SlideCommand& command) {
+    // The output is never one of the files read: the slid mesh would replace the rest mesh.
+    std::vector<io::FileUse> files = {{command.out, "the output (--out)", true}, {command.mesh, "the mesh"}};
+    if (command.weights) files.push_back({*command.weights, "the weights (--weights)"});
+    if (command.weightsPtex) files.push_back({*command.weightsPtex, "the weights (--weights-ptex)"});
+    io::requireFilesApart(files);
     io::ObjContent obj = io::readMesh(command.mesh);
     const size_t count = static_cast<size_t>(obj.mesh.numVertices());
     if (command.weights && command.weightsPtex) {

@@ -7,12 +7,16 @@
 #include <sstream>
 
 #include "deformkit/error.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/image.h"
 #include "deformkit/scene/feature_lines_file.h"
 
 namespace deformkit::harness {
 
 void warpImageCommand(const WarpImageCommand& command) {
+    io::requireFilesApart({{command.out, "the output (--out)", true},
+                           {command.image, "the image"},
+                           {command.lines, "the lines (--lines)"}});
     const std::vector<warp::SegmentPair> pairs = scene::readFeatureLines(command.lines);
     const io::Image source = io::readImage(command.image);
     if (source.width <= 0 || source.height <= 0) {

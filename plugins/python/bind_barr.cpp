@@ -28,6 +28,7 @@ using warp::AxisFrame;
 using warp::ProfileCurve;
 
 glm::vec3 vec3Of(const FloatArray& a, const char* source, const char* name) {
+    requireFloats(a, source, name);
     if (a.ndim() != 1 || a.shape(0) != 3) {
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "3 numbers"));
     }
@@ -35,6 +36,7 @@ glm::vec3 vec3Of(const FloatArray& a, const char* source, const char* name) {
 }
 
 std::vector<float> floatsOf(const FloatArray& a, const char* source, const char* name) {
+    requireFloats(a, source, name);
     if (a.ndim() != 1)
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "a 1-D array"));
     return std::vector<float>(a.data(), a.data() + a.shape(0));
@@ -52,6 +54,7 @@ py::array_t<float> run(AxialWarp& warp, std::mutex* mutex, const FloatArray& poi
     const std::span<const glm::vec3> in = pointsView(points, source, "points");
     std::span<const float> w;
     if (weights) {
+        requireFloats(*weights, source, "weights");
         if (weights->ndim() != 1) {
             throw InvalidInput(
                 formatError(source, "weights", "has shape " + shapeOf(*weights), "a 1-D array"));
@@ -244,6 +247,7 @@ void bindBarr(py::module_& m) {
             warp::BlenderSimpleDeform b;
             if (origin) b.origin = vec3Of(*origin, "Blender SimpleDeform", "origin");
             if (basis) {
+                requireFloats(*basis, "Blender SimpleDeform", "basis");
                 if (basis->ndim() != 2 || basis->shape(0) != 3 || basis->shape(1) != 3) {
                     throw InvalidInput(formatError("Blender SimpleDeform", "basis",
                                                    "has shape " + shapeOf(*basis),

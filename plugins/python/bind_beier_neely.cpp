@@ -33,6 +33,7 @@ constexpr const char* kBeierNeely = "beier_neely";
 
 // (n, 2, 2) lines: line i from (x, y) = a[i, 0] to a[i, 1], pixels.
 std::vector<glm::vec2> linesOf(const FloatArray& a, const char* name) {
+    requireFloats(a, kBeierNeely, name);
     if (a.ndim() != 3 || a.shape(1) != 2 || a.shape(2) != 2) {
         throw InvalidInput(formatError(kBeierNeely, name, "has shape " + shapeOf(a),
                                        "(n, 2, 2): n lines of 2 (x, y) points"));
@@ -158,6 +159,7 @@ class PyBeierNeely {
         }
     }
     static std::vector<glm::vec3> points3(const FloatArray& a, const char* name) {
+        requireFloats(a, kBeierNeely, name);
         if (a.ndim() != 2 || a.shape(1) != 3) {
             throw InvalidInput(formatError(kBeierNeely, name, "has shape " + shapeOf(a), "(n, 3) float32"));
         }

@@ -32,9 +32,11 @@ using warp::Lattice;
 
 Lattice latticeOf(const FloatArray& origin, const FloatArray& axes, const IntArray& divisions,
                   const char* source) {
+    requireFloats(origin, source, "origin");
     if (origin.ndim() != 1 || origin.shape(0) != 3) {
         throw InvalidInput(formatError(source, "origin", "has shape " + shapeOf(origin), "(3,)"));
     }
+    requireFloats(axes, source, "axes");
     if (axes.ndim() != 2 || axes.shape(0) != 3 || axes.shape(1) != 3) {
         throw InvalidInput(
             formatError(source, "axes", "has shape " + shapeOf(axes), "(3, 3), one axis X, Y, Z per row"));
@@ -104,6 +106,7 @@ warp::FfdOptions optionsOf(const std::string& basis, const std::string& outside,
 // A (l+1, m+1, n+1, trailing...) array in the lattice's index order, checked against the divisions.
 void checkLatticeShape(const FloatArray& a, const Lattice& l, std::vector<py::ssize_t> trailing,
                        const char* source, const char* name) {
+    requireFloats(a, source, name);
     std::vector<py::ssize_t> expected{l.divisions.x + 1, l.divisions.y + 1, l.divisions.z + 1};
     expected.insert(expected.end(), trailing.begin(), trailing.end());
     bool ok = a.ndim() == static_cast<py::ssize_t>(expected.size());

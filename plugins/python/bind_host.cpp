@@ -76,11 +76,14 @@ std::optional<std::vector<double>> valuesOf(py::handle value) {
 std::optional<std::vector<float>> weightValuesOf(py::handle weights, std::string& problem) {
     if (weights.is_none()) return std::vector<float>{};
     if (!py::isinstance<py::str>(weights) && !py::isinstance<py::bytes>(weights)) {
-        auto a = FloatArray::ensure(weights);
-        if (a && a.size() == 0) return std::vector<float>{};
-        if (a && a.ndim() == 1) return std::vector<float>(a.data(), a.data() + a.size());
-        if (a) {
-            problem = "has shape " + shapeOf(a);
+        if (const std::optional<FloatArray> a = floatArrayOf(weights)) {
+            if (!a->problem.empty()) {
+                problem = a->problem;
+                return std::nullopt;
+            }
+            if (a->size() == 0) return std::vector<float>{};
+            if (a->ndim() == 1) return std::vector<float>(a->data(), a->data() + a->size());
+            problem = "has shape " + shapeOf(*a);
             return std::nullopt;
         }
     }

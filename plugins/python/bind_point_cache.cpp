@@ -61,6 +61,7 @@ void bindPointCache(py::module_& m) {
     m.def(
         "write_point_cache",
         [](const std::filesystem::path& path, const FloatArray& positions, int firstFrame, double fps) {
+            requireFloats(positions, "write_point_cache", "positions");
             if (positions.ndim() != 3 || positions.shape(2) != 3) {
                 throw InvalidInput(formatError("write_point_cache", "positions",
                                                "has shape " + shapeOf(positions),

@@ -33,13 +33,13 @@ std::map<int, io::Image> tileImages(const py::object& value, const std::string& 
         if (!tile || *tile < 1001 || *tile > 9999) {
             throw InvalidInput(formatError(kReport, element, "is not a UDIM tile", "1001..9999"));
         }
-        const auto image = FloatArray::ensure(array);
+        const std::optional<FloatArray> image = floatArrayOf(array);
         if (!image) {
-            PyErr_Clear();
             throw InvalidInput(
                 formatError(kReport, element, "is " + aTypeName(array), "(T, T) or (T, T, C) float32"));
         }
-        out.emplace(static_cast<int>(*tile), imageOf(image, kReport, element, "(T, T) or (T, T, C) float32"));
+        out.emplace(static_cast<int>(*tile),
+                    imageOf(*image, kReport, element, "(T, T) or (T, T, C) float32"));
     }
     return out;
 }
@@ -76,16 +76,16 @@ py::dict shotReport(const py::object& logs, const std::filesystem::path& page, c
                 const auto pair = py::reinterpret_borrow<py::tuple>(result);
                 result = pair.empty() ? py::none() : py::object(pair[0]);
             }
-            const auto array = FloatArray::ensure(result);
+            const std::optional<FloatArray> array = floatArrayOf(result);
             const std::string element = "deformed(" + std::to_string(frame) + ")";
-            if (!array || array.ndim() != 2 || array.shape(1) != 3 ||
-                static_cast<size_t>(array.shape(0)) != rest->points().size()) {
-                PyErr_Clear();
+            if (array) requireFloats(*array, kReport, element);
+            if (!array || array->ndim() != 2 || array->shape(1) != 3 ||
+                static_cast<size_t>(array->shape(0)) != rest->points().size()) {
                 throw InvalidInput(formatError(kReport, element, "is not the rest mesh's positions",
                                                "(" + std::to_string(rest->points().size()) + ", 3) float32"));
             }
-            const auto* p = reinterpret_cast<const glm::vec3*>(array.data());
-            return uvwarp::ReportGeometry{*rest, std::vector<glm::vec3>(p, p + array.shape(0))};
+            const auto* p = reinterpret_cast<const glm::vec3*>(array->data());
+            return uvwarp::ReportGeometry{*rest, std::vector<glm::vec3>(p, p + array->shape(0))};
         };
     }
     const std::map<int, io::Image> rigidityMaps = tileImages(rigidity, "rigidity");

@@ -95,12 +95,14 @@ Falloff falloffOf(py::handle value, const std::string& source, const std::string
     if (!py::isinstance<py::sequence>(value) && !py::isinstance<py::array>(value)) {
         throw InvalidInput(formatError(source, name, "is a " + type, expected));
     }
-    const FloatArray samples = FloatArray::ensure(value);  // null (error cleared) when not numeric
+    const std::optional<FloatArray> samples = floatArrayOf(value);
     if (!samples)
         throw InvalidInput(formatError(source, name, "is a " + type + " that is not numeric", expected));
-    if (samples.ndim() != 1)
-        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(samples), expected));
-    return Falloff::ramp(std::span<const float>(samples.data(), static_cast<size_t>(samples.shape(0))), name);
+    requireFloats(*samples, source, name);
+    if (samples->ndim() != 1)
+        throw InvalidInput(formatError(source, name, "has shape " + shapeOf(*samples), expected));
+    return Falloff::ramp(std::span<const float>(samples->data(), static_cast<size_t>(samples->shape(0))),
+                         name);
 }
 
 // One falloff for every handle, or a list of one per handle: a list whose items are strings or

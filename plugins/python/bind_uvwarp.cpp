@@ -45,6 +45,7 @@ using uvwarp::TileWarpOptions;
 // A one-channel map: (T, T) or (T, T, 1) float32. Squareness and values are checked by the core, which
 // names the texel.
 io::Image mapOf(const FloatArray& a, const std::string& source, const char* name) {
+    requireFloats(a, source, name);
     if (!(a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1)) || a.shape(0) < 1 || a.shape(1) < 1) {
         throw InvalidInput(
             formatError(source, name, "has shape " + shapeOf(a), "(T, T) or (T, T, 1) float32"));
@@ -257,12 +258,14 @@ py::dict metricsDict(const uvwarp::DeliveredMetrics& delivered, const uvwarp::Wa
 // A redirect map argument: (T, T, 2) float32, the tile-local (u', v'), as redirect_map returns it. A third
 // channel is more likely a texture passed in its place (the arguments swapped) than a map: refused.
 io::Image redirectOf(const FloatArray& a, const std::string& source, const char* expected) {
+    requireFloats(a, source, "redirect");
     if (a.ndim() != 3 || a.shape(2) != 2)
         throw InvalidInput(formatError(source, "redirect", "has shape " + shapeOf(a), expected));
     return imageOf(a, source, "redirect", expected);
 }
 
 std::vector<glm::vec3> deformedOf(const FloatArray& a, int32_t vertices, const std::string& source) {
+    requireFloats(a, source, "deformed_points");
     if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != vertices) {
         throw InvalidInput(formatError(source, "deformed_points", "has shape " + shapeOf(a),
                                        "(" + std::to_string(vertices) + ", 3), one row per rest vertex"));
@@ -418,13 +421,12 @@ uvwarp::TileMapSource mapSourceOf(const py::object& value, const std::string& na
                 formatError(kShot, name + " key " + keyText, "is not a UDIM tile", "1001..9999"));
         }
         const std::string element = name + "[" + std::to_string(tile) + "]";
-        const auto image = FloatArray::ensure(array);
+        const std::optional<FloatArray> image = floatArrayOf(array);
         if (!image) {
-            PyErr_Clear();
             throw InvalidInput(
                 formatError(kShot, element, "is " + aTypeName(array), "(T, T) or (T, T, C) float32"));
         }
-        map.images.emplace(tile, imageOf(image, kShot, element, "(T, T) or (T, T, C) float32"));
+        map.images.emplace(tile, imageOf(*image, kShot, element, "(T, T) or (T, T, C) float32"));
     }
     if (map.images.empty()) throw InvalidInput(formatError(kShot, name, "has no tile", expected));
     return map;
@@ -577,18 +579,17 @@ py::dict uvwarpShot(const geom::Mesh& rest, const std::vector<int>& frames, cons
             name = py::str(pair[1]);
             result = pair[0];
         }
-        const auto array = FloatArray::ensure(result);
-        if (!array) {
-            PyErr_Clear();
+        const std::optional<FloatArray> array = floatArrayOf(result);
+        if (!array)
             throw InvalidInput(formatError(kShot, element, "returned " + aTypeName(result), expected));
-        }
-        if (array.ndim() != 2 || array.shape(1) != 3 || array.shape(0) != vertices) {
+        requireFloats(*array, kShot, element);
+        if (array->ndim() != 2 || array->shape(1) != 3 || array->shape(0) != vertices) {
             const std::string what = py::isinstance<py::array>(result) ? "" : aTypeName(result) + " of ";
-            throw InvalidInput(formatError(kShot, element, "returned " + what + "shape " + shapeOf(array),
+            throw InvalidInput(formatError(kShot, element, "returned " + what + "shape " + shapeOf(*array),
                                            "(" + std::to_string(vertices) + ", 3), one row per rest vertex"));
         }
         points.resize(static_cast<size_t>(vertices));
-        if (!points.empty()) std::memcpy(points.data(), array.data(), points.size() * sizeof(glm::vec3));
+        if (!points.empty()) std::memcpy(points.data(), array->data(), points.size() * sizeof(glm::vec3));
         return points;
     };
 

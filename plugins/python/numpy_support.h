@@ -26,7 +26,17 @@
 
 namespace deformkit::python {
 
-using FloatArray = pybind11::array_t<float, pybind11::array::c_style | pybind11::array::forcecast>;
+// Numbers from Python (a list, a numpy array of any float or integer type) as a C-contiguous float32 array:
+// a view of a float32 C-contiguous array, otherwise numpy's cast. The conversion never fails when the
+// argument is taken; `problem` says why the values are not float32 numbers ("is an array of bool values",
+// "holds 1e+39 at flat index 4, beyond float32's range": numpy's cast would give 1 for True and inf for
+// 1e39), and the helpers below (requireFloats), which name the argument, refuse them.
+struct FloatArray : pybind11::array_t<float, pybind11::array::c_style | pybind11::array::forcecast> {
+    using Base = pybind11::array_t<float, pybind11::array::c_style | pybind11::array::forcecast>;
+    FloatArray() = default;
+    explicit FloatArray(Base values) : Base(std::move(values)) {}
+    std::string problem;
+};
 // Values read in double (a few parameters: a float32 copy would turn 4e38 into inf before it is checked).
 using DoubleArray = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
 
@@ -52,6 +62,13 @@ inline std::string shapeOf(const pybind11::array& a) {
     return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
+// InvalidInput naming the argument when its values are not float32 numbers (FloatArray::problem).
+inline void requireFloats(const FloatArray& a, const std::string& source, const std::string& name) {
+    if (!a.problem.empty()) {
+        throw InvalidInput(formatError(source, name, a.problem, "numbers within float32's range"));
+    }
+}
+
 // How an in-memory mesh is named in messages: "(16 vertices, 9 faces)".
 inline std::string meshLabel(const geom::Mesh& mesh) {
     return "(" + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numFaces()) +
@@ -61,6 +78,7 @@ inline std::string meshLabel(const geom::Mesh& mesh) {
 // An (n, 3) array as positions (a copy the C++ side owns).
 inline std::vector<glm::vec3> pointsOf(const FloatArray& a, const std::string& source,
                                        const std::string& name) {
+    requireFloats(a, source, name);
     if (a.ndim() != 2 || a.shape(1) != 3) {
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
     }
@@ -73,6 +91,7 @@ inline std::vector<glm::vec3> pointsOf(const FloatArray& a, const std::string& s
 // anything else when the argument is taken). Valid while `a` lives.
 inline std::span<const glm::vec3> pointsView(const FloatArray& a, const std::string& source,
                                              const std::string& name) {
+    requireFloats(a, source, name);
     if (a.ndim() != 2 || a.shape(1) != 3) {
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), "(n, 3) float32"));
     }
@@ -111,6 +130,7 @@ inline geom::Mesh meshOf(const FloatArray& points, const IntArray& counts, const
                                        "both uvs and uv_indices, or neither"));
     }
     if (uvs) {
+        requireFloats(*uvs, source, prefix + "uvs");
         if (uvs->ndim() != 2 || uvs->shape(1) != 2)
             throw InvalidInput(
                 formatError(source, prefix + "uvs", "has shape " + shapeOf(*uvs), "(k, 2) float32"));
@@ -167,6 +187,7 @@ T castArgument(pybind11::handle value, const std::string& source, const std::str
 inline std::vector<float> weightsOf(const std::optional<FloatArray>& weights, size_t count,
                                     const std::string& source) {
     if (!weights) return {};
+    requireFloats(*weights, source, "weights");
     if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != count) {
         throw InvalidInput(formatError(source, "weights", "has shape " + shapeOf(*weights),
                                        "(" + std::to_string(count) + ",), one per point"));
@@ -178,6 +199,7 @@ inline std::vector<float> weightsOf(const std::optional<FloatArray>& weights, si
 inline std::span<const float> weightsView(const std::optional<FloatArray>& weights, size_t count,
                                           const std::string& source) {
     if (!weights) return {};
+    requireFloats(*weights, source, "weights");
     if (weights->ndim() != 1 || static_cast<size_t>(weights->shape(0)) != count) {
         throw InvalidInput(formatError(source, "weights", "has shape " + shapeOf(*weights),
                                        "(" + std::to_string(count) + ",), one per point"));
@@ -226,6 +248,7 @@ inline void requireSameOrApart(std::span<const glm::vec3> in, std::span<const gl
 // An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.
 inline io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
                          const std::string& expected = "(H, W) or (H, W, C) float32") {
+    requireFloats(a, source, name);
     if (a.ndim() != 2 && a.ndim() != 3)
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
     if (a.size() == 0)
@@ -254,6 +277,60 @@ inline pybind11::array_t<float> toArray(std::span<const glm::vec3> points) {
 }  // namespace deformkit::python
 
 namespace pybind11::detail {
+
+// Takes what numpy reads as an array of numbers; None is no FloatArray (an optional one is then absent), nor
+// is a str or bytes (another overload may take a path). Arrays of bool, strings, objects or complex numbers,
+// and float64 values beyond float32's range, are taken with FloatArray::problem set.
+template <>
+struct type_caster<deformkit::python::FloatArray> {
+    PYBIND11_TYPE_CASTER(deformkit::python::FloatArray, const_name("numpy.ndarray[float32]"));
+
+    bool load(handle src, bool convert) {
+        using Base = deformkit::python::FloatArray::Base;
+        if (src.is_none() || isinstance<str>(src) || isinstance<bytes>(src)) return false;
+        if (!convert && !Base::check_(src)) return false;
+        value = deformkit::python::FloatArray();
+        array a = isinstance<array>(src) ? reinterpret_borrow<array>(src) : array::ensure(src);
+        if (!a) return false;
+        const char kind = a.dtype().kind();
+        if (kind != 'f' && kind != 'i' && kind != 'u') {
+            // numpy's cast of bools and strings, for a caller that reads the values without requireFloats
+            // (not of complex numbers, whose cast warns).
+            if (kind == 'b' || kind == 'U' || kind == 'S') {
+                if (Base cast = Base::ensure(a)) value = deformkit::python::FloatArray(std::move(cast));
+                PyErr_Clear();
+            }
+            value.problem = isinstance<array>(src)
+                                ? "is an array of " + std::string(str(a.dtype())) + " values"
+                                : "is " + deformkit::python::aTypeName(src) + " that is not numeric";
+            return true;
+        }
+        Base values = Base::ensure(a);
+        if (!values) return false;
+        if (kind == 'f' && a.itemsize() > 4) {
+            // numpy's cast gives inf for a finite value beyond float32's range: find the first such one.
+            const ssize_t n = values.size();
+            const float* v = values.data();
+            std::optional<array_t<double, array::c_style | array::forcecast>> wide;  // once an inf is found
+            for (ssize_t i = 0; i < n; ++i) {
+                if (!std::isinf(v[i])) continue;
+                if (!wide) wide = array_t<double, array::c_style | array::forcecast>::ensure(a);
+                if (!*wide || !std::isfinite(wide->data()[i])) continue;
+                value = deformkit::python::FloatArray(std::move(values));
+                value.problem = "holds " + deformkit::numberText(wide->data()[i]) +
+                                (a.ndim() == 1 ? " at index " : " at flat index ") + std::to_string(i) +
+                                ", beyond float32's range";
+                return true;
+            }
+        }
+        value = deformkit::python::FloatArray(std::move(values));
+        return true;
+    }
+
+    static handle cast(const deformkit::python::FloatArray& src, return_value_policy, handle) {
+        return src.inc_ref();
+    }
+};
 
 // Takes anything numpy reads as an array (None is no IntArray: an optional one is then absent).
 template <>
@@ -323,3 +400,19 @@ struct type_caster<deformkit::python::IntArray> {
 };
 
 }  // namespace pybind11::detail
+
+namespace deformkit::python {
+
+// The argument conversion (FloatArray's caster) for a value taken from a container or a callback (a dict's
+// map, a function's result): nullopt, the Python error cleared, when numpy cannot read it as an array of
+// numbers; otherwise the array, with `problem` set as for an argument (requireFloats).
+inline std::optional<FloatArray> floatArrayOf(pybind11::handle value) {
+    pybind11::detail::make_caster<FloatArray> caster;
+    if (!caster.load(value, true)) {
+        PyErr_Clear();
+        return std::nullopt;
+    }
+    return pybind11::detail::cast_op<FloatArray&&>(std::move(caster));
+}
+
+}  // namespace deformkit::python

@@ -185,6 +185,15 @@ expect slide-max-walk-0 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 -
     --out "$work/x.obj" --max-walk 0
 contains slide-max-walk-0 "$work/err" "--max-walk: is 0 (expected a number > 0)"
 grep -q "e+308" "$work/err" && { echo "FAIL slide-max-walk-0: prints a range to 1.8e308"; failures=$((failures + 1)); }
+# An output named as a file the command reads is refused before anything is written (a slid mesh over its
+# rest mesh, a warped image over its source, a preview over its texture), symbolic links resolved.
+cp "$work/quad.obj" "$work/quad-keep.obj"
+expect slide-out-is-mesh 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/quad.obj"
+contains slide-out-is-mesh "$work/err" "$work/quad.obj: is the mesh, and the output (--out)"
+cmp -s "$work/quad.obj" "$work/quad-keep.obj" || { echo "FAIL slide-out-is-mesh: the mesh was written"; failures=$((failures + 1)); }
+ln -sf "$work/quad.obj" "$work/quad-link.obj"
+expect slide-out-links-mesh 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 --out "$work/quad-link.obj"
+contains slide-out-links-mesh "$work/err" "is the mesh, and the output (--out)"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt -0.45 0.1\nvt 0.05 0.1\nvt 0.05 0.9\nvt -0.45 0.9\nf 1/1 2/2 3/3 4/4\n' >"$work/left.obj"
 printf '[0, 0.5, 1, 0.5]\n' >"$work/left.json"
 expect ptex-left 0 "$dk" ptex from-vertex "$work/left.json" "$work/left.obj" --out "$work/left.ptx"
@@ -254,6 +263,12 @@ if ! cmp -s "$work/demo/albedo.1001.png" "$work/w.png"; then
     contains warp-identity-info "$work/out" "64 x 64"
 fi
 printf '{"lines": [{"src": [[0, 0], [1, "x"]], "dst": [[0, 0], [1, 1]]}]}' >"$work/bad.json"
+cp "$work/demo/albedo.1001.png" "$work/albedo-copy.png"
+expect warp-out-is-image 2 "$dk" warp "$work/albedo-copy.png" --lines "$work/same.json" --out "$work/albedo-copy.png"
+contains warp-out-is-image "$work/err" "$work/albedo-copy.png: is the image, and the output (--out)"
+cmp -s "$work/albedo-copy.png" "$work/demo/albedo.1001.png" || { echo "FAIL warp-out-is-image: the image was written"; failures=$((failures + 1)); }
+expect preview-out-is-texture 2 "$dk" preview "$work/demo/tube.obj" --texture "$work/albedo-copy.png" --out "$work/albedo-copy.png"
+contains preview-out-is-texture "$work/err" "is the texture (--texture), and the picture (--out)"
 expect warp-bad-json 2 "$dk" warp "$work/demo/albedo.1001.png" --lines "$work/bad.json" --out "$work/w2.png"
 contains warp-bad-json "$work/err" "lines[0].src[1][1]"
 [ ! -e "$work/w2.png" ] || { echo "FAIL warp-bad-json: output written"; failures=$((failures + 1)); }

@@ -13,7 +13,8 @@ import deformkit as dk
 
 # numpy warns when a huge Python int or a NaN is cast to an int array; such values are among those tried.
 pytestmark = [pytest.mark.filterwarnings("ignore::DeprecationWarning"),
-              pytest.mark.filterwarnings("ignore:invalid value encountered in cast:RuntimeWarning")]
+              pytest.mark.filterwarnings("ignore:invalid value encountered in cast:RuntimeWarning"),
+              pytest.mark.filterwarnings("ignore:overflow encountered in cast:RuntimeWarning")]
 
 CALLS = 1000  # per callable: the whole module in about 10 seconds
 
@@ -32,6 +33,7 @@ def argument_pool():
         np.zeros((3, 3), np.int64), np.zeros((2, 2, 2), np.float32), np.zeros(7, np.float32),
         np.zeros((3, 3), np.float64), np.ones((16, 16), np.float32), np.ones((16, 16, 4), np.float32),
         np.zeros((16, 16, 0), np.float32), np.full((8, 8), np.inf, np.float32),
+        np.ones((4, 3), bool), np.full((4, 3), "1"), np.full((4, 3), 1e39), [[True, False, True]], ["1", "2"],
         np.zeros((4, 3), np.float32)[:, ::2], points[::-1], points, points[:3], grid, b"bytes", object(),
     ]
 

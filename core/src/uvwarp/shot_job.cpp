@@ -15,6 +15,7 @@
 #include "deformkit/error.h"
 #include "deformkit/io/animated_positions.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/obj_sequence.h"
@@ -248,41 +249,10 @@ struct ShotSolver::Impl {
 
 namespace {
 
-// A path as outputs and inputs are compared: absolute, with the symbolic links of its existing part resolved
-// (a folder reached through a link is the same folder), lexically normal.
-std::string pathKey(const fs::path& path) {
-    std::error_code error;
-    fs::path key = fs::weakly_canonical(path, error);
-    if (error) key = fs::absolute(path, error);
-    return (error ? path : key).lexically_normal().string();
-}
-
-// Names written and read, checked as they are added: no two outputs alike, no output the name of an input.
-// Otherwise a report or log, another tile's map or an input is overwritten, and a resumed job takes the
-// damaged file for a finished output. Add every output before the inputs.
-class FileNames {
-  public:
-    void output(const fs::path& path, const std::string& what) {
-        if (const auto [it, added] = outputs_.emplace(pathKey(path), what); !added) {
-            throw InvalidInput(formatError(path.string(), "", "is both " + it->second + " and " + what,
-                                           "a file of its own for each output"));
-        }
-    }
-    void input(const fs::path& path, const std::string& what) const {
-        if (const auto it = outputs_.find(pathKey(path)); it != outputs_.end()) {
-            throw InvalidInput(formatError(path.string(), "", "is " + what + ", and " + it->second,
-                                           "outputs apart from the job's inputs and the caller's files"));
-        }
-    }
-
-  private:
-    std::map<std::string, std::string> outputs_;  // path key -> what is written there
-};
-
 // Every output of the job has a name of its own, none the name of an input (the rest mesh, a map's file at
 // any frame, the caller's files).
 void requireOutputsApart(const std::vector<detail::TilePlan>& plans, const ShotJob& j) {
-    FileNames names;
+    io::FileNames names;
     for (const detail::TilePlan& plan : plans) {
         if (!plan.report.warped) continue;
         for (size_t k = 0; k < j.frames.size(); ++k) {
@@ -820,14 +790,6 @@ std::vector<ShotJob::CallerFile> deformedShotFiles(const fs::path& deformed, con
     for (const int frame : frames)
         files.push_back({sequence.framePath(frame), "the deformed frame " + std::to_string(frame) + named});
     return files;
-}
-
-void requireFilesApart(const std::vector<ShotJob::CallerFile>& files) {
-    FileNames names;
-    for (const ShotJob::CallerFile& file : files)
-        if (file.written) names.output(file.path, file.what);
-    for (const ShotJob::CallerFile& file : files)
-        if (!file.written) names.input(file.path, file.what);
 }
 
 fs::path tileFramePath(const fs::path& pattern, int tile, int frame) {

@@ -15,6 +15,7 @@
 
 #include "deformkit/geom/mesh.h"
 #include "deformkit/interrupter.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/image.h"
 #include "deformkit/io/sampling.h"
 #include "deformkit/uvwarp/metrics.h"
@@ -120,11 +121,7 @@ struct ShotJob {
     // outputs and inputs (the rest mesh when restName is a file, every map file at every frame): two
     // outputs with one name, or an output named as an input, is InvalidInput naming both. Names are
     // compared with symbolic links resolved.
-    struct CallerFile {
-        std::filesystem::path path;
-        std::string what;
-        bool written = false;  // an output of the caller's (a log, a report); else an input it reads
-    };
+    using CallerFile = io::FileUse;
     std::vector<CallerFile> callerFiles;
     // runShotJob calls it once the job is planned and checked, before any frame is solved or any output
     // written: a caller opens its log there, so that a job refused leaves the file as it was.
@@ -200,11 +197,6 @@ using DeformedFrames = std::function<std::span<const glm::vec3>(int frame, std::
 [[nodiscard]] std::vector<ShotJob::CallerFile> deformedShotFiles(const std::filesystem::path& deformed,
                                                                  const std::vector<int>& frames,
                                                                  const std::string& named = {});
-
-// A caller's own files checked as a job checks its outputs (ShotJob::callerFiles): no two written files
-// share a name and none is named as a file read, names compared with symbolic links resolved. InvalidInput
-// naming the file and both uses.
-void requireFilesApart(const std::vector<ShotJob::CallerFile>& files);
 
 // The whole job: ShotSolver fed by `deformed`, asked once per frame up to the last needed one. The
 // interrupter, when given, is started with the job's units, told after each tile and frame, and ended.
