@@ -160,6 +160,7 @@ struct PlyProperty {
     int32_t size = 0;      // bytes of a scalar, or of a list's count
     int32_t itemSize = 0;  // bytes of a list's items; 0 for a scalar
     bool unsignedCount = false;
+    std::string name;
 };
 struct PlyElement {
     std::string name;
@@ -202,7 +203,7 @@ void requireCompletePly(const fs::path& path) {
             PlyProperty property;
             if (type == "list") {
                 std::string countType, itemType;
-                words >> countType >> itemType;
+                words >> countType >> itemType >> property.name;
                 property.size = plyTypeSize(countType);
                 property.itemSize = plyTypeSize(itemType);
                 property.unsignedCount = countType.starts_with('u');
@@ -211,6 +212,7 @@ void requireCompletePly(const fs::path& path) {
                 if (property.itemSize == 0 || !integer) property.size = 0;
             } else {
                 property.size = plyTypeSize(type);
+                words >> property.name;
             }
             elements.back().properties.push_back(property);
         } else if (keyword == "end_header") {
@@ -218,7 +220,26 @@ void requireCompletePly(const fs::path& path) {
             break;
         }
     }
-    // What assimp refuses on its own (no header end, an unknown type, a negative count) is left to it.
+    // A header cut short (no end_header) keeps assimp's reader looping: refused here.
+    if (!ended && text.starts_with("ply")) {
+        throw InvalidInput(formatError(
+            path.string(), "", "has no end_header line after " + std::to_string(lineNumber) + " header lines",
+            "a PLY header ending in end_header (a file cut short in its header)"));
+    }
+    // Positions: assimp reads a vertex element without x, y or z as zeros.
+    for (const PlyElement& element : elements) {
+        if (element.name != "vertex") continue;
+        for (const char* axis : {"x", "y", "z"}) {
+            const bool has = std::any_of(element.properties.begin(), element.properties.end(),
+                                         [&](const PlyProperty& p) { return p.name == axis; });
+            if (!has) {
+                throw InvalidInput(formatError(path.string(), "element vertex",
+                                               std::string("has no property ") + axis,
+                                               "vertex positions as properties x, y and z"));
+            }
+        }
+    }
+    // What assimp refuses on its own (an unknown type, a negative count) is left to it.
     if (!ended) return;
     for (const PlyElement& element : elements) {
         if (element.count < 0) return;

@@ -388,6 +388,22 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
         CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
                           Contains("liar.ply: declares ") && Contains("elements but holds 7 data lines"));
     }
+    // Cut anywhere in its header (assimp's reader loops for ever without end_header): refused, naming the
+    // header; a vertex element without x, y or z (assimp reads zeros): refused, naming the property.
+    const size_t headerEnd = std::string(kPly).find("end_header");
+    for (size_t cut = 3; cut < headerEnd + 3; ++cut) {
+        test::writeText(dir / "cut.ply", std::string(kPly).substr(0, cut));
+        CAPTURE(cut);
+        CHECK_THROWS_WITH(io::readMesh(dir / "cut.ply"), Contains("cut.ply: has no end_header line after"));
+    }
+    for (const char* axis : {"x", "y", "z"}) {
+        std::string renamed = kPly;
+        const std::string from = std::string("property float ") + axis + "\n";
+        renamed.replace(renamed.find(from), from.size(), "property float w\n");
+        test::writeText(dir / "noaxis.ply", renamed);
+        CHECK_THROWS_WITH(io::readMesh(dir / "noaxis.ply"),
+                          Contains(std::string("noaxis.ply: element vertex: has no property ") + axis));
+    }
     // A line short of a value (or with one too many) would take its neighbour's: refused, naming its line.
     for (const auto& [from, to, where] :
          {std::tuple{"2 1 0 1 0.5\n", "2 1 0 1\n0.5 ", "line 14 (vertex 2): holds 4 values (expected 5"},
