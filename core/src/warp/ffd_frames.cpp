@@ -123,6 +123,12 @@ void FfdFrames::setTargetFrames(std::span<const Frame> frames) {
                                            "is not finite", "finite origins and basis vectors"));
         }
     }
+    // Every control's map checked before changing anything (as update() computes it): a refused set leaves
+    // the last targets in place.
+    for (size_t c = 0; c < frames.size(); ++c) {
+        if (!mapBetween(source_[c], frames[c]))
+            (void)frameToFrame(source_[c], frames[c], controlName(lattice_.lattice(), c));
+    }
     target_.assign(frames.begin(), frames.end());
     update();
 }

@@ -237,6 +237,24 @@ TEST_CASE("ffd frames: bad input names the control", "[warp][ffd][frames][errors
                                                      Catch::Contains("26 frames") &&
                                                      Catch::Contains("27 frames"));
     CHECK(frames.targetFrames()[5].origin == l.controlPoint(0, 1, 2));  // nothing changed
+
+    // Targets refused at the last control (a scale beyond 1e18) leave every control as it was: the same
+    // deformation as before the call, not the first controls' new targets.
+    const std::vector<glm::vec3> points = {l.origin + 0.3f * l.axes[0] + 0.6f * l.axes[1] + 0.4f * l.axes[2],
+                                           l.origin + 0.9f * l.axes[0] + 0.1f * l.axes[1] + 0.8f * l.axes[2]};
+    frames.setSourceFrames(std::vector<Frame>(frames.targetFrames().begin(), frames.targetFrames().end()));
+    frames.bind(points);
+    std::vector<glm::vec3> before = points, after = points;
+    frames.evaluate(before);
+    f = {frames.targetFrames().begin(), frames.targetFrames().end()};
+    for (Frame& frame : f)
+        frame.origin += glm::vec3(0.2f);
+    f.back().basis *= 1e19f;
+    CHECK_THROWS_WITH(frames.setTargetFrames(f),
+                      Catch::Contains("control 26") && Catch::Contains("with a scale beyond 1e18"));
+    frames.evaluate(after);
+    CHECK(after == before);
+    CHECK(frames.targetFrames()[0].origin == l.controlPoint(0, 0, 0));
 }
 
 TEST_CASE("ffd frames: the 4x4x4 lattice takes the block kernels, bit for bit the per-point path",
