@@ -48,7 +48,9 @@ class OiioReader final : public codec::Reader {
         return in_->spec().find_attribute(name) != nullptr;
     }
     bool readFloats(float* pixels) override {
-        return in_->read_image(0, 0, 0, spec_.channels, OIIO::TypeDesc::FLOAT, pixels);
+        // A reader that met an error (a TIFF strip cut short) may still report success, the pixels it could
+        // not read left as they were: its pending error counts.
+        return in_->read_image(0, 0, 0, spec_.channels, OIIO::TypeDesc::FLOAT, pixels) && !in_->has_error();
     }
     std::string error() override { return in_->geterror(); }
     void close() override { in_->close(); }

@@ -97,10 +97,16 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
 // The fewest bytes an OpenEXR file can hold the declared pixels in: an 8-byte offset and a chunk header of
 // at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles), whatever the
 // pixels hold. A header that declares more (a few hundred bytes claiming gigapixels) is refused before its
-// pixels are allocated. 0 for other formats, whose packing (1-bit PNGs, bilevel TIFFs) bounds nothing here.
+// pixels are allocated. A PNG: its rows at one bit a sample with a filter byte each, deflated at most 1032
+// to 1 (deflate's limit), whatever the bit depth. 0 for other formats, whose codecs bound nothing here (a
+// bilevel TIFF's fax coding packs a blank page into a few bytes).
 uint64_t fewestFileBytes(const codec::Spec& spec, std::string_view format) {
-    if (format != "openexr") return 0;
     const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
+    if (format == "png") {
+        const uint64_t rowBytes = 1 + (w * static_cast<uint64_t>(spec.channels) + 7) / 8;
+        return h * rowBytes / 1032;
+    }
+    if (format != "openexr") return 0;
     uint64_t chunks = 0;
     if (spec.tileWidth > 0 && spec.tileHeight > 0) {
         chunks = ((w + static_cast<uint64_t>(spec.tileWidth) - 1) / static_cast<uint64_t>(spec.tileWidth)) *

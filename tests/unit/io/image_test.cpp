@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <zlib.h>
+
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
 #include "test_support.h"
@@ -24,6 +26,30 @@ using deformkit::test::writeText;
 namespace fs = std::filesystem;
 
 namespace {
+
+// A 1-bit gray PNG declaring width x height pixels: its IDAT the first row only (a header that lies), or
+// with `whole` every row, all 0, deflated at zlib's best.
+std::string pngDeclaring(uint32_t width, uint32_t height, bool whole = false) {
+    const auto bigEndian = [](uint32_t v) {
+        return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+                           static_cast<char>(v)};
+    };
+    const auto chunk = [&](const std::string& type, const std::string& data) {
+        const std::string body = type + data;
+        const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(body.data()),
+                                static_cast<uInt>(body.size()));
+        return bigEndian(static_cast<uint32_t>(data.size())) + body + bigEndian(static_cast<uint32_t>(crc));
+    };
+    const std::string raw((whole ? height : 1) * static_cast<size_t>(1 + (width + 7) / 8), '\0');
+    std::string packed(compressBound(raw.size()), '\0');
+    uLongf packedSize = packed.size();
+    REQUIRE(compress2(reinterpret_cast<Bytef*>(packed.data()), &packedSize,
+                      reinterpret_cast<const Bytef*>(raw.data()), raw.size(), 9) == Z_OK);
+    packed.resize(packedSize);
+    const std::string header = bigEndian(width) + bigEndian(height) + std::string{1, 0, 0, 0, 0};
+    return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", header) + chunk("IDAT", packed) +
+           chunk("IEND", "");
+}
 
 // The header of a single-part OpenEXR file of `channels` float channels, uncompressed, declaring width x
 // height pixels, followed by its offset table (of zeros) and no chunks (spelled out from the OpenEXR file
@@ -391,6 +417,17 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
                             ": header: declares 30000x30000 pixels with 1 channel, which take at "
                             "least 480000 bytes, but the file has "));
         CHECK(readImageInfo(dir / "bomb.exr").width == 30000);  // the header alone reads
+        // A PNG of 20000^2 gray pixels in 82 bytes: its rows, at one bit a sample and a filter byte each, are
+        // 50 MB, which deflate (1032 to 1 at most) packs into no fewer than 48468 bytes.
+        writeText(dir / "bomb.png", pngDeclaring(20000, 20000));
+        CHECK_THROWS_AS(readImage(dir / "bomb.png"), ParseError);
+        CHECK_THROWS_WITH(
+            readImage(dir / "bomb.png"),
+            Catch::Contains("bomb.png: header: declares 20000x20000 pixels with 1 channel, which "
+                            "take at least 48468 bytes, but the file has 82"));
+        // At that limit a real file reads: a blank 1-bit PNG deflated as hard as zlib can.
+        writeText(dir / "blank.png", pngDeclaring(4096, 4096, true));
+        CHECK(readImage(dir / "blank.png").width == 4096);
         // One tile of 2^29 x 2^29 pixels of 64 channels: 2^64 floats, whose count wraps in size_t.
         writeText(dir / "wrap.exr", exrWithoutPixels(1 << 29, 1 << 29, 64, 1 << 29));
         CHECK_THROWS_AS(readImage(dir / "wrap.exr"), InvalidInput);
@@ -399,7 +436,7 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
                                           "too large to load"));
     }
 
-    SECTION("truncated EXR and PNG") {
+    SECTION("truncated EXR, PNG and TIFF") {
         writeImage(dir / "t.exr", patternImage(64, 64, 3), {PixelType::Float, {}});
         writeImage(dir / "t.png", patternImage(64, 64, 3));
         truncateToHalf(dir / "t.exr");
@@ -412,6 +449,13 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         CHECK_THROWS_WITH(readImage(dir / "t.png"), Catch::Contains((dir / "t.png").string()) &&
                                                         Catch::Contains("chunk IDAT") &&
                                                         Catch::Contains("truncated PNG"));
+        // A TIFF cut short (libtiff reads what is there and OpenImageIO may report success, the rest left 0):
+        // the reader's error counts, naming the pixels.
+        writeImage(dir / "t.tif", patternImage(64, 64, 3), {PixelType::Float, {}});
+        truncateToHalf(dir / "t.tif");
+        CHECK_THROWS_AS(readImage(dir / "t.tif"), ParseError);
+        CHECK_THROWS_WITH(readImage(dir / "t.tif"),
+                          Catch::Contains((dir / "t.tif").string() + ": pixels: cannot read"));
         // A header read checks the chunks before the pixels (libpng would print its own message first).
         std::string bytes = readText(dir / "t.png");
         writeText(dir / "t.png", bytes.substr(0, bytes.find("IHDR") + 10));
