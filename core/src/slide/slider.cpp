@@ -457,6 +457,27 @@ void Slider::Impl::evaluateSurface(std::span<const SlideDrive> drives, std::span
         counts = m.limitFolds(restDisplacement, scales, drives, in, weights, envelope, flipped);
 
     const auto count = static_cast<int32_t>(m.active.size());
+    if (m.options.surface != SurfaceMode::Limit) {
+        // On the cage a landed point is its triangle's combination of the incoming corners: a corner outside
+        // the points checked above that is not finite would make a finite vertex not finite. Named by file
+        // index (a welded vertex by its first copy), the first landing in order whatever the schedule.
+        const auto fileIndex = [&](int32_t q) {
+            return m.weld ? m.weld->firstOf[static_cast<size_t>(q)] : q;
+        };
+        for (int32_t i = 0; i < count; ++i) {
+            const detail::Landing& landing = m.landings[i];
+            if (landing.stop == detail::Stop::None) continue;
+            for (int k = 0; k < 3; ++k) {
+                const int32_t q = m.surface.vertex(3 * landing.triangle + k);
+                const glm::vec3& p = in[q];
+                if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) continue;
+                throw InvalidInput(formatError(m.source, "point of vertex " + std::to_string(fileIndex(q)),
+                                               "not finite",
+                                               "finite x, y, z: a corner of the triangle vertex " +
+                                                   std::to_string(fileIndex(m.active[i])) + " lands on"));
+            }
+        }
+    }
 #pragma omp parallel for schedule(static) if (count >= detail::kParallelFrom)
     for (int32_t i = 0; i < count; ++i) {
         if (m.landings[i].stop != detail::Stop::None) points[m.active[i]] = glm::vec3(m.slid[i]);

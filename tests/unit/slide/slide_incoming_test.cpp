@@ -396,6 +396,33 @@ TEST_CASE("slide: a non-finite incoming point it reads is an error naming the ve
                       Catch::Contains("point of vertex " + std::to_string(outside) + ": not finite") &&
                           Catch::Contains("the limit surface reads the points around the region's faces"));
     CHECK(std::memcmp(points.data(), moved.data(), points.size() * sizeof(glm::vec3)) == 0);
+
+    // On the cage a landed point combines its triangle's corners: a NaN corner outside the active vertices
+    // and the handle's ring made the finite vertices landing beside it NaN. Named, nothing written.
+    const std::span<const int32_t> cageActive = slider.activeVertices();
+    const SlideDrive far{glm::dvec3(0.15, 0.0, 0.0), Falloff::smooth()};
+    int checked = 0;
+    for (int32_t corner = 0; corner < plane.numVertices(); ++corner) {
+        const bool ring =
+            std::abs(corner % 11 - handle % 11) <= 1 && std::abs(corner / 11 - handle / 11) <= 1;
+        if (ring || std::ranges::count(cageActive, corner) > 0) continue;
+        points = std::vector<glm::vec3>(plane.points().begin(), plane.points().end());
+        points[corner].y = std::nanf("");
+        const std::vector<glm::vec3> given = points;
+        try {
+            slider.evaluate({&far, 1}, points);
+            // No landing reads it: every vertex but the NaN one stays finite.
+            for (int32_t v = 0; v < plane.numVertices(); ++v)
+                if (v != corner) CHECK(std::isfinite(points[v].x + points[v].y + points[v].z));
+        } catch (const InvalidInput& e) {
+            CHECK_THAT(e.what(),
+                       Catch::Contains("point of vertex " + std::to_string(corner) + ": not finite") &&
+                           Catch::Contains("a corner of the triangle vertex"));
+            CHECK(std::memcmp(points.data(), given.data(), points.size() * sizeof(glm::vec3)) == 0);
+            ++checked;
+        }
+    }
+    CHECK(checked > 0);  // some corners outside are read
 }
 
 TEST_CASE("slide: a drag beyond float range is an error; one within it stays on the surface",
