@@ -486,6 +486,11 @@ head -c 1000 "$work/eval-pc2/grid.pc2" >"$work/cut.pc2"
 expect uvwarp-pc2-cut 2 "$dk" uvwarp --rest "$work/grid.obj" --deformed "$work/cut.pc2" --frames 1-2 \
     --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-pc2/redirect.<UDIM>.####.exr"
 contains uvwarp-pc2-cut "$work/err" "cut.pc2: frame 1: is cut short"
+# A rest position beyond the solver's range is the rest mesh's fault, not the cache's vertex order.
+awk 'BEGIN { done = 0 } /^v / && !done { print "v 1e20 0 0"; done = 1; next } { print }' "$work/grid.obj" >"$work/grid-far.obj"
+expect uvwarp-rest-far 2 "$dk" uvwarp --rest "$work/grid-far.obj" --deformed "$work/eval-pc2/grid.pc2" --frames 1-2 \
+    --rigidity "$work/demo/rigidity.<UDIM>.exr" --out "$work/uv-far/redirect.<UDIM>.####.exr"
+contains uvwarp-rest-far "$work/err" "grid-far.obj: vertex 0: is (1e+20, 0, 0) (expected finite coordinates within +-1e15"
 
 # eval with the UV warp as the scene's last stage, then a farm plan of frame-range x tile tasks.
 cat >"$work/uvshot.json" <<JSON

@@ -715,13 +715,14 @@ void ShotSolver::solveFrame(int frame, std::span<const glm::vec3> deformed, cons
             std::to_string(vertices) + ", the vertex count of the rest mesh '" + s.job.restName + "'"));
     }
     // Named here, by the frame's own input: the imager's own check names the rest mesh it was bound to. The
-    // frame once: an input without a file is named by its frame already ("frame 2").
+    // frame once: an input without a file ("frame 2") or a cache's frame ("anim.pc2 frame 2") names it.
     if (const size_t v = firstUnusablePoint(deformed); v < deformed.size()) {
         const std::string frameText = "frame " + std::to_string(frame);
+        const bool frameNamed = inputName == frameText || inputName.ends_with(" " + frameText);
         const glm::vec3 p = deformed[v];
         const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
         throw InvalidInput(formatError(
-            inputName, (inputName == frameText ? "" : frameText + ": ") + "vertex " + std::to_string(v),
+            inputName, (frameNamed ? "" : frameText + ": ") + "vertex " + std::to_string(v),
             finite ? "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")"
                    : std::string("is not finite"),
             "finite coordinates within +-1e15 (the solver squares lengths in float)"));
@@ -849,6 +850,15 @@ std::vector<int> shotTiles(const geom::Mesh& rest, const std::string& restName, 
 DeformedFrames animatedFrames(const fs::path& path, const std::vector<int>& frames, const std::string& name,
                               const geom::Mesh& rest, const std::string& restName,
                               std::optional<double> cacheFirstFrame) {
+    // The rest mesh first: a cache's vertex order is checked against it, and a rest position beyond the
+    // solver's range would be taken for a cache in another order.
+    if (const size_t v = firstUnusablePoint(rest.points()); v < rest.points().size()) {
+        const glm::vec3 p = rest.points()[v];
+        throw InvalidInput(
+            formatError(restName, "vertex " + std::to_string(v),
+                        "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")",
+                        "finite coordinates within +-1e15 (the solver squares lengths in float)"));
+    }
     auto source = std::make_shared<io::AnimatedPositions>(path, name, cacheFirstFrame);
     source->setReference(rest, restName);  // a cache in the rest mesh's order, a sequence its topology
     source->requireFrames(frames);
