@@ -23,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "deformkit/error.h"
 #include "deformkit/io/read_file.h"
 #include "polygon_loops.h"
@@ -442,6 +444,94 @@ class DroppedDataLog : public Assimp::LogStream {
     }
 };
 
+// The JSON of a .gltf file, or of a .glb's first chunk; nullopt where it is not there to read (assimp then
+// refuses the file with its own message).
+std::optional<nlohmann::json> gltfJson(const fs::path& path) {
+    const std::string bytes = readFile(path, "glTF file");
+    std::string_view text = bytes;
+    if (bytes.size() >= 20 && bytes.compare(0, 4, "glTF") == 0) {
+        const auto le32 = [&](size_t at) {
+            uint32_t v = 0;
+            for (int k = 3; k >= 0; --k)
+                v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<size_t>(k)]);
+            return v;
+        };
+        const uint32_t length = le32(12);
+        if (le32(16) != 0x4E4F534Au || length > bytes.size() - 20) return std::nullopt;  // "JSON"
+        text = std::string_view(bytes).substr(20, length);
+    }
+    nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+    if (json.is_discarded() || !json.is_object()) return std::nullopt;
+    return json;
+}
+
+// What assimp would read wrong without a word: positions that are not 3 floats (KHR_mesh_quantization's
+// integers, read as float bits), a buffer view stride shorter than a position (overlapping reads), and any
+// required extension that changes geometry (only materials, textures and lights are not).
+void requireReadableGltf(const fs::path& path) {
+    const std::optional<nlohmann::json> json = gltfJson(path);
+    if (!json) return;
+    const std::string name = path.string();
+    if (const auto required = json->find("extensionsRequired");
+        required != json->end() && required->is_array()) {
+        for (const nlohmann::json& extension : *required) {
+            if (!extension.is_string()) continue;
+            const std::string e = extension.get<std::string>();
+            const bool looks = e.starts_with("KHR_materials_") || e.starts_with("KHR_texture_") ||
+                               e.starts_with("EXT_texture_") || e == "KHR_lights_punctual" ||
+                               e == "KHR_draco_mesh_compression";
+            if (!looks) {
+                throw InvalidInput(formatError(name, "extensionsRequired",
+                                               "names " + e + ", which is not read",
+                                               "a glTF without required geometry extensions (KHR_draco_mesh_"
+                                               "compression is read; export without quantization or "
+                                               "meshopt compression)"));
+            }
+        }
+    }
+    const auto accessors = json->find("accessors");
+    const auto views = json->find("bufferViews");
+    const auto meshes = json->find("meshes");
+    if (accessors == json->end() || !accessors->is_array() || meshes == json->end() || !meshes->is_array())
+        return;
+    for (size_t m = 0; m < meshes->size(); ++m) {
+        const auto primitives = (*meshes)[m].find("primitives");
+        if (primitives == (*meshes)[m].end() || !primitives->is_array()) continue;
+        for (size_t p = 0; p < primitives->size(); ++p) {
+            const auto attributes = (*primitives)[p].find("attributes");
+            if (attributes == (*primitives)[p].end() || !attributes->is_object()) continue;
+            const auto position = attributes->find("POSITION");
+            if (position == attributes->end() || !position->is_number_unsigned()) continue;
+            const auto a = position->get<size_t>();
+            if (a >= accessors->size() || !(*accessors)[a].is_object()) continue;
+            const nlohmann::json& accessor = (*accessors)[a];
+            const std::string element = "accessors[" + std::to_string(a) + "] (POSITION of meshes[" +
+                                        std::to_string(m) + "].primitives[" + std::to_string(p) + "])";
+            const bool vec3 = accessor.value("type", std::string()) == "VEC3";
+            const bool floats = accessor.value("componentType", 0) == 5126;
+            if (!vec3 || !floats) {
+                throw InvalidInput(formatError(name, element,
+                                               "is " + accessor.value("type", std::string("?")) +
+                                                   " of component type " +
+                                                   std::to_string(accessor.value("componentType", 0)),
+                                               "VEC3 of floats (5126): quantized positions are not read"));
+            }
+            const auto view = accessor.find("bufferView");
+            if (view == accessor.end() || !view->is_number_unsigned() || views == json->end() ||
+                !views->is_array() || view->get<size_t>() >= views->size())
+                continue;
+            const nlohmann::json& bufferView = (*views)[view->get<size_t>()];
+            if (bufferView.is_object() && bufferView.contains("byteStride") &&
+                bufferView.value("byteStride", 0) < 12) {
+                throw InvalidInput(formatError(
+                    name, "bufferViews[" + std::to_string(view->get<size_t>()) + "] of " + element,
+                    "has byteStride " + std::to_string(bufferView.value("byteStride", 0)),
+                    "a stride of at least 12 bytes, one position"));
+            }
+        }
+    }
+}
+
 ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     const std::string name = path.string();
     std::error_code ec;
@@ -451,6 +541,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
         throw IoError(formatError(name, "", "is not a regular file", "a mesh file"));
 
     if (format == MeshFormat::Ply) requireCompletePly(path);
+    if (format == MeshFormat::Gltf) requireReadableGltf(path);
     Assimp::Importer importer;
     const auto check = [&](const aiScene* scene) {
         if (!scene) {

@@ -219,6 +219,46 @@ std::vector<glm::vec3> pointsOf(const geom::Mesh& m) {
 
 }  // namespace
 
+TEST_CASE("mesh files: a glTF whose positions assimp would misread is refused, naming the accessor",
+          "[io][mesh_file][errors]") {
+    // Quantized positions (KHR_mesh_quantization: integers, read by assimp as float bits), positions of 2
+    // components, a stride shorter than a position, and a required extension that is not read: each read
+    // without a word before. Materials', textures' and lights' extensions do not touch geometry: read.
+    const test::TempDir dir;
+    const auto edited = [&](const std::string& from, const std::string& to) {
+        std::string text = kGltf;
+        REQUIRE(text.find(from) != std::string::npos);
+        text.replace(text.find(from), from.size(), to);
+        test::writeText(dir / "edited.gltf", text);
+        return dir / "edited.gltf";
+    };
+    const std::string position = R"("componentType": 5126, "count": 4, "type": "VEC3")";
+    CHECK_THROWS_WITH(
+        io::readMesh(edited(position, R"("componentType": 5123, "count": 4, "type": "VEC3")")),
+        Contains("edited.gltf: accessors[0] (POSITION of meshes[0].primitives[0]): is VEC3 of component type "
+                 "5123 (expected VEC3 of floats (5126): quantized positions are not read)"));
+    CHECK_THROWS_WITH(
+        io::readMesh(edited(position, R"("componentType": 5126, "count": 4, "type": "VEC2")")),
+        Contains("accessors[0] (POSITION of meshes[0].primitives[0]): is VEC2 of component type "
+                 "5126"));
+    CHECK_THROWS_WITH(
+        io::readMesh(edited(R"("byteOffset": 0, "byteLength": 48})",
+                            R"("byteOffset": 0, "byteLength": 48, "byteStride": 4})")),
+        Contains("bufferViews[0] of accessors[0] (POSITION of meshes[0].primitives[0]): has byteStride 4"));
+    const std::string asset = R"({"asset": {"version": "2.0"},)";
+    CHECK_THROWS_WITH(
+        io::readMesh(edited(
+            asset,
+            asset +
+                R"( "extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"],)")),
+        Contains("edited.gltf: extensionsRequired: names KHR_mesh_quantization, which is not read"));
+    const io::ObjContent read = io::readMesh(edited(
+        asset,
+        asset +
+            R"( "extensionsUsed": ["KHR_materials_unlit"], "extensionsRequired": ["KHR_materials_unlit"],)"));
+    CHECK(read.mesh.numVertices() == 8);
+}
+
 TEST_CASE("mesh files: a glTF's nodes place its meshes, one group each, vertices in the file's order",
           "[io][mesh_file]") {
     const test::TempDir dir;
