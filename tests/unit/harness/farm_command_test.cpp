@@ -526,24 +526,31 @@ TEST_CASE("eval and farm plan check every input before any work: a vertex out of
     }
 }
 
-TEST_CASE("farm run: a map removed after planning is named, not taken for a changed scene",
-          "[harness][farm][errors]") {
-    Shot shot;
+// The shot's twisted tube given a UV-warp stage (`stage`: the entry's keys after its type, maps written by
+// the caller), planned into shot.dir/farm: the plan and the index of its first UV-warp task.
+static std::pair<scene::FarmPlan, int> planWithUvStage(const Shot& shot, const std::string& stage) {
     std::string text = kScene;
     const size_t twistEnd = text.find("}}}]}") + 3;
-    text.replace(twistEnd, 0,
-                 R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr"})");
+    text.replace(twistEnd, 0, R"(, {"type": "uvwarp", )" + stage + "}");
     test::writeText(shot.scene, text);
-    io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
-    io::writeImage(shot.dir / "col.1001.exr", io::Image(32, 32, 3, 0.5f));
     harness::FarmPlanCommand planCommand;
     planCommand.scene = shot.scene;
     planCommand.outDir = shot.dir / "farm";
-    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
+    scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
     int uvTask = -1;
     for (size_t k = 0; k < plan.tasks.size() && uvTask < 0; ++k)
         if (!plan.tasks[k].tiles.empty()) uvTask = static_cast<int>(k);
     REQUIRE(uvTask >= 0);
+    return {std::move(plan), uvTask};
+}
+
+TEST_CASE("farm run: a map removed after planning is named, not taken for a changed scene",
+          "[harness][farm][errors]") {
+    Shot shot;
+    io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
+    io::writeImage(shot.dir / "col.1001.exr", io::Image(32, 32, 3, 0.5f));
+    const auto [plan, uvTask] =
+        planWithUvStage(shot, R"("rigidity": "rig.<UDIM>.exr", "texture": "col.<UDIM>.exr")");
     harness::FarmRunCommand run;
     run.plan = shot.dir / "farm" / "farm_plan.json";
     run.task = uvTask;
@@ -564,21 +571,10 @@ TEST_CASE("farm run: a warp mask or orientation map removed or added after plann
     // Either map is optional per tile: without the file the tile takes a derived mask or the density
     // heuristic, so a change after planning would warp this task's tiles unlike the tasks run before it.
     Shot shot;
-    std::string text = kScene;
-    const size_t twistEnd = text.find("}}}]}") + 3;
-    text.replace(twistEnd, 0,
-                 R"(, {"type": "uvwarp", "rigidity": "rig.<UDIM>.exr", "mask": "mask.<UDIM>.exr"})");
-    test::writeText(shot.scene, text);
     io::writeImage(shot.dir / "rig.1001.exr", io::Image(32, 32, 1, 0.0f));
     io::writeImage(shot.dir / "mask.1001.exr", io::Image(32, 32, 1, 1.0f));
-    harness::FarmPlanCommand planCommand;
-    planCommand.scene = shot.scene;
-    planCommand.outDir = shot.dir / "farm";
-    const scene::FarmPlan plan = harness::farmPlanCommand(planCommand);
-    int uvTask = -1;
-    for (size_t k = 0; k < plan.tasks.size() && uvTask < 0; ++k)
-        if (!plan.tasks[k].tiles.empty()) uvTask = static_cast<int>(k);
-    REQUIRE(uvTask >= 0);
+    const auto [plan, uvTask] =
+        planWithUvStage(shot, R"("rigidity": "rig.<UDIM>.exr", "mask": "mask.<UDIM>.exr")");
     const std::string mask = (shot.dir / "mask.1001.exr").string();
     CHECK(plan.tasks[static_cast<size_t>(uvTask)].maps == std::vector<std::string>{mask});
     // Written and read back.
