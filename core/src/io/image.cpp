@@ -97,16 +97,11 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
 // The fewest bytes an OpenEXR file can hold the declared pixels in: an 8-byte offset and a chunk header of
 // at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles), whatever the
 // pixels hold. A header that declares more (a few hundred bytes claiming gigapixels) is refused before its
-// pixels are allocated. A PNG: its rows at one bit a sample with a filter byte each, deflated at most 1032
-// to 1 (deflate's limit), whatever the bit depth. 0 for other formats, whose codecs bound nothing here (a
-// bilevel TIFF's fax coding packs a blank page into a few bytes).
+// pixels are allocated. 0 for other formats: a PNG's image data is inflated and measured before its pixels
+// are (requireCompletePng), and a bilevel TIFF's fax coding packs a blank page into a few bytes.
 uint64_t fewestFileBytes(const codec::Spec& spec, std::string_view format) {
-    const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
-    if (format == "png") {
-        const uint64_t rowBytes = 1 + (w * static_cast<uint64_t>(spec.channels) + 7) / 8;
-        return h * rowBytes / 1032;
-    }
     if (format != "openexr") return 0;
+    const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
     uint64_t chunks = 0;
     if (spec.tileWidth > 0 && spec.tileHeight > 0) {
         chunks = ((w + static_cast<uint64_t>(spec.tileWidth) - 1) / static_cast<uint64_t>(spec.tileWidth)) *
@@ -129,10 +124,41 @@ uint32_t bigEndian32(const unsigned char* p) {
     return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
 }
 
+// The bytes of a PNG's filtered image data (a filter byte and the packed samples of each row, every Adam7
+// pass in turn when interlaced), from its header's fields; 0 for a header libpng refuses (a zero size, a
+// bit depth its colour type does not take, an unknown method), whose own message would go to stderr.
+uint64_t pngImageBytes(const unsigned char* ihdr) {
+    const uint64_t width = bigEndian32(ihdr), height = bigEndian32(ihdr + 4);
+    const int depth = ihdr[8], colour = ihdr[9];
+    const bool depthOk =
+        (colour == 0 && (depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16)) ||
+        (colour == 3 && (depth == 1 || depth == 2 || depth == 4 || depth == 8)) ||
+        ((colour == 2 || colour == 4 || colour == 6) && (depth == 8 || depth == 16));
+    if (width == 0 || height == 0 || width > 0x7fffffffu || height > 0x7fffffffu || !depthOk ||
+        ihdr[10] != 0 || ihdr[11] != 0 || ihdr[12] > 1)
+        return 0;
+    const uint64_t samples = colour == 2 ? 3 : colour == 4 ? 2 : colour == 6 ? 4 : 1;
+    const auto rows = [&](uint64_t w, uint64_t h) {
+        return w == 0 || h == 0 ? 0 : h * (1 + (w * samples * static_cast<uint64_t>(depth) + 7) / 8);
+    };
+    if (ihdr[12] == 0) return rows(width, height);
+    // Adam7: pass p takes columns x0 + k dx and rows y0 + k dy.
+    static constexpr int kPass[7][4] = {{0, 0, 8, 8}, {4, 0, 8, 8}, {0, 4, 4, 8}, {2, 0, 4, 4},
+                                        {0, 2, 2, 4}, {1, 0, 2, 2}, {0, 1, 1, 2}};
+    uint64_t total = 0;
+    for (const auto& [x0, y0, dx, dy] : kPass) {
+        const uint64_t w = width > static_cast<uint64_t>(x0) ? (width - x0 + dx - 1) / dx : 0;
+        const uint64_t h = height > static_cast<uint64_t>(y0) ? (height - y0 + dy - 1) / dy : 0;
+        total += rows(w, h);
+    }
+    return total;
+}
+
 // libpng prints its own message to stderr before failing on a truncated or corrupt file, and
 // OpenImageIO gives no way to silence it. Walking the chunk structure first (lengths, CRCs, a final
-// IEND) catches those files with a precise error and keeps the one-line error contract. `headerOnly`: the
-// chunks before the pixels (IDAT), which a header read parses.
+// IEND), then the header's fields and the image data's zlib stream (its size, each non-interlaced row's
+// filter type), catches those files with a precise error and keeps the one-line error contract.
+// `headerOnly`: the chunks before the pixels (IDAT), which a header read parses.
 void requireCompletePng(const fs::path& path, bool headerOnly = false) {
     static constexpr std::array<unsigned char, 8> kSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     std::ifstream in(path, std::ios::binary);
@@ -140,6 +166,8 @@ void requireCompletePng(const fs::path& path, bool headerOnly = false) {
     const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
     if (bytes.size() < 8 || std::memcmp(data, kSignature.data(), 8) != 0) return;  // not a PNG: OIIO decides
     size_t pos = 8;
+    uint64_t imageBytes = 0;
+    std::vector<std::pair<size_t, uint32_t>> idat;  // each IDAT chunk's data: offset, length
     while (true) {
         if (pos + 12 > bytes.size()) {
             throw ParseError(formatError(path.string(), "byte " + std::to_string(pos),
@@ -161,8 +189,65 @@ void requireCompletePng(const fs::path& path, bool headerOnly = false) {
             throw ParseError(formatError(path.string(), "chunk " + type + " at byte " + std::to_string(pos),
                                          "fails its CRC check (corrupt PNG)", "an uncorrupted PNG"));
         }
+        if (type == "IHDR") {
+            imageBytes = length == 13 ? pngImageBytes(data + pos + 8) : 0;
+            if (imageBytes == 0) {
+                throw ParseError(formatError(path.string(), "chunk IHDR",
+                                             "holds a size, bit depth, colour type or method libpng refuses",
+                                             "a PNG header with sizes above 0 and a valid bit depth for its "
+                                             "colour type"));
+            }
+        }
+        if (type == "IDAT") idat.emplace_back(pos + 8, length);
         pos += 12 + length;
-        if (type == "IEND") return;
+        if (type == "IEND") break;
+    }
+    if (headerOnly) return;
+    const auto corrupt = [&](const std::string& what) {
+        throw ParseError(
+            formatError(path.string(), "image data (IDAT)", what + " (corrupt PNG)",
+                        "a zlib stream of the " + std::to_string(imageBytes) + " bytes its header declares"));
+    };
+    if (idat.empty()) corrupt("is missing");
+    // Inflated in slices, nothing kept but each non-interlaced row's filter byte.
+    const bool interlaced = data[8 + 8 + 12] == 1;  // IHDR is the first chunk
+    const uint64_t rowBytes = interlaced ? 0 : imageBytes / bigEndian32(data + 8 + 8 + 4);
+    z_stream z{};
+    if (inflateInit(&z) != Z_OK) corrupt("cannot be inflated");
+    std::array<unsigned char, 1 << 16> slice{};
+    uint64_t produced = 0;
+    int status = Z_OK;
+    for (size_t chunk = 0; chunk < idat.size() && status != Z_STREAM_END; ++chunk) {
+        z.next_in = const_cast<Bytef*>(data + idat[chunk].first);
+        z.avail_in = idat[chunk].second;
+        while (z.avail_in > 0 && status != Z_STREAM_END) {
+            z.next_out = slice.data();
+            z.avail_out = static_cast<uInt>(slice.size());
+            status = inflate(&z, Z_NO_FLUSH);
+            if (status != Z_OK && status != Z_STREAM_END && status != Z_BUF_ERROR) {
+                const std::string message = z.msg ? z.msg : "a zlib error";
+                inflateEnd(&z);
+                corrupt("does not inflate: " + message);
+            }
+            const uint64_t got = slice.size() - z.avail_out;
+            if (rowBytes > 0) {
+                for (uint64_t row = (produced + rowBytes - 1) / rowBytes * rowBytes; row < produced + got;
+                     row += rowBytes) {
+                    if (slice[row - produced] > 4) {
+                        inflateEnd(&z);
+                        corrupt("gives row " + std::to_string(row / rowBytes) + " the filter type " +
+                                std::to_string(slice[row - produced]) + ", beyond 4");
+                    }
+                }
+            }
+            produced += got;
+            if (status == Z_BUF_ERROR && got == 0) break;  // needs the next chunk's bytes
+        }
+    }
+    inflateEnd(&z);
+    if (status != Z_STREAM_END || produced != imageBytes) {
+        corrupt("inflates to " + std::to_string(produced) + " bytes" +
+                (status == Z_STREAM_END ? std::string() : ", its stream unfinished"));
     }
 }
 

@@ -12,7 +12,11 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
 #include <zlib.h>
+
+#include <cstdio>
+#include <functional>
 
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
@@ -27,28 +31,60 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A 1-bit gray PNG declaring width x height pixels: its IDAT the first row only (a header that lies), or
-// with `whole` every row, all 0, deflated at zlib's best.
-std::string pngDeclaring(uint32_t width, uint32_t height, bool whole = false) {
+// A PNG of the given header whose IDAT holds `data` deflated at zlib's best (or as it is, `deflated`
+// false: not a zlib stream).
+std::string pngOf(uint32_t width, uint32_t height, unsigned char depth, unsigned char colour,
+                  const std::string& data, bool deflated = true) {
     const auto bigEndian = [](uint32_t v) {
         return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
                            static_cast<char>(v)};
     };
-    const auto chunk = [&](const std::string& type, const std::string& data) {
-        const std::string body = type + data;
-        const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(body.data()),
-                                static_cast<uInt>(body.size()));
-        return bigEndian(static_cast<uint32_t>(data.size())) + body + bigEndian(static_cast<uint32_t>(crc));
+    const auto chunk = [&](const std::string& type, const std::string& body) {
+        const std::string typed = type + body;
+        const uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(typed.data()),
+                                static_cast<uInt>(typed.size()));
+        return bigEndian(static_cast<uint32_t>(body.size())) + typed + bigEndian(static_cast<uint32_t>(crc));
     };
-    const std::string raw((whole ? height : 1) * static_cast<size_t>(1 + (width + 7) / 8), '\0');
-    std::string packed(compressBound(raw.size()), '\0');
-    uLongf packedSize = packed.size();
-    REQUIRE(compress2(reinterpret_cast<Bytef*>(packed.data()), &packedSize,
-                      reinterpret_cast<const Bytef*>(raw.data()), raw.size(), 9) == Z_OK);
-    packed.resize(packedSize);
-    const std::string header = bigEndian(width) + bigEndian(height) + std::string{1, 0, 0, 0, 0};
+    std::string packed = data;
+    if (deflated) {
+        packed.assign(compressBound(data.size()), '\0');
+        uLongf packedSize = packed.size();
+        REQUIRE(compress2(reinterpret_cast<Bytef*>(packed.data()), &packedSize,
+                          reinterpret_cast<const Bytef*>(data.data()), data.size(), 9) == Z_OK);
+        packed.resize(packedSize);
+    }
+    const std::string header = bigEndian(width) + bigEndian(height) +
+                               std::string{static_cast<char>(depth), static_cast<char>(colour), 0, 0, 0};
     return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", header) + chunk("IDAT", packed) +
            chunk("IEND", "");
+}
+
+// A 1-bit gray PNG declaring width x height pixels: its IDAT the first row only (a header that lies), or
+// with `whole` every row, all 0.
+std::string pngDeclaring(uint32_t width, uint32_t height, bool whole = false) {
+    return pngOf(width, height, 1, 0,
+                 std::string((whole ? height : 1) * static_cast<size_t>(1 + (width + 7) / 8), '\0'));
+}
+
+// What `run` writes to the process's stderr (file descriptor 2) while it runs; its exception is ignored.
+std::string stderrOf(const std::function<void()>& run) {
+    std::fflush(stderr);
+    FILE* capture = std::tmpfile();
+    const int saved = dup(2);
+    dup2(fileno(capture), 2);
+    try {
+        run();
+    } catch (...) {
+    }
+    std::fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    std::rewind(capture);
+    std::string text;
+    for (int c = std::fgetc(capture); c != EOF; c = std::fgetc(capture))
+        text += static_cast<char>(c);
+    std::fclose(capture);
+    return text;
 }
 
 // The header of a single-part OpenEXR file of `channels` float channels, uncompressed, declaring width x
@@ -417,15 +453,15 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
                             ": header: declares 30000x30000 pixels with 1 channel, which take at "
                             "least 480000 bytes, but the file has "));
         CHECK(readImageInfo(dir / "bomb.exr").width == 30000);  // the header alone reads
-        // A PNG of 20000^2 gray pixels in 82 bytes: its rows, at one bit a sample and a filter byte each, are
-        // 50 MB, which deflate (1032 to 1 at most) packs into no fewer than 48468 bytes.
+        // A PNG of 20000^2 gray pixels in 82 bytes: its data, inflated and measured before any pixel is
+        // allocated, is one row of 2501 bytes, not the 50 MB its header declares.
         writeText(dir / "bomb.png", pngDeclaring(20000, 20000));
         CHECK_THROWS_AS(readImage(dir / "bomb.png"), ParseError);
         CHECK_THROWS_WITH(
             readImage(dir / "bomb.png"),
-            Catch::Contains("bomb.png: header: declares 20000x20000 pixels with 1 channel, which "
-                            "take at least 48468 bytes, but the file has 82"));
-        // At that limit a real file reads: a blank 1-bit PNG deflated as hard as zlib can.
+            Catch::Contains("bomb.png: image data (IDAT): inflates to 2501 bytes (corrupt PNG) "
+                            "(expected a zlib stream of the 50020000 bytes its header declares)"));
+        // A real file of that kind reads: a blank 1-bit PNG deflated as hard as zlib can.
         writeText(dir / "blank.png", pngDeclaring(4096, 4096, true));
         CHECK(readImage(dir / "blank.png").width == 4096);
         // One tile of 2^29 x 2^29 pixels of 64 channels: 2^64 floats, whose count wraps in size_t.
@@ -461,6 +497,43 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         writeText(dir / "t.png", bytes.substr(0, bytes.find("IHDR") + 10));
         CHECK_THROWS_WITH(readImageInfo(dir / "t.png"),
                           Catch::Contains("chunk IHDR at byte 8") && Catch::Contains("truncated PNG"));
+    }
+
+    SECTION(
+        "a PNG whose chunks are whole but whose header or data libpng refuses: one error, nothing on "
+        "stderr") {
+        // 16 x 4 gray, 8 bits: rows of a filter byte and 16 samples.
+        const std::string rows(4 * 17, '\0');
+        std::string filtered = rows;
+        filtered[17] = 9;  // row 1's filter type
+        for (const auto& [bytes, message] :
+             {std::pair{pngOf(16, 4, 7, 0, rows),
+                        "chunk IHDR: holds a size, bit depth, colour type or method"},
+              std::pair{pngOf(0, 4, 8, 0, rows), "chunk IHDR: holds a size"},
+              std::pair{pngOf(16, 4, 8, 0, "garbage!!", false), "image data (IDAT): does not inflate"},
+              std::pair{pngOf(16, 4, 8, 0, filtered),
+                        "image data (IDAT): gives row 1 the filter type 9, beyond 4"},
+              std::pair{pngOf(16, 4, 8, 0, rows.substr(0, 40)), "image data (IDAT): inflates to 40 bytes"}}) {
+            writeText(dir / "bad.png", bytes);
+            CAPTURE(message);
+            CHECK_THROWS_AS(readImage(dir / "bad.png"), ParseError);
+            CHECK_THROWS_WITH(readImage(dir / "bad.png"),
+                              Catch::Contains("bad.png: " + std::string(message)));
+            CHECK(stderrOf([&] { (void)readImage(dir / "bad.png"); }).empty());
+        }
+        // The same rows whole read, interlaced too.
+        writeText(dir / "good.png", pngOf(16, 4, 8, 0, rows));
+        CHECK(readImage(dir / "good.png").height == 4);
+        // Adam7's passes of 16 x 4: 2x1, 2x1, none, 4x1, 8x1, 8x2, 16x2 samples, each row after a filter
+        // byte.
+        std::string interlaced = pngOf(16, 4, 8, 0, std::string(3 + 3 + 5 + 9 + 2 * 9 + 2 * 17, '\0'));
+        interlaced[8 + 8 + 12] = 1;  // IHDR's interlace method; its CRC made again below
+        const uLong crc =
+            crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(interlaced.data() + 12), 17);
+        for (int k = 0; k < 4; ++k)
+            interlaced[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
+        writeText(dir / "adam7.png", interlaced);
+        CHECK(readImage(dir / "adam7.png").width == 16);
     }
 
     SECTION("a PNG with a flipped byte inside its pixel data fails its CRC") {
