@@ -110,8 +110,13 @@ void addPreviewCommand(CommandLine& cli) {
                    "box for every frame of a shot)");
     preview.flag("--edges", o->command.options.drawEdges, "draw polygon edges");
     preview.option("--weights", o->weights, "show painted weights (JSON array, one per vertex) as colours");
-    preview.option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");
-    preview.option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel").showDefault();
+    const Option ptex =
+        preview.option("--weights-ptex", o->weightsPtex, "show a Ptex map's per-vertex values as colours");
+    preview
+        .option("--weights-channel", o->command.weightsChannel,
+                "the Ptex map's channel (needs --weights-ptex)")
+        .showDefault()
+        .needs(ptex);
 }
 
 }  // namespace deformkit::harness

@@ -151,9 +151,13 @@ void addSlideCommand(CommandLine& cli) {
     slide.option("--falloff", o->falloff, "smooth, linear, or ramp samples v0,v1,... over distance/radius")
         .showDefault();
     slide.option("--weights", o->weights, "painted weights: a JSON array of one number per vertex");
-    slide.option("--weights-ptex", o->weightsPtex,
-                 "painted weights from a Ptex map of the mesh (per-vertex values)");
-    slide.option("--weights-channel", o->command.weightsChannel, "the Ptex map's channel").showDefault();
+    const Option ptex = slide.option("--weights-ptex", o->weightsPtex,
+                                     "painted weights from a Ptex map of the mesh (per-vertex values)");
+    slide
+        .option("--weights-channel", o->command.weightsChannel,
+                "the Ptex map's channel (needs --weights-ptex)")
+        .showDefault()
+        .needs(ptex);
     slide
         .option("--painted-weights", o->paintedWeights,
                 "scale (weight x falloff) or falloff (the paper's: the weight is the falloff, the radius "

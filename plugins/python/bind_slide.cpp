@@ -102,7 +102,7 @@ Falloff falloffOf(py::handle value, const std::string& source, const std::string
     if (samples->ndim() != 1)
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(*samples), expected));
     return Falloff::ramp(std::span<const float>(samples->data(), static_cast<size_t>(samples->shape(0))),
-                         name);
+                         source + ": " + name);
 }
 
 // One falloff for every handle, or a list of one per handle: a list whose items are strings or

@@ -184,6 +184,10 @@ expect ptex-truncated 2 "$dk" ptex to-vertex "$work/trunc.ptx" "$work/demo/ptex/
 expect slide-max-walk-0 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 \
     --out "$work/x.obj" --max-walk 0
 contains slide-max-walk-0 "$work/err" "--max-walk: is 0 (expected a number > 0)"
+# A Ptex channel without a Ptex map is a usage error, not ignored.
+expect slide-channel-alone 2 "$dk" slide "$work/quad.obj" --handle 0 --from 0,0,0 --to 0.1,0,0 --radius 0.5 \
+    --out "$work/x.obj" --weights-channel 2
+contains slide-channel-alone "$work/err" "--weights-channel requires --weights-ptex"
 grep -q "e+308" "$work/err" && { echo "FAIL slide-max-walk-0: prints a range to 1.8e308"; failures=$((failures + 1)); }
 # An output named as a file the command reads is refused before anything is written (a slid mesh over its
 # rest mesh, a warped image over its source, a preview over its texture), symbolic links resolved.

@@ -87,7 +87,7 @@ def test_falloff_samples_are_a_linear_ramp_over_distance_by_radius():
     for given in (samples, np.array(samples, dtype=np.float32), tuple(samples)):
         out = dk.slide(pts, counts, idx, handle, d, 0.6, falloff=given)
         np.testing.assert_allclose(out, pts + f[:, None] * d, atol=TOL)
-    with pytest.raises(dk.InvalidInput, match="falloff"):
+    with pytest.raises(dk.InvalidInput, match="^slide: falloff: sample 1: is 1.5"):
         dk.slide(pts, counts, idx, handle, d, 0.6, falloff=[1.0, 1.5, 0.0])  # a sample above 1
     with pytest.raises(dk.InvalidInput, match="falloff"):
         dk.slide(pts, counts, idx, handle, d, 0.6, falloff=[1.0])  # one sample is no ramp

@@ -162,6 +162,7 @@ struct PlyProperty {
     int32_t size = 0;      // bytes of a scalar, or of a list's count
     int32_t itemSize = 0;  // bytes of a list's items; 0 for a scalar
     bool unsignedCount = false;
+    bool integerItems = false;  // a list of an integer type (face indices)
     std::string name;
 };
 struct PlyElement {
@@ -209,6 +210,7 @@ void requireCompletePly(const fs::path& path) {
                 property.size = plyTypeSize(countType);
                 property.itemSize = plyTypeSize(itemType);
                 property.unsignedCount = countType.starts_with('u');
+                property.integerItems = itemType.find("float") == std::string::npos && itemType != "double";
                 // A count of floating-point type is left to assimp, as an unknown type is.
                 const bool integer = countType.find("float") == std::string::npos && countType != "double";
                 if (property.itemSize == 0 || !integer) property.size = 0;
@@ -292,7 +294,23 @@ void requireCompletePly(const fs::path& path) {
                 const std::string& count = tokens[needed];
                 const bool whole = !count.empty() && count.size() < 10 &&
                                    count.find_first_not_of("0123456789") == std::string::npos;
-                needed += 1 + (whole ? static_cast<size_t>(std::stoul(count)) : 0);
+                const size_t items = whole ? static_cast<size_t>(std::stoul(count)) : 0;
+                // Integer items (face indices) whole numbers: assimp reads 2.5 as 2.
+                for (size_t k = needed + 1; property.integerItems && k <= needed + items && k < tokens.size();
+                     ++k) {
+                    const std::string& item = tokens[k];
+                    const size_t digits = !item.empty() && (item[0] == '+' || item[0] == '-') ? 1 : 0;
+                    if (item.size() == digits ||
+                        item.find_first_not_of("0123456789", digits) != std::string::npos) {
+                        throw InvalidInput(
+                            formatError(path.string(),
+                                        "line " + std::to_string(lineNumber) + " (" + element.name + " " +
+                                            std::to_string(index) + ")",
+                                        "holds '" + item + "' in its list " + property.name,
+                                        "whole numbers, as the header's integer list type declares"));
+                    }
+                }
+                needed += 1 + items;
             }
             if (tokens.size() != needed) {
                 throw InvalidInput(formatError(

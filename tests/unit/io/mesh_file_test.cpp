@@ -436,6 +436,12 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
         CAPTURE(cut);
         CHECK_THROWS_WITH(io::readMesh(dir / "cut.ply"), Contains("cut.ply: has no end_header line after"));
     }
+    // A face index 2.5 (assimp reads 2): refused, naming the line and the list.
+    std::string fraction = kPly;
+    fraction.replace(fraction.find("3 3 2 4\n"), 8, "3 3 2.5 4\n");
+    test::writeText(dir / "fraction.ply", fraction);
+    CHECK_THROWS_WITH(io::readMesh(dir / "fraction.ply"),
+                      Contains("fraction.ply: line 18 (face 1): holds '2.5' in its list vertex_indices"));
     for (const char* axis : {"x", "y", "z"}) {
         std::string renamed = kPly;
         const std::string from = std::string("property float ") + axis + "\n";
