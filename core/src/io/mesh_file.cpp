@@ -9,6 +9,8 @@
 #include <assimp/LogStream.hpp>
 #include <cctype>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <iterator>
 #include <map>
 #include <mutex>
@@ -462,21 +464,28 @@ class DroppedDataLog : public Assimp::LogStream {
     }
 };
 
-// The JSON of a .gltf file, or of a .glb's first chunk; nullopt where it is not there to read (assimp then
-// refuses the file with its own message).
+// The JSON of a .gltf file, or of a .glb's first chunk (read alone: its binary chunk, the bulk of the file,
+// is assimp's to read); nullopt where it is not there to read (assimp then refuses the file with its own
+// message).
 std::optional<nlohmann::json> gltfJson(const fs::path& path) {
-    const std::string bytes = readFile(path, "glTF file");
-    std::string_view text = bytes;
-    if (bytes.size() >= 20 && bytes.compare(0, 4, "glTF") == 0) {
-        const auto le32 = [&](size_t at) {
-            uint32_t v = 0;
-            for (int k = 3; k >= 0; --k)
-                v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<size_t>(k)]);
-            return v;
-        };
+    std::ifstream in(path, std::ios::binary);
+    unsigned char header[20] = {};
+    in.read(reinterpret_cast<char*>(header), sizeof(header));
+    const auto le32 = [&](size_t at) {
+        return uint32_t(header[at]) | (uint32_t(header[at + 1]) << 8) | (uint32_t(header[at + 2]) << 16) |
+               (uint32_t(header[at + 3]) << 24);
+    };
+    std::string text;
+    if (in.gcount() == sizeof(header) && std::memcmp(header, "glTF", 4) == 0) {
         const uint32_t length = le32(12);
-        if (le32(16) != 0x4E4F534Au || length > bytes.size() - 20) return std::nullopt;  // "JSON"
-        text = std::string_view(bytes).substr(20, length);
+        std::error_code error;
+        const uintmax_t size = fs::file_size(path, error);
+        if (error || le32(16) != 0x4E4F534Au || length > size - sizeof(header))
+            return std::nullopt;  // "JSON"
+        text.resize(length);
+        if (!in.read(text.data(), length)) return std::nullopt;
+    } else {
+        text = readFile(path, "glTF file");
     }
     nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
     if (json.is_discarded() || !json.is_object()) return std::nullopt;

@@ -257,6 +257,23 @@ TEST_CASE("mesh files: a glTF whose positions assimp would misread is refused, n
         asset +
             R"( "extensionsUsed": ["KHR_materials_unlit"], "extensionsRequired": ["KHR_materials_unlit"],)"));
     CHECK(read.mesh.numVertices() == 8);
+    // The same check on a binary glTF, whose JSON chunk alone is read for it (Fox.glb reads: other tests).
+    const auto glb = [&](std::string json) {
+        json.append((4 - json.size() % 4) % 4, ' ');
+        const auto le32 = [](uint32_t v) {
+            return std::string{static_cast<char>(v), static_cast<char>(v >> 8), static_cast<char>(v >> 16),
+                               static_cast<char>(v >> 24)};
+        };
+        test::writeText(dir / "edited.glb", "glTF" + le32(2) + le32(static_cast<uint32_t>(20 + json.size())) +
+                                                le32(static_cast<uint32_t>(json.size())) + "JSON" + json);
+        return dir / "edited.glb";
+    };
+    std::string quantized = kGltf;
+    quantized.replace(quantized.find(position), position.size(),
+                      R"("componentType": 5123, "count": 4, "type": "VEC3")");
+    CHECK_THROWS_WITH(io::readMesh(glb(quantized)),
+                      Contains("edited.glb: accessors[0] (POSITION of meshes[0].primitives[0]): is VEC3 of "
+                               "component type 5123"));
 }
 
 TEST_CASE("mesh files: a glTF's nodes place its meshes, one group each, vertices in the file's order",
