@@ -6,7 +6,8 @@
 #   ./scripts/bench.sh --quick         1 repetition (a smoke run)
 #   DEFORMKIT_BUILD_DIR=build-perf ./scripts/bench.sh    benchmarks of another build folder
 #
-# Then scripts/bench_python.py prints what the Python module costs over the C++ benchmarks of the same work.
+# With chromium, tests/bench/shot_report_load.py times the shot report of a 240-frame x 10-tile shot against an
+# empty page. Then scripts/bench_python.py prints what the Python module costs over the C++ benchmarks of the same work.
 # When `blender` is on PATH, scripts/bench_blender.py also times Blender's Lattice and SimpleDeform modifiers
 # on the same 1,001,000-vertex grid, and the table gets their shares and our / Blender ratios
 # (target: ours at least 3x faster than Blender's modifier).
@@ -66,6 +67,13 @@ if command -v blender >/dev/null 2>&1 && [ -f "$build/blender/deformkit/__init__
     cat "$out/blender_slide.txt"
 else
     echo "Blender slide frame change skipped: blender or the staged add-on ($build/blender) is missing"
+fi
+if [ -d "$build/python" ] && { command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1; }; then
+    echo "running the shot report's load time (tests/bench/shot_report_load.py) ..." >&2
+    echo
+    PYTHONPATH="$build/python" /usr/bin/python3 tests/bench/shot_report_load.py --reps "$reps"
+else
+    echo "Shot report load time skipped: chromium or the Python module ($build/python) is missing"
 fi
 if [ -d "$build/python" ]; then
     echo "running the Python module against the C++ benchmarks (scripts/bench_python.py) ..." >&2
