@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <set>
 #include <span>
 #include <unordered_map>
 #include <utility>
@@ -24,42 +25,36 @@ inline std::vector<std::vector<size_t>> polygonLoops(std::span<const int32_t> ve
     }
     while (corners.size() > 1 && vertices[corners.back()] == vertices[corners.front()])
         corners.pop_back();
+    // One pass with a stack of the corners not yet in a loop, and where on it each of their vertices is: a
+    // corner whose vertex is on the stack closes the loop from that vertex's corner to the top, which leaves
+    // the stack (the vertex's corner stays, the repeat is dropped). Linear in the corners, whatever the
+    // polygon (a line walked there and back closes one loop of 2 corners per corner).
     std::vector<std::vector<size_t>> loops;
-    std::vector<std::vector<int32_t>> emitted;  // the loops' vertices, rotated to start at their least
-    std::vector<std::vector<size_t>> pending{std::move(corners)};
-    while (!pending.empty()) {
-        std::vector<size_t> loop = std::move(pending.back());
-        pending.pop_back();
-        // The first corner that revisits a vertex (`again`) and that vertex's first corner (`first`), in one
-        // pass: a long polygon must not cost the square of its corners.
-        size_t first = 0, again = 0;
-        std::unordered_map<int32_t, size_t> seen;
-        for (size_t j = 0; j < loop.size(); ++j) {
-            const auto [at, inserted] = seen.try_emplace(vertices[loop[j]], j);
-            if (!inserted) {
-                first = at->second;
-                again = j;
-                break;
-            }
-        }
-        if (again == 0) {
-            if (loop.size() < 3) continue;
-            std::vector<int32_t> key;
-            for (const size_t k : loop)
-                key.push_back(vertices[k]);
-            std::rotate(key.begin(), std::min_element(key.begin(), key.end()), key.end());
-            if (std::find(emitted.begin(), emitted.end(), key) != emitted.end()) continue;
-            emitted.push_back(std::move(key));
-            loops.push_back(std::move(loop));
+    std::set<std::vector<int32_t>> emitted;  // the loops' vertices, rotated to start at their least
+    const auto emit = [&](std::vector<size_t> loop) {
+        if (loop.size() < 3) return;
+        std::vector<int32_t> key;
+        key.reserve(loop.size());
+        for (const size_t k : loop)
+            key.push_back(vertices[k]);
+        std::rotate(key.begin(), std::min_element(key.begin(), key.end()), key.end());
+        if (emitted.insert(std::move(key)).second) loops.push_back(std::move(loop));
+    };
+    std::vector<size_t> stack;
+    std::unordered_map<int32_t, size_t> onStack;  // a vertex on the stack -> its position there
+    for (const size_t k : corners) {
+        const auto [at, inserted] = onStack.try_emplace(vertices[k], stack.size());
+        if (inserted) {
+            stack.push_back(k);
             continue;
         }
-        std::vector<size_t> inner(loop.begin() + static_cast<ptrdiff_t>(first),
-                                  loop.begin() + static_cast<ptrdiff_t>(again));
-        loop.erase(loop.begin() + static_cast<ptrdiff_t>(first) + 1,
-                   loop.begin() + static_cast<ptrdiff_t>(again) + 1);
-        pending.push_back(std::move(loop));
-        pending.push_back(std::move(inner));
+        const size_t first = at->second;
+        for (size_t p = first + 1; p < stack.size(); ++p)
+            onStack.erase(vertices[stack[p]]);
+        emit(std::vector<size_t>(stack.begin() + static_cast<ptrdiff_t>(first), stack.end()));
+        stack.resize(first + 1);
     }
+    emit(std::move(stack));
     return loops;
 }
 
