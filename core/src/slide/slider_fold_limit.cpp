@@ -29,15 +29,26 @@ double Slider::Impl::foldLimitScale(std::span<const glm::dvec3> restDisplacement
                                     std::span<const int32_t> triangles, std::span<const SlideDrive> drives,
                                     std::span<const glm::vec3> in, std::span<const float> weights,
                                     double envelope) {
-    constexpr int kSteps = 14;
-    double lo = 0.0, hi = 1.0;
+    // The largest scale that flips nothing, to a precision relative to itself (a drag a hundred times the
+    // radius keeps a hundredth of itself, not 0): halvings from 1 (which folds) until nothing flips, then
+    // bisection between that scale and the one before it. Both assume the flip-free scales are an interval
+    // from 0. 0 when even 2^-kHalvings folds (the slide folds for any drag).
+    constexpr int kHalvings = 60;
+    constexpr int kBisections = 12;
     std::vector<double> scales(base.size());
-    for (int step = 0; step < kSteps; ++step) {
-        const double mid = 0.5 * (lo + hi);
+    const auto foldsAt = [&](double scale) {
         for (size_t h = 0; h < base.size(); ++h)
-            scales[h] = base[h] * mid;
+            scales[h] = base[h] * scale;
         slideOnce(restDisplacement, scales, drives, in, weights, envelope);
-        (countFlips(triangles, in) == 0 ? lo : hi) = mid;
+        return countFlips(triangles, in) > 0;
+    };
+    double lo = 0.0, hi = 1.0;
+    for (int step = 0; step < kHalvings && lo == 0.0; ++step)
+        (foldsAt(0.5 * hi) ? hi : lo) = 0.5 * hi;
+    if (lo == 0.0) return 0.0;
+    for (int step = 0; step < kBisections; ++step) {
+        const double mid = 0.5 * (lo + hi);
+        (foldsAt(mid) ? hi : lo) = mid;
     }
     return lo;
 }
