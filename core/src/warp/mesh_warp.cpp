@@ -32,6 +32,11 @@ void checkOptions(const MeshWarpOptions& o, const std::string& source) {
         bad("alpha", "is " + std::to_string(o.alpha) + " with beta " + std::to_string(o.beta),
             "alpha < beta");
     }
+    if (!(o.mu > 0.0f)) {
+        bad("mu",
+            "is " + std::to_string(o.mu) + ": every control vertex would weigh 0 past itself along its edges",
+            "mu > 0 (1: the weight ends at each edge's far end)");
+    }
     if (!(o.gamma < o.mu)) {
         bad("gamma", "is " + std::to_string(o.gamma) + " with mu " + std::to_string(o.mu), "gamma < mu");
     }
@@ -223,10 +228,35 @@ void MeshWarp::setTarget(std::span<const glm::vec3> targetCagePoints) {
     }
     if (firstCopy_.empty()) {
         target_.assign(targetCagePoints.begin(), targetCagePoints.end());
-    } else {
-        for (size_t i = 0; i < firstCopy_.size(); ++i)
-            target_[i] = targetCagePoints[static_cast<size_t>(firstCopy_[i])];
+        return;
     }
+    // A split vertex's copies are one control vertex: its target is their mean (exactly their position when
+    // they coincide: a double sum of equal floats). Copies apart by more than the weld allows plus 1% of the
+    // vertex's shortest cage edge are a torn cage, which no control vertex can follow: refused, nothing set.
+    std::vector<glm::dvec3> sum(target_.size(), glm::dvec3(0.0));
+    std::vector<int32_t> copies(target_.size(), 0);
+    for (size_t v = 0; v < targetCagePoints.size(); ++v) {
+        const auto c = static_cast<size_t>(controlOf_[v]);
+        const glm::vec3 first = targetCagePoints[static_cast<size_t>(firstCopy_[c])];
+        const double apart = glm::distance(glm::dvec3(targetCagePoints[v]), glm::dvec3(first));
+        if (apart > 0.0) {
+            float longestInv = 0.0f;
+            for (int32_t e = neighborOffsets_[c]; e < neighborOffsets_[c + 1]; ++e)
+                longestInv = std::max(longestInv, invLengthSq_[e]);
+            const double allowed = 2.0 * options_.weldTolerance + 0.01 / std::sqrt(double(longestInv));
+            if (!(apart <= allowed)) {
+                throw InvalidInput(formatError(
+                    source_, "target cage point " + std::to_string(v),
+                    "is " + numberText(apart) + " from point " + std::to_string(firstCopy_[c]) +
+                        ", a copy of the same split vertex (control vertex " + std::to_string(c) + ")",
+                    "the copies of a split vertex moved together (within " + numberText(allowed) + ")"));
+            }
+        }
+        sum[c] += glm::dvec3(targetCagePoints[v]);
+        ++copies[c];
+    }
+    for (size_t c = 0; c < target_.size(); ++c)
+        target_[c] = glm::vec3(sum[c] / static_cast<double>(copies[c]));
 }
 
 float MeshWarp::weight(int32_t i, const glm::vec3& p) const {

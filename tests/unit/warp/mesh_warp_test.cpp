@@ -525,3 +525,65 @@ TEST_CASE("mesh warp: a cage with split vertices warps as the shared-vertex cage
         CHECK(moved > 0.01);
     }
 }
+
+TEST_CASE(
+    "mesh warp: a split vertex's copies move it by their mean; copies torn apart are refused, naming both",
+    "[mesh_warp][weld]") {
+    const geom::Mesh cage = geom::makeSphere({});
+    std::vector<int32_t> original, newIndex;
+    const geom::Mesh split = test::splitCopy(cage, true, original);
+    const geom::Mesh shared =
+        test::renumbered(cage, test::firstCopyOrder(original, cage.numVertices()), newIndex);
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::vector<glm::vec3> points(400);
+    for (glm::vec3& p : points)
+        p = glm::vec3(unit(rng), unit(rng), unit(rng)) * 0.8f;
+    // Each copy moved by a little noise of its own (a DCC's per-copy rounding), well within 1% of an edge.
+    std::vector<glm::vec3> splitTarget;
+    std::vector<glm::dvec3> sum(static_cast<size_t>(cage.numVertices()), glm::dvec3(0.0));
+    std::vector<int32_t> count(sum.size(), 0);
+    for (const int32_t v : original) {
+        const glm::vec3 p = cage.points()[static_cast<size_t>(v)] + glm::vec3(0.05f, -0.02f, 0.03f) +
+                            glm::vec3(unit(rng), unit(rng), unit(rng)) * 1e-5f;
+        splitTarget.push_back(p);
+        sum[static_cast<size_t>(v)] += glm::dvec3(p);
+        ++count[static_cast<size_t>(v)];
+    }
+    std::vector<glm::vec3> sharedTarget(sum.size());
+    for (size_t v = 0; v < sum.size(); ++v)
+        sharedTarget[static_cast<size_t>(newIndex[v])] = glm::vec3(sum[v] / static_cast<double>(count[v]));
+    std::vector<glm::vec3> want = points, got = points;
+    warp::meshWarp(want, shared, sharedTarget);
+    warp::meshWarp(got, split, splitTarget);
+    CHECK(std::memcmp(got.data(), want.data(), got.size() * sizeof(glm::vec3)) == 0);
+
+    // One copy of a vertex dragged alone (an edit to one side of a seam): refused, the target unchanged.
+    warp::MeshWarp warp(split, {}, "cage.obj");
+    warp.setTarget(splitTarget);
+    const std::vector<glm::vec3> before(warp.targetCage().begin(), warp.targetCage().end());
+    int32_t second = -1, firstOfIt = -1;
+    for (size_t k = 0; k < original.size() && second < 0; ++k) {
+        for (size_t j = 0; j < k; ++j) {
+            if (original[j] == original[k]) {
+                second = static_cast<int32_t>(k);
+                firstOfIt = static_cast<int32_t>(j);
+                break;
+            }
+        }
+    }
+    REQUIRE(second >= 0);
+    std::vector<glm::vec3> torn = splitTarget;
+    torn[static_cast<size_t>(second)] += glm::vec3(0.0f, 0.2f, 0.0f);
+    CHECK_THROWS_WITH(warp.setTarget(torn),
+                      Catch::Contains("cage.obj") &&
+                          Catch::Contains("target cage point " + std::to_string(second)) &&
+                          Catch::Contains("from point " + std::to_string(firstOfIt)) &&
+                          Catch::Contains("copies of a split vertex moved together"));
+    CHECK(std::equal(before.begin(), before.end(), warp.targetCage().begin()));
+    // mu <= 0 would give every control vertex zero weight past itself: refused.
+    warp::MeshWarpOptions o;
+    o.gamma = -1.0f;
+    o.mu = 0.0f;
+    CHECK_THROWS_WITH(warp::MeshWarp(cage, o), Catch::Contains("mu") && Catch::Contains("mu > 0"));
+}

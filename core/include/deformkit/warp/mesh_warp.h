@@ -23,7 +23,8 @@ struct MeshWarpOptions {
     float alpha = 0.0f;  // radial: full weight within alpha * |E_im| of P_i; 0 <= alpha < beta
     float beta = 1.0f;   // radial: zero weight beyond beta * |E_im|
     float gamma = 0.0f;  // along each edge: full weight up to gamma of the edge; gamma < mu
-    float mu = 1.0f;     // along each edge: zero weight from mu of the edge on (1 = the neighbour vertex)
+    float mu =
+        1.0f;  // along each edge: zero weight from mu of the edge on (1 = the neighbour vertex); mu > 0
     // Singular values of a control vertex's edge matrix below this fraction of the largest are treated
     // as zero (a planar or collinear star); see A_i in MeshWarp.
     double rankTolerance = 1e-6;
@@ -60,7 +61,9 @@ class MeshWarp : public Warp {
     // #cage vertices target positions (same order and topology as the rest cage). Throws InvalidInput
     // if the count differs or a coordinate is not finite. Until called, the target is the rest cage. A cage
     // with split vertices (coincident copies, geom/weld.h) is welded at construction: its control vertices
-    // are its positions, each target read from the position's first copy.
+    // are its positions, each target the mean of its copies' targets. Copies farther apart than twice the
+    // weld tolerance plus 1% of their shortest cage edge (a torn cage) throw InvalidInput naming both;
+    // nothing is set when it throws.
     void setTarget(std::span<const glm::vec3> targetCagePoints);
 
     // Fields on the rest surface (#points positions): only control vertices with non-zero weight at a
