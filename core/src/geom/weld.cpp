@@ -150,6 +150,33 @@ Welding weldVertices(const Mesh& mesh, double tolerance, const std::string& sour
         w.copies[static_cast<size_t>(fill[static_cast<size_t>(w.weldedOf[v])]++)] = static_cast<int32_t>(v);
 
     if (w.merged() == 0) return w;  // nothing to weld: no welded mesh (callers use the file's)
+    // Corners of one face never join directly (groupRoots), but a tolerance that reaches across the mesh
+    // joins them through a chain of other vertices: the edge collapses, and the mesh around it tears or turns
+    // non-manifold. A tolerance meant for a split vertex's copies does not: refused. Edges of zero length
+    // (slivers of coincident points) may weld so.
+    if (tolerance > 0.0) {
+        const auto counts = mesh.faceCounts();
+        const auto indices = mesh.faceIndices();
+        size_t offset = 0;
+        for (size_t f = 0; f < counts.size(); ++f) {
+            const auto n = static_cast<size_t>(counts[f]);
+            for (size_t k = 0; k < n; ++k) {
+                const auto a = static_cast<size_t>(indices[offset + k]);
+                const auto b = static_cast<size_t>(indices[offset + (k + 1) % n]);
+                if (w.weldedOf[a] != w.weldedOf[b] || points[a] == points[b]) continue;
+                const double length = glm::distance(glm::dvec3(points[a]), glm::dvec3(points[b]));
+                throw InvalidInput(formatError(source, "weld tolerance",
+                                               "is " + numberText(tolerance) +
+                                                   ": it welds the two ends of edge (" + std::to_string(a) +
+                                                   ", " + std::to_string(b) + ") of face " +
+                                                   std::to_string(f) + ", " + numberText(length) + " long",
+                                               "a tolerance below the mesh's edges that must stay (about the "
+                                               "gap between a split vertex's "
+                                               "copies)"));
+            }
+            offset += n;
+        }
+    }
     Mesh::Data data;
     data.points.reserve(w.firstOf.size());
     for (int32_t v : w.firstOf)

@@ -224,6 +224,38 @@ TEST_CASE("slide on split vertices: without welding the split mesh tears", "[sli
     CHECK(geom::weldVertices(apart, 1e-3).merged() == 2);
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)geom::weldVertices(apart, -1.0, "apart.obj"); }),
                Contains("apart.obj: weld tolerance: is -1"));
+    // Corners of one face never weld onto each other, but a tolerance that reaches across the mesh welds
+    // them through a chain of copies (0 onto 4 onto 1): the edge collapses and the mesh around it tears or
+    // turns non-manifold (on Spot at 0.05, a handle's fan). Refused, naming the edge, its face and length.
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] { (void)geom::weldVertices(apart, 1.5, "apart.obj"); }),
+        Contains(
+            "apart.obj: weld tolerance: is 1.5: it welds the two ends of edge (0, 1) of face 0, 1 long"));
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)geom::weldVertices(test::spot(), 0.05, "spot.obj"); }),
+               Contains("spot.obj: weld tolerance: is 0.05: it welds the two ends of edge") &&
+                   Contains(" of face "));
+    // Every copy of the split Spot within a tolerance half its shortest edge: welded as exactly.
+    double shortest = 1e30;
+    const geom::Mesh spot = test::spot();
+    for (size_t f = 0, offset = 0; f < spot.faceCounts().size(); offset += spot.faceCounts()[f++]) {
+        const auto n = static_cast<size_t>(spot.faceCounts()[f]);
+        for (size_t k = 0; k < n; ++k) {
+            shortest = std::min(
+                shortest, glm::distance(glm::dvec3(spot.points()[spot.faceIndices()[offset + k]]),
+                                        glm::dvec3(spot.points()[spot.faceIndices()[offset + (k + 1) % n]])));
+        }
+    }
+    REQUIRE(shortest > 0.0);
+    CHECK(geom::weldVertices(split, 0.5 * shortest).merged() == weld.merged());
+    // An edge of zero length (a sliver of coincident points, 2-3) welded through a copy (4) is no collapse of
+    // the mesh: its face goes, nothing is refused.
+    geom::Mesh::Data sliver;
+    sliver.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
+    sliver.faceCounts = {3, 3, 3};
+    sliver.faceIndices = {0, 1, 2, 2, 3, 0, 4, 1, 0};
+    const geom::Welding welded = geom::weldVertices(geom::Mesh(std::move(sliver), "sliver"), 1e-3);
+    CHECK(welded.merged() == 2);
+    CHECK(welded.mesh.numFaces() == 2);
 }
 
 TEST_CASE("weld: a face whose corners weld keeps the corners left, with their UVs", "[slide][weld]") {
