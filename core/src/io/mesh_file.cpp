@@ -282,7 +282,14 @@ void requireCompletePly(const fs::path& path) {
                 ++e;
                 index = 0;
             }
-            if (e == elements.size()) break;  // lines after the declared elements: assimp ignores them
+            // Lines after the declared elements: assimp ignores them, the header's counts too small.
+            if (e == elements.size()) {
+                throw InvalidInput(
+                    formatError(path.string(), "line " + std::to_string(lineNumber),
+                                "holds data after the " + declared + " elements its header declares",
+                                "a header whose element counts cover the file's data (a count too small "
+                                "drops the rest)"));
+            }
             const PlyElement& element = elements[e];
             std::istringstream values(line);
             const std::vector<std::string> tokens{std::istream_iterator<std::string>(values), {}};
@@ -371,6 +378,19 @@ void requireCompletePly(const fs::path& path) {
                 at += bytes;
             }
         }
+    }
+    // Bytes after the declared elements (beyond a line end or padding of spaces or zeros): the header's
+    // counts are too small, and assimp drops what follows without a word.
+    size_t extra = 0;
+    for (uint64_t k = at; k < fileSize; ++k)
+        if (const char c = text[k]; c != '\n' && c != '\r' && c != ' ' && c != '\0') ++extra;
+    if (extra > 0) {
+        throw InvalidInput(
+            formatError(path.string(), "",
+                        "holds " + std::to_string(fileSize - at) + " bytes after the " + declared +
+                            " elements its header declares",
+                        "a header whose element counts cover the file's data (a count too small "
+                        "drops the rest)"));
     }
 }
 

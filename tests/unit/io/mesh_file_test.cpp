@@ -516,7 +516,26 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
         test::writeText(dir / "liar.ply", liar);
         CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
                           Contains("liar.ply: is cut short: ") && Contains("ends in face 2 of 9"));
+        // A header declaring fewer faces than the file holds: assimp read the first and dropped the rest.
+        std::string shy = whole;
+        shy.replace(shy.find("element face 2"), 14, "element face 1");
+        test::writeText(dir / "shy.ply", shy);
+        CHECK_THROWS_WITH(
+            io::readMesh(dir / "shy.ply"),
+            Contains("shy.ply: holds 13 bytes after the 5 vertex and 1 face elements its header "
+                     "declares (expected a header whose element counts cover the file's data"));
+        // A line end or zero padding after the data is no data.
+        test::writeText(dir / "padded.ply", whole + std::string("\n\0\0 ", 4));
+        CHECK(pointsOf(io::readMesh(dir / "padded.ply").mesh) == pointsOf(m));
     }
+    // The same in ASCII: a line after the declared elements.
+    std::string shy = kPly;
+    shy.replace(shy.find("element face 2"), 14, "element face 1");
+    test::writeText(dir / "shy.ply", shy);
+    CHECK_THROWS_WITH(
+        io::readMesh(dir / "shy.ply"),
+        Contains("shy.ply: line 18: holds data after the 5 vertex and 1 face elements its header "
+                 "declares"));
 }
 
 TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and the formats",
