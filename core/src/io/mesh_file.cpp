@@ -579,6 +579,47 @@ void requireReadableGltf(const fs::path& path) {
     }
 }
 
+// Collada's index lists (<p> of polygons and triangles, <vcount>, a skin's <v> and <vcount>) hold whole
+// numbers >= 0. Assimp reads "-2" as a wrapped index and drops the face without a word, and "2.5" or "x" as
+// a count that fails allocating ("std::bad_alloc"): refused here, naming the list and its line.
+void requireColladaIndices(const fs::path& path) {
+    const std::string text = readFile(path, "Collada file");
+    for (const char* tag : {"p", "vcount", "v"}) {
+        const std::string open = std::string("<") + tag + ">", close = std::string("</") + tag + ">";
+        int64_t ordinal = 0;
+        for (size_t at = text.find(open); at != std::string::npos; at = text.find(open, at)) {
+            const size_t begin = at + open.size(), end = text.find(close, begin);
+            if (end == std::string::npos) return;  // left to assimp's XML reader
+            const std::string_view list(text.data() + begin, end - begin);
+            size_t k = 0;
+            int64_t item = 0;
+            while (k < list.size()) {
+                while (k < list.size() && std::isspace(static_cast<unsigned char>(list[k])))
+                    ++k;
+                const size_t start = k;
+                while (k < list.size() && !std::isspace(static_cast<unsigned char>(list[k])))
+                    ++k;
+                if (k == start) break;
+                const std::string_view token = list.substr(start, k - start);
+                if (token.find_first_not_of("0123456789") != std::string_view::npos || token.size() > 9) {
+                    const auto line =
+                        1 +
+                        std::count(text.begin(), text.begin() + static_cast<ptrdiff_t>(begin + start), '\n');
+                    throw InvalidInput(formatError(path.string(),
+                                                   "line " + std::to_string(line) + " (<" + tag + "> list " +
+                                                       std::to_string(ordinal) + ", item " +
+                                                       std::to_string(item) + ")",
+                                                   "holds '" + std::string(token) + "'",
+                                                   "whole numbers from 0 to 999999999 (indices and counts)"));
+                }
+                ++item;
+            }
+            ++ordinal;
+            at = end;
+        }
+    }
+}
+
 ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
     const std::string name = path.string();
     std::error_code ec;
@@ -589,6 +630,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
 
     if (format == MeshFormat::Ply) requireCompletePly(path);
     if (format == MeshFormat::Gltf) requireReadableGltf(path);
+    if (format == MeshFormat::Collada) requireColladaIndices(path);
     Assimp::Importer importer;
     const auto check = [&](const aiScene* scene) {
         if (!scene) {

@@ -570,6 +570,17 @@ TEST_CASE("mesh files: OBJ stays DeformKit's reader; bad files name the file and
         Contains("nan.dae: mesh 'quad': vertex 2: is (nan, ") && Contains("(expected finite coordinates)"));
     test::writeText(dir / "quad.dae", kCollada);
     CHECK(io::readMesh(dir / "quad.dae").mesh.numFaces() == 2);
+    // An index list item that is not a whole number >= 0: assimp dropped a face on "-2" and failed
+    // allocating on "2.5". Named by line, list and item.
+    for (const auto& [item, what] :
+         {std::pair{"-2", "'-2'"}, std::pair{"2.5", "'2.5'"}, std::pair{"x", "'x'"}}) {
+        std::string bad = kCollada;
+        bad.replace(bad.find("<p>0 1 2 0 2 3</p>"), 18, std::string("<p>0 1 2 0 ") + item + " 3</p>");
+        test::writeText(dir / "bad.dae", bad);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)io::readMesh(dir / "bad.dae"); }),
+                   Contains("bad.dae: line 11 (<p> list 0, item 4): holds " + std::string(what) +
+                            " (expected whole numbers from 0 to 999999999"));
+    }
     CHECK(io::meshFormat("a.GLTF") == io::MeshFormat::Gltf);
     CHECK(io::meshFormat("a.Dae") == io::MeshFormat::Collada);
     CHECK_FALSE(io::meshFormat("a.exr"));
