@@ -64,6 +64,10 @@ scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
             frames.push_back(f);
     std::sort(frames.begin(), frames.end());
     frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    // Outputs, the plan and the scene's inputs apart: a task would skip an input it takes for a finished
+    // output, and the plan be written over the scene.
+    const fs::path planFile = farmPlanPath(command);
+    scene::requireFarmFilesApart(scene, plan, planFile, true);
     for (size_t o = 0; o < scene.objects.size(); ++o) {
         if (!scene.objects[o].uvwarp) continue;
         scene::UvWarpStageRun run;
@@ -73,7 +77,7 @@ scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
         (void)scene::uvwarpStageSolver(scene, o, run);
     }
     io::createFolder(plan.outDir);
-    scene::writeFarmPlan(plan, farmPlanPath(command));
+    scene::writeFarmPlan(plan, planFile);
     return plan;
 }
 

@@ -10,6 +10,7 @@
 
 #include "deformkit/error.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/obj.h"
 #include "deformkit/io/read_file.h"
 #include "deformkit/scene/evaluator.h"
@@ -311,6 +312,26 @@ FarmPlan readFarmPlan(const fs::path& path) {
     return parseFarmPlan(io::readFile(path, "farm plan"), path);
 }
 
+void requireFarmFilesApart(const Scene& scene, const FarmPlan& plan, const fs::path& planFile,
+                           bool planWritten, std::optional<int> task) {
+    std::vector<io::FileUse> files;
+    std::vector<int> frames;
+    for (size_t i = 0; i < plan.tasks.size(); ++i) {
+        if (task && static_cast<int>(i) != *task) continue;
+        const FarmTask& t = plan.tasks[i];
+        for (const std::string& name : t.outputs)
+            files.push_back({plan.outDir / name, "an output of task " + std::to_string(i), true});
+        for (int f = t.firstFrame; f <= t.lastFrame; ++f)
+            frames.push_back(f);
+    }
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    files.push_back({planFile, "the farm plan", planWritten});
+    for (io::FileUse& input : sceneInputFiles(scene, frames))
+        files.push_back(std::move(input));
+    io::requireFilesApart(files);
+}
+
 FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int task,
                            const SceneReadOptions& readOptions, std::ostream* log, Interrupter* interrupter) {
     using Clock = std::chrono::steady_clock;
@@ -386,6 +407,7 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
                             "a task per tile the scene warps (plan again after changing it)"));
         }
     }
+    requireFarmFilesApart(scene, plan, planFile, false, task);
     io::createFolder(plan.outDir);
 
     FarmTaskReport report;

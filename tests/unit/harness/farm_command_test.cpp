@@ -609,3 +609,41 @@ TEST_CASE("farm run: a warp mask or orientation map removed or added after plann
     CHECK_FALSE(report.written.empty());
     CHECK(fs::exists(shot.dir / "farm" / scene::uvwarpRedirectName("tube", 1001, 1)));
 }
+
+TEST_CASE("farm plan and run: an output that is an input, or a plan written over the scene, is refused",
+          "[harness][farm][errors]") {
+    // The scene's rest mesh named as a frame's output (the scene written for frame 1's mesh, planned into
+    // its own folder): a task took the input for a finished output and reported the frame skipped.
+    test::TempDir dir;
+    io::writeObj(dir / "tube.0001.obj", test::tube({.rings = 6, .sides = 10}));
+    test::writeText(dir / "shot.json", R"({"deformkit_scene": 1, "frames": [1, 3], "objects": [
+      {"name": "tube", "mesh": "tube.0001.obj", "stack": [{"type": "twist", "params": {"endAngle": 1.5}}]}]})");
+    const std::string rest = test::readText(dir / "tube.0001.obj");
+    harness::FarmPlanCommand plan;
+    plan.scene = dir / "shot.json";
+    plan.outDir = dir.path();
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }),
+               Contains("tube.0001.obj: is the rest mesh of ") && Contains(", and an output of task 0"));
+    CHECK_FALSE(fs::exists(dir / "farm_plan.json"));
+    // The plan named as the scene: refused, the scene kept.
+    const std::string scene = test::readText(dir / "shot.json");
+    plan.outDir = dir / "out";
+    plan.plan = dir / "shot.json";
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }),
+               Contains("shot.json: is the scene, and the farm plan"));
+    CHECK(test::readText(dir / "shot.json") == scene);
+    // A plan moved to write into the scene's folder by hand: its task refuses to run, nothing written.
+    plan.plan = dir / "out" / "farm_plan.json";
+    (void)harness::farmPlanCommand(plan);
+    std::string text = test::readText(plan.plan);
+    const std::string out = "\"out\": " + nlohmann::json((dir / "out").string()).dump();
+    REQUIRE(text.find(out) != std::string::npos);
+    text.replace(text.find(out), out.size(), "\"out\": " + nlohmann::json(dir.path().string()).dump());
+    test::writeText(plan.plan, text);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                   (void)harness::farmRunCommand({plan.plan, 0});
+               }),
+               Contains("tube.0001.obj: is the rest mesh of ") && Contains(", and an output of task 0"));
+    CHECK(test::readText(dir / "tube.0001.obj") == rest);
+    CHECK_FALSE(fs::exists(dir / "tube.0002.obj"));
+}

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -67,6 +68,14 @@ struct FarmPlanOptions {
 // in scene order; with tiles the UV-warp outputs, frame by frame, objects in scene order, tiles ascending.
 [[nodiscard]] std::vector<std::string> farmTaskOutputs(const Scene& scene, int first, int last,
                                                        const std::vector<int>& tiles);
+
+// Checks that no output of the plan's tasks (all of them, or task `task` alone) is a file the scene reads
+// (the scene, rest meshes, animated inputs' frames of the tasks, weights files) or the plan file, and that
+// the plan file, when `planWritten`, is no input either (io::requireFilesApart). Without it, a task skips an
+// input it takes for its finished output, or the plan is written over the scene. Throws InvalidInput naming
+// the file and both uses.
+void requireFarmFilesApart(const Scene& scene, const FarmPlan& plan, const std::filesystem::path& planFile,
+                           bool planWritten, std::optional<int> task = std::nullopt);
 
 // The plan's JSON text, one task per line (a plan of thousands of tasks stays readable and diffable).
 [[nodiscard]] std::string formatFarmPlan(const FarmPlan& plan);
