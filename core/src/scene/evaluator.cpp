@@ -134,12 +134,17 @@ void SceneEvaluator::check(std::span<const int> frames) {
     for (size_t o = 0; o < objects_.size(); ++o) {
         const SceneObject& so = scene_.objects[o];
         Object& ob = objects_[o];
-        setFrame(o, frames.front(), true);
-        try {
-            ob.stack.bind();
-        } catch (const Error& e) {
-            throw InvalidInput(
-                formatError(scene_.source, so.path + ".stack", frameText(frames.front()) + ": " + e.what()));
+        // Every frame's values set (a key between frames may overshoot, a stepped key reach a bad value)
+        // and bound where a bind-time value changed: the stack binds only entries whose bind-time values
+        // changed, as evaluating the frames does.
+        for (size_t k = 0; k < frames.size(); ++k) {
+            setFrame(o, frames[k], k == 0);
+            try {
+                ob.stack.bind();
+            } catch (const Error& e) {
+                throw InvalidInput(
+                    formatError(scene_.source, so.path + ".stack", frameText(frames[k]) + ": " + e.what()));
+            }
         }
         if (!ob.sequence) continue;
         for (const int frame : frames) {

@@ -497,6 +497,29 @@ TEST_CASE("eval and farm plan check every input before any work: a vertex out of
     CHECK(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }) == evalError);
     CHECK_FALSE(fs::exists(shot.dir / "farm"));
 
+    // Values that go bad after the first frame: a stepped key to a vertex out of range at frame 5, and a
+    // radius whose Bezier keys (1 at frames 1 and 4, a steep tangent) overshoot below 0 in between. Found
+    // before frame 1 is written, naming the frame.
+    for (const auto& [params, where] :
+         {std::pair{R"({"vertex": {"keys": [{"frame": 1, "value": 3, "interpolation": "constant"},
+                                            {"frame": 5, "value": 99999}]}, "radius": 0.5})",
+                    "frame 5: stack entry 0 (slide 'slide1'): parameter 'vertex': is 99999"},
+          std::pair{
+              R"({"vertex": 3, "radius": {"keys": [
+                      {"frame": 1, "value": 1, "tangent": "explicit", "in": 0, "out": 0},
+                      {"frame": 4, "value": 1, "tangent": "explicit", "in": 2.5, "out": 0}]}})",
+              "params.radius: frame 3: stack entry 0 (slide 'slide1'): parameter 'radius': is -0.111"}}) {
+        text = kScene;
+        text.replace(text.find(R"({"type": "bend")"), 0,
+                     std::string(R"({"type": "slide", "params": )") + params + "}, ");
+        test::writeText(shot.scene, text);
+        const std::string late = test::errorOf<InvalidInput>([&] { (void)harness::evalCommand(eval); });
+        CHECK_THAT(late, Contains("objects[1].") && Contains(where));
+        CHECK_FALSE(fs::exists(shot.dir / "eval"));
+        CHECK(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(plan); }) == late);
+        CHECK_FALSE(fs::exists(shot.dir / "farm"));
+    }
+
     // A UV-warp stage whose rigidity pattern finds no map: eval and plan refuse it alike, before any output.
     text = kScene;
     const size_t twistEnd = text.find("}}}]}") + 3;  // after the twist entry, inside the first stack

@@ -44,8 +44,9 @@ class SceneEvaluator {
     const geom::Mesh& evaluate(size_t object, double frame);
 
     // Checks, before any work, what evaluating `frames` would find wrong that does not depend on the frame's
-    // deformation: every object's stack set at the first frame and bound (a slide vertex out of range, a
-    // bind-time value a deformer rejects), and for an object with an animated input, that each frame is
+    // deformation: every object's stack set at every frame and bound where its bind-time values change (a
+    // slide vertex out of range, a key that overshoots to a value a deformer rejects: as costly as the
+    // binds evaluating the frames does), and for an object with an animated input, that each frame is
     // there (an OBJ of the sequence, a sample of the cache). Throws InvalidInput / IoError as evaluate()
     // names them. No evaluation is counted.
     void check(std::span<const int> frames);
