@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -20,6 +21,20 @@ constexpr std::uintmax_t kPc2Header = 32;
 constexpr std::uintmax_t kBytesPerVertex = 12;
 // How close a sample's frame must be to a whole frame to be that frame (PC2 sampling such as 0.1).
 constexpr double kFrameTolerance = 1.0e-4;
+
+// A PC2 stores its sampling (frames per sample) as a 32-bit float: 1/3 as 0.33333334, 0.1 as 0.100000001.
+// Multiplied by a sample's index that rounding drifts past kFrameTolerance after about 10^4 samples, and
+// whole frames inside the cache go missing. The value the writer meant: 1/n when the float is 1/n rounded,
+// else the shortest decimal that rounds to the float (0.4, 2.5).
+double intendedSampling(float sampling) {
+    const double n = std::round(1.0 / static_cast<double>(sampling));
+    if (n >= 1.0 && static_cast<float>(1.0 / n) == sampling) return 1.0 / n;
+    char text[32];
+    const auto written = std::to_chars(text, text + sizeof text, sampling);
+    double meant = sampling;
+    if (written.ec == std::errc()) (void)std::from_chars(text, written.ptr, meant);
+    return meant;
+}
 
 // 4-byte words in a file's byte order (PC2 little-endian, MDD big-endian), whatever the machine's.
 uint32_t loadWord(const char* bytes, bool bigEndian) {
@@ -125,7 +140,7 @@ PointCache::PointCache(fs::path path, std::optional<double> firstFrame) : path_(
                                            "a positive number of frames per sample"));
         }
         first_ = start;
-        sampling_ = sampling;
+        sampling_ = intendedSampling(sampling);
         dataOffset_ = kPc2Header;
     } else {
         char header[8];

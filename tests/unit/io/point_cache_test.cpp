@@ -101,6 +101,28 @@ TEST_CASE("point cache: PC2 and MDD written by hand read back bit for bit, frame
         CHECK(before.sampleOf(0) == 2);
         CHECK(test::sameBits(read(before, 0), frames[2]));
     }
+    SECTION(
+        "PC2 sampled a third or a tenth of a frame, stored as floats: every whole frame of a long cache") {
+        // 0.33333334f and 0.100000001f times a sample's index drift past the frame tolerance after about
+        // 10^4 samples: the cache reads as the 1/3 and 0.1 its writer meant.
+        for (const auto& [sampling, perFrame] : {std::pair{1.0f / 3.0f, 3}, std::pair{0.1f, 10}}) {
+            INFO("sampling " << sampling);
+            const int samples = 5000 * perFrame;
+            test::writeText(dir / "long.pc2", test::pc2Bytes(1.0f, sampling, randomFrames(samples, 1, 5)));
+            io::PointCache cache(dir / "long.pc2");
+            const std::vector<int> whole = cache.frames();
+            REQUIRE(whole.size() == 5000);
+            CHECK((whole.front() == 1 && whole.back() == 5000));
+            for (const int frame : {1, 3356, 4999, 5000})
+                CHECK(cache.sampleOf(frame) == (frame - 1) * perFrame);
+        }
+        // A sampling that is no 1/n reads as its shortest decimal: 0.4f as 0.4, frames 1, 3, 5, ...
+        test::writeText(dir / "four.pc2", test::pc2Bytes(1.0f, 0.4f, randomFrames(25001, 1, 6)));
+        io::PointCache four(dir / "four.pc2");
+        CHECK(four.sampling() == 0.4);
+        CHECK(four.frames().size() == 5001);
+        CHECK(four.sampleOf(10001) == 25000);
+    }
     SECTION("PC2 with the first frame set by the reader") {
         test::writeText(dir / "a.pc2", test::pc2Bytes(10.0f, 1.0f, frames));
         io::PointCache cache(dir / "a.pc2", 1.0);
