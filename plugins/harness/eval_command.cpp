@@ -194,7 +194,7 @@ void writeShotPage(const EvalCommand& command, EvalReport& report, const std::st
     uvwarp::HtmlReportOptions options;
     options.title = "Shot " + command.scene.stem().string();
     // The heatmaps' geometry from the scene itself: the shot may be written as point caches alone.
-    options.geometry = sceneGeometry(fs::absolute(command.scene).lexically_normal());
+    options.geometry = sceneGeometry(io::absolutePath(command.scene));
     std::string frames;
     if (!report.frames.empty()) {
         frames =
@@ -240,7 +240,7 @@ ContactSheetLayout contactSheetLayout(int32_t tiles, int32_t previewWidth, int32
 EvalReport evalCommand(const EvalCommand& command, std::ostream* progress) {
     // The scene by its absolute path, as farm plans hold it: inputs resolve to absolute paths, so the
     // provenance headers of eval's maps equal those a farm task writes.
-    scene::SceneEvaluator evaluator(readScene(std::filesystem::absolute(command.scene).lexically_normal()));
+    scene::SceneEvaluator evaluator(readScene(io::absolutePath(command.scene)));
     const scene::Scene& scene = evaluator.scene();
     EvalReport report;
     if (command.frames.empty()) {

@@ -22,14 +22,6 @@ namespace deformkit::harness {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-fs::path absolutePath(const fs::path& path) {
-    return fs::absolute(path).lexically_normal();
-}
-
-}  // namespace
-
 fs::path farmPlanPath(const FarmPlanCommand& command) {
     return command.plan.empty() ? command.outDir / "farm_plan.json" : command.plan;
 }
@@ -127,7 +119,7 @@ std::string slurmOutput(const fs::path& planAbs, const std::string& suffix) {
 std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const fs::path& planFile,
                                              const fs::path& deformkit,
                                              const std::vector<std::string>& extra) {
-    const fs::path planAbs = absolutePath(planFile);
+    const fs::path planAbs = io::absolutePath(planFile);
     std::vector<std::string> args = {
         "--parsable",
         "--array=0-" + std::to_string(plan.tasks.size() - 1),
@@ -136,7 +128,7 @@ std::vector<std::string> farmSbatchArguments(const scene::FarmPlan& plan, const 
         slurmOutput(planAbs, ".%A_%a.log"),
     };
     args.insert(args.end(), extra.begin(), extra.end());
-    args.push_back("--wrap=exec " + shellQuote(absolutePath(deformkit).string()) + " farm run " +
+    args.push_back("--wrap=exec " + shellQuote(io::absolutePath(deformkit).string()) + " farm run " +
                    shellQuote(planAbs.string()) + " --task \"$SLURM_ARRAY_TASK_ID\"");
     return args;
 }
@@ -184,7 +176,7 @@ std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, 
                                                    const fs::path& deformkit,
                                                    const std::vector<std::string>& extra,
                                                    const std::string& arrayJob) {
-    const fs::path planAbs = absolutePath(planFile);
+    const fs::path planAbs = io::absolutePath(planFile);
     std::vector<std::string> args = {
         "--parsable",
         "--dependency=afterany:" + arrayJob,
@@ -193,11 +185,11 @@ std::vector<std::string> farmReportSbatchArguments(const scene::FarmPlan& plan, 
     };
     const ArrayOptions split = splitArrayOptions(extra);
     args.insert(args.end(), split.rest.begin(), split.rest.end());
-    std::string wrap = "exec " + shellQuote(absolutePath(deformkit).string()) + " report --plan " +
+    std::string wrap = "exec " + shellQuote(io::absolutePath(deformkit).string()) + " report --plan " +
                        shellQuote(planAbs.string());
     // Task logs moved by the array's --output are read from that folder.
     if (!split.output.empty())
-        wrap += " " + shellQuote(absolutePath(fs::path(split.output)).parent_path().string());
+        wrap += " " + shellQuote(io::absolutePath(fs::path(split.output)).parent_path().string());
     args.push_back("--wrap=" + wrap);
     return args;
 }

@@ -26,9 +26,6 @@ namespace {
 
 constexpr const char* kPlanExpected = "a DeformKit farm plan (docs/farm.md)";
 
-fs::path absolutePath(const fs::path& path) {
-    return fs::absolute(path).lexically_normal();
-}
 
 // Every tile some object's UV-warp stage warps (animated maps: those with a map at `frame`), ascending.
 std::vector<int> warpedTiles(const Scene& scene, int frame) {
@@ -150,7 +147,7 @@ class PlanReader {
     fs::path path(const json& j, const std::string& at) const {
         if (!j.is_string() || j.get<std::string>().empty()) fail(at, "is " + describe(j), "a path");
         const fs::path p = j.get<std::string>();
-        return p.is_absolute() ? p : absolutePath(source_.parent_path() / p);
+        return p.is_absolute() ? p : io::absolutePath(source_.parent_path() / p);
     }
 
     static std::string describe(const json& j) {
@@ -234,8 +231,8 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
     for (size_t o = 0; o < scene.objects.size(); ++o)
         requireRigidityMaps(scene, o, frames.front());
     FarmPlan plan;
-    plan.scene = absolutePath(sceneFile);
-    plan.outDir = absolutePath(outDir);
+    plan.scene = io::absolutePath(sceneFile);
+    plan.outDir = io::absolutePath(outDir);
     plan.chunk = options.chunk;
     plan.warmUp = options.warmUp;
     // Runs of consecutive frames, each at most `chunk` long.

@@ -9,6 +9,7 @@
 #include "deformkit/error.h"
 #include "deformkit/geom/primitives.h"
 #include "deformkit/io/atomic_file.h"
+#include "deformkit/io/file_uses.h"
 #include "deformkit/io/obj.h"
 #include "test_support.h"
 
@@ -237,4 +238,26 @@ TEST_CASE("temporary names carry the process, a random number drawn once and a c
     CHECK(ma[1] == mb[1]);
     CHECK(std::stoul(mb[2]) == std::stoul(ma[2]) + 1);
     CHECK(ma[1] != std::string(16, '0'));
+}
+
+TEST_CASE("absolutePath keeps '..' after a symbolic link: it names the file the system opens",
+          "[io][atomic]") {
+    const test::TempDir dir;
+    fs::create_directories(dir / "real" / "shots");
+    fs::create_directories(dir / "work");
+    test::writeText(dir / "real" / "shot.json", "real");
+    test::writeText(dir / "work" / "shot.json", "other");
+    fs::create_directory_symlink(fs::path("..") / "real" / "shots", dir / "work" / "link");
+    const fs::path through = dir / "work" / "link" / ".." / "shot.json";
+    // The system opens real/shot.json; a text normalisation would name work/shot.json.
+    CHECK(test::readText(through) == "real");
+    CHECK(test::readText(io::absolutePath(through)) == "real");
+    CHECK(io::absolutePath(through) == dir.path() / "real" / "shot.json");
+    // Links not followed by ".." stay: a plan keeps the show's paths, not one machine's mount points.
+    CHECK(io::absolutePath(dir / "work" / "link" / "x" / ".." / "y") == dir.path() / "work" / "link" / "y");
+    CHECK(io::absolutePath(dir / "work" / ".." / "real" / "shot.json") == dir.path() / "real" / "shot.json");
+    // "." parts and a trailing separator go; a relative path is made absolute from the working folder.
+    CHECK(io::absolutePath(dir / "work" / "." / "shot.json") == dir.path() / "work" / "shot.json");
+    CHECK(io::absolutePath(dir.path() / "work" / "") == dir.path() / "work");
+    CHECK(io::absolutePath("a/./b") == fs::current_path() / "a" / "b");
 }

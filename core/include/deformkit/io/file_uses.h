@@ -18,6 +18,13 @@ struct FileUse {
 // (a folder reached through a link is the same folder), lexically normal.
 [[nodiscard]] std::string pathKey(const std::filesystem::path& path);
 
+// A path made absolute as a command names a file it keeps (a scene, a plan's folders): "." parts and
+// trailing separators dropped, each ".." taking its parent, where the part before it is a symbolic link
+// the parent of the link's target (as the system opens it). No other link is resolved: "link/.." dropped
+// as text would name another file than the system opens, and resolving every link would write a
+// machine's mount points into a plan other machines read.
+[[nodiscard]] std::filesystem::path absolutePath(const std::filesystem::path& path);
+
 // Names written and read, checked as they are added: no two outputs alike, no output the name of an input.
 // Otherwise an output is written over another one or over an input (and a resumed job takes the damaged
 // file for a finished output). Add every output before the inputs; each refusal is InvalidInput naming the
