@@ -26,7 +26,6 @@ namespace {
 
 constexpr const char* kPlanExpected = "a DeformKit farm plan (docs/farm.md)";
 
-
 // Every tile some object's UV-warp stage warps (animated maps: those with a map at `frame`), ascending.
 std::vector<int> warpedTiles(const Scene& scene, int frame) {
     std::vector<int> tiles;
