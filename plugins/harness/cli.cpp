@@ -6,6 +6,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -68,12 +69,36 @@ Option& Option::typeName(const std::string& name) {
     return *this;
 }
 
+// Text and path options: an empty value names nothing (no file, no value), and the command would fail later
+// with a message that names nothing; refused as a usage error naming the option. (CLI11 runs no validator
+// on an empty value.)
+namespace {
+
+template <class Target>
+CLI::Option* nonEmptyOption(CLI::App& app, const std::string& name, Target& target, const std::string& help) {
+    CLI::Option* option = app.add_option_function<std::string>(
+        name,
+        [&target, name](const std::string& value) {
+            if (value.empty()) throw CLI::ValidationError(name, "is empty (expected a value)");
+            target = value;
+        },
+        help);
+    if constexpr (std::is_same_v<Target, std::filesystem::path>) {
+        option->default_str(target.string());
+    } else {
+        option->default_str(target);
+    }
+    return option;
+}
+
+}  // namespace
+
 Option Command::option(const std::string& name, std::string& target, const std::string& help) {
-    return Option(app_->add_option(name, target, help));
+    return Option(nonEmptyOption(*app_, name, target, help));
 }
 
 Option Command::option(const std::string& name, std::filesystem::path& target, const std::string& help) {
-    return Option(app_->add_option(name, target, help));
+    return Option(nonEmptyOption(*app_, name, target, help));
 }
 
 Option Command::option(const std::string& name, int32_t& target, const std::string& help) {

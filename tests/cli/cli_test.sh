@@ -38,6 +38,11 @@ contains unknown-command "$work/err" "'nosuch' is not a command (expected one of
 expect unknown-farm-command 2 "$dk" farm nosuch
 contains unknown-farm-command "$work/err" "'nosuch' is not a farm command (expected one of: plan, run, submit, report)"
 expect unknown-option 2 "$dk" info --bogus x
+# An empty path or value names nothing: refused naming the option, for every command.
+expect empty-out 2 "$dk" eval "$work/none.json" --out ""
+contains empty-out "$work/err" "usage error: --out: is empty (expected a value)"
+expect empty-positional 2 "$dk" info ""
+contains empty-positional "$work/err" "usage error: FILE: is empty (expected a value)"
 expect missing-mesh 2 "$dk" info "$work/nope.obj"
 contains missing-mesh "$work/err" "nope.obj"
 

@@ -69,7 +69,11 @@ class DuplicateKeyDom {
     bool number_float(json::number_float_t v, const json::string_t& s) {
         return element() && dom_.number_float(v, s);
     }
-    bool string(json::string_t& v) { return element() && dom_.string(v); }
+    bool string(json::string_t& v) {
+        element();
+        if (v.find('\0') != std::string::npos && nul_.empty()) nul_ = where(open_.size());
+        return dom_.string(v);
+    }
     bool binary(json::binary_t& v) { return element() && dom_.binary(v); }
     bool start_object(std::size_t n) {
         element();
@@ -77,6 +81,12 @@ class DuplicateKeyDom {
         return dom_.start_object(n);
     }
     bool key(json::string_t& k) {
+        if (k.find('\0') != std::string::npos && nul_.empty()) {
+            std::string shown;  // the key as the file spells it
+            for (const char c : k)
+                shown += c == '\0' ? std::string("\\u0000") : std::string(1, c);
+            nul_ = jsonMember(where(open_.size() - 1), shown);
+        }
         if (!open_.back().keys.insert(k).second && duplicate_.empty())
             duplicate_ = jsonMember(where(open_.size() - 1), k);
         open_.back().key = k;
@@ -101,6 +111,10 @@ class DuplicateKeyDom {
 
     // The first key given twice, by its path; empty when none was.
     [[nodiscard]] const std::string& duplicate() const { return duplicate_; }
+    // The first string or key holding a NUL character (\u0000), by its path (a key by its own, spelt with
+    // \u0000); empty when none did. Paths and names are C strings to the system: the text after it would
+    // be cut off there.
+    [[nodiscard]] const std::string& nul() const { return nul_; }
 
   private:
     // Per open container: an object's keys so far and the key being read, or an array's element index.
@@ -125,7 +139,7 @@ class DuplicateKeyDom {
 
     nlohmann::detail::json_sax_dom_parser<json> dom_;
     std::vector<Open> open_;
-    std::string duplicate_;
+    std::string duplicate_, nul_;
 };
 
 // Parses `text`; ParseError naming `source`, the line and column and what the file should be (`expected`).
@@ -133,6 +147,16 @@ class DuplicateKeyDom {
 // ("objects[1].stack[0].label"): the text is JSON, but JSON readers keep one of the two silently (nlohmann
 // the last), so a value the user wrote would be ignored.
 inline json parseJson(std::string_view text, const std::string& source, const std::string& expected) {
+    // nlohmann ends its input at a NUL byte: the text after one would be ignored.
+    if (const size_t nul = text.find('\0'); nul != std::string_view::npos) {
+        const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<ptrdiff_t>(nul), '\n');
+        const size_t lineStart = text.rfind('\n', nul == 0 ? 0 : nul - 1);
+        const size_t column = lineStart == std::string_view::npos || nul == 0 ? nul + 1 : nul - lineStart;
+        throw ParseError(formatError(
+            source, "",
+            "holds a NUL byte at line " + std::to_string(line) + ", column " + std::to_string(column),
+            expected + ", without NUL bytes"));
+    }
     try {
         json root;
         DuplicateKeyDom dom(root);
@@ -140,6 +164,10 @@ inline json parseJson(std::string_view text, const std::string& source, const st
         if (!dom.duplicate().empty()) {
             throw InvalidInput(
                 formatError(source, dom.duplicate(), "is given twice in one object", "each key once"));
+        }
+        if (!dom.nul().empty()) {
+            throw InvalidInput(formatError(source, dom.nul(), "holds a NUL character (\\u0000)",
+                                           "text without NUL characters (names and paths end at one)"));
         }
         return root;
     } catch (const json::exception& e) {

@@ -102,6 +102,16 @@ TEST_CASE("scene: bad scenes name the file and the JSON path", "[host][scene][er
                Contains(file + ": a.list[2].b: is given twice"));  // elements of every kind counted
     CHECK_THAT(f.error(R"({"a": {"list": [{}, {"b": 1}], "z": 1, "z": 2}})"),
                Contains(file + ": a.z: is given twice"));  // containers closed inside keep the path right
+    // A NUL character in a string cut the message (and a path) off there; a NUL byte ended the text, so
+    // what followed it was ignored.
+    CHECK_THAT(f.error(withEntry(twist + R"({"endAngle": 1}, "label": "a\u0000b"})")),
+               Contains(file + ": objects[0].stack[0].label: holds a NUL character (\\u0000)"));
+    CHECK_THAT(f.error(R"({"deformkit_scene": 1, "frames": [1, 2], "objects": [], "x\u0000": 1})"),
+               Contains(file + ": x\\u0000: holds a NUL character"));
+    const std::string cut =
+        std::string(R"({"deformkit_scene": 1, "frames": [1, 2], "objects": []})") + '\0' + "junk";
+    CHECK_THAT(test::errorOf<ParseError>([&] { (void)f.parse(cut); }),
+               Contains(file + ": holds a NUL byte at line 1, column 56"));
     CHECK(f.error(withEntry(twist + R"({"endAngle": 1.5}}, )" + twist +
                             R"({"endAngle": 1}, "label": "b"})")) == "no error");
     // A range of more frames than a job takes (a typo) is refused before anything is written.
