@@ -26,12 +26,12 @@ namespace {
 
 constexpr const char* kPlanExpected = "a DeformKit farm plan (docs/farm.md)";
 
-// Every tile some object's UV-warp stage warps (animated maps: those with a map at `frame`), ascending.
-std::vector<int> warpedTiles(const Scene& scene, int frame) {
+// Every tile some object's UV-warp stage warps over `frames` (uvwarpWarpedTiles), ascending.
+std::vector<int> warpedTiles(const Scene& scene, std::span<const int> frames) {
     std::vector<int> tiles;
     for (const SceneObject& object : scene.objects) {
         if (!object.uvwarp) continue;
-        for (int tile : uvwarpWarpedTiles(*object.uvwarp, frame))
+        for (int tile : uvwarpWarpedTiles(*object.uvwarp, frames))
             tiles.push_back(tile);
     }
     std::sort(tiles.begin(), tiles.end());
@@ -228,7 +228,7 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
     // vertex out of range or a UV-warp stage without any rigidity map.
     SceneEvaluator(scene).check(frames);
     for (size_t o = 0; o < scene.objects.size(); ++o)
-        requireRigidityMaps(scene, o, frames.front());
+        requireRigidityMaps(scene, o, frames);
     FarmPlan plan;
     plan.scene = io::absolutePath(sceneFile);
     plan.outDir = io::absolutePath(outDir);
@@ -251,7 +251,7 @@ FarmPlan planFarm(const Scene& scene, const fs::path& sceneFile, const fs::path&
         task.outputs = farmTaskOutputs(scene, first, last, {});
         plan.tasks.push_back(std::move(task));
     }
-    const std::vector<int> tiles = warpedTiles(scene, frames.front());
+    const std::vector<int> tiles = warpedTiles(scene, frames);
     for (const auto& [first, last] : ranges) {
         for (size_t t = 0; t < tiles.size(); t += static_cast<size_t>(options.tilesPerTask)) {
             FarmTask task;
@@ -388,14 +388,16 @@ FarmTaskReport runFarmTask(const FarmPlan& plan, const fs::path& planFile, int t
         }
     }
     // A UV-warp stage added to the scene after planning has no task: every task checks the plan still
-    // covers the tiles the scene warps (at the plan's first frame, as planned).
+    // covers the tiles the scene warps over the plan's frames, as planned.
     std::set<int> planned;
-    int firstFrame = t.firstFrame;
+    std::set<int> planFrames;
     for (const FarmTask& other : plan.tasks) {
         planned.insert(other.tiles.begin(), other.tiles.end());
-        firstFrame = std::min(firstFrame, other.firstFrame);
+        for (int f = other.firstFrame; f <= other.lastFrame; ++f)
+            planFrames.insert(f);
     }
-    for (const int tile : warpedTiles(scene, firstFrame)) {
+    const std::vector<int> frameList(planFrames.begin(), planFrames.end());
+    for (const int tile : warpedTiles(scene, frameList)) {
         if (!planned.contains(tile)) {
             throw InvalidInput(
                 formatError(planName, "tasks",

@@ -47,6 +47,10 @@ auto inStage(const Scene& scene, const SceneUvWarp& stage, Work&& work) {
         const std::string what = e.what();
         if (what.rfind(scene.source, 0) == 0) throw;
         throw InvalidInput(formatError(scene.source, stage.path, what, ""));
+    } catch (const IoError& e) {  // a map's file missing or unreadable: the stage that names it said too
+        const std::string what = e.what();
+        if (what.rfind(scene.source, 0) == 0 || dynamic_cast<const StorageError*>(&e)) throw;
+        throw IoError(formatError(scene.source, stage.path, what, ""));
     }
 }
 
@@ -68,21 +72,25 @@ std::string uvwarpBakeName(const SceneObject& object, int tile, int frame) {
                          object.uvwarp->texture->extension().string());
 }
 
-std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame) {
+std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, std::span<const int> frames) {
     std::vector<int> tiles;
     for (int tile : stage.tiles) {
-        if (fileExists(tileFile(stage.rigidity, tile, frame))) tiles.push_back(tile);
+        if (std::any_of(frames.begin(), frames.end(),
+                        [&](int frame) { return fileExists(tileFile(stage.rigidity, tile, frame)); }))
+            tiles.push_back(tile);
     }
     return tiles;
 }
 
-void requireRigidityMaps(const Scene& scene, size_t object, int frame) {
+void requireRigidityMaps(const Scene& scene, size_t object, std::span<const int> frames) {
     const SceneObject& so = scene.objects.at(object);
-    if (!so.uvwarp || so.uvwarp->tiles.empty() || !uvwarpWarpedTiles(*so.uvwarp, frame).empty()) return;
+    if (!so.uvwarp || so.uvwarp->tiles.empty() || frames.empty() ||
+        !uvwarpWarpedTiles(*so.uvwarp, frames).empty())
+        return;
     const SceneUvWarp& stage = *so.uvwarp;
     std::string list;
     for (int tile : stage.tiles)
-        list += (list.empty() ? "'" : ", '") + tileFile(stage.rigidity, tile, frame).string() + "'";
+        list += (list.empty() ? "'" : ", '") + tileFile(stage.rigidity, tile, frames.front()).string() + "'";
     throw IoError(formatError(scene.source + ": " + stage.path + ".rigidity", stage.rigidity.string(),
                               "no tile has a rigidity map", "at least one of " + list));
 }

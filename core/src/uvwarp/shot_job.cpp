@@ -150,12 +150,15 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
     if (!source.pattern.empty()) {
         const std::string tilePattern = io::expandUdim(source.pattern.string(), tile);
         if (io::ObjSequence::isPattern(tilePattern)) {
-            // Animated: one file per frame. Found when the first frame's is there; then every frame's must
-            // be, with the same size (headers only), before anything is written.
+            // Animated: one file per frame. Found when any frame's is there (whether a tile is warped does
+            // not depend on the frame a run starts at); then every frame's must be, with the same size
+            // (headers only), before anything is written.
             const io::ObjSequence sequence(tilePattern);
             map.name = tilePattern;
-            const fs::path first = sequence.framePath(frames.front());
-            if (!fileExists(first)) return map;
+            const auto any = std::find_if(frames.begin(), frames.end(),
+                                          [&](int frame) { return fileExists(sequence.framePath(frame)); });
+            if (any == frames.end()) return map;
+            const fs::path first = sequence.framePath(*any);
             const io::ImageInfo info = io::readImageInfo(first);
             map.file = first;
             map.framePattern = tilePattern;

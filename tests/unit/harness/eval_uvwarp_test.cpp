@@ -255,8 +255,32 @@ TEST_CASE("scene uvwarp: an animated rigidity map (rig.<UDIM>.####.exr) is follo
         }
     }
     const scene::Scene parsed = scene::readScene(shot.scene);
-    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, 1) == std::vector<int>{1001, 1002});
-    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, 7).empty());  // no map at frame 7
+    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, std::vector<int>{1}) ==
+          std::vector<int>{1001, 1002});
+    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, std::vector<int>{7}).empty());  // no map at 7
+    CHECK(scene::uvwarpWarpedTiles(*parsed.objects[0].uvwarp, std::vector<int>{7, 3}) ==
+          std::vector<int>{1001, 1002});
+
+    // A tile whose animated map starts after the run's first frame is warped or not whatever frame the
+    // run starts at: the run over frames 1-3 refuses it, naming the missing frame and the stage, before
+    // anything is written (it was left unwarped there and warped from frame 2 on, so frame 2's maps
+    // depended on where the run began); the run from frame 2 warps it.
+    fs::remove(shot.dir / "rig.1002.0001.exr");
+    command.outDir = shot.dir / "from1";
+    const std::string missing = test::errorOf<IoError>([&] { (void)harness::evalCommand(command); });
+    CHECK_THAT(missing,
+               Contains(shot.scene.string() + ": objects[0].stack[1]: ") &&
+                   Contains("rig.1002.0001.exr: frame 1: does not exist (expected a map for every frame"));
+    CHECK_FALSE(fs::exists(command.outDir / "tubes.0001.obj"));
+    harness::FarmPlanCommand plan;
+    plan.scene = shot.scene;
+    plan.outDir = shot.dir / "farm1";
+    CHECK_THAT(test::errorOf<IoError>([&] { (void)harness::farmPlanCommand(plan); }),
+               Contains("rig.1002.0001.exr: frame 1: does not exist"));
+    command.outDir = shot.dir / "from2";
+    command.frames = {2, 3};
+    (void)harness::evalCommand(command);
+    CHECK(fs::exists(command.outDir / scene::uvwarpRedirectName("tubes", 1002, 2)));
 }
 
 TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm][errors]") {

@@ -47,7 +47,7 @@ TEST_CASE("scene uvwarp: the last stack entry becomes the object's texture-space
     CHECK(object.uvwarp->options.solver.coarseRelaxation == 1.0f);  // the paper's, by default
     test::writeText(shot.scene, kScene);
     CHECK(object.uvwarp->options.solver.smoothing == uvwarp::SolverOptions{}.smoothing);
-    CHECK(scene::uvwarpWarpedTiles(*object.uvwarp, 1) == std::vector<int>{1001, 1002});
+    CHECK(scene::uvwarpWarpedTiles(*object.uvwarp, std::vector<int>{1}) == std::vector<int>{1001, 1002});
     CHECK(scene::uvwarpOutputs(object, 1001, 7) ==
           std::vector<std::string>{"tubes.redirect.1001.0007.exr", "tubes.bake.1001.0007.exr"});
     CHECK(scene::uvwarpOutputs(object, 1002, -2) ==

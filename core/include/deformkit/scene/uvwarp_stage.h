@@ -53,12 +53,13 @@ namespace deformkit::scene {
 [[nodiscard]] std::vector<std::string> uvwarpOptionalMaps(const Scene& scene, int firstFrame, int lastFrame,
                                                           const std::vector<int>& tiles);
 
-// The stage's tiles that are warped: those with a rigidity map on disk (an animated map: its file at
-// `frame`), ascending. A tile without one is left unwarped (no outputs).
-[[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, int frame);
-// Throws IoError, as eval's stage does, when no tile of object `object`'s stage has a rigidity map at
-// `frame`: farm plans check what eval checks.
-void requireRigidityMaps(const Scene& scene, size_t object, int frame);
+// The stage's tiles that are warped over `frames`: those with a rigidity map on disk (an animated map: its
+// file at any of the frames; the stage then requires it at every one), ascending. A tile without one is
+// left unwarped (no outputs). Whether a tile is warped does not depend on which frame a run starts at.
+[[nodiscard]] std::vector<int> uvwarpWarpedTiles(const SceneUvWarp& stage, std::span<const int> frames);
+// Throws IoError, as eval's stage does, when no tile of object `object`'s stage has a rigidity map over
+// `frames`: farm plans check what eval checks.
+void requireRigidityMaps(const Scene& scene, size_t object, std::span<const int> frames);
 
 // The files the object's stage writes for `tile` at `frame`: the redirect map, then the bake when the
 // stage has a texture and the tile's texture exists. Empty without a stage or for a tile it does not warp.
