@@ -39,6 +39,22 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
             for (size_t t = 0; t < count; ++t)
                 out[t] = detail::loadValue(texels.data() + t * bytes, file.dataType);
         }
+        // A non-finite texel (half and float files) would spread through every filtered look-up that
+        // reaches it (inf - inf is NaN): named, as the per-vertex read names its corner texels.
+        const size_t count = (constant_[f] ? 1 : faces_[f].texelCount()) * static_cast<size_t>(channels_);
+        for (size_t t = 0; t < count; ++t) {
+            if (std::isfinite(out[t])) continue;
+            const auto texel = static_cast<int64_t>(t / static_cast<size_t>(channels_));
+            const int32_t ures = faces_[f].ures();
+            const std::string where = constant_[f] ? "constant value"
+                                                   : "texel (" + std::to_string(texel % ures) + ", " +
+                                                         std::to_string(texel / ures) + ")";
+            throw InvalidInput(formatError(source,
+                                           "face " + std::to_string(f) + " " + where + " channel " +
+                                               std::to_string(t % static_cast<size_t>(channels_)),
+                                           "is " + numberText(out[t]),
+                                           "finite values (look-ups filter across texels)"));
+        }
     }
 }
 

@@ -193,6 +193,13 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
                                            "tiles of the mesh: " + have));
         }
     }
+    // A face off its tile (a layout shifted off the UDIM tiles, or across two) would be drawn outside the
+    // tile's image: its texels would be missing without a word.
+    const auto tileSource = [&](int tile) {
+        return ptexMesh.source() + ", UDIM tile " + std::to_string(tile);
+    };
+    for (int tile : tiles)
+        geom::requireUdimFacesInTile(mesh, tile, tileSource);
     const PtexSampler sampler(file, fileSource);
     const int32_t channels = sampler.channels(), res = options.resolution;
     const int32_t outChannels = channels + (options.coverageChannel ? 1 : 0);
@@ -318,6 +325,9 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
         return static_cast<int8_t>(
             std::clamp(static_cast<int>(std::lround(std::log2(std::max(texels, 1.0)))), 0, 12));
     };
+    // A face off its tile would be read from the tile's clamped edge texels.
+    geom::requireUdimFacesInTile(
+        mesh, 0, [&](int tile) { return ptexMesh.source() + ", UDIM tile " + std::to_string(tile); });
     for (int32_t p = 0; p < ptexMesh.numPtexFaces(); ++p) {
         const int32_t f = ptexMesh.meshFace(p);
         if (!mesh.faceHasUVs(f)) {  // in no tile: 0, at the fixed resolution or 1 × 1

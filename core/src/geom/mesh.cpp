@@ -216,6 +216,41 @@ UdimOverhang udimOverhang(const Mesh& mesh, int tile, float tolerance) {
     return out;
 }
 
+void requireUdimFacesInTile(const Mesh& mesh, int tile, const std::function<std::string(int tile)>& source,
+                            float tolerance) {
+    if (!mesh.hasUVs()) return;
+    const auto uvs = mesh.uvs();
+    for (int32_t f = 0; f < mesh.numFaces(); ++f) {
+        const int faceTile = mesh.faceUdimTile(f);
+        if (faceTile == 0 || (tile != 0 && faceTile != tile)) continue;
+        const float overhang = mesh.faceUdimOverhang(f);
+        if (!(overhang > kUdimMaxOverhang + tolerance)) continue;
+        const glm::vec2 origin(static_cast<float>((faceTile - 1001) % 10),
+                               static_cast<float>((faceTile - 1001) / 10));
+        const auto corners = mesh.faceUVIndices(f);
+        size_t worst = 0;
+        float reach = -1.0f;
+        for (size_t k = 0; k < corners.size(); ++k) {
+            const glm::vec2 uv = uvs[corners[k]] - origin;
+            const float outside = std::max({-uv.x, uv.x - 1.0f, -uv.y, uv.y - 1.0f});
+            if (outside > reach) {
+                reach = outside;
+                worst = k;
+            }
+        }
+        const glm::vec2 uv = uvs[corners[worst]];
+        const int corner = udimTileOf(uv);
+        const bool onTile = uv.x >= 0.0f && uv.x < 10.0f && uv.y >= 0.0f;
+        throw InvalidInput(formatError(
+            source(faceTile), "face " + std::to_string(f),
+            "overhangs the tile by " + std::to_string(overhang) + " (corner " + std::to_string(worst) +
+                " at (" + std::to_string(uv.x) + ", " + std::to_string(uv.y) + "), " +
+                (onTile ? "in tile " + std::to_string(corner) : std::string("off the UDIM tiles")) + ")",
+            "a face whose UV corners reach at most " + std::to_string(kUdimMaxOverhang) +
+                " of a tile past the tile of its UV centroid, on the UDIM tiles (0 <= u < 10, v >= 0)"));
+    }
+}
+
 const HalfEdgeMesh& Mesh::halfEdges() const {
     std::call_once(topology_->once,
                    [this] { topology_->value = std::make_unique<const HalfEdgeMesh>(*this); });

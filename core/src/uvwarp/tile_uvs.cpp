@@ -58,33 +58,11 @@ TileUVs collectTileUVs(const geom::Mesh& mesh, int tile, std::string_view label)
     }
 
     // The tile's faces (Mesh::faceUdimTile), refusing those that overhang it by more than kMaxOverhang.
+    geom::requireUdimFacesInTile(
+        mesh, tile, [&](int) { return source; }, kTileTolerance);
     std::vector<uint8_t> inTile(static_cast<size_t>(mesh.numFaces()), 0);
-    for (int32_t f = 0; f < mesh.numFaces(); ++f) {
-        if (mesh.faceUdimTile(f) != tile) continue;
-        const float overhang = mesh.faceUdimOverhang(f);
-        if (overhang > kMaxOverhang + kTileTolerance) {
-            const auto corners = mesh.faceUVIndices(f);
-            size_t worst = 0;
-            float reach = -1.0f;
-            for (size_t k = 0; k < corners.size(); ++k) {
-                const glm::vec2 uv = uvs[corners[k]] - out.origin;
-                const float outside = std::max({-uv.x, uv.x - 1.0f, -uv.y, uv.y - 1.0f});
-                if (outside > reach) {
-                    reach = outside;
-                    worst = k;
-                }
-            }
-            const glm::vec2 uv = uvs[corners[worst]];
-            throw InvalidInput(formatError(
-                source, "face " + std::to_string(f),
-                "overhangs the tile by " + std::to_string(overhang) + " (corner " + std::to_string(worst) +
-                    " at (" + std::to_string(uv.x) + ", " + std::to_string(uv.y) + "), in tile " +
-                    std::to_string(geom::udimTileOf(uv)) + ")",
-                "a face whose UV corners reach at most " + std::to_string(kMaxOverhang) +
-                    " of a tile past the tile of its UV centroid"));
-        }
-        inTile[f] = 1;
-    }
+    for (int32_t f = 0; f < mesh.numFaces(); ++f)
+        inTile[f] = mesh.faceUdimTile(f) == tile ? 1 : 0;
 
     const geom::Triangulation tris = geom::triangulate(mesh);
     // Sized once: grown by push_back, these buffers' copies and first-touched pages cost more than the rest.

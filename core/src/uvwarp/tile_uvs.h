@@ -21,7 +21,7 @@ inline constexpr float kTileTolerance = 1e-5f;
 // How far (UV units, tile widths) a face's corners may overhang its tile (geom::Mesh::faceUdimTile): the
 // overhang of artists' layouts (a few corners past a tile edge), rasterised as far as the tile reaches and
 // reported; beyond it a face is refused as lying in two tiles.
-inline constexpr float kMaxOverhang = 0.1f;
+inline constexpr float kMaxOverhang = geom::kUdimMaxOverhang;
 
 struct TileUVs {
     int tile = 0;

@@ -461,6 +461,16 @@ TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and bot
     bad.faces[3].adjFaces[1] = 99;
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::PtexSampler(bad, "bad.ptx"); }),
                Catch::Contains("face 3 edge 1"));
+    // A non-finite texel: filtered look-ups would spread it (a UDIM image made from it held 256 NaN
+    // pixels for one NaN texel, inf became NaN). Named where it is.
+    ptex::PtexFile holed = bakePaint(mesh, pm, 1);
+    REQUIRE(holed.dataType == ptex::DataType::Float);
+    const float nan = std::nanf("");
+    const size_t at =
+        (static_cast<size_t>(1) * holed.faces[5].ures() + 1) * holed.pixelSize();  // texel (1, 1)
+    std::memcpy(holed.texels[5].data() + at, &nan, sizeof nan);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::PtexSampler(holed, "holed.ptx"); }),
+               Catch::Contains("holed.ptx: face 5 texel (1, 1) channel 0: is nan (expected finite values"));
 }
 
 TEST_CASE("ptex mesh: a file whose mesh metadata lists other polygons, or these in another order, is refused",
@@ -659,6 +669,34 @@ TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[p
         const std::vector<ptex::UdimTile> oneTile(tiles.begin(), tiles.begin() + 1);
         CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::udimToPtex(pm, mesh, oneTile); }),
                    Catch::Contains("UDIM tile 1002"));
+    }
+    SECTION("errors: a face off the UDIM tiles or across two, both ways, naming it") {
+        // The layout shifted left by a tile (u in [-0.8, 0.8]): its left faces lie off the tiles (u < 0),
+        // where tile 1001's image was written blank and read from its clamped edge. Shifted right by 0.4 (u
+        // in [0.6, 2.2]): the last column of faces, u in [1.8, 2.2], lies in tile 1003 and 0.2 into tile
+        // 1002.
+        for (const auto& [shift, tile, where] :
+             {std::tuple{-1.0f, 1001, "off the UDIM tiles"}, std::tuple{0.4f, 1003, "in tile 1002"}}) {
+            geom::Mesh::Data d;
+            d.points.assign(mesh.points().begin(), mesh.points().end());
+            for (const glm::vec2& uv : mesh.uvs())
+                d.uvs.push_back(uv + glm::vec2(shift, 0.0f));
+            d.faceCounts.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
+            d.faceIndices.assign(mesh.faceIndices().begin(), mesh.faceIndices().end());
+            d.uvIndices.assign(mesh.uvIndices().begin(), mesh.uvIndices().end());
+            const geom::Mesh shifted(std::move(d), "shifted.obj");
+            const PtexMesh shiftedPm(shifted, "shifted.obj");
+            INFO("shift " << shift);
+            for (const std::string& what :
+                 {test::errorOf<InvalidInput>([&] { (void)ptex::udimToPtex(shiftedPm, shifted, tiles); }),
+                  test::errorOf<InvalidInput>([&] {
+                      (void)ptex::ptexToUdim(shiftedPm, shifted, file, "paint.ptx", {res, {tile}});
+                  })}) {
+                CHECK_THAT(what,
+                           Catch::Contains("shifted.obj, UDIM tile " + std::to_string(tile) + ": face ") &&
+                               Catch::Contains(": overhangs the tile by ") && Catch::Contains(where));
+            }
+        }
     }
 }
 

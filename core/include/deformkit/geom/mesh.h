@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -113,5 +114,15 @@ struct UdimOverhang {
     float worst = 0.0f;
 };
 [[nodiscard]] UdimOverhang udimOverhang(const Mesh& mesh, int tile = 0, float tolerance = 1e-5f);
+
+// How far (UV units, tile widths) a face's corners may overhang its tile (Mesh::faceUdimTile): the overhang
+// of artists' layouts (a few corners past a tile edge), drawn as far as the tile reaches; beyond it a face
+// lies in two tiles, or off every tile (u < 0, u >= 10, v < 0), and no tile's image holds it.
+inline constexpr float kUdimMaxOverhang = 0.1f;
+// Throws InvalidInput naming `source` (a function of the tile), the face, its corner farthest out and the
+// tile that corner lies in, for the first face of `tile` (every tile: 0) that overhangs its tile by more
+// than kUdimMaxOverhang (plus `tolerance`, for UVs rounded on a tile border).
+void requireUdimFacesInTile(const Mesh& mesh, int tile, const std::function<std::string(int tile)>& source,
+                            float tolerance = 1e-5f);
 
 }  // namespace deformkit::geom
