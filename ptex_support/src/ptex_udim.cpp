@@ -366,6 +366,16 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
                                       static_cast<float>((1.0 - (uv.y - origin.v)) * image.height));
                 io::sampleImage(image, pixel, io::SampleFilter::Bilinear, value);
                 for (int32_t c = 0; c < channels; ++c) {
+                    // A value beyond the type's range would be clamped (u8, u16) or become inf (half).
+                    if (const std::string range = detail::outsideTypeRange(value[c], options.dataType);
+                        !range.empty()) {
+                        throw InvalidInput(formatError("UDIM tile " + std::to_string(tile),
+                                                       "pixel (" + std::to_string(pixel.x) + ", " +
+                                                           std::to_string(pixel.y) + ") channel " +
+                                                           std::to_string(c) + ", read for mesh face " +
+                                                           std::to_string(f),
+                                                       "is " + numberText(value[c]), range));
+                    }
                     const size_t at = ((static_cast<size_t>(j) * info.ures() + i) * channels + c) * bytes;
                     detail::storeValue(value[c], options.dataType, texels.data() + at);
                 }

@@ -143,6 +143,12 @@ PtexFile bakeVertexValues(const PtexMesh& mesh, std::span<const float> values, i
             throw InvalidInput(formatError(mesh.source(), "vertex " + std::to_string(i / channels),
                                            "has value " + numberText(values[i]), "finite values"));
         }
+        // Texels are blends of their face's vertex values (weights >= 0, summing to 1): in the type's range
+        // when the vertices are. A value beyond it would be clamped (u8, u16) or become inf (half).
+        if (const std::string range = detail::outsideTypeRange(values[i], options.dataType); !range.empty()) {
+            throw InvalidInput(formatError(mesh.source(), "vertex " + std::to_string(i / channels),
+                                           "has value " + numberText(values[i]), range));
+        }
     }
     PtexFile file;
     file.meshType = MeshType::Quad;

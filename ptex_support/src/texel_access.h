@@ -15,6 +15,25 @@
 
 namespace deformkit::ptex::detail {
 
+// Whether `value` is one a texel of `type` holds: u8 and u16 in [0, 1] (a rounding's 1e-5 beyond is taken
+// as the bound), half within +-65504 (beyond it, inf); float any finite value. Empty when it is, else what
+// a texel of the type holds, for a message.
+inline std::string outsideTypeRange(double value, DataType type) {
+    switch (type) {
+        case DataType::UInt8:
+        case DataType::UInt16:
+            if (value >= -1e-5 && value <= 1.0 + 1e-5) return {};
+            return std::string("values in [0, 1] for ") + (type == DataType::UInt8 ? "u8" : "u16") +
+                   " texels (half or float hold others)";
+        case DataType::Half:
+            if (std::abs(value) <= 65504.0) return {};
+            return "values within +-65504 for half texels (float holds larger ones)";
+        case DataType::Float:
+            return {};
+    }
+    return {};
+}
+
 // A float value in the file's data type, little-endian bytes.
 inline void storeValue(float value, DataType type, uint8_t* out) {
     switch (type) {

@@ -208,9 +208,13 @@ printf '[0, 0.5, 1, 0.5]\n' >"$work/left.json"
 expect ptex-left 0 "$dk" ptex from-vertex "$work/left.json" "$work/left.obj" --out "$work/left.ptx"
 expect ptex-udim-tile 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --tiles 1000
 contains ptex-udim-tile "$work/err" "--tiles: '1000' is not a UDIM tile"
-# A face that overhangs its tile (u from -0.45 to 0.05) belongs to it, as everywhere else: its part inside is
-# rendered (it was skipped, its centroid being left of the tile).
-expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --resolution 16
+# A face that lies mostly off the tiles (u from -0.45 to 0.05) would lose that part: refused, as the UV warp
+# refuses it, naming the face. One that overhangs its tile by up to a tenth (u from -0.05 to 0.45) belongs to
+# it: its part inside is rendered.
+expect ptex-udim-off-tiles 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --resolution 16
+contains ptex-udim-off-tiles "$work/err" "left.obj, UDIM tile 1001: face 0: overhangs the tile by 0.450000 (corner 0 at (-0.450000, 0.100000), off the UDIM tiles)"
+sed 's/^vt -0.45 /vt -0.05 /; s/^vt 0.05 /vt 0.45 /' "$work/left.obj" >"$work/edge.obj"
+expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/edge.obj" --out "$work/l.<UDIM>.png" --resolution 16
 [ -s "$work/l.1001.png" ] || { echo "FAIL ptex-udim-overhang: tile missing"; failures=$((failures + 1)); }
 # Faces without UVs beside faces with them (as exporters write them): read, in no tile, reported.
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nf 1/1 2/2 3/3 4/4\nf 2 5 3\n' >"$work/mixed.obj"

@@ -670,6 +670,33 @@ TEST_CASE("ptex mesh: UDIM and Ptex convert both ways through the mesh UVs", "[p
         CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::udimToPtex(pm, mesh, oneTile); }),
                    Catch::Contains("UDIM tile 1002"));
     }
+    SECTION("errors: values a texel of the type cannot hold, named where they are read") {
+        // u8 and u16 hold [0, 1] (clamped before), half +-65504 (inf before): 2.0 and 1e5 are refused.
+        std::vector<ptex::UdimTile> bright = tiles;
+        bright[1].image.at(40, 20, 0) = 2.0f;
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)ptex::udimToPtex(pm, mesh, bright, {3, 3, ptex::DataType::UInt8});
+                   }),
+                   Catch::Contains("UDIM tile 1002: pixel (") && Catch::Contains(": is ") &&
+                       Catch::Contains("(expected values in [0, 1] for u8 texels"));
+        std::fill(bright[1].image.pixels.begin(), bright[1].image.pixels.end(), 1e5f);
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)ptex::udimToPtex(pm, mesh, bright, {3, 3, ptex::DataType::Half});
+                   }),
+                   Catch::Contains("(expected values within +-65504 for half texels"));
+        CHECK_NOTHROW(ptex::udimToPtex(pm, mesh, bright, {3, 3, ptex::DataType::Float}));
+        std::vector<float> values(static_cast<size_t>(mesh.numVertices()), 0.5f);
+        values[7] = -0.5f;
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)ptex::bakeVertexValues(pm, values, 1, {2, 2, ptex::DataType::UInt16});
+                   }),
+                   Catch::Contains("vertex 7: has value -0.5 (expected values in [0, 1] for u16"));
+        values[7] = 7e4f;
+        CHECK_THAT(test::errorOf<InvalidInput>([&] {
+                       (void)ptex::bakeVertexValues(pm, values, 1, {2, 2, ptex::DataType::Half});
+                   }),
+                   Catch::Contains("vertex 7: has value 70000 (expected values within +-65504"));
+    }
     SECTION("errors: a face off the UDIM tiles or across two, both ways, naming it") {
         // The layout shifted left by a tile (u in [-0.8, 0.8]): its left faces lie off the tiles (u < 0),
         // where tile 1001's image was written blank and read from its clamped edge. Shifted right by 0.4 (u
