@@ -140,6 +140,13 @@ std::vector<fs::path> ptexToUdimCommand(const PtexToUdimCommand& command) {
                          ? io::PixelType::Float
                          : io::PixelType::Half;
     }
+    // Every tile's file checked before the first is written: a tile that could not be written after
+    // others were left a partial set of maps.
+    for (const int tile : command.tiles.empty() ? mesh.udimTiles() : command.tiles) {
+        const fs::path path = io::expandUdim(command.out, tile);
+        io::requireImageWriter(path);
+        io::requireWritable(path);
+    }
     std::vector<fs::path> written;
     for (const ptex::UdimTile& tile :
          ptex::ptexToUdim(ptexMesh, mesh, file, command.ptex.string(), options)) {

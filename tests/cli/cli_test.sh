@@ -216,6 +216,14 @@ contains ptex-udim-off-tiles "$work/err" "left.obj, UDIM tile 1001: face 0: over
 sed 's/^vt -0.45 /vt -0.05 /; s/^vt 0.05 /vt 0.45 /' "$work/left.obj" >"$work/edge.obj"
 expect ptex-udim-overhang 0 "$dk" ptex to-udim "$work/left.ptx" "$work/edge.obj" --out "$work/l.<UDIM>.png" --resolution 16
 [ -s "$work/l.1001.png" ] || { echo "FAIL ptex-udim-overhang: tile missing"; failures=$((failures + 1)); }
+# Two tiles, the second's folder missing: nothing is written (the first tile was, before).
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nvt 1.1 0.1\nvt 1.9 0.1\nvt 1.9 0.9\nvt 1.1 0.9\nf 1/1 2/2 3/3 4/4\nf 2/5 5/6 6/7 3/8\n' >"$work/two.obj"
+printf '[0, 0.2, 0.4, 0.6, 0.8, 1]\n' >"$work/two.json"
+expect ptex-two 0 "$dk" ptex from-vertex "$work/two.json" "$work/two.obj" --out "$work/two.ptx"
+mkdir -p "$work/d1001"
+expect ptex-udim-folder 2 "$dk" ptex to-udim "$work/two.ptx" "$work/two.obj" --out "$work/d<UDIM>/t.exr" --resolution 16
+contains ptex-udim-folder "$work/err" "d1002/t.exr: cannot write: folder '$work/d1002' does not exist"
+[ ! -e "$work/d1001/t.exr" ] || { echo "FAIL ptex-udim-folder: tile 1001 written"; failures=$((failures + 1)); }
 # Faces without UVs beside faces with them (as exporters write them): read, in no tile, reported.
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nvt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nf 1/1 2/2 3/3 4/4\nf 2 5 3\n' >"$work/mixed.obj"
 expect info-mixed-uvs 0 "$dk" info "$work/mixed.obj"

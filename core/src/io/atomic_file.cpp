@@ -107,10 +107,22 @@ std::string uniqueToken() {
     return process + "-" + std::to_string(counter.fetch_add(1));
 }
 
-void writeAtomically(const fs::path& requested, const std::function<void(const fs::path& tmp)>& write) {
+namespace {
+
+// What writeAtomically checks before writing: the file it writes (a link's target), and whether it replaces
+// one (with its mode in `before`).
+struct WriteCheck {
+    fs::path path;
+    bool replacing = false;
+    struct stat before {};
+};
+
+WriteCheck checkWritable(const fs::path& requested) {
     // Through a symbolic link the link's target is written (atomically, in the target's folder) and the link
     // stays; a FIFO, a device, a socket or a folder at the path is refused, never replaced.
-    const fs::path path = writeTarget(requested);
+    WriteCheck check;
+    check.path = writeTarget(requested);
+    const fs::path& path = check.path;
     const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
     std::error_code ec;
     const fs::file_status existing = fs::status(path, ec);
@@ -141,9 +153,8 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
     // An existing file is replaced only where it could be written in place: a write-protected one (a
     // published map) is refused, as a shell's redirection refuses it, and the one replaced keeps its
     // permissions (a group-writable file stays group-writable).
-    struct stat before {};
-    const bool replacing = fs::is_regular_file(existing) && ::stat(path.c_str(), &before) == 0;
-    if (replacing && ::access(path.c_str(), W_OK) != 0) {
+    check.replacing = fs::is_regular_file(existing) && ::stat(path.c_str(), &check.before) == 0;
+    if (check.replacing && ::access(path.c_str(), W_OK) != 0) {
         throw IoError(
             formatError(requested.string(), "",
                         std::string("cannot write: ") +
@@ -151,6 +162,21 @@ void writeAtomically(const fs::path& requested, const std::function<void(const f
                             " is write-protected (" + std::strerror(errno) + ")",
                         "a file this user may write, or a new path"));
     }
+    return check;
+}
+
+}  // namespace
+
+void requireWritable(const fs::path& path) {
+    (void)checkWritable(path);
+}
+
+void writeAtomically(const fs::path& requested, const std::function<void(const fs::path& tmp)>& write) {
+    const WriteCheck check = checkWritable(requested);
+    const fs::path& path = check.path;
+    const bool replacing = check.replacing;
+    const struct stat& before = check.before;
+    std::error_code ec;
     const fs::path tmp = temporaryPathFor(path);
     try {
         write(tmp);

@@ -16,6 +16,11 @@ namespace deformkit::io {
 void writeAtomically(const std::filesystem::path& path,
                      const std::function<void(const std::filesystem::path& tmp)>& write);
 
+// Throws IoError, as writeAtomically would before writing, when `path` cannot be written (its folder missing
+// or not writable, a folder or FIFO there, a write-protected file): for a command that writes several files
+// to check them all before the first.
+void requireWritable(const std::filesystem::path& path);
+
 // Creates folder `path` and its parents when missing. Throws IoError naming it (and the system's reason)
 // when it cannot be created or exists as something else.
 void createFolder(const std::filesystem::path& path);
