@@ -109,7 +109,10 @@ std::vector<uint8_t> chartMask(const geom::Mesh& mesh, int tile, const io::TileO
 // Gives uncovered texels the (u, v) of the nearest point of a covered 8-neighbour's cell, one ring at a
 // time: every texel of `chart` (hairline cracks where the cell grids of two faces meet) and `padding` rings
 // around the charts, as texture bakers pad chart edges. Neighbours are taken in a fixed order and ties
-// keep the first, so the result is the same on every run.
+// keep the first, and each ring reads the texels as the ring before left them, so the result is the same
+// on every run. A ring visits only the texels beside the ones the ring before covered (a texel that could
+// take a value earlier took it then): the work is the texels filled, not rings x tile (a padding as large
+// as the tile took minutes at 2048^2).
 void fillFromNeighbours(geom::AttributeRaster& raster, std::span<const glm::vec2> positions,
                         std::span<const std::array<int32_t, 3>> triangles, std::span<const float> attributes,
                         const std::vector<uint8_t>& chart, int32_t padding) {
@@ -119,47 +122,77 @@ void fillFromNeighbours(geom::AttributeRaster& raster, std::span<const glm::vec2
         int32_t triangle;
         glm::vec2 uv;
     };
+    const auto covered = [&](int32_t x, int32_t y) {
+        return x >= 0 && y >= 0 && x < w && y < h && raster.triangle[static_cast<size_t>(y) * w + x] >= 0;
+    };
+    // Ring 1's candidates: uncovered texels beside a covered one.
+    std::vector<size_t> candidates;
+    size_t chartLeft = 0;  // chart texels not covered
+    for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+            const size_t i = static_cast<size_t>(y) * w + x;
+            if (raster.triangle[i] >= 0) continue;
+            chartLeft += chart[i] ? 1 : 0;
+            bool beside = false;
+            for (int32_t dy = -1; dy <= 1 && !beside; ++dy)
+                for (int32_t dx = -1; dx <= 1 && !beside; ++dx)
+                    beside = covered(x + dx, y + dy);
+            if (beside) candidates.push_back(i);
+        }
+    }
+    std::vector<int32_t> queued(static_cast<size_t>(w) * h, 0);  // the ring a texel was last queued for
     std::vector<Update> updates;
     for (int32_t ring = 1;; ++ring) {
         updates.clear();
-        size_t chartLeft = 0;
-        for (int32_t y = 0; y < h; ++y) {
-            for (int32_t x = 0; x < w; ++x) {
-                const size_t i = static_cast<size_t>(y) * w + x;
-                if (raster.triangle[i] >= 0 || (!chart[i] && ring > padding)) continue;
-                const glm::dvec2 centre(x + 0.5, y + 0.5);
-                double bestD2 = std::numeric_limits<double>::infinity();
-                Update best{i, -1, {}};
-                for (int32_t dy = -1; dy <= 1; ++dy) {
-                    for (int32_t dx = -1; dx <= 1; ++dx) {
-                        const int32_t nx = x + dx, ny = y + dy;
-                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-                        const int32_t t = raster.triangle[static_cast<size_t>(ny) * w + nx];
-                        if (t < 0) continue;
-                        const auto& tri = triangles[t];
-                        const auto [l, d2] = nearestOnTriangle(centre, positions[tri[0]], positions[tri[1]],
-                                                               positions[tri[2]]);
-                        if (d2 >= bestD2) continue;
-                        bestD2 = d2;
-                        glm::dvec2 uv(0.0);
-                        for (int k = 0; k < 3; ++k)
-                            uv += l[k] * glm::dvec2(attributes[2 * tri[k]], attributes[2 * tri[k] + 1]);
-                        best = {i, t, glm::vec2(uv)};
-                    }
-                }
-                if (best.triangle >= 0) {
-                    updates.push_back(best);
-                } else if (chart[i]) {
-                    ++chartLeft;
+        for (const size_t i : candidates) {
+            if (raster.triangle[i] >= 0 || (!chart[i] && ring > padding)) continue;
+            const auto x = static_cast<int32_t>(i % static_cast<size_t>(w));
+            const auto y = static_cast<int32_t>(i / static_cast<size_t>(w));
+            const glm::dvec2 centre(x + 0.5, y + 0.5);
+            double bestD2 = std::numeric_limits<double>::infinity();
+            Update best{i, -1, {}};
+            for (int32_t dy = -1; dy <= 1; ++dy) {
+                for (int32_t dx = -1; dx <= 1; ++dx) {
+                    const int32_t nx = x + dx, ny = y + dy;
+                    if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                    const int32_t t = raster.triangle[static_cast<size_t>(ny) * w + nx];
+                    if (t < 0) continue;
+                    const auto& tri = triangles[t];
+                    const auto [l, d2] =
+                        nearestOnTriangle(centre, positions[tri[0]], positions[tri[1]], positions[tri[2]]);
+                    if (d2 >= bestD2) continue;
+                    bestD2 = d2;
+                    glm::dvec2 uv(0.0);
+                    for (int k = 0; k < 3; ++k)
+                        uv += l[k] * glm::dvec2(attributes[2 * tri[k]], attributes[2 * tri[k] + 1]);
+                    best = {i, t, glm::vec2(uv)};
                 }
             }
+            if (best.triangle >= 0) updates.push_back(best);
         }
         for (const Update& u : updates) {
             raster.triangle[u.texel] = u.triangle;
             raster.values[2 * u.texel] = u.uv.x;
             raster.values[2 * u.texel + 1] = u.uv.y;
+            chartLeft -= chart[u.texel] ? 1 : 0;
         }
         if (updates.empty() || (ring >= padding && chartLeft == 0)) break;
+        // The next ring's candidates: uncovered texels beside the ones this ring covered.
+        candidates.clear();
+        for (const Update& u : updates) {
+            const auto x = static_cast<int32_t>(u.texel % static_cast<size_t>(w));
+            const auto y = static_cast<int32_t>(u.texel / static_cast<size_t>(w));
+            for (int32_t dy = -1; dy <= 1; ++dy) {
+                for (int32_t dx = -1; dx <= 1; ++dx) {
+                    const int32_t nx = x + dx, ny = y + dy;
+                    if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                    const size_t n = static_cast<size_t>(ny) * w + nx;
+                    if (raster.triangle[n] >= 0 || queued[n] == ring + 1) continue;
+                    queued[n] = ring + 1;
+                    candidates.push_back(n);
+                }
+            }
+        }
     }
 }
 
