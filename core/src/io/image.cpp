@@ -404,6 +404,12 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
         throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
                                        "at most 4 channels in " + format + " files"));
     }
+    // JPEG holds grey or RGB: OpenImageIO's writer drops a second or fourth channel (alpha, a coverage
+    // channel) without a word.
+    if (format == "jpeg" && channels != 1 && channels != 3) {
+        throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
+                                       "1 or 3 channels in jpeg files (no alpha; PNG, TIFF or EXR keep it)"));
+    }
     const std::string type = requestedType(options.type, format);
 
     writeAtomically(path, [&](const fs::path& tmp) {

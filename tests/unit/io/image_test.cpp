@@ -633,6 +633,18 @@ TEST_CASE("writeImage rejects what it cannot store faithfully and leaves no file
     CHECK_THROWS_AS(writeImage(dir / "a.exr", img, {PixelType::UInt16, {}}), InvalidInput);
     CHECK_THROWS_AS(writeImage(dir / "a.jpg", img, {PixelType::Float, {}}), InvalidInput);
     CHECK_THROWS_AS(writeImage(dir / "five.png", patternImage(2, 2, 5)), InvalidInput);
+    // JPEG holds grey or RGB: a second or fourth channel was dropped without a word.
+    for (const int32_t channels : {2, 4}) {
+        CHECK_THROWS_WITH(writeImage(dir / "a.jpg", patternImage(2, 2, channels)),
+                          Catch::Contains("a.jpg: has " + std::to_string(channels) +
+                                          " channels (expected 1 or 3 channels in jpeg files"));
+    }
+    CHECK_FALSE(fs::exists(dir / "a.jpg"));
+    for (const int32_t channels : {1, 3}) {
+        writeImage(dir / "a.jpg", patternImage(2, 2, channels));
+        CHECK(readImage(dir / "a.jpg").channels == channels);
+    }
+    fs::remove(dir / "a.jpg");  // the checks below count what the refused writes left
     CHECK_THROWS_WITH(writeImage(dir / "a.notaformat", img), Catch::Contains("'.notaformat'"));
     // TIFF keeps only its standard tags: a custom attribute would be lost.
     CHECK_THROWS_WITH(writeImage(dir / "a.tif", img, {PixelType::Auto, {{"deformkit:solver", "x"}}}),
