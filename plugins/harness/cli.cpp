@@ -32,7 +32,23 @@ Option& Option::choices(std::vector<std::string> values) {
 }
 
 Option& Option::range(double lo, double hi) {
-    option_->check(CLI::Range(lo, hi));
+    // CLI11's Range prints its bounds with six decimals ("1.000000 to 65536.000000"): this says them as
+    // written.
+    const auto text = [](double v) {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, "%g", v);
+        return std::string(buffer);
+    };
+    const std::string expected = "a number from " + text(lo) + " to " + text(hi);
+    option_->check(CLI::Validator(
+        [lo, hi, expected](std::string& value) -> std::string {
+            double number = 0.0;
+            if (!CLI::detail::lexical_cast(value, number))
+                return "is '" + value + "' (expected " + expected + ")";
+            if (!(number >= lo && number <= hi)) return "is " + value + " (expected " + expected + ")";
+            return {};
+        },
+        "[" + text(lo) + ", " + text(hi) + "]"));
     return *this;
 }
 

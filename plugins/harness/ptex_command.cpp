@@ -267,9 +267,12 @@ void addPtexCommands(CommandLine& cli) {
     toUdim.option("FILE", tu->command.ptex, "Ptex file painted on MESH").required();
     toUdim.option("MESH", tu->command.mesh, "mesh with UVs (.obj, .gltf, .glb, .fbx, .ply, .dae)").required();
     toUdim.option("--out", tu->command.out, "UDIM pattern, such as 'map.<UDIM>.exr'").required();
-    toUdim.option("--resolution", tu->command.resolution, "pixels per tile side").showDefault();
+    toUdim.option("--resolution", tu->command.resolution, "pixels per tile side")
+        .range(1, 65536)
+        .showDefault();
     toUdim.option("--tiles", tu->tiles, "tiles to write, each once (default: every tile of the mesh)");
     toUdim.option("--padding", tu->command.padding, "texels of edge padding around the UV charts")
+        .range(0, 65536)
         .showDefault();
     toUdim.flag("--coverage", tu->command.coverage,
                 "add a last channel: 1 on the UV charts, 0 in the padding and outside them");

@@ -231,7 +231,7 @@ contains info-mixed-uvs "$work/out" "warning     1 face has no UVs (first on lin
 expect ptex-from-udim-mixed 0 "$dk" ptex from-udim "$work/demo/albedo.<UDIM>.png" "$work/mixed.obj" --out "$work/mixed.ptx"
 contains ptex-from-udim-mixed "$work/out" "1 face has no UVs: written as 0"
 expect ptex-udim-padding 2 "$dk" ptex to-udim "$work/left.ptx" "$work/left.obj" --out "$work/l.<UDIM>.png" --padding -1
-contains ptex-udim-padding "$work/err" "padding: is -1 (expected texels of edge padding in [0, 65536])"
+contains ptex-udim-padding "$work/err" "usage error: --padding: is -1 (expected a number from 0 to 65536)"
 printf 'not a ptex file, just some text that is long enough to hold a header of sixty-four bytes\n' >"$work/bad.ptx"
 expect ptex-bad-file 2 "$dk" ptex info "$work/bad.ptx"
 contains ptex-bad-file "$work/err" "bad.ptx"
