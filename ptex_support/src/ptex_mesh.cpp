@@ -146,6 +146,21 @@ void PtexMesh::requireMatches(const PtexFile& file, const std::string& fileSourc
                                        std::to_string(meshFace_.size()) +
                                            " Ptex faces (one per quad, N per N-gon) for mesh " + source_));
     }
+    // Without the mesh metadata the face count alone would pair a file of 2 quads and a triangle (5 Ptex
+    // faces, 3 of them sub-faces) with a mesh of 5 quads: each face's sub-face flag must be the mesh's.
+    for (size_t p = 0; p < meshFace_.size(); ++p) {
+        const bool sub = subFace_[p] >= 0;
+        if (file.faces[p].subface == sub) continue;
+        throw InvalidInput(
+            formatError(fileSource, "face " + std::to_string(p),
+                        std::string(file.faces[p].subface ? "is a sub-face of an N-gon" : "is a whole quad") +
+                            ", where mesh " + source_ + " has " +
+                            (sub ? "sub-face " + std::to_string(subFace_[p]) + " of its " +
+                                       std::to_string(faceCounts_[static_cast<size_t>(meshFace_[p])]) +
+                                       "-gon " + std::to_string(meshFace_[p])
+                                 : "its quad " + std::to_string(meshFace_[p])),
+                        "the Ptex faces of this mesh (a file painted on another mesh with as many faces?)"));
+    }
     requireSameMesh(file, fileSource);
     detail::requireAdjacency(file.faces, fileSource);
 }

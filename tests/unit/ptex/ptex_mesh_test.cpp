@@ -456,6 +456,18 @@ TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and bot
     CHECK_THAT(message, Catch::Contains("has 4 faces"));
     CHECK_THAT(message, Catch::Contains("14 Ptex faces"));
     CHECK_THAT(message, Catch::Contains("mixed.obj"));
+    // As many faces, other kinds (no mesh metadata to tell): a quad and a triangle (4 Ptex faces, 3 of them
+    // sub-faces) against a file of 4 quads, whose texels would land on the wrong faces.
+    geom::Mesh::Data d;
+    d.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0.5f, 0}};
+    d.faceCounts = {4, 3};
+    d.faceIndices = {0, 1, 2, 3, 1, 4, 2};
+    const geom::Mesh quadTriangle(std::move(d), "qt.obj");
+    const PtexMesh qt(quadTriangle, "qt.obj");
+    REQUIRE(qt.numPtexFaces() == 4);
+    CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::vertexValues(qt, file, "paint.ptx"); }),
+               Catch::Contains(
+                   "paint.ptx: face 1: is a whole quad, where mesh qt.obj has sub-face 0 of its 3-gon 1"));
 
     ptex::PtexFile bad = bakePaint(mesh, pm, 1);
     bad.faces[3].adjFaces[1] = 99;
