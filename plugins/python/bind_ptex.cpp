@@ -126,6 +126,13 @@ py::object metaValue(const ptex::MetaValue& m) {
 ptex::MetaValue metaFrom(const std::string& key, py::handle value, const std::string& source) {
     if (py::isinstance<py::str>(value))
         return ptex::MetaValue::ofString(key, bytesOf(value, source, "metadata '" + key + "'"));
+    // numpy makes None (and any object) a 0-dimensional array of objects: said as what it is.
+    if (value.is_none() || (!py::isinstance<py::array>(value) && !py::isinstance<py::sequence>(value))) {
+        throw InvalidInput(
+            formatError(source, "metadata '" + key + "'",
+                        "is " + py::str(py::type::of(value).attr("__name__")).cast<std::string>(),
+                        "a string or a 1-D int8/int16/int32/float32/float64 array"));
+    }
     const py::array a = py::array::ensure(value);
     if (!a || a.ndim() != 1) {
         throw InvalidInput(formatError(
@@ -303,6 +310,14 @@ ptex::PtexFile fromDict(const py::dict& d, const std::optional<geom::Mesh>& mesh
     file.edgeFilterMode =
         static_cast<ptex::EdgeFilterMode>(nameIndex(d, "edge_filter_mode", kEdgeFilterModes, 0, source));
     if (mesh) {
+        // A mesh's Ptex faces are Catmull-Clark's (quads, N sub-faces per N-gon): a triangle-type file
+        // cannot be laid out on it.
+        if (file.meshType == ptex::MeshType::Triangle) {
+            throw InvalidInput(
+                formatError(source, "mesh_type", "is 'triangle' with a mesh",
+                            "'quad' (a mesh's Ptex faces are quads and N-gons' sub-faces), or no "
+                            "mesh and the faces' adjacency given"));
+        }
         const ptex::PtexMesh pm(*mesh, source);
         const std::vector<ptex::FaceInfo> infos = pm.faceInfos(0, 0);
         if (infos.size() != file.faces.size()) {

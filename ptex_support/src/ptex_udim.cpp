@@ -332,9 +332,12 @@ PtexFile udimToPtex(const PtexMesh& ptexMesh, const geom::Mesh& mesh, std::span<
         }
     }
     if (channels < 1 || channels > 64) {
-        throw InvalidInput(formatError("UDIM tile " + std::to_string(tiles.front().tile), "",
-                                       "has " + std::to_string(channels) + " channels", "1 to 64 channels"));
+        const UdimTile& first = tiles.front();
+        throw InvalidInput(formatError(
+            first.source.empty() ? "UDIM tile " + std::to_string(first.tile) : first.source, "",
+            "has " + std::to_string(channels) + " channels", "1 to 64 channels (a Ptex file's most)"));
     }
+
     const auto fixedLog2 = [](int8_t value, const char* name) {
         if (value < -1 || value > 15) {
             throw InvalidInput(formatError("from-udim", name, "is " + std::to_string(value),

@@ -129,6 +129,15 @@ def test_metadata_text_in_any_encoding_reads_and_writes_back_byte_for_byte(tmp_p
         dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {"k": "\ud800"}})
     with pytest.raises(dk.InvalidInput, match=r"metadata key 7: is of type int \(expected a str\)"):
         dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {7: "x"}})
+    # A triangle-type file cannot be laid out on a mesh's Ptex faces: said so, not as a face count.
+    mesh = dk.Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), np.array([3], np.int32),
+                   np.array([0, 1, 2], np.int32))
+    with pytest.raises(dk.InvalidInput, match=r"mesh_type: is 'triangle' with a mesh \(expected 'quad'"):
+        dk.write_ptex(tmp_path / "t.ptx", {**data, "mesh_type": "triangle"}, mesh=mesh)
+    # A value that is no string or array is named by its type (None was "an array of 0 dimensions").
+    for value, kind in ((None, "NoneType"), (3.5, "float"), ({"a": 1}, "dict")):
+        with pytest.raises(dk.InvalidInput, match=rf"metadata 'k': is {kind} \(expected a string or a 1-D"):
+            dk.write_ptex(tmp_path / "c.ptx", {**data, "metadata": {"k": value}})
 
 
 def test_constant_faces_read_as_one_pixel_seen_everywhere_and_write_back_as_constants(tmp_path):

@@ -1,21 +1,24 @@
 #pragma once
 
-// How the warps' messages print a point: "(x, y, z)" with std::to_string's six decimals.
+// How the warps' messages print a point: "(x, y, z)", each the shortest text that reads back as the float
+// ("0.5", "2e+19"; std::to_string printed 20-digit integers and rounded small values to 0.000000).
 
 #include <string>
 
 #include <glm/vec3.hpp>
+
+#include "deformkit/error.h"
 
 namespace deformkit::warp::detail {
 
 // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on a chain of "literal" + std::string.
 inline std::string pointText(const glm::vec3& v) {
     std::string text = "(";
-    text += std::to_string(v.x);
+    text += numberText(v.x);
     text += ", ";
-    text += std::to_string(v.y);
+    text += numberText(v.y);
     text += ", ";
-    text += std::to_string(v.z);
+    text += numberText(v.z);
     text += ")";
     return text;
 }

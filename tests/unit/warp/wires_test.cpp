@@ -572,8 +572,19 @@ TEST_CASE("wires: bad input names the element", "[wires][errors]") {
     CHECK_THROWS_WITH(wires.setWire(0, nanCurve), Catch::Contains("wire 0 wire curve point 0"));
     CHECK(wires.wire(0).wire == good.wire);  // a rejected curve changes nothing
 
+    // Beyond +-1e15 squared distances near float's limit (past 1.8e19 they overflowed, and the points were
+    // left unmoved without a word): refused with the coordinates.
+    std::vector<glm::vec3> farCurve = good.wire;
+    farCurve[1].x = 2e19f;
+    CHECK_THROWS_WITH(wires.setWire(0, farCurve),
+                      Catch::Contains("wire 0 wire curve point 1: is (2e+19, ") &&
+                          Catch::Contains("(expected finite coordinates within +-1e15"));
+    CHECK(wires.wire(0).wire == good.wire);
+
     std::vector<glm::vec3> pts{{0, 0, 0}, {0.5f, NAN, 0}};
     CHECK_THROWS_WITH(wires.bind(pts), Catch::Contains("rest point 1"));
+    pts[1] = {0.5f, 0.0f, -3e19f};
+    CHECK_THROWS_WITH(wires.bind(pts), Catch::Contains("rest point 1: is (0.5, 0, -3e+19)"));
     std::vector<glm::vec3> three(3);
     CHECK_THROWS_WITH(wires.evaluate(three), Catch::Contains("before bind"));
     wires.bind(std::vector<glm::vec3>(2));
