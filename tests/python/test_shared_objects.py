@@ -124,7 +124,7 @@ def test_a_rejected_wires_call_leaves_the_wires_as_they_were():
         wires.evaluate(P, wire_curves=moved, weights=np.ones(3, np.float32))
     bad = [moved[0], moved[1].copy()]
     bad[1][1, 2] = np.nan  # the second curve is refused after the first was taken
-    with pytest.raises(dk.InvalidInput, match="wire 1 wire curve point 1: is not finite"):
+    with pytest.raises(dk.InvalidInput, match=r"wire 1 wire curve point 1: is \(1.3, 0, nan\)"):
         wires.evaluate(P, wire_curves=bad)
     with pytest.raises(dk.InvalidInput, match="wire 1 wire curve point 1"):
         wires.set_wire_curves(bad)

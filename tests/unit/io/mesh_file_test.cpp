@@ -485,6 +485,10 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
     test::writeText(dir / "crlf.ply", crlf + "\r\n\r\n");
     CHECK(pointsOf(io::readMesh(dir / "crlf.ply").mesh) == pointsOf(m));
 
+    // The PLY `text` (2 faces) with a header declaring `faces` faces.
+    const auto withFaces = [](std::string text, int faces) {
+        return text.replace(text.find("element face 2"), 14, "element face " + std::to_string(faces));
+    };
     // Binary, both byte orders: the same mesh. Cut short anywhere in its data, or with a header declaring
     // more than it holds, it is refused naming the element where it ends (assimp itself said "mIndices[1] is
     // out of range", or read made-up data).
@@ -511,15 +515,11 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
                     Contains("(expected the 5 vertex and 2 face elements its header declares)"));
         }
         CHECK(whole.size() - data == 5 * 20 + 17 + 13);
-        std::string liar = whole;
-        liar.replace(liar.find("element face 2"), 14, "element face 9");
-        test::writeText(dir / "liar.ply", liar);
+        test::writeText(dir / "liar.ply", withFaces(whole, 9));
         CHECK_THROWS_WITH(io::readMesh(dir / "liar.ply"),
                           Contains("liar.ply: is cut short: ") && Contains("ends in face 2 of 9"));
         // A header declaring fewer faces than the file holds: assimp read the first and dropped the rest.
-        std::string shy = whole;
-        shy.replace(shy.find("element face 2"), 14, "element face 1");
-        test::writeText(dir / "shy.ply", shy);
+        test::writeText(dir / "shy.ply", withFaces(whole, 1));
         CHECK_THROWS_WITH(
             io::readMesh(dir / "shy.ply"),
             Contains("shy.ply: holds 13 bytes after the 5 vertex and 1 face elements its header "
@@ -529,9 +529,7 @@ TEST_CASE("mesh files: a PLY keeps its vertex order and its quads", "[io][mesh_f
         CHECK(pointsOf(io::readMesh(dir / "padded.ply").mesh) == pointsOf(m));
     }
     // The same in ASCII: a line after the declared elements.
-    std::string shy = kPly;
-    shy.replace(shy.find("element face 2"), 14, "element face 1");
-    test::writeText(dir / "shy.ply", shy);
+    test::writeText(dir / "shy.ply", withFaces(kPly, 1));
     CHECK_THROWS_WITH(
         io::readMesh(dir / "shy.ply"),
         Contains("shy.ply: line 18: holds data after the 5 vertex and 1 face elements its header "
