@@ -29,6 +29,18 @@ void checkSegment(const std::string& source, const std::string& element, const c
                         std::string(which) + " segment has a non-finite endpoint " + str(p) + " -> " + str(q),
                         "finite pixel coordinates"));
     }
+    // Lengths and distances are squared in float: endpoints near float's largest gave an infinite length,
+    // a map of inf and a weight of NaN. Within +-1e15, as the other warps' coordinates.
+    constexpr float kMaxCoordinate = 1e15f;
+    const auto far = [](glm::vec2 v) {
+        return !(std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate);
+    };
+    if (far(p) || far(q)) {
+        throw InvalidInput(formatError(
+            source, element,
+            std::string(which) + " segment has an endpoint beyond +-1e15: " + str(p) + " -> " + str(q),
+            "pixel coordinates within +-1e15 (lengths are squared in float)"));
+    }
     if (const float length = glm::length(q - p); !(length > kMinSegmentLength)) {
         const std::string what = length == 0.0f ? " segment has zero length (P = Q = " + str(p) + ")"
                                                 : " segment is " + numberText(length) +

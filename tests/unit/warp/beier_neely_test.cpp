@@ -424,6 +424,13 @@ TEST_CASE("Beier-Neely: bad input names the segment pair", "[warp][beier_neely][
     nanEnd.dstP.y = nan;
     CHECK_THROWS_WITH(beierNeelyMap(8, 8, withSecond(nanEnd)),
                       Catch::Contains("segment pair 1") && Catch::Contains("non-finite endpoint"));
+    // Endpoints near float's largest: the length overflowed, the map was inf and the weight message "nan".
+    SegmentPair farEnd = good;
+    farEnd.srcP = glm::vec2(-3e38f, 0.0f);
+    farEnd.srcQ = glm::vec2(3e38f, 0.0f);
+    CHECK_THROWS_WITH(beierNeelyMap(8, 8, withSecond(farEnd)),
+                      Catch::Contains("segment pair 1: source segment has an endpoint beyond +-1e15") &&
+                          Catch::Contains("(expected pixel coordinates within +-1e15"));
     for (float a : {0.0f, -1.0f, nan}) {
         SegmentPair bad = good;
         bad.a = a;
