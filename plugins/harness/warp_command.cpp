@@ -25,8 +25,8 @@ void warpImageCommand(const WarpImageCommand& command) {
     const warp::BeierNeelyWarp warp(pairs, {command.variant});
     std::vector<glm::vec2> map(static_cast<size_t>(source.width) * source.height);
     warp.mapPixelCentres(source.width, source.height, map);
-    const io::Image out =
-        warp::resampleImage(source, map, source.width, source.height, command.interpolation);
+    const io::Image out = warp::resampleImage(source, map, source.width, source.height, command.interpolation,
+                                              command.image.string());
     io::writeImage(command.out, out);
 }
 

@@ -10,7 +10,7 @@
 namespace deformkit::warp {
 namespace {
 
-void checkSource(const io::Image& image) {
+void checkSource(const io::Image& image, const std::string& name) {
     if (image.width <= 0 || image.height <= 0 || image.channels <= 0) {
         throw InvalidInput(formatError("image warp", "source image",
                                        "is " + std::to_string(image.width) + " x " +
@@ -24,13 +24,25 @@ void checkSource(const io::Image& image) {
                                        "has " + std::to_string(image.pixels.size()) + " values",
                                        std::to_string(expected) + " (width * height * channels)"));
     }
+    const auto bad =
+        std::find_if(image.pixels.begin(), image.pixels.end(), [](float v) { return !std::isfinite(v); });
+    if (bad != image.pixels.end()) {
+        const auto k = static_cast<size_t>(bad - image.pixels.begin());
+        const size_t pixel = k / static_cast<size_t>(image.channels);
+        throw InvalidInput(
+            formatError(name,
+                        "pixel (" + std::to_string(pixel % static_cast<size_t>(image.width)) + ", " +
+                            std::to_string(pixel / static_cast<size_t>(image.width)) + ") channel " +
+                            std::to_string(k % static_cast<size_t>(image.channels)),
+                        "is " + numberText(*bad), "finite values (a warped pixel blends its neighbours)"));
+    }
 }
 
 }  // namespace
 
 io::Image resampleImage(const io::Image& source, std::span<const glm::vec2> map, int32_t width,
-                        int32_t height, io::SampleFilter filter) {
-    checkSource(source);
+                        int32_t height, io::SampleFilter filter, const std::string& sourceName) {
+    checkSource(source, sourceName);
     if (width <= 0 || height <= 0) {
         throw InvalidInput(formatError("image warp", "destination size",
                                        "is " + std::to_string(width) + " x " + std::to_string(height),

@@ -81,4 +81,10 @@ TEST_CASE("image warp: bad input", "[warp][beier_neely][image_warp][errors]") {
     io::Image broken(4, 3, 2);
     broken.pixels.pop_back();
     CHECK_THROWS_WITH(resampleImage(broken, map, 4, 3), Catch::Contains("has 23 values"));
+    // A non-finite source pixel spread into every pixel sampled next to it: named with the image.
+    io::Image holed(4, 3, 2, 0.5f);
+    holed.at(3, 2, 1) = std::numeric_limits<float>::infinity();
+    map[6].y = 1.0f;
+    CHECK_THROWS_WITH(resampleImage(holed, map, 4, 3, io::SampleFilter::Bilinear, "photo.exr"),
+                      Catch::Contains("photo.exr: pixel (3, 2) channel 1: is inf (expected finite values"));
 }
