@@ -41,8 +41,7 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
         }
         // A non-finite texel (half and float files) would spread through every filtered look-up that
         // reaches it (inf - inf is NaN): named, as the per-vertex read names its corner texels.
-        const size_t count = (constant_[f] ? 1 : faces_[f].texelCount()) * static_cast<size_t>(channels_);
-        for (size_t t = 0; t < count; ++t) {
+        for (size_t t = 0; t < offsets_[f + 1] - offsets_[f]; ++t) {
             if (std::isfinite(out[t])) continue;
             const auto texel = static_cast<int64_t>(t / static_cast<size_t>(channels_));
             const int32_t ures = faces_[f].ures();

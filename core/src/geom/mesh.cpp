@@ -225,9 +225,8 @@ void requireUdimFacesInTile(const Mesh& mesh, int tile, const std::function<std:
         if (faceTile == 0 || (tile != 0 && faceTile != tile)) continue;
         const float overhang = mesh.faceUdimOverhang(f);
         if (!(overhang > kUdimMaxOverhang + tolerance)) continue;
-        const glm::vec2 origin(static_cast<float>((faceTile - 1001) % 10),
-                               static_cast<float>((faceTile - 1001) / 10));
         const auto corners = mesh.faceUVIndices(f);
+        const glm::vec2 origin(faceTileCell(uvs, corners));
         size_t worst = 0;
         float reach = -1.0f;
         for (size_t k = 0; k < corners.size(); ++k) {

@@ -381,10 +381,9 @@ void requireCompletePly(const fs::path& path) {
     }
     // Bytes after the declared elements (beyond a line end or padding of spaces or zeros): the header's
     // counts are too small, and assimp drops what follows without a word.
-    size_t extra = 0;
-    for (uint64_t k = at; k < fileSize; ++k)
-        if (const char c = text[k]; c != '\n' && c != '\r' && c != ' ' && c != '\0') ++extra;
-    if (extra > 0) {
+    const bool extra = std::any_of(text.begin() + static_cast<ptrdiff_t>(std::min(at, fileSize)), text.end(),
+                                   [](char c) { return c != '\n' && c != '\r' && c != ' ' && c != '\0'; });
+    if (extra) {
         throw InvalidInput(
             formatError(path.string(), "",
                         "holds " + std::to_string(fileSize - at) + " bytes after the " + declared +

@@ -30,12 +30,8 @@ void checkSegment(const std::string& source, const std::string& element, const c
                         "finite pixel coordinates"));
     }
     // Lengths and distances are squared in float: endpoints near float's largest gave an infinite length,
-    // a map of inf and a weight of NaN. Within +-1e15, as the other warps' coordinates.
-    constexpr float kMaxCoordinate = 1e15f;
-    const auto far = [](glm::vec2 v) {
-        return !(std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate);
-    };
-    if (far(p) || far(q)) {
+    // a map of inf and a weight of NaN.
+    if (!geom::isWithinSquaredRange(p) || !geom::isWithinSquaredRange(q)) {
         throw InvalidInput(formatError(
             source, element,
             std::string(which) + " segment has an endpoint beyond +-1e15: " + str(p) + " -> " + str(q),

@@ -22,18 +22,9 @@ std::string wireLabel(size_t i) {
     return "wire " + std::to_string(i);
 }
 
-// Wires square distances in float, which overflow beyond about 1.8e19: a point or curve that far away was
-// left unmoved without a word (its distances infinite, its weights 0). Coordinates within +-1e15, as the UV
-// warp's.
-constexpr float kMaxCoordinate = 1e15f;
-bool withinRange(const glm::vec3& p) {
-    return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
-           std::abs(p.z) <= kMaxCoordinate;
-}
-
 void requireCurve(std::span<const glm::vec3> curve, const std::string& label) {
     for (size_t j = 0; j < curve.size(); ++j) {
-        if (!withinRange(curve[j])) {
+        if (!geom::isWithinSquaredRange(curve[j])) {
             throw InvalidInput(formatError(
                 "wires", label + " point " + std::to_string(j), "is " + detail::pointText(curve[j]),
                 "finite coordinates within +-1e15 (wires square lengths in float)"));
@@ -377,7 +368,7 @@ void Wires::bind(std::span<const glm::vec3> restPoints) {
     bound_ = false;
     const int64_t n = static_cast<int64_t>(restPoints.size());
     for (int64_t u = 0; u < n; ++u) {
-        if (!withinRange(restPoints[u])) {
+        if (!geom::isWithinSquaredRange(restPoints[u])) {
             throw InvalidInput(formatError(
                 "wires", "rest point " + std::to_string(u), "is " + detail::pointText(restPoints[u]),
                 "finite coordinates within +-1e15 (wires square lengths in float)"));

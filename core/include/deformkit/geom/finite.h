@@ -19,6 +19,18 @@ namespace deformkit::geom {
     return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
 }
 
+// The largest coordinate magnitude where lengths are squared in float (the UV warp's solver, Wires,
+// Beier-Neely): squares overflow near 1.8e19 (a point that far was left unmoved, a length became inf); 1e15
+// keeps a margin of 1e4 below that, far above any scene's units.
+inline constexpr float kMaxSquaredCoordinate = 1e15f;
+// Finite, and within +-kMaxSquaredCoordinate in every coordinate.
+[[nodiscard]] inline bool isWithinSquaredRange(glm::vec2 p) {
+    return std::abs(p.x) <= kMaxSquaredCoordinate && std::abs(p.y) <= kMaxSquaredCoordinate;
+}
+[[nodiscard]] inline bool isWithinSquaredRange(const glm::vec3& p) {
+    return isWithinSquaredRange(glm::vec2(p)) && std::abs(p.z) <= kMaxSquaredCoordinate;
+}
+
 // Whether every coordinate of `points` is finite: a float whose exponent bits are all ones is infinite or
 // NaN, and adding one to such an exponent carries into the sign bit. Integer operations over the coordinates
 // as one array, which the compiler vectorises; inline, so that a loop can check a run of outputs it has just

@@ -8,6 +8,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "deformkit/geom/finite.h"
 #include "deformkit/geom/mesh.h"
 #include "deformkit/uvwarp/grid.h"
 
@@ -39,9 +40,8 @@ struct TileUVs;  // a tile's UV triangles (uvwarp/tile_uvs.h, private to the lib
 // nearest covered point (Euclidean, exact distance transform; ties go to the lower column, then the lower
 // row). The rings and weights are computed once at bind; each frame only re-applies them.
 // The largest coordinate magnitude a surface sampled for the UV warp may have: the solver measures squared
-// lengths in float, which overflow near 1e19 (a mesh scaled to 1e18 gave NaN positions); 1e15 keeps a
-// margin of 1e4 below that, and far above any scene's units.
-inline constexpr float kMaxCoordinate = 1e15f;
+// lengths in float (a mesh scaled to 1e18 gave NaN positions).
+inline constexpr float kMaxCoordinate = geom::kMaxSquaredCoordinate;
 
 // The first of `points` with a coordinate that is not finite or beyond kMaxCoordinate in magnitude, or
 // points.size() when there is none.
