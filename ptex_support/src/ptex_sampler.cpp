@@ -8,7 +8,7 @@
 
 namespace deformkit::ptex {
 
-PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
+PtexSampler::PtexSampler(const PtexFile& file, const std::string& source, uint64_t maxBytes)
     : source_(source), channels_(file.channels), faces_(file.faces) {
     if (file.meshType != MeshType::Quad) {
         throw InvalidInput(formatError(source, "header", "is a triangle-mesh Ptex file",
@@ -27,6 +27,17 @@ PtexSampler::PtexSampler(const PtexFile& file, const std::string& source)
         total += (constant_[f] ? 1 : faces_[f].texelCount()) * static_cast<size_t>(channels_);
     }
     offsets_.back() = total;
+    uint64_t stored = file.constData.size();
+    for (const std::vector<uint8_t>& texels : file.texels)
+        stored += texels.size();
+    const uint64_t copy = static_cast<uint64_t>(total) * sizeof(float);
+    if (copy > maxBytes || stored > maxBytes - copy) {
+        throw InvalidInput(formatError(
+            source, "texels",
+            std::to_string(stored) + " bytes as stored and " + std::to_string(copy) +
+                " as floats for filtering",
+            "at most " + std::to_string(maxBytes) + " bytes in all (ReadOptions::maxDecodedBytes)"));
+    }
     values_.resize(total);
     for (size_t f = 0; f < faces_.size(); ++f) {
         float* out = values_.data() + offsets_[f];

@@ -233,7 +233,7 @@ std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mes
     };
     for (int tile : tiles)
         geom::requireUdimFacesInTile(mesh, tile, tileSource);
-    const PtexSampler sampler(file, fileSource);
+    const PtexSampler sampler(file, fileSource, options.maxDecodedBytes);
     const int32_t channels = sampler.channels(), res = options.resolution;
     const int32_t outChannels = channels + (options.coverageChannel ? 1 : 0);
 

@@ -483,6 +483,22 @@ TEST_CASE("ptex mesh: a file of another mesh is refused, naming the file and bot
     std::memcpy(holed.texels[5].data() + at, &nan, sizeof nan);
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)ptex::PtexSampler(holed, "holed.ptx"); }),
                Catch::Contains("holed.ptx: face 5 texel (1, 1) channel 0: is nan (expected finite values"));
+    // The float copy counts against the reading cap with the texels as stored. In a float file each face's
+    // copy is its texels as stored, or its one constant value: the cap fits both and not one byte fewer.
+    const ptex::PtexFile paint = bakePaint(mesh, pm, 2);
+    REQUIRE(paint.dataType == ptex::DataType::Float);
+    uint64_t stored = paint.constData.size(), floats = 0;
+    for (const auto& texels : paint.texels) {
+        stored += texels.size();
+        floats += texels.empty() ? paint.pixelSize() : texels.size();
+    }
+    REQUIRE(floats > 0);
+    CHECK_NOTHROW(ptex::PtexSampler(paint, "paint.ptx", stored + floats));
+    CHECK_THAT(test::errorOf<InvalidInput>(
+                   [&] { (void)ptex::PtexSampler(paint, "paint.ptx", stored + floats - 1); }),
+               Catch::Contains("paint.ptx: texels: " + std::to_string(stored) + " bytes as stored and " +
+                               std::to_string(floats) + " as floats for filtering (expected at most " +
+                               std::to_string(stored + floats - 1)));
 }
 
 TEST_CASE("ptex mesh: a file whose mesh metadata lists other polygons, or these in another order, is refused",

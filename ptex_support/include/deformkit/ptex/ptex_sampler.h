@@ -18,10 +18,16 @@ namespace deformkit::ptex {
 // resolution, the texel under the mirrored centre), so a map is continuous across face edges; a centre
 // beyond a corner is extrapolated from the two edge neighbours and the corner texel (exact for a linear
 // painting); beyond a boundary edge the face's own edge texel is repeated (clamp).
+//
+// The float copy counts against the same cap as the file's decoded texels: the file's texels as stored plus
+// their float copy may take at most `maxBytes` (ReadOptions::maxDecodedBytes by default), so a small file of
+// one huge face cannot claim four times the cap its reading allowed.
 class PtexSampler {
   public:
-    // Throws InvalidInput naming `source` when the file's adjacency points outside it.
-    PtexSampler(const PtexFile& file, const std::string& source);
+    // Throws InvalidInput naming `source` when the file's adjacency points outside it, a texel is not finite,
+    // or the texels and their float copy would take more than `maxBytes`.
+    PtexSampler(const PtexFile& file, const std::string& source,
+                uint64_t maxBytes = ReadOptions{}.maxDecodedBytes);
 
     [[nodiscard]] int32_t channels() const { return channels_; }
     [[nodiscard]] int32_t numFaces() const { return static_cast<int32_t>(faces_.size()); }

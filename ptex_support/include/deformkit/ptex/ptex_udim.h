@@ -32,6 +32,8 @@ struct ToUdimOptions {
     std::vector<int> tiles;     // empty: every tile the mesh's UV faces touch
     bool coverageChannel = false;
     int32_t padding = 8;  // texels of edge padding around the charts (0: none)
+    // Cap on the file's texels and their float copy for filtering (PtexSampler), as when reading the file.
+    uint64_t maxDecodedBytes = ReadOptions{}.maxDecodedBytes;
 };
 [[nodiscard]] std::vector<UdimTile> ptexToUdim(const PtexMesh& ptexMesh, const geom::Mesh& mesh,
                                                const PtexFile& file, const std::string& fileSource,
