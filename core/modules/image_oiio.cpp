@@ -3,6 +3,8 @@
 // message is the library's.
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -50,7 +52,25 @@ class OiioReader final : public codec::Reader {
     bool readFloats(float* pixels) override {
         // A reader that met an error (a TIFF strip cut short) may still report success, the pixels it could
         // not read left as they were: its pending error counts.
-        return in_->read_image(0, 0, 0, spec_.channels, OIIO::TypeDesc::FLOAT, pixels) && !in_->has_error();
+        //
+        // OpenImageIO converts a chunk of pixels with an int count: an image of more than 2^31 - 1 values in
+        // one strip would overflow it (a crash). Such an image is read in bands of rows below that count.
+        const auto rowValues = static_cast<int64_t>(spec_.width) * spec_.channels;
+        constexpr int64_t kMostValues = int64_t{1} << 30;
+        if (spec_.tileWidth > 0 || rowValues * spec_.height <= kMostValues) {
+            return in_->read_image(0, 0, 0, spec_.channels, OIIO::TypeDesc::FLOAT, pixels) &&
+                   !in_->has_error();
+        }
+        const int32_t band = static_cast<int32_t>(std::max<int64_t>(1, kMostValues / rowValues));
+        for (int32_t y = 0; y < spec_.height; y += band) {
+            const int32_t end = std::min(spec_.height, y + band);
+            if (!in_->read_scanlines(0, 0, y, end, 0, 0, spec_.channels, OIIO::TypeDesc::FLOAT,
+                                     pixels + static_cast<int64_t>(y) * rowValues) ||
+                in_->has_error()) {
+                return false;
+            }
+        }
+        return true;
     }
     std::string error() override { return in_->geterror(); }
     void close() override { in_->close(); }

@@ -94,12 +94,34 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
     return in;
 }
 
-// The fewest bytes an OpenEXR file can hold the declared pixels in: an 8-byte offset and a chunk header of
-// at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles), whatever the
-// pixels hold. A header that declares more (a few hundred bytes claiming gigapixels) is refused before its
-// pixels are allocated. 0 for other formats: a PNG's image data is inflated and measured before its pixels
-// are (requireCompletePng), and a bilevel TIFF's fax coding packs a blank page into a few bytes.
+// The fewest bytes a TIFF file can hold the declared pixels in, by its compression's largest ratio: the
+// samples at 1 bit each (a bilevel image's; deeper ones need more) over 1 uncompressed, 64 for PackBits (2
+// bytes repeat one byte at most 128 times), 4096 for LZW (a 12-bit code stands for fewer than 4096 bytes)
+// and 1032 for Deflate (zlib's). Fax coding (CCITT) spends at least one bit a row, however blank. 0 for
+// other compressions (JPEG's arithmetic coding has no such bound).
+uint64_t fewestTiffBytes(const codec::Spec& spec) {
+    const auto samples = static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height) *
+                         static_cast<uint64_t>(spec.channels);  // each below 2^31: no overflow
+    for (const auto& [name, value] : spec.stringAttributes) {
+        if (name != "compression") continue;
+        uint64_t ratio = 0;
+        if (value == "none") ratio = 1;
+        if (value == "packbits") ratio = 64;
+        if (value == "lzw") ratio = 4096;
+        if (value == "zip" || value == "deflate") ratio = 1032;
+        if (ratio > 0) return (samples + 8 * ratio - 1) / (8 * ratio);
+        if (value.rfind("ccitt", 0) == 0) return (static_cast<uint64_t>(spec.height) + 7) / 8;
+    }
+    return 0;
+}
+
+// The fewest bytes a file can hold the declared pixels in, so that a header declaring more (a few hundred
+// bytes claiming gigapixels) is refused before its pixels are allocated. OpenEXR: an 8-byte offset and a
+// chunk header of at least 8 bytes per chunk (scanline chunks of 1 to 256 lines by compression, or tiles),
+// whatever the pixels hold. TIFF: fewestTiffBytes. 0 for other formats: a PNG's image data is inflated and
+// measured before its pixels are (requireCompletePng).
 uint64_t fewestFileBytes(const codec::Spec& spec, std::string_view format) {
+    if (format == "tiff") return fewestTiffBytes(spec);
     if (format != "openexr") return 0;
     const auto w = static_cast<uint64_t>(spec.width), h = static_cast<uint64_t>(spec.height);
     uint64_t chunks = 0;

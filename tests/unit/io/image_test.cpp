@@ -66,6 +66,37 @@ std::string pngDeclaring(uint32_t width, uint32_t height, bool whole = false) {
                  std::string((whole ? height : 1) * static_cast<size_t>(1 + (width + 7) / 8), '\0'));
 }
 
+// A little-endian TIFF of one gray strip holding `data` as it is (spelled out from the TIFF 6.0 layout: the
+// header, one directory of nine entries, then the strip). Compression 1 none, 4 CCITT Group 4, 5 LZW, 8
+// Deflate, 32773 PackBits; photometric 0 is white-is-zero.
+std::string tiffOf(uint32_t width, uint32_t height, uint16_t bitsPerSample, uint16_t compression,
+                   const std::string& data) {
+    std::string out("II*\0\x08\0\0\0", 8);
+    const auto u16 = [&](uint16_t v) { out.append(reinterpret_cast<const char*>(&v), 2); };
+    const auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+    const auto entry = [&](uint16_t tag, uint16_t type, uint32_t value) {
+        u16(tag), u16(type), u32(1);
+        if (type == 3) {
+            u16(static_cast<uint16_t>(value)), u16(0);
+        } else {
+            u32(value);
+        }
+    };
+    constexpr uint16_t kShort = 3, kLong = 4, kEntries = 9;
+    u16(kEntries);
+    entry(256, kLong, width);
+    entry(257, kLong, height);
+    entry(258, kShort, bitsPerSample);
+    entry(259, kShort, compression);
+    entry(262, kShort, 0);
+    entry(273, kLong, 8 + 2 + 12 * kEntries + 4);  // the strip right after the directory
+    entry(277, kShort, 1);
+    entry(278, kLong, height);  // one strip
+    entry(279, kLong, static_cast<uint32_t>(data.size()));
+    u32(0);
+    return out + data;
+}
+
 // What `run` writes to the process's stderr (file descriptor 2) while it runs; its exception is ignored.
 std::string stderrOf(const std::function<void()>& run) {
     std::fflush(stderr);
@@ -464,6 +495,40 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         // A real file of that kind reads: a blank 1-bit PNG deflated as hard as zlib can.
         writeText(dir / "blank.png", pngDeclaring(4096, 4096, true));
         CHECK(readImage(dir / "blank.png").width == 4096);
+        // TIFF headers of 30000^2 8-bit pixels over 16 bytes, refused by their compression's largest ratio
+        // (the samples counted at 1 bit: 112.5 MB uncompressed; over 64, 4096 and 1032; fax coding at least
+        // one bit a row) before 3.6 GB are allocated; a 10-GB fax page used to crash OpenImageIO.
+        for (const auto& [compression, fewest] : {std::pair<uint16_t, uint64_t>{1, 112500000},
+                                                  {32773, 1757813},
+                                                  {5, 27466},
+                                                  {8, 109012},
+                                                  {4, 3750}}) {
+            CAPTURE(compression);
+            writeText(dir / "bomb.tif",
+                      tiffOf(30000, 30000, compression == 4 ? 1 : 8, compression, std::string(16, '\0')));
+            CHECK_THROWS_AS(readImage(dir / "bomb.tif"), ParseError);
+            CHECK_THROWS_WITH(readImage(dir / "bomb.tif"),
+                              Catch::Contains(": header: declares 30000x30000 pixels with 1 channel, which "
+                                              "take at least " +
+                                              std::to_string(fewest) + " bytes, but the file has 138"));
+        }
+        // The fax bound is tight: a blank Group 4 page codes each row as one vertical-mode bit (V0, '1'),
+        // then the end-of-facsimile block. 4096 rows in 512 bytes read, white.
+        writeText(dir / "blank.tif",
+                  tiffOf(4096, 4096, 1, 4, std::string(4096 / 8, '\xff') + std::string("\x00\x10\x01", 3)));
+        const Image blankPage = readImage(dir / "blank.tif");
+        REQUIRE(blankPage.width == 4096);
+        CHECK(std::ranges::all_of(blankPage.pixels, [](float v) { return v == 1.0f; }));
+        // Files as compressible as can be, as OpenImageIO writes them, read whatever their compression.
+        for (const char* compression : {"none", "packbits", "lzw", "zip"}) {
+            CAPTURE(compression);
+            writeImage(dir / "flat.tif", Image(1024, 1024, 1),
+                       {PixelType::UInt8, {{"compression", compression}}});
+            const auto attributes = readImageInfo(dir / "flat.tif").attributes;
+            CHECK(std::ranges::count(attributes,
+                                     std::pair<std::string, std::string>{"compression", compression}) == 1);
+            CHECK(readImage(dir / "flat.tif").width == 1024);
+        }
         // One tile of 2^29 x 2^29 pixels of 64 channels: 2^64 floats, whose count wraps in size_t.
         writeText(dir / "wrap.exr", exrWithoutPixels(1 << 29, 1 << 29, 64, 1 << 29));
         CHECK_THROWS_AS(readImage(dir / "wrap.exr"), InvalidInput);
