@@ -76,15 +76,8 @@ py::array arrayOf(const std::vector<T>& values) {
 }
 
 // Ptex metadata text is bytes, Python text is str: bytes that are not UTF-8 (a key or value written by a
-// Latin-1 tool) become surrogate escapes (PEP 383), so a file reads whatever its encoding and writes back
+// Latin-1 tool) become surrogate escapes (textOf), so a file reads whatever its encoding and writes back
 // byte for byte.
-py::str textOf(const std::string& bytes) {
-    PyObject* text =
-        PyUnicode_DecodeUTF8(bytes.data(), static_cast<Py_ssize_t>(bytes.size()), "surrogateescape");
-    if (text == nullptr) throw py::error_already_set();
-    return py::reinterpret_steal<py::str>(text);
-}
-
 // The bytes of `text` (a str: UTF-8, surrogate escapes back to their bytes); InvalidInput naming `element`
 // for anything else.
 std::string bytesOf(py::handle text, const std::string& source, const std::string& element) {

@@ -2,6 +2,8 @@
 
 #include <pybind11/pybind11.h>
 
+#include <string>
+
 #include "deformkit/uvwarp/tile_warp.h"
 
 // Each area of the module registers its functions from its own file (bind_<area>.cpp).
@@ -19,6 +21,10 @@ void bindHost(pybind11::module_& m);
 void bindPtex(pybind11::module_& m);
 void bindPointCache(pybind11::module_& m);
 void bindShotReport(pybind11::module_& m);
+
+// Text read from a file or a header (bytes) as a str: bytes that are not UTF-8 (a Latin-1 header attribute,
+// a Ptex key) become surrogate escapes (PEP 383), which encode back to the same bytes.
+[[nodiscard]] pybind11::str textOf(const std::string& bytes);
 
 // Every UV-warp option of `options` (uvwarp/options.h) as {name: value}, the names in snake_case (Python's
 // keywords) or camelCase (scenes'): bool, int, float or a list of ints.

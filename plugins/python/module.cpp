@@ -6,6 +6,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cstring>
+#include <exception>
+#include <new>
 
 #include "bindings.h"
 #include "deformkit/error.h"
@@ -55,7 +57,65 @@ io::PixelType pixelType(const std::string& name) {
                                    "auto, uint8, uint16, half or float"));
 }
 
+// The Python errors of the library's, made once at import.
+struct ErrorTypes {
+    PyObject* error = nullptr;
+    PyObject* io = nullptr;
+    PyObject* parse = nullptr;
+    PyObject* invalid = nullptr;
+    PyObject* topology = nullptr;
+    PyObject* cancelled = nullptr;
+};
+ErrorTypes& errorTypes() {
+    static ErrorTypes types;
+    return types;
+}
+
+// Raises `type` with `message` decoded from UTF-8, a byte that is not UTF-8 (a file name in another encoding,
+// a Latin-1 key in a scene) shown as its \xNN escape: PyErr_SetString would leave the error without a
+// message, and a surrogate escape would fail to print.
+void raise(PyObject* type, const char* message) {
+    PyObject* text =
+        PyUnicode_DecodeUTF8(message, static_cast<Py_ssize_t>(std::strlen(message)), "backslashreplace");
+    if (text == nullptr) {  // only when memory runs out
+        PyErr_Clear();
+        PyErr_SetNone(type);
+        return;
+    }
+    PyErr_SetObject(type, text);
+    Py_DECREF(text);
+}
+
+void translateErrors(std::exception_ptr thrown) {
+    const ErrorTypes& types = errorTypes();
+    try {
+        std::rethrow_exception(thrown);
+    } catch (const TopologyError& e) {
+        raise(types.topology, e.what());
+    } catch (const InvalidInput& e) {
+        raise(types.invalid, e.what());
+    } catch (const ParseError& e) {
+        raise(types.parse, e.what());
+    } catch (const IoError& e) {
+        raise(types.io, e.what());
+    } catch (const Cancelled& e) {
+        raise(types.cancelled, e.what());
+    } catch (const Error& e) {
+        raise(types.error, e.what());
+    } catch (const std::bad_alloc& e) {
+        raise(PyExc_MemoryError, e.what());
+    }
+}
+
 }  // namespace
+
+py::str textOf(const std::string& bytes) {
+    PyObject* text =
+        PyUnicode_DecodeUTF8(bytes.data(), static_cast<Py_ssize_t>(bytes.size()), "surrogateescape");
+    if (text == nullptr) throw py::error_already_set();
+    return py::reinterpret_steal<py::str>(text);
+}
+
 }  // namespace deformkit::python
 
 PYBIND11_MODULE(deformkit, m) {
@@ -64,12 +124,18 @@ PYBIND11_MODULE(deformkit, m) {
     m.doc() = "DeformKit: production deformers. Meshes and images as numpy float32 arrays.";
     m.attr("__version__") = kVersionString;
 
-    auto error = py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
-    py::register_exception<IoError>(m, "IoError", error.ptr());
-    py::register_exception<ParseError>(m, "ParseError", error.ptr());
-    auto invalid = py::register_exception<InvalidInput>(m, "InvalidInput", error.ptr());
-    py::register_exception<TopologyError>(m, "TopologyError", invalid.ptr());
-    py::register_exception<Cancelled>(m, "Cancelled", error.ptr());
+    ErrorTypes& types = errorTypes();
+    const auto addError = [&](const char* name, PyObject* base) {
+        py::exception<Error> type(m, name, base);
+        return type.release().ptr();  // held for the life of the process, as the module's other types
+    };
+    types.error = addError("Error", PyExc_RuntimeError);
+    types.io = addError("IoError", types.error);
+    types.parse = addError("ParseError", types.error);
+    types.invalid = addError("InvalidInput", types.error);
+    types.topology = addError("TopologyError", types.invalid);
+    types.cancelled = addError("Cancelled", types.error);
+    py::register_exception_translator(translateErrors);
 
     py::class_<geom::Mesh>(
         m, "Mesh", "A polygon mesh: float32 points, faces as counts + indices, optional face-varying UVs.")
@@ -170,11 +236,14 @@ PYBIND11_MODULE(deformkit, m) {
             }
             py::dict attributes;
             for (const auto& [name, value] : info.attributes)
-                attributes[py::str(name)] = value;
+                attributes[textOf(name)] = textOf(value);
+            py::list channelNames;
+            for (const std::string& name : info.channelNames)
+                channelNames.append(textOf(name));
             using namespace pybind11::literals;
             return py::dict("width"_a = info.width, "height"_a = info.height, "channels"_a = info.channels,
                             "format"_a = info.format, "pixel_type"_a = info.pixelType,
-                            "channel_names"_a = info.channelNames, "attributes"_a = attributes);
+                            "channel_names"_a = channelNames, "attributes"_a = attributes);
         },
         py::arg("path"),
         "Read an image's header only: a dict of width, height, channels, format (\"openexr\", \"png\", "

@@ -1,7 +1,9 @@
 """The deformkit Python module: numpy views, round trips and errors, checked against numpy references."""
 import os
+import struct
 import subprocess
 import sys
+import zlib
 
 import numpy as np
 import pytest
@@ -115,6 +117,25 @@ def test_errors_are_deformkit_errors(tmp_path):
         dk.read_image(tmp_path / "rgb.exr", channels=1)
     with pytest.raises(dk.Error, match="matches no file"):
         dk.udim_tiles(str(tmp_path / "none.<UDIM>.exr"))
+
+
+def test_text_that_is_not_utf8_reaches_python_whole(tmp_path):
+    # A file name of other bytes: the message names it, the byte shown as its escape (an error whose text
+    # was not UTF-8 used to reach Python without a message).
+    name = os.fsdecode(bytes(tmp_path) + b"/x\xff.obj")
+    with pytest.raises(dk.IoError) as raised:
+        dk.read_mesh(name)
+    assert str(raised.value).startswith(str(tmp_path) + "/x\\xff.obj: cannot open")
+    # A PNG comment in Latin-1 (as its format says tEXt is): read as surrogate escapes, which encode back to
+    # the file's bytes (a UnicodeDecodeError before).
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 0, 0, 0, 0)) +
+           chunk(b"tEXt", b"Comment\x00caf\xe9") + chunk(b"IDAT", zlib.compress(b"\x00" * 6)) + chunk(b"IEND", b""))
+    (tmp_path / "latin1.png").write_bytes(png)
+    comment = dk.read_image_info(tmp_path / "latin1.png")["attributes"]["Comment"]
+    assert comment.encode("utf-8", "surrogateescape") == b"caf\xe9"
 
 
 def test_array_arguments_are_checked_alike_by_every_function(tmp_path):
