@@ -263,7 +263,9 @@ PYBIND11_MODULE(deformkit, m) {
         },
         py::arg("path"), py::arg("array"), py::arg("type") = "auto",
         py::arg("attributes") = std::map<std::string, std::string>{},
-        "Write a (H, W) or (H, W, C) float array atomically; type: auto, uint8, uint16, half, float.");
+        "Write a (H, W) or (H, W, C) float array atomically; type: auto, uint8, uint16, half, float (auto: "
+        "half\n"
+        "for EXR, float when a value would round to inf as a half; 8-bit for other formats).");
     m.def(
         "udim_tiles",
         [](const std::filesystem::path& pattern) {

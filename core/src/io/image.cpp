@@ -277,8 +277,37 @@ std::string channelCount(int32_t n) {
     return std::to_string(n) + (n == 1 ? " channel" : " channels");
 }
 
-// The pixel type's name, as the codec takes it.
-std::string requestedType(PixelType type, std::string_view format) {
+// The smallest magnitude a half rounds to inf (the largest finite half is 65504, the next step 65536).
+constexpr float kHalfOverflow = 65520.0f;
+
+// The first value of `count` at `values` that is finite and rounds to inf as a half, or `count` when none
+// does.
+size_t firstBeyondHalf(const float* values, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+        if (std::isfinite(values[i]) && std::abs(values[i]) >= kHalfOverflow) return i;
+    return count;
+}
+
+// Refuses a finite value a half cannot hold among `rows` rows of pixels starting at row `firstRow`: it would
+// be written as inf.
+void requireHalfRange(const fs::path& path, const float* pixels, int32_t width, int32_t rows,
+                      int32_t channels, int32_t firstRow) {
+    const size_t count = static_cast<size_t>(width) * rows * channels;
+    const size_t at = firstBeyondHalf(pixels, count);
+    if (at == count) return;
+    const size_t pixel = at / static_cast<size_t>(channels);
+    throw InvalidInput(formatError(
+        path.string(),
+        "pixel (" + std::to_string(pixel % static_cast<size_t>(width)) + ", " +
+            std::to_string(firstRow + static_cast<int64_t>(pixel / static_cast<size_t>(width))) +
+            ") channel " + std::to_string(at % static_cast<size_t>(channels)),
+        "is " + numberText(pixels[at]) + ", which a half would hold as inf (the largest half is 65504)",
+        "a float image for such values"));
+}
+
+// The pixel type's name, as the codec takes it. Auto writes EXR as half, unless a finite value is beyond
+// half's range (`fitsHalf` false): then as float, rather than as inf.
+std::string requestedType(PixelType type, std::string_view format, bool fitsHalf) {
     switch (type) {
         case PixelType::UInt8:
             return "uint8";
@@ -291,7 +320,8 @@ std::string requestedType(PixelType type, std::string_view format) {
         case PixelType::Auto:
             break;
     }
-    return format == "openexr" ? "half" : "uint8";
+    if (format != "openexr") return "uint8";
+    return fitsHalf ? "half" : "float";
 }
 
 InvalidInput noWriter(const fs::path& path) {
@@ -406,9 +436,11 @@ ImageInfo readImageInfo(const fs::path& path) {
 namespace {
 
 // Checks the size and format, opens the file under a temporary name, lets `writePixels` write every pixel
-// (false: OpenImageIO failed, its error is reported), closes it and moves it into place.
+// in the type it is given (false: OpenImageIO failed, its error is reported), closes it and moves it into
+// place. `fitsHalf`: every finite value is within half's range (requestedType).
 void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t channels,
-                  const ImageWriteOptions& options, const std::function<bool(codec::Writer&)>& writePixels) {
+                  const ImageWriteOptions& options, bool fitsHalf,
+                  const std::function<bool(codec::Writer&, const std::string& type)>& writePixels) {
     if (width < 1 || height < 1 || channels < 1) {
         throw InvalidInput(formatError(path.string(), "",
                                        "cannot write an empty image (" + std::to_string(width) + "x" +
@@ -432,7 +464,7 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
         throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
                                        "1 or 3 channels in jpeg files (no alpha; PNG, TIFF or EXR keep it)"));
     }
-    const std::string type = requestedType(options.type, format);
+    const std::string type = requestedType(options.type, format, fitsHalf);
 
     writeAtomically(path, [&](const fs::path& tmp) {
         const std::unique_ptr<codec::Writer> out = std::move(probe);  // owned here: closed before rename
@@ -475,7 +507,7 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
                 formatError(path.string(), "pixel type", format + " files cannot store " + type + " pixels",
                             "a type the format stores, such as " + out->openedPixelType());
         }
-        if (!writePixels(*out)) {
+        if (!writePixels(*out, type)) {
             throw StorageError(formatError(path.string(), "pixels",
                                            "cannot write: " + oiioError(oiio, out->error()),
                                            "enough space to write"));
@@ -502,8 +534,15 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
                                        "has " + std::to_string(image.pixels.size()) + " values",
                                        std::to_string(expected) + " = width * height * channels"));
     }
-    writeChecked(path, image.width, image.height, image.channels, options,
-                 [&](codec::Writer& out) { return out.writeFloats(image.pixels.data()); });
+    const bool fitsHalf = firstBeyondHalf(image.pixels.data(), image.pixels.size()) == image.pixels.size();
+    writeChecked(path, image.width, image.height, image.channels, options, fitsHalf,
+                 [&](codec::Writer& out, const std::string& type) {
+                     if (type == "half") {
+                         requireHalfRange(path, image.pixels.data(), image.width, image.height,
+                                          image.channels, 0);
+                     }
+                     return out.writeFloats(image.pixels.data());
+                 });
 }
 
 void writeImageInBands(const fs::path& path, int32_t width, int32_t height, int32_t channels,
@@ -512,36 +551,39 @@ void writeImageInBands(const fs::path& path, int32_t width, int32_t height, int3
         throw InvalidInput(formatError(path.string(), "band", "has " + std::to_string(bandRows) + " rows",
                                        "at least 1 row"));
     }
-    writeChecked(path, width, height, channels, options, [&](codec::Writer& out) {
-        Image band;
-        int32_t written = 0;  // rows in the file
-        try {
-            for (; written < height; written += bandRows) {
-                const int32_t rows = std::min(bandRows, height - written);
-                if (band.height != rows) band = Image(width, rows, channels);
-                std::fill(band.pixels.begin(), band.pixels.end(), 0.0f);
-                fill(written, band);
-                if (band.width != width || band.height != rows || band.channels != channels ||
-                    band.pixels.size() != static_cast<size_t>(width) * rows * channels) {
-                    throw InvalidInput(formatError(path.string(), "band at row " + std::to_string(written),
-                                                   "was resized to " + std::to_string(band.width) + "x" +
-                                                       std::to_string(band.height) + " pixels, " +
-                                                       channelCount(band.channels),
-                                                   std::to_string(width) + "x" + std::to_string(rows) +
-                                                       " pixels, " + channelCount(channels)));
+    writeChecked(
+        path, width, height, channels, options, true, [&](codec::Writer& out, const std::string& type) {
+            Image band;
+            int32_t written = 0;  // rows in the file
+            try {
+                for (; written < height; written += bandRows) {
+                    const int32_t rows = std::min(bandRows, height - written);
+                    if (band.height != rows) band = Image(width, rows, channels);
+                    std::fill(band.pixels.begin(), band.pixels.end(), 0.0f);
+                    fill(written, band);
+                    if (band.width != width || band.height != rows || band.channels != channels ||
+                        band.pixels.size() != static_cast<size_t>(width) * rows * channels) {
+                        throw InvalidInput(formatError(
+                            path.string(), "band at row " + std::to_string(written),
+                            "was resized to " + std::to_string(band.width) + "x" +
+                                std::to_string(band.height) + " pixels, " + channelCount(band.channels),
+                            std::to_string(width) + "x" + std::to_string(rows) + " pixels, " +
+                                channelCount(channels)));
+                    }
+                    if (type == "half")
+                        requireHalfRange(path, band.pixels.data(), width, rows, channels, written);
+                    if (!out.writeRows(written, written + rows, band.pixels.data())) return false;
                 }
-                if (!out.writeRows(written, written + rows, band.pixels.data())) return false;
+            } catch (...) {
+                // The temporary file is dropped, but a PNG writer closed short of its rows makes libpng print
+                // to stderr: the rest is written as zeros first, one row at a time.
+                const std::vector<float> zeros(static_cast<size_t>(width) * channels, 0.0f);
+                for (int32_t y = written; y < height; ++y)
+                    if (!out.writeRows(y, y + 1, zeros.data())) break;
+                throw;
             }
-        } catch (...) {
-            // The temporary file is dropped, but a PNG writer closed short of its rows makes libpng print
-            // to stderr: the rest is written as zeros first, one row at a time.
-            const std::vector<float> zeros(static_cast<size_t>(width) * channels, 0.0f);
-            for (int32_t y = written; y < height; ++y)
-                if (!out.writeRows(y, y + 1, zeros.data())) break;
-            throw;
-        }
-        return true;
-    });
+            return true;
+        });
 }
 
 void requireImageWriter(const fs::path& path) {

@@ -737,6 +737,38 @@ TEST_CASE("writeImage rejects what it cannot store faithfully and leaves no file
         REQUIRE(back.pixels[i] == many.pixels[i]);
 }
 
+TEST_CASE("values beyond half's range are not written as inf", "[io][image]") {
+    // The largest finite half is 65504 (binary16: (2 - 2^-10) * 2^15); from 65520, halfway to the next step
+    // 65536, values round to inf.
+    TempDir dir;
+    Image img = patternImage(3, 2, 2);
+    img.at(2, 1, 1) = std::nextafter(65520.0f, 0.0f);
+    img.at(0, 0, 0) = -std::numeric_limits<float>::infinity();  // not finite: a half holds it as it is
+    writeImage(dir / "fits.exr", img);
+    CHECK(readImageInfo(dir / "fits.exr").pixelType == "half");
+    CHECK(readImage(dir / "fits.exr").at(2, 1, 1) == 65504.0f);
+    // Auto: float once a finite value would not fit, so the file holds what was given.
+    img.at(2, 1, 1) = 65520.0f;
+    writeImage(dir / "beyond.exr", img);
+    CHECK(readImageInfo(dir / "beyond.exr").pixelType == "float");
+    CHECK(readImage(dir / "beyond.exr").pixels == img.pixels);
+    // Half asked for: refused, naming the pixel, in an EXR and a TIFF; nothing is left.
+    for (const char* name : {"half.exr", "half.tif"}) {
+        CHECK_THROWS_WITH(
+            writeImage(dir / name, img, {PixelType::Half, {}}),
+            Catch::Contains(std::string(name) + ": pixel (2, 1) channel 1: is 65520, which a half would "
+                                                "hold as inf"));
+        CHECK_FALSE(fs::exists(dir / name));
+    }
+    // A band of an EXR written in bands (Auto is half there): refused at its row.
+    CHECK_THROWS_WITH(writeImageInBands(dir / "bands.exr", 4, 4, 1, 2,
+                                        [](int32_t y0, Image& band) {
+                                            if (y0 == 2) band.at(3, 1, 0) = -1e5f;
+                                        }),
+                      Catch::Contains("bands.exr: pixel (3, 3) channel 0: is -1e+05"));
+    CHECK_FALSE(fs::exists(dir / "bands.exr"));
+}
+
 TEST_CASE("writeImage replaces a file atomically and fails on a missing or unwritable folder",
           "[io][image]") {
     TempDir dir;

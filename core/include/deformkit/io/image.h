@@ -29,7 +29,8 @@ struct Image {
     }
 };
 
-// Pixel type of a written file. Auto: half for EXR, 8-bit for every other format.
+// Pixel type of a written file. Auto: half for EXR (float when a finite value is beyond half's range, which
+// would be written as inf), 8-bit for every other format. Half refuses such a value.
 enum class PixelType { Auto, UInt8, UInt16, Half, Float };
 
 struct ImageReadOptions {
@@ -81,7 +82,8 @@ using ImageBand = std::function<void(int32_t y0, Image& band)>;
 // Writes a width x height image made `bandRows` rows at a time, top to bottom, so that only one band is in
 // memory (a contact sheet of thousands of frames). Atomic and checked as writeImage; a format whose writer
 // cannot take rows in order (none of the scanline formats) fails with IoError. An exception thrown by `fill`
-// leaves no file.
+// leaves no file. Auto writes EXR as half, whatever the bands hold: a band with a value beyond half's range
+// fails as Half does.
 void writeImageInBands(const std::filesystem::path& path, int32_t width, int32_t height, int32_t channels,
                        int32_t bandRows, const ImageBand& fill, const ImageWriteOptions& options = {});
 
