@@ -22,6 +22,13 @@ namespace deformkit::warp::detail {
 // 0 (the point left unmoved). Only then the weights are taken relative to the longest displacement among
 // the entries with a weight, w_e (|d_e| / max |d|)^m <= w_e: the same mean, within range. Points whose
 // weights stay in range keep the bits of the plain sum.
+// |d| in float, as the weights have always been taken, or in double where d . d overflows float (|d| beyond
+// about 1.8e19): an infinite length would make every weight inf / inf and leave the point unmoved.
+inline double displacementLength(const glm::vec3& d) {
+    const float length = glm::length(d);
+    return std::isfinite(length) ? static_cast<double>(length) : glm::length(glm::dvec3(d));
+}
+
 template <class Displacement, class Weight, class Power>
 bool weightedMeanDisplacement(int32_t begin, int32_t end, double m, Displacement&& displacement,
                               Weight&& weight, Power&& power, glm::dvec3& mean) {
@@ -33,7 +40,7 @@ bool weightedMeanDisplacement(int32_t begin, int32_t end, double m, Displacement
         if (w == 0.0) continue;
         const glm::vec3 d = displacement(e);
         if (m != 0.0) {
-            const double length = static_cast<double>(glm::length(d));
+            const double length = displacementLength(d);
             plainSum += w;
             longest = std::max(longest, length);
             w *= power(length, m);
@@ -50,7 +57,7 @@ bool weightedMeanDisplacement(int32_t begin, int32_t end, double m, Displacement
         for (int32_t e = begin; e < end; ++e) {
             if (weight(e) == 0.0) continue;
             const glm::vec3 d = displacement(e);
-            const double w = weight(e) * power(static_cast<double>(glm::length(d)) / longest, m);
+            const double w = weight(e) * power(displacementLength(d) / longest, m);
             sum += w * glm::dvec3(d);
             weightSum += w;
         }

@@ -504,6 +504,33 @@ TEST_CASE("wires: an exponent whose weights leave double's range still moves eve
     }
 }
 
+TEST_CASE("wires: displacements whose squared length overflows float still move the points", "[wires]") {
+    // A scale of 1e21 moves points ~1e20 away: |d|^2 beyond float's range made every weight inf / inf and
+    // left the points unmoved. Against the brute-force reference in double, within 1e-7 of the scale: float's
+    // precision of the largest displacements (near the dropoff's edge the falloff of a point's float
+    // distance differs from the double one by more than 1e-5 of that point's own, small, travel).
+    const auto rest = randomPoints(500, -0.5f, 2.5f, 5);
+    Wire wire = bentWire(0.6f, 1.3f);
+    wire.scale = 1e21f;
+    for (bool smooth : {false, true}) {
+        CAPTURE(smooth);
+        Wires wires({wire}, {smooth ? WiresVariant::Smooth : WiresVariant::Original, 1.0f, 0});
+        const auto got = evaluateFast(wires, rest);
+        size_t far = 0;
+        for (size_t i = 0; i < rest.size(); ++i) {
+            CAPTURE(i);
+            const glm::dvec3 expected =
+                referenceWires(wire, glm::dvec3(rest[i]), smooth, 1.0, wires.smoothSamples(0));
+            const double travel = glm::length(expected - glm::dvec3(rest[i]));
+            REQUIRE(geom::isFinite(got[i]));
+            CHECK(glm::length(glm::dvec3(got[i]) - expected) <= 1e-7 * 1e21);
+            far += travel > 1.9e19 ? 1 : 0;
+        }
+        CHECK(far > 10);  // the case that overflowed is there
+        CHECK(maxDistance(evaluateGeneric(wires, rest), got) <= 1e-5f * 1e21f);
+    }
+}
+
 TEST_CASE("wires: bit-identical for 1 and 2 threads", "[wires][determinism]") {
     const auto rest = randomPoints(40000, -0.5f, 2.5f, 3);
     for (auto variant : {WiresVariant::Original, WiresVariant::Smooth}) {
