@@ -37,6 +37,12 @@ class OiioReader final : public codec::Reader {
         spec_.deep = s.deep;
         spec_.tileWidth = s.tile_width;
         spec_.tileHeight = s.tile_height;
+        spec_.x = s.x;
+        spec_.y = s.y;
+        spec_.fullX = s.full_x;
+        spec_.fullY = s.full_y;
+        spec_.fullWidth = s.full_width;
+        spec_.fullHeight = s.full_height;
         spec_.pixelType = typeName(s.format);
         spec_.channelNames = s.channelnames;
         for (const OIIO::ParamValue& p : s.extra_attribs) {

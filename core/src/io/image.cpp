@@ -91,6 +91,21 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
                                          " pixels with " + std::to_string(spec.channels) + " channels",
                                      "a 2D image with at least one pixel and one channel"));
     }
+    // A crop or an overscan: its pixels would be read as the whole image, stretched over the tile a map
+    // covers. Refused, naming both windows.
+    if (spec.x != spec.fullX || spec.y != spec.fullY || spec.width != spec.fullWidth ||
+        spec.height != spec.fullHeight) {
+        const auto window = [](int32_t w, int32_t h, int32_t x, int32_t y) {
+            return std::to_string(w) + "x" + std::to_string(h) + " at (" + std::to_string(x) + ", " +
+                   std::to_string(y) + ")";
+        };
+        throw InvalidInput(formatError(
+            path.string(), "header",
+            "holds pixels " + window(spec.width, spec.height, spec.x, spec.y) +
+                " (its data window) of an image " +
+                window(spec.fullWidth, spec.fullHeight, spec.fullX, spec.fullY) + " (its display window)",
+            "pixels for the whole image, as `oiiotool in.exr --croptofull -o out.exr` writes them"));
+    }
     return in;
 }
 

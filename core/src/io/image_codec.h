@@ -18,7 +18,7 @@
 
 namespace deformkit::io::codec {
 
-inline constexpr int kAbiVersion = 2;
+inline constexpr int kAbiVersion = 3;
 
 // Pixel types by name: "uint8", "uint16", "half", "float", or OpenImageIO's name of any other type.
 struct Spec {
@@ -29,6 +29,14 @@ struct Spec {
     bool deep = false;
     int32_t tileWidth = 0;  // 0: scanlines
     int32_t tileHeight = 0;
+    // The pixels' place (the data window, width x height from its origin) and the image's frame (the
+    // display window); the same in most files, an EXR's may differ (a crop, an overscan).
+    int32_t x = 0;
+    int32_t y = 0;
+    int32_t fullX = 0;
+    int32_t fullY = 0;
+    int32_t fullWidth = 0;
+    int32_t fullHeight = 0;
     std::string pixelType;
     std::vector<std::string> channelNames;
     std::vector<std::pair<std::string, std::string>> stringAttributes;  // in the file's order

@@ -3,13 +3,16 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <unistd.h>
@@ -121,7 +124,9 @@ std::string stderrOf(const std::function<void()>& run) {
 // The header of a single-part OpenEXR file of `channels` float channels, uncompressed, declaring width x
 // height pixels, followed by its offset table (of zeros) and no chunks (spelled out from the OpenEXR file
 // layout: magic, version, attributes, an empty name closing them). Tiled: one tile of `tile` x `tile` pixels.
-std::string exrWithoutPixels(int32_t width, int32_t height, int channels, int32_t tile = 0) {
+// The pixels (data window) from (x, y); the display window `display` (x0, y0, x1, y1), or the data window.
+std::string exrWithoutPixels(int32_t width, int32_t height, int channels, int32_t tile = 0, int32_t x = 0,
+                             int32_t y = 0, std::optional<std::array<int32_t, 4>> display = {}) {
     std::string out;
     auto bytes = [&](const void* p, size_t n) { out.append(static_cast<const char*>(p), n); };
     auto i32 = [&](int32_t v) { bytes(&v, 4); };
@@ -144,8 +149,9 @@ std::string exrWithoutPixels(int32_t width, int32_t height, int channels, int32_
             "c" + std::to_string(c) + '\0' + packed({2, 0, 1, 1});  // float, pLinear 0 + reserved, sampling
     attribute("channels", "chlist", list + '\0');
     attribute("compression", "compression", std::string(1, '\0'));
-    attribute("dataWindow", "box2i", packed({0, 0, width - 1, height - 1}));
-    attribute("displayWindow", "box2i", packed({0, 0, width - 1, height - 1}));
+    attribute("dataWindow", "box2i", packed({x, y, x + width - 1, y + height - 1}));
+    const std::array<int32_t, 4> shown = display.value_or(std::array{x, y, x + width - 1, y + height - 1});
+    attribute("displayWindow", "box2i", packed({shown[0], shown[1], shown[2], shown[3]}));
     attribute("lineOrder", "lineOrder", std::string(1, '\0'));
     attribute("pixelAspectRatio", "float", packed({0x3f800000}));
     attribute("screenWindowCenter", "v2f", packed({0, 0}));
@@ -535,6 +541,29 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         CHECK_THROWS_WITH(readImage(dir / "wrap.exr"),
                           Catch::Contains("wrap.exr: image of 536870912x536870912 pixels with 64 channels is "
                                           "too large to load"));
+    }
+
+    SECTION("an EXR whose pixels are a crop or an overscan of its image") {
+        // Read as they are, the pixels of a crop were stretched over the whole image (a rigidity map over
+        // the whole tile): refused, naming both windows, by the header read too.
+        for (const auto& [name, header, message] :
+             {std::tuple{"crop.exr", exrWithoutPixels(64, 64, 1, 0, 32, 32, std::array{0, 0, 127, 127}),
+                         "holds pixels 64x64 at (32, 32) (its data window) of an image 128x128 at (0, 0)"},
+              std::tuple{"overscan.exr", exrWithoutPixels(256, 256, 1, 0, 0, 0, std::array{0, 0, 127, 127}),
+                         "holds pixels 256x256 at (0, 0) (its data window) of an image 128x128 at (0, 0)"},
+              std::tuple{"moved.exr", exrWithoutPixels(128, 128, 1, 0, 5, 0, std::array{0, 0, 127, 127}),
+                         "holds pixels 128x128 at (5, 0) (its data window) of an image 128x128 at (0, 0)"}}) {
+            CAPTURE(name);
+            writeText(dir / name, header);
+            CHECK_THROWS_AS(readImage(dir / name), deformkit::InvalidInput);
+            CHECK_THROWS_WITH(readImage(dir / name),
+                              Catch::Contains(std::string(name) + ": header: " + message) &&
+                                  Catch::Contains("--croptofull"));
+            CHECK_THROWS_WITH(readImageInfo(dir / name), Catch::Contains(message));
+        }
+        // The same window both ways, anywhere, is a whole image.
+        writeText(dir / "offset.exr", exrWithoutPixels(64, 64, 1, 0, 32, 32));
+        CHECK(readImageInfo(dir / "offset.exr").width == 64);
     }
 
     SECTION("truncated EXR, PNG and TIFF") {
