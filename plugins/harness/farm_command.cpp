@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,7 +27,7 @@ fs::path farmPlanPath(const FarmPlanCommand& command) {
     return command.plan.empty() ? command.outDir / "farm_plan.json" : command.plan;
 }
 
-scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
+scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command, std::vector<std::string>* notes) {
     if (command.chunk < 1) {
         throw InvalidInput(formatError("--chunk", "", "is " + std::to_string(command.chunk),
                                        "a whole number of frames per task >= 1"));
@@ -66,7 +67,11 @@ scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command) {
         run.frames = frames;
         run.tiles = scene.objects[o].uvwarp->tiles;
         run.outDir = plan.outDir;
-        (void)scene::uvwarpStageSolver(scene, o, run);
+        const std::optional<uvwarp::ShotSolver> solver = scene::uvwarpStageSolver(scene, o, run);
+        if (solver && notes) {
+            for (const std::string& note : solver->plannedNotes())
+                notes->push_back("object '" + scene.objects[o].name + "': " + note);
+        }
     }
     io::createFolder(plan.outDir);
     scene::writeFarmPlan(plan, planFile);
@@ -304,7 +309,10 @@ void addFarmCommands(CommandLine& cli) {
             c.scene = p->scene;
             c.outDir = p->out;
             c.plan = p->plan;
-            const scene::FarmPlan made = farmPlanCommand(c);
+            std::vector<std::string> notes;
+            const scene::FarmPlan made = farmPlanCommand(c, &notes);
+            for (const std::string& note : notes)
+                std::cout << "farm: " << note << "\n";
             std::cout << "farm: wrote " << farmPlanPath(c).string() << ": " << made.tasks.size()
                       << (made.tasks.size() == 1 ? " task" : " tasks") << "\n";
             return 0;

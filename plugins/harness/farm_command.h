@@ -35,8 +35,10 @@ struct FarmPlanCommand {
 
 // Reads the scene (checking it the way eval does), cuts the frames into tasks (scene::planFarm) and writes
 // the plan JSON atomically. Returns the plan as written (paths absolute). Throws InvalidInput naming the
-// option for a chunk or tile count below 1, and as evalCommand for a bad scene.
-scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command);
+// option for a chunk or tile count below 1, and as evalCommand for a bad scene. `notes`, when given, receives
+// what the UV-warp stages' planning says, as eval prints it, per object ("object 'body': tile 1002: left
+// unwarped: no rigidity map 'rig.1002.exr'").
+scene::FarmPlan farmPlanCommand(const FarmPlanCommand& command, std::vector<std::string>* notes = nullptr);
 
 // The plan file farmPlanCommand writes for `command`.
 [[nodiscard]] std::filesystem::path farmPlanPath(const FarmPlanCommand& command);

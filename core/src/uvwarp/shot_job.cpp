@@ -478,6 +478,14 @@ int64_t ShotSolver::units() const {
     return static_cast<int64_t>(impl_->plans.size() * impl_->job.frames.size());
 }
 
+std::vector<std::string> ShotSolver::plannedNotes() const {
+    std::vector<std::string> lines;
+    for (const TilePlan& plan : impl_->plans)
+        for (const std::string& note : plan.report.notes)
+            lines.push_back("tile " + std::to_string(plan.tile) + ": " + note);
+    return lines;
+}
+
 bool ShotSolver::needsPositions() const {
     const Impl& s = *impl_;
     if (s.nextFrame >= s.job.frames.size()) return false;

@@ -305,6 +305,24 @@ TEST_CASE("scene uvwarp: farm plans check their tiles", "[harness][uvwarp][farm]
          "\"tubes.redirect.1001.0002.exr\""},
     };
     test::checkPlanEdits(good, planFile, cases);
+    // A tile without its rigidity map gets no task, and the plan says why, as eval does (it was left out
+    // without a word).
+    fs::remove(shot.dir / "rig.1002.exr");
+    std::vector<std::string> notes;
+    const scene::FarmPlan without = harness::farmPlanCommand(planCommand, &notes);
+    for (const scene::FarmTask& task : without.tasks)
+        CHECK(std::ranges::find(task.tiles, 1002) == task.tiles.end());
+    REQUIRE(notes.size() == 1);
+    CHECK_THAT(notes[0], Contains("object 'tubes': tile 1002: left unwarped: no rigidity map '") &&
+                             Contains("rig.1002.exr'"));
+    harness::EvalCommand eval;
+    eval.scene = shot.scene;
+    eval.outDir = shot.dir / "eval";
+    eval.previews = false;
+    const harness::EvalReport evaluated = harness::evalCommand(eval);
+    CHECK(std::ranges::count_if(evaluated.uvwarpLines, [](const std::string& line) {
+              return line.find("tile 1002: left unwarped: no rigidity map") != std::string::npos;
+          }) == 1);
     planCommand.tilesPerTask = 0;
     CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::farmPlanCommand(planCommand); }),
                Contains("--tiles-per-task: is 0"));

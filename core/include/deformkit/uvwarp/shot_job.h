@@ -165,6 +165,9 @@ class ShotSolver {
 
     // Progress units of the job: tiles x frames.
     [[nodiscard]] int64_t units() const;
+    // What planning found to say, one line per note as the report prints it ("tile 1002: left unwarped: no
+    // rigidity map 'rig.1002.exr'"): a host that only plans (a farm plan) shows them.
+    [[nodiscard]] std::vector<std::string> plannedNotes() const;
     // The last frame whose deformed positions some tile needs; frames after it need no evaluation. None
     // when every output exists.
     [[nodiscard]] std::optional<int> lastNeededFrame() const;
