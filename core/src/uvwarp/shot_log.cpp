@@ -188,6 +188,15 @@ void openShotLog(const std::filesystem::path& path, std::ofstream& file) {
     if (!file) {
         throw IoError(formatError(path.string(), "", "cannot open the log for appending", "a writable file"));
     }
+    // A log whose writer was killed mid-line: the next record starts on a line of its own, not glued to the
+    // cut one (which stays, a problem the report names).
+    std::ifstream existing(path, std::ios::binary | std::ios::ate);
+    if (existing && existing.tellg() > 0) {
+        existing.seekg(-1, std::ios::end);
+        char last = '\n';
+        existing.get(last);
+        if (last != '\n') file << '\n' << std::flush;
+    }
 }
 
 }  // namespace deformkit::uvwarp

@@ -118,6 +118,31 @@ TEST_CASE("shot log: broken and partial lines are problems naming the file and l
     CHECK_THAT(missing.problems[0].message, Contains("cannot be opened"));
 }
 
+TEST_CASE("shot log: a log cut mid-line by a kill is appended to on a line of its own", "[uvwarp][report]") {
+    // The resumed run's first record used to be glued to the cut one, and both were lost.
+    test::TempDir dir;
+    const fs::path path = dir / "logs" / "shot.jsonl";
+    for (const std::string& before :
+         {std::string(), written(1001, 1, 0.8), std::string(R"({"tile":1001,"fra)")}) {
+        CAPTURE(before);
+        if (!before.empty()) test::writeText(path, before);
+        {
+            std::ofstream file;
+            uvwarp::openShotLog(path, file);
+            file << written(1001, 2, 0.7);
+        }
+        uvwarp::ShotLog log;
+        uvwarp::readShotLogFile(path, log);
+        const bool cut = !before.empty() && before.back() != '\n';
+        CHECK(log.problems.size() == (cut ? 1u : 0u));
+        REQUIRE(!log.lines.empty());
+        CHECK(log.lines.back().frame == 2);
+        CHECK(log.lines.back().line == (before.empty() ? 1 : 2));
+        CHECK(test::readText(path) == before + (cut ? "\n" : "") + written(1001, 2, 0.7));
+        fs::remove(path);
+    }
+}
+
 TEST_CASE("shot log: logs merge in any order; a written line tells its frame; the worst frame",
           "[uvwarp][report]") {
     // Task 0 wrote frames 1-3 of tile 1001 and was killed; its rerun skipped them and wrote frame 4. Another

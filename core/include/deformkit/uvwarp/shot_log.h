@@ -49,7 +49,8 @@ void readShotLog(std::istream& in, const std::string& file, ShotLog& log);
 void readShotLogFile(const std::filesystem::path& path, ShotLog& log);
 
 // Opens `path` for appending a shot's log lines (`deformkit uvwarp --log`, Python's log=), its folder made
-// when missing, as the shot's outputs' are. Throws IoError naming the file when it cannot be opened.
+// when missing, as the shot's outputs' are; a log that ends inside a line (its writer killed) gets a line end
+// first. Throws IoError naming the file when it cannot be opened.
 void openShotLog(const std::filesystem::path& path, std::ofstream& file);
 
 // One frame of an object's tile as the logs tell it.
