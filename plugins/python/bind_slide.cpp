@@ -130,6 +130,7 @@ std::vector<Falloff> falloffsOf(py::handle value, size_t handles, const std::str
 
 // Displacements: (3,) for one handle, (H, 3) for H handles.
 std::vector<glm::dvec3> displacementsOf(const DoubleArray& a, size_t handles, const std::string& source) {
+    requireDoubles(a, source, "displacement");
     const bool single = a.ndim() == 1 && a.shape(0) == 3 && handles == 1;
     const bool rows = a.ndim() == 2 && a.shape(1) == 3 && static_cast<size_t>(a.shape(0)) == handles;
     if (!single && !rows) {

@@ -37,8 +37,15 @@ struct FloatArray : pybind11::array_t<float, pybind11::array::c_style | pybind11
     explicit FloatArray(Base values) : Base(std::move(values)) {}
     std::string problem;
 };
-// Values read in double (a few parameters: a float32 copy would turn 4e38 into inf before it is checked).
-using DoubleArray = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
+// Values read in double (a few parameters: a float32 copy would turn 4e38 into inf before it is checked), as
+// FloatArray: `problem` says why they are not numbers (numpy's cast would read "0.1" as 0.1, True as 1 and
+// drop an imaginary part), and requireDoubles refuses them.
+struct DoubleArray : pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast> {
+    using Base = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
+    DoubleArray() = default;
+    explicit DoubleArray(Base values) : Base(std::move(values)) {}
+    std::string problem;
+};
 
 // Whole numbers from Python (a list, a numpy array of any integer or float type) as int32, converted
 // exactly: numpy's own cast would truncate 1.9 to 1 and wrap 2^32 + 2 to 2. The conversion never fails
@@ -60,6 +67,11 @@ inline std::string shapeOf(const pybind11::array& a) {
     for (pybind11::ssize_t i = 0; i < a.ndim(); ++i)
         s += (i ? ", " : "") + std::to_string(a.shape(i));
     return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+// InvalidInput naming the argument when its values are not numbers (DoubleArray::problem).
+inline void requireDoubles(const DoubleArray& a, const std::string& source, const std::string& name) {
+    if (!a.problem.empty()) throw InvalidInput(formatError(source, name, a.problem, "numbers"));
 }
 
 // InvalidInput naming the argument when its values are not float32 numbers (FloatArray::problem).
@@ -328,6 +340,37 @@ struct type_caster<deformkit::python::FloatArray> {
     }
 
     static handle cast(const deformkit::python::FloatArray& src, return_value_policy, handle) {
+        return src.inc_ref();
+    }
+};
+
+// As FloatArray's caster, in double: arrays of bool, strings, objects or complex numbers are taken with
+// DoubleArray::problem set.
+template <>
+struct type_caster<deformkit::python::DoubleArray> {
+    PYBIND11_TYPE_CASTER(deformkit::python::DoubleArray, const_name("numpy.ndarray[float64]"));
+
+    bool load(handle src, bool convert) {
+        using Base = deformkit::python::DoubleArray::Base;
+        if (src.is_none() || isinstance<str>(src) || isinstance<bytes>(src)) return false;
+        if (!convert && !Base::check_(src)) return false;
+        value = deformkit::python::DoubleArray();
+        array a = isinstance<array>(src) ? reinterpret_borrow<array>(src) : array::ensure(src);
+        if (!a) return false;
+        const char kind = a.dtype().kind();
+        if (kind != 'f' && kind != 'i' && kind != 'u') {
+            value.problem = isinstance<array>(src)
+                                ? "is an array of " + std::string(str(a.dtype())) + " values"
+                                : "is " + deformkit::python::aTypeName(src) + " that is not numeric";
+            return true;
+        }
+        Base values = Base::ensure(a);
+        if (!values) return false;
+        value = deformkit::python::DoubleArray(std::move(values));
+        return true;
+    }
+
+    static handle cast(const deformkit::python::DoubleArray& src, return_value_policy, handle) {
         return src.inc_ref();
     }
 };

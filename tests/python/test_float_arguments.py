@@ -40,6 +40,33 @@ def test_non_numbers_are_refused_naming_the_argument(bad, what):
     refused(lambda: dk.Mesh(bad(points), counts, indices), "points: " + what)
 
 
+@pytest.mark.parametrize("bad, what", [
+    (np.array([True, False, False]), r"is an array of bool values"),
+    (np.array([1 + 2j, 0, 0]), r"is an array of complex128 values"),
+    (["0.1", "0", "0"], r"is a list that is not numeric"),
+    ([None, 0, 0], r"is a list that is not numeric"),
+])
+def test_double_arguments_take_numbers_only(bad, what):
+    # Slide displacements and stack parameters are read in double: numpy's cast read "0.1" as 0.1, True as
+    # 1, dropped an imaginary part and None became NaN.
+    points, counts, indices = grid_mesh()
+    refused(lambda: dk.slide(points, counts, indices, 20, bad, 0.3), "slide: displacement: " + what)
+    slider = dk.Slider(points, counts, indices, handle=20, radius=0.3)
+    refused(lambda: slider.evaluate(bad), "Slider.evaluate: displacement: " + what)
+    stack = dk.DeformerStack()
+    stack.set_rest(dk.Mesh(points, counts, indices))
+    stack.add("twist")
+    refused(lambda: stack.set(0, "handleOrigin", bad), "parameter 'handleOrigin': " + what)
+    for flag in (True, np.bool_(True)):
+        refused(lambda: stack.set(0, "envelope", flag), "parameter 'envelope': is an? (bool|bool_) ")
+    # The same values as numbers are taken, and give the float32 path's result.
+    moved = slider.evaluate(np.array([0.1, 0, 0])).points
+    assert np.array_equal(moved, slider.evaluate([0.1, 0, 0]).points)
+    stack.set(0, "handleOrigin", np.array([0, 1, 0], np.int64))
+    assert list(stack.get(0, "handleOrigin")) == [0, 1, 0]
+    refused(lambda: stack.evaluate(points > 0), "DeformerStack.evaluate: points: is an array of bool values")
+
+
 def test_profile_samples_beyond_float_range_are_named():
     points, _, _ = grid_mesh()
     refused(lambda: dk.taper(points, axis_origin=(0, 0, 0), axis_dir=(0, 1, 0), z_samples=[0, 1e39],
