@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <bit>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -380,6 +382,32 @@ void requireAttributesStored(const codec::Codec& oiio, const fs::path& path, con
 }
 
 }  // namespace
+
+void requireFinitePixels(const Image& image, const std::string& source, const std::string& expected) {
+    // Blocks scanned branch-free on the exponent bits (vectorised: a texture is checked at memory speed),
+    // the first non-finite value then found in its block.
+    constexpr size_t kBlock = 4096;
+    const size_t n = image.pixels.size();
+    size_t block = 0;
+    for (; block < n; block += kBlock) {
+        const size_t end = std::min(n, block + kBlock);
+        uint32_t any = 0;
+        for (size_t i = block; i < end; ++i)
+            any |= (std::bit_cast<uint32_t>(image.pixels[i]) & 0x7f800000u) == 0x7f800000u ? 1u : 0u;
+        if (any != 0) break;
+    }
+    if (block >= n) return;
+    const auto bad = std::find_if(image.pixels.begin() + static_cast<ptrdiff_t>(block), image.pixels.end(),
+                                  [](float v) { return !std::isfinite(v); });
+    const auto k = static_cast<size_t>(bad - image.pixels.begin());
+    const auto channels = static_cast<size_t>(std::max(image.channels, 1));
+    const size_t pixel = k / channels, width = static_cast<size_t>(std::max(image.width, 1));
+    throw InvalidInput(formatError(source,
+                                   "pixel (" + std::to_string(pixel % width) + ", " +
+                                       std::to_string(pixel / width) + ") channel " +
+                                       std::to_string(k % channels),
+                                   "is " + numberText(*bad), expected));
+}
 
 Image readImage(const fs::path& path, const ImageReadOptions& options) {
     requireReadableFile(path);

@@ -55,6 +55,9 @@ void bakeTexture(const io::Image& texture, const io::Image& redirect, io::Image&
         }
     }
 
+    // A non-finite texel would spread into every baked texel that filters it (inf - inf is NaN).
+    io::requireFinitePixels(texture, "bake: texture", "finite values (a baked texel filters its neighbours)");
+
     const int32_t width = options.width > 0 ? options.width : texture.width;
     const int32_t height = options.height > 0 ? options.height : texture.height;
     const int32_t channels = texture.channels;

@@ -67,6 +67,9 @@ using detail::TilePlan;
 
 namespace {
 
+// Why a texture to bake must hold finite values, said when one does not.
+constexpr const char* kFiniteTexture = "finite values (a baked texel filters its neighbours)";
+
 namespace fs = std::filesystem;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
@@ -564,6 +567,7 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     if (plan.texture.file) {
         const fs::path file = *mapFile(plan.texture, frame);
         plan.texturePixels = io::readImage(file);
+        io::requireFinitePixels(plan.texturePixels, file.string(), kFiniteTexture);
         plan.texturePixelType = pixelTypeOf(file);
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
@@ -582,6 +586,7 @@ void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame) {
     if (!plan.texture.framePattern.empty()) {
         const fs::path file = *mapFile(plan.texture, frame);
         plan.texturePixels = io::readImage(file);
+        io::requireFinitePixels(plan.texturePixels, file.string(), kFiniteTexture);
         plan.texturePixelType = pixelTypeOf(file);
     }
     if (!rigidityMoves && !maskMoves && !orientationMoves) return;

@@ -24,18 +24,7 @@ void checkSource(const io::Image& image, const std::string& name) {
                                        "has " + std::to_string(image.pixels.size()) + " values",
                                        std::to_string(expected) + " (width * height * channels)"));
     }
-    const auto bad =
-        std::find_if(image.pixels.begin(), image.pixels.end(), [](float v) { return !std::isfinite(v); });
-    if (bad != image.pixels.end()) {
-        const auto k = static_cast<size_t>(bad - image.pixels.begin());
-        const size_t pixel = k / static_cast<size_t>(image.channels);
-        throw InvalidInput(
-            formatError(name,
-                        "pixel (" + std::to_string(pixel % static_cast<size_t>(image.width)) + ", " +
-                            std::to_string(pixel / static_cast<size_t>(image.width)) + ") channel " +
-                            std::to_string(k % static_cast<size_t>(image.channels)),
-                        "is " + numberText(*bad), "finite values (a warped pixel blends its neighbours)"));
-    }
+    io::requireFinitePixels(image, name, "finite values (a warped pixel blends its neighbours)");
 }
 
 }  // namespace

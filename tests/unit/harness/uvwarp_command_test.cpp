@@ -343,6 +343,20 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
                                    "(expected textures for some tiles, or none given)"));
         CHECK(fs::is_empty(s.dir / "out"));
     }
+    SECTION("a texture with a texel that is not finite") {
+        // One NaN texel became a patch of NaN in every bake: refused naming the file and the texel, before
+        // the frame's outputs are written.
+        Scene s;
+        io::Image texture = io::readImage(s.dir / "col.1001.exr");
+        texture.at(5, 9, 2) = std::nanf("");
+        io::writeImage(s.dir / "col.1001.exr", texture, {io::PixelType::Float, {}});
+        s.command.texture = s.dir / "col.<UDIM>.exr";
+        s.command.bake = s.dir / "out/col.<UDIM>.####.exr";
+        CHECK_THAT(test::errorOf<InvalidInput>([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains((s.dir / "col.1001.exr").string() +
+                                   ": pixel (5, 9) channel 2: is nan (expected finite values"));
+        CHECK(fs::is_empty(s.dir / "out"));
+    }
     SECTION("a rest mesh without UVs") {
         Scene s;
         test::writeText(s.dir / "rest.obj", planeObj(1.0, {0}, false));

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <tuple>
 
 #include "deformkit/error.h"
 #include "deformkit/uvwarp/bake.h"
@@ -180,4 +182,18 @@ TEST_CASE("baking bad input", "[uvwarp][bake]") {
     CHECK_THROWS_WITH(bakeTexture(texture, io::Image(8, 8, 1)), Catch::Contains("redirect map"));
     redirect.at(6, 1, 0) = std::numeric_limits<float>::quiet_NaN();
     CHECK_THROWS_WITH(bakeTexture(texture, redirect), Catch::Contains("redirect texel (6, 1)"));
+    // A non-finite texel of the texture: one NaN became 8 baked NaNs (its filter's neighbours). Named, for
+    // every position in a texture larger than one scanned block.
+    const io::Image identity = invertWarp(WarpGrid::identity(8), 8);
+    io::Image holed = rampTexture(96, 3);
+    for (const auto& [x, y, c] : {std::tuple{0, 0, 0}, std::tuple{95, 95, 2}, std::tuple{37, 60, 1}}) {
+        CAPTURE(x, y, c);
+        io::Image image = holed;
+        image.at(x, y, c) = c == 1 ? -std::numeric_limits<float>::infinity() : std::nanf("");
+        CHECK_THROWS_WITH(
+            bakeTexture(image, identity),
+            Catch::Contains("bake: texture: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") channel " + std::to_string(c) + ": is " + (c == 1 ? "-inf" : "nan")));
+    }
+    CHECK_NOTHROW(bakeTexture(holed, identity));
 }

@@ -28,7 +28,7 @@ struct BakeOptions {
 // (R x R x >= 2: channel 0 = u', channel 1 = v', tile-local, as invertWarp writes it) into `out`, resized
 // only when its size differs. OpenMP over rows; bit-identical for any thread count. Throws InvalidInput
 // for an empty texture or redirect, a non-square redirect or one with fewer than 2 channels, or a
-// non-finite redirect texel (naming it).
+// non-finite texel of either (naming it).
 void bakeTexture(const io::Image& texture, const io::Image& redirect, io::Image& out,
                  const BakeOptions& options = {});
 [[nodiscard]] io::Image bakeTexture(const io::Image& texture, const io::Image& redirect,
