@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <bit>
 #include <cstring>
 #include <fstream>
 #include <functional>
