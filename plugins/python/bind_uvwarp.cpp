@@ -50,6 +50,7 @@ io::Image mapOf(const FloatArray& a, const std::string& source, const char* name
         throw InvalidInput(
             formatError(source, name, "has shape " + shapeOf(a), "(T, T) or (T, T, 1) float32"));
     }
+    requireImageSides(a, source, name);
     io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), 1);
     std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));
     return image;

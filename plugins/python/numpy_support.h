@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -258,6 +259,17 @@ inline void requireSameOrApart(std::span<const glm::vec3> in, std::span<const gl
 }
 
 // An (H, W) or (H, W, C) array as an image (a copy); `expected` says which shapes the caller takes.
+// InvalidInput naming the argument when a side (or the channel count) of an image array is beyond what an
+// image holds (2^31 - 1): it would be cut to its low 32 bits, and the image cropped without a word.
+inline void requireImageSides(const pybind11::array& a, const std::string& source, const std::string& name) {
+    for (pybind11::ssize_t i = 0; i < a.ndim(); ++i) {
+        if (a.shape(i) > std::numeric_limits<int32_t>::max()) {
+            throw InvalidInput(
+                formatError(source, name, "has shape " + shapeOf(a), "at most 2147483647 along each axis"));
+        }
+    }
+}
+
 inline io::Image imageOf(const FloatArray& a, const std::string& source, const std::string& name,
                          const std::string& expected = "(H, W) or (H, W, C) float32") {
     requireFloats(a, source, name);
@@ -265,6 +277,7 @@ inline io::Image imageOf(const FloatArray& a, const std::string& source, const s
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a), expected));
     if (a.size() == 0)
         throw InvalidInput(formatError(source, name, "has shape " + shapeOf(a) + " with 0 pixels", expected));
+    requireImageSides(a, source, name);
     const int32_t channels = a.ndim() == 3 ? static_cast<int32_t>(a.shape(2)) : 1;
     io::Image image(static_cast<int32_t>(a.shape(1)), static_cast<int32_t>(a.shape(0)), channels);
     std::memcpy(image.pixels.data(), a.data(), image.pixels.size() * sizeof(float));

@@ -119,6 +119,18 @@ def test_errors_are_deformkit_errors(tmp_path):
         dk.udim_tiles(str(tmp_path / "none.<UDIM>.exr"))
 
 
+def test_an_image_side_beyond_int32_is_refused_not_cropped(tmp_path):
+    # (1, 2^31) float32 zeros: 8 GiB of address space numpy maps without touching. Its side was cut to its low
+    # 32 bits and the image written as a crop of it without a word.
+    wide = np.zeros((1, 2**31), np.float32)
+    with pytest.raises(dk.InvalidInput, match=r"write_image: array: has shape \(1, 2147483648\) \(expected at most"):
+        dk.write_image(tmp_path / "wide.exr", wide)
+    assert not (tmp_path / "wide.exr").exists()
+    identity = np.zeros((4, 4, 2), np.float32)
+    with pytest.raises(dk.InvalidInput, match=r"apply_redirect: texture: has shape \(1, 2147483648\)"):
+        dk.apply_redirect(wide, identity)
+
+
 def test_text_that_is_not_utf8_reaches_python_whole(tmp_path):
     # A file name of other bytes: the message names it, the byte shown as its escape (an error whose text
     # was not UTF-8 used to reach Python without a message).
