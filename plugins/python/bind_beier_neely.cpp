@@ -8,6 +8,7 @@
 
 #include <cstring>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -101,7 +102,16 @@ class PyBeierNeely {
 
     py::array map(int32_t width, int32_t height) {
         checkSize(width, height);
-        std::vector<glm::vec2> out(static_cast<size_t>(width) * height);
+        std::vector<glm::vec2> out;
+        try {
+            out.resize(static_cast<size_t>(width) * height);
+        } catch (const std::bad_alloc&) {
+            throw OutOfMemory(formatError(
+                kBeierNeely, "map",
+                "cannot be held in memory: " + std::to_string(width) + " x " + std::to_string(height) +
+                    " pixels (" + std::to_string(static_cast<uint64_t>(width) * height * 8) + " bytes)",
+                "a map that fits in this machine's memory"));
+        }
         {
             py::gil_scoped_release release;
             const Lock lock(mutex_);
@@ -151,11 +161,12 @@ class PyBeierNeely {
     }
 
   private:
+    // Sides from 1 to 65536 (the largest image side DeformKit writes a map for, as to-udim's tiles).
     static void checkSize(int32_t width, int32_t height) {
-        if (width <= 0 || height <= 0) {
+        if (width <= 0 || height <= 0 || width > 65536 || height > 65536) {
             throw InvalidInput(formatError(kBeierNeely, "width, height",
                                            "are " + std::to_string(width) + ", " + std::to_string(height),
-                                           "at least 1 x 1 pixels"));
+                                           "1 to 65536 pixels per side"));
         }
     }
     static std::vector<glm::vec3> points3(const FloatArray& a, const char* name) {

@@ -116,6 +116,13 @@ def test_errors():
         dk.beier_neely_map(8, 8, good, np.zeros((1, 3), np.float32))
     with pytest.raises(dk.InvalidInput, match="0 pixels"):
         dk.beier_neely(np.zeros((0, 4, 3), np.float32), good, good)
+    # Sides beyond 65536 were allocated as asked (50000^2 pixels: 20 GB, an anonymous bad_alloc at best).
+    for width, height in ((0, 8), (8, -1), (65537, 8), (8, 2**31 - 1)):
+        with pytest.raises(dk.InvalidInput, match=r"width, height: are .* \(expected 1 to 65536 pixels per side\)"):
+            dk.beier_neely_map(width, height, good, good)
+        with pytest.raises(dk.InvalidInput, match="1 to 65536 pixels per side"):
+            dk.BeierNeely(good, good).map(width, height)
+    assert dk.beier_neely_map(65536, 1, good, good).shape == (1, 65536, 2)
 
 
 def test_evaluate_names_the_class_and_a_point_as_it_came_in():
