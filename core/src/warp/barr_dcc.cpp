@@ -20,6 +20,17 @@ struct Range {
     double lo, hi;
 };
 
+// `v` as a float, or InvalidInput naming what it is (`element`, made from the DCC's `from`) when it is beyond
+// float32's range: it would become inf and be refused later under a name the DCC user never typed.
+float floatOf(double v, const char* source, const char* element, const char* from) {
+    const auto f = static_cast<float>(v);
+    if (!std::isfinite(f)) {
+        throw InvalidInput(formatError(source, element, "is " + numberText(v) + ", beyond float32's range",
+                                       std::string(from) + " giving a value within float32's range"));
+    }
+    return f;
+}
+
 // Blender's limits: fractions of the [min, max] extent of the points along `axis` of the origin space.
 Range blenderLimits(const BlenderSimpleDeform& b, std::span<const glm::vec3> points, int axis,
                     const char* source) {
@@ -86,10 +97,14 @@ AxisFrame blenderFrame(const BlenderSimpleDeform& b, int along, int up) {
 }
 
 // Linear profile a * clamp(z, lo, hi) + offset, exactly as two samples with constant extension.
-ProfileCurve linearProfile(const Range& r, double slope, double offset, const char* name) {
-    return ProfileCurve(
-        {static_cast<float>(r.lo), static_cast<float>(r.hi)},
-        {static_cast<float>(offset + slope * r.lo), static_cast<float>(offset + slope * r.hi)}, name);
+// `value` names the DCC's parameter the values come from ("angle", "factor").
+ProfileCurve linearProfile(const Range& r, double slope, double offset, const char* name, const char* value) {
+    const char* limits = "limits and points";
+    return ProfileCurve({floatOf(r.lo, name, "lower limit's position", limits),
+                         floatOf(r.hi, name, "upper limit's position", limits)},
+                        {floatOf(offset + slope * r.lo, name, "value at the lower limit", value),
+                         floatOf(offset + slope * r.hi, name, "value at the upper limit", value)},
+                        name);
 }
 
 }  // namespace
@@ -124,8 +139,10 @@ BendSetup fromMayaBend(const MayaBend& m) {
     BendSetup out;
     out.frame = {m.handleOrigin, m.handleY, m.handleX};
     // Handle units -> world units: lengths times sy, a rate (angle per length) divided by sy.
-    out.params = {static_cast<float>(m.curvature / sy), 0.0f, static_cast<float>(m.lowBound * sy),
-                  static_cast<float>(m.highBound * sy)};
+    out.params = {floatOf(m.curvature / sy, "Maya bend", "rate (curvature over the handle's scale)",
+                          "a curvature and handle scale"),
+                  0.0f, floatOf(m.lowBound * sy, "Maya bend", "lowBound times the handle's scale", "bounds"),
+                  floatOf(m.highBound * sy, "Maya bend", "highBound times the handle's scale", "bounds")};
     return out;
 }
 
@@ -157,8 +174,10 @@ TwistSamples mayaTwistSamples(const MayaTwist& m) {
     const Range r{m.lowBound * sy, m.highBound * sy};
     const double slope = (m.endAngle - m.startAngle) / (r.hi - r.lo);
     const double offset = m.startAngle - slope * r.lo;  // as linearProfile computes its samples
-    return {{static_cast<float>(r.lo), static_cast<float>(r.hi)},
-            {static_cast<float>(offset + slope * r.lo), static_cast<float>(offset + slope * r.hi)}};
+    return {{floatOf(r.lo, source, "lowBound times the handle's scale", "bounds"),
+             floatOf(r.hi, source, "highBound times the handle's scale", "bounds")},
+            {floatOf(offset + slope * r.lo, source, "angle at lowBound", "angles"),
+             floatOf(offset + slope * r.hi, source, "angle at highBound", "angles")}};
 }
 
 AxialSetup fromBlenderTwist(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
@@ -166,7 +185,7 @@ AxialSetup fromBlenderTwist(const BlenderSimpleDeform& b, std::span<const glm::v
     const int axis = static_cast<int>(b.deformAxis);
     const Range r = blenderLimits(b, points, axis, "Blender twist");
     return {blenderFrame(b, axis, (axis + 1) % 3),
-            linearProfile(r, b.angle / (r.hi - r.lo), 0.0, "Blender twist")};
+            linearProfile(r, b.angle / (r.hi - r.lo), 0.0, "Blender twist", "an angle")};
 }
 
 AxialSetup fromBlenderTaper(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
@@ -174,7 +193,7 @@ AxialSetup fromBlenderTaper(const BlenderSimpleDeform& b, std::span<const glm::v
     const int axis = static_cast<int>(b.deformAxis);
     const Range r = blenderLimits(b, points, axis, "Blender taper");
     return {blenderFrame(b, axis, (axis + 1) % 3),
-            linearProfile(r, b.factor / (r.hi - r.lo), 1.0, "Blender taper")};
+            linearProfile(r, b.factor / (r.hi - r.lo), 1.0, "Blender taper", "a factor")};
 }
 
 BendSetup fromBlenderBend(const BlenderSimpleDeform& b, std::span<const glm::vec3> points) {
@@ -187,8 +206,10 @@ BendSetup fromBlenderBend(const BlenderSimpleDeform& b, std::span<const glm::vec
     const Range r = blenderLimits(b, points, along, "Blender bend");
     BendSetup out;
     out.frame = blenderFrame(b, along, up);
-    out.params = {static_cast<float>(b.angle / (r.hi - r.lo)), 0.0f, static_cast<float>(r.lo),
-                  static_cast<float>(r.hi)};
+    out.params = {floatOf(b.angle / (r.hi - r.lo), "Blender bend", "rate (angle over the limited length)",
+                          "an angle and limits"),
+                  0.0f, floatOf(r.lo, "Blender bend", "lower limit's position", "limits and points"),
+                  floatOf(r.hi, "Blender bend", "upper limit's position", "limits and points")};
     return out;
 }
 

@@ -418,6 +418,18 @@ TEST_CASE("host: Maya bend maps onto Barr's bend (hand-worked)", "[barr][warp][h
     maya.handleX = {0, 0, 2};
     maya.lowBound = 3.0;
     CHECK_THROWS_WITH(fromMayaBend(maya), Contains("lowBound"));
+    // Values that leave float32's range once scaled to world units (0.5e39 / 2, and 2 * 2e38) are named by
+    // what the Maya user typed, not as an inf rate refused later by the bend.
+    maya.lowBound = -1.0;
+    maya.curvature = 1e39;
+    CHECK_THROWS_WITH(fromMayaBend(maya),
+                      Contains("Maya bend: rate (curvature over the handle's scale): is 5e+38, "
+                               "beyond float32's range"));
+    maya.curvature = 0.5;
+    maya.highBound = 2e38;
+    CHECK_THROWS_WITH(
+        fromMayaBend(maya),
+        Contains("Maya bend: highBound times the handle's scale: is 4e+38, beyond float32's range"));
 }
 
 TEST_CASE("host: Blender SimpleDeform twist, taper, bend (hand-worked)", "[barr][warp][host]") {
@@ -475,5 +487,22 @@ TEST_CASE("host: Blender SimpleDeform twist, taper, bend (hand-worked)", "[barr]
         CHECK(glm::length(out[0] - glm::vec3(0.5f, 4.0f / kPi, 4.0f / kPi)) < 1e-6f);
         const std::vector<glm::vec3> flat{{0, 0, 1}, {0, 0, 1}};
         CHECK_THROWS_WITH(fromBlenderBend(b, flat), Contains("zero length"));
+    }
+    SECTION("angles and factors whose rate or values leave float32's range") {
+        // Over z in [0, 2]: rate 1e300 / 2; twist values 0 and 1e300; taper 1 + 1e39 (limits whole).
+        const std::vector<glm::vec3> mesh{{0, 0, 0}, {0, 0, 2}};
+        BlenderSimpleDeform b;
+        b.angle = 1e300;
+        b.deformAxis = BlenderAxis::X;
+        CHECK_THROWS_WITH(fromBlenderBend(b, mesh),
+                          Contains("Blender bend: rate (angle over the limited length): is 5e+299, beyond"));
+        b.deformAxis = BlenderAxis::Z;
+        CHECK_THROWS_WITH(
+            fromBlenderTwist(b, mesh),
+            Contains("Blender twist: value at the upper limit: is 1e+300, beyond float32's range "
+                     "(expected an angle giving a value within float32's range)"));
+        b.factor = 2e39;
+        CHECK_THROWS_WITH(fromBlenderTaper(b, mesh),
+                          Contains("Blender taper: value at the upper limit: is 2e+39"));
     }
 }
