@@ -167,7 +167,7 @@ int32_t ptexFromUdimCommand(const PtexFromUdimCommand& command) {
     options.dataType = command.type;
     const ptex::PtexFile file = ptex::udimToPtex(ptexMesh, mesh, tiles, options);
     ptex::WriteOptions write;
-    write.mesh = ptex::meshData(mesh);
+    write.mesh = ptex::meshData(mesh, command.mesh.string());
     ptex::writePtex(command.out, file, write);
     return mesh.numFacesWithoutUVs();
 }
@@ -183,7 +183,7 @@ void ptexFromVertexCommand(const PtexFromVertexCommand& command) {
     const ptex::PtexFile file =
         ptex::bakeVertexValues(ptexMesh, weights, 1, {command.faceLog2, command.faceLog2, command.type});
     ptex::WriteOptions write;
-    write.mesh = ptex::meshData(mesh);
+    write.mesh = ptex::meshData(mesh, command.mesh.string());
     ptex::writePtex(command.out, file, write);
 }
 

@@ -427,7 +427,7 @@ void bindPtex(py::module_& m) {
             ptex::WriteOptions options;
             options.compressionLevel = compression;
             options.reductions = reductions;
-            if (m) options.mesh = ptex::meshData(*m);
+            if (m) options.mesh = ptex::meshData(*m, "write_ptex: mesh");
             py::gil_scoped_release release;
             ptex::writePtex(path, file, options);
         },

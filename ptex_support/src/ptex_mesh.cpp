@@ -10,6 +10,7 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "deformkit/error.h"
+#include "deformkit/geom/finite.h"
 #include "deformkit/geom/limit_surface.h"
 #include "deformkit/geom/weld.h"
 #include "texel_access.h"
@@ -232,7 +233,7 @@ void PtexMesh::requireSameMesh(const PtexFile& file, const std::string& fileSour
     throw InvalidInput(welded);
 }
 
-MeshData meshData(const geom::Mesh& mesh) {
+MeshData meshData(const geom::Mesh& mesh, const std::string& source) {
     MeshData data;
     data.faceVertCounts.assign(mesh.faceCounts().begin(), mesh.faceCounts().end());
     std::vector<int32_t> weldedOf, firstOf;
@@ -240,6 +241,12 @@ MeshData meshData(const geom::Mesh& mesh) {
     data.vertPositions.reserve(firstOf.size() * 3);
     for (const int32_t v : firstOf) {
         const glm::vec3& p = mesh.points()[static_cast<size_t>(v)];
+        if (!geom::isFinite(p)) {  // points changed after the mesh was made (a Python view)
+            throw InvalidInput(
+                formatError(source, "vertex " + std::to_string(v),
+                            "is (" + numberText(p.x) + ", " + numberText(p.y) + ", " + numberText(p.z) + ")",
+                            "finite coordinates (the file's mesh metadata)"));
+        }
         data.vertPositions.push_back(p.x);
         data.vertPositions.push_back(p.y);
         data.vertPositions.push_back(p.z);

@@ -81,3 +81,18 @@ def test_a_mesh_whose_points_were_made_nan_is_not_written():
         dk.write_mesh(path, mesh)
         assert np.array_equal(dk.read_mesh(path).points, mesh.points)
 
+
+
+def test_a_mesh_whose_points_were_made_nan_is_not_written_into_a_ptex_file():
+    # The file's mesh metadata held the NaN positions (PtexVertPositions) without a word.
+    mesh = dk.make_grid(2, 2)
+    mesh.points[3] = np.nan
+    ptex = {"data": [np.zeros((2, 2, 1), np.float32)] * mesh.num_faces}
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "a.ptx")
+        with pytest.raises(dk.InvalidInput, match=r"^write_ptex: mesh: vertex 3: is \(nan, nan, nan\)"):
+            dk.write_ptex(path, ptex, mesh=mesh)
+        assert not os.path.exists(path)
+        mesh.points[3] = (1, 0, 0)
+        dk.write_ptex(path, ptex, mesh=mesh)
+        assert not np.isnan(dk.read_ptex(path)["metadata"]["PtexVertPositions"]).any()

@@ -97,7 +97,7 @@ class PtexMesh {
 
 // The standard mesh metadata of a mesh (face vertex counts and indices, positions), for WriteOptions::mesh:
 // its polygons on welded vertices, each at its first copy's position, as a painter's shared-vertex mesh has
-// them.
-[[nodiscard]] MeshData meshData(const geom::Mesh& mesh);
+// them. Throws InvalidInput naming `source` and the vertex when a position is not finite.
+[[nodiscard]] MeshData meshData(const geom::Mesh& mesh, const std::string& source = "mesh");
 
 }  // namespace deformkit::ptex
