@@ -316,7 +316,10 @@ std::string shownOptionValue(const OptionValue& value) {
 }
 
 // Whether one number (an element of a list) is a valid value of `spec`.
-bool validOptionNumber(const OptionSpec& spec, double v) {
+bool validOptionNumber(const OptionSpec& spec, double given) {
+    // A number option is stored as a float: its range holds for the float (1e-60 is 0 as a float, 1e39 inf),
+    // so a value is refused as given, not later as what it became.
+    const double v = spec.type == OptionType::Number ? static_cast<double>(static_cast<float>(given)) : given;
     if (!std::isfinite(v)) return false;
     if (spec.type != OptionType::Number && v != std::floor(v)) return false;
     if (spec.lowOpen ? !(v > spec.low) : v < spec.low) return false;

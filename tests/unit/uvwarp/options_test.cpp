@@ -36,9 +36,11 @@ std::string joined(const std::string& camel, char separator) {
     return out;
 }
 
-// The test's own reading of a declared range: may `v` be a value (an element, for a list) of `spec`?
-bool allowed(const OptionSpec& spec, double v) {
+// The test's own reading of a declared range: may `given` be a value (an element, for a list) of `spec`? A
+// number option holds a float, and the range is of what it holds (1e-60 above an open 0 is 0 as a float).
+bool allowed(const OptionSpec& spec, double given) {
     const bool whole = spec.type != OptionType::Number;
+    const double v = whole ? given : static_cast<double>(static_cast<float>(given));
     if (!std::isfinite(v) || (whole && std::floor(v) != v) || v > spec.high) return false;
     if (spec.lowOpen ? v <= spec.low : v < spec.low) return false;
     if (spec.powerOfTwo && v != 0) {
@@ -131,6 +133,9 @@ TEST_CASE("uv warp options: setOption takes what the declared range allows and n
                                           3,
                                           64,
                                           48,
+                                          spec.low + 1e-60,  // the low bound as a float
+                                          spec.high + 1e-9,  // the high bound as a float, when it is large
+                                          spec.high * 1e30,  // beyond float's range for the largest highs
                                           NAN,
                                           INFINITY,
                                           -INFINITY};
