@@ -104,7 +104,8 @@ std::string slideSummary(const fs::path& out, const slide::SlideResult& result) 
         std::to_string(result.limited) + " (boundary-stopped " + std::to_string(result.boundaryStopped) +
         ", walk-limit-stopped " + std::to_string(result.walkLimitStopped) + "), flipped triangles " +
         std::to_string(result.flippedTriangles) + ", unreachable " + std::to_string(result.unreachable) +
-        ", degenerate " + std::to_string(result.degenerateTriangles);
+        ", without a tangent plane " + std::to_string(result.withoutTangentPlane) +
+        ", degenerate triangles " + std::to_string(result.degenerateTriangles);
     if (!result.foldScale.empty() && result.foldScale[0] < 1.0) {
         std::ostringstream scale;
         scale << result.foldScale[0];
@@ -147,7 +148,7 @@ void addSlideCommand(CommandLine& cli) {
     slide.option("--from", o->from, "start locator x,y,z").required();
     slide.option("--to", o->to, "end locator x,y,z: the handle region slides by to - from").required();
     slide.option("--radius", o->command.handle.radius, "support radius, scene units").required();
-    slide.option("--out", o->out, "output mesh (.obj), UVs and groups kept").required();
+    slide.option("--out", o->out, "output mesh (.obj): the slid positions, UVs, faces and groups").required();
     slide.option("--falloff", o->falloff, "smooth, linear, or ramp samples v0,v1,... over distance/radius")
         .showDefault();
     slide.option("--weights", o->weights, "painted weights: a JSON array of one number per vertex");

@@ -38,7 +38,8 @@ struct SlideCommand {
 slide::SlideResult slideCommand(const SlideCommand& command);
 
 // The one summary line the CLI prints: "wrote OUT: moved M, limited L (boundary-stopped B,
-// walk-limit-stopped S), flipped triangles T, unreachable U, degenerate D", then ", fold limit: drag scaled
+// walk-limit-stopped S), flipped triangles T, unreachable U, without a tangent plane N, degenerate triangles
+// D", then ", fold limit: drag scaled
 // to K" when it applied and "; W split vertices welded onto a coincident vertex ..." when the mesh had some.
 [[nodiscard]] std::string slideSummary(const std::filesystem::path& out, const slide::SlideResult& result);
 

@@ -308,7 +308,7 @@ awk 'BEGIN {
 }' >"$work/grid.obj"
 expect slide 0 "$dk" slide "$work/grid.obj" --handle 60 --from 0,0,0 --to 0.1,0,0 --radius 0.3 --out "$work/slid.obj"
 contains slide "$work/out" "wrote $work/slid.obj: moved "
-contains slide "$work/out" "limited 0 (boundary-stopped 0, walk-limit-stopped 0), flipped triangles 0, unreachable 0, degenerate 0"
+contains slide "$work/out" "limited 0 (boundary-stopped 0, walk-limit-stopped 0), flipped triangles 0, unreachable 0, without a tangent plane 0, degenerate triangles 0"
 [ "$(wc -l <"$work/out")" -eq 1 ] || { echo "FAIL slide: expected one summary line"; failures=$((failures + 1)); }
 [ "$(grep -c '^vt ' "$work/slid.obj")" -eq 121 ] || { echo "FAIL slide-uvs: UVs not kept"; failures=$((failures + 1)); }
 contains slide-group "$work/slid.obj" "g sheet"

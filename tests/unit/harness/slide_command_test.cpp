@@ -127,7 +127,7 @@ TEST_CASE("slide command: slides an OBJ plane by d times the falloff, keeping UV
     CHECK(harness::slideSummary("o.obj", result) ==
           "wrote o.obj: moved " + std::to_string(result.moved) +
               ", limited 0 (boundary-stopped 0, walk-limit-stopped 0), flipped triangles 0, unreachable 0, "
-              "degenerate 0");
+              "without a tangent plane 0, degenerate triangles 0");
 }
 
 TEST_CASE("slide command: bad input is an error naming it, and nothing is written",
