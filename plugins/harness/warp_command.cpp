@@ -2,7 +2,10 @@
 #include <iostream>
 #include "cli.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -12,6 +15,8 @@
 #include "deformkit/scene/feature_lines_file.h"
 
 namespace deformkit::harness {
+
+namespace fs = std::filesystem;
 
 void warpImageCommand(const WarpImageCommand& command) {
     io::requireFilesApart({{command.out, "the output (--out)", true},
@@ -27,7 +32,17 @@ void warpImageCommand(const WarpImageCommand& command) {
     warp.mapPixelCentres(source.width, source.height, map);
     const io::Image out = warp::resampleImage(source, map, source.width, source.height, command.interpolation,
                                               command.image.string());
-    io::writeImage(command.out, out);
+    // Written as the source is stored when the output has its format (an identity warp is then a copy: a
+    // 16-bit PNG stays 16-bit, a float EXR float); the output format's default otherwise.
+    const auto lowercase = [](const fs::path& path) {
+        std::string extension = path.extension().string();
+        std::ranges::transform(extension, extension.begin(), [](unsigned char c) { return std::tolower(c); });
+        return extension;
+    };
+    io::ImageWriteOptions write;
+    if (lowercase(command.out) == lowercase(command.image))
+        write.type = io::pixelTypeOf(io::readImageInfo(command.image));
+    io::writeImage(command.out, out, write);
 }
 
 void addWarpCommand(CommandLine& cli) {

@@ -382,6 +382,14 @@ void requireAttributesStored(const codec::Codec& oiio, const fs::path& path, con
 
 }  // namespace
 
+PixelType pixelTypeOf(const ImageInfo& info) {
+    if (info.pixelType == "float") return PixelType::Float;
+    if (info.pixelType == "half") return PixelType::Half;
+    if (info.pixelType == "uint16") return PixelType::UInt16;
+    if (info.pixelType == "uint8") return PixelType::UInt8;
+    return PixelType::Auto;
+}
+
 void requireFinitePixels(const Image& image, const std::string& source, const std::string& expected) {
     // Blocks scanned branch-free on the exponent bits (vectorised: a texture is checked at memory speed),
     // the first non-finite value then found in its block.
@@ -505,6 +513,13 @@ void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t c
     if (format == "jpeg" && channels != 1 && channels != 3) {
         throw InvalidInput(formatError(path.string(), "", "has " + channelCount(channels),
                                        "1 or 3 channels in jpeg files (no alpha; PNG, TIFF or EXR keep it)"));
+    }
+    // OpenJPEG codes 6 resolution levels, which need 32 pixels a side: OpenImageIO wrote a smaller image as
+    // a 77-byte file no reader opens, and reported success.
+    if (format == "jpeg2000" && (width < 32 || height < 32)) {
+        throw InvalidInput(formatError(
+            path.string(), "", "is " + std::to_string(width) + "x" + std::to_string(height) + " pixels",
+            "at least 32 pixels a side in jpeg2000 files"));
     }
     const std::string type = requestedType(options.type, format, fitsHalf);
 

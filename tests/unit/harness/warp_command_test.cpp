@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 #include "deformkit/error.h"
 #include "deformkit/io/image.h"
@@ -42,4 +43,35 @@ TEST_CASE("warp command: warps an image file and writes atomically", "[harness][
     command.out = dir / "never.exr";
     CHECK_THROWS_WITH(harness::warpImageCommand(command), Catch::Contains("lines[0].dst"));
     CHECK_FALSE(std::filesystem::exists(dir / "never.exr"));
+}
+
+TEST_CASE("warp command: an empty set of lines copies the image, stored as the source is",
+          "[harness][beier_neely]") {
+    // A 16-bit PNG came back 8-bit and a float EXR half: the copy lost up to half an 8-bit step. With the
+    // source's format the output keeps its pixel type, so no lines give the same pixels.
+    test::TempDir dir;
+    io::Image image(40, 33, 3);
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+        image.pixels[i] = static_cast<float>((i * 7919) % 65536) / 65535.0f;
+    test::writeText(dir / "none.json", R"({"lines": []})");
+    for (const auto& [name, type, stored] : {std::tuple{"in.png", io::PixelType::UInt16, "uint16"},
+                                             std::tuple{"in.exr", io::PixelType::Float, "float"},
+                                             std::tuple{"in.tif", io::PixelType::UInt16, "uint16"}}) {
+        CAPTURE(name);
+        io::writeImage(dir / name, image, {type, {}});
+        harness::WarpImageCommand command;
+        command.image = dir / name;
+        command.lines = dir / "none.json";
+        command.out = dir / ("copy" + std::filesystem::path(name).extension().string());
+        harness::warpImageCommand(command);
+        CHECK(io::readImageInfo(command.out).pixelType == stored);
+        CHECK(io::readImage(command.out).pixels == io::readImage(dir / name).pixels);
+    }
+    // Another format takes its own default: a 16-bit PNG warped into an EXR is half.
+    harness::WarpImageCommand command;
+    command.image = dir / "in.png";
+    command.lines = dir / "none.json";
+    command.out = dir / "other.exr";
+    harness::warpImageCommand(command);
+    CHECK(io::readImageInfo(command.out).pixelType == "half");
 }

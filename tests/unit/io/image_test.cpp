@@ -747,7 +747,16 @@ TEST_CASE("writeImage rejects what it cannot store faithfully and leaves no file
     CHECK_THROWS_WITH(writeImage(dir / "a.exr", img, {PixelType::Auto, {{"channels", "x"}}}),
                       Catch::Contains("attribute 'channels': is a name the EXR header itself uses") &&
                           Catch::Contains("'studio:channels'"));
+    // JPEG 2000 below 32 pixels a side: a 77-byte file no reader opens was written, and reported written.
+    for (const auto& [w, h] : {std::pair{16, 64}, std::pair{64, 31}, std::pair{1, 1}}) {
+        CHECK_THROWS_WITH(writeImage(dir / "small.jp2", patternImage(w, h, 3)),
+                          Catch::Contains("small.jp2: is " + std::to_string(w) + "x" + std::to_string(h) +
+                                          " pixels (expected at least 32 pixels a side in jpeg2000 files)"));
+    }
     CHECK(folderEntries(dir.path()).empty());
+    writeImage(dir / "square.jp2", patternImage(32, 32, 3));
+    CHECK(readImage(dir / "square.jp2").width == 32);
+    fs::remove(dir / "square.jp2");
 
     // A rejected write over an existing file leaves it as it was.
     writeImage(dir / "keep.png", img);

@@ -33,11 +33,6 @@ struct Image {
 // would be written as inf), 8-bit for every other format. Half refuses such a value.
 enum class PixelType { Auto, UInt8, UInt16, Half, Float };
 
-// Throws InvalidInput naming `source`, the first pixel (x, y from the top row), its channel and value when a
-// value of `image` is not finite; `expected` says why finite values are needed ("finite values (a baked
-// texel filters its neighbours)").
-void requireFinitePixels(const Image& image, const std::string& source, const std::string& expected);
-
 struct ImageReadOptions {
     int32_t expectedChannels = 0;  // 0: any; otherwise a file with another count is an InvalidInput error
     std::string role;              // what the image is for ("rigidity map"), named in errors when set
@@ -58,6 +53,15 @@ struct ImageInfo {
     std::vector<std::string> channelNames;
     std::vector<std::pair<std::string, std::string>> attributes;  // string header attributes
 };
+
+// The pixel type of a file's header (ImageInfo::pixelType): UInt8, UInt16, Half, Float, or Auto for another
+// (OpenImageIO's uint32, double, ...), so that a file written again keeps what it held.
+[[nodiscard]] PixelType pixelTypeOf(const ImageInfo& info);
+
+// Throws InvalidInput naming `source`, the first pixel (x, y from the top row), its channel and value when a
+// value of `image` is not finite; `expected` says why finite values are needed ("finite values (a baked
+// texel filters its neighbours)").
+void requireFinitePixels(const Image& image, const std::string& source, const std::string& expected);
 
 // Reads any format OpenImageIO reads (first subimage, first mip level) as float32.
 // Throws IoError for a missing or unreadable file, ParseError for a truncated or corrupt one (naming
