@@ -40,6 +40,7 @@ struct TileMap {
     const io::Image* image = nullptr;
     std::string name;
     int32_t width = 0, height = 0, channels = 0;
+    std::string firstChannel;  // the file's name for channel 0 (EXR sorts channels by name), "" for an image
 
     [[nodiscard]] bool found() const { return file.has_value() || image != nullptr; }
 };
@@ -168,6 +169,7 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
             map.width = info.width;
             map.height = info.height;
             map.channels = info.channels;
+            if (!info.channelNames.empty()) map.firstChannel = info.channelNames.front();
             for (int frame : frames) {
                 const fs::path path = sequence.framePath(frame);
                 if (!fileExists(path)) {
@@ -193,6 +195,7 @@ TileMap findTileMap(const TileMapSource& source, int tile, const std::vector<int
         map.width = info.width;
         map.height = info.height;
         map.channels = info.channels;
+        if (!info.channelNames.empty()) map.firstChannel = info.channelNames.front();
         return map;
     }
     map.name = (source.name.empty() ? std::string("map") : source.name) + " tile " + std::to_string(tile);
@@ -398,9 +401,14 @@ ShotSolver::ShotSolver(ShotJob job) : impl_(std::make_unique<Impl>()) {
         // A map of several channels (an RGB or RGBA export of a painted map): channel 0 is read, said once.
         const auto noteChannels = [&](const TileMap& map, const char* what) {
             if (map.channels > 1) {
+                // Named as the file names it: an EXR stores channels sorted by name, so its channel 0 is not
+                // always red ("mask.Y" before "rigidity.Y").
+                const std::string first = map.firstChannel.empty() || map.firstChannel == "R"
+                                              ? "red"
+                                              : "'" + map.firstChannel + "'";
                 plan.report.notes.push_back(std::string(what) + " '" + map.name + "' has " +
-                                            std::to_string(map.channels) +
-                                            " channels: channel 0 (red) is read");
+                                            std::to_string(map.channels) + " channels: channel 0 (" + first +
+                                            ") is read");
             }
         };
         noteChannels(r, "rigidity map");
@@ -516,12 +524,7 @@ std::string lowercaseExtension(const fs::path& path) {
 
 // The pixel type an image file stores (Auto for one a writer cannot write as such).
 io::PixelType pixelTypeOf(const fs::path& file) {
-    const std::string type = io::readImageInfo(file).pixelType;
-    if (type == "float") return io::PixelType::Float;
-    if (type == "half") return io::PixelType::Half;
-    if (type == "uint16") return io::PixelType::UInt16;
-    if (type == "uint8") return io::PixelType::UInt8;
-    return io::PixelType::Auto;
+    return io::pixelTypeOf(io::readImageInfo(file));
 }
 
 // The file of `map` at `frame`: its frame's file when animated, its one file otherwise.
@@ -562,6 +565,13 @@ bool samePixels(const io::Image& a, const io::Image& b) {
 
 void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     io::Image rigidity = readMap(plan.rigidity, frame, plan.tile, "rigidity map");
+    // Nothing rigid: every map is the identity, correct but most likely a map painted on another channel or
+    // tile. Said, as an unwarped tile is.
+    if (std::ranges::all_of(rigidity.pixels, [](float v) { return v <= 0.0f; })) {
+        plan.report.notes.push_back("rigidity map '" + plan.rigidity.name + "' is 0 at every texel" +
+                                    (plan.rigidity.framePattern.empty() ? "" : " of its first frame") +
+                                    ": nothing is held rigid, the redirect maps are the identity");
+    }
     const io::Image mask = readMap(plan.mask, frame, plan.tile, "warp mask");
     const io::Image orientation = readMap(plan.orientation, frame, plan.tile, "orientation map");
     if (plan.texture.file) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "deformkit/error.h"
@@ -74,6 +75,58 @@ io::Image disks(int t = kTexels) {
 
 // The scene: rest.obj, anim.0001-0003.obj (undeformed, 1.25x and 1.5x along u), rig.1001.exr, col.1001.exr
 // and an out folder.
+// An uncompressed scanline OpenEXR file of float channels named `names` (stored sorted by name, as the
+// format requires), channel k holding planes[k] (width x height, top row first); spelled out from the
+// OpenEXR file layout: magic, version, header attributes, the offset table, then one chunk per scanline.
+std::string layeredExr(int32_t width, int32_t height,
+                       const std::vector<std::pair<std::string, io::Image>>& planes) {
+    std::vector<std::pair<std::string, io::Image>> sorted = planes;
+    std::ranges::sort(sorted, {}, &std::pair<std::string, io::Image>::first);
+    std::string out;
+    const auto i32 = [&](int32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+    const auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+        out += name + '\0' + type + '\0';
+        i32(static_cast<int32_t>(value.size()));
+        out += value;
+    };
+    const auto ints = [](std::initializer_list<int32_t> values) {
+        std::string v;
+        for (int32_t x : values)
+            v.append(reinterpret_cast<const char*>(&x), 4);
+        return v;
+    };
+    out += "\x76\x2f\x31\x01";
+    i32(2);
+    std::string list;
+    for (const auto& [name, plane] : sorted)
+        list += name + '\0' + ints({2, 0, 1, 1});  // float, pLinear 0 + reserved, sampling 1 x 1
+    attribute("channels", "chlist", list + '\0');
+    attribute("compression", "compression", std::string(1, '\0'));
+    attribute("dataWindow", "box2i", ints({0, 0, width - 1, height - 1}));
+    attribute("displayWindow", "box2i", ints({0, 0, width - 1, height - 1}));
+    attribute("lineOrder", "lineOrder", std::string(1, '\0'));
+    attribute("pixelAspectRatio", "float", ints({0x3f800000}));
+    attribute("screenWindowCenter", "v2f", ints({0, 0}));
+    attribute("screenWindowWidth", "float", ints({0x3f800000}));
+    out += '\0';
+    const auto lineBytes = static_cast<int64_t>(width) * 4 * static_cast<int64_t>(sorted.size());
+    const auto first = static_cast<int64_t>(out.size()) + 8 * static_cast<int64_t>(height);
+    for (int32_t y = 0; y < height; ++y) {
+        const int64_t offset = first + y * (8 + lineBytes);
+        out.append(reinterpret_cast<const char*>(&offset), 8);
+    }
+    for (int32_t y = 0; y < height; ++y) {
+        i32(y);
+        i32(static_cast<int32_t>(lineBytes));
+        for (const auto& [name, plane] : sorted)
+            for (int32_t x = 0; x < width; ++x) {
+                const float v = plane.at(x, y, 0);
+                out.append(reinterpret_cast<const char*>(&v), 4);
+            }
+    }
+    return out;
+}
+
 struct Scene {
     test::TempDir dir;
     harness::UvWarpCommand command;
@@ -342,6 +395,38 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
                    Catch::Contains("colr.<UDIM>.exr: matches no file for any of the mesh's tiles (1001) "
                                    "(expected textures for some tiles, or none given)"));
         CHECK(fs::is_empty(s.dir / "out"));
+    }
+    SECTION("a layered EXR: the channel read is named as the file names it") {
+        // Channels are stored sorted by name: "mask.Y" is channel 0, not the rigidity layer. The note said
+        // "channel 0 (red) is read" of it; it names the layer, so the mistake shows.
+        Scene s;
+        test::writeText(
+            s.dir / "layers.1001.exr",
+            layeredExr(kTexels, kTexels,
+                       {{"rigidity.Y", disks()}, {"mask.Y", io::Image(kTexels, kTexels, 1, 1.0f)}}));
+        REQUIRE(io::readImageInfo(s.dir / "layers.1001.exr").channelNames ==
+                std::vector<std::string>{"mask.Y", "rigidity.Y"});
+        CHECK(io::readImage(s.dir / "layers.1001.exr").at(3, 5, 1) == disks().at(3, 5, 0));
+        s.command.rigidity = s.dir / "layers.<UDIM>.exr";
+        s.command.frames = {1};
+        const uvwarp::ShotReport report = harness::uvwarpCommand(s.command);
+        REQUIRE(report.tiles.size() == 1);
+        CHECK_THAT(report.tiles[0].notes.at(0), Catch::Contains("layers.1001.exr' has 2 channels: channel 0 "
+                                                                "('mask.Y') is read"));
+    }
+    SECTION("a rigidity map that is 0 everywhere") {
+        // Identity maps were written with "0 fold-overs" and nothing else said.
+        Scene s;
+        io::writeImage(s.dir / "rig.1001.exr", io::Image(kTexels, kTexels, 1, 0.0f),
+                       {io::PixelType::Float, {}});
+        s.command.frames = {2};
+        const uvwarp::ShotReport report = harness::uvwarpCommand(s.command);
+        REQUIRE(report.tiles.size() == 1);
+        REQUIRE(report.tiles[0].notes.size() == 1);
+        CHECK_THAT(report.tiles[0].notes[0],
+                   Catch::Contains("rig.1001.exr' is 0 at every texel: nothing is held "
+                                   "rigid, the redirect maps are the identity"));
+        CHECK(distanceFromIdentity(io::readImage(s.redirect(2))) < 1e-5);
     }
     SECTION("a texture with a texel that is not finite") {
         // One NaN texel became a patch of NaN in every bake: refused naming the file and the texel, before
