@@ -652,3 +652,33 @@ def test_shot_maps_of_several_channels_read_channel_0_and_say_so(tmp_path):
     assert len(out["rgba"][1]) == 1 and "has 4 channels: channel 0 (red) is read" in out["rgba"][1][0]
     with pytest.raises(dk.InvalidInput, match=r"rigidity: has shape \(64, 64, 4\)"):
         dk.UvWarpSolver(mesh, 1001, rgba)
+
+
+def test_a_map_worse_than_no_warp_is_said(tmp_path):
+    # Charts inset to [0.05, 0.95] with a warp mask of 1 everywhere: the solver moves content across the
+    # empty border, and the delivered maps hold more rigid stretch than the identity. They were written with
+    # nothing said; the shot notes it once, with the first such frame.
+    grid = dk.make_grid(16, 16)
+    points = np.asarray(grid.points).copy()
+    mesh = (points, grid.face_counts, grid.face_indices, np.asarray(grid.uvs) * 0.9 + 0.05, grid.uv_indices)
+
+    def pose(frame):
+        moved = points.copy()
+        moved[:, 0] *= 1 + 0.3 * frame
+        moved[:, 2] = 0.2 * np.sin(3 * points[:, 0] * frame)
+        return moved
+
+    y, x = np.mgrid[0:64, 0:64]
+    rigidity = np.zeros((64, 64), np.float32)
+    for cx in range(8, 64, 16):
+        for cy in range(8, 64, 16):
+            rigidity[(x - cx)**2 + (y - cy)**2 < 4.6**2] = 1
+    report = dk.uvwarp_shot(*mesh, [1, 2], pose, {1001: rigidity}, str(tmp_path / "r.<UDIM>.####.exr"),
+                            mask={1001: np.ones((64, 64), np.float32)})[1001]
+    assert report["metrics"]["rigid_stretch_removed"] < 0
+    worse = [note for note in report["notes"] if "holds more rigid stretch than no warp" in note]
+    assert len(worse) == 1 and worse[0].startswith("frame 1: ")
+    # The same rigidity without the mask removes stretch, and nothing is said.
+    plain = dk.uvwarp_shot(*mesh, [1, 2], pose, {1001: rigidity}, str(tmp_path / "p.<UDIM>.####.exr"))[1001]
+    assert plain["metrics"]["rigid_stretch_removed"] > 0.3  # 41%
+    assert not any("no warp" in note for note in plain["notes"])

@@ -56,6 +56,7 @@ struct TilePlan {
     std::optional<TileWarp> warp;                            // bound at the first frame it solves
     io::Image texturePixels, redirect, baked;
     io::PixelType texturePixelType = io::PixelType::Auto;  // the texture file's, kept by a bake of its format
+    bool saidWorseThanIdentity = false;                    // the note of a map worse than no warp, once
     // Animated maps: the rigidity, mask and orientation images last given to the warp, to tell a change.
     io::Image lastRigidity, lastMask, lastOrientation;
     nlohmann::json inputs;
@@ -655,6 +656,16 @@ void ShotSolver::Impl::solveTile(TilePlan& plan, size_t k, std::span<const glm::
         delivered = warp.measure(plan.redirect);
         seconds["measure"] = secondsSince(t);
         r.lastDelivered = *delivered;
+        // A delivered map with more rigid stretch than no warp at all (a mask or rigidity painted off the
+        // charts): correct by its maps, but not what anyone wants; said once, with the first such frame.
+        if (delivered->removed < 0.0 && !plan.saidWorseThanIdentity) {
+            plan.saidWorseThanIdentity = true;
+            std::ostringstream note;
+            note.precision(3);
+            note << "frame " << frame << ": the redirect map holds more rigid stretch than no warp (removed "
+                 << 100.0 * delivered->removed << "%): are the mask and rigidity maps painted on the charts?";
+            r.notes.push_back(note.str());
+        }
         r.lastRepair = *repair;
         if (repair->regionsScaled > 0) ++r.scaledBack;
         r.lastWrittenFrame = frame;
