@@ -60,7 +60,11 @@ void parameters(const json& object, const std::string& source, const std::string
         const std::string path = prefix + key;
         value = number(object.at(key), source, path);
         if (strictlyPositive ? !(value > 0.0f) : !(value >= 0.0f)) {
-            throw InvalidInput(formatError(source, path, "is " + object.at(key).dump(),
+            // A positive number below float's least (1e-300) is 0 as the float the warp keeps: said so.
+            const std::string shown =
+                object.at(key).dump() +
+                (value == 0.0f && object.at(key).get<double>() != 0.0 ? ", 0 as a float" : "");
+            throw InvalidInput(formatError(source, path, "is " + shown,
                                            std::string(key) + (strictlyPositive ? " > 0" : " >= 0")));
         }
     };

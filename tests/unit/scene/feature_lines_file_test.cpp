@@ -47,6 +47,9 @@ TEST_CASE("feature lines file: bad JSON names the JSON path", "[scene][feature_l
                    Catch::Contains("longer than 1e-06 pixels"));
     CHECK_THAT(fails(R"({"a": 0, "lines": []})"),
                Catch::Contains("lines.json: a: is 0") && Catch::Contains("a > 0"));
+    // Positive, but 0 as the float the warp keeps: said so, not "is 1e-300 (expected a > 0)".
+    CHECK_THAT(fails(R"({"a": 1e-300, "lines": []})"),
+               Catch::Contains("lines.json: a: is 1e-300, 0 as a float (expected a > 0)"));
     CHECK_THAT(fails(R"({"lines": [{"src": [[1, 2], [3, 4]], "dst": [[5, 6], [7, 8]], "b": -1}]})"),
                Catch::Contains("lines[0].b") && Catch::Contains("b >= 0"));
     CHECK_THAT(fails(R"({"lines": [{"dst": [[5, 6], [7, 8]]}]})"),

@@ -166,6 +166,13 @@ TEST_CASE("weight maps: a scene's weights may be an image sampled through the UV
                                            dir / "shot.json");
                }),
                Contains("shot.json: objects[0].stack[0].weights.image: ") && Contains("channel 5 asked"));
+    CHECK_THAT(
+        test::errorOf<InvalidInput>([&] {
+            (void)scene::parseScene(head + R"({"image": "w.<UDIM>.exr", "channel": 1.5}}]}]})",
+                                    dir / "shot.json");
+        }),
+        Contains("shot.json: objects[0].stack[0].weights.channel: is 1.5 (expected a whole number from 0 "
+                 "to 64)"));
     CHECK_THAT(test::errorOf<InvalidInput>([&] {
                    (void)scene::parseScene(head + R"({"image": "v.<UDIM>.exr"}}]}]})", dir / "shot.json");
                }),
