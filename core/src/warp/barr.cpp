@@ -207,7 +207,11 @@ OrthoFrame orthonormalFrame(const AxisFrame& frame, bool needUp, std::string_vie
     }
     const double axisLength = glm::length(glm::dvec3(frame.axis));
     if (!(axisLength > 1e-12)) {
-        throw InvalidInput(formatError(source, "axis_dir", "is the zero vector", "a non-zero direction"));
+        throw InvalidInput(formatError(source, "axis_dir",
+                                       axisLength == 0.0 ? std::string("is the zero vector")
+                                                         : "is " + detail::pointText(frame.axis) +
+                                                               ", of length " + numberText(axisLength),
+                                       "a direction longer than 1e-12"));
     }
     OrthoFrame out;
     out.origin = frame.origin;

@@ -176,6 +176,16 @@ TEST_CASE("taper adapter: scales across the handle axis linearly between the bou
     std::vector<glm::vec3> direct(out.size());
     taper.evaluate(rest.points(), direct);
     CHECK(test::sameBits(out, direct));
+
+    // Bounds beyond float32's range once in scene units (3e38 times handle Y's length 2): named as the
+    // parameter, not as the profile's z sample that became inf.
+    const auto far = makeDeformer("taper", "tp");
+    far->set("handleY", std::vector<double>{0, 2, 0});
+    far->set("highBound", 3e38);
+    CHECK_THROWS_WITH(
+        test::runAlone(*far, rest),
+        Contains("taper 'tp': parameter 'highBound': is 3e+38, times handle Y's length 2 beyond "
+                 "float32's range"));
 }
 
 TEST_CASE("bend, wires and slide adapters equal their core deformers", "[host][deformers]") {

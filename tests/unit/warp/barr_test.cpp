@@ -128,6 +128,10 @@ TEST_CASE("axis frame: orthonormal, right-handed, bad axes named", "[barr][warp]
     CHECK(glm::length(glm::cross(f.side, f.up) - f.axis) < 1e-6f);
     CHECK_THROWS_WITH(orthonormalFrame({{0, 0, 0}, {0, 0, 0}, {0, 1, 0}}, false, "taper"),
                       Contains("taper") && Contains("axis_dir") && Contains("zero"));
+    // Too short to give a direction, but not zero: said as it is, not as "the zero vector".
+    CHECK_THROWS_WITH(orthonormalFrame({{0, 0, 0}, {0, 1e-30f, 0}, {0, 1, 0}}, false, "twist"),
+                      Contains("twist: axis_dir: is (0, 1e-30, 0), of length ") &&
+                          Contains("(expected a direction longer than 1e-12)"));
     CHECK_THROWS_WITH(orthonormalFrame({{0, 0, 0}, {0, 2, 0}, {0, -3, 0}}, true, "bend"),
                       Contains("up_dir") && Contains("parallel"));
     CHECK_THROWS_WITH(orthonormalFrame({{std::nanf(""), 0, 0}, {0, 0, 1}, {0, 1, 0}}, true, "bend"),

@@ -1,6 +1,8 @@
 // "twist", "bend", "taper": Barr's warps with a handle in the Maya style (warp/barr.h, warp/barr_dcc.h).
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
@@ -184,9 +186,7 @@ class TaperDeformer final : public HandleDeformer {
     }
     void pushControls() override {
         // In place: animated scales cost no allocation (the samples are checked finite and ascending there).
-        const auto [lo, hi] = bounds();
-        const double sy = glm::length(dvec3At(value(y_)));
-        const std::array<float, 2> z{static_cast<float>(lo * sy), static_cast<float>(hi * sy)};
+        const std::array<float, 2> z = sceneBounds();
         const std::array<float, 2> scale{static_cast<float>(value(start_)[0]),
                                          static_cast<float>(value(end_)[0])};
         taper_->setProfile(z, scale, "taper profile");
@@ -196,12 +196,30 @@ class TaperDeformer final : public HandleDeformer {
     }
 
   private:
+    // lowBound and highBound in scene units (times handle Y's length), refused under the parameters' names
+    // when that leaves float32's range (the profile would name its own z samples).
+    [[nodiscard]] std::array<float, 2> sceneBounds() const {
+        const auto [lo, hi] = bounds();
+        const double sy = glm::length(dvec3At(value(y_)));
+        std::array<float, 2> z{};
+        const std::array<std::pair<double, const char*>, 2> given{{{lo, "lowBound"}, {hi, "highBound"}}};
+        for (size_t k = 0; k < 2; ++k) {
+            z[k] = static_cast<float>(given[k].first * sy);
+            if (!std::isfinite(z[k])) {
+                throw InvalidInput(formatError(context(), std::string("parameter '") + given[k].second + "'",
+                                               "is " + numberText(given[k].first) +
+                                                   ", times handle Y's length " + numberText(sy) +
+                                                   " beyond float32's range",
+                                               "bounds and a handle that keep it within float32's range"));
+            }
+        }
+        return z;
+    }
     // f(z) through (lowBound |Y|, startScale) and (highBound |Y|, endScale): the monotone cubic through two
     // samples is that line; held beyond them. z is in scene units along the unit axis from the origin.
     [[nodiscard]] warp::ProfileCurve profile() const {
-        const auto [lo, hi] = bounds();
-        const double sy = glm::length(dvec3At(value(y_)));
-        return warp::ProfileCurve({static_cast<float>(lo * sy), static_cast<float>(hi * sy)},
+        const std::array<float, 2> z = sceneBounds();
+        return warp::ProfileCurve({z[0], z[1]},
                                   {static_cast<float>(value(start_)[0]), static_cast<float>(value(end_)[0])},
                                   context() + " profile");
     }
