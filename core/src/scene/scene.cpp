@@ -226,9 +226,9 @@ class Reader {
                                          : "has neither \"image\" nor \"ptex\"",
                      "one of an image file name or UDIM pattern (\"image\") and a Ptex file (\"ptex\")");
             const int32_t channel =
-                v.contains("channel")
-                    ? static_cast<int32_t>(ranged(v.at("channel"), path + ".channel", 0, 64, true, "a whole number from 0 to 64"))
-                    : 0;
+                v.contains("channel") ? static_cast<int32_t>(ranged(v.at("channel"), path + ".channel", 0, 64,
+                                                                    true, "a whole number from 0 to 64"))
+                                      : 0;
             if (v.contains("ptex")) {
                 file = this->file(v.at("ptex"), path + ".ptex", "a Ptex file name");
                 if (!options_.ptexWeights)
