@@ -111,13 +111,12 @@ std::unique_ptr<codec::Reader> openInput(const codec::Codec& oiio, const fs::pat
 }
 
 // The fewest bytes a TIFF file can hold the declared pixels in, by its compression's largest ratio: the
-// samples at 1 bit each (a bilevel image's; deeper ones need more) over 1 uncompressed, 64 for PackBits (2
-// bytes repeat one byte at most 128 times), 4096 for LZW (a 12-bit code stands for fewer than 4096 bytes)
-// and 1032 for Deflate (zlib's). Fax coding (CCITT) spends at least one bit a row, however blank. 0 for
-// other compressions (JPEG's arithmetic coding has no such bound).
+// pixels at 1 bit each (a bilevel image's; a palette index or subsampled colour takes at least that) over 1
+// uncompressed, 64 for PackBits (2 bytes repeat one byte at most 128 times), 4096 for LZW (a 12-bit code
+// stands for fewer than 4096 bytes) and 1032 for Deflate (zlib's). Fax coding (CCITT) spends at least one
+// bit a row, however blank. 0 for other compressions (JPEG's arithmetic coding has no such bound).
 uint64_t fewestTiffBytes(const codec::Spec& spec) {
-    const auto samples = static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height) *
-                         static_cast<uint64_t>(spec.channels);  // each below 2^31: no overflow
+    const auto pixels = static_cast<uint64_t>(spec.width) * static_cast<uint64_t>(spec.height);
     for (const auto& [name, value] : spec.stringAttributes) {
         if (name != "compression") continue;
         uint64_t ratio = 0;
@@ -125,7 +124,7 @@ uint64_t fewestTiffBytes(const codec::Spec& spec) {
         if (value == "packbits") ratio = 64;
         if (value == "lzw") ratio = 4096;
         if (value == "zip" || value == "deflate") ratio = 1032;
-        if (ratio > 0) return (samples + 8 * ratio - 1) / (8 * ratio);
+        if (ratio > 0) return (pixels + 8 * ratio - 1) / (8 * ratio);
         if (value.rfind("ccitt", 0) == 0) return (static_cast<uint64_t>(spec.height) + 7) / 8;
     }
     return 0;

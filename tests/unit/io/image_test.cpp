@@ -69,35 +69,43 @@ std::string pngDeclaring(uint32_t width, uint32_t height, bool whole = false) {
                  std::string((whole ? height : 1) * static_cast<size_t>(1 + (width + 7) / 8), '\0'));
 }
 
-// A little-endian TIFF of one gray strip holding `data` as it is (spelled out from the TIFF 6.0 layout: the
-// header, one directory of nine entries, then the strip). Compression 1 none, 4 CCITT Group 4, 5 LZW, 8
-// Deflate, 32773 PackBits; photometric 0 is white-is-zero.
+// A little-endian TIFF of one strip holding `data` as it is (spelled out from the TIFF 6.0 layout: the
+// header, one directory, then the strip and the colour map). Compression 1 none, 4 CCITT Group 4, 5 LZW, 8
+// Deflate, 32773 PackBits. Gray, white-is-zero; with `palette` a palette image (photometric 3) whose colour
+// map (tag 320) gives index 0 black and every other index white, which a reader shows as RGB.
 std::string tiffOf(uint32_t width, uint32_t height, uint16_t bitsPerSample, uint16_t compression,
-                   const std::string& data) {
+                   const std::string& data, bool palette = false) {
     std::string out("II*\0\x08\0\0\0", 8);
     const auto u16 = [&](uint16_t v) { out.append(reinterpret_cast<const char*>(&v), 2); };
     const auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
-    const auto entry = [&](uint16_t tag, uint16_t type, uint32_t value) {
-        u16(tag), u16(type), u32(1);
-        if (type == 3) {
+    const auto entry = [&](uint16_t tag, uint16_t type, uint32_t count, uint32_t value) {
+        u16(tag), u16(type), u32(count);
+        if (type == 3 && count == 1) {
             u16(static_cast<uint16_t>(value)), u16(0);
         } else {
             u32(value);
         }
     };
-    constexpr uint16_t kShort = 3, kLong = 4, kEntries = 9;
-    u16(kEntries);
-    entry(256, kLong, width);
-    entry(257, kLong, height);
-    entry(258, kShort, bitsPerSample);
-    entry(259, kShort, compression);
-    entry(262, kShort, 0);
-    entry(273, kLong, 8 + 2 + 12 * kEntries + 4);  // the strip right after the directory
-    entry(277, kShort, 1);
-    entry(278, kLong, height);  // one strip
-    entry(279, kLong, static_cast<uint32_t>(data.size()));
+    constexpr uint16_t kShort = 3, kLong = 4;
+    const uint16_t entries = palette ? 10 : 9;
+    const uint32_t strip = 8 + 2 + 12 * entries + 4;  // the strip right after the directory
+    const uint32_t colours = uint32_t{1} << bitsPerSample;
+    u16(entries);
+    entry(256, kLong, 1, width);
+    entry(257, kLong, 1, height);
+    entry(258, kShort, 1, bitsPerSample);
+    entry(259, kShort, 1, compression);
+    entry(262, kShort, 1, palette ? 3 : 0);
+    entry(273, kLong, 1, strip);
+    entry(277, kShort, 1, 1);
+    entry(278, kLong, 1, height);  // one strip
+    entry(279, kLong, 1, static_cast<uint32_t>(data.size()));
+    if (palette) entry(320, kShort, 3 * colours, strip + static_cast<uint32_t>(data.size()));
     u32(0);
-    return out + data;
+    out += data;
+    for (uint32_t c = 0; palette && c < 3 * colours; ++c)
+        u16(c % colours == 0 ? 0 : 65535);  // red, green, blue tables
+    return out;
 }
 
 // What `run` writes to the process's stderr (file descriptor 2) while it runs; its exception is ignored.
@@ -502,7 +510,7 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         writeText(dir / "blank.png", pngDeclaring(4096, 4096, true));
         CHECK(readImage(dir / "blank.png").width == 4096);
         // TIFF headers of 30000^2 8-bit pixels over 16 bytes, refused by their compression's largest ratio
-        // (the samples counted at 1 bit: 112.5 MB uncompressed; over 64, 4096 and 1032; fax coding at least
+        // (the pixels counted at 1 bit: 112.5 MB uncompressed; over 64, 4096 and 1032; fax coding at least
         // one bit a row) before 3.6 GB are allocated; a 10-GB fax page used to crash OpenImageIO.
         for (const auto& [compression, fewest] : {std::pair<uint16_t, uint64_t>{1, 112500000},
                                                   {32773, 1757813},
@@ -525,6 +533,17 @@ TEST_CASE("readImage errors name the file and the cause", "[io][image]") {
         const Image blankPage = readImage(dir / "blank.tif");
         REQUIRE(blankPage.width == 4096);
         CHECK(std::ranges::all_of(blankPage.pixels, [](float v) { return v == 1.0f; }));
+        // A 1-bit palette image holds one bit a pixel however many channels it reads as (RGB): the bound
+        // counts pixels, so a whole one reads (512 bytes for 64 x 64), and a cut one is refused.
+        std::string bits(64 * 64 / 8, '\0');
+        bits[5] = '\x80';  // pixel (40, 0): index 1, white
+        writeText(dir / "palette.tif", tiffOf(64, 64, 1, 1, bits, true));
+        const Image palette = readImage(dir / "palette.tif");
+        REQUIRE(palette.channels == 3);
+        CHECK(palette.at(40, 0, 1) == 1.0f);
+        CHECK(palette.at(41, 0, 1) == 0.0f);
+        writeText(dir / "palette.tif", tiffOf(640, 640, 1, 1, bits, true));
+        CHECK_THROWS_WITH(readImage(dir / "palette.tif"), Catch::Contains("which take at least 51200 bytes"));
         // Files as compressible as can be, as OpenImageIO writes them, read whatever their compression.
         for (const char* compression : {"none", "packbits", "lzw", "zip"}) {
             CAPTURE(compression);
