@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <glm/common.hpp>
@@ -23,25 +24,24 @@ void checkOptions(const MeshWarpOptions& o, const std::string& source) {
     const auto bad = [&](const char* element, const std::string& problem, const char* expected) {
         throw InvalidInput(formatError(source, element, problem, expected));
     };
-    if (!std::isfinite(o.alpha) || !std::isfinite(o.beta) || !std::isfinite(o.gamma) ||
-        !std::isfinite(o.mu)) {
-        bad("options", "alpha, beta, gamma or mu is not finite", "finite numbers");
+    for (const auto& [name, value] : {std::pair{"alpha", o.alpha}, std::pair{"beta", o.beta},
+                                      std::pair{"gamma", o.gamma}, std::pair{"mu", o.mu}}) {
+        if (!std::isfinite(value)) bad(name, "is " + numberText(value), "a finite number");
     }
-    if (o.alpha < 0.0f) bad("alpha", "is " + std::to_string(o.alpha), "alpha >= 0");
+    if (o.alpha < 0.0f) bad("alpha", "is " + numberText(o.alpha), "alpha >= 0");
     if (!(o.alpha < o.beta)) {
-        bad("alpha", "is " + std::to_string(o.alpha) + " with beta " + std::to_string(o.beta),
-            "alpha < beta");
+        bad("alpha", "is " + numberText(o.alpha) + " with beta " + numberText(o.beta), "alpha < beta");
     }
     if (!(o.mu > 0.0f)) {
         bad("mu",
-            "is " + std::to_string(o.mu) + ": every control vertex would weigh 0 past itself along its edges",
+            "is " + numberText(o.mu) + ": every control vertex would weigh 0 past itself along its edges",
             "mu > 0 (1: the weight ends at each edge's far end)");
     }
     if (!(o.gamma < o.mu)) {
-        bad("gamma", "is " + std::to_string(o.gamma) + " with mu " + std::to_string(o.mu), "gamma < mu");
+        bad("gamma", "is " + numberText(o.gamma) + " with mu " + numberText(o.mu), "gamma < mu");
     }
     if (!(o.rankTolerance >= 0.0 && o.rankTolerance < 1.0)) {
-        bad("rankTolerance", "is " + std::to_string(o.rankTolerance), "a value in [0, 1)");
+        bad("rankTolerance", "is " + numberText(o.rankTolerance), "a value in [0, 1)");
     }
 }
 

@@ -469,7 +469,13 @@ TEST_CASE("mesh warp: bad input names the element", "[mesh_warp][errors]") {
     CHECK_THROWS_WITH(MeshWarp(cage, o), Catch::Contains("gamma") && Catch::Contains("gamma < mu"));
     o = {};
     o.mu = NAN;
-    CHECK_THROWS_WITH(MeshWarp(cage, o), Catch::Contains("not finite"));
+    CHECK_THROWS_WITH(MeshWarp(cage, o), Catch::Contains(": mu: is nan (expected a finite number)"));
+    o = {};
+    o.beta = INFINITY;
+    CHECK_THROWS_WITH(MeshWarp(cage, o), Catch::Contains(": beta: is inf (expected a finite number)"));
+    o = {};
+    o.alpha = -0.5f;
+    CHECK_THROWS_WITH(MeshWarp(cage, o), Catch::Contains("alpha: is -0.5 (expected alpha >= 0)"));
 
     MeshWarp warp(cage);
     const std::vector<glm::vec3> three{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
