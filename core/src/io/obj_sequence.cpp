@@ -78,6 +78,15 @@ std::string describeFace(std::span<const int32_t> vertices) {
 
 }  // namespace
 
+std::string ObjSequence::patternProblem(const std::string& pattern) {
+    FrameToken token;
+    const int count = findTokens(fileNameOf(pattern), token);
+    if (count == 0) return "has no frame token in its file name";
+    if (count > 1) return "has " + std::to_string(count) + " frame tokens in its file name";
+    if (token.padding > kMaxPadding) return "asks for more than 32 digits of padding";
+    return {};
+}
+
 ObjSequence::ObjSequence(fs::path pattern) : pattern_(std::move(pattern)) {
     const std::string name = pattern_.filename().string();
     FrameToken token;
@@ -98,8 +107,7 @@ ObjSequence::ObjSequence(fs::path pattern) : pattern_(std::move(pattern)) {
 }
 
 bool ObjSequence::isPattern(const std::string& pattern) {
-    FrameToken token;
-    return findTokens(fileNameOf(pattern), token) == 1 && token.padding <= kMaxPadding;
+    return patternProblem(pattern).empty();
 }
 
 fs::path ObjSequence::framePath(int frame) const {

@@ -843,8 +843,10 @@ void setOutputPatterns(ShotJob& job, const fs::path& out, const fs::path& bake, 
                 formatError(name, text, "has no UDIM token", "<UDIM>, <UVTILE>, %(UDIM)d or _MAPID_"));
         }
         if (!io::ObjSequence::isPattern(io::expandUdim(text, 1001))) {
-            throw InvalidInput(formatError(name, text, "has no frame token in its file name",
-                                           "one token such as #### (one # per digit) or %04d"));
+            // No token, two, or a padding beyond 32 digits: the sequence's own reading says which.
+            const std::string problem = io::ObjSequence::patternProblem(io::expandUdim(text, 1001));
+            throw InvalidInput(
+                formatError(name, text, problem, "one token such as #### (one # per digit) or %04d"));
         }
     };
     check(out, outName);

@@ -491,6 +491,10 @@ TEST_CASE("uvwarp command: bad input names the file and writes nothing", "[harne
         s.command.out = s.dir / "out/redirect.<UDIM>.exr";
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
                    Catch::Contains("--out") && Catch::Contains("no frame token"));
+        // Two tokens were said to be none.
+        s.command.out = s.dir / "out/redirect.<UDIM>.####.v###.exr";
+        CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),
+                   Catch::Contains("--out") && Catch::Contains("has 2 frame tokens in its file name"));
         s.command.out = s.dir / "out/redirect.<UDIM>.####.exr";
         s.command.tiles = {1001, 1005};
         CHECK_THAT(test::errorOf<Error>([&] { (void)harness::uvwarpCommand(s.command); }),

@@ -28,8 +28,11 @@ class ObjSequence {
     // frame read.
     void setReference(const geom::Mesh& mesh, const std::filesystem::path& path);
 
-    // True when `pattern` has a frame token (#... or %0Nd).
+    // True when `pattern`'s file name has one frame token (#... or %0Nd) of at most 32 digits.
     [[nodiscard]] static bool isPattern(const std::string& pattern);
+    // Why it is not ("has no frame token in its file name", "has 2 frame tokens in its file name", "asks for
+    // more than 32 digits of padding"); empty when it is.
+    [[nodiscard]] static std::string patternProblem(const std::string& pattern);
 
   private:
     std::filesystem::path pattern_;
