@@ -172,16 +172,25 @@ std::vector<SlideHandle> handlesOf(const std::optional<int64_t>& handle, const s
                     throw InvalidInput(formatError(source, at + "." + key, "is missing", "a value"));
                 }
             }
+            // Each value named by its own path ("handles[0].vertex: is a float"), bools refused as numbers.
             SlideHandle s;
-            try {
-                s.vertex = vertexOf(item["vertex"].cast<int64_t>(), source, at + ".vertex");
-                s.radius = item["radius"].cast<double>();
-                if (item.contains("region")) {
-                    s.region = regionOf(item["region"].cast<std::string>(), source, at + ".region");
+            const py::handle vertex = item["vertex"], radius = item["radius"];
+            const std::optional<int64_t> index = wholeNumber(vertex);
+            if (!index)
+                throw InvalidInput(formatError(source, at + ".vertex", "is " + aTypeName(vertex), "an int"));
+            s.vertex = vertexOf(*index, source, at + ".vertex");
+            if (!isRealNumber(radius)) {
+                throw InvalidInput(
+                    formatError(source, at + ".radius", "is " + aTypeName(radius), "a number"));
+            }
+            s.radius = radius.cast<double>();
+            if (item.contains("region")) {
+                const py::handle region = item["region"];
+                if (!py::isinstance<py::str>(region)) {
+                    throw InvalidInput(formatError(source, at + ".region", "is " + aTypeName(region),
+                                                   "'euclidean' or 'geodesic'"));
                 }
-            } catch (const py::cast_error&) {
-                throw InvalidInput(formatError(source, at, "has a value of the wrong type",
-                                               "vertex an int, radius a number, region a string"));
+                s.region = regionOf(region.cast<std::string>(), source, at + ".region");
             }
             out.push_back(s);
         }

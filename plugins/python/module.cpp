@@ -5,9 +5,11 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <new>
+#include <utility>
 
 #include "bindings.h"
 #include "deformkit/error.h"
@@ -300,6 +302,19 @@ PYBIND11_MODULE(deformkit, m) {
     m.def(
         "make_grid",
         [](int32_t cx, int32_t cy, float sx, float sy) {
+            // Named by the keywords (the library names its own fields, "primitive: cellsX").
+            for (const auto& [name, cells] : {std::pair{"cells_x", cx}, std::pair{"cells_y", cy}}) {
+                if (cells < 1) {
+                    throw InvalidInput(
+                        formatError("make_grid", name, "is " + std::to_string(cells), "at least 1"));
+                }
+            }
+            for (const auto& [name, size] : {std::pair{"size_x", sx}, std::pair{"size_y", sy}}) {
+                if (!std::isfinite(size)) {
+                    throw InvalidInput(
+                        formatError("make_grid", name, "is " + numberText(size), "a finite size"));
+                }
+            }
             return geom::makeGrid({cx, cy, sx, sy});
         },
         py::arg("cells_x") = 16, py::arg("cells_y") = 16, py::arg("size_x") = 1.0f, py::arg("size_y") = 1.0f);

@@ -162,6 +162,15 @@ inline bool isBool(pybind11::handle value) {
            pybind11::str(type.attr("__name__")).cast<std::string>() == "bool_";
 }
 
+// A real number from Python: an int or a float (not a bool), or a numpy integer or floating scalar.
+inline bool isRealNumber(pybind11::handle value) {
+    if (isBool(value)) return false;
+    if (pybind11::isinstance<pybind11::float_>(value) || PyLong_Check(value.ptr())) return true;
+    if (pybind11::isinstance<pybind11::str>(value) || !pybind11::hasattr(value, "dtype")) return false;
+    const std::string kind = pybind11::str(value.attr("dtype").attr("kind"));
+    return kind == "f" || kind == "i" || kind == "u";
+}
+
 // A whole number from Python: an int or numpy's integer scalars (not a bool); nullopt otherwise.
 inline std::optional<int64_t> wholeNumber(pybind11::handle value) {
     if (isBool(value) || !PyIndex_Check(value.ptr())) return std::nullopt;

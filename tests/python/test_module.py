@@ -185,3 +185,15 @@ def test_points_and_uvs_written_after_the_mesh_was_made_are_checked_where_used()
     mesh.uvs[500] = np.nan
     with pytest.raises(dk.InvalidInput, match=r"UV 500: is \(nan, nan\) \(expected finite texture coordinates\)"):
         dk.UvWarpSolver(mesh, 1001, np.zeros((64, 64), np.float32))
+
+
+def test_make_grid_names_its_keywords():
+    # The library named its own fields ("primitive: cellsX: is -1").
+    with pytest.raises(dk.InvalidInput, match=r"^make_grid: cells_x: is -1 \(expected at least 1\)"):
+        dk.make_grid(-1, 2)
+    with pytest.raises(dk.InvalidInput, match=r"^make_grid: cells_y: is 0"):
+        dk.make_grid(2, 0)
+    with pytest.raises(dk.InvalidInput, match=r"^make_grid: size_y: is nan \(expected a finite size\)"):
+        dk.make_grid(2, 2, 1.0, float("nan"))
+    grid = dk.make_grid(3, 2, 6.0, 4.0)
+    assert grid.num_vertices == 12 and np.asarray(grid.points).max(axis=0).tolist() == [6, 4, 0]

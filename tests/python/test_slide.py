@@ -278,6 +278,17 @@ def test_bad_input_names_the_argument():
         dk.Slider(pts, counts, idx, handles=[{"vertex": 1, "radius": 0.5}, {"vertex": 2}])
     with pytest.raises(dk.InvalidInput, match="handles\\[0\\].*'radious'"):
         dk.Slider(pts, counts, idx, handles=[{"vertex": 1, "radious": 0.5}])
+    # Each value named by its path (all were "handles[0]: has a value of the wrong type"); bools are not
+    # numbers; numpy scalars are.
+    for handle, where in (({"vertex": 40.7, "radius": 0.5}, r"handles\[0\]\.vertex: is a float \(expected an int\)"),
+                          ({"vertex": True, "radius": 0.5}, r"handles\[0\]\.vertex: is a bool"),
+                          ({"vertex": 1, "radius": True}, r"handles\[0\]\.radius: is a bool \(expected a number\)"),
+                          ({"vertex": 1, "radius": "0.5"}, r"handles\[0\]\.radius: is a str"),
+                          ({"vertex": 1, "radius": 0.5, "region": 3}, r"handles\[0\]\.region: is an int")):
+        with pytest.raises(dk.InvalidInput, match=where):
+            dk.Slider(pts, counts, idx, handles=[handle])
+    numpy_handle = dk.Slider(pts, counts, idx, handles=[{"vertex": np.int64(5), "radius": np.float32(0.5)}])
+    assert numpy_handle.num_handles == 1
     with pytest.raises(dk.InvalidInput, match="handles\\[0\\].region.*'sphere'"):
         dk.Slider(pts, counts, idx, handles=[{"vertex": 1, "radius": 0.5, "region": "sphere"}])
     with pytest.raises(dk.InvalidInput, match=r"handle 1 \(vertex -3\)"):
