@@ -524,6 +524,126 @@ def test_a_linked_duplicate_with_a_stack_is_refused():
         message
 
 
+def test_a_linked_duplicate_never_takes_or_drops_the_other_stacks_rest():
+    # Adding to the twin took the twisted shape as the rest of both meshes' stacks before refusing; removing
+    # a copied stack's last entry put back and dropped the rest the original still used.
+    fresh()
+    obj = grid_object()
+    model = positions(obj).copy()
+    add("twist").end_value = 1.0
+    bpy.context.view_layer.update()
+    twin = bpy.data.objects.new("twin", obj.data)  # Alt+D: the same mesh, no stack
+    bpy.context.scene.collection.objects.link(twin)
+    bpy.context.view_layer.objects.active = twin
+    try:
+        bpy.ops.deformkit.add(type="slide")
+        raise AssertionError("adding to a linked duplicate of a stacked mesh was not refused")
+    except RuntimeError as refused:  # the operator's error report
+        assert "its mesh 'grid' is also 'grid''s" in str(refused), refused
+    assert len(twin.deformkit.entries) == 0
+    assert_same(addon.evaluate.rest_points(obj), model, "the original's rest, after the refused add")
+    copy = obj.copy()  # a linked duplicate of the stacked object: its entries come along
+    bpy.context.scene.collection.objects.link(copy)
+    bpy.context.view_layer.objects.active = copy
+    assert bpy.ops.deformkit.remove() == {'FINISHED'}
+    assert len(copy.deformkit.entries) == 0 and addon.evaluate.has_rest(obj)
+    assert_same(addon.evaluate.rest_points(obj), model, "the original's rest, after the copy's last remove")
+
+
+def test_remove_and_reset_rest_work_from_edit_mode():
+    # Both read or wrote the mesh's rest attribute, which Blender keeps empty in Edit Mode: a traceback, the
+    # entry gone and the twisted mesh left as the next stack's rest.
+    fresh()
+    obj = grid_object()
+    model = positions(obj).copy()
+    add("twist").end_value = 1.0
+    bpy.context.view_layer.update()
+    assert float(np.abs(positions(obj) - model).max()) > 0.1
+    bpy.ops.object.mode_set(mode='EDIT')
+    assert bpy.ops.deformkit.remove() == {'FINISHED'}
+    assert obj.mode == 'EDIT'
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert len(obj.deformkit.entries) == 0 and not addon.evaluate.has_rest(obj)
+    assert_same(positions(obj), model, "the mesh back to its rest shape")
+    twist = add("twist")
+    twist.enabled = False
+    bpy.context.view_layer.update()
+    bpy.ops.object.mode_set(mode='EDIT')
+    assert bpy.ops.deformkit.reset_rest() == {'FINISHED'}
+    assert obj.mode == 'EDIT'
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert_same(addon.evaluate.rest_points(obj), model, "the rest taken from Edit Mode")
+
+
+def test_modelling_in_edit_mode_with_every_entry_off_survives_leaving_it():
+    # The documented way to change a stacked mesh: entries off, model, Reset Rest. Leaving Edit Mode
+    # evaluated the stack, which wrote the stored rest shape over the modelling before Reset Rest.
+    import bmesh
+    fresh()
+    obj = grid_object()
+    model = positions(obj).copy()
+    twist = add("twist")
+    twist.end_value = 1.0
+    bpy.context.view_layer.update()
+    twist.enabled = False
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), model, "entries off: the rest shape")
+    bpy.ops.object.mode_set(mode='EDIT')
+    edit = bmesh.from_edit_mesh(obj.data)
+    for vertex in edit.verts:
+        vertex.co.z += 0.25
+    bmesh.update_edit_mesh(obj.data)
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.context.view_layer.update()
+    modelled = model + np.float32([0.0, 0.0, 0.25])
+    assert_same(positions(obj), modelled, "the modelling, after leaving Edit Mode")
+    assert bpy.ops.deformkit.reset_rest() == {'FINISHED'}
+    assert_same(addon.evaluate.rest_points(obj), modelled, "the rest taken from the modelling")
+    twist.enabled = True
+    bpy.context.view_layer.update()
+    assert float(np.abs(positions(obj) - modelled).max()) > 0.1  # the twist, on the new rest
+    twist.enabled = False
+    bpy.context.view_layer.update()
+    assert_same(positions(obj), modelled, "entries off again: the new rest")
+
+
+def test_a_transform_without_inverse_is_named():
+    # numpy's bare "Singular matrix" was the whole message.
+    fresh()
+    obj = grid_object()
+    add("twist")
+    obj.scale.z = 0.0
+    bpy.context.view_layer.update()
+    message = addon.evaluate.evaluate_safely(obj, force=True)
+    assert message.startswith("grid: its transform has no inverse (a scale of 0"), message
+
+
+def test_ffd_follows_a_lattice_edited_in_edit_mode():
+    # In Edit Mode Blender's `co` of a lattice point is garbage (it is computed from the point's index in
+    # another array): the FFD read a rest grid of 1e8 and differed from Blender's Lattice modifier by 20.
+    fresh()
+    obj = grid_object("ours")
+    entry = add("ffd")
+    lattice = entry.lattice
+    theirs = bpy.data.objects.new("theirs", obj.data.copy())
+    bpy.context.scene.collection.objects.link(theirs)
+    theirs.modifiers.new("Lattice", 'LATTICE').object = lattice
+    bpy.context.view_layer.update()
+    bpy.context.view_layer.objects.active = lattice
+    bpy.ops.object.mode_set(mode='EDIT')
+    lattice.data.points[len(lattice.data.points) // 2].co_deform = (0.2, 0.3, 0.9)
+    lattice.data.update_tag()
+    bpy.context.view_layer.update()
+    assert addon.evaluate.evaluate_safely(obj, force=True) == ""
+    blender = theirs.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    expected = np.empty(len(blender.vertices) * 3, np.float32)
+    blender.vertices.foreach_get("co", expected)
+    moved = float(np.abs(expected.reshape(-1, 3) - positions(theirs)).max())
+    assert moved > 0.05, moved  # the edit reached Blender's modifier
+    assert_same(positions(obj), expected.reshape(-1, 3), "the FFD against the Lattice modifier, in Edit Mode")
+    bpy.ops.object.mode_set(mode='OBJECT')
+
+
 def test_moving_the_deformed_object_evaluates_it_again():
     # Controls are read in the object's space: moving the object under a still handle changes the
     # deformation at once, as Blender's SimpleDeform does, not at the next frame change.

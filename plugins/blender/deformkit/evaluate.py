@@ -127,6 +127,15 @@ def require_own_mesh(obj):
                 f"(Object > Relations > Make Single User > Object & Data)")
 
 
+def other_stack_on_mesh(obj):
+    """The name of another object with DeformKit entries that uses this object's mesh (a linked duplicate),
+    or None."""
+    for other in bpy.data.objects:
+        if other is not obj and other.data == obj.data and len(other.deformkit.entries) > 0:
+            return other.name
+    return None
+
+
 def rest_points(obj):
     mesh = obj.data
     attribute = mesh.attributes.get(REST_ATTRIBUTE)
@@ -181,12 +190,22 @@ def _matrix(m):
     return np.array(m, dtype=np.float64)
 
 
+def inverse_world(obj):
+    """The inverse of `obj`'s world matrix; DeformKitError naming the object when it has none (a scale of 0 on
+    some axis), not numpy's bare "Singular matrix"."""
+    try:
+        return np.linalg.inv(_matrix(obj.matrix_world))
+    except np.linalg.LinAlgError:
+        raise DeformKitError(f"{obj.name}: its transform has no inverse (a scale of 0 on some axis), so the "
+                             "deformers' controls cannot be placed in its space") from None
+
+
 def local_matrix(obj, control, depsgraph=None):
     """The control's world matrix in `obj`'s local space (evaluated when a depsgraph is given)."""
     if depsgraph is not None:
         control = control.evaluated_get(depsgraph)
         obj = obj.evaluated_get(depsgraph)
-    return np.linalg.inv(_matrix(obj.matrix_world)) @ _matrix(control.matrix_world)
+    return inverse_world(obj) @ _matrix(control.matrix_world)
 
 
 def _apply(m, points):
@@ -219,12 +238,28 @@ def curve_points(obj, curve):
     return np.array(points, np.float64)
 
 
+# Each lattice's rest points (`co`) as last read outside Edit Mode, by its data and resolution.
+_lattice_rest = {}
+
+
 def lattice_points(lattice, deformed):
+    """The lattice's deformed points (`co_deform`) or its rest points (`co`), u fastest. In Edit Mode Blender's
+    `co` is garbage (it is computed from the point's index in the lattice's own array, and Edit Mode's points
+    are another array): the rest points are then the ones last read outside Edit Mode."""
     data = lattice.data
     n = len(data.points)
+    key = (data.as_pointer(), data.points_u, data.points_v, data.points_w)
+    if not deformed and lattice.mode == 'EDIT':
+        if key not in _lattice_rest:
+            raise DeformKitError(f"lattice '{lattice.name}': its rest points cannot be read in Edit Mode; leave "
+                                 "Edit Mode once so that they are")
+        return _lattice_rest[key]
     points = np.empty(n * 3, np.float32)
     data.points.foreach_get("co_deform" if deformed else "co", points)
-    return points.reshape(-1, 3).astype(np.float64)
+    points = points.reshape(-1, 3).astype(np.float64)
+    if not deformed:
+        _lattice_rest[key] = points
+    return points
 
 
 # Blender's lattice interpolation types as the FFD's basis codes.
@@ -491,10 +526,16 @@ def evaluate_object(obj, depsgraph=None, force=False):
                 cached["weights"][i] = weights
         elif name != "envelope":
             stack.set(i, name, value)
+    active = any(entry.enabled and entry.envelope != 0.0 for entry in entries)
+    if not active and not shows_deformation(obj):
+        # Every entry off and the mesh not showing a deformation: it shows its rest shape, or modelling done
+        # on it since (the documented way to change a stacked mesh, then Reset Rest). Writing the stored
+        # rest shape would throw that modelling away on leaving Edit Mode.
+        cached["inputs"] = inputs
+        return
     out = stack.evaluate(cached["rest"])
     obj.data.vertices.foreach_set("co", out.ravel())
     obj.data.update()
-    active = any(entry.enabled and entry.envelope != 0.0 for entry in entries)
     rest = cached["rest"]
     # A sample first: a deformed mesh nearly always shows it there, without comparing every point.
     deformed = active and (not np.array_equal(out[::61], rest[::61]) or not np.array_equal(out, rest))

@@ -61,8 +61,7 @@ def _handle_vertex(context, obj, rest, from_edit_mode):
     mesh.vertices.foreach_get("select", selected)
     if from_edit_mode and selected.any():
         return int(np.flatnonzero(selected)[0])
-    m = np.array(obj.matrix_world, np.float64)
-    cursor = np.linalg.inv(m) @ np.append(np.array(context.scene.cursor.location, np.float64), 1.0)
+    cursor = evaluate.inverse_world(obj) @ np.append(np.array(context.scene.cursor.location, np.float64), 1.0)
     return int(np.argmin(((rest - cursor[:3]) ** 2).sum(axis=1)))
 
 
@@ -179,6 +178,9 @@ class DEFORMKIT_OT_add(bpy.types.Operator):
         try:
             if len(obj.data.vertices) == 0:
                 raise evaluate.DeformKitError(f"{obj.name}: the mesh has no vertices to deform")
+            # Before the rest shape is taken: on a linked duplicate's mesh it would be the other stack's
+            # deformation, taken as the rest of both.
+            evaluate.require_own_mesh(obj)
             if len(settings.entries) == 0 or not evaluate.has_rest(obj):
                 # A first entry takes the mesh as it is: a rest shape already on the mesh without entries
                 # came with its data from elsewhere (objects joined into this one) and is not this mesh's.
@@ -221,9 +223,28 @@ class DEFORMKIT_OT_remove(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
+        # The rest shape lives on the mesh, which Blender keeps apart in Edit Mode: removed from there, the
+        # entry is removed in Object Mode and Edit Mode entered again.
+        from_edit_mode = obj.mode == 'EDIT'
+        if from_edit_mode:
+            bpy.ops.object.mode_set(mode='OBJECT')
+        try:
+            return self._remove(obj)
+        finally:
+            if from_edit_mode:
+                bpy.ops.object.mode_set(mode='EDIT')
+
+    def _remove(self, obj):
         settings = obj.deformkit
         settings.entries.remove(settings.active_index)
         settings.active_index = max(0, min(settings.active_index, len(settings.entries) - 1))
+        other = evaluate.other_stack_on_mesh(obj) if len(settings.entries) == 0 else None
+        if other is not None:
+            # A linked duplicate's last entry: the mesh and its rest shape are the other stack's too.
+            settings.status = ""
+            self.report({'WARNING'}, f"{obj.name}: its mesh is also '{other}''s, whose DeformKit stack keeps "
+                                     "the mesh's rest shape")
+            return {'FINISHED'}
         if len(settings.entries) == 0:
             # The mesh back to its rest shape, which is then forgotten: modelling done before the next
             # deformer is added is the rest shape that deformer takes. Polygons changed under the stack leave
@@ -305,9 +326,18 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        if obj.mode == 'EDIT':
-            bpy.ops.object.mode_set(mode='OBJECT')  # the positions Edit Mode keeps apart, written back
-            bpy.ops.object.mode_set(mode='EDIT')
+        # The positions Edit Mode keeps apart are written back, the rest taken in Object Mode, and Edit Mode
+        # entered again.
+        from_edit_mode = obj.mode == 'EDIT'
+        if from_edit_mode:
+            bpy.ops.object.mode_set(mode='OBJECT')
+        try:
+            return self._reset(obj)
+        finally:
+            if from_edit_mode:
+                bpy.ops.object.mode_set(mode='EDIT')
+
+    def _reset(self, obj):
         active = [e.name for e in obj.deformkit.entries if e.enabled and e.envelope != 0.0]
         if active:
             # The mesh shows their deformation: taken as the rest, it would be deformed twice.
