@@ -328,6 +328,23 @@ def test_wire_curve_and_cage_mesh():
     assert np.abs(expected2 - expected).max() > 0.01
     assert_same(positions(obj), expected2, "wire then cage")
 
+    # The cage edited in Edit Mode, as the docs say to: its positions are in its edit mesh there (its mesh
+    # read 0 vertices, and the stack refused the cage).
+    import bmesh
+    bpy.context.view_layer.objects.active = cage.cage
+    bpy.ops.object.mode_set(mode='EDIT')
+    edit = bmesh.from_edit_mesh(cage.cage.data)
+    edit.verts.ensure_lookup_table()
+    edit.verts[top].co.z += 0.25
+    bmesh.update_edit_mesh(cage.cage.data)
+    bpy.context.view_layer.update()
+    deformed[top, 2] += np.float32(0.25)
+    stack.set(1, "cage", deformed.ravel())
+    assert addon.evaluate.evaluate_safely(obj, force=True) == ""
+    assert_same(positions(obj), stack.evaluate(rest), "the cage edited in Edit Mode")
+    bpy.ops.object.mode_set(mode='OBJECT')
+    bpy.context.view_layer.objects.active = obj
+
 
 def test_reorder_and_remove():
     fresh()

@@ -224,6 +224,17 @@ def _need(entry, attribute, what):
     return control
 
 
+def mesh_points(obj):
+    """A mesh object's vertex positions in its object space: from its edit mesh while it is in Edit Mode
+    (Blender keeps them apart there, and its evaluated copy then lists no vertices)."""
+    original = obj.original
+    if original.mode == 'EDIT':
+        import bmesh  # noqa: PLC0415 - Blender's module, needed only here
+        edit = bmesh.from_edit_mesh(original.data)
+        return np.array([v.co[:] for v in edit.verts], np.float64).reshape(-1, 3)
+    return np.array([v.co[:] for v in obj.data.vertices], np.float64).reshape(-1, 3)
+
+
 def curve_points(obj, curve):
     """A curve object's control points (the first spline), in object space of `curve`."""
     if not curve.data.splines:
@@ -331,13 +342,14 @@ def entry_parameters(obj, entry, depsgraph=None):
     if t == "meshwarp":
         cage = _need(entry, "cage", "cage mesh")
         rest = _need(entry, "rest_cage", "rest cage mesh")
-        if len(cage.data.vertices) != len(rest.data.vertices):
-            raise DeformKitError(f"{entry.name}: cage '{cage.name}' has {len(cage.data.vertices)} vertices, "
-                                 f"its rest '{rest.name}' {len(rest.data.vertices)}")
+        cage_points, rest_points_ = mesh_points(cage), mesh_points(rest)
+        if len(cage_points) != len(rest_points_):
+            raise DeformKitError(f"{entry.name}: cage '{cage.name}' has {len(cage_points)} vertices, "
+                                 f"its rest '{rest.name}' {len(rest_points_)}")
         counts = [len(p.vertices) for p in rest.data.polygons]
         indices = [i for p in rest.data.polygons for i in p.vertices]
-        rest_co = _apply(local_matrix(obj, rest, depsgraph), [v.co[:] for v in rest.data.vertices])
-        cage_co = _apply(local_matrix(obj, cage, depsgraph), [v.co[:] for v in cage.data.vertices])
+        rest_co = _apply(local_matrix(obj, rest, depsgraph), rest_points_)
+        cage_co = _apply(local_matrix(obj, cage, depsgraph), cage_points)
         return [("restCage", rest_co.ravel()), ("cageFaceCounts", counts), ("cageFaceIndices", indices),
                 ("cage", cage_co.ravel())]
     raise DeformKitError(f"{entry.name}: unknown deformer type '{t}'")
