@@ -200,7 +200,21 @@ void requireCompletePly(const fs::path& path) {
         } else if (keyword == "element") {
             PlyElement element;
             element.count = -1;
-            words >> element.name >> element.count;
+            std::string count;
+            words >> element.name >> count;
+            // Read as whole digits: a count beyond int64 saturated and overflowed the total below, and
+            // assimp takes it modulo 2^32 (2^64 + 1000 read 1000 faces made up from the last line).
+            if (!count.empty() && std::all_of(count.begin(), count.end(),
+                                              [](unsigned char c) { return std::isdigit(c) != 0; })) {
+                const std::string digits = count.substr(std::min(count.find_first_not_of('0'), count.size()));
+                if (digits.size() > 10 || (digits.size() == 10 && digits > "2147483647")) {
+                    throw InvalidInput(
+                        formatError(path.string(), "line " + std::to_string(lineNumber),
+                                    "element " + element.name + " declares " + count + " elements",
+                                    "at most 2147483647 elements"));
+                }
+                element.count = digits.empty() ? 0 : std::stoll(digits);
+            }
             elements.push_back(std::move(element));
         } else if (keyword == "property" && !elements.empty()) {
             std::string type;
@@ -441,10 +455,20 @@ class DroppedDataLog : public Assimp::LogStream {
         Collect(const Collect&) = delete;
         Collect& operator=(const Collect&) = delete;
         [[nodiscard]] std::optional<std::string> dropped() const {
-            for (const std::string& w : warnings())
+            for (const std::string& w : warnings()) {
+                // An FBX object that fails to read (a damaged array) is logged as an error with its
+                // exception's text ("FBX-DOM ...", "FBX-Parser ...", "CompressionFailure ...") and left out
+                // of a read that succeeds. The reader's other errors ("FBX: no material assigned to mesh")
+                // are notes.
+                if (w.starts_with("Error")) {
+                    const std::string text = w.substr(std::min(w.find(": ") + 2, w.size()));
+                    if (text.starts_with("FBX-") || text.starts_with("Compression")) return text;
+                    continue;
+                }
                 for (const char* sign : {"Texcoord stream size", "not compatible with the TRIANGLE",
                                          "out-of-range indices", "Positions of target"})
                     if (w.find(sign) != std::string::npos) return w;
+            }
             return std::nullopt;
         }
 
@@ -456,8 +480,10 @@ class DroppedDataLog : public Assimp::LogStream {
         std::string text(message);
         while (!text.empty() && (text.back() == '\n' || text.back() == '\r'))
             text.pop_back();
-        const size_t body = text.find(": ");  // after "Warn,  T0"
-        warnings().push_back(body == std::string::npos ? text : text.substr(body + 2));
+        // "Warn,  T0: ..." kept as its text, "Error, T0: ..." whole (dropped() reads its level).
+        const size_t body = text.find(": ");
+        warnings().push_back(body == std::string::npos || text.starts_with("Error") ? text
+                                                                                    : text.substr(body + 2));
     }
 
   private:
@@ -477,7 +503,7 @@ class DroppedDataLog : public Assimp::LogStream {
             Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);  // no file, no debugger
         Assimp::Logger* logger = Assimp::DefaultLogger::get();
         if (logger != attachedTo) {
-            logger->attachStream(new DroppedDataLog, Assimp::Logger::Warn);
+            logger->attachStream(new DroppedDataLog, Assimp::Logger::Warn | Assimp::Logger::Err);
             attachedTo = logger;
         }
     }
@@ -511,12 +537,8 @@ std::optional<nlohmann::json> gltfJson(const fs::path& path) {
     return json;
 }
 
-// What assimp would read wrong without a word: positions that are not 3 floats (KHR_mesh_quantization's
-// integers, read as float bits), a buffer view stride shorter than a position (overlapping reads), and any
-// required extension that changes geometry (only materials, textures and lights are not).
-void requireReadableGltf(const fs::path& path) {
-    const std::optional<nlohmann::json> json = gltfJson(path);
-    if (!json) return;
+// requireReadableGltf's checks on the file's JSON.
+void requireReadableGltfJson(const fs::path& path, const std::optional<nlohmann::json>& json) {
     const std::string name = path.string();
     if (const auto required = json->find("extensionsRequired");
         required != json->end() && required->is_array()) {
@@ -562,6 +584,21 @@ void requireReadableGltf(const fs::path& path) {
                                                    std::to_string(accessor.value("componentType", 0)),
                                                "VEC3 of floats (5126): quantized positions are not read"));
             }
+            // UVs as normalized integers (core glTF 2.0): assimp copies their bytes as float bits.
+            const auto uv = attributes->find("TEXCOORD_0");
+            if (uv != attributes->end() && uv->is_number_unsigned() &&
+                uv->get<size_t>() < accessors->size() && (*accessors)[uv->get<size_t>()].is_object()) {
+                const nlohmann::json& uvs = (*accessors)[uv->get<size_t>()];
+                const int type = uvs.value("componentType", 5126);
+                if (type != 5126) {
+                    throw InvalidInput(formatError(
+                        name,
+                        "accessors[" + std::to_string(uv->get<size_t>()) + "] (TEXCOORD_0 of meshes[" +
+                            std::to_string(m) + "].primitives[" + std::to_string(p) + "])",
+                        "is of component type " + std::to_string(type) + " (normalized integers)",
+                        "UVs as floats (5126): export without texture-coordinate quantization"));
+                }
+            }
             const auto view = accessor.find("bufferView");
             if (view == accessor.end() || !view->is_number_unsigned() || views == json->end() ||
                 !views->is_array() || view->get<size_t>() >= views->size())
@@ -575,6 +612,22 @@ void requireReadableGltf(const fs::path& path) {
                     "a stride of at least 12 bytes, one position"));
             }
         }
+    }
+}
+
+// What assimp would read wrong without a word: positions that are not 3 floats (KHR_mesh_quantization's
+// integers, read as float bits), UVs that are not floats, a buffer view stride shorter than a position
+// (overlapping reads), and any required extension that changes geometry (only materials, textures and
+// lights are not). A field of the wrong JSON type ("byteStride": "12") is named, not an internal error.
+void requireReadableGltf(const fs::path& path) {
+    const std::optional<nlohmann::json> json = gltfJson(path);
+    if (!json) return;
+    try {
+        requireReadableGltfJson(path, json);
+    } catch (const nlohmann::json::exception& e) {
+        throw InvalidInput(
+            formatError(path.string(), "", std::string("holds a field of the wrong type: ") + e.what(),
+                        "a glTF 2.0 file whose fields have the types the specification gives"));
     }
 }
 
