@@ -4,6 +4,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
@@ -25,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include <zlib.h>
 #include <nlohmann/json.hpp>
 
 #include "deformkit/error.h"
@@ -631,6 +633,163 @@ void requireReadableGltf(const fs::path& path) {
     }
 }
 
+// A binary FBX's arrays checked before assimp reads them: each array's declared length against its bytes (a
+// compressed one inflated in pieces, its zlib stream whole and of exactly that length). assimp allocates a
+// declared length before inflating (52 KB claiming 4.2 GB), and leaves out an object whose array does not
+// inflate, reporting success (it also leaks the stream). Node records as the FBX binary layout gives them:
+// end offset, property count and list length (64-bit from version 7500), name, properties, nested records.
+class FbxArrays {
+  public:
+    FbxArrays(const fs::path& path, std::string bytes) : path_(path), bytes_(std::move(bytes)) {}
+
+    void check() {
+        if (!bytes_.starts_with(std::string("Kaydara FBX Binary  \0", 21)) || bytes_.size() < 27) return;
+        wide_ = u32(23) >= 7500;
+        records(27, bytes_.size(), 0);
+    }
+
+  private:
+    [[noreturn]] void fail(uint64_t at, const std::string& what, const std::string& problem,
+                           const std::string& expected) const {
+        throw InvalidInput(
+            formatError(path_.string(), what + " at byte " + std::to_string(at), problem, expected));
+    }
+    void need(uint64_t at, uint64_t size, const std::string& what) const {
+        if (at > bytes_.size() || size > bytes_.size() - at)
+            fail(at, what, "needs " + std::to_string(size) + " bytes past the end of the file",
+                 "a complete FBX file");
+    }
+    [[nodiscard]] uint32_t u32(uint64_t at) const {
+        uint32_t v = 0;
+        std::memcpy(&v, bytes_.data() + at, 4);
+        return v;
+    }
+    [[nodiscard]] uint64_t word(uint64_t at) const {
+        if (!wide_) return u32(at);
+        uint64_t v = 0;
+        std::memcpy(&v, bytes_.data() + at, 8);
+        return v;
+    }
+
+    // The records in [at, end), nested `depth` deep; a record of zeros ends a nested list.
+    void records(uint64_t at, uint64_t end, int depth) {
+        const uint64_t header = wide_ ? 25 : 13;
+        while (at + header <= end) {
+            need(at, header, "node record");
+            const uint64_t next = word(at), count = word(at + (wide_ ? 8 : 4));
+            const uint8_t nameLength = static_cast<uint8_t>(bytes_[at + header - 1]);
+            if (next == 0) return;  // the null record closing a list
+            if (depth > 64) fail(at, "node record", "nests more than 64 deep", "an FBX file's node tree");
+            if (next <= at || next > end) {
+                fail(at, "node record", "ends at byte " + std::to_string(next),
+                     "an end after its start and within its parent");
+            }
+            need(at + header, nameLength, "node name");
+            const std::string name = bytes_.substr(at + header, nameLength);
+            uint64_t p = at + header + nameLength;
+            for (uint64_t k = 0; k < count; ++k)
+                p = property(p, next, name);
+            if (p < next) records(p, next, depth + 1);
+            at = next;
+        }
+    }
+
+    // The property at `at` of node `node`, checked; returns where the next one starts.
+    uint64_t property(uint64_t at, uint64_t end, const std::string& node) {
+        need(at, 1, "property of node " + node);
+        const char type = bytes_[at];
+        const auto fixed = [&](uint64_t size) {
+            need(at + 1, size, "property of node " + node);
+            return at + 1 + size;
+        };
+        switch (type) {
+            case 'Y':
+                return fixed(2);
+            case 'C':
+                return fixed(1);
+            case 'I':
+            case 'F':
+                return fixed(4);
+            case 'D':
+            case 'L':
+                return fixed(8);
+            case 'S':
+            case 'R':
+                need(at + 1, 4, "property of node " + node);
+                return fixed(4 + uint64_t{u32(at + 1)});
+            case 'f':
+            case 'i':
+                return array(at, end, node, 4);
+            case 'd':
+            case 'l':
+                return array(at, end, node, 8);
+            case 'b':
+            case 'c':
+                return array(at, end, node, 1);
+            default:
+                fail(at, "property of node " + node, std::string("has the type code '") + type + "'",
+                     "one of Y C I F D L S R f d l i b c");
+        }
+    }
+
+    uint64_t array(uint64_t at, uint64_t end, const std::string& node, uint64_t itemSize) {
+        const std::string what = "array of node " + node;
+        need(at + 1, 12, what);
+        const uint64_t length = u32(at + 1), encoding = u32(at + 5), stored = u32(at + 9);
+        const uint64_t data = at + 13, bytes = length * itemSize;
+        need(data, stored, what);
+        if (data + stored > end) fail(at, what, "runs past its node's end", "an array inside its node");
+        if (encoding == 0 && stored != bytes) {
+            fail(at, what,
+                 "holds " + std::to_string(stored) + " bytes for " + std::to_string(length) + " items",
+                 std::to_string(bytes) + " bytes");
+        }
+        if (encoding == 1)
+            inflated(at, what, data, stored, bytes);
+        else if (encoding != 0)
+            fail(at, what, "has encoding " + std::to_string(encoding), "0 (raw) or 1 (zlib)");
+        return data + stored;
+    }
+
+    // Inflates the zlib stream in pieces: it must end, whole, after exactly `bytes` bytes.
+    void inflated(uint64_t at, const std::string& what, uint64_t data, uint64_t stored,
+                  uint64_t bytes) const {
+        if (bytes > stored * 1032 + 64) {  // zlib's largest ratio
+            fail(at, what, std::to_string(stored) + " zipped bytes declared to hold " + std::to_string(bytes),
+                 "at most 1032 times the zipped size (zlib's limit)");
+        }
+        z_stream stream{};
+        if (inflateInit(&stream) != Z_OK) fail(at, what, "cannot start inflating", "memory for zlib");
+        std::array<unsigned char, 16384> piece{};
+        stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes_.data() + data));
+        stream.avail_in = static_cast<uInt>(stored);
+        uint64_t produced = 0;
+        int status = Z_OK;
+        while (status == Z_OK) {
+            stream.next_out = piece.data();
+            stream.avail_out = static_cast<uInt>(piece.size());
+            status = inflate(&stream, Z_NO_FLUSH);
+            produced += piece.size() - stream.avail_out;
+            if (status == Z_BUF_ERROR && stream.avail_in == 0) break;  // cut short
+        }
+        inflateEnd(&stream);
+        if (status != Z_STREAM_END || produced != bytes) {
+            fail(at, what,
+                 status == Z_STREAM_END ? "inflates to " + std::to_string(produced) + " bytes"
+                                        : "does not inflate (a damaged or cut zlib stream)",
+                 "a zlib stream of the " + std::to_string(bytes) + " bytes its length declares");
+        }
+    }
+
+    fs::path path_;
+    std::string bytes_;
+    bool wide_ = false;
+};
+
+void requireReadableFbx(const fs::path& path) {
+    FbxArrays(path, readFile(path, "FBX file")).check();
+}
+
 // Collada's index lists (<p> of polygons and triangles, <vcount>, a skin's <v> and <vcount>) hold whole
 // numbers >= 0. Assimp reads "-2" as a wrapped index and drops the face without a word, and "2.5" or "x" as
 // a count that fails allocating ("std::bad_alloc"): refused here, naming the list and its line.
@@ -682,6 +841,7 @@ ObjContent readWithAssimp(const fs::path& path, MeshFormat format) {
 
     if (format == MeshFormat::Ply) requireCompletePly(path);
     if (format == MeshFormat::Gltf) requireReadableGltf(path);
+    if (format == MeshFormat::Fbx) requireReadableFbx(path);
     if (format == MeshFormat::Collada) requireColladaIndices(path);
     Assimp::Importer importer;
     const auto check = [&](const aiScene* scene) {
