@@ -308,6 +308,24 @@ inline pybind11::array_t<float> toArray(std::span<const glm::vec3> points) {
     return out;
 }
 
+// For the array casters below: the numpy array of `src` in `a`, and in `problem` why its values are not
+// numbers (an array of bool, strings, objects or complex numbers, or a list of such); empty when they are.
+// False when numpy reads no array from it (None, a str or bytes: another overload may take them).
+inline bool numericArray(pybind11::handle src, pybind11::array& a, std::string& problem) {
+    namespace py = pybind11;
+    if (src.is_none() || py::isinstance<py::str>(src) || py::isinstance<py::bytes>(src)) return false;
+    a = py::isinstance<py::array>(src) ? py::reinterpret_borrow<py::array>(src) : py::array::ensure(src);
+    if (!a) return false;
+    const char kind = a.dtype().kind();
+    problem.clear();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+        problem = py::isinstance<py::array>(src)
+                      ? "is an array of " + std::string(py::str(a.dtype())) + " values"
+                      : "is " + aTypeName(src) + " that is not numeric";
+    }
+    return true;
+}
+
 }  // namespace deformkit::python
 
 namespace pybind11::detail {
@@ -321,22 +339,20 @@ struct type_caster<deformkit::python::FloatArray> {
 
     bool load(handle src, bool convert) {
         using Base = deformkit::python::FloatArray::Base;
-        if (src.is_none() || isinstance<str>(src) || isinstance<bytes>(src)) return false;
         if (!convert && !Base::check_(src)) return false;
         value = deformkit::python::FloatArray();
-        array a = isinstance<array>(src) ? reinterpret_borrow<array>(src) : array::ensure(src);
-        if (!a) return false;
+        array a;
+        std::string problem;
+        if (!deformkit::python::numericArray(src, a, problem)) return false;
         const char kind = a.dtype().kind();
-        if (kind != 'f' && kind != 'i' && kind != 'u') {
+        if (!problem.empty()) {
             // numpy's cast of bools and strings, for a caller that reads the values without requireFloats
             // (not of complex numbers, whose cast warns).
             if (kind == 'b' || kind == 'U' || kind == 'S') {
                 if (Base cast = Base::ensure(a)) value = deformkit::python::FloatArray(std::move(cast));
                 PyErr_Clear();
             }
-            value.problem = isinstance<array>(src)
-                                ? "is an array of " + std::string(str(a.dtype())) + " values"
-                                : "is " + deformkit::python::aTypeName(src) + " that is not numeric";
+            value.problem = problem;
             return true;
         }
         Base values = Base::ensure(a);
@@ -374,18 +390,11 @@ struct type_caster<deformkit::python::DoubleArray> {
 
     bool load(handle src, bool convert) {
         using Base = deformkit::python::DoubleArray::Base;
-        if (src.is_none() || isinstance<str>(src) || isinstance<bytes>(src)) return false;
         if (!convert && !Base::check_(src)) return false;
         value = deformkit::python::DoubleArray();
-        array a = isinstance<array>(src) ? reinterpret_borrow<array>(src) : array::ensure(src);
-        if (!a) return false;
-        const char kind = a.dtype().kind();
-        if (kind != 'f' && kind != 'i' && kind != 'u') {
-            value.problem = isinstance<array>(src)
-                                ? "is an array of " + std::string(str(a.dtype())) + " values"
-                                : "is " + deformkit::python::aTypeName(src) + " that is not numeric";
-            return true;
-        }
+        array a;
+        if (!deformkit::python::numericArray(src, a, value.problem)) return false;
+        if (!value.problem.empty()) return true;
         Base values = Base::ensure(a);
         if (!values) return false;
         value = deformkit::python::DoubleArray(std::move(values));

@@ -152,6 +152,19 @@ def _output_folder(settings):
     return bpy.path.abspath(settings.uv_output)
 
 
+def _in_object_mode(obj, work):
+    """`work()`'s result, run with `obj` in Object Mode: the rest shape lives on the mesh, whose positions
+    Blender keeps apart in Edit Mode (they are written back on leaving it). Edit Mode is entered again after."""
+    from_edit_mode = obj.mode == 'EDIT'
+    if from_edit_mode:
+        bpy.ops.object.mode_set(mode='OBJECT')
+    try:
+        return work()
+    finally:
+        if from_edit_mode:
+            bpy.ops.object.mode_set(mode='EDIT')
+
+
 class DEFORMKIT_OT_add(bpy.types.Operator):
     """Add a DeformKit deformer to the active mesh, with its controls"""
     bl_idname = "deformkit.add"
@@ -223,16 +236,7 @@ class DEFORMKIT_OT_remove(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        # The rest shape lives on the mesh, which Blender keeps apart in Edit Mode: removed from there, the
-        # entry is removed in Object Mode and Edit Mode entered again.
-        from_edit_mode = obj.mode == 'EDIT'
-        if from_edit_mode:
-            bpy.ops.object.mode_set(mode='OBJECT')
-        try:
-            return self._remove(obj)
-        finally:
-            if from_edit_mode:
-                bpy.ops.object.mode_set(mode='EDIT')
+        return _in_object_mode(obj, lambda: self._remove(obj))
 
     def _remove(self, obj):
         settings = obj.deformkit
@@ -326,16 +330,7 @@ class DEFORMKIT_OT_reset_rest(bpy.types.Operator):
 
     def execute(self, context):
         obj = _mesh_object(context)
-        # The positions Edit Mode keeps apart are written back, the rest taken in Object Mode, and Edit Mode
-        # entered again.
-        from_edit_mode = obj.mode == 'EDIT'
-        if from_edit_mode:
-            bpy.ops.object.mode_set(mode='OBJECT')
-        try:
-            return self._reset(obj)
-        finally:
-            if from_edit_mode:
-                bpy.ops.object.mode_set(mode='EDIT')
+        return _in_object_mode(obj, lambda: self._reset(obj))
 
     def _reset(self, obj):
         active = [e.name for e in obj.deformkit.entries if e.enabled and e.envelope != 0.0]
