@@ -58,22 +58,18 @@ struct PyEvaluator {
 };
 
 // A parameter value from Python: a number, or any sequence or array of numbers (flattened in C order, so
-// an (n, 3) array of points gives x, y, z of each point in turn). nullopt for anything else.
-std::optional<std::vector<double>> valuesOf(py::handle value) {
+// an (n, 3) array of points gives x, y, z of each point in turn). nullopt for anything else, `problem` then
+// saying what it is ("is a bool", "is an array of complex128 values", "is a list that is not numeric").
+std::optional<std::vector<double>> valuesOf(py::handle value, std::string& problem) {
+    problem = "is " + aTypeName(value);
     if (isBool(value)) return std::nullopt;  // True is an int to Python, not a parameter value
     if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
         return std::vector<double>{value.cast<double>()};
     }
     // numpy would read "1.5" as 1.5, None as NaN, True as 1 and drop an imaginary part: none is a value.
-    if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value))
-        return std::nullopt;
-    const py::array a = py::array::ensure(value);
-    if (!a) {
-        PyErr_Clear();
-        return std::nullopt;
-    }
-    const char kind = a.dtype().kind();
-    if (kind != 'f' && kind != 'i' && kind != 'u') return std::nullopt;
+    py::array a;
+    if (!numericArray(value, a, problem)) return std::nullopt;
+    if (!problem.empty()) return std::nullopt;
     auto values = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
     if (!values) return std::nullopt;
     return std::vector<double>(values.data(), values.data() + values.size());
@@ -299,16 +295,8 @@ void bindHost(py::module_& m) {
             "set",
             [](PyStack& s, int64_t entry, const std::string& name, py::handle value) {
                 const size_t index = entryIndex(entry);
-                const std::optional<std::vector<double>> values = valuesOf(value);
-                const bool sequence = !isBool(value) && !py::isinstance<py::float_>(value) &&
-                                      !py::isinstance<py::int_>(value) && !py::isinstance<py::str>(value) &&
-                                      !value.is_none();
                 std::string found;
-                if (!values && py::isinstance<py::array>(value)) {
-                    found = "is an array of " + std::string(py::str(value.attr("dtype"))) + " values";
-                } else if (!values) {
-                    found = "is " + aTypeName(value) + (sequence ? " that is not numeric" : "");
-                }
+                const std::optional<std::vector<double>> values = valuesOf(value, found);
                 Lock lock(s.mutex);
                 if (!values) {
                     throw InvalidInput(formatError(s.stack.entryName(index), "parameter '" + name + "'",

@@ -321,8 +321,8 @@ void requireHalfRange(const fs::path& path, const float* pixels, int32_t width, 
 }
 
 // The pixel type's name, as the codec takes it. Auto writes EXR as half, unless a finite value is beyond
-// half's range (`fitsHalf` false): then as float, rather than as inf.
-std::string requestedType(PixelType type, std::string_view format, bool fitsHalf) {
+// half's range (`fitsHalf()` false, asked only then): then as float, rather than as inf.
+std::string requestedType(PixelType type, std::string_view format, const std::function<bool()>& fitsHalf) {
     switch (type) {
         case PixelType::UInt8:
             return "uint8";
@@ -336,7 +336,7 @@ std::string requestedType(PixelType type, std::string_view format, bool fitsHalf
             break;
     }
     if (format != "openexr") return "uint8";
-    return fitsHalf ? "half" : "float";
+    return fitsHalf() ? "half" : "float";
 }
 
 InvalidInput noWriter(const fs::path& path) {
@@ -486,9 +486,10 @@ namespace {
 
 // Checks the size and format, opens the file under a temporary name, lets `writePixels` write every pixel
 // in the type it is given (false: OpenImageIO failed, its error is reported), closes it and moves it into
-// place. `fitsHalf`: every finite value is within half's range (requestedType).
+// place. `fitsHalf`: whether every finite value is within half's range (requestedType asks it for an EXR of
+// Auto type only: a scan of the pixels, which other writes do not pay).
 void writeChecked(const fs::path& path, int32_t width, int32_t height, int32_t channels,
-                  const ImageWriteOptions& options, bool fitsHalf,
+                  const ImageWriteOptions& options, const std::function<bool()>& fitsHalf,
                   const std::function<bool(codec::Writer&, const std::string& type)>& writePixels) {
     if (width < 1 || height < 1 || channels < 1) {
         throw InvalidInput(formatError(path.string(), "",
@@ -590,10 +591,13 @@ void writeImage(const fs::path& path, const Image& image, const ImageWriteOption
                                        "has " + std::to_string(image.pixels.size()) + " values",
                                        std::to_string(expected) + " = width * height * channels"));
     }
-    const bool fitsHalf = firstBeyondHalf(image.pixels.data(), image.pixels.size()) == image.pixels.size();
+    const auto fitsHalf = [&] {
+        return firstBeyondHalf(image.pixels.data(), image.pixels.size()) == image.pixels.size();
+    };
     writeChecked(path, image.width, image.height, image.channels, options, fitsHalf,
                  [&](codec::Writer& out, const std::string& type) {
-                     if (type == "half") {
+                     // Half asked for is checked here; Auto chose half only for pixels that fit.
+                     if (type == "half" && options.type == PixelType::Half) {
                          requireHalfRange(path, image.pixels.data(), image.width, image.height,
                                           image.channels, 0);
                      }
@@ -608,7 +612,8 @@ void writeImageInBands(const fs::path& path, int32_t width, int32_t height, int3
                                        "at least 1 row"));
     }
     writeChecked(
-        path, width, height, channels, options, true, [&](codec::Writer& out, const std::string& type) {
+        path, width, height, channels, options, [] { return true; },
+        [&](codec::Writer& out, const std::string& type) {
             Image band;
             int32_t written = 0;  // rows in the file
             try {

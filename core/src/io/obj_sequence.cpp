@@ -4,8 +4,10 @@
 #include <charconv>
 #include <cstdlib>
 #include <span>
+#include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
 
 #include "deformkit/error.h"
 
@@ -78,29 +80,31 @@ std::string describeFace(std::span<const int32_t> vertices) {
 
 }  // namespace
 
+namespace {
+
+// Why `pattern` is not a sequence's, and what is expected instead; an empty problem when it is one (its
+// token then in `token`).
+std::pair<std::string, std::string_view> patternFault(const std::string& pattern, FrameToken& token) {
+    const int count = findTokens(fileNameOf(pattern), token);
+    if (count == 0) return {"has no frame token in its file name", kPatternForm};
+    if (count > 1) return {"has " + std::to_string(count) + " frame tokens in its file name", kPatternForm};
+    if (token.padding > kMaxPadding)
+        return {"asks for more than 32 digits of padding", "a padding of 1 to 32 digits"};
+    return {};
+}
+
+}  // namespace
+
 std::string ObjSequence::patternProblem(const std::string& pattern) {
     FrameToken token;
-    const int count = findTokens(fileNameOf(pattern), token);
-    if (count == 0) return "has no frame token in its file name";
-    if (count > 1) return "has " + std::to_string(count) + " frame tokens in its file name";
-    if (token.padding > kMaxPadding) return "asks for more than 32 digits of padding";
-    return {};
+    return patternFault(pattern, token).first;
 }
 
 ObjSequence::ObjSequence(fs::path pattern) : pattern_(std::move(pattern)) {
     const std::string name = pattern_.filename().string();
     FrameToken token;
-    const int count = findTokens(name, token);
-    if (count != 1) {
-        throw InvalidInput(formatError(
-            pattern_.string(), "",
-            count == 0 ? std::string("has no frame token") : "has " + std::to_string(count) + " frame tokens",
-            kPatternForm));
-    }
-    if (token.padding > kMaxPadding) {
-        throw InvalidInput(formatError(pattern_.string(), "", "asks for more than 32 digits of padding",
-                                       "a padding of 1 to 32 digits"));
-    }
+    if (const auto [problem, expected] = patternFault(pattern_.string(), token); !problem.empty())
+        throw InvalidInput(formatError(pattern_.string(), "", problem, expected));
     prefix_ = name.substr(0, token.position);
     suffix_ = name.substr(token.position + token.length);
     padding_ = token.padding;

@@ -69,9 +69,6 @@ using detail::TilePlan;
 
 namespace {
 
-// Why a texture to bake must hold finite values, said when one does not.
-constexpr const char* kFiniteTexture = "finite values (a baked texel filters its neighbours)";
-
 namespace fs = std::filesystem;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
@@ -534,6 +531,16 @@ std::optional<fs::path> mapFile(const TileMap& map, int frame) {
     return map.file;
 }
 
+// The tile's texture file at `frame`, with its pixel type; refused before anything of the frame is baked when
+// a texel is not finite (a baked texel filters its neighbours: one NaN would spread).
+void readTexture(TilePlan& plan, int frame) {
+    const fs::path file = *mapFile(plan.texture, frame);
+    plan.texturePixels = io::readImage(file);
+    io::requireFinitePixels(plan.texturePixels, file.string(),
+                            "finite values (a baked texel filters its neighbours)");
+    plan.texturePixelType = pixelTypeOf(file);
+}
+
 io::Image readMap(const TileMap& map, int frame, int tile, const char* role) {
     // Files are checked as they are read (values in [0, 1], finite; a mask's not NaN), naming the file and
     // texel; maps in memory likewise here, named as the caller named them ("mask tile 1001", a label).
@@ -576,10 +583,7 @@ void ShotSolver::Impl::bind(TilePlan& plan, int frame) {
     const io::Image mask = readMap(plan.mask, frame, plan.tile, "warp mask");
     const io::Image orientation = readMap(plan.orientation, frame, plan.tile, "orientation map");
     if (plan.texture.file) {
-        const fs::path file = *mapFile(plan.texture, frame);
-        plan.texturePixels = io::readImage(file);
-        io::requireFinitePixels(plan.texturePixels, file.string(), kFiniteTexture);
-        plan.texturePixelType = pixelTypeOf(file);
+        readTexture(plan, frame);
     } else if (plan.texture.image) {
         plan.texturePixels = *plan.texture.image;
     }
@@ -594,12 +598,7 @@ void ShotSolver::Impl::animateMaps(TilePlan& plan, int frame) {
     const bool rigidityMoves = !plan.rigidity.framePattern.empty();
     const bool maskMoves = !plan.mask.framePattern.empty();
     const bool orientationMoves = !plan.orientation.framePattern.empty();
-    if (!plan.texture.framePattern.empty()) {
-        const fs::path file = *mapFile(plan.texture, frame);
-        plan.texturePixels = io::readImage(file);
-        io::requireFinitePixels(plan.texturePixels, file.string(), kFiniteTexture);
-        plan.texturePixelType = pixelTypeOf(file);
-    }
+    if (!plan.texture.framePattern.empty()) readTexture(plan, frame);
     if (!rigidityMoves && !maskMoves && !orientationMoves) return;
     bool changed = false;
     const auto next = [&](const TileMap& map, io::Image& last, const char* role) {

@@ -113,27 +113,26 @@ def require_writable_mesh(obj):
             f"Relations > Make Local > Selected Objects and Data) or append it")
 
 
-def require_own_mesh(obj):
-    """Raises DeformKitError when another object with DeformKit entries uses this object's mesh (a linked
-    duplicate): each stack writes the mesh's positions, and the last one evaluated would win."""
-    mesh = obj.data
-    if mesh.users < 2:
-        return
-    for other in bpy.data.objects:
-        if other is not obj and other.data == mesh and len(other.deformkit.entries) > 0:
-            raise DeformKitError(
-                f"{obj.name}: its mesh '{mesh.name}' is also '{other.name}''s, which has DeformKit deformers "
-                f"too (a linked duplicate): each stack writes the mesh's positions. Make the mesh single-user "
-                f"(Object > Relations > Make Single User > Object & Data)")
-
-
 def other_stack_on_mesh(obj):
     """The name of another object with DeformKit entries that uses this object's mesh (a linked duplicate),
     or None."""
+    if obj.data.users < 2:
+        return None
     for other in bpy.data.objects:
         if other is not obj and other.data == obj.data and len(other.deformkit.entries) > 0:
             return other.name
     return None
+
+
+def require_own_mesh(obj):
+    """Raises DeformKitError when another object with DeformKit entries uses this object's mesh (a linked
+    duplicate): each stack writes the mesh's positions, and the last one evaluated would win."""
+    other = other_stack_on_mesh(obj)
+    if other is not None:
+        raise DeformKitError(
+            f"{obj.name}: its mesh '{obj.data.name}' is also '{other}''s, which has DeformKit deformers "
+            f"too (a linked duplicate): each stack writes the mesh's positions. Make the mesh single-user "
+            f"(Object > Relations > Make Single User > Object & Data)")
 
 
 def rest_points(obj):
